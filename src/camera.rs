@@ -1,0 +1,220 @@
+//! Pinhole cameras: pose, intrinsics, rays and projection.
+//!
+//! A camera looks down its local −z with +x right and +y up (the glTF convention). Pixel
+//! coordinates are continuous: pixel `(i, j)` covers `[i, i+1) × [j, j+1)`, its centre is at
+//! `(i + 0.5, j + 0.5)`, and `(0, 0)` is the top-left corner of the image. Pixels are square.
+
+use glam::{DAffine3, DMat3, DVec2, DVec3};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Rigid transform from camera space to world space (metres). Camera space: the camera
+    /// looks down −z, +x is right, +y is up.
+    pub world_from_camera: DAffine3,
+    /// Horizontal half angle of view, in radians, in (0, π/2). The paper's θ.
+    pub half_angle_x: f64,
+    /// Image width in pixels, ≥ 1.
+    pub width: u32,
+    /// Image height in pixels, ≥ 1.
+    pub height: u32,
+}
+
+/// Why a camera cannot be built.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CameraError {
+    /// `look_at` equals the eye, or `up` is parallel to the viewing direction.
+    DegenerateOrientation,
+    HalfAngleOutOfRange(f64),
+}
+
+impl std::fmt::Display for CameraError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CameraError::DegenerateOrientation => write!(
+                f,
+                "viewing direction is zero or parallel to `up`; choose a look_at away from the eye and an up not along the view"
+            ),
+            CameraError::HalfAngleOutOfRange(a) => write!(
+                f,
+                "half angle of view must be in (0°, 90°), got {:.3}°",
+                a.to_degrees()
+            ),
+        }
+    }
+}
+
+/// Rotation whose columns are camera +x, +y, +z (= −forward) in world space.
+pub fn world_from_camera_rotation(forward: DVec3, up: DVec3) -> Result<DMat3, CameraError> {
+    let back = -forward.normalize_or_zero();
+    let right = up.cross(back).normalize_or_zero();
+    if back == DVec3::ZERO || right == DVec3::ZERO || !right.is_finite() {
+        return Err(CameraError::DegenerateOrientation);
+    }
+    let true_up = back.cross(right);
+    Ok(DMat3::from_cols(right, true_up, back))
+}
+
+impl Camera {
+    pub fn new(
+        world_from_camera: DAffine3,
+        half_angle_x: f64,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, CameraError> {
+        if !(half_angle_x > 0.0 && half_angle_x < std::f64::consts::FRAC_PI_2) {
+            return Err(CameraError::HalfAngleOutOfRange(half_angle_x));
+        }
+        Ok(Self {
+            world_from_camera,
+            half_angle_x,
+            width,
+            height,
+        })
+    }
+
+    /// A camera at `eye` looking towards `target`, with `up` as the approximate up direction.
+    pub fn look_at(
+        eye: DVec3,
+        target: DVec3,
+        up: DVec3,
+        half_angle_x: f64,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, CameraError> {
+        let rotation = world_from_camera_rotation(target - eye, up)?;
+        Self::new(
+            DAffine3::from_mat3_translation(rotation, eye),
+            half_angle_x,
+            width,
+            height,
+        )
+    }
+
+    pub fn with_resolution(mut self, width: u32, height: u32) -> Self {
+        self.width = width;
+        self.height = height;
+        self
+    }
+
+    pub fn position(&self) -> DVec3 {
+        self.world_from_camera.translation
+    }
+
+    /// Unit viewing direction (camera −z) in world space.
+    pub fn forward(&self) -> DVec3 {
+        -self.world_from_camera.matrix3.z_axis
+    }
+
+    pub fn tan_half_x(&self) -> f64 {
+        self.half_angle_x.tan()
+    }
+
+    /// Tangent of the vertical half angle (square pixels).
+    pub fn tan_half_y(&self) -> f64 {
+        self.tan_half_x() * self.height as f64 / self.width as f64
+    }
+
+    /// Camera-space direction (not normalised, z = −1) through continuous pixel coordinates.
+    pub fn camera_direction(&self, pixel: DVec2) -> DVec3 {
+        let ndc_x = 2.0 * pixel.x / self.width as f64 - 1.0;
+        let ndc_y = 1.0 - 2.0 * pixel.y / self.height as f64;
+        DVec3::new(ndc_x * self.tan_half_x(), ndc_y * self.tan_half_y(), -1.0)
+    }
+
+    /// World-space ray (origin, unit direction) through continuous pixel coordinates.
+    pub fn world_ray(&self, pixel: DVec2) -> (DVec3, DVec3) {
+        let dir = self
+            .world_from_camera
+            .transform_vector3(self.camera_direction(pixel))
+            .normalize();
+        (self.position(), dir)
+    }
+
+    /// Continuous pixel coordinates of a camera-space direction or point; `None` behind the camera.
+    pub fn project_camera(&self, p: DVec3) -> Option<DVec2> {
+        if p.z >= 0.0 {
+            return None;
+        }
+        let x = p.x / -p.z / self.tan_half_x();
+        let y = p.y / -p.z / self.tan_half_y();
+        Some(DVec2::new(
+            (x + 1.0) * 0.5 * self.width as f64,
+            (1.0 - y) * 0.5 * self.height as f64,
+        ))
+    }
+
+    /// Pixel coordinates of a world point; `None` behind the camera. May fall outside the image.
+    pub fn project_point(&self, world: DVec3) -> Option<DVec2> {
+        self.project_camera(self.world_from_camera.inverse().transform_point3(world))
+    }
+
+    /// Pixel coordinates of the vanishing point of a world direction (a point at infinity).
+    pub fn project_direction(&self, world_dir: DVec3) -> Option<DVec2> {
+        self.project_camera(self.world_from_camera.inverse().transform_vector3(world_dir))
+    }
+
+    /// Depth along the camera's viewing axis (−z in camera space) of a world point, metres.
+    pub fn axial_depth(&self, world: DVec3) -> f64 {
+        -self.world_from_camera.inverse().transform_point3(world).z
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn test_camera() -> Camera {
+        Camera::look_at(
+            DVec3::new(1.0, 2.0, 3.0),
+            DVec3::new(-4.0, 0.5, -7.0),
+            DVec3::Y,
+            0.6,
+            320,
+            200,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn project_unproject_round_trip() {
+        let cam = test_camera();
+        for &(x, y) in &[(0.5, 0.5), (160.0, 100.0), (319.25, 3.75), (12.0, 199.9)] {
+            let pixel = DVec2::new(x, y);
+            let (origin, dir) = cam.world_ray(pixel);
+            for distance in [0.1, 3.0, 250.0] {
+                let back = cam.project_point(origin + dir * distance).unwrap();
+                assert!((back - pixel).length() < 1e-9, "{pixel} -> {back}");
+            }
+            let back = cam.project_direction(dir).unwrap();
+            assert!((back - pixel).length() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn image_corners_span_the_half_angle() {
+        let cam = test_camera();
+        let left = cam.camera_direction(DVec2::new(0.0, 100.0));
+        assert!((left.x.atan2(-left.z) + 0.6).abs() < 1e-12);
+        let top = cam.camera_direction(DVec2::new(160.0, 0.0));
+        let expected = (0.6f64.tan() * 200.0 / 320.0).atan();
+        assert!((top.y.atan2(-top.z) - expected).abs() < 1e-12);
+    }
+
+    #[test]
+    fn points_behind_do_not_project() {
+        let cam = test_camera();
+        let behind = cam.position() - cam.forward();
+        assert_eq!(cam.project_point(behind), None);
+        assert!((cam.axial_depth(cam.position() + 2.0 * cam.forward()) - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn degenerate_cameras_are_rejected() {
+        let e = Camera::look_at(DVec3::ZERO, DVec3::ZERO, DVec3::Y, 0.5, 10, 10);
+        assert_eq!(e, Err(CameraError::DegenerateOrientation));
+        let e = Camera::look_at(DVec3::ZERO, DVec3::Y, DVec3::Y, 0.5, 10, 10);
+        assert_eq!(e, Err(CameraError::DegenerateOrientation));
+        let e = Camera::look_at(DVec3::ZERO, DVec3::X, DVec3::Y, 1.6, 10, 10);
+        assert!(matches!(e, Err(CameraError::HalfAngleOutOfRange(_))));
+    }
+}

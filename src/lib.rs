@@ -1,0 +1,19 @@
+//! seethru: a ray-traced simulator of video see-through displays for driver assistance.
+#![forbid(unsafe_code)]
+
+pub mod accel;
+pub mod camera;
+pub mod color;
+pub mod frame;
+pub mod mesh_io;
+pub mod output;
+pub mod progress;
+pub mod render;
+pub mod sampling;
+pub mod scene;
+pub mod scene_file;
+pub mod shapes;
+pub mod sky;
+pub mod texture;
+pub mod views;
+pub mod world;

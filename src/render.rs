@@ -1,0 +1,144 @@
+//! The integrator: primary rays per pixel, Lambert shading with the sun (hard shadow ray)
+//! and sky ambient, textures, and the AOVs of the pixel-centre ray.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+use anyhow::Result;
+use glam::{DVec2, Vec3};
+use rayon::prelude::*;
+
+use crate::accel::{Accel, BvhKind, make_ray};
+use crate::camera::Camera;
+use crate::frame::{Frame, Pixel};
+use crate::progress::Progress;
+use crate::sampling::pixel_offset;
+use crate::scene::Scene;
+use crate::sky::SkyModel;
+use crate::world::{SurfaceHit, World};
+
+/// Largest number of samples per pixel accepted.
+pub const MAX_SPP: u32 = 4096;
+
+#[derive(Clone, Copy, Debug)]
+pub struct RenderSettings {
+    /// Samples per pixel, in [1, MAX_SPP]. Sample 0 is the pixel centre; the others are
+    /// jittered deterministically from (pixel, sample).
+    pub spp: u32,
+    /// Print a progress line on stderr if the render takes over a second.
+    pub progress: bool,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self { spp: 1, progress: false }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RenderStats {
+    pub primary_rays: u64,
+    pub shadow_rays: u64,
+    pub seconds: f64,
+}
+
+/// Everything needed to render a scene from any camera.
+pub struct RenderContext {
+    pub scene: Scene,
+    pub world: World,
+    pub accel: Accel,
+    pub sky: SkyModel,
+}
+
+impl RenderContext {
+    pub fn new(scene: Scene, bvh: BvhKind) -> Result<Self> {
+        let world = World::build(&scene)?;
+        let accel = Accel::build(&world, bvh);
+        let sky = SkyModel::new(&scene.sky, &scene.sun);
+        Ok(Self { scene, world, accel, sky })
+    }
+
+    /// Renders the frame seen by `camera`, showing the primitives visible in `view`
+    /// (a [`crate::world::view_bit`]).
+    pub fn render(&self, camera: &Camera, view: u8, settings: RenderSettings, label: &str) -> (Frame, RenderStats) {
+        let start = Instant::now();
+        let (w, h) = (camera.width as usize, camera.height as usize);
+        let mut pixels = vec![Pixel::SKY; w * h];
+        let shadow_rays = AtomicU64::new(0);
+        let progress = Progress::new(format!("rendering {label}"), h, settings.progress);
+        pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            let mut shadows = 0;
+            for (x, out) in row.iter_mut().enumerate() {
+                *out = self.render_pixel(camera, view, x as u32, y as u32, settings.spp, &mut shadows);
+            }
+            shadow_rays.fetch_add(shadows, Ordering::Relaxed);
+            progress.advance(1);
+        });
+        progress.finish();
+        let stats = RenderStats {
+            primary_rays: (w * h) as u64 * settings.spp as u64,
+            shadow_rays: shadow_rays.into_inner(),
+            seconds: start.elapsed().as_secs_f64(),
+        };
+        (Frame::from_pixels(camera.width, camera.height, &pixels), stats)
+    }
+
+    fn render_pixel(&self, camera: &Camera, view: u8, x: u32, y: u32, spp: u32, shadows: &mut u64) -> Pixel {
+        let mut pixel = Pixel::SKY;
+        let mut sum = Vec3::ZERO;
+        for sample in 0..spp {
+            let (dx, dy) = pixel_offset(x, y, sample);
+            let (origin, dir) = camera.world_ray(DVec2::new(x as f64 + dx as f64, y as f64 + dy as f64));
+            let (origin, dir) = (origin.as_vec3(), dir.as_vec3());
+            let hit = self.trace(origin, dir, view);
+            let color = match &hit {
+                Some(s) => self.shade(s, view, shadows),
+                None => self.sky.radiance(dir),
+            };
+            sum += color;
+            if sample == 0
+                && let Some(s) = hit
+            {
+                pixel = Pixel {
+                    color: Vec3::ZERO,
+                    depth: s.t,
+                    camera_z: camera.axial_depth(s.position.as_dvec3()) as f32,
+                    position: s.position,
+                    normal: s.normal,
+                    object_id: s.object,
+                    part_id: s.part,
+                };
+            }
+        }
+        pixel.color = sum / spp as f32;
+        pixel
+    }
+
+    /// The closest surface visible in `view` along a ray from `origin` (unit `dir`).
+    pub fn trace(&self, origin: Vec3, dir: Vec3, view: u8) -> Option<SurfaceHit> {
+        let hit = self.accel.closest(&self.world, make_ray(origin, dir, 0.0, f32::INFINITY), view)?;
+        Some(self.world.surface(hit.prim, origin, dir, hit.t))
+    }
+
+    /// Lambert shading: albedo × (sun × cos × visibility + sky ambient).
+    fn shade(&self, s: &SurfaceHit, view: u8, shadows: &mut u64) -> Vec3 {
+        let material = &self.world.materials[s.material as usize];
+        let mut albedo = material.albedo;
+        if let Some(t) = material.texture {
+            albedo *= self.world.textures[t].sample(s.uv * material.uv_repeat);
+        }
+        let mut light = self.sky.ambient(s.normal);
+        let cos = s.normal.dot(self.sky.sun_direction);
+        if cos > 0.0 {
+            *shadows += 1;
+            // Offset along the normal, scaled with the coordinates' magnitude to stay above
+            // f32 rounding of the hit point.
+            let eps = 2e-4 * (1.0 + s.position.abs().max_element());
+            let ray = make_ray(s.position + s.normal * eps, self.sky.sun_direction, 0.0, f32::INFINITY);
+            if !self.accel.occluded(&self.world, ray, view) {
+                light += self.sky.sun_irradiance * cos;
+            }
+        }
+        albedo * light
+    }
+}
