@@ -6,14 +6,20 @@
 
 use std::time::{Duration, Instant};
 
+
 use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
-use obvhs::bvh2::builder::build_bvh2;
-use obvhs::cwbvh::CwBvh;
-use obvhs::cwbvh::builder::build_cwbvh;
 use obvhs::bvh2::Bvh2;
+use obvhs::bvh2::leaf_collapser::collapse;
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
+use obvhs::cwbvh::CwBvh;
+use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
+use obvhs::ploc::PlocBuilder;
+use obvhs::splits::split_aabbs_preset;
+use obvhs::triangle::Triangle;
 use obvhs::ray::{Ray, RayHit};
+use obvhs::rt_triangle::RtTriangle;
 
 use crate::world::World;
 
@@ -34,11 +40,22 @@ enum Hierarchy {
 /// A primitive in BVH order: the leaf data a traversal touches, kept together for locality.
 #[derive(Clone, Copy)]
 struct Leaf {
+    /// Copy of the primitive's triangle (unused for ellipsoids): traversal reads leaves in
+    /// BVH order, and the copy saves a cache miss into the world's own array.
+    tri: RtTriangle,
     /// Index of the primitive in the [`World`].
     prim: u32,
+    is_triangle: bool,
     /// Views that show the primitive ([`crate::world::view_bit`]).
     views: u8,
     casts_shadow: bool,
+}
+
+impl Leaf {
+    #[inline(always)]
+    fn intersect(&self, world: &World, ray: &Ray) -> f32 {
+        if self.is_triangle { self.tri.intersect(ray) } else { world.intersect(self.prim as usize, ray) }
+    }
 }
 
 /// A closest-hit answer: which primitive, at which distance.
@@ -55,12 +72,29 @@ pub struct Accel {
     pub build_time: Duration,
 }
 
-struct PrimBox(Aabb);
-
-impl obvhs::Boundable for PrimBox {
-    fn aabb(&self) -> Aabb {
-        self.0
+/// Boxes to build the hierarchy over, and the primitive each belongs to. Large triangles (the
+/// ground, the street, long kerbs) get several tight boxes instead of one that overlaps
+/// everything (obvhs' spatial pre-splits); a primitive may then appear in several leaves.
+fn split_primitive_boxes(world: &World) -> (Vec<Aabb>, Vec<u32>) {
+    let tris: Vec<Triangle> = world
+        .triangles
+        .iter()
+        .map(|t| Triangle { v0: t.v0, v1: t.v0 - t.e1, v2: t.v0 + t.e2 })
+        .collect();
+    let mut aabbs: Vec<Aabb> = tris.iter().map(Triangle::aabb).collect();
+    let mut indices: Vec<u32> = (0..tris.len() as u32).collect();
+    if !tris.is_empty() {
+        let areas: Vec<f32> = aabbs.iter().map(Aabb::half_area).collect();
+        let average = areas.iter().sum::<f32>() / areas.len() as f32;
+        let largest = areas.iter().copied().fold(0.0, f32::max);
+        split_aabbs_preset(&mut aabbs, &mut indices, &tris, average, largest);
     }
+    // Ellipsoids are never split: their boxes are already tight enough.
+    for prim in tris.len()..world.primitive_count() {
+        aabbs.push(world.aabb(prim));
+        indices.push(prim as u32);
+    }
+    (aabbs, indices)
 }
 
 pub fn make_ray(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Ray {
@@ -70,26 +104,38 @@ pub fn make_ray(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Ray {
 impl Accel {
     pub fn build(world: &World, kind: BvhKind) -> Accel {
         let start = Instant::now();
-        let boxes: Vec<PrimBox> = (0..world.primitive_count()).map(|p| PrimBox(world.aabb(p))).collect();
         let params = BvhBuildParams::medium_build();
-        let mut core = Duration::default();
-        let (hierarchy, order) = match kind {
-            BvhKind::Cwbvh => {
-                let bvh = build_cwbvh(&boxes, params, &mut core);
-                let order = bvh.primitive_indices.clone();
-                (Hierarchy::Cwbvh(bvh), order)
-            }
+        let (aabbs, indices) = split_primitive_boxes(world);
+        let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
+            params.ploc_search_distance,
+            &aabbs,
+            indices,
+            params.sort_precision,
+            params.search_depth_threshold,
+        );
+        bvh2.uses_spatial_splits = true;
+        let mut optimizer = ReinsertionOptimizer::default();
+        optimizer.run(&mut bvh2, params.reinsertion_batch_ratio, None);
+        let hierarchy = match kind {
+            BvhKind::Cwbvh => Hierarchy::Cwbvh(bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false)),
             BvhKind::Bvh2 => {
-                let bvh = build_bvh2(&boxes, params, &mut core);
-                let order = bvh.primitive_indices.clone();
-                (Hierarchy::Bvh2(bvh), order)
+                collapse(&mut bvh2, params.max_prims_per_leaf, params.collapse_traversal_cost);
+                let ratio = params.reinsertion_batch_ratio * params.post_collapse_reinsertion_batch_ratio_multiplier;
+                optimizer.run(&mut bvh2, ratio, None);
+                Hierarchy::Bvh2(bvh2)
             }
+        };
+        let order = match &hierarchy {
+            Hierarchy::Cwbvh(b) => &b.primitive_indices,
+            Hierarchy::Bvh2(b) => &b.primitive_indices,
         };
         let leaves = order
             .iter()
             .map(|&p| {
                 let (views, casts_shadow) = world.visibility(p as usize);
-                Leaf { prim: p, views, casts_shadow }
+                let is_triangle = (p as usize) < world.triangles.len();
+                let tri = if is_triangle { world.triangles[p as usize] } else { RtTriangle::default() };
+                Leaf { tri, prim: p, is_triangle, views, casts_shadow }
             })
             .collect();
         Accel { hierarchy, leaves, build_time: start.elapsed() }
@@ -100,7 +146,7 @@ impl Accel {
         let mut hit = RayHit::none();
         let test = |r: &Ray, id: usize| {
             let leaf = &self.leaves[id];
-            if leaf.views & view == 0 { f32::INFINITY } else { world.intersect(leaf.prim as usize, r) }
+            if leaf.views & view == 0 { f32::INFINITY } else { leaf.intersect(world, r) }
         };
         let found = match &self.hierarchy {
             Hierarchy::Cwbvh(b) => b.ray_traverse(ray, &mut hit, test),
@@ -116,7 +162,7 @@ impl Accel {
             if leaf.views & view == 0 || !leaf.casts_shadow {
                 f32::INFINITY
             } else {
-                world.intersect(leaf.prim as usize, r)
+                leaf.intersect(world, r)
             }
         };
         let miss = match &self.hierarchy {

@@ -52,17 +52,28 @@ impl Pixel {
 impl Frame {
     pub fn from_pixels(width: u32, height: u32, pixels: &[Pixel]) -> Frame {
         assert_eq!(pixels.len(), width as usize * height as usize);
-        Frame {
+        let n = pixels.len();
+        let mut frame = Frame {
             width,
             height,
-            color: pixels.iter().map(|p| p.color).collect(),
-            depth: pixels.iter().map(|p| p.depth).collect(),
-            camera_z: pixels.iter().map(|p| p.camera_z).collect(),
-            position: pixels.iter().map(|p| p.position).collect(),
-            normal: pixels.iter().map(|p| p.normal).collect(),
-            object_id: pixels.iter().map(|p| p.object_id).collect(),
-            part_id: pixels.iter().map(|p| p.part_id).collect(),
+            color: Vec::with_capacity(n),
+            depth: Vec::with_capacity(n),
+            camera_z: Vec::with_capacity(n),
+            position: Vec::with_capacity(n),
+            normal: Vec::with_capacity(n),
+            object_id: Vec::with_capacity(n),
+            part_id: Vec::with_capacity(n),
+        };
+        for p in pixels {
+            frame.color.push(p.color);
+            frame.depth.push(p.depth);
+            frame.camera_z.push(p.camera_z);
+            frame.position.push(p.position);
+            frame.normal.push(p.normal);
+            frame.object_id.push(p.object_id);
+            frame.part_id.push(p.part_id);
         }
+        frame
     }
 
     pub fn index(&self, x: u32, y: u32) -> usize {

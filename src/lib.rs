@@ -17,3 +17,8 @@ pub mod sky;
 pub mod texture;
 pub mod views;
 pub mod world;
+pub mod bench;
+pub mod commands;
+pub mod export;
+pub mod options;
+pub mod procedural;

@@ -5,7 +5,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use anyhow::Result;
-use glam::{DVec2, Vec3};
+use glam::{DAffine3, Mat3, Vec3};
 use rayon::prelude::*;
 
 use crate::accel::{Accel, BvhKind, make_ray};
@@ -66,10 +66,12 @@ impl RenderContext {
         let mut pixels = vec![Pixel::SKY; w * h];
         let shadow_rays = AtomicU64::new(0);
         let progress = Progress::new(format!("rendering {label}"), h, settings.progress);
+        let camera_from_world = camera.world_from_camera.inverse();
+        let rays = RayGenerator::new(camera);
         pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
             let mut shadows = 0;
             for (x, out) in row.iter_mut().enumerate() {
-                *out = self.render_pixel(camera, view, x as u32, y as u32, settings.spp, &mut shadows);
+                *out = self.render_pixel(&rays, &camera_from_world, view, x as u32, y as u32, settings.spp, &mut shadows);
             }
             shadow_rays.fetch_add(shadows, Ordering::Relaxed);
             progress.advance(1);
@@ -83,13 +85,13 @@ impl RenderContext {
         (Frame::from_pixels(camera.width, camera.height, &pixels), stats)
     }
 
-    fn render_pixel(&self, camera: &Camera, view: u8, x: u32, y: u32, spp: u32, shadows: &mut u64) -> Pixel {
+    #[allow(clippy::too_many_arguments)]
+    fn render_pixel(&self, rays: &RayGenerator, camera_from_world: &DAffine3, view: u8, x: u32, y: u32, spp: u32, shadows: &mut u64) -> Pixel {
         let mut pixel = Pixel::SKY;
         let mut sum = Vec3::ZERO;
         for sample in 0..spp {
             let (dx, dy) = pixel_offset(x, y, sample);
-            let (origin, dir) = camera.world_ray(DVec2::new(x as f64 + dx as f64, y as f64 + dy as f64));
-            let (origin, dir) = (origin.as_vec3(), dir.as_vec3());
+            let (origin, dir) = rays.world_ray(x as f32 + dx, y as f32 + dy);
             let hit = self.trace(origin, dir, view);
             let color = match &hit {
                 Some(s) => self.shade(s, view, shadows),
@@ -102,7 +104,7 @@ impl RenderContext {
                 pixel = Pixel {
                     color: Vec3::ZERO,
                     depth: s.t,
-                    camera_z: camera.axial_depth(s.position.as_dvec3()) as f32,
+                    camera_z: -camera_from_world.transform_point3(s.position.as_dvec3()).z as f32,
                     position: s.position,
                     normal: s.normal,
                     object_id: s.object,
@@ -140,5 +142,34 @@ impl RenderContext {
             }
         }
         albedo * light
+    }
+}
+
+/// Primary rays of a camera in f32, with the per-camera constants hoisted out of the pixel loop.
+struct RayGenerator {
+    origin: Vec3,
+    world_from_camera: Mat3,
+    /// Camera-space direction of the pixel coordinates (0, 0), and its change per pixel.
+    corner: Vec3,
+    step_x: f32,
+    step_y: f32,
+}
+
+impl RayGenerator {
+    fn new(camera: &Camera) -> Self {
+        let (tx, ty) = (camera.tan_half_x() as f32, camera.tan_half_y() as f32);
+        Self {
+            origin: camera.position().as_vec3(),
+            world_from_camera: camera.world_from_camera.matrix3.as_mat3(),
+            corner: Vec3::new(-tx, ty, -1.0),
+            step_x: 2.0 * tx / camera.width as f32,
+            step_y: -2.0 * ty / camera.height as f32,
+        }
+    }
+
+    /// Ray through continuous pixel coordinates (as [`Camera::world_ray`], in f32).
+    fn world_ray(&self, px: f32, py: f32) -> (Vec3, Vec3) {
+        let local = self.corner + Vec3::new(px * self.step_x, py * self.step_y, 0.0);
+        (self.origin, (self.world_from_camera * local).normalize())
     }
 }

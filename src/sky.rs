@@ -4,8 +4,10 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::texture::Texture;
+
 use crate::color::srgb_to_linear3;
-use crate::sampling::{hash_words, unit_float};
+use crate::sampling::{hash_u32, unit_float};
 use crate::scene::{Sky, Sun};
 
 /// Sky and sun in linear RGB, ready for shading.
@@ -18,7 +20,9 @@ pub struct SkyModel {
     cloud_cover: f32,
     cloud_height: f32,
     cloud_size: f32,
-    seed: u32,
+    /// Cloud noise over one period of the cloud layer, precomputed: evaluating five octaves
+    /// of noise per sky pixel cost more than tracing its ray.
+    clouds: Texture,
     /// Unit direction towards the sun, world frame.
     pub sun_direction: Vec3,
     /// Sun irradiance on a surface facing it, linear RGB.
@@ -39,7 +43,7 @@ impl SkyModel {
             cloud_cover: sky.cloud_cover as f32,
             cloud_height: sky.cloud_height as f32,
             cloud_size: sky.cloud_size as f32,
-            seed: sky.cloud_seed,
+            clouds: cloud_table(sky.cloud_seed),
             sun_direction: sun.direction.as_vec3(),
             sun_irradiance: srgb_to_linear3(sun.color) * sun.intensity as f32,
         }
@@ -54,16 +58,17 @@ impl SkyModel {
 
     /// Cloud density in [0, 1] seen in direction `dir` (upper hemisphere only).
     pub fn cloud_density(&self, dir: Vec3) -> f32 {
-        if dir.y <= 0.0 || self.cloud_cover <= 0.0 {
+        let haze = smoothstep(0.02, 0.18, dir.y);
+        if haze == 0.0 || self.cloud_cover <= 0.0 {
             return 0.0;
         }
         // Where the ray meets the cloud layer, in units of cloud size.
         let p = Vec2::new(dir.x, dir.z) * (self.cloud_height / dir.y) / self.cloud_size;
-        let n = fbm(p, self.seed);
+        let n = self.clouds.sample(p / CLOUD_PERIOD as f32).x;
         let threshold = 0.72 - 0.45 * self.cloud_cover;
         let density = ((n - threshold) / 0.12).clamp(0.0, 1.0);
         // Far clouds dissolve into the haze at the horizon.
-        density * smoothstep(0.02, 0.18, dir.y)
+        density * haze
     }
 
     /// Radiance seen along a ray that leaves the scene in direction `dir` (unit).
@@ -90,12 +95,34 @@ fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
     t * t * (3.0 - 2.0 * t)
 }
 
-/// Value noise in [0, 1] on the integer lattice, smoothly interpolated.
-fn value_noise(p: Vec2, seed: u32) -> f32 {
-    let (i, f) = (p.floor(), p - p.floor());
+/// Cloud sizes per period of the cloud table; the pattern repeats every `CLOUD_PERIOD` cloud
+/// sizes (kilometres away, where the haze hides it).
+const CLOUD_PERIOD: u32 = 8;
+/// Texels of the cloud table per side.
+const CLOUD_TABLE: u32 = 512;
+
+fn cloud_table(seed: u32) -> Texture {
+    let n = CLOUD_TABLE;
+    let texels = (0..n * n)
+        .map(|i| {
+            let p = Vec2::new((i % n) as f32 + 0.5, (i / n) as f32 + 0.5) * (CLOUD_PERIOD as f32 / n as f32);
+            Vec3::splat(fbm(p, seed))
+        })
+        .collect();
+    Texture { width: n, height: n, texels }
+}
+
+/// Value noise in [0, 1] on the integer lattice, smoothly interpolated, repeating every
+/// `period` cells.
+fn value_noise(p: Vec2, seed: u32, period: u32) -> f32 {
+    let i = Vec2::new(fast_floor(p.x), fast_floor(p.y));
+    let f = p - i;
     let corner = |dx: f32, dy: f32| {
-        let (x, y) = ((i.x + dx) as i32, (i.y + dy) as i32);
-        unit_float(hash_words(&[x as u32, y as u32, seed]))
+        let wrap = |v: f32| (v as i32).rem_euclid(period as i32) as u32;
+        let (x, y) = (wrap(i.x + dx), wrap(i.y + dy));
+        // One hash of the lattice point: the noise is evaluated ~20 times per sky pixel.
+        let key = x.wrapping_mul(0x8da6_b343) ^ y.wrapping_mul(0xd816_3841) ^ seed;
+        unit_float(hash_u32(key))
     };
     let u = f * f * (Vec2::splat(3.0) - 2.0 * f);
     let top = corner(0.0, 0.0) + (corner(1.0, 0.0) - corner(0.0, 0.0)) * u.x;
@@ -103,14 +130,22 @@ fn value_noise(p: Vec2, seed: u32) -> f32 {
     top + (bottom - top) * u.y
 }
 
-/// Fractal sum of five octaves of value noise, in [0, 1].
+/// `floor` without a libm call (the x86-64 baseline has no rounding instruction).
+fn fast_floor(x: f32) -> f32 {
+    let t = x as i32 as f32;
+    if t > x { t - 1.0 } else { t }
+}
+
+/// Fractal sum of five octaves of value noise, in [0, 1], repeating every `CLOUD_PERIOD`.
 fn fbm(p: Vec2, seed: u32) -> f32 {
-    let (mut sum, mut amplitude, mut norm, mut q) = (0.0, 0.5, 0.0, p);
+    let (mut sum, mut amplitude, mut norm, mut q, mut period) = (0.0, 0.5, 0.0, p, CLOUD_PERIOD);
     for octave in 0..5 {
-        sum += amplitude * value_noise(q, seed.wrapping_add(octave));
+        sum += amplitude * value_noise(q, seed.wrapping_add(octave), period);
         norm += amplitude;
         amplitude *= 0.5;
-        q = q * 2.03 + Vec2::new(17.1, 5.3);
+        // Doubling keeps every octave periodic; the integer shift decorrelates the lattices.
+        q = q * 2.0 + Vec2::new(17.0, 5.0);
+        period *= 2;
     }
     sum / norm
 }

@@ -1,0 +1,17 @@
+//! Regenerates the bundled assets in `assets/`: `cargo run --example make_assets`.
+
+use std::path::Path;
+
+use seethru::output::{write_atomically, write_text};
+use seethru::procedural::{car_mtl, car_obj, street_texture};
+
+fn main() -> anyhow::Result<()> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
+    std::fs::create_dir_all(&dir)?;
+    write_text(&dir.join("car.obj"), &car_obj())?;
+    write_text(&dir.join("car.mtl"), &car_mtl())?;
+    let street = street_texture();
+    write_atomically(&dir.join("street.png"), |tmp| Ok(street.save_with_format(tmp, image::ImageFormat::Png)?))?;
+    println!("wrote car.obj, car.mtl and street.png to {}", dir.display());
+    Ok(())
+}
