@@ -6,7 +6,6 @@
 
 use std::time::{Duration, Instant};
 
-
 use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
@@ -16,10 +15,10 @@ use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
 use obvhs::ploc::PlocBuilder;
-use obvhs::splits::split_aabbs_preset;
-use obvhs::triangle::Triangle;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::rt_triangle::RtTriangle;
+use obvhs::splits::split_aabbs_preset;
+use obvhs::triangle::Triangle;
 
 use crate::world::World;
 
@@ -54,7 +53,11 @@ struct Leaf {
 impl Leaf {
     #[inline(always)]
     fn intersect(&self, world: &World, ray: &Ray) -> f32 {
-        if self.is_triangle { self.tri.intersect(ray) } else { world.intersect(self.prim as usize, ray) }
+        if self.is_triangle {
+            self.tri.intersect(ray)
+        } else {
+            world.intersect(self.prim as usize, ray)
+        }
     }
 }
 
@@ -79,7 +82,11 @@ fn split_primitive_boxes(world: &World) -> (Vec<Aabb>, Vec<u32>) {
     let tris: Vec<Triangle> = world
         .triangles
         .iter()
-        .map(|t| Triangle { v0: t.v0, v1: t.v0 - t.e1, v2: t.v0 + t.e2 })
+        .map(|t| Triangle {
+            v0: t.v0,
+            v1: t.v0 - t.e1,
+            v2: t.v0 + t.e2,
+        })
         .collect();
     let mut aabbs: Vec<Aabb> = tris.iter().map(Triangle::aabb).collect();
     let mut indices: Vec<u32> = (0..tris.len() as u32).collect();
@@ -117,10 +124,20 @@ impl Accel {
         let mut optimizer = ReinsertionOptimizer::default();
         optimizer.run(&mut bvh2, params.reinsertion_batch_ratio, None);
         let hierarchy = match kind {
-            BvhKind::Cwbvh => Hierarchy::Cwbvh(bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false)),
+            BvhKind::Cwbvh => Hierarchy::Cwbvh(bvh2_to_cwbvh(
+                &bvh2,
+                params.max_prims_per_leaf.clamp(1, 3),
+                true,
+                false,
+            )),
             BvhKind::Bvh2 => {
-                collapse(&mut bvh2, params.max_prims_per_leaf, params.collapse_traversal_cost);
-                let ratio = params.reinsertion_batch_ratio * params.post_collapse_reinsertion_batch_ratio_multiplier;
+                collapse(
+                    &mut bvh2,
+                    params.max_prims_per_leaf,
+                    params.collapse_traversal_cost,
+                );
+                let ratio = params.reinsertion_batch_ratio
+                    * params.post_collapse_reinsertion_batch_ratio_multiplier;
                 optimizer.run(&mut bvh2, ratio, None);
                 Hierarchy::Bvh2(bvh2)
             }
@@ -134,11 +151,25 @@ impl Accel {
             .map(|&p| {
                 let (views, casts_shadow) = world.visibility(p as usize);
                 let is_triangle = (p as usize) < world.triangles.len();
-                let tri = if is_triangle { world.triangles[p as usize] } else { RtTriangle::default() };
-                Leaf { tri, prim: p, is_triangle, views, casts_shadow }
+                let tri = if is_triangle {
+                    world.triangles[p as usize]
+                } else {
+                    RtTriangle::default()
+                };
+                Leaf {
+                    tri,
+                    prim: p,
+                    is_triangle,
+                    views,
+                    casts_shadow,
+                }
             })
             .collect();
-        Accel { hierarchy, leaves, build_time: start.elapsed() }
+        Accel {
+            hierarchy,
+            leaves,
+            build_time: start.elapsed(),
+        }
     }
 
     /// Closest primitive visible in `view` that `ray` hits in [tmin, tmax].
@@ -146,13 +177,20 @@ impl Accel {
         let mut hit = RayHit::none();
         let test = |r: &Ray, id: usize| {
             let leaf = &self.leaves[id];
-            if leaf.views & view == 0 { f32::INFINITY } else { leaf.intersect(world, r) }
+            if leaf.views & view == 0 {
+                f32::INFINITY
+            } else {
+                leaf.intersect(world, r)
+            }
         };
         let found = match &self.hierarchy {
             Hierarchy::Cwbvh(b) => b.ray_traverse(ray, &mut hit, test),
             Hierarchy::Bvh2(b) => b.ray_traverse(ray, &mut hit, test),
         };
-        found.then(|| Hit { prim: self.leaves[hit.primitive_id as usize].prim as usize, t: hit.t })
+        found.then(|| Hit {
+            prim: self.leaves[hit.primitive_id as usize].prim as usize,
+            t: hit.t,
+        })
     }
 
     /// Whether any shadow-casting primitive visible in `view` blocks `ray` in [tmin, tmax].

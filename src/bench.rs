@@ -26,36 +26,64 @@ pub fn bench(scene_path: &Path, options: &BenchOptions) -> Result<serde_json::Va
     let context = RenderContext::new(scene, options.bvh)?;
     let load_s = load.elapsed().as_secs_f64();
     let prims = context.world.primitive_count();
-    println!("scene        {} ({prims} primitives, loaded in {load_s:.3} s)", scene_path.display());
-    println!("bvh          {:?} built in {:.1} ms", options.bvh, context.accel.build_time.as_secs_f64() * 1e3);
+    println!(
+        "scene        {} ({prims} primitives, loaded in {load_s:.3} s)",
+        scene_path.display()
+    );
+    println!(
+        "bvh          {:?} built in {:.1} ms",
+        options.bvh,
+        context.accel.build_time.as_secs_f64() * 1e3
+    );
     println!("threads      {}", rayon::current_num_threads());
     let mut views = serde_json::Map::new();
     let (mut total_rays, mut total_s) = (0u64, 0.0);
     for view in [View::Truth, View::Frontal] {
-        let camera = view.camera(&context.scene).with_resolution(options.width, options.height);
+        let camera = view
+            .camera(&context.scene)
+            .with_resolution(options.width, options.height);
         let runs: Vec<_> = (0..options.repeat.max(1))
-            .map(|_| context.render(&camera, view.bit(), RenderSettings::default(), view.name()).1)
+            .map(|_| {
+                context
+                    .render(&camera, view.bit(), RenderSettings::default(), view.name())
+                    .1
+            })
             .collect();
-        let best = runs.iter().min_by(|a, b| a.seconds.total_cmp(&b.seconds)).copied().unwrap_or_default();
+        let best = runs
+            .iter()
+            .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
+            .copied()
+            .unwrap_or_default();
         let rays = best.primary_rays + best.shadow_rays;
         total_rays += rays;
         total_s += best.seconds;
         println!(
             "{:<12} {}×{}: frame {:7.1} ms  primary {:6.2} Mrays/s  primary+shadow {:6.2} Mrays/s ({} + {} rays)",
-            view.name(), options.width, options.height, best.seconds * 1e3,
-            best.primary_rays as f64 / best.seconds / 1e6, rays as f64 / best.seconds / 1e6,
-            best.primary_rays, best.shadow_rays,
+            view.name(),
+            options.width,
+            options.height,
+            best.seconds * 1e3,
+            best.primary_rays as f64 / best.seconds / 1e6,
+            rays as f64 / best.seconds / 1e6,
+            best.primary_rays,
+            best.shadow_rays,
         );
-        views.insert(view.name().into(), json!({
-            "frame_ms": best.seconds * 1e3,
-            "frame_ms_all_runs": runs.iter().map(|r| r.seconds * 1e3).collect::<Vec<_>>(),
-            "primary_rays": best.primary_rays,
-            "shadow_rays": best.shadow_rays,
-            "primary_rays_per_s": best.primary_rays as f64 / best.seconds,
-            "rays_per_s": rays as f64 / best.seconds,
-        }));
+        views.insert(
+            view.name().into(),
+            json!({
+                "frame_ms": best.seconds * 1e3,
+                "frame_ms_all_runs": runs.iter().map(|r| r.seconds * 1e3).collect::<Vec<_>>(),
+                "primary_rays": best.primary_rays,
+                "shadow_rays": best.shadow_rays,
+                "primary_rays_per_s": best.primary_rays as f64 / best.seconds,
+                "rays_per_s": rays as f64 / best.seconds,
+            }),
+        );
     }
-    println!("overall      {:.2} Mrays/s primary+shadow", total_rays as f64 / total_s / 1e6);
+    println!(
+        "overall      {:.2} Mrays/s primary+shadow",
+        total_rays as f64 / total_s / 1e6
+    );
     let report = json!({
         "scene": scene_path.display().to_string(),
         "primitives": prims,

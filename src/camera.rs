@@ -150,7 +150,11 @@ impl Camera {
 
     /// Pixel coordinates of the vanishing point of a world direction (a point at infinity).
     pub fn project_direction(&self, world_dir: DVec3) -> Option<DVec2> {
-        self.project_camera(self.world_from_camera.inverse().transform_vector3(world_dir))
+        self.project_camera(
+            self.world_from_camera
+                .inverse()
+                .transform_vector3(world_dir),
+        )
     }
 
     /// Depth along the camera's viewing axis (−z in camera space) of a world point, metres.

@@ -21,7 +21,12 @@ pub struct RenderOptions {
 }
 
 /// Renders `views` of the scene into `out` (created if needed).
-pub fn render_views(scene_path: &Path, views: &[View], out: &Path, options: &RenderOptions) -> Result<()> {
+pub fn render_views(
+    scene_path: &Path,
+    views: &[View],
+    out: &Path,
+    options: &RenderOptions,
+) -> Result<()> {
     crate::options::check_spp(options.spp)?;
     let scene = Scene::load(scene_path)?;
     // Check every camera before the first (possibly long) render.
@@ -30,12 +35,23 @@ pub fn render_views(scene_path: &Path, views: &[View], out: &Path, options: &Ren
         .map(|v| resized(v.camera(&scene), options.width, options.height))
         .collect::<Result<Vec<_>>>()?;
     let context = RenderContext::new(scene, options.bvh)?;
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create output directory {}", out.display()))?;
-    let settings = RenderSettings { spp: options.spp, progress: options.progress };
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create output directory {}", out.display()))?;
+    let settings = RenderSettings {
+        spp: options.spp,
+        progress: options.progress,
+    };
     for (view, camera) in views.iter().zip(&cameras) {
         let (frame, stats) = context.render(camera, view.bit(), settings, view.name());
         write_frame(&frame, out, view.name())?;
-        eprintln!("{}: {}×{} in {:.2} s → {}", view.name(), camera.width, camera.height, stats.seconds, out.join(format!("{}.png", view.name())).display());
+        eprintln!(
+            "{}: {}×{} in {:.2} s → {}",
+            view.name(),
+            camera.width,
+            camera.height,
+            stats.seconds,
+            out.join(format!("{}.png", view.name())).display()
+        );
     }
     Ok(())
 }
@@ -44,6 +60,10 @@ pub fn export_scene(scene_path: &Path, out: &Path) -> Result<()> {
     let scene = Scene::load(scene_path)?;
     let world = World::build(&scene)?;
     let count = crate::export::export(&scene, &world, out)?;
-    eprintln!("wrote {count} triangles to {} and cameras to {}", out.display(), out.with_extension("cameras.json").display());
+    eprintln!(
+        "wrote {count} triangles to {} and cameras to {}",
+        out.display(),
+        out.with_extension("cameras.json").display()
+    );
     Ok(())
 }

@@ -25,14 +25,26 @@ pub fn object_triangles(world: &World) -> Vec<Vec<[Vec3; 3]>> {
     let (lat, lon) = SPHERE_BANDS;
     for el in &world.ellipsoids {
         let point = |i: usize, j: usize| {
-            let (theta, phi) = (std::f32::consts::PI * i as f32 / lat as f32, std::f32::consts::TAU * j as f32 / lon as f32);
-            let local = Vec3A::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+            let (theta, phi) = (
+                std::f32::consts::PI * i as f32 / lat as f32,
+                std::f32::consts::TAU * j as f32 / lon as f32,
+            );
+            let local = Vec3A::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                -theta.sin() * phi.sin(),
+            );
             Vec3::from(el.world_from_object.transform_point3a(local))
         };
         let tris = &mut out[el.object as usize - 1];
         for i in 0..lat {
             for j in 0..lon {
-                let (a, b, c, d) = (point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1));
+                let (a, b, c, d) = (
+                    point(i, j),
+                    point(i + 1, j),
+                    point(i + 1, j + 1),
+                    point(i, j + 1),
+                );
                 if i > 0 {
                     tris.push([a, b, d]);
                 }
@@ -89,7 +101,13 @@ fn obj_text(world: &World, objects: &[Vec<[Vec3; 3]>]) -> String {
             }
         }
         for i in 0..tris.len() {
-            let _ = writeln!(s, "f {} {} {}", base + 3 * i, base + 3 * i + 1, base + 3 * i + 2);
+            let _ = writeln!(
+                s,
+                "f {} {} {}",
+                base + 3 * i,
+                base + 3 * i + 1,
+                base + 3 * i + 2
+            );
         }
         base += 3 * tris.len();
     }
@@ -99,7 +117,12 @@ fn obj_text(world: &World, objects: &[Vec<[Vec3; 3]>]) -> String {
 fn glb_bytes(world: &World, objects: &[Vec<[Vec3; 3]>]) -> Vec<u8> {
     let mut bin: Vec<u8> = Vec::new();
     let (mut nodes, mut meshes, mut accessors, mut views) = (vec![], vec![], vec![], vec![]);
-    for (info, tris) in world.objects.iter().zip(objects).filter(|(_, t)| !t.is_empty()) {
+    for (info, tris) in world
+        .objects
+        .iter()
+        .zip(objects)
+        .filter(|(_, t)| !t.is_empty())
+    {
         let count = tris.len() * 3;
         let (mut min, mut max) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         let start = bin.len();
@@ -113,7 +136,9 @@ fn glb_bytes(world: &World, objects: &[Vec<[Vec3; 3]>]) -> Vec<u8> {
         views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": index_start - start, "target": 34962}));
         views.push(json!({"buffer": 0, "byteOffset": index_start, "byteLength": 4 * count, "target": 34963}));
         accessors.push(json!({"bufferView": a, "componentType": 5126, "count": count, "type": "VEC3", "min": min.to_array(), "max": max.to_array()}));
-        accessors.push(json!({"bufferView": a + 1, "componentType": 5125, "count": count, "type": "SCALAR"}));
+        accessors.push(
+            json!({"bufferView": a + 1, "componentType": 5125, "count": count, "type": "SCALAR"}),
+        );
         nodes.push(json!({"mesh": meshes.len(), "name": info.name}));
         meshes.push(json!({"name": info.name, "primitives": [{"attributes": {"POSITION": a}, "indices": a + 1}]}));
     }
@@ -125,10 +150,10 @@ fn glb_bytes(world: &World, objects: &[Vec<[Vec3; 3]>]) -> Vec<u8> {
         "buffers": [{"byteLength": bin.len()}],
     });
     let mut json_chunk = doc.to_string().into_bytes();
-    while json_chunk.len() % 4 != 0 {
+    while !json_chunk.len().is_multiple_of(4) {
         json_chunk.push(b' ');
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + json_chunk.len() + 8 + bin.len();
@@ -149,7 +174,9 @@ fn glb_bytes(world: &World, objects: &[Vec<[Vec3; 3]>]) -> Vec<u8> {
 /// `<path without extension>.cameras.json`. Returns the number of triangles written.
 pub fn export(scene: &Scene, world: &World, path: &Path) -> Result<usize> {
     let objects = object_triangles(world);
-    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
     match ext.as_deref() {
         Some("obj") => write_text(path, &obj_text(world, &objects))?,
         Some("glb") => {

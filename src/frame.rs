@@ -95,9 +95,14 @@ impl Frame {
 
     /// Bit-exact equality, treating NaN as equal to itself (sky positions are NaN).
     pub fn bit_identical(&self, other: &Frame) -> bool {
-        let f = |a: &[f32], b: &[f32]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+        let f = |a: &[f32], b: &[f32]| {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+        };
         let v = |a: &[Vec3], b: &[Vec3]| {
-            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| f(&x.to_array(), &y.to_array()))
+            a.len() == b.len()
+                && a.iter()
+                    .zip(b)
+                    .all(|(x, y)| f(&x.to_array(), &y.to_array()))
         };
         self.width == other.width
             && self.height == other.height

@@ -2,11 +2,16 @@
 #![forbid(unsafe_code)]
 
 pub mod accel;
+pub mod bench;
 pub mod camera;
 pub mod color;
+pub mod commands;
+pub mod export;
 pub mod frame;
 pub mod mesh_io;
+pub mod options;
 pub mod output;
+pub mod procedural;
 pub mod progress;
 pub mod render;
 pub mod sampling;
@@ -17,8 +22,3 @@ pub mod sky;
 pub mod texture;
 pub mod views;
 pub mod world;
-pub mod bench;
-pub mod commands;
-pub mod export;
-pub mod options;
-pub mod procedural;

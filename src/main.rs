@@ -12,7 +12,11 @@ use seethru::options::{check_resolution, with_threads};
 use seethru::views::View;
 
 #[derive(Parser)]
-#[command(name = "seethru", version, about = "Simulates video see-through displays for driver assistance and measures how well they work")]
+#[command(
+    name = "seethru",
+    version,
+    about = "Simulates video see-through displays for driver assistance and measures how well they work"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -71,15 +75,46 @@ enum Command {
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Render { scene, views, out, width, height, spp, threads, bvh } => {
-            let views = if views.is_empty() { View::ALL.to_vec() } else { views };
-            let options = RenderOptions { width, height, spp, bvh, progress: true };
+        Command::Render {
+            scene,
+            views,
+            out,
+            width,
+            height,
+            spp,
+            threads,
+            bvh,
+        } => {
+            let views = if views.is_empty() {
+                View::ALL.to_vec()
+            } else {
+                views
+            };
+            let options = RenderOptions {
+                width,
+                height,
+                spp,
+                bvh,
+                progress: true,
+            };
             with_threads(threads, || render_views(&scene, &views, &out, &options))?
         }
         Command::Export { scene, out } => export_scene(&scene, &out),
-        Command::Bench { scene, width, height, repeat, threads, bvh } => {
+        Command::Bench {
+            scene,
+            width,
+            height,
+            repeat,
+            threads,
+            bvh,
+        } => {
             check_resolution(width, height)?;
-            let options = BenchOptions { width, height, repeat, bvh };
+            let options = BenchOptions {
+                width,
+                height,
+                repeat,
+                bvh,
+            };
             with_threads(threads, || bench(&scene, &options).map(|_| ()))?
         }
     }

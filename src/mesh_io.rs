@@ -46,13 +46,20 @@ pub fn load_mesh(path: &Path) -> Result<LoadedMesh> {
 }
 
 fn load_obj(path: &Path) -> Result<LoadedMesh> {
-    let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
     let (models, materials) = tobj::load_obj(path, &options).map_err(|e| anyhow::anyhow!("{e}"))?;
     let materials = materials.map_err(|e| anyhow::anyhow!("material library: {e}"))?;
     let mut out = LoadedMesh {
         materials: materials
             .iter()
-            .map(|m| FileMaterial { name: m.name.clone(), linear_color: m.diffuse.unwrap_or([0.8; 3]) })
+            .map(|m| FileMaterial {
+                name: m.name.clone(),
+                linear_color: m.diffuse.unwrap_or([0.8; 3]),
+            })
             .collect(),
         ..Default::default()
     };
@@ -60,7 +67,11 @@ fn load_obj(path: &Path) -> Result<LoadedMesh> {
         let mesh = &model.mesh;
         let vertex = |i: u32| {
             let i = i as usize;
-            Vec3::new(mesh.positions[3 * i], mesh.positions[3 * i + 1], mesh.positions[3 * i + 2])
+            Vec3::new(
+                mesh.positions[3 * i],
+                mesh.positions[3 * i + 1],
+                mesh.positions[3 * i + 2],
+            )
         };
         let uv = |i: u32| {
             let i = i as usize;
@@ -71,8 +82,14 @@ fn load_obj(path: &Path) -> Result<LoadedMesh> {
             }
         };
         for idx in mesh.indices.chunks_exact(3) {
-            if idx.iter().any(|&i| 3 * i as usize + 2 >= mesh.positions.len()) {
-                bail!("object `{}` indexes a vertex that does not exist", model.name);
+            if idx
+                .iter()
+                .any(|&i| 3 * i as usize + 2 >= mesh.positions.len())
+            {
+                bail!(
+                    "object `{}` indexes a vertex that does not exist",
+                    model.name
+                );
             }
             out.tris.push(Tri {
                 p: [vertex(idx[0]), vertex(idx[1]), vertex(idx[2])],
@@ -92,13 +109,18 @@ fn load_gltf(path: &Path) -> Result<LoadedMesh> {
             .materials()
             .map(|m| {
                 let c = m.pbr_metallic_roughness().base_color_factor();
-                FileMaterial { name: m.name().unwrap_or("").to_string(), linear_color: [c[0], c[1], c[2]] }
+                FileMaterial {
+                    name: m.name().unwrap_or("").to_string(),
+                    linear_color: [c[0], c[1], c[2]],
+                }
             })
             .collect(),
         ..Default::default()
     };
     let scene = doc.default_scene().or_else(|| doc.scenes().next());
-    let Some(scene) = scene else { bail!("the file has no scene") };
+    let Some(scene) = scene else {
+        bail!("the file has no scene")
+    };
     let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
     let mut part = 0u32;
     while let Some((node, parent)) = stack.pop() {
@@ -106,7 +128,10 @@ fn load_gltf(path: &Path) -> Result<LoadedMesh> {
         if let Some(mesh) = node.mesh() {
             for primitive in mesh.primitives() {
                 if primitive.mode() != gltf::mesh::Mode::Triangles {
-                    bail!("mesh `{}` has a primitive that is not a triangle list", mesh.name().unwrap_or(""));
+                    bail!(
+                        "mesh `{}` has a primitive that is not a triangle list",
+                        mesh.name().unwrap_or("")
+                    );
                 }
                 let reader = primitive.reader(|b| Some(&buffers[b.index()]));
                 let positions: Vec<Vec3> = reader

@@ -24,8 +24,15 @@ pub fn resized(camera: Camera, width: Option<u32>, height: Option<u32>) -> Resul
 }
 
 pub fn check_resolution(w: u32, h: u32) -> Result<()> {
-    if w == 0 || h == 0 || w > MAX_RESOLUTION || h > MAX_RESOLUTION || w as u64 * h as u64 > MAX_PIXELS {
-        bail!("resolution {w}×{h} is out of range: each side in [1, {MAX_RESOLUTION}], at most {MAX_PIXELS} pixels");
+    if w == 0
+        || h == 0
+        || w > MAX_RESOLUTION
+        || h > MAX_RESOLUTION
+        || w as u64 * h as u64 > MAX_PIXELS
+    {
+        bail!(
+            "resolution {w}×{h} is out of range: each side in [1, {MAX_RESOLUTION}], at most {MAX_PIXELS} pixels"
+        );
     }
     Ok(())
 }
@@ -44,6 +51,8 @@ pub fn with_threads<T: Send>(threads: Option<usize>, job: impl FnOnce() -> T + S
     {
         bail!("--threads {n} is out of range [1, 1024]");
     }
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build()?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()?;
     Ok(pool.install(job))
 }

@@ -14,10 +14,17 @@ use crate::sampling::hash_u32;
 /// Writes a file through `write` to a temporary sibling, then renames it into place, so that
 /// readers never see a partial file and a failure leaves nothing behind.
 pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    let name = path.file_name().with_context(|| format!("not a file path: {}", path.display()))?;
-    let tmp: PathBuf = path.with_file_name(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id()));
+    let name = path
+        .file_name()
+        .with_context(|| format!("not a file path: {}", path.display()))?;
+    let tmp: PathBuf = path.with_file_name(format!(
+        ".{}.tmp-{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
     let result = write(&tmp).and_then(|()| {
-        std::fs::rename(&tmp, path).with_context(|| format!("cannot move {} into place", path.display()))
+        std::fs::rename(&tmp, path)
+            .with_context(|| format!("cannot move {} into place", path.display()))
     });
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -30,8 +37,11 @@ pub fn write_text(path: &Path, text: &str) -> Result<()> {
 }
 
 fn write_png(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<()> {
-    let img = image::RgbImage::from_raw(width, height, rgb).context("image buffer has the wrong size")?;
-    write_atomically(path, |tmp| Ok(img.save_with_format(tmp, image::ImageFormat::Png)?))
+    let img =
+        image::RgbImage::from_raw(width, height, rgb).context("image buffer has the wrong size")?;
+    write_atomically(path, |tmp| {
+        Ok(img.save_with_format(tmp, image::ImageFormat::Png)?)
+    })
 }
 
 /// The colour AOV as an 8-bit sRGB PNG (clamped to [0, 1]).
@@ -46,7 +56,11 @@ pub fn id_color(id: u32) -> [u8; 3] {
         return [0, 0, 0];
     }
     let h = hash_u32(id);
-    [(h & 0xff) as u8 | 0x30, ((h >> 8) & 0xff) as u8 | 0x30, ((h >> 16) & 0xff) as u8 | 0x30]
+    [
+        (h & 0xff) as u8 | 0x30,
+        ((h >> 8) & 0xff) as u8 | 0x30,
+        ((h >> 16) & 0xff) as u8 | 0x30,
+    ]
 }
 
 /// Object ids in false colour, for looking at; part ids modulate the brightness.
@@ -61,7 +75,12 @@ pub fn write_id_png(frame: &Frame, path: &Path) -> Result<()> {
 }
 
 fn vec_channels(name: &str, values: &[Vec3], axes: [&str; 3]) -> [AnyChannel<FlatSamples>; 3] {
-    [0, 1, 2].map(|i| AnyChannel::new(format!("{name}.{}", axes[i]).as_str(), FlatSamples::F32(values.iter().map(|v| v[i]).collect())))
+    [0, 1, 2].map(|i| {
+        AnyChannel::new(
+            format!("{name}.{}", axes[i]).as_str(),
+            FlatSamples::F32(values.iter().map(|v| v[i]).collect()),
+        )
+    })
 }
 
 /// Every AOV in one EXR: `color.{R,G,B}`, `depth.Z`, `camera_z.Z`, `position.{X,Y,Z}`,
@@ -69,12 +88,24 @@ fn vec_channels(name: &str, values: &[Vec3], axes: [&str; 3]) -> [AnyChannel<Fla
 pub fn write_exr(frame: &Frame, path: &Path) -> Result<()> {
     let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
     channels.extend(vec_channels("color", &frame.color, ["R", "G", "B"]));
-    channels.push(AnyChannel::new("depth.Z", FlatSamples::F32(frame.depth.clone())));
-    channels.push(AnyChannel::new("camera_z.Z", FlatSamples::F32(frame.camera_z.clone())));
+    channels.push(AnyChannel::new(
+        "depth.Z",
+        FlatSamples::F32(frame.depth.clone()),
+    ));
+    channels.push(AnyChannel::new(
+        "camera_z.Z",
+        FlatSamples::F32(frame.camera_z.clone()),
+    ));
     channels.extend(vec_channels("position", &frame.position, ["X", "Y", "Z"]));
     channels.extend(vec_channels("normal", &frame.normal, ["X", "Y", "Z"]));
-    channels.push(AnyChannel::new("object_id.id", FlatSamples::U32(frame.object_id.clone())));
-    channels.push(AnyChannel::new("part_id.id", FlatSamples::U32(frame.part_id.clone())));
+    channels.push(AnyChannel::new(
+        "object_id.id",
+        FlatSamples::U32(frame.object_id.clone()),
+    ));
+    channels.push(AnyChannel::new(
+        "part_id.id",
+        FlatSamples::U32(frame.part_id.clone()),
+    ));
     let layer = Layer::new(
         (frame.width as usize, frame.height as usize),
         LayerAttributes::named("seethru"),
@@ -87,7 +118,8 @@ pub fn write_exr(frame: &Frame, path: &Path) -> Result<()> {
 
 /// Reads an EXR written by [`write_exr`] back into a frame.
 pub fn read_exr(path: &Path) -> Result<Frame> {
-    let image = read_first_flat_layer_from_file(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let image = read_first_flat_layer_from_file(path)
+        .with_context(|| format!("cannot read {}", path.display()))?;
     let layer = &image.layer_data;
     let (width, height) = (layer.size.width() as u32, layer.size.height() as u32);
     let find = |name: &str| -> Result<&FlatSamples> {
@@ -112,8 +144,16 @@ pub fn read_exr(path: &Path) -> Result<Frame> {
         }
     };
     let vec3s = |name: &str, axes: [&str; 3]| -> Result<Vec<Vec3>> {
-        let [x, y, z] = [f32s(&format!("{name}.{}", axes[0]))?, f32s(&format!("{name}.{}", axes[1]))?, f32s(&format!("{name}.{}", axes[2]))?];
-        Ok(x.iter().zip(&y).zip(&z).map(|((&x, &y), &z)| Vec3::new(x, y, z)).collect())
+        let [x, y, z] = [
+            f32s(&format!("{name}.{}", axes[0]))?,
+            f32s(&format!("{name}.{}", axes[1]))?,
+            f32s(&format!("{name}.{}", axes[2]))?,
+        ];
+        Ok(x.iter()
+            .zip(&y)
+            .zip(&z)
+            .map(|((&x, &y), &z)| Vec3::new(x, y, z))
+            .collect())
     };
     Ok(Frame {
         width,

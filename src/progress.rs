@@ -20,7 +20,14 @@ const REFRESH: Duration = Duration::from_millis(200);
 
 impl Progress {
     pub fn new(label: impl Into<String>, total: usize, enabled: bool) -> Self {
-        Self { label: label.into(), total, done: AtomicUsize::new(0), start: Instant::now(), last: Mutex::new(None), enabled }
+        Self {
+            label: label.into(),
+            total,
+            done: AtomicUsize::new(0),
+            start: Instant::now(),
+            last: Mutex::new(None),
+            enabled,
+        }
     }
 
     pub fn advance(&self, n: usize) {
@@ -28,18 +35,30 @@ impl Progress {
         if !self.enabled || self.start.elapsed() < QUIET_START {
             return;
         }
-        let Ok(mut last) = self.last.try_lock() else { return };
+        let Ok(mut last) = self.last.try_lock() else {
+            return;
+        };
         if last.is_some_and(|t| t.elapsed() < REFRESH) {
             return;
         }
         *last = Some(Instant::now());
         let pct = 100.0 * done as f64 / self.total.max(1) as f64;
-        let _ = write!(std::io::stderr(), "\r{}: {pct:5.1}% ({:.1} s)", self.label, self.start.elapsed().as_secs_f64());
+        let _ = write!(
+            std::io::stderr(),
+            "\r{}: {pct:5.1}% ({:.1} s)",
+            self.label,
+            self.start.elapsed().as_secs_f64()
+        );
     }
 
     pub fn finish(&self) {
         if self.last.lock().map(|l| l.is_some()).unwrap_or(false) {
-            let _ = writeln!(std::io::stderr(), "\r{}: done in {:.2} s     ", self.label, self.start.elapsed().as_secs_f64());
+            let _ = writeln!(
+                std::io::stderr(),
+                "\r{}: done in {:.2} s     ",
+                self.label,
+                self.start.elapsed().as_secs_f64()
+            );
         }
     }
 }

@@ -31,7 +31,10 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { spp: 1, progress: false }
+        Self {
+            spp: 1,
+            progress: false,
+        }
     }
 }
 
@@ -55,12 +58,23 @@ impl RenderContext {
         let world = World::build(&scene)?;
         let accel = Accel::build(&world, bvh);
         let sky = SkyModel::new(&scene.sky, &scene.sun);
-        Ok(Self { scene, world, accel, sky })
+        Ok(Self {
+            scene,
+            world,
+            accel,
+            sky,
+        })
     }
 
     /// Renders the frame seen by `camera`, showing the primitives visible in `view`
     /// (a [`crate::world::view_bit`]).
-    pub fn render(&self, camera: &Camera, view: u8, settings: RenderSettings, label: &str) -> (Frame, RenderStats) {
+    pub fn render(
+        &self,
+        camera: &Camera,
+        view: u8,
+        settings: RenderSettings,
+        label: &str,
+    ) -> (Frame, RenderStats) {
         let start = Instant::now();
         let (w, h) = (camera.width as usize, camera.height as usize);
         let mut pixels = vec![Pixel::SKY; w * h];
@@ -71,7 +85,15 @@ impl RenderContext {
         pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
             let mut shadows = 0;
             for (x, out) in row.iter_mut().enumerate() {
-                *out = self.render_pixel(&rays, &camera_from_world, view, x as u32, y as u32, settings.spp, &mut shadows);
+                *out = self.render_pixel(
+                    &rays,
+                    &camera_from_world,
+                    view,
+                    x as u32,
+                    y as u32,
+                    settings.spp,
+                    &mut shadows,
+                );
             }
             shadow_rays.fetch_add(shadows, Ordering::Relaxed);
             progress.advance(1);
@@ -82,11 +104,23 @@ impl RenderContext {
             shadow_rays: shadow_rays.into_inner(),
             seconds: start.elapsed().as_secs_f64(),
         };
-        (Frame::from_pixels(camera.width, camera.height, &pixels), stats)
+        (
+            Frame::from_pixels(camera.width, camera.height, &pixels),
+            stats,
+        )
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn render_pixel(&self, rays: &RayGenerator, camera_from_world: &DAffine3, view: u8, x: u32, y: u32, spp: u32, shadows: &mut u64) -> Pixel {
+    fn render_pixel(
+        &self,
+        rays: &RayGenerator,
+        camera_from_world: &DAffine3,
+        view: u8,
+        x: u32,
+        y: u32,
+        spp: u32,
+        shadows: &mut u64,
+    ) -> Pixel {
         let mut pixel = Pixel::SKY;
         let mut sum = Vec3::ZERO;
         for sample in 0..spp {
@@ -118,7 +152,9 @@ impl RenderContext {
 
     /// The closest surface visible in `view` along a ray from `origin` (unit `dir`).
     pub fn trace(&self, origin: Vec3, dir: Vec3, view: u8) -> Option<SurfaceHit> {
-        let hit = self.accel.closest(&self.world, make_ray(origin, dir, 0.0, f32::INFINITY), view)?;
+        let hit =
+            self.accel
+                .closest(&self.world, make_ray(origin, dir, 0.0, f32::INFINITY), view)?;
         Some(self.world.surface(hit.prim, origin, dir, hit.t))
     }
 
@@ -136,7 +172,12 @@ impl RenderContext {
             // Offset along the normal, scaled with the coordinates' magnitude to stay above
             // f32 rounding of the hit point.
             let eps = 2e-4 * (1.0 + s.position.abs().max_element());
-            let ray = make_ray(s.position + s.normal * eps, self.sky.sun_direction, 0.0, f32::INFINITY);
+            let ray = make_ray(
+                s.position + s.normal * eps,
+                self.sky.sun_direction,
+                0.0,
+                f32::INFINITY,
+            );
             if !self.accel.occluded(&self.world, ray, view) {
                 light += self.sky.sun_irradiance * cos;
             }

@@ -147,8 +147,10 @@ impl Obstacle {
     /// Display corners in world space: top-left, top-right, bottom-right, bottom-left.
     pub fn display_corners(&self) -> [DVec3; 4] {
         let (hw, hh) = (self.width / 2.0, self.height / 2.0);
-        [(-hw, hh), (hw, hh), (hw, -hh), (-hw, -hh)]
-            .map(|(x, y)| self.world_from_obstacle.transform_point3(DVec3::new(x, y, 0.0)))
+        [(-hw, hh), (hw, hh), (hw, -hh), (-hw, -hh)].map(|(x, y)| {
+            self.world_from_obstacle
+                .transform_point3(DVec3::new(x, y, 0.0))
+        })
     }
 
     /// Unit normal of the display, pointing towards the driver (obstacle +z), world frame.
@@ -203,9 +205,12 @@ impl Scene {
             .ok_or_else(|| root.error("obstacle", "the scene needs an [obstacle] table"))?;
         let obstacle = read_obstacle(&obstacle_table)?;
         obstacle_table.finish()?;
-        let cameras = root
-            .table("camera")?
-            .ok_or_else(|| root.error("camera", "the scene needs [camera.driver], [camera.frontal] and [camera.back]"))?;
+        let cameras = root.table("camera")?.ok_or_else(|| {
+            root.error(
+                "camera",
+                "the scene needs [camera.driver], [camera.frontal] and [camera.back]",
+            )
+        })?;
         let driver = read_driver(&cameras, &obstacle)?;
         let frontal = read_frontal(&cameras, &obstacle)?;
         let back = read_back(&cameras, &obstacle)?;
@@ -308,7 +313,12 @@ fn read_materials(root: &TableReader, file: &SourceFile) -> Result<Vec<Material>
 }
 
 /// Resolves an asset path relative to the scene file and checks that it exists.
-fn existing_asset(t: &TableReader, key: &str, rel: &str, file: &SourceFile) -> Result<PathBuf, SceneError> {
+fn existing_asset(
+    t: &TableReader,
+    key: &str,
+    rel: &str,
+    file: &SourceFile,
+) -> Result<PathBuf, SceneError> {
     let path = file.dir().join(rel);
     if !path.is_file() {
         return Err(t.error(key, format!("asset not found: {}", path.display())));
@@ -325,26 +335,61 @@ fn read_transform(t: &TableReader) -> Result<DAffine3, SceneError> {
         Err(_) => t.required_array("scale")?,
     };
     if scale.iter().any(|&s| !(s > 0.0 && s <= MAX_LENGTH)) {
-        return Err(t.error("scale", format!("every factor must be in (0, {MAX_LENGTH}], got {scale:?}")));
+        return Err(t.error(
+            "scale",
+            format!("every factor must be in (0, {MAX_LENGTH}], got {scale:?}"),
+        ));
     }
     if translate.abs().max_element() > MAX_LENGTH {
-        return Err(t.error("translate", format!("coordinates must be within ±{MAX_LENGTH} m")));
+        return Err(t.error(
+            "translate",
+            format!("coordinates must be within ±{MAX_LENGTH} m"),
+        ));
     }
     // Rotations apply about x, then y, then z (world axes).
-    let rotation = DQuat::from_euler(EulerRot::ZYX, rz.to_radians(), ry.to_radians(), rx.to_radians());
-    Ok(DAffine3::from_scale_rotation_translation(dvec3(scale), rotation, translate))
+    let rotation = DQuat::from_euler(
+        EulerRot::ZYX,
+        rz.to_radians(),
+        ry.to_radians(),
+        rx.to_radians(),
+    );
+    Ok(DAffine3::from_scale_rotation_translation(
+        dvec3(scale),
+        rotation,
+        translate,
+    ))
 }
 
-fn read_object(t: TableReader, materials: &[Material], file: &SourceFile) -> Result<Object, SceneError> {
+fn read_object(
+    t: TableReader,
+    materials: &[Material],
+    file: &SourceFile,
+) -> Result<Object, SceneError> {
     let kind = t.choice("kind", "", &OBJECT_KINDS).map_err(|e| {
-        if t.has("kind") { e } else { t.error("kind", format!("required key is missing (one of: {})", OBJECT_KINDS.join(", "))) }
+        if t.has("kind") {
+            e
+        } else {
+            t.error(
+                "kind",
+                format!(
+                    "required key is missing (one of: {})",
+                    OBJECT_KINDS.join(", ")
+                ),
+            )
+        }
     })?;
     let name = t.opt_str("name")?.unwrap_or(kind).to_string();
     let segments = |t: &TableReader| t.usize_in("segments", 48, 3, 4096);
     let shape = match kind {
-        "plane" => Shape::Plane { size: t.positive_array("size", [200.0, 200.0])? },
-        "box" => Shape::Box { size: t.positive_array("size", [1.0, 1.0, 1.0])? },
-        "sphere" => Shape::Sphere { radius: t.positive("radius", 0.5, MAX_LENGTH)? },
+        "plane" => Shape::Plane {
+            size: t.positive_array("size", [200.0, 200.0])?,
+        },
+        "box" => Shape::Box {
+            size: t.positive_array("size", [1.0, 1.0, 1.0])?,
+        },
+        "sphere" => Shape::Sphere {
+            radius: t.positive("radius", 0.5, MAX_LENGTH)?,
+        },
         "cylinder" => Shape::Cylinder {
             radius: t.positive("radius", 0.5, MAX_LENGTH)?,
             height: t.positive("height", 1.0, MAX_LENGTH)?,
@@ -355,23 +400,41 @@ fn read_object(t: TableReader, materials: &[Material], file: &SourceFile) -> Res
             height: t.positive("height", 1.0, MAX_LENGTH)?,
             segments: segments(&t)?,
         },
-        "quad" => Shape::Quad { size: t.positive_array("size", [1.0, 1.0])? },
+        "quad" => Shape::Quad {
+            size: t.positive_array("size", [1.0, 1.0])?,
+        },
         _ => {
             let rel = t.required_str("path")?;
             let lower = rel.to_ascii_lowercase();
-            if ![".obj", ".gltf", ".glb"].iter().any(|ext| lower.ends_with(ext)) {
-                return Err(t.error("path", format!("`{rel}`: mesh files must be .obj, .gltf or .glb")));
+            if ![".obj", ".gltf", ".glb"]
+                .iter()
+                .any(|ext| lower.ends_with(ext))
+            {
+                return Err(t.error(
+                    "path",
+                    format!("`{rel}`: mesh files must be .obj, .gltf or .glb"),
+                ));
             }
-            Shape::Mesh { path: existing_asset(&t, "path", rel, file)? }
+            Shape::Mesh {
+                path: existing_asset(&t, "path", rel, file)?,
+            }
         }
     };
     let material = match t.opt_str("material")? {
         Some(m) => Some(materials.iter().position(|x| x.name == m).ok_or_else(|| {
             let names: Vec<&str> = materials.iter().map(|x| x.name.as_str()).collect();
-            t.error("material", format!("no material named `{m}` (defined: {})", names.join(", ")))
+            t.error(
+                "material",
+                format!("no material named `{m}` (defined: {})", names.join(", ")),
+            )
         })?),
         None if matches!(shape, Shape::Mesh { .. }) => None,
-        None => return Err(t.error("material", "required key is missing (only meshes may omit it)")),
+        None => {
+            return Err(t.error(
+                "material",
+                "required key is missing (only meshes may omit it)",
+            ));
+        }
     };
     let hidden = t.str_list("hidden_from", &CameraKind::NAMES)?;
     let visible_to = hidden
@@ -410,7 +473,10 @@ fn read_obstacle(t: &TableReader) -> Result<Obstacle, SceneError> {
 fn half_angle(t: &TableReader, default_deg: f64) -> Result<f64, SceneError> {
     let deg = t.opt_f64("half_angle_deg")?.unwrap_or(default_deg);
     if !(deg > 0.0 && deg < 89.0) {
-        return Err(t.error("half_angle_deg", format!("must be in (0, 89) degrees, got {deg}")));
+        return Err(t.error(
+            "half_angle_deg",
+            format!("must be in (0, 89) degrees, got {deg}"),
+        ));
     }
     Ok(deg.to_radians())
 }
@@ -429,7 +495,11 @@ fn read_driver(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, Sce
     let [w, h] = t.resolution("resolution", [1280, 720])?;
     let camera = Camera::look_at(eye, target, up, half_angle(&t, 40.0)?, w, h)
         .map_err(|e| t.error("look_at", e.to_string()))?;
-    let d1 = obstacle.world_from_obstacle.inverse().transform_point3(eye).z;
+    let d1 = obstacle
+        .world_from_obstacle
+        .inverse()
+        .transform_point3(eye)
+        .z;
     if d1 <= 0.0 {
         return Err(t.error(
             "position",
@@ -442,7 +512,14 @@ fn read_driver(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, Sce
 
 /// A camera mounted on the obstacle: pose from an offset (obstacle frame) and yaw/pitch about
 /// a base viewing direction.
-fn mounted_camera(t: &TableReader, obstacle: &Obstacle, default_offset: [f64; 3], base: DMat3, default_half_deg: f64, default_res: [u32; 2]) -> Result<Camera, SceneError> {
+fn mounted_camera(
+    t: &TableReader,
+    obstacle: &Obstacle,
+    default_offset: [f64; 3],
+    base: DMat3,
+    default_half_deg: f64,
+    default_res: [u32; 2],
+) -> Result<Camera, SceneError> {
     let offset = dvec3(t.array_or("offset", default_offset)?);
     let yaw = t.f64_in("yaw_deg", 0.0, -80.0, 80.0)?.to_radians();
     let pitch = t.f64_in("pitch_deg", 0.0, -80.0, 80.0)?.to_radians();
@@ -451,15 +528,31 @@ fn mounted_camera(t: &TableReader, obstacle: &Obstacle, default_offset: [f64; 3]
         base * DMat3::from_rotation_y(yaw) * DMat3::from_rotation_x(pitch),
         offset,
     );
-    Camera::new(obstacle.world_from_obstacle * obstacle_from_camera, half_angle(t, default_half_deg)?, w, h)
-        .map_err(|e| t.error("half_angle_deg", e.to_string()))
+    Camera::new(
+        obstacle.world_from_obstacle * obstacle_from_camera,
+        half_angle(t, default_half_deg)?,
+        w,
+        h,
+    )
+    .map_err(|e| t.error("half_angle_deg", e.to_string()))
 }
 
 fn read_frontal(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, SceneError> {
     let t = camera_table(cameras, "frontal")?;
     // Camera −z along obstacle −z: the identity rotation.
-    let camera = mounted_camera(&t, obstacle, [0.0, 0.0, 0.0], DMat3::IDENTITY, 45.0, [1280, 720])?;
-    let z = obstacle.world_from_obstacle.inverse().transform_point3(camera.position()).z;
+    let camera = mounted_camera(
+        &t,
+        obstacle,
+        [0.0, 0.0, 0.0],
+        DMat3::IDENTITY,
+        45.0,
+        [1280, 720],
+    )?;
+    let z = obstacle
+        .world_from_obstacle
+        .inverse()
+        .transform_point3(camera.position())
+        .z;
     if z > 1e-9 {
         return Err(t.error("offset", format!("the frontal camera must be on the scene side of the display (z ≤ 0 in the obstacle frame), got z = {z:.3} m")));
     }
@@ -471,7 +564,14 @@ fn read_back(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, Scene
     let t = camera_table(cameras, "back")?;
     // Camera −z along obstacle +z (towards the driver): half a turn about y.
     let base = DMat3::from_rotation_y(std::f64::consts::PI);
-    let camera = mounted_camera(&t, obstacle, [0.0, obstacle.height / 2.0, 0.0], base, 35.0, [640, 480])?;
+    let camera = mounted_camera(
+        &t,
+        obstacle,
+        [0.0, obstacle.height / 2.0, 0.0],
+        base,
+        35.0,
+        [640, 480],
+    )?;
     t.finish()?;
     Ok(camera)
 }

@@ -150,14 +150,17 @@ impl<'a> TableReader<'a> {
         let Some(item) = self.item(key) else {
             return Ok(None);
         };
-        let table = item
-            .as_table_like()
-            .ok_or_else(|| self.error(key, format!("expected a table, found {}", item.type_name())))?;
+        let table = item.as_table_like().ok_or_else(|| {
+            self.error(key, format!("expected a table, found {}", item.type_name()))
+        })?;
         Ok(Some(TableReader {
             file: self.file,
             table,
             prefix: self.full_key(key),
-            line: item.span().map(|s| self.file.line_of(s.start)).or(self.line),
+            line: item
+                .span()
+                .map(|s| self.file.line_of(s.start))
+                .or(self.line),
             read: RefCell::new(Vec::new()),
         }))
     }
@@ -187,13 +190,19 @@ impl<'a> TableReader<'a> {
             let mut out = Vec::new();
             for (i, value) in array.iter().enumerate() {
                 let table = value.as_inline_table().ok_or_else(|| {
-                    self.error(key, format!("element {i} is a {}, expected a table", value.type_name()))
+                    self.error(
+                        key,
+                        format!("element {i} is a {}, expected a table", value.type_name()),
+                    )
                 })?;
                 out.push(make(i, table as &dyn TableLike, value.span()));
             }
             return Ok(out);
         }
-        Err(self.error(key, format!("expected an array of tables, found {}", item.type_name())))
+        Err(self.error(
+            key,
+            format!("expected an array of tables, found {}", item.type_name()),
+        ))
     }
 
     /// Rejects every key that was not read: scene files have no ignored keys.
@@ -220,7 +229,12 @@ impl<'a> TableReader<'a> {
         let value = item
             .as_float()
             .or_else(|| item.as_integer().map(|i| i as f64))
-            .ok_or_else(|| self.error(key, format!("expected a number, found {}", item.type_name())))?;
+            .ok_or_else(|| {
+                self.error(
+                    key,
+                    format!("expected a number, found {}", item.type_name()),
+                )
+            })?;
         if !value.is_finite() {
             return Err(self.error(key, format!("must be finite, got {value}")));
         }
@@ -261,20 +275,34 @@ impl<'a> TableReader<'a> {
         }
     }
 
-    pub fn opt_usize(&self, key: &str, min: usize, max: usize) -> Result<Option<usize>, SceneError> {
+    pub fn opt_usize(
+        &self,
+        key: &str,
+        min: usize,
+        max: usize,
+    ) -> Result<Option<usize>, SceneError> {
         let Some(item) = self.item(key) else {
             return Ok(None);
         };
-        let value = item
-            .as_integer()
-            .ok_or_else(|| self.error(key, format!("expected an integer, found {}", item.type_name())))?;
+        let value = item.as_integer().ok_or_else(|| {
+            self.error(
+                key,
+                format!("expected an integer, found {}", item.type_name()),
+            )
+        })?;
         if value < min as i64 || value > max as i64 {
             return Err(self.error(key, format!("must be in [{min}, {max}], got {value}")));
         }
         Ok(Some(value as usize))
     }
 
-    pub fn usize_in(&self, key: &str, default: usize, min: usize, max: usize) -> Result<usize, SceneError> {
+    pub fn usize_in(
+        &self,
+        key: &str,
+        default: usize,
+        min: usize,
+        max: usize,
+    ) -> Result<usize, SceneError> {
         Ok(self.opt_usize(key, min, max)?.unwrap_or(default))
     }
 
@@ -282,17 +310,24 @@ impl<'a> TableReader<'a> {
         let Some(item) = self.item(key) else {
             return Ok(default);
         };
-        item.as_bool()
-            .ok_or_else(|| self.error(key, format!("expected true or false, found {}", item.type_name())))
+        item.as_bool().ok_or_else(|| {
+            self.error(
+                key,
+                format!("expected true or false, found {}", item.type_name()),
+            )
+        })
     }
 
     pub fn opt_str(&self, key: &str) -> Result<Option<&'a str>, SceneError> {
         let Some(item) = self.item(key) else {
             return Ok(None);
         };
-        item.as_str()
-            .map(Some)
-            .ok_or_else(|| self.error(key, format!("expected a string, found {}", item.type_name())))
+        item.as_str().map(Some).ok_or_else(|| {
+            self.error(
+                key,
+                format!("expected a string, found {}", item.type_name()),
+            )
+        })
     }
 
     pub fn required_str(&self, key: &str) -> Result<&'a str, SceneError> {
@@ -300,7 +335,12 @@ impl<'a> TableReader<'a> {
     }
 
     /// A string that must be one of `choices`.
-    pub fn choice(&self, key: &str, default: &'a str, choices: &[&str]) -> Result<&'a str, SceneError> {
+    pub fn choice(
+        &self,
+        key: &str,
+        default: &'a str,
+        choices: &[&str],
+    ) -> Result<&'a str, SceneError> {
         let value = self.opt_str(key)?.unwrap_or(default);
         if !choices.contains(&value) {
             return Err(self.error(
@@ -315,14 +355,20 @@ impl<'a> TableReader<'a> {
         let Some(item) = self.item(key) else {
             return Ok(Vec::new());
         };
-        let array = item
-            .as_array()
-            .ok_or_else(|| self.error(key, format!("expected an array of strings, found {}", item.type_name())))?;
+        let array = item.as_array().ok_or_else(|| {
+            self.error(
+                key,
+                format!("expected an array of strings, found {}", item.type_name()),
+            )
+        })?;
         let mut out = Vec::new();
         for value in array.iter() {
-            let s = value
-                .as_str()
-                .ok_or_else(|| self.error(key, format!("expected strings, found {}", value.type_name())))?;
+            let s = value.as_str().ok_or_else(|| {
+                self.error(
+                    key,
+                    format!("expected strings, found {}", value.type_name()),
+                )
+            })?;
             if !choices.contains(&s) {
                 return Err(self.error(key, format!("`{s}` is not one of: {}", choices.join(", "))));
             }
@@ -354,7 +400,11 @@ impl<'a> TableReader<'a> {
         Ok(Some(out))
     }
 
-    pub fn array_or<const N: usize>(&self, key: &str, default: [f64; N]) -> Result<[f64; N], SceneError> {
+    pub fn array_or<const N: usize>(
+        &self,
+        key: &str,
+        default: [f64; N],
+    ) -> Result<[f64; N], SceneError> {
         Ok(self.opt_array(key)?.unwrap_or(default))
     }
 
@@ -363,7 +413,11 @@ impl<'a> TableReader<'a> {
     }
 
     /// An array whose every element is strictly positive (sizes, scales).
-    pub fn positive_array<const N: usize>(&self, key: &str, default: [f64; N]) -> Result<[f64; N], SceneError> {
+    pub fn positive_array<const N: usize>(
+        &self,
+        key: &str,
+        default: [f64; N],
+    ) -> Result<[f64; N], SceneError> {
         let value = self.array_or(key, default)?;
         if value.iter().any(|&v| v <= 0.0) {
             return Err(self.error(key, format!("every element must be > 0, got {value:?}")));
@@ -375,7 +429,10 @@ impl<'a> TableReader<'a> {
     pub fn color(&self, key: &str, default: [f64; 3]) -> Result<[f64; 3], SceneError> {
         let value = self.array_or(key, default)?;
         if value.iter().any(|&v| !(0.0..=1.0).contains(&v)) {
-            return Err(self.error(key, format!("colour components must be in [0, 1], got {value:?}")));
+            return Err(self.error(
+                key,
+                format!("colour components must be in [0, 1], got {value:?}"),
+            ));
         }
         Ok(value)
     }
@@ -386,9 +443,13 @@ impl<'a> TableReader<'a> {
             return Ok(default);
         };
         let array = item.as_array().filter(|a| a.len() == 2);
-        let values: Option<Vec<i64>> = array.map(|a| a.iter().filter_map(|v| v.as_integer()).collect());
+        let values: Option<Vec<i64>> =
+            array.map(|a| a.iter().filter_map(|v| v.as_integer()).collect());
         match values.as_deref() {
-            Some(&[w, h]) if (1..=MAX_RESOLUTION as i64).contains(&w) && (1..=MAX_RESOLUTION as i64).contains(&h) => {
+            Some(&[w, h])
+                if (1..=MAX_RESOLUTION as i64).contains(&w)
+                    && (1..=MAX_RESOLUTION as i64).contains(&h) =>
+            {
                 Ok([w as u32, h as u32])
             }
             _ => Err(self.error(

@@ -30,17 +30,42 @@ fn quad(out: &mut Vec<Tri>, corners: [Vec3; 4], uvs: [Vec2; 4], part: u32) {
     // Corners go counter-clockwise seen from the front.
     let [a, b, c, d] = corners;
     let [ua, ub, uc, ud] = uvs;
-    out.push(Tri { p: [a, b, c], uv: [ua, ub, uc], part, file_material: None });
-    out.push(Tri { p: [a, c, d], uv: [ua, uc, ud], part, file_material: None });
+    out.push(Tri {
+        p: [a, b, c],
+        uv: [ua, ub, uc],
+        part,
+        file_material: None,
+    });
+    out.push(Tri {
+        p: [a, c, d],
+        uv: [ua, uc, ud],
+        part,
+        file_material: None,
+    });
 }
 
-const FULL_UV: [Vec2; 4] = [Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.0)];
+const FULL_UV: [Vec2; 4] = [
+    Vec2::new(0.0, 1.0),
+    Vec2::new(1.0, 1.0),
+    Vec2::new(1.0, 0.0),
+    Vec2::new(0.0, 0.0),
+];
 
 /// Rectangle in the xy plane facing +z, centred at the origin.
 pub fn quad_xy(size: [f32; 2], part: u32) -> Vec<Tri> {
     let (x, y) = (size[0] / 2.0, size[1] / 2.0);
     let mut out = Vec::new();
-    quad(&mut out, [Vec3::new(-x, -y, 0.0), Vec3::new(x, -y, 0.0), Vec3::new(x, y, 0.0), Vec3::new(-x, y, 0.0)], FULL_UV, part);
+    quad(
+        &mut out,
+        [
+            Vec3::new(-x, -y, 0.0),
+            Vec3::new(x, -y, 0.0),
+            Vec3::new(x, y, 0.0),
+            Vec3::new(-x, y, 0.0),
+        ],
+        FULL_UV,
+        part,
+    );
     out
 }
 
@@ -49,7 +74,17 @@ pub fn quad_xy(size: [f32; 2], part: u32) -> Vec<Tri> {
 pub fn plane_xz(size: [f32; 2]) -> Vec<Tri> {
     let (x, z) = (size[0] / 2.0, size[1] / 2.0);
     let mut out = Vec::new();
-    quad(&mut out, [Vec3::new(-x, 0.0, z), Vec3::new(x, 0.0, z), Vec3::new(x, 0.0, -z), Vec3::new(-x, 0.0, -z)], FULL_UV, 0);
+    quad(
+        &mut out,
+        [
+            Vec3::new(-x, 0.0, z),
+            Vec3::new(x, 0.0, z),
+            Vec3::new(x, 0.0, -z),
+            Vec3::new(-x, 0.0, -z),
+        ],
+        FULL_UV,
+        0,
+    );
     out
 }
 
@@ -68,7 +103,12 @@ pub fn cuboid(size: [f32; 3]) -> Vec<Tri> {
     ];
     for &(n, r, u, part) in &faces {
         let (n, r, u) = (n * h, r * h, u * h);
-        quad(&mut out, [n - r - u, n + r - u, n + r + u, n - r + u], FULL_UV, part);
+        quad(
+            &mut out,
+            [n - r - u, n + r - u, n + r + u, n - r + u],
+            FULL_UV,
+            part,
+        );
     }
     out
 }
@@ -93,18 +133,46 @@ pub fn frustum(radius: f32, top_radius: f32, height: f32, segments: usize) -> Ve
         let (b0, b1) = (ring(i, radius, 0.0), ring(i + 1, radius, 0.0));
         if top_radius > 0.0 {
             let (t0, t1) = (ring(i, top_radius, height), ring(i + 1, top_radius, height));
-            quad(&mut out, [b1, b0, t0, t1], [Vec2::new(u1, 1.0), Vec2::new(u0, 1.0), Vec2::new(u0, 0.0), Vec2::new(u1, 0.0)], round_part::SIDE);
-            out.push(Tri { p: [top, t0, t1], uv: [Vec2::splat(0.5); 3], part: round_part::TOP, file_material: None });
+            quad(
+                &mut out,
+                [b0, b1, t1, t0],
+                [
+                    Vec2::new(u0, 1.0),
+                    Vec2::new(u1, 1.0),
+                    Vec2::new(u1, 0.0),
+                    Vec2::new(u0, 0.0),
+                ],
+                round_part::SIDE,
+            );
+            out.push(Tri {
+                p: [top, t0, t1],
+                uv: [Vec2::splat(0.5); 3],
+                part: round_part::TOP,
+                file_material: None,
+            });
         } else {
             out.push(Tri {
-                p: [b1, b0, top],
-                uv: [Vec2::new(u1, 1.0), Vec2::new(u0, 1.0), Vec2::new((u0 + u1) / 2.0, 0.0)],
+                p: [b0, b1, top],
+                uv: [
+                    Vec2::new(u0, 1.0),
+                    Vec2::new(u1, 1.0),
+                    Vec2::new((u0 + u1) / 2.0, 0.0),
+                ],
                 part: round_part::SIDE,
                 file_material: None,
             });
         }
-        let base_part = if top_radius > 0.0 { round_part::BOTTOM } else { round_part::TOP };
-        out.push(Tri { p: [Vec3::ZERO, b1, b0], uv: [Vec2::splat(0.5); 3], part: base_part, file_material: None });
+        let base_part = if top_radius > 0.0 {
+            round_part::BOTTOM
+        } else {
+            round_part::TOP
+        };
+        out.push(Tri {
+            p: [Vec3::ZERO, b1, b0],
+            uv: [Vec2::splat(0.5); 3],
+            part: base_part,
+            file_material: None,
+        });
     }
     out
 }
@@ -114,7 +182,9 @@ mod tests {
     use super::*;
 
     fn area(tris: &[Tri]) -> f32 {
-        tris.iter().map(|t| (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).length() / 2.0).sum()
+        tris.iter()
+            .map(|t| (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).length() / 2.0)
+            .sum()
     }
 
     /// Outward-facing winding: the normal of every face points away from the centroid.

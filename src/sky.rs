@@ -105,11 +105,16 @@ fn cloud_table(seed: u32) -> Texture {
     let n = CLOUD_TABLE;
     let texels = (0..n * n)
         .map(|i| {
-            let p = Vec2::new((i % n) as f32 + 0.5, (i / n) as f32 + 0.5) * (CLOUD_PERIOD as f32 / n as f32);
+            let p = Vec2::new((i % n) as f32 + 0.5, (i / n) as f32 + 0.5)
+                * (CLOUD_PERIOD as f32 / n as f32);
             Vec3::splat(fbm(p, seed))
         })
         .collect();
-    Texture { width: n, height: n, texels }
+    Texture {
+        width: n,
+        height: n,
+        texels,
+    }
 }
 
 /// Value noise in [0, 1] on the integer lattice, smoothly interpolated, repeating every
@@ -165,7 +170,11 @@ mod tests {
             cloud_size: 900.0,
             cloud_seed: 7,
         };
-        let sun = Sun { direction: glam::DVec3::Y, color: [1.0; 3], intensity: 2.0 };
+        let sun = Sun {
+            direction: glam::DVec3::Y,
+            color: [1.0; 3],
+            intensity: 2.0,
+        };
         SkyModel::new(&sky, &sun)
     }
 
@@ -187,7 +196,11 @@ mod tests {
     #[test]
     fn cloud_cover_controls_the_cloudy_fraction() {
         assert_eq!(covered_fraction(&model(0.0)), 0.0);
-        let (low, mid, high) = (covered_fraction(&model(0.2)), covered_fraction(&model(0.5)), covered_fraction(&model(0.9)));
+        let (low, mid, high) = (
+            covered_fraction(&model(0.2)),
+            covered_fraction(&model(0.5)),
+            covered_fraction(&model(0.9)),
+        );
         assert!(low < mid && mid < high, "{low} {mid} {high}");
         assert!(mid > 0.05 && mid < 0.95);
     }
@@ -195,10 +208,16 @@ mod tests {
     #[test]
     fn gradient_runs_from_horizon_to_zenith() {
         let m = model(0.0);
-        assert!(m.radiance(Vec3::new(1.0, 0.0, 0.0)).abs_diff_eq(m.horizon, 1e-6));
+        assert!(
+            m.radiance(Vec3::new(1.0, 0.0, 0.0))
+                .abs_diff_eq(m.horizon, 1e-6)
+        );
         // Straight up is the sun's disc in this model; look just beside it.
         let up = Vec3::new(0.02, 1.0, 0.0).normalize();
-        assert!(m.radiance(up).abs_diff_eq(m.horizon.lerp(m.zenith, up.y.sqrt()), 1e-6));
+        assert!(
+            m.radiance(up)
+                .abs_diff_eq(m.horizon.lerp(m.zenith, up.y.sqrt()), 1e-6)
+        );
         assert!(m.radiance(Vec3::Y).x > m.zenith.x + 1.0);
     }
 }

@@ -26,7 +26,13 @@ impl Texture {
             height: img.height(),
             texels: img
                 .pixels()
-                .map(|p| Vec3::new(srgb_to_linear(p[0] as f32 / 255.0), srgb_to_linear(p[1] as f32 / 255.0), srgb_to_linear(p[2] as f32 / 255.0)))
+                .map(|p| {
+                    Vec3::new(
+                        srgb_to_linear(p[0] as f32 / 255.0),
+                        srgb_to_linear(p[1] as f32 / 255.0),
+                        srgb_to_linear(p[2] as f32 / 255.0),
+                    )
+                })
                 .collect(),
         })
     }
@@ -59,10 +65,17 @@ mod tests {
 
     #[test]
     fn bilinear_lookup_interpolates_and_repeats() {
-        let t = Texture { width: 2, height: 1, texels: vec![Vec3::ZERO, Vec3::ONE] };
+        let t = Texture {
+            width: 2,
+            height: 1,
+            texels: vec![Vec3::ZERO, Vec3::ONE],
+        };
         assert_eq!(t.sample(Vec2::new(0.25, 0.5)), Vec3::ZERO);
         assert_eq!(t.sample(Vec2::new(0.75, 0.5)), Vec3::ONE);
-        assert!(t.sample(Vec2::new(0.5, 0.5)).abs_diff_eq(Vec3::splat(0.5), 1e-6));
+        assert!(
+            t.sample(Vec2::new(0.5, 0.5))
+                .abs_diff_eq(Vec3::splat(0.5), 1e-6)
+        );
         assert!(t.sample(Vec2::new(1.75, 3.5)).abs_diff_eq(Vec3::ONE, 1e-6));
     }
 }

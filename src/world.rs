@@ -141,39 +141,67 @@ impl World {
             let tris = match &object.shape {
                 Shape::Sphere { radius } => {
                     let scale = DAffine3::from_scale(DVec3::splat(*radius));
-                    world.add_ellipsoid(object.world_from_object * scale, id, material.unwrap_or(0));
+                    world.add_ellipsoid(
+                        object.world_from_object * scale,
+                        id,
+                        material.unwrap_or(0),
+                    );
                     continue;
                 }
                 Shape::Plane { size } => plane_xz(size2(*size)),
                 Shape::Box { size } => cuboid(size.map(|s| s as f32)),
-                Shape::Cylinder { radius, height, segments } => frustum(*radius as f32, *radius as f32, *height as f32, *segments),
-                Shape::Cone { radius, height, segments } => frustum(*radius as f32, 0.0, *height as f32, *segments),
+                Shape::Cylinder {
+                    radius,
+                    height,
+                    segments,
+                } => frustum(*radius as f32, *radius as f32, *height as f32, *segments),
+                Shape::Cone {
+                    radius,
+                    height,
+                    segments,
+                } => frustum(*radius as f32, 0.0, *height as f32, *segments),
                 Shape::Quad { size } => quad_xy(size2(*size), 0),
                 Shape::Mesh { path } => {
                     let mesh = load_mesh(path)?;
                     let first = world.materials.len() as u32;
-                    world.materials.extend(mesh.materials.iter().map(|m| SurfaceMaterial {
-                        albedo: Vec3::from_array(m.linear_color),
-                        texture: None,
-                        uv_repeat: Vec2::ONE,
-                    }));
+                    world
+                        .materials
+                        .extend(mesh.materials.iter().map(|m| SurfaceMaterial {
+                            albedo: Vec3::from_array(m.linear_color),
+                            texture: None,
+                            uv_repeat: Vec2::ONE,
+                        }));
                     if mesh.materials.is_empty() && material.is_none() {
-                        world.materials.push(SurfaceMaterial { albedo: Vec3::splat(0.6), texture: None, uv_repeat: Vec2::ONE });
+                        world.materials.push(SurfaceMaterial {
+                            albedo: Vec3::splat(0.6),
+                            texture: None,
+                            uv_repeat: Vec2::ONE,
+                        });
                     }
                     let fallback = world.materials.len() as u32 - 1;
                     world.add_tris(&mesh.tris, object.world_from_object, id, |t| {
-                        material.or(t.file_material.map(|m| first + m)).unwrap_or(fallback)
+                        material
+                            .or(t.file_material.map(|m| first + m))
+                            .unwrap_or(fallback)
                     });
                     continue;
                 }
             };
-            world.add_tris(&tris, object.world_from_object, id, |_| material.unwrap_or(0));
+            world.add_tris(&tris, object.world_from_object, id, |_| {
+                material.unwrap_or(0)
+            });
         }
         world.add_obstacle(&scene.obstacle);
         Ok(world)
     }
 
-    fn add_tris(&mut self, tris: &[Tri], world_from_object: DAffine3, object: u32, material: impl Fn(&Tri) -> u32) {
+    fn add_tris(
+        &mut self,
+        tris: &[Tri],
+        world_from_object: DAffine3,
+        object: u32,
+        material: impl Fn(&Tri) -> u32,
+    ) {
         let m = world_from_object;
         let to_world = |p: Vec3| m.transform_point3(p.as_dvec3()).as_vec3();
         for tri in tris {
@@ -182,13 +210,20 @@ impl World {
             if (b - a).cross(c - a).length_squared() == 0.0 {
                 continue;
             }
-            self.triangles.push(RtTriangle::new(a.into(), b.into(), c.into()));
-            self.tri_attrs.push(TriAttr { uv: tri.uv, part: tri.part, object, material: material(tri) });
+            self.triangles
+                .push(RtTriangle::new(a.into(), b.into(), c.into()));
+            self.tri_attrs.push(TriAttr {
+                uv: tri.uv,
+                part: tri.part,
+                object,
+                material: material(tri),
+            });
         }
     }
 
     fn add_ellipsoid(&mut self, world_from_object: DAffine3, object: u32, material: u32) {
-        let world_from_object = Affine3A::from_cols_array(&world_from_object.to_cols_array().map(|v| v as f32));
+        let world_from_object =
+            Affine3A::from_cols_array(&world_from_object.to_cols_array().map(|v| v as f32));
         let object_from_world = world_from_object.inverse();
         self.ellipsoids.push(Ellipsoid {
             world_from_object,
@@ -210,13 +245,31 @@ impl World {
         self.obstacle_id = self.objects.len() as u32;
         let body = self.materials.len() as u32;
         for (color, _) in [(obstacle.body_color, 0), (obstacle.display_off_color, 1)] {
-            self.materials.push(SurfaceMaterial { albedo: srgb_to_linear3(color), texture: None, uv_repeat: Vec2::ONE });
+            self.materials.push(SurfaceMaterial {
+                albedo: srgb_to_linear3(color),
+                texture: None,
+                uv_repeat: Vec2::ONE,
+            });
         }
-        let tris = cuboid([obstacle.width as f32, obstacle.height as f32, obstacle.thickness as f32]);
-        let obstacle_from_box = DAffine3::from_translation(DVec3::new(0.0, 0.0, -obstacle.thickness / 2.0));
-        self.add_tris(&tris, obstacle.world_from_obstacle * obstacle_from_box, self.obstacle_id, |t| {
-            if t.part == box_face::POS_Z { body + 1 } else { body }
-        });
+        let tris = cuboid([
+            obstacle.width as f32,
+            obstacle.height as f32,
+            obstacle.thickness as f32,
+        ]);
+        let obstacle_from_box =
+            DAffine3::from_translation(DVec3::new(0.0, 0.0, -obstacle.thickness / 2.0));
+        self.add_tris(
+            &tris,
+            obstacle.world_from_obstacle * obstacle_from_box,
+            self.obstacle_id,
+            |t| {
+                if t.part == box_face::POS_Z {
+                    body + 1
+                } else {
+                    body
+                }
+            },
+        );
     }
 
     pub fn primitive_count(&self) -> usize {
@@ -243,7 +296,11 @@ impl World {
                 // The unit sphere's box under an affine map: centre ± the rows' absolute sums.
                 let m = &self.ellipsoids[e].world_from_object;
                 let c = m.translation;
-                let abs = Mat3A::from_cols(m.matrix3.x_axis.abs(), m.matrix3.y_axis.abs(), m.matrix3.z_axis.abs());
+                let abs = Mat3A::from_cols(
+                    m.matrix3.x_axis.abs(),
+                    m.matrix3.y_axis.abs(),
+                    m.matrix3.z_axis.abs(),
+                );
                 let r = abs * Vec3A::ONE;
                 Aabb::new(c - r, c + r)
             }
@@ -284,8 +341,20 @@ impl World {
                 (n, Vec2::new(u, v), el.object, 0, el.material)
             }
         };
-        let normal = if normal.dot(dir) > 0.0 { -normal } else { normal };
-        SurfaceHit { t, position, normal, uv, object, part, material }
+        let normal = if normal.dot(dir) > 0.0 {
+            -normal
+        } else {
+            normal
+        };
+        SurfaceHit {
+            t,
+            position,
+            normal,
+            uv,
+            object,
+            part,
+            material,
+        }
     }
 }
 

@@ -45,7 +45,12 @@ fn closest_and_occluded_equal_brute_force() {
         let accel = Accel::build(&world, kind);
         let mut hits = 0;
         for (i, &(origin, dir)) in rays.iter().enumerate() {
-            let view = [view_bit::TRUTH, view_bit::OCCLUDED, view_bit::FRONTAL, view_bit::BACK][i % 4];
+            let view = [
+                view_bit::TRUTH,
+                view_bit::OCCLUDED,
+                view_bit::FRONTAL,
+                view_bit::BACK,
+            ][i % 4];
             let tmax = if i % 5 == 0 { 7.5 } else { f32::INFINITY };
             let ray = make_ray(origin, dir, 0.0, tmax);
             let fast = accel.closest(&world, ray, view);
@@ -56,17 +61,29 @@ fn closest_and_occluded_equal_brute_force() {
                     hits += 1;
                     // The same distance, bit for bit; at an exact tie (a shared edge) either
                     // primitive is a correct answer.
-                    assert_eq!(f.t.to_bits(), s.t.to_bits(), "{kind:?} ray {i}: {f:?} vs {s:?}");
+                    assert_eq!(
+                        f.t.to_bits(),
+                        s.t.to_bits(),
+                        "{kind:?} ray {i}: {f:?} vs {s:?}"
+                    );
                     if f.prim != s.prim {
                         assert_eq!(world.intersect(f.prim, &ray), s.t, "{kind:?} ray {i}");
                     }
                 }
                 _ => panic!("{kind:?} ray {i}: accelerated {fast:?}, brute force {slow:?}"),
             }
-            assert_eq!(accel.occluded(&world, ray, view), occluded_brute_force(&world, ray, view), "{kind:?} ray {i}");
+            assert_eq!(
+                accel.occluded(&world, ray, view),
+                occluded_brute_force(&world, ray, view),
+                "{kind:?} ray {i}"
+            );
         }
         // The comparison means something only if many rays hit something and many miss.
-        assert!(hits > rays.len() / 3 && hits < rays.len(), "{kind:?}: {hits} hits of {}", rays.len());
+        assert!(
+            hits > rays.len() / 3 && hits < rays.len(),
+            "{kind:?}: {hits} hits of {}",
+            rays.len()
+        );
     }
 }
 
@@ -81,7 +98,9 @@ fn hidden_objects_are_invisible_only_in_their_views() {
     let ray = make_ray(eye, (centre - eye).normalize(), 0.0, f32::INFINITY);
     let occluded = accel.closest(&world, ray, view_bit::OCCLUDED).unwrap();
     assert_eq!(world.object_of(occluded.prim), world.obstacle_id);
-    let truth = accel.closest(&world, ray, view_bit::TRUTH).map(|h| world.object_of(h.prim));
+    let truth = accel
+        .closest(&world, ray, view_bit::TRUTH)
+        .map(|h| world.object_of(h.prim));
     assert_ne!(truth, Some(world.obstacle_id));
     // From the back camera towards the eye: the head in `back`; the driver never sees it.
     let back = scene.back.position().as_vec3();
@@ -89,7 +108,14 @@ fn hidden_objects_are_invisible_only_in_their_views() {
     let head = accel.closest(&world, ray, view_bit::BACK).unwrap();
     let head_id = scene.objects.iter().position(|o| o.name == "head").unwrap() as u32 + 1;
     assert_eq!(world.object_of(head.prim), head_id);
-    let ray = make_ray(eye + Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.0, 0.0, -1.0), 0.0, f32::INFINITY);
-    let seen = accel.closest(&world, ray, view_bit::TRUTH).map(|h| world.object_of(h.prim));
+    let ray = make_ray(
+        eye + Vec3::new(0.0, 0.0, 0.5),
+        Vec3::new(0.0, 0.0, -1.0),
+        0.0,
+        f32::INFINITY,
+    );
+    let seen = accel
+        .closest(&world, ray, view_bit::TRUTH)
+        .map(|h| world.object_of(h.prim));
     assert_ne!(seen, Some(head_id));
 }

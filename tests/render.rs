@@ -48,7 +48,11 @@ fn sphere_and_plane_depths_are_analytic() {
                 Some((t, id)) => {
                     assert_eq!(px.object_id, id, "pixel {x},{y}");
                     // f32 ray tracing: relative error of a few ulps of the coordinates.
-                    assert!((px.depth as f64 - t).abs() < 2e-5 * t.max(1.0), "pixel {x},{y}: {} vs {t}", px.depth);
+                    assert!(
+                        (px.depth as f64 - t).abs() < 2e-5 * t.max(1.0),
+                        "pixel {x},{y}: {} vs {t}",
+                        px.depth
+                    );
                     let expected_z = camera.axial_depth(origin + dir * t);
                     assert!((px.camera_z as f64 - expected_z).abs() < 2e-5 * t.max(1.0));
                     let p = (origin + dir * t).as_vec3();
@@ -65,21 +69,33 @@ fn sphere_and_plane_depths_are_analytic() {
             }
         }
     }
-    assert!(sphere_pixels > 50 && ground_pixels > 1000, "{sphere_pixels} {ground_pixels}");
+    assert!(
+        sphere_pixels > 50 && ground_pixels > 1000,
+        "{sphere_pixels} {ground_pixels}"
+    );
 }
 
 #[test]
 fn images_do_not_depend_on_the_thread_count() {
     let ctx = RenderContext::new(common::das(), BvhKind::Cwbvh).unwrap();
-    let settings = RenderSettings { spp: 3, progress: false };
+    let settings = RenderSettings {
+        spp: 3,
+        progress: false,
+    };
     for view in [View::Truth, View::Occluded] {
         let camera = view.camera(&ctx.scene).with_resolution(120, 68);
         let render = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
             pool.install(|| ctx.render(&camera, view.bit(), settings, "test").0)
         };
         let (one, two, three) = (render(1), render(2), render(3));
-        assert!(one.bit_identical(&two) && one.bit_identical(&three), "{view:?}");
+        assert!(
+            one.bit_identical(&two) && one.bit_identical(&three),
+            "{view:?}"
+        );
         // Not a trivially constant image.
         assert!(one.object_id.iter().any(|&i| i != one.object_id[0]));
     }
@@ -88,7 +104,15 @@ fn images_do_not_depend_on_the_thread_count() {
 #[test]
 fn exr_round_trip_keeps_every_aov_bit_exact() {
     let ctx = minimal_context();
-    let (frame, _) = ctx.render(&ctx.scene.driver, view_bit::TRUTH, RenderSettings { spp: 2, progress: false }, "test");
+    let (frame, _) = ctx.render(
+        &ctx.scene.driver,
+        view_bit::TRUTH,
+        RenderSettings {
+            spp: 2,
+            progress: false,
+        },
+        "test",
+    );
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("frame.exr");
     write_exr(&frame, &path).unwrap();
@@ -101,11 +125,36 @@ fn exr_round_trip_keeps_every_aov_bit_exact() {
 #[test]
 fn more_samples_smooth_edges_but_keep_centre_aovs() {
     let ctx = minimal_context();
-    let one = ctx.render(&ctx.scene.driver, view_bit::TRUTH, RenderSettings { spp: 1, progress: false }, "t").0;
-    let many = ctx.render(&ctx.scene.driver, view_bit::TRUTH, RenderSettings { spp: 16, progress: false }, "t").0;
+    let one = ctx
+        .render(
+            &ctx.scene.driver,
+            view_bit::TRUTH,
+            RenderSettings {
+                spp: 1,
+                progress: false,
+            },
+            "t",
+        )
+        .0;
+    let many = ctx
+        .render(
+            &ctx.scene.driver,
+            view_bit::TRUTH,
+            RenderSettings {
+                spp: 16,
+                progress: false,
+            },
+            "t",
+        )
+        .0;
     assert_eq!(one.object_id, many.object_id);
     assert_eq!(one.depth, many.depth);
     // Anti-aliasing changes colours on silhouettes only.
-    let changed = one.color.iter().zip(&many.color).filter(|(a, b)| (**a - **b).abs().max_element() > 0.02).count();
+    let changed = one
+        .color
+        .iter()
+        .zip(&many.color)
+        .filter(|(a, b)| (**a - **b).abs().max_element() > 0.02)
+        .count();
     assert!(changed > 0 && changed < one.color.len() / 4, "{changed}");
 }

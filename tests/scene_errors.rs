@@ -6,12 +6,18 @@ use common::{MINIMAL, parse, parse_in, repo_path};
 
 /// Replaces the first occurrence of `from` in the minimal scene (which must exist).
 fn edited(from: &str, to: &str) -> String {
-    assert!(MINIMAL.contains(from), "test bug: `{from}` not in the minimal scene");
+    assert!(
+        MINIMAL.contains(from),
+        "test bug: `{from}` not in the minimal scene"
+    );
     MINIMAL.replacen(from, to, 1)
 }
 
 fn line_of(text: &str, needle: &str) -> usize {
-    text.lines().position(|l| l.contains(needle)).expect("needle in text") + 1
+    text.lines()
+        .position(|l| l.contains(needle))
+        .expect("needle in text")
+        + 1
 }
 
 #[test]
@@ -25,24 +31,114 @@ fn the_minimal_scene_is_valid() {
 fn errors_name_file_line_and_key() {
     let cases: &[(&str, &str, &str, &str)] = &[
         // (original, replacement, expected key, expected words in the message)
-        ("radius = 1.0", "radius = -1.0", "object[1].radius", "must be in (0,"),
-        ("radius = 1.0", "radius = \"big\"", "object[1].radius", "expected a number, found string"),
-        ("radius = 1.0", "radius = nan", "object[1].radius", "must be finite"),
-        ("radius = 1.0", "radius = 1.0\ncolour = 3", "object[1].colour", "unknown key"),
-        ("kind = \"sphere\"", "kind = \"torus\"", "object[1].kind", "`torus` is not one of"),
-        ("material = \"grey\"\nradius", "material = \"gray\"\nradius", "object[1].material", "no material named `gray`"),
-        ("color = [0.5, 0.5, 0.5]", "color = [0.5, 1.5, 0.5]", "material[0].color", "must be in [0, 1]"),
-        ("color = [0.5, 0.5, 0.5]", "color = [0.5, 0.5]", "material[0].color", "expected 3 numbers"),
-        ("width = 0.3", "width = 0.0", "obstacle.width", "must be in (0,"),
-        ("resolution = [64, 36]", "resolution = [64, 0]", "camera.driver.resolution", "integers in [1, 16384]"),
-        ("resolution = [64, 36]", "resolution = [1000000, 36]", "camera.driver.resolution", "integers in [1, 16384]"),
-        ("position = [0.0, 1.2, 0.0]", "position = [0.0, 1.2, -2.0]", "camera.driver.position", "d1 > 0"),
-        ("look_at = [0.0, 1.2, -10.0]", "look_at = [0.0, 1.2, 0.0]", "camera.driver.look_at", "viewing direction"),
-        ("[camera.frontal]\n", "[camera.frontal]\nhalf_angle_deg = 95\n", "camera.frontal.half_angle_deg", "(0, 89)"),
-        ("[camera.frontal]\n", "[camera.frontal]\noffset = [0.0, 0.0, 0.5]\n", "camera.frontal.offset", "scene side"),
-        ("[camera.back]\n", "[camera.back]\nfov = 3\n", "camera.back.fov", "unknown key"),
-        ("size = [100.0, 100.0]", "size = [100.0, -1.0]", "object[0].size", "every element must be > 0"),
-        ("[[object]]\nname = \"ground\"", "[[object]]\nname = \"ground\"\nhidden_from = [\"rear\"]", "object[0].hidden_from", "`rear` is not one of"),
+        (
+            "radius = 1.0",
+            "radius = -1.0",
+            "object[1].radius",
+            "must be in (0,",
+        ),
+        (
+            "radius = 1.0",
+            "radius = \"big\"",
+            "object[1].radius",
+            "expected a number, found string",
+        ),
+        (
+            "radius = 1.0",
+            "radius = nan",
+            "object[1].radius",
+            "must be finite",
+        ),
+        (
+            "radius = 1.0",
+            "radius = 1.0\ncolour = 3",
+            "object[1].colour",
+            "unknown key",
+        ),
+        (
+            "kind = \"sphere\"",
+            "kind = \"torus\"",
+            "object[1].kind",
+            "`torus` is not one of",
+        ),
+        (
+            "material = \"grey\"\nradius",
+            "material = \"gray\"\nradius",
+            "object[1].material",
+            "no material named `gray`",
+        ),
+        (
+            "color = [0.5, 0.5, 0.5]",
+            "color = [0.5, 1.5, 0.5]",
+            "material[0].color",
+            "must be in [0, 1]",
+        ),
+        (
+            "color = [0.5, 0.5, 0.5]",
+            "color = [0.5, 0.5]",
+            "material[0].color",
+            "expected 3 numbers",
+        ),
+        (
+            "width = 0.3",
+            "width = 0.0",
+            "obstacle.width",
+            "must be in (0,",
+        ),
+        (
+            "resolution = [64, 36]",
+            "resolution = [64, 0]",
+            "camera.driver.resolution",
+            "integers in [1, 16384]",
+        ),
+        (
+            "resolution = [64, 36]",
+            "resolution = [1000000, 36]",
+            "camera.driver.resolution",
+            "integers in [1, 16384]",
+        ),
+        (
+            "position = [0.0, 1.2, 0.0]",
+            "position = [0.0, 1.2, -2.0]",
+            "camera.driver.position",
+            "d1 > 0",
+        ),
+        (
+            "look_at = [0.0, 1.2, -10.0]",
+            "look_at = [0.0, 1.2, 0.0]",
+            "camera.driver.look_at",
+            "viewing direction",
+        ),
+        (
+            "[camera.frontal]\n",
+            "[camera.frontal]\nhalf_angle_deg = 95\n",
+            "camera.frontal.half_angle_deg",
+            "(0, 89)",
+        ),
+        (
+            "[camera.frontal]\n",
+            "[camera.frontal]\noffset = [0.0, 0.0, 0.5]\n",
+            "camera.frontal.offset",
+            "scene side",
+        ),
+        (
+            "[camera.back]\n",
+            "[camera.back]\nfov = 3\n",
+            "camera.back.fov",
+            "unknown key",
+        ),
+        (
+            "size = [100.0, 100.0]",
+            "size = [100.0, -1.0]",
+            "object[0].size",
+            "every element must be > 0",
+        ),
+        (
+            "[[object]]\nname = \"ground\"",
+            "[[object]]\nname = \"ground\"\nhidden_from = [\"rear\"]",
+            "object[0].hidden_from",
+            "`rear` is not one of",
+        ),
     ];
     for &(from, to, key, words) in cases {
         let text = edited(from, to);
@@ -84,13 +180,22 @@ fn invalid_toml_gives_the_line() {
 
 #[test]
 fn missing_assets_name_their_path() {
-    let text = edited("radius = 1.0\n", "radius = 1.0\n\n[[object]]\nkind = \"mesh\"\npath = \"nowhere/car.obj\"\n");
+    let text = edited(
+        "radius = 1.0\n",
+        "radius = 1.0\n\n[[object]]\nkind = \"mesh\"\npath = \"nowhere/car.obj\"\n",
+    );
     let err = parse_in(&repo_path("scenes"), "x.toml", &text).unwrap_err();
     let shown = err.to_string();
     assert_eq!(err.key, "object[2].path");
-    assert!(shown.contains("asset not found") && shown.contains("nowhere/car.obj"), "{shown}");
+    assert!(
+        shown.contains("asset not found") && shown.contains("nowhere/car.obj"),
+        "{shown}"
+    );
 
-    let text = edited("color = [0.5, 0.5, 0.5]", "color = [0.5, 0.5, 0.5]\ntexture = \"missing.png\"");
+    let text = edited(
+        "color = [0.5, 0.5, 0.5]",
+        "color = [0.5, 0.5, 0.5]\ntexture = \"missing.png\"",
+    );
     let err = parse_in(&repo_path("scenes"), "x.toml", &text).unwrap_err();
     assert!(err.to_string().contains("missing.png"), "{err}");
 }

@@ -1,0 +1,53 @@
+//! Golden images of each view of the das scene, small. They catch regressions only; what is
+//! right is tested against analytic answers elsewhere.
+
+mod common;
+
+use common::golden;
+
+use seethru::accel::BvhKind;
+use seethru::color::encode_srgb8;
+use seethru::render::{RenderContext, RenderSettings};
+use seethru::views::View;
+
+#[test]
+fn views_match_their_goldens() {
+    let ctx = RenderContext::new(common::das(), BvhKind::Cwbvh).unwrap();
+    for view in View::ALL {
+        let camera = view.camera(&ctx.scene);
+        let camera = if view == View::Back {
+            camera.with_resolution(96, 72)
+        } else {
+            camera.with_resolution(192, 108)
+        };
+        let (frame, _) = ctx.render(
+            &camera,
+            view.bit(),
+            RenderSettings {
+                spp: 4,
+                progress: false,
+            },
+            view.name(),
+        );
+        let img = image::RgbImage::from_fn(frame.width, frame.height, |x, y| {
+            image::Rgb(encode_srgb8(frame.color[frame.index(x, y)]))
+        });
+        golden::check(view.name(), &img);
+    }
+}
+
+#[test]
+fn the_comparison_catches_a_small_regression() {
+    let golden = image::open(common::repo_path("golden/truth.png"))
+        .unwrap()
+        .to_rgb8();
+    assert!(std::panic::catch_unwind(|| golden::check("truth", &golden)).is_ok());
+    // A 12×12 patch recoloured (an object moved by a few pixels) must fail.
+    let mut changed = golden.clone();
+    for y in 40..52 {
+        for x in 60..72 {
+            changed.put_pixel(x, y, image::Rgb([255, 0, 255]));
+        }
+    }
+    assert!(std::panic::catch_unwind(|| golden::check("truth", &changed)).is_err());
+}
