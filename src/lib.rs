@@ -2,10 +2,12 @@
 #![forbid(unsafe_code)]
 
 pub mod accel;
+pub mod analysis;
 pub mod bench;
 pub mod camera;
 pub mod color;
 pub mod commands;
+pub mod compensation;
 pub mod export;
 pub mod frame;
 pub mod mesh_io;

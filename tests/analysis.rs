@@ -1,0 +1,507 @@
+//! The paper's closed forms against finite differences and against independent geometry:
+//! ray–plane intersections of each setup, and the 3-D compensation code.
+
+use glam::{DAffine3, DVec2, DVec3};
+use seethru::analysis::{
+    CropParams, ForeshorteningParams, OcclusionParams, Side, head_distance, head_offset, k_px,
+    physical,
+};
+use seethru::camera::Camera;
+use seethru::compensation::{ModelPlane, compute_crop};
+use seethru::scene::Obstacle;
+
+const SIDES: [Side; 2] = [Side::Left, Side::Right];
+
+fn crop_params() -> Vec<CropParams> {
+    let mut out = Vec::new();
+    for &(d1, d2, b_h, width, theta_deg) in &[
+        (1.0, 5.0, 0.125, 0.5, 40.0f64),
+        (0.8, 2.0, -0.05, 0.3, 63.5),
+        (2.5, 30.0, 0.3, 1.0, 30.0),
+        (0.6, 0.9, 0.0, 0.25, 80.0),
+    ] {
+        out.push(CropParams {
+            d1,
+            d2,
+            b_h,
+            width,
+            theta_f: theta_deg.to_radians(),
+        });
+    }
+    out
+}
+
+/// Central difference of `f` at `x`, step relative to `x`.
+fn central(f: impl Fn(f64) -> f64, x: f64) -> f64 {
+    let h = 1e-5 * x.abs().max(1.0);
+    (f(x + h) - f(x - h)) / (2.0 * h)
+}
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * (1.0 + b.abs())
+}
+
+#[test]
+fn ratio1_equals_k_over_the_frontal_width() {
+    for p in crop_params() {
+        for side in SIDES {
+            let k = p.discarded_width(side);
+            assert!(close(
+                p.cutting_ratio(side),
+                k / (2.0 * p.d2 * p.theta_f.tan()),
+                1e-12
+            ));
+        }
+    }
+}
+
+#[test]
+fn sensitivities_equal_finite_differences() {
+    for p in crop_params() {
+        for side in SIDES {
+            let fd_d1 = central(|d1| CropParams { d1, ..p }.cutting_ratio(side), p.d1);
+            let fd_bh = central(|b_h| CropParams { b_h, ..p }.cutting_ratio(side), p.b_h);
+            let fd_d2 = central(|d2| CropParams { d2, ..p }.cutting_ratio(side), p.d2);
+            let fd_dphi = central(|d2| CropParams { d2, ..p }.phi_d2(), p.d2);
+            assert!(
+                close(p.phi_d1(side), fd_d1, 1e-7),
+                "{p:?} {side:?}: {} vs {fd_d1}",
+                p.phi_d1(side)
+            );
+            assert!(close(p.phi_bh(side), fd_bh, 1e-7), "{p:?} {side:?}");
+            assert!(close(p.phi_d2(), fd_d2, 1e-7), "{p:?} {side:?}");
+            assert!(close(p.dphi_d2_dd2(), fd_dphi, 1e-6), "{p:?}");
+            // Erratum 1: the printed φ_d2 has the opposite sign of the derivative.
+            assert!(fd_d2 > 0.0 && p.phi_d2_as_printed() < 0.0);
+        }
+    }
+}
+
+#[test]
+fn d2_min_is_where_the_ratio_reaches_the_bound() {
+    for p in crop_params() {
+        for side in SIDES {
+            let Some(d2) = p.d2_min(side, 0.05) else {
+                continue;
+            };
+            let at = CropParams { d2, ..p };
+            assert!(close(
+                at.cutting_ratio(side),
+                0.95 * p.cutting_ratio_at_infinity(side),
+                1e-12
+            ));
+            assert!(
+                CropParams { d2: d2 * 1.01, ..p }.cutting_ratio(side)
+                    > 0.95 * p.cutting_ratio_at_infinity(side)
+            );
+        }
+    }
+    // The paper's claim for Fig. 3: θ_F = 80°, d1 = 1, b_h = 0.125, D = 0.5 → d2 > 0.9.
+    let paper = CropParams {
+        d1: 1.0,
+        d2: 1.0,
+        b_h: 0.125,
+        width: 0.5,
+        theta_f: 80f64.to_radians(),
+    };
+    let d2 = paper.d2_min(Side::Left, 0.05).unwrap();
+    assert!((d2 - 0.9016).abs() < 1e-3, "{d2}");
+}
+
+/// An obstacle at the origin facing +z, `width` × `height`, and a frontal camera at its centre
+/// looking down −z.
+fn paper_rig(width: f64, height: f64, theta_f: f64, res: [u32; 2]) -> (Obstacle, Camera) {
+    let obstacle = Obstacle {
+        world_from_obstacle: DAffine3::IDENTITY,
+        width,
+        height,
+        thickness: 0.05,
+        display_resolution: [200, 300],
+        display_off_color: [0.0; 3],
+        body_color: [0.0; 3],
+    };
+    let camera = Camera::new(DAffine3::IDENTITY, theta_f, res[0], res[1]).unwrap();
+    (obstacle, camera)
+}
+
+#[test]
+fn the_3d_crop_equals_ratio1_in_the_papers_configuration() {
+    for p in crop_params() {
+        let height = 0.7 * p.width;
+        let (obstacle, frontal) = paper_rig(p.width, height, p.theta_f, [1280, 720]);
+        let b_v = 0.4 * p.b_h + 0.02;
+        // Paper convention: b_h > 0 puts the eye at −b_h; the vertical offset b_v > 0 is up.
+        let eye = DVec3::new(-p.b_h, b_v, p.d1);
+        for (plane, params) in [
+            (ModelPlane::At(p.d2), p),
+            (
+                ModelPlane::Infinity,
+                CropParams {
+                    d2: f64::INFINITY,
+                    ..p
+                },
+            ),
+        ] {
+            let crop = compute_crop(eye, &obstacle, &frontal, plane, [200, 300]).unwrap();
+            assert!(crop.is_axis_aligned(1e-9));
+            let r = crop.ratios();
+            assert!(
+                close(r.left, params.cutting_ratio(Side::Left), 1e-12),
+                "{p:?} {plane:?}: {} vs {}",
+                r.left,
+                params.cutting_ratio(Side::Left)
+            );
+            assert!(
+                close(r.right, params.cutting_ratio(Side::Right), 1e-12),
+                "{p:?} {plane:?}"
+            );
+            // Vertically the same formula with H, b_v and the vertical half angle; the top
+            // border plays the left's role (the eye above the axis crops more at the top).
+            let vertical = CropParams {
+                b_h: b_v,
+                width: height,
+                theta_f: frontal.tan_half_y().atan(),
+                ..params
+            };
+            assert!(
+                close(r.top, vertical.cutting_ratio(Side::Left), 1e-12),
+                "{p:?} {plane:?}"
+            );
+            assert!(
+                close(r.bottom, vertical.cutting_ratio(Side::Right), 1e-12),
+                "{p:?} {plane:?}"
+            );
+            assert_eq!(
+                k_px(r.left, 1280),
+                (params.cutting_ratio(Side::Left) * 1280.0).round() as i64
+            );
+        }
+    }
+}
+
+#[test]
+fn the_crop_maps_every_display_point_to_its_model_plane_point() {
+    // A tilted, offset frontal camera: the crop is a homography, exact for points on the plane.
+    let (obstacle, _) = paper_rig(0.4, 0.3, 0.7, [640, 480]);
+    let pose = DAffine3::from_translation(DVec3::new(0.03, -0.02, -0.05))
+        * DAffine3::from_rotation_y(0.15)
+        * DAffine3::from_rotation_x(-0.08);
+    let frontal = Camera::new(pose, 0.7, 640, 480).unwrap();
+    let eye = DVec3::new(0.12, 0.05, 0.7);
+    for plane in [ModelPlane::At(4.0), ModelPlane::Infinity] {
+        let crop = compute_crop(eye, &obstacle, &frontal, plane, [200, 150]).unwrap();
+        assert!(!crop.is_axis_aligned(0.5));
+        for &(u, v) in &[(0.0, 0.0), (100.0, 75.0), (13.5, 140.25), (199.0, 3.0)] {
+            // The display point in the world (display x right, y down from the top-left).
+            let x = DVec3::new(-0.2 + 0.4 * u / 200.0, 0.15 - 0.3 * v / 150.0, 0.0);
+            let expected = match plane {
+                ModelPlane::At(d2) => frontal.project_point(eye + (x - eye) * (eye.z + d2) / eye.z),
+                ModelPlane::Infinity => frontal.project_direction(x - eye),
+            }
+            .unwrap();
+            let got = crop.frontal_point(DVec2::new(u, v));
+            assert!(
+                (got - expected).length() < 1e-8,
+                "{plane:?} ({u},{v}): {got} vs {expected}"
+            );
+        }
+    }
+}
+
+#[test]
+fn an_eye_behind_the_display_is_rejected() {
+    let (obstacle, frontal) = paper_rig(0.3, 0.3, 0.7, [64, 48]);
+    let err = compute_crop(
+        DVec3::new(0.0, 0.0, -0.1),
+        &obstacle,
+        &frontal,
+        ModelPlane::Infinity,
+        [10, 10],
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("d1 > 0"));
+}
+
+/// Where the ray from `from` through `through` meets the plane z = `z` (2-D: x across, z depth).
+fn hit_plane(from: DVec2, through: DVec2, z: f64) -> f64 {
+    let t = (z - from.y) / (through.y - from.y);
+    from.x + t * (through.x - from.x)
+}
+
+/// Signed occluded width by visibility: for the box [b1 − 10, b1] × [d2 − L, d2] on the plane
+/// z = d2, the width of background hidden just beyond b1 (positive), or of the box's side
+/// face visible there (negative), found by bisection on what the viewer's rays hit.
+fn occluded_width_by_visibility(viewer: DVec2, b1: f64, l: f64, d2: f64) -> f64 {
+    // What the ray from the viewer to the background point (x, d2) meets first.
+    #[derive(PartialEq, Clone, Copy, Debug)]
+    enum Seen {
+        Background,
+        Front,
+        Side,
+    }
+    let seen = |x: f64| {
+        let target = DVec2::new(x, d2);
+        let at_front = hit_plane(viewer, target, d2 - l);
+        if at_front <= b1 && at_front >= b1 - 10.0 {
+            return Seen::Front;
+        }
+        // The side face x = b1, z in [d2 − L, d2], crossed between the front plane and the target.
+        let t = (b1 - viewer.x) / (x - viewer.x);
+        let z = viewer.y + t * (d2 - viewer.y);
+        if t > 0.0 && t < 1.0 && z > d2 - l && z < d2 {
+            Seen::Side
+        } else {
+            Seen::Background
+        }
+    };
+    // The boundary between `a` (seen at x = b1 + tiny) and background, searched outwards.
+    let boundary = |lo: f64, hi: f64, inside: Seen| {
+        let (mut lo, mut hi) = (lo, hi);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if seen(mid) == inside {
+                lo = mid
+            } else {
+                hi = mid
+            }
+        }
+        0.5 * (lo + hi)
+    };
+    let just_beyond = seen(b1 + 1e-9);
+    match just_beyond {
+        Seen::Front => boundary(b1 + 1e-9, b1 + 100.0, Seen::Front) - b1,
+        Seen::Side => -(b1 - boundary(b1 + 1e-9, b1 + 100.0, Seen::Side)).abs(),
+        Seen::Background => {
+            // The side face shows to the left of b1 (inside the box's x range is the front).
+            let left = boundary(b1 - 1e-9, b1 - 100.0, Seen::Side);
+            if seen(b1 - 1e-9) == Seen::Side {
+                left - b1
+            } else {
+                0.0
+            }
+        }
+    }
+}
+
+fn occlusion_cases() -> Vec<OcclusionParams> {
+    vec![
+        OcclusionParams {
+            l: 5.0,
+            b1: -0.35,
+            d2: 6.3,
+            d1: 2.5,
+            b_h: 1.75,
+        }, // the paper's
+        OcclusionParams {
+            l: 1.0,
+            b1: 0.5,
+            d2: 4.0,
+            d1: 1.0,
+            b_h: 0.25,
+        },
+        OcclusionParams {
+            l: 2.0,
+            b1: 1.5,
+            d2: 10.0,
+            d1: 0.8,
+            b_h: -0.3,
+        },
+        OcclusionParams {
+            l: 0.5,
+            b1: -1.2,
+            d2: 3.0,
+            d1: 1.2,
+            b_h: 0.4,
+        },
+    ]
+}
+
+#[test]
+fn occlusion_widths_equal_ray_casting() {
+    for p in occlusion_cases() {
+        let camera = DVec2::new(0.0, 0.0);
+        let eye = DVec2::new(-p.b_h, -p.d1);
+        let cam = occluded_width_by_visibility(camera, p.b1, p.l, p.d2);
+        let user = occluded_width_by_visibility(eye, p.b1, p.l, p.d2);
+        assert!(
+            close(cam, p.p_cam(), 1e-9),
+            "{p:?}: camera {cam} vs {}",
+            p.p_cam()
+        );
+        assert!(
+            close(user, p.p_user(), 1e-9),
+            "{p:?}: user {user} vs {}",
+            p.p_user()
+        );
+        assert!(close(p.ratio(), cam / user, 1e-9));
+    }
+    let paper = occlusion_cases()[0];
+    assert!((paper.ratio() - (-0.73)).abs() < 0.005, "{}", paper.ratio());
+}
+
+#[test]
+fn occlusion_approximations_hold_in_their_regimes() {
+    // OCLUSION2: d2 ≫ L, d2 ≫ d1.
+    let far = OcclusionParams {
+        l: 0.5,
+        b1: 0.8,
+        d2: 5000.0,
+        d1: 1.0,
+        b_h: 0.3,
+    };
+    assert!(close(far.ratio(), far.ratio_far(), 1e-3));
+    // OCLUSION3: b_h → 0. The geometry gives 1 + d1/(d2 − L) (erratum 3: printed 1 − …).
+    let small = OcclusionParams {
+        l: 1.0,
+        b1: 0.6,
+        d2: 3.0,
+        d1: 1.0,
+        b_h: 1e-9,
+    };
+    assert!(close(small.ratio(), small.ratio_small_bh(), 1e-6));
+    assert!(!close(
+        small.ratio(),
+        small.ratio_small_bh_as_printed(),
+        0.1
+    ));
+}
+
+fn foreshortening_cases() -> Vec<ForeshorteningParams> {
+    let p = |l, b1, d2, d1, b_h, g: f64| ForeshorteningParams {
+        l,
+        b1,
+        d2,
+        d1,
+        b_h,
+        gamma: g.to_radians(),
+    };
+    vec![
+        p(5.0, -1.5, 1.3, 2.0, 0.7, 90.0), // the paper's
+        p(1.0, 0.25, 3.0, 1.0, 0.125, 45.0),
+        p(2.0, -0.5, 5.0, 1.5, -0.2, 60.0),
+        p(0.8, 1.0, 2.0, 0.7, 0.3, 20.0),
+    ]
+}
+
+#[test]
+fn foreshortening_widths_equal_ray_plane_intersections() {
+    for p in foreshortening_cases() {
+        let corner = DVec2::new(p.b1, p.d2);
+        let far_end = corner + p.l * DVec2::new(p.gamma.cos(), p.gamma.sin());
+        let width_from = |viewer: DVec2| hit_plane(viewer, far_end, p.d2) - corner.x;
+        let (cam, user) = (
+            width_from(DVec2::ZERO),
+            width_from(DVec2::new(-p.b_h, -p.d1)),
+        );
+        assert!(
+            close(cam, p.p_cam(), 1e-12) && close(user, p.p_user(), 1e-12),
+            "{p:?}"
+        );
+        assert!(close(p.ratio(), cam / user, 1e-12));
+        // The limit d2 → ∞: 1, except at γ = 90° (erratum 4).
+        let far = ForeshorteningParams { d2: 1e8, ..p };
+        assert!(
+            close(far.ratio(), p.ratio_far_limit(), 1e-6),
+            "{p:?}: {} vs {}",
+            far.ratio(),
+            p.ratio_far_limit()
+        );
+    }
+    let paper = foreshortening_cases()[0];
+    assert!((paper.ratio() - 2.47).abs() < 0.005);
+    assert!(paper.ratio_far_limit() != 1.0);
+}
+
+#[test]
+fn head_equations_invert_the_pinhole_projection() {
+    let (face, half_angle, image_px) = (0.15, 35f64.to_radians(), 640.0);
+    for &(d1, b_h) in &[(0.7, 0.05), (0.9, -0.12), (1.2, 0.0)] {
+        // A face of width A at distance d1 spans A / (2 d1 tan θ) of the image width.
+        let face_px = face / (2.0 * d1 * half_angle.tan()) * image_px;
+        let offset_px = b_h / (2.0 * d1 * half_angle.tan()) * image_px;
+        let d1_est = head_distance(face, face_px, image_px, half_angle);
+        assert!(close(d1_est, d1, 1e-12));
+        assert!(close(
+            head_offset(offset_px, image_px, d1_est, half_angle),
+            b_h,
+            1e-12
+        ));
+    }
+}
+
+/// Misregistration angle at the true eye, in the plane of a top view: the display point `x`
+/// shows the model-plane point of the ray from `model_eye` (model plane at `model_d2`, seen by
+/// the camera at the origin), while the truth there is the plane point at the true `d2`.
+fn misregistration(eye: DVec2, model_eye: DVec2, x: f64, d2: f64, model_d2: f64) -> f64 {
+    let display = DVec2::new(x, 0.0);
+    // Model: the point on the model plane, then the camera's ray to it continued to the scene.
+    let model_point = DVec2::new(hit_plane(model_eye, display, model_d2), model_d2);
+    let shown = DVec2::new(hit_plane(DVec2::ZERO, model_point, d2), d2);
+    let truth = DVec2::new(hit_plane(eye, display, d2), d2);
+    let (a, b) = (shown - eye, truth - eye);
+    a.perp_dot(b).atan2(a.dot(b)).abs()
+}
+
+#[test]
+fn physical_sensitivities_equal_the_ray_geometry() {
+    for &(d1, d2, x, b_h) in &[
+        (0.8, 6.0, 0.125, 0.05),
+        (1.0, 2.0, -0.2, -0.1),
+        (0.7, 40.0, 0.3, 0.0),
+    ] {
+        // Eye at (−b_h, −d1) in (x across, z depth) with the scene at +d2.
+        let eye = DVec2::new(-b_h, -d1);
+        let h = 1e-6;
+        let lateral = misregistration(eye, eye + DVec2::new(h, 0.0), x, d2, d2) / h;
+        // The formula is the small-angle limit: it holds near the line of sight.
+        let obliquity = ((x + b_h) / d1).atan().cos().powi(2);
+        assert!(
+            close(
+                lateral,
+                physical::per_lateral_head_error(d1, d2) * obliquity,
+                1e-4
+            ),
+            "{lateral}"
+        );
+        let depth = misregistration(eye, eye + DVec2::new(0.0, -h), x, d2, d2) / h;
+        assert!(
+            close(
+                depth,
+                physical::per_head_distance_error((x + b_h).abs(), d1, d2) * obliquity,
+                1e-4
+            ),
+            "{depth}"
+        );
+        let plane = misregistration(eye, eye, x, d2, d2 + h) / h;
+        assert!(
+            close(
+                plane,
+                physical::per_d2_error(x.abs(), d1, d2) * obliquity,
+                1e-4
+            ),
+            "{plane}"
+        );
+        // The d2 → ∞ model: exact, not linearised.
+        let inf = misregistration(eye, eye, x, d2, 1e12);
+        let expected = physical::infinite_plane_error(x.abs(), d1, d2) * obliquity;
+        assert!(close(inf, expected, 2e-2), "{inf} vs {expected}");
+    }
+}
+
+#[test]
+fn paper_sensitivities_convert_to_the_physical_ones() {
+    // φ · (frontal image width at d2) seen from the eye = the physical sensitivity.
+    for p in crop_params() {
+        let scale = 2.0 * p.d2 * p.theta_f.tan() / (p.d1 + p.d2);
+        assert!(close(
+            p.phi_bh(Side::Left).abs() * scale,
+            physical::per_lateral_head_error(p.d1, p.d2),
+            1e-12
+        ));
+        assert!(close(
+            p.phi_d2() * scale,
+            physical::per_d2_error(p.width / 2.0, p.d1, p.d2),
+            1e-12
+        ));
+    }
+}
