@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use seethru::accel::BvhKind;
 use seethru::bench::{BenchOptions, bench};
+use seethru::claims::{AnalyzeParams, claims_table, evaluate, paper_claims};
 use seethru::commands::{RenderOptions, export_scene, render_views};
 use seethru::options::{check_resolution, with_threads};
 use seethru::views::View;
@@ -56,6 +57,50 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Regenerate the paper's Fig. 3–5 and the physical-unit sensitivity figure (PNG + CSV).
+    Figures {
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// The paper's numerical claims beside seethru's values; every closed form at a parameter set.
+    Analyze {
+        /// Print JSON instead of tables.
+        #[arg(long)]
+        json: bool,
+        /// Eye distance from the display d1 [m].
+        #[arg(long, default_value_t = 1.0)]
+        d1: f64,
+        /// Working distance d2 [m] (use inf for the d2 → ∞ model).
+        #[arg(long, default_value_t = 1.0)]
+        d2: f64,
+        /// Lateral eye offset b_h [m] (> 0: the eye on the side of the left crop R1).
+        #[arg(long = "bh", default_value_t = 0.125, allow_hyphen_values = true)]
+        b_h: f64,
+        /// Display width D [m].
+        #[arg(long, default_value_t = 0.5)]
+        width: f64,
+        /// Frontal half angle θ_F [degrees].
+        #[arg(long = "theta-f", default_value_t = 80.0)]
+        theta_f: f64,
+        /// Frontal image width [pixels].
+        #[arg(long = "frontal-px", default_value_t = 1280)]
+        frontal_px: u32,
+        /// Occluder depth L [m].
+        #[arg(long = "L", default_value_t = 1.0)]
+        occluder_depth: f64,
+        /// Lateral position of the object's corner b1 [m].
+        #[arg(long, default_value_t = 0.25, allow_hyphen_values = true)]
+        b1: f64,
+        /// Length of the angled surface l [m].
+        #[arg(long = "l", default_value_t = 1.0)]
+        surface_length: f64,
+        /// Angle of the surface γ [degrees].
+        #[arg(long, default_value_t = 45.0, allow_hyphen_values = true)]
+        gamma: f64,
+        /// Tolerance of the d2_min bound, as a fraction of R(∞).
+        #[arg(long, default_value_t = 0.05)]
+        tolerance: f64,
+    },
     /// Benchmark: BVH build time, rays per second, frame times; ends with one JSON line.
     Bench {
         scene: PathBuf,
@@ -100,6 +145,61 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             with_threads(threads, || render_views(&scene, &views, &out, &options))?
         }
         Command::Export { scene, out } => export_scene(&scene, &out),
+        Command::Figures { out } => {
+            let names = seethru::figures::write_all(&out)?;
+            eprintln!(
+                "wrote {} figures (PNG + CSV) to {}",
+                names.len(),
+                out.display()
+            );
+            Ok(())
+        }
+        Command::Analyze {
+            json,
+            d1,
+            d2,
+            b_h,
+            width,
+            theta_f,
+            frontal_px,
+            occluder_depth,
+            b1,
+            surface_length,
+            gamma,
+            tolerance,
+        } => {
+            let params = AnalyzeParams {
+                d1,
+                d2,
+                b_h,
+                width,
+                theta_f_deg: theta_f,
+                frontal_px,
+                occluder_depth,
+                b1,
+                surface_length,
+                gamma_deg: gamma,
+                tolerance,
+            };
+            params.validate().map_err(anyhow::Error::msg)?;
+            let claims = paper_claims();
+            let values = evaluate(&params);
+            if json {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(
+                        &serde_json::json!({"claims": claims, "evaluation": values})
+                    )?
+                );
+            } else {
+                print!("{}", claims_table(&claims));
+                println!(
+                    "\nEvery closed form at the given parameters:\n{}",
+                    serde_json::to_string_pretty(&values)?
+                );
+            }
+            Ok(())
+        }
         Command::Bench {
             scene,
             width,

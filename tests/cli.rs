@@ -130,3 +130,39 @@ fn bad_input_gives_one_line_and_no_output() {
         assert!(!out.exists(), "{args:?} left output behind");
     }
 }
+
+#[test]
+fn analyze_reports_the_papers_claims_and_any_parameter_set() {
+    let (ok, out, err) = seethru(&[
+        "analyze",
+        "--json",
+        "--d1",
+        "0.8",
+        "--d2",
+        "10",
+        "--bh",
+        "-0.05",
+        "--theta-f",
+        "30",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let claims = v["claims"].as_array().unwrap();
+    let find = |prefix: &str| {
+        claims
+            .iter()
+            .find(|c| c["claim"].as_str().unwrap().contains(prefix))
+            .unwrap()["seethru"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!((find("occlusion p_cam/p_user") - (-0.7308)).abs() < 1e-4);
+    assert!((find("foreshortening p_cam/p_user") - 2.4702).abs() < 1e-4);
+    assert!((find("Fig. 3") - 0.9015).abs() < 1e-3);
+    // The evaluation uses the given parameters: R1 from eq. RATIO1 by hand.
+    let t = 30f64.to_radians().tan();
+    let r1 = (10.0 * t - 10.8 * (0.25 + 0.05) / 0.8 + 0.05) / (20.0 * t);
+    assert!((v["evaluation"]["left"]["R"].as_f64().unwrap() - r1).abs() < 1e-12);
+    let (ok, _, err) = seethru(&["analyze", "--d1", "0"]);
+    assert!(!ok && err.starts_with("error: --d1 must be > 0"), "{err}");
+}
