@@ -9,7 +9,9 @@ use seethru::accel::BvhKind;
 use seethru::bench::{BenchOptions, bench};
 use seethru::claims::{AnalyzeParams, claims_table, evaluate, paper_claims};
 use seethru::commands::{RenderOptions, export_scene, render_views};
+use seethru::display::Filter;
 use seethru::options::{check_resolution, with_threads};
+use seethru::pipeline::{HeadSource, Method, Outside, RunOptions, WorkingDistance, run_command};
 use seethru::views::View;
 
 #[derive(Parser)]
@@ -45,6 +47,58 @@ enum Command {
         #[arg(long, default_value_t = 4)]
         spp: u32,
         /// Worker threads (default: all cores). Images are identical for any value.
+        #[arg(long)]
+        threads: Option<usize>,
+        #[arg(long, value_enum, default_value_t = BvhKind::Cwbvh)]
+        bvh: BvhKind,
+    },
+    /// Run the see-through system: truth, occluded, frontal, back, display and seethru views,
+    /// each as PNG, ids PNG and EXR, and run.json with every parameter and the crop.
+    Run {
+        scene: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+        /// none: the whole frontal image in the display; planar: the paper's compensation.
+        #[arg(long, value_enum, default_value_t = Method::Planar)]
+        method: Method,
+        /// Working distance of the planar model: inf, auto (median frontal depth behind the
+        /// display) or metres.
+        #[arg(long, default_value = "inf")]
+        d2: WorkingDistance,
+        /// oracle: the true eye; estimated: face detection on the back camera's image.
+        #[arg(long, value_enum, default_value_t = HeadSource::Oracle)]
+        head: HeadSource,
+        /// Head-tracking bias, obstacle frame, centimetres: x,y,z.
+        #[arg(long = "head-bias-cm", value_delimiter = ',', num_args = 3, allow_hyphen_values = true, default_values_t = [0.0, 0.0, 0.0])]
+        head_bias_cm: Vec<f64>,
+        /// Head-tracking jitter, standard deviation per axis, centimetres.
+        #[arg(long = "head-jitter-cm", default_value_t = 0.0)]
+        head_jitter_cm: f64,
+        /// Seed of the jitter.
+        #[arg(long, default_value_t = 1)]
+        seed: u32,
+        /// The detector's known feature width A (interpupillary distance), metres.
+        #[arg(long = "feature-width", default_value_t = 0.064)]
+        feature_width: f64,
+        /// When the crop leaves the frontal view: error, or black (flagged as missing).
+        #[arg(long, value_enum, default_value_t = Outside::Error)]
+        outside: Outside,
+        /// Colour resampling of the display image.
+        #[arg(long, value_enum, default_value_t = Filter::Bilinear)]
+        filter: Filter,
+        /// Driver-view width in pixels (truth, occluded, seethru).
+        #[arg(long)]
+        width: Option<u32>,
+        #[arg(long)]
+        height: Option<u32>,
+        /// Frontal camera width in pixels (aspect ratio kept).
+        #[arg(long = "frontal-width")]
+        frontal_width: Option<u32>,
+        /// Back camera width in pixels (aspect ratio kept).
+        #[arg(long = "back-width")]
+        back_width: Option<u32>,
+        #[arg(long, default_value_t = 4)]
+        spp: u32,
         #[arg(long)]
         threads: Option<usize>,
         #[arg(long, value_enum, default_value_t = BvhKind::Cwbvh)]
@@ -145,6 +199,45 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             with_threads(threads, || render_views(&scene, &views, &out, &options))?
         }
         Command::Export { scene, out } => export_scene(&scene, &out),
+        Command::Run {
+            scene,
+            out,
+            method,
+            d2,
+            head,
+            head_bias_cm,
+            head_jitter_cm,
+            seed,
+            feature_width,
+            outside,
+            filter,
+            width,
+            height,
+            frontal_width,
+            back_width,
+            spp,
+            threads,
+            bvh,
+        } => {
+            let options = RunOptions {
+                method,
+                d2,
+                head,
+                head_bias_cm: [head_bias_cm[0], head_bias_cm[1], head_bias_cm[2]],
+                head_jitter_cm,
+                seed,
+                feature_width,
+                width,
+                height,
+                frontal_width,
+                back_width,
+                spp,
+                outside,
+                filter,
+                progress: true,
+            };
+            with_threads(threads, || run_command(&scene, &out, &options, bvh))?
+        }
         Command::Figures { out } => {
             let names = seethru::figures::write_all(&out)?;
             eprintln!(

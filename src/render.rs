@@ -10,12 +10,14 @@ use rayon::prelude::*;
 
 use crate::accel::{Accel, BvhKind, make_ray};
 use crate::camera::Camera;
+use crate::display::DisplayImage;
 use crate::frame::{Frame, Pixel};
 use crate::progress::Progress;
 use crate::sampling::pixel_offset;
 use crate::scene::Scene;
+use crate::shapes::box_face;
 use crate::sky::SkyModel;
-use crate::world::{SurfaceHit, World};
+use crate::world::{SurfaceHit, World, view_bit};
 
 /// Largest number of samples per pixel accepted.
 pub const MAX_SPP: u32 = 4096;
@@ -75,6 +77,35 @@ impl RenderContext {
         settings: RenderSettings,
         label: &str,
     ) -> (Frame, RenderStats) {
+        self.render_with_display(camera, view, None, settings, label)
+    }
+
+    /// The `seethru` view: the driver's eye with the obstacle present and its display showing
+    /// `display`. Where a ray meets the display face, the pixel takes the display pixel there
+    /// — colour and every AOV, so the frame holds the world point and id the display shows.
+    pub fn render_seethru(
+        &self,
+        camera: &Camera,
+        display: &DisplayImage,
+        settings: RenderSettings,
+    ) -> (Frame, RenderStats) {
+        self.render_with_display(
+            camera,
+            view_bit::SEETHRU,
+            Some(display),
+            settings,
+            "seethru",
+        )
+    }
+
+    fn render_with_display(
+        &self,
+        camera: &Camera,
+        view: u8,
+        display: Option<&DisplayImage>,
+        settings: RenderSettings,
+        label: &str,
+    ) -> (Frame, RenderStats) {
         let start = Instant::now();
         let (w, h) = (camera.width as usize, camera.height as usize);
         let mut pixels = vec![Pixel::SKY; w * h];
@@ -85,15 +116,13 @@ impl RenderContext {
         pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
             let mut shadows = 0;
             for (x, out) in row.iter_mut().enumerate() {
-                *out = self.render_pixel(
-                    &rays,
-                    &camera_from_world,
+                let job = PixelJob {
+                    rays: &rays,
+                    camera_from_world: &camera_from_world,
                     view,
-                    x as u32,
-                    y as u32,
-                    settings.spp,
-                    &mut shadows,
-                );
+                    display,
+                };
+                *out = self.render_pixel(&job, x as u32, y as u32, settings.spp, &mut shadows);
             }
             shadow_rays.fetch_add(shadows, Ordering::Relaxed);
             progress.advance(1);
@@ -110,41 +139,64 @@ impl RenderContext {
         )
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn render_pixel(
-        &self,
-        rays: &RayGenerator,
-        camera_from_world: &DAffine3,
-        view: u8,
-        x: u32,
-        y: u32,
-        spp: u32,
-        shadows: &mut u64,
-    ) -> Pixel {
+    fn render_pixel(&self, job: &PixelJob, x: u32, y: u32, spp: u32, shadows: &mut u64) -> Pixel {
         let mut pixel = Pixel::SKY;
         let mut sum = Vec3::ZERO;
         for sample in 0..spp {
             let (dx, dy) = pixel_offset(x, y, sample);
-            let (origin, dir) = rays.world_ray(x as f32 + dx, y as f32 + dy);
-            let hit = self.trace(origin, dir, view);
-            let color = match &hit {
-                Some(s) => self.shade(s, view, shadows),
-                None => self.sky.radiance(dir),
+            let (origin, dir) = job.rays.world_ray(x as f32 + dx, y as f32 + dy);
+            let hit = self.trace(origin, dir, job.view);
+            let shown = match (&hit, job.display) {
+                (Some(s), Some(d))
+                    if s.object == self.world.obstacle_id && s.part == box_face::POS_Z =>
+                {
+                    Some(d.lookup(s.position))
+                }
+                _ => None,
             };
-            sum += color;
-            if sample == 0
-                && let Some(s) = hit
-            {
-                pixel = Pixel {
+            // A display emits its image: no shading.
+            sum += match (&hit, &shown) {
+                (_, Some(d)) => d.color,
+                (Some(s), None) => self.shade(s, job.view, shadows),
+                (None, None) => self.sky.radiance(dir),
+            };
+            if sample != 0 {
+                continue;
+            }
+            pixel = match (hit, shown) {
+                (_, Some(d)) => {
+                    // The AOVs of what the display shows, measured from this eye.
+                    let finite = d.position.is_finite();
+                    Pixel {
+                        depth: if finite {
+                            (d.position - origin).length()
+                        } else {
+                            f32::INFINITY
+                        },
+                        camera_z: if finite {
+                            -job.camera_from_world
+                                .transform_point3(d.position.as_dvec3())
+                                .z as f32
+                        } else {
+                            f32::INFINITY
+                        },
+                        ..d
+                    }
+                }
+                (Some(s), None) => Pixel {
                     color: Vec3::ZERO,
                     depth: s.t,
-                    camera_z: -camera_from_world.transform_point3(s.position.as_dvec3()).z as f32,
+                    camera_z: -job
+                        .camera_from_world
+                        .transform_point3(s.position.as_dvec3())
+                        .z as f32,
                     position: s.position,
                     normal: s.normal,
                     object_id: s.object,
                     part_id: s.part,
-                };
-            }
+                },
+                (None, None) => Pixel::SKY,
+            };
         }
         pixel.color = sum / spp as f32;
         pixel
@@ -184,6 +236,14 @@ impl RenderContext {
         }
         albedo * light
     }
+}
+
+/// What every pixel of one render shares.
+struct PixelJob<'a> {
+    rays: &'a RayGenerator,
+    camera_from_world: &'a DAffine3,
+    view: u8,
+    display: Option<&'a DisplayImage>,
 }
 
 /// Primary rays of a camera in f32, with the per-camera constants hoisted out of the pixel loop.

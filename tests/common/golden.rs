@@ -40,11 +40,23 @@ pub fn check(name: &str, actual: &RgbImage) {
             );
         }
     };
-    assert_eq!(
-        expected.dimensions(),
-        actual.dimensions(),
-        "golden {name}: size changed"
-    );
+    if let Err(why) = compare(actual, &expected) {
+        save_failure(name, actual, Some(&expected));
+        panic!(
+            "golden {name}: {why}; see target/golden-failures/{name}-*.png, bless with SEETHRU_BLESS=1"
+        );
+    }
+}
+
+/// Whether `actual` is within the tolerances of `expected`; the reason if not.
+pub fn compare(actual: &RgbImage, expected: &RgbImage) -> Result<(), String> {
+    if expected.dimensions() != actual.dimensions() {
+        return Err(format!(
+            "size {:?} differs from the golden's {:?}",
+            actual.dimensions(),
+            expected.dimensions()
+        ));
+    }
     let (mut outliers, mut sum) = (0usize, 0u64);
     for (a, e) in actual.pixels().zip(expected.pixels()) {
         let d = (0..3).map(|c| a[c].abs_diff(e[c])).max().unwrap();
@@ -54,13 +66,13 @@ pub fn check(name: &str, actual: &RgbImage) {
     let n = actual.pixels().len();
     let (outlier_fraction, mean_abs) = (outliers as f64 / n as f64, sum as f64 / (3 * n) as f64);
     if outlier_fraction > MAX_OUTLIER_FRACTION || mean_abs > MAX_MEAN_ABS {
-        save_failure(name, actual, Some(&expected));
-        panic!(
-            "golden {name}: {:.3}% pixels off by > {OUTLIER_LEVEL}/255 (max {:.3}%), mean |diff| {mean_abs:.3}/255 (max {MAX_MEAN_ABS}); see target/golden-failures/{name}-*.png, bless with SEETHRU_BLESS=1",
+        return Err(format!(
+            "{:.3}% pixels off by > {OUTLIER_LEVEL}/255 (max {:.3}%), mean |diff| {mean_abs:.3}/255 (max {MAX_MEAN_ABS})",
             100.0 * outlier_fraction,
             100.0 * MAX_OUTLIER_FRACTION
-        );
+        ));
     }
+    Ok(())
 }
 
 fn save_failure(name: &str, actual: &RgbImage, expected: Option<&RgbImage>) {

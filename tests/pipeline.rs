@@ -1,0 +1,356 @@
+//! The see-through system end to end: a scene that is the model plane comes out right, the
+//! head tracker recovers the eye, out-of-view crops behave as chosen, run.json is truthful.
+
+mod common;
+
+use glam::DVec3;
+use seethru::accel::BvhKind;
+use seethru::analysis::{CropParams, Side};
+use seethru::display::MISSING_ID;
+use seethru::head::{detect, eye_from_detection};
+use seethru::pipeline::{HeadSource, Outside, RunOptions, WorkingDistance, run};
+use seethru::render::{RenderContext, RenderSettings};
+use seethru::shapes::box_face;
+use seethru::views::View;
+
+/// A wall (textured quad) that *is* the model plane at `d2` behind a display at the origin.
+fn wall_scene(d2: f64, frontal_half_angle: f64) -> String {
+    format!(
+        r#"
+[obstacle]
+center = [0.0, 0.0, 0.0]
+width = 0.3
+height = 0.2
+display_resolution = [150, 100]
+
+[camera.driver]
+position = [0.08, 0.03, 0.7]
+look_at = [0.0, 0.0, -6.0]
+half_angle_deg = 20.0
+resolution = [200, 150]
+
+[camera.frontal]
+half_angle_deg = {frontal_half_angle}
+resolution = [640, 480]
+
+[camera.back]
+resolution = [64, 48]
+
+[[material]]
+name = "wall"
+texture = "../assets/street.png"
+uv_repeat = [6.0, 2.0]
+
+[[object]]
+name = "wall"
+kind = "quad"
+material = "wall"
+size = [60.0, 40.0]
+translate = [0.0, 0.0, -{d2}]
+"#
+    )
+}
+
+fn context(text: &str) -> RenderContext {
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", text).unwrap();
+    RenderContext::new(scene, BvhKind::Cwbvh).unwrap()
+}
+
+/// Pixels of the driver's view where the display is (from the `occluded` frame's ids).
+fn display_mask(ctx: &RenderContext, occluded: &seethru::frame::Frame) -> Vec<bool> {
+    occluded
+        .object_id
+        .iter()
+        .zip(&occluded.part_id)
+        .map(|(&o, &p)| o == ctx.world.obstacle_id && p == box_face::POS_Z)
+        .collect()
+}
+
+#[test]
+fn a_scene_that_is_the_model_plane_comes_out_registered() {
+    let d2 = 6.0;
+    let ctx = context(&wall_scene(d2, 45.0));
+    let options = RunOptions {
+        d2: WorkingDistance::Metres(d2),
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options).unwrap();
+    let mask = display_mask(&ctx, &r.occluded);
+    let count = mask.iter().filter(|&&m| m).count();
+    assert!(count > 1000, "{count} display pixels");
+    // Resampling bound on the wall, per axis: half a display pixel seen from the eye through
+    // the display to the plane, plus half a frontal pixel's footprint on the plane.
+    let (d1, scene) = (0.7, &ctx.scene);
+    let display_px = [scene.obstacle.width / 150.0, scene.obstacle.height / 100.0];
+    let frontal_px = [
+        2.0 * d2 * scene.frontal.tan_half_x() / 640.0,
+        2.0 * d2 * scene.frontal.tan_half_y() / 480.0,
+    ];
+    let bound = [0, 1].map(|a| 0.5 * display_px[a] * (d1 + d2) / d1 + 0.5 * frontal_px[a]);
+    let (mut worst, mut sum) = ([0.0f64; 2], 0.0);
+    for (i, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
+        let (t, s) = (
+            r.truth.position[i].as_dvec3(),
+            r.seethru.position[i].as_dvec3(),
+        );
+        assert_eq!(
+            r.seethru.object_id[i], 1,
+            "pixel {i} shows object {}",
+            r.seethru.object_id[i]
+        );
+        assert!((s.z + d2).abs() < 1e-4 && (t.z + d2).abs() < 1e-4);
+        worst = [
+            worst[0].max((s.x - t.x).abs()),
+            worst[1].max((s.y - t.y).abs()),
+        ];
+        sum += (s - t).length();
+    }
+    for a in 0..2 {
+        assert!(
+            worst[a] <= bound[a] * 1.001 + 1e-5,
+            "axis {a}: {} > bound {}",
+            worst[a],
+            bound[a]
+        );
+    }
+    // On average far inside the bound: the error is quantisation, not a systematic offset.
+    assert!(
+        sum / (count as f64) < 0.6 * bound[0].hypot(bound[1]),
+        "mean {}",
+        sum / count as f64
+    );
+
+    // A wrong working distance shows up as a larger, systematic error.
+    let wrong = run(
+        &ctx,
+        &RunOptions {
+            d2: WorkingDistance::Infinity,
+            spp: 1,
+            ..RunOptions::default()
+        },
+    )
+    .unwrap();
+    let mean_wrong = mask
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| **m)
+        .map(|(i, _)| (wrong.seethru.position[i] - r.truth.position[i]).length() as f64)
+        .sum::<f64>()
+        / count as f64;
+    assert!(mean_wrong > 3.0 * bound[0], "{mean_wrong}");
+}
+
+#[test]
+fn run_json_reports_the_crop_of_eq_ratio1() {
+    let ctx = context(&wall_scene(6.0, 45.0));
+    let r = run(
+        &ctx,
+        &RunOptions {
+            d2: WorkingDistance::Metres(6.0),
+            spp: 1,
+            width: Some(40),
+            ..RunOptions::default()
+        },
+    )
+    .unwrap();
+    // Paper convention: the eye at x = 0.08 has b_h = −0.08.
+    let p = CropParams {
+        d1: 0.7,
+        d2: 6.0,
+        b_h: -0.08,
+        width: 0.3,
+        theta_f: 45f64.to_radians(),
+    };
+    let crop = &r.report["crop"];
+    assert!((crop["R1_left"].as_f64().unwrap() - p.cutting_ratio(Side::Left)).abs() < 1e-12);
+    assert!((crop["R2_right"].as_f64().unwrap() - p.cutting_ratio(Side::Right)).abs() < 1e-12);
+    assert_eq!(
+        crop["K_px"]["left"].as_i64().unwrap(),
+        (p.cutting_ratio(Side::Left) * 640.0).round() as i64
+    );
+    assert_eq!(
+        r.report["eye_true"]["paper"]["b_h_m"].as_f64().unwrap(),
+        -0.08
+    );
+    assert_eq!(r.report["missing_fraction"].as_f64().unwrap(), 0.0);
+}
+
+#[test]
+fn out_of_view_crops_error_or_show_black() {
+    // θ_F = 8°: the display's view from the eye needs more than the frontal camera sees.
+    let ctx = context(&wall_scene(6.0, 8.0));
+    let err = run(
+        &ctx,
+        &RunOptions {
+            spp: 1,
+            width: Some(40),
+            ..RunOptions::default()
+        },
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(
+        err.contains("leaves the frontal camera's view on the")
+            && err.contains("px")
+            && err.contains("must stay within x ∈"),
+        "{err}"
+    );
+    let r = run(
+        &ctx,
+        &RunOptions {
+            spp: 1,
+            width: Some(40),
+            outside: Outside::Black,
+            ..RunOptions::default()
+        },
+    )
+    .unwrap();
+    let missing = r.report["missing_fraction"].as_f64().unwrap();
+    assert!(missing > 0.05 && missing < 0.95, "{missing}");
+    let dark = r
+        .display
+        .object_id
+        .iter()
+        .zip(&r.display.color)
+        .filter(|(id, _)| **id == MISSING_ID)
+        .all(|(_, c)| *c == glam::Vec3::ZERO);
+    assert!(dark);
+}
+
+#[test]
+fn the_head_tracker_recovers_the_eye_better_at_higher_resolution() {
+    let scene = common::das();
+    let ctx = RenderContext::new(scene, BvhKind::Cwbvh).unwrap();
+    let truth = ctx.scene.eye();
+    let obstacle_from_world = ctx.scene.obstacle.world_from_obstacle.inverse();
+    let back_from_world = |back: &seethru::camera::Camera| back.world_from_camera.inverse();
+    let mut errors = Vec::new();
+    for (w, h) in [(320, 240), (640, 480), (1280, 960)] {
+        let back = ctx.scene.back.with_resolution(w, h);
+        let frame = ctx
+            .render(
+                &back,
+                View::Back.bit(),
+                RenderSettings {
+                    spp: 1,
+                    progress: false,
+                },
+                "back",
+            )
+            .0;
+        let detection = detect(&frame).unwrap();
+        let estimate = eye_from_detection(&detection, &back, 0.064);
+        // Error bound from eqs. d1 and b_h: one pixel of feature width gives d/A_px of
+        // distance; one pixel of centre gives 2 d tan θ / E_px of offset, plus the distance
+        // error carried into the offset.
+        let cam = back_from_world(&back).transform_point3(truth);
+        let d = -cam.z;
+        let a_px = detection.feature_px();
+        let depth_bound = d / a_px;
+        let offset_bound = 2.0 * d * back.half_angle_x.tan() / w as f64
+            + depth_bound * cam.x.abs().max(cam.y.abs()) / d;
+        let err_cam = back_from_world(&back).transform_point3(estimate) - cam;
+        assert!(
+            err_cam.z.abs() <= depth_bound,
+            "{w}: depth error {} > {depth_bound}",
+            err_cam.z
+        );
+        assert!(
+            err_cam.x.abs() <= offset_bound && err_cam.y.abs() <= offset_bound,
+            "{w}: offset error {err_cam} > {offset_bound}"
+        );
+        let err_obstacle = obstacle_from_world.transform_vector3(estimate - truth);
+        errors.push(err_obstacle.length());
+    }
+    assert!(errors[2] < errors[0], "{errors:?}");
+    assert!(errors[1] < 0.01, "640×480 within 1 cm: {errors:?}");
+}
+
+#[test]
+fn estimated_head_and_injected_errors_move_the_eye() {
+    let ctx = RenderContext::new(common::das(), BvhKind::Cwbvh).unwrap();
+    let base = RunOptions {
+        spp: 1,
+        width: Some(64),
+        ..RunOptions::default()
+    };
+    let estimated = run(
+        &ctx,
+        &RunOptions {
+            head: HeadSource::Estimated,
+            ..base.clone()
+        },
+    )
+    .unwrap();
+    let error = estimated.report["eye_used"]["error_m"].as_f64().unwrap();
+    assert!(error > 0.0 && error < 0.01, "{error}");
+    assert!(
+        estimated.report["head_detection"]["feature_px"]
+            .as_f64()
+            .unwrap()
+            > 20.0
+    );
+    let biased = run(
+        &ctx,
+        &RunOptions {
+            head_bias_cm: [1.0, 0.0, -2.0],
+            ..base.clone()
+        },
+    )
+    .unwrap();
+    let moved = biased.eye_used - ctx.scene.eye();
+    assert!(
+        (moved - DVec3::new(0.01, 0.0, -0.02)).length() < 1e-12,
+        "{moved}"
+    );
+    let jitter = |seed| {
+        run(
+            &ctx,
+            &RunOptions {
+                head_jitter_cm: 0.5,
+                seed,
+                ..base.clone()
+            },
+        )
+        .unwrap()
+        .eye_used
+    };
+    assert_eq!(jitter(3), jitter(3));
+    assert_ne!(jitter(3), jitter(4));
+}
+
+#[test]
+fn d2_auto_finds_the_wall() {
+    let ctx = context(&wall_scene(6.0, 45.0));
+    let r = run(
+        &ctx,
+        &RunOptions {
+            d2: WorkingDistance::Auto,
+            spp: 1,
+            width: Some(40),
+            ..RunOptions::default()
+        },
+    )
+    .unwrap();
+    let d2 = r.report["d2_m"].as_f64().unwrap();
+    assert!((d2 - 6.0).abs() < 1e-4, "{d2}");
+}
+
+#[test]
+fn a_back_image_without_a_face_is_a_clear_error() {
+    let ctx = context(&wall_scene(6.0, 45.0));
+    let err = run(
+        &ctx,
+        &RunOptions {
+            head: HeadSource::Estimated,
+            spp: 1,
+            width: Some(40),
+            ..RunOptions::default()
+        },
+    )
+    .err()
+    .unwrap();
+    assert!(err.to_string().contains("no face found"), "{err}");
+}
