@@ -77,3 +77,14 @@ fn the_comparison_catches_a_small_regression() {
     speck.put_pixel(5, 5, image::Rgb([255, 0, 255]));
     assert!(golden::compare(&speck, &golden).is_ok());
 }
+
+#[test]
+fn a_missing_golden_fails_and_is_not_written() {
+    if std::env::var("SEETHRU_BLESS").is_ok_and(|v| v == "1") {
+        return; // Blessing writes goldens by design.
+    }
+    let img = image::RgbImage::new(4, 4);
+    assert!(std::panic::catch_unwind(|| golden::check("no-such-view", &img)).is_err());
+    assert!(!common::repo_path("golden/no-such-view.png").exists());
+    assert!(common::repo_path("target/golden-failures/no-such-view-actual.png").exists());
+}
