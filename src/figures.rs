@@ -46,7 +46,7 @@ pub struct Figure {
 const FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
 const SIZE: (u32, u32) = (900, 600);
 
-fn register_font() -> Result<()> {
+pub fn register_font() -> Result<()> {
     plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
         .map_err(|_| anyhow!("the bundled font is invalid"))
 }

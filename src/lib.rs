@@ -15,6 +15,7 @@ pub mod figures;
 pub mod frame;
 pub mod head;
 pub mod mesh_io;
+pub mod metrics;
 pub mod options;
 pub mod output;
 pub mod pipeline;

@@ -11,7 +11,9 @@ use seethru::claims::{AnalyzeParams, claims_table, evaluate, paper_claims};
 use seethru::commands::{RenderOptions, export_scene, render_views};
 use seethru::display::Filter;
 use seethru::options::{check_resolution, with_threads};
-use seethru::pipeline::{HeadSource, Method, Outside, RunOptions, WorkingDistance, run_command};
+use seethru::pipeline::{
+    HeadSource, Method, Outside, RunOptions, WorkingDistance, measure_command, run_command,
+};
 use seethru::views::View;
 
 #[derive(Parser)]
@@ -97,10 +99,21 @@ enum Command {
         /// Back camera width in pixels (aspect ratio kept).
         #[arg(long = "back-width")]
         back_width: Option<u32>,
+        /// Width of the border band of the mismatch metrics, display pixels.
+        #[arg(long, default_value_t = 5)]
+        band: u32,
         #[arg(long, default_value_t = 4)]
         spp: u32,
         #[arg(long)]
         threads: Option<usize>,
+        #[arg(long, value_enum, default_value_t = BvhKind::Cwbvh)]
+        bvh: BvhKind,
+    },
+    /// Recompute metrics.json and the misregistration maps of a `run` directory from its EXRs.
+    Measure {
+        dir: PathBuf,
+        #[arg(long, default_value_t = 5)]
+        band: u32,
         #[arg(long, value_enum, default_value_t = BvhKind::Cwbvh)]
         bvh: BvhKind,
     },
@@ -199,6 +212,11 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             with_threads(threads, || render_views(&scene, &views, &out, &options))?
         }
         Command::Export { scene, out } => export_scene(&scene, &out),
+        Command::Measure { dir, band, bvh } => {
+            let metrics = measure_command(&dir, band, bvh)?;
+            println!("{}", serde_json::to_string_pretty(&metrics)?);
+            Ok(())
+        }
         Command::Run {
             scene,
             out,
@@ -215,6 +233,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             height,
             frontal_width,
             back_width,
+            band,
             spp,
             threads,
             bvh,
@@ -236,7 +255,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 filter,
                 progress: true,
             };
-            with_threads(threads, || run_command(&scene, &out, &options, bvh))?
+            with_threads(threads, || run_command(&scene, &out, &options, band, bvh))?
         }
         Command::Figures { out } => {
             let names = seethru::figures::write_all(&out)?;

@@ -36,7 +36,8 @@ pub fn write_text(path: &Path, text: &str) -> Result<()> {
     write_atomically(path, |tmp| Ok(std::fs::write(tmp, text)?))
 }
 
-fn write_png(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<()> {
+/// Writes an RGB8 buffer as PNG.
+pub fn write_png(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<()> {
     let img =
         image::RgbImage::from_raw(width, height, rgb).context("image buffer has the wrong size")?;
     write_atomically(path, |tmp| {
@@ -106,8 +107,18 @@ pub fn write_exr(frame: &Frame, path: &Path) -> Result<()> {
         "part_id.id",
         FlatSamples::U32(frame.part_id.clone()),
     ));
+    write_exr_channels(path, frame.width, frame.height, channels)
+}
+
+/// Writes named channels (`layer.channel`) of a `width`×`height` image as one EXR.
+pub fn write_exr_channels(
+    path: &Path,
+    width: u32,
+    height: u32,
+    channels: Vec<AnyChannel<FlatSamples>>,
+) -> Result<()> {
     let layer = Layer::new(
-        (frame.width as usize, frame.height as usize),
+        (width as usize, height as usize),
         LayerAttributes::named("seethru"),
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(SmallVec::from_vec(channels)),

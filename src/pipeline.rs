@@ -455,11 +455,12 @@ fn report(
     })
 }
 
-/// `seethru run`: renders the six views into `out` with `run.json`.
+/// `seethru run`: renders the six views into `out` with `run.json` and the metrics.
 pub fn run_command(
     scene_path: &Path,
     out: &Path,
     options: &RunOptions,
+    band: u32,
     bvh: crate::accel::BvhKind,
 ) -> Result<()> {
     let scene = crate::scene::Scene::load(scene_path)?;
@@ -481,9 +482,42 @@ pub fn run_command(
         &out.join("run.json"),
         &serde_json::to_string_pretty(&result.report)?,
     )?;
+    let frames = [&result.truth, &result.seethru, &result.occluded];
+    let (maps, metrics) = crate::metrics::measure(&ctx, &ctx.scene, ctx.scene.eye(), frames, band);
+    crate::metrics::write_metrics(out, &maps, &result.truth, &metrics)?;
     eprintln!(
-        "wrote truth, occluded, frontal, back, display and seethru (PNG, ids PNG, EXR) and run.json to {}",
+        "wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",
         out.display()
     );
     Ok(())
+}
+
+/// `seethru measure`: the metrics of a run directory, from its saved EXRs.
+pub fn measure_command(
+    dir: &Path,
+    band: u32,
+    bvh: crate::accel::BvhKind,
+) -> Result<serde_json::Value> {
+    let text = std::fs::read_to_string(dir.join("run.json")).with_context(|| {
+        format!(
+            "{}: no run.json (not a `seethru run` directory?)",
+            dir.display()
+        )
+    })?;
+    let run_json: serde_json::Value = serde_json::from_str(&text)?;
+    let scene_path = run_json["scene"]
+        .as_str()
+        .context("run.json has no scene path")?;
+    let ctx = RenderContext::new(crate::scene::Scene::load(Path::new(scene_path))?, bvh)?;
+    let read = |name: &str| crate::output::read_exr(&dir.join(format!("{name}.exr")));
+    let (truth, seethru, occluded) = (read("truth")?, read("seethru")?, read("occluded")?);
+    let (maps, metrics) = crate::metrics::measure(
+        &ctx,
+        &ctx.scene,
+        ctx.scene.eye(),
+        [&truth, &seethru, &occluded],
+        band,
+    );
+    crate::metrics::write_metrics(dir, &maps, &truth, &metrics)?;
+    Ok(metrics)
 }

@@ -1,0 +1,401 @@
+//! Metrics of a `seethru` frame against the `truth` (DESIGN.md §5), inside the display
+//! region: misregistration, border mismatch, PSNR/SSIM, missing pixels.
+
+use glam::{DVec3, Vec3};
+use serde_json::json;
+
+use crate::analysis::physical::ARCMIN_PER_RAD;
+use crate::color::encode_srgb8;
+use crate::frame::Frame;
+use crate::render::RenderContext;
+use crate::scene::Scene;
+use crate::shapes::box_face;
+use crate::world::view_bit;
+
+/// Per-pixel results over the driver's view (NaN / false outside the display region).
+pub struct MetricMaps {
+    pub width: u32,
+    pub height: u32,
+    /// Angle at the eye between the shown and the true world point, arc-minutes.
+    pub misregistration: Vec<f32>,
+    /// Display pixels whose truth point the frontal camera cannot see.
+    pub missing: Vec<bool>,
+    /// Pixels where the driver sees the display.
+    pub display: Vec<bool>,
+}
+
+/// Summary statistics of a set of values.
+fn stats(values: &mut [f64]) -> serde_json::Value {
+    if values.is_empty() {
+        return json!({"count": 0});
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    let mean = values.iter().sum::<f64>() / n as f64;
+    let p95 = values[((0.95 * n as f64).ceil() as usize).clamp(1, n) - 1];
+    json!({"count": n, "mean": mean, "p95": p95, "max": values[n - 1]})
+}
+
+fn luminance(c: [u8; 3]) -> f64 {
+    0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64
+}
+
+/// SSIM map on 8-bit luminance with 7×7 windows (Wang et al. 2004 constants).
+fn ssim_map(a: &[f64], b: &[f64], w: usize, h: usize) -> Vec<f64> {
+    let (c1, c2) = ((0.01f64 * 255.0).powi(2), (0.03f64 * 255.0).powi(2));
+    let r = 3i64;
+    let mut out = vec![f64::NAN; w * h];
+    for y in 0..h as i64 {
+        for x in 0..w as i64 {
+            let (mut sa, mut sb, mut saa, mut sbb, mut sab, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    let (xx, yy) = (
+                        (x + dx).clamp(0, w as i64 - 1) as usize,
+                        (y + dy).clamp(0, h as i64 - 1) as usize,
+                    );
+                    let (va, vb) = (a[yy * w + xx], b[yy * w + xx]);
+                    sa += va;
+                    sb += vb;
+                    saa += va * va;
+                    sbb += vb * vb;
+                    sab += va * vb;
+                    n += 1.0;
+                }
+            }
+            let (ma, mb) = (sa / n, sb / n);
+            let (va, vb, cov) = (saa / n - ma * ma, sbb / n - mb * mb, sab / n - ma * mb);
+            out[y as usize * w + x as usize] = ((2.0 * ma * mb + c1) * (2.0 * cov + c2))
+                / ((ma * ma + mb * mb + c1) * (va + vb + c2));
+        }
+    }
+    out
+}
+
+/// PSNR (dB) of 8-bit sRGB colours over the pixels of `mask`.
+fn psnr(a: &[[u8; 3]], b: &[[u8; 3]], mask: &[bool]) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for ((x, y), _) in a.iter().zip(b).zip(mask).filter(|(_, m)| **m) {
+        for c in 0..3 {
+            sum += (x[c] as f64 - y[c] as f64).powi(2);
+        }
+        n += 3;
+    }
+    if n == 0 {
+        return f64::NAN;
+    }
+    let mse = sum / n as f64;
+    if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (255.0 * 255.0 / mse).log10()
+    }
+}
+
+/// Computes the maps and the metrics JSON. `truth`, `seethru` and `occluded` are frames of the
+/// driver's camera `driver` (as rendered by `run`); `band` is the border band width in display
+/// pixels.
+pub fn measure(
+    ctx: &RenderContext,
+    scene: &Scene,
+    driver_eye: DVec3,
+    frames: [&Frame; 3],
+    band: u32,
+) -> (MetricMaps, serde_json::Value) {
+    let [truth, seethru, occluded] = frames;
+    let (w, h) = (truth.width as usize, truth.height as usize);
+    let obstacle = &scene.obstacle;
+    let obstacle_from_world = obstacle.world_from_obstacle.inverse();
+    let [dw, dh] = obstacle.display_resolution;
+    let display: Vec<bool> = occluded
+        .object_id
+        .iter()
+        .zip(&occluded.part_id)
+        .map(|(&o, &p)| o == ctx.world.obstacle_id && p == box_face::POS_Z)
+        .collect();
+    let mut misregistration = vec![f32::NAN; w * h];
+    let mut missing = vec![false; w * h];
+    let (mut out_of_view, mut hidden, mut sky) = (0usize, 0usize, 0usize);
+    // Which side bands each pixel is in: left, right, top, bottom.
+    let mut sides = vec![[false; 4]; w * h];
+    let frontal = &scene.frontal;
+    for i in (0..w * h).filter(|&i| display[i]) {
+        let on_display = obstacle_from_world.transform_point3(occluded.position[i].as_dvec3());
+        let u = (on_display.x / obstacle.width + 0.5) * dw as f64;
+        let v = (0.5 - on_display.y / obstacle.height) * dh as f64;
+        sides[i] = [
+            u < band as f64,
+            u >= (dw - band) as f64,
+            v < band as f64,
+            v >= (dh - band) as f64,
+        ];
+        let (t, s) = (truth.position[i], seethru.position[i]);
+        if !t.is_finite() {
+            sky += 1;
+            continue;
+        }
+        // Can the frontal camera see the truth's point?
+        let p = t.as_dvec3();
+        let inside = frontal.project_point(p).is_some_and(|q| {
+            q.x >= 0.0 && q.y >= 0.0 && q.x < frontal.width as f64 && q.y < frontal.height as f64
+        });
+        if !inside {
+            missing[i] = true;
+            out_of_view += 1;
+        } else {
+            let origin = frontal.position().as_vec3();
+            let to = t - origin;
+            let distance = to.length();
+            let hit = ctx.trace(origin, to / distance, view_bit::FRONTAL);
+            if hit.is_some_and(|h| h.t < distance - 1e-3 * distance.max(1.0)) {
+                missing[i] = true;
+                hidden += 1;
+            }
+        }
+        if s.is_finite() {
+            let (a, b) = ((s.as_dvec3() - driver_eye), (p - driver_eye));
+            misregistration[i] = (a.cross(b).length().atan2(a.dot(b)) * ARCMIN_PER_RAD) as f32;
+        }
+    }
+    let count = display.iter().filter(|&&m| m).count();
+    let driver_pixel_arcmin = (2.0 * scene.driver.tan_half_x() / w as f64).atan() * ARCMIN_PER_RAD;
+    let collect = |keep: &dyn Fn(usize) -> bool| -> Vec<f64> {
+        (0..w * h)
+            .filter(|&i| keep(i) && misregistration[i].is_finite())
+            .map(|i| misregistration[i] as f64)
+            .collect()
+    };
+    let srgb_t: Vec<[u8; 3]> = truth.color.iter().map(|&c| encode_srgb8(c)).collect();
+    let srgb_s: Vec<[u8; 3]> = seethru.color.iter().map(|&c| encode_srgb8(c)).collect();
+    let colour_error = |keep: &dyn Fn(usize) -> bool| {
+        let (mut sum, mut n) = (0.0, 0usize);
+        for i in (0..w * h).filter(|&i| keep(i)) {
+            sum += (0..3)
+                .map(|c| (srgb_t[i][c] as f64 - srgb_s[i][c] as f64).abs())
+                .sum::<f64>()
+                / 3.0;
+            n += 1;
+        }
+        if n == 0 { f64::NAN } else { sum / n as f64 }
+    };
+    let lum_t: Vec<f64> = srgb_t.iter().map(|&c| luminance(c)).collect();
+    let lum_s: Vec<f64> = srgb_s.iter().map(|&c| luminance(c)).collect();
+    let ssim = ssim_map(&lum_t, &lum_s, w, h);
+    let mean_over = |mask: &dyn Fn(usize) -> bool| {
+        let v: Vec<f64> = (0..w * h).filter(|&i| mask(i)).map(|i| ssim[i]).collect();
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            v.iter().sum::<f64>() / v.len() as f64
+        }
+    };
+    let region = |keep: &dyn Fn(usize) -> bool| {
+        let mask: Vec<bool> = (0..w * h).map(keep).collect();
+        let mut values = collect(keep);
+        json!({
+            "misregistration_arcmin": stats(&mut values),
+            "mean_abs_colour_error_8bit": colour_error(keep),
+            "psnr_db": psnr(&srgb_t, &srgb_s, &mask),
+            "ssim": mean_over(keep),
+        })
+    };
+    let in_band = |i: usize| display[i] && sides[i].iter().any(|&s| s);
+    let per_side: serde_json::Map<String, serde_json::Value> = ["left", "right", "top", "bottom"]
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            (
+                name.to_string(),
+                region(&|i: usize| display[i] && sides[i][k]),
+            )
+        })
+        .collect();
+    let all = collect(&|i| display[i]);
+    let mean_px = if all.is_empty() {
+        f64::NAN
+    } else {
+        all.iter().sum::<f64>() / all.len() as f64 / driver_pixel_arcmin
+    };
+    let json = json!({
+        "display_pixels": count,
+        "driver_pixel_arcmin": driver_pixel_arcmin,
+        "display": region(&|i| display[i]),
+        "misregistration_mean_driver_px": mean_px,
+        "border_band_display_px": band,
+        "border": region(&in_band),
+        "border_per_side": per_side,
+        "missing": {
+            "fraction": if count == 0 { 0.0 } else { (out_of_view + hidden) as f64 / count as f64 },
+            "outside_frontal_view": out_of_view,
+            "hidden_from_frontal": hidden,
+        },
+        "sky_pixels_excluded": sky,
+        "notes": "misregistration: angle at the eye between the world point seethru shows and the truth's, over display pixels where both are surfaces; colour metrics on 8-bit sRGB; SSIM on luminance, 7×7 windows",
+    });
+    (
+        MetricMaps {
+            width: w as u32,
+            height: h as u32,
+            misregistration,
+            missing,
+            display,
+        },
+        json,
+    )
+}
+
+/// A perceptually ordered colour for t in [0, 1] (dark blue → green → yellow → red).
+pub fn heat_color(t: f32) -> [u8; 3] {
+    const STOPS: [(f32, [f32; 3]); 5] = [
+        (0.0, [0.05, 0.05, 0.35]),
+        (0.25, [0.1, 0.4, 0.85]),
+        (0.5, [0.2, 0.75, 0.35]),
+        (0.75, [0.95, 0.8, 0.1]),
+        (1.0, [0.85, 0.1, 0.05]),
+    ];
+    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+    for pair in STOPS.windows(2) {
+        let ((t0, c0), (t1, c1)) = (pair[0], pair[1]);
+        if t <= t1 {
+            let f = (t - t0) / (t1 - t0);
+            let c = Vec3::from(c0).lerp(Vec3::from(c1), f);
+            return [
+                (c.x * 255.0) as u8,
+                (c.y * 255.0) as u8,
+                (c.z * 255.0) as u8,
+            ];
+        }
+    }
+    [217, 25, 13]
+}
+
+/// The misregistration heatmap beside a colour bar in arc-minutes; outside the display, the
+/// truth in dimmed grey for context.
+pub fn heatmap_rgb(maps: &MetricMaps, truth: &Frame) -> anyhow::Result<(u32, u32, Vec<u8>)> {
+    use plotters::prelude::*;
+    let (w, h) = (maps.width, maps.height);
+    let values: Vec<f32> = maps
+        .misregistration
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .collect();
+    let top = {
+        let mut v = values.clone();
+        v.sort_by(f32::total_cmp);
+        v.get((v.len() as f32 * 0.99) as usize)
+            .copied()
+            .unwrap_or(1.0)
+            .max(1.0)
+    };
+    let (cw, ch) = (w + 130, h.max(160));
+    let mut buffer = vec![255u8; (cw * ch * 3) as usize];
+    {
+        crate::figures::register_font()?;
+        let err = |e: DrawingAreaErrorKind<_>| anyhow::anyhow!("{e}");
+        let root = BitMapBackend::with_buffer(&mut buffer, (cw, ch)).into_drawing_area();
+        root.fill(&WHITE).map_err(err)?;
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y * w + x) as usize;
+                let c = if maps.display[i] {
+                    if maps.misregistration[i].is_finite() {
+                        heat_color(maps.misregistration[i] / top)
+                    } else {
+                        [255, 0, 255]
+                    }
+                } else {
+                    let g = (encode_srgb8(truth.color[i])
+                        .iter()
+                        .map(|&v| v as u32)
+                        .sum::<u32>()
+                        / 6) as u8;
+                    [g, g, g]
+                };
+                root.draw_pixel((x as i32, y as i32), &RGBColor(c[0], c[1], c[2]))
+                    .map_err(err)?;
+            }
+        }
+        let (x0, y0, bar_h) = (w as i32 + 20, 30i32, ch as i32 - 70);
+        for k in 0..bar_h {
+            let c = heat_color(1.0 - k as f32 / bar_h as f32);
+            root.draw(&Rectangle::new(
+                [(x0, y0 + k), (x0 + 22, y0 + k + 1)],
+                RGBColor(c[0], c[1], c[2]).filled(),
+            ))
+            .map_err(err)?;
+        }
+        let style = ("sans-serif", 14).into_font().color(&BLACK);
+        for (frac, label) in [
+            (0.0, format!("{top:.1}′")),
+            (0.5, format!("{:.1}′", top / 2.0)),
+            (1.0, "0′".to_string()),
+        ] {
+            root.draw(&Text::new(
+                label,
+                (x0 + 28, y0 + (frac * bar_h as f64) as i32 - 7),
+                style.clone(),
+            ))
+            .map_err(err)?;
+        }
+        root.draw(&Text::new("arcmin", (x0 - 4, 8), style.clone()))
+            .map_err(err)?;
+        root.draw(&Rectangle::new(
+            [(x0, ch as i32 - 30), (x0 + 22, ch as i32 - 18)],
+            RGBColor(255, 0, 255).filled(),
+        ))
+        .map_err(err)?;
+        root.draw(&Text::new("sky", (x0 + 28, ch as i32 - 32), style))
+            .map_err(err)?;
+        root.present().map_err(err)?;
+    }
+    Ok((cw, ch, buffer))
+}
+
+/// Writes `metrics.json`, `misregistration.exr` (`misregistration.arcmin`, `missing.mask`),
+/// `misregistration.png` (heatmap with colour bar) and `missing.png` into `dir`.
+pub fn write_metrics(
+    dir: &std::path::Path,
+    maps: &MetricMaps,
+    truth: &Frame,
+    json: &serde_json::Value,
+) -> anyhow::Result<()> {
+    use exr::prelude::{AnyChannel, FlatSamples};
+    crate::output::write_text(
+        &dir.join("metrics.json"),
+        &serde_json::to_string_pretty(json)?,
+    )?;
+    let channels = vec![
+        AnyChannel::new(
+            "misregistration.arcmin",
+            FlatSamples::F32(maps.misregistration.clone()),
+        ),
+        AnyChannel::new(
+            "missing.mask",
+            FlatSamples::F32(maps.missing.iter().map(|&m| m as u8 as f32).collect()),
+        ),
+    ];
+    crate::output::write_exr_channels(
+        &dir.join("misregistration.exr"),
+        maps.width,
+        maps.height,
+        channels,
+    )?;
+    let (w, h, rgb) = heatmap_rgb(maps, truth)?;
+    crate::output::write_png(&dir.join("misregistration.png"), w, h, rgb)?;
+    let mask = maps
+        .missing
+        .iter()
+        .zip(&maps.display)
+        .flat_map(|(&m, &d)| {
+            if m {
+                [255, 0, 255]
+            } else if d {
+                [60, 60, 60]
+            } else {
+                [0, 0, 0]
+            }
+        })
+        .collect();
+    crate::output::write_png(&dir.join("missing.png"), maps.width, maps.height, mask)
+}
