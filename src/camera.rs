@@ -54,6 +54,8 @@ pub fn world_from_camera_rotation(forward: DVec3, up: DVec3) -> Result<DMat3, Ca
     Ok(DMat3::from_cols(right, true_up, back))
 }
 
+impl std::error::Error for CameraError {}
+
 impl Camera {
     pub fn new(
         world_from_camera: DAffine3,

@@ -21,6 +21,7 @@ pub mod output;
 pub mod pipeline;
 pub mod procedural;
 pub mod progress;
+pub mod ratio;
 pub mod render;
 pub mod sampling;
 pub mod scene;

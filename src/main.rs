@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use seethru::accel::BvhKind;
+use seethru::analysis::{ForeshorteningParams, OcclusionParams};
 use seethru::bench::{BenchOptions, bench};
 use seethru::claims::{AnalyzeParams, claims_table, evaluate, paper_claims};
 use seethru::commands::{RenderOptions, export_scene, render_views};
@@ -14,6 +15,7 @@ use seethru::options::{check_resolution, with_threads};
 use seethru::pipeline::{
     HeadSource, Method, Outside, RunOptions, WorkingDistance, measure_command, run_command,
 };
+use seethru::ratio::{Setup, describe, measure_ratio};
 use seethru::views::View;
 
 #[derive(Parser)]
@@ -109,6 +111,12 @@ enum Command {
         #[arg(long, value_enum, default_value_t = BvhKind::Cwbvh)]
         bvh: BvhKind,
     },
+    /// Observed p_cam/p_user of the paper's occlusion or foreshortening setup: predicted,
+    /// observed and the uncertainty pixel quantisation leaves.
+    Ratio {
+        #[command(subcommand)]
+        setup: RatioSetup,
+    },
     /// Recompute metrics.json and the misregistration maps of a `run` directory from its EXRs.
     Measure {
         dir: PathBuf,
@@ -185,6 +193,56 @@ enum Command {
     },
 }
 
+#[derive(Subcommand)]
+enum RatioSetup {
+    /// A box of depth L standing on the scene plane at d2, its near edge at lateral b1.
+    Occlusion {
+        #[arg(long = "L")]
+        l: f64,
+        #[arg(long, allow_hyphen_values = true)]
+        b1: f64,
+        #[arg(long)]
+        d2: f64,
+        #[arg(long)]
+        d1: f64,
+        /// Eye offset b_h (the eye at lateral −b_h).
+        #[arg(long = "bh", allow_hyphen_values = true)]
+        b_h: f64,
+        #[command(flatten)]
+        common: RatioCommon,
+    },
+    /// A surface of length l from its corner at b1 on the plane at d2, at angle γ to the plane.
+    Foreshortening {
+        #[arg(long = "l")]
+        l: f64,
+        #[arg(long, allow_hyphen_values = true)]
+        b1: f64,
+        #[arg(long)]
+        d2: f64,
+        #[arg(long)]
+        d1: f64,
+        #[arg(long = "bh", allow_hyphen_values = true)]
+        b_h: f64,
+        /// Angle between the surface and the plane, degrees, in (0, 90].
+        #[arg(long)]
+        gamma: f64,
+        #[command(flatten)]
+        common: RatioCommon,
+    },
+}
+
+#[derive(clap::Args)]
+struct RatioCommon {
+    /// Width of the driver view, the frontal image and the display, pixels.
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Render {
@@ -212,6 +270,48 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             with_threads(threads, || render_views(&scene, &views, &out, &options))?
         }
         Command::Export { scene, out } => export_scene(&scene, &out),
+        Command::Ratio { setup } => {
+            let (setup, common) = match setup {
+                RatioSetup::Occlusion {
+                    l,
+                    b1,
+                    d2,
+                    d1,
+                    b_h,
+                    common,
+                } => (
+                    Setup::Occlusion(OcclusionParams { l, b1, d2, d1, b_h }),
+                    common,
+                ),
+                RatioSetup::Foreshortening {
+                    l,
+                    b1,
+                    d2,
+                    d1,
+                    b_h,
+                    gamma,
+                    common,
+                } => (
+                    Setup::Foreshortening(ForeshorteningParams {
+                        l,
+                        b1,
+                        d2,
+                        d1,
+                        b_h,
+                        gamma: gamma.to_radians(),
+                    }),
+                    common,
+                ),
+            };
+            check_resolution(common.width, common.width)?;
+            let result = with_threads(common.threads, || measure_ratio(&setup, common.width))??;
+            if common.json {
+                println!("{}", serde_json::to_string_pretty(&result)?);
+            } else {
+                print!("{}", describe(&result));
+            }
+            Ok(())
+        }
         Command::Measure { dir, band, bvh } => {
             let metrics = measure_command(&dir, band, bvh)?;
             println!("{}", serde_json::to_string_pretty(&metrics)?);
