@@ -23,6 +23,7 @@ pub mod procedural;
 pub mod progress;
 pub mod ratio;
 pub mod render;
+pub mod reproduce;
 pub mod sampling;
 pub mod scene;
 pub mod scene_file;

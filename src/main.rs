@@ -117,6 +117,19 @@ enum Command {
         #[command(subcommand)]
         setup: RatioSetup,
     },
+    /// Reproduce the paper's §5: report.md, a self-contained report.html and report.json.
+    Reproduce {
+        #[arg(long)]
+        out: PathBuf,
+        /// Small renders (CI-sized).
+        #[arg(long)]
+        quick: bool,
+        /// The driver-assistance scene.
+        #[arg(long, default_value = "scenes/das.toml")]
+        scene: PathBuf,
+        #[arg(long)]
+        threads: Option<usize>,
+    },
     /// Recompute metrics.json and the misregistration maps of a `run` directory from its EXRs.
     Measure {
         dir: PathBuf,
@@ -310,6 +323,21 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             } else {
                 print!("{}", describe(&result));
             }
+            Ok(())
+        }
+        Command::Reproduce {
+            out,
+            quick,
+            scene,
+            threads,
+        } => {
+            with_threads(threads, || {
+                seethru::reproduce::reproduce(&scene, &out, quick)
+            })??;
+            eprintln!(
+                "wrote report.md, report.html and report.json to {}",
+                out.display()
+            );
             Ok(())
         }
         Command::Measure { dir, band, bvh } => {

@@ -17,7 +17,7 @@ use crate::accel::BvhKind;
 use crate::analysis::{ForeshorteningParams, OcclusionParams};
 use crate::camera::Camera;
 use crate::frame::Frame;
-use crate::pipeline::{RunOptions, WorkingDistance, run};
+use crate::pipeline::{RunOptions, RunResult, WorkingDistance, run};
 use crate::render::RenderContext;
 use crate::scene::{Material, Object, Obstacle, Scene, Shape, Sky, Sun};
 use crate::shapes::box_face;
@@ -340,6 +340,11 @@ pub struct RatioResult {
 
 /// Renders a setup and measures the observed widths and ratio.
 pub fn measure_ratio(setup: &Setup, width: u32) -> Result<RatioResult> {
+    Ok(measure_ratio_with_frames(setup, width)?.0)
+}
+
+/// As [`measure_ratio`], also returning the rendered frames.
+pub fn measure_ratio_with_frames(setup: &Setup, width: u32) -> Result<(RatioResult, RunResult)> {
     let scene = build_scene(setup, width)?;
     let (b1, _, d2, _) = setup.common();
     let eye = scene.eye();
@@ -374,7 +379,7 @@ pub fn measure_ratio(setup: &Setup, width: u32) -> Result<RatioResult> {
     let (pc, pu) = setup.predicted();
     let ratio = cam.value / user.value;
     let paper = setup.paper_values();
-    Ok(RatioResult {
+    let ratio_result = RatioResult {
         setup: format!("{setup:?}"),
         resolution: width,
         p_cam_predicted: pc,
@@ -387,7 +392,8 @@ pub fn measure_ratio(setup: &Setup, width: u32) -> Result<RatioResult> {
             * (cam.uncertainty / cam.value.abs() + user.uncertainty / user.value.abs()),
         paper_predicted: paper.map(|p| p.0),
         paper_measured: paper.map(|p| p.1),
-    })
+    };
+    Ok((ratio_result, result))
 }
 
 /// The result as lines of text, each value labelled.
