@@ -29,6 +29,7 @@ pub mod scene;
 pub mod scene_file;
 pub mod shapes;
 pub mod sky;
+pub mod sweep;
 pub mod texture;
 pub mod views;
 pub mod world;

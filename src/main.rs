@@ -16,6 +16,7 @@ use seethru::pipeline::{
     HeadSource, Method, Outside, RunOptions, WorkingDistance, measure_command, run_command,
 };
 use seethru::ratio::{Setup, describe, measure_ratio};
+use seethru::sweep::{SweepOptions, parse_param, sweep};
 use seethru::views::View;
 
 #[derive(Parser)]
@@ -127,6 +128,27 @@ enum Command {
         /// The driver-assistance scene.
         #[arg(long, default_value = "scenes/das.toml")]
         scene: PathBuf,
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+    /// Metrics for every combination of parameter values, as CSV and a plot; resumable.
+    /// Parameters: theta_f, d2, display_width, eye_x, eye_z, head_bias_x_cm, frontal_width.
+    Sweep {
+        scene: PathBuf,
+        /// name=start:stop:step or name=v1,v2,... (repeat for a grid).
+        #[arg(long = "param", required = true)]
+        params: Vec<String>,
+        #[arg(long, default_value = "sweep.csv")]
+        out: PathBuf,
+        /// Driver-view width in pixels.
+        #[arg(long, default_value_t = 320)]
+        width: u32,
+        #[arg(long, default_value_t = 1)]
+        spp: u32,
+        #[arg(long, value_enum, default_value_t = HeadSource::Oracle)]
+        head: HeadSource,
+        #[arg(long, default_value_t = 5)]
+        band: u32,
         #[arg(long)]
         threads: Option<usize>,
     },
@@ -336,6 +358,33 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             })??;
             eprintln!(
                 "wrote report.md, report.html and report.json to {}",
+                out.display()
+            );
+            Ok(())
+        }
+        Command::Sweep {
+            scene,
+            params,
+            out,
+            width,
+            spp,
+            head,
+            band,
+            threads,
+        } => {
+            let params = params
+                .iter()
+                .map(|p| parse_param(p))
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            let options = SweepOptions {
+                width,
+                spp,
+                head,
+                band,
+            };
+            let computed = with_threads(threads, || sweep(&scene, &params, &out, &options))??;
+            eprintln!(
+                "computed {computed} configurations; results in {}",
                 out.display()
             );
             Ok(())

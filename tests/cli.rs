@@ -166,3 +166,59 @@ fn analyze_reports_the_papers_claims_and_any_parameter_set() {
     let (ok, _, err) = seethru(&["analyze", "--d1", "0"]);
     assert!(!ok && err.starts_with("error: --d1 must be > 0"), "{err}");
 }
+
+#[test]
+fn run_writes_six_views_run_json_and_metrics_and_measure_recomputes_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let out_arg = out.to_str().unwrap();
+    let (ok, _, err) = seethru(&[
+        "run",
+        "scenes/das.toml",
+        "--out",
+        out_arg,
+        "--width",
+        "96",
+        "--frontal-width",
+        "320",
+        "--back-width",
+        "160",
+        "--spp",
+        "1",
+        "--head",
+        "oracle",
+    ]);
+    assert!(ok, "{err}");
+    for view in ["truth", "occluded", "frontal", "back", "display", "seethru"] {
+        for ext in [".png", "_ids.png", ".exr"] {
+            assert!(out.join(format!("{view}{ext}")).is_file(), "{view}{ext}");
+        }
+    }
+    let run: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(run["eye_true"]["paper"]["d1_m"].as_f64().unwrap(), 0.75);
+    let metrics = std::fs::read_to_string(out.join("metrics.json")).unwrap();
+    let m: serde_json::Value = serde_json::from_str(&metrics).unwrap();
+    assert!(
+        m["display"]["misregistration_arcmin"]["mean"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
+    assert!(
+        m["border_per_side"]["left"]["misregistration_arcmin"]["count"]
+            .as_u64()
+            .unwrap()
+            > 0
+    );
+    let heat = image::open(out.join("misregistration.png")).unwrap();
+    assert!(heat.width() > 96);
+    // `measure` on the saved EXRs gives the same metrics.
+    std::fs::remove_file(out.join("metrics.json")).unwrap();
+    let (ok, _, err) = seethru(&["measure", out_arg]);
+    assert!(ok, "{err}");
+    assert_eq!(
+        std::fs::read_to_string(out.join("metrics.json")).unwrap(),
+        metrics
+    );
+}
