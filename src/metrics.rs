@@ -189,6 +189,26 @@ pub fn measure(
             v.iter().sum::<f64>() / v.len() as f64
         }
     };
+    // FLIP with the driver's eye as the observer: pixels per degree of the driver's camera.
+    let ppd = w as f32 / (2.0 * scene.driver.half_angle_x.to_degrees() as f32);
+    let flat = |c: &[[u8; 3]]| c.iter().flatten().copied().collect::<Vec<u8>>();
+    let flip = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(w as u32, h as u32, &flat(&srgb_t)),
+        nv_flip::FlipImageRgb8::with_data(w as u32, h as u32, &flat(&srgb_s)),
+        ppd,
+    )
+    .to_vec();
+    let flip_mean = |keep: &dyn Fn(usize) -> bool| {
+        let v: Vec<f64> = (0..w * h)
+            .filter(|&i| keep(i))
+            .map(|i| flip[i] as f64)
+            .collect();
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            v.iter().sum::<f64>() / v.len() as f64
+        }
+    };
     let region = |keep: &dyn Fn(usize) -> bool| {
         let mask: Vec<bool> = (0..w * h).map(keep).collect();
         let mut values = collect(keep);
@@ -197,6 +217,7 @@ pub fn measure(
             "mean_abs_colour_error_8bit": colour_error(keep),
             "psnr_db": psnr(&srgb_t, &srgb_s, &mask),
             "ssim": mean_over(keep),
+            "flip_mean": flip_mean(keep),
         })
     };
     let in_band = |i: usize| display[i] && sides[i].iter().any(|&s| s);
@@ -230,7 +251,8 @@ pub fn measure(
             "hidden_from_frontal": hidden,
         },
         "sky_pixels_excluded": sky,
-        "notes": "misregistration: angle at the eye between the world point seethru shows and the truth's, over display pixels where both are surfaces; colour metrics on 8-bit sRGB; SSIM on luminance, 7×7 windows",
+        "flip_pixels_per_degree": ppd,
+        "notes": "misregistration: angle at the eye between the world point seethru shows and the truth's, over display pixels where both are surfaces; colour metrics on 8-bit sRGB; SSIM on luminance, 7×7 windows; FLIP (NVIDIA, via nv-flip) with the driver's camera as observer, averaged inside the masks",
     });
     (
         MetricMaps {

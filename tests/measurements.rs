@@ -178,6 +178,7 @@ fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
         .unwrap();
     assert!(max <= quantum(6.0) * 1.01, "{max} > {}", quantum(6.0));
     assert_eq!(json["missing"]["fraction"].as_f64().unwrap(), 0.0);
+    let flip_on_plane = json["display"]["flip_mean"].as_f64().unwrap();
     assert!(maps.display.iter().filter(|&&d| d).count() > 1000);
 
     // A wall at 12 m with the model at 6 m: at display point x from the camera axis the
