@@ -22,6 +22,8 @@ pub struct MetricMaps {
     pub missing: Vec<bool>,
     /// Pixels where the driver sees the display.
     pub display: Vec<bool>,
+    /// Display pixels that show nothing (their crop point is outside the frontal image).
+    pub blank: Vec<bool>,
 }
 
 /// Summary statistics of a set of values.
@@ -251,9 +253,13 @@ pub fn measure(
             "hidden_from_frontal": hidden,
         },
         "sky_pixels_excluded": sky,
+        "blank_display_fraction": if count == 0 { 0.0 } else { (0..w * h).filter(|&i| display[i] && seethru.object_id[i] == crate::display::MISSING_ID).count() as f64 / count as f64 },
         "flip_pixels_per_degree": ppd,
         "notes": "misregistration: angle at the eye between the world point seethru shows and the truth's, over display pixels where both are surfaces; colour metrics on 8-bit sRGB; SSIM on luminance, 7×7 windows; FLIP (NVIDIA, via nv-flip) with the driver's camera as observer, averaged inside the masks",
     });
+    let blank = (0..w * h)
+        .map(|i| display[i] && seethru.object_id[i] == crate::display::MISSING_ID)
+        .collect();
     (
         MetricMaps {
             width: w as u32,
@@ -261,6 +267,7 @@ pub fn measure(
             misregistration,
             missing,
             display,
+            blank,
         },
         json,
     )
@@ -320,7 +327,9 @@ pub fn heatmap_rgb(maps: &MetricMaps, truth: &Frame) -> anyhow::Result<(u32, u32
         for y in 0..h {
             for x in 0..w {
                 let i = (y * w + x) as usize;
-                let c = if maps.display[i] {
+                let c = if maps.blank[i] {
+                    [0, 0, 0]
+                } else if maps.display[i] {
                     if maps.misregistration[i].is_finite() {
                         heat_color(maps.misregistration[i] / top)
                     } else {
@@ -338,7 +347,7 @@ pub fn heatmap_rgb(maps: &MetricMaps, truth: &Frame) -> anyhow::Result<(u32, u32
                     .map_err(err)?;
             }
         }
-        let (x0, y0, bar_h) = (w as i32 + 20, 30i32, ch as i32 - 70);
+        let (x0, y0, bar_h) = (w as i32 + 20, 30i32, ch as i32 - 85);
         for k in 0..bar_h {
             let c = heat_color(1.0 - k as f32 / bar_h as f32);
             root.draw(&Rectangle::new(
@@ -367,7 +376,14 @@ pub fn heatmap_rgb(maps: &MetricMaps, truth: &Frame) -> anyhow::Result<(u32, u32
             RGBColor(255, 0, 255).filled(),
         ))
         .map_err(err)?;
-        root.draw(&Text::new("sky", (x0 + 28, ch as i32 - 32), style))
+        root.draw(&Text::new("sky", (x0 + 28, ch as i32 - 32), style.clone()))
+            .map_err(err)?;
+        root.draw(&Rectangle::new(
+            [(x0, ch as i32 - 14), (x0 + 22, ch as i32 - 2)],
+            BLACK.filled(),
+        ))
+        .map_err(err)?;
+        root.draw(&Text::new("blank", (x0 + 28, ch as i32 - 16), style))
             .map_err(err)?;
         root.present().map_err(err)?;
     }

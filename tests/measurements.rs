@@ -152,7 +152,9 @@ fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
     // Identical frames: exactly zero.
     let (ctx, r) = wall_run(6.0, 6.0);
     let eye = ctx.scene.eye();
-    let (maps, _) = measure(&ctx, &ctx.scene, eye, [&r.truth, &r.truth, &r.occluded], 5);
+    let (maps, same) = measure(&ctx, &ctx.scene, eye, [&r.truth, &r.truth, &r.occluded], 5);
+    assert_eq!(same["display"]["flip_mean"].as_f64().unwrap(), 0.0);
+    assert!((same["display"]["ssim"].as_f64().unwrap() - 1.0).abs() < 1e-12);
     assert!(
         maps.misregistration
             .iter()
@@ -184,13 +186,15 @@ fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
     // A wall at 12 m with the model at 6 m: at display point x from the camera axis the
     // shown point is off by x(1/6 − 1/12)·12 on the wall: the analytic angle, ± quantum.
     let (ctx, r) = wall_run(12.0, 6.0);
-    let (maps, _) = measure(
+    let (maps, off_plane) = measure(
         &ctx,
         &ctx.scene,
         eye,
         [&r.truth, &r.seethru, &r.occluded],
         5,
     );
+    // The image difference grows with the misregistration.
+    assert!(off_plane["display"]["flip_mean"].as_f64().unwrap() > flip_on_plane);
     let obstacle_from_world = ctx.scene.obstacle.world_from_obstacle.inverse();
     let mut checked = 0;
     for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
