@@ -43,8 +43,8 @@ pub struct CropRatios {
 impl Crop {
     /// The crop rectangle's ratios, from the bounding box of the corners (exact when the
     /// frontal camera's axis is perpendicular to the display, the paper's case).
-    pub fn ratios(&self) -> CropRatios {
-        let [w, h] = self.frontal_size.map(f64::from);
+    /// The corners' bounding box in frontal pixels: (min, max).
+    pub fn bounds(&self) -> (DVec2, DVec2) {
         let min = self
             .corners
             .iter()
@@ -53,6 +53,12 @@ impl Crop {
             .corners
             .iter()
             .fold(DVec2::splat(f64::NEG_INFINITY), |a, c| a.max(*c));
+        (min, max)
+    }
+
+    pub fn ratios(&self) -> CropRatios {
+        let [w, h] = self.frontal_size.map(f64::from);
+        let (min, max) = self.bounds();
         CropRatios {
             left: min.x / w,
             right: (w - max.x) / w,

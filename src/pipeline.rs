@@ -245,14 +245,7 @@ fn crop_for(
 /// Median distance from the display plane of the surfaces the frontal camera sees inside the
 /// crop's bounding box.
 fn median_depth_in_crop(frontal: &Frame, crop: &Crop, obstacle: &Obstacle) -> Option<f64> {
-    let min = crop
-        .corners
-        .iter()
-        .fold(DVec2::splat(f64::INFINITY), |a, c| a.min(*c));
-    let max = crop
-        .corners
-        .iter()
-        .fold(DVec2::splat(f64::NEG_INFINITY), |a, c| a.max(*c));
+    let (min, max) = crop.bounds();
     let mut depths: Vec<f64> = Vec::new();
     for y in (min.y.max(0.0) as u32)..(max.y.min(frontal.height as f64) as u32) {
         for x in (min.x.max(0.0) as u32)..(max.x.min(frontal.width as f64) as u32) {
@@ -269,14 +262,7 @@ fn median_depth_in_crop(frontal: &Frame, crop: &Crop, obstacle: &Obstacle) -> Op
 /// How far the crop leaves the frontal image on each side, pixels (0 inside).
 fn overflow(crop: &Crop) -> [(&'static str, f64); 4] {
     let [w, h] = crop.frontal_size.map(f64::from);
-    let min = crop
-        .corners
-        .iter()
-        .fold(DVec2::splat(f64::INFINITY), |a, c| a.min(*c));
-    let max = crop
-        .corners
-        .iter()
-        .fold(DVec2::splat(f64::NEG_INFINITY), |a, c| a.max(*c));
+    let (min, max) = crop.bounds();
     [
         ("left", (-min.x).max(0.0)),
         ("right", (max.x - w).max(0.0)),

@@ -16,6 +16,7 @@ use serde_json::json;
 use crate::accel::BvhKind;
 use crate::analysis::{ForeshorteningParams, OcclusionParams};
 use crate::camera::Camera;
+use crate::claims::{paper_foreshortening, paper_occlusion};
 use crate::frame::Frame;
 use crate::pipeline::{RunOptions, RunResult, WorkingDistance, run};
 use crate::render::RenderContext;
@@ -47,27 +48,9 @@ impl Setup {
 
     /// The paper's predicted and measured ratios, for its own two examples.
     pub fn paper_values(&self) -> Option<(f64, f64)> {
-        let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
         match *self {
-            Setup::Occlusion(p)
-                if close(p.l, 5.0)
-                    && close(p.b1, -0.35)
-                    && close(p.d2, 6.3)
-                    && close(p.d1, 2.5)
-                    && close(p.b_h, 1.75) =>
-            {
-                Some((-0.73, -0.71))
-            }
-            Setup::Foreshortening(p)
-                if close(p.l, 5.0)
-                    && close(p.b1, -1.5)
-                    && close(p.d2, 1.3)
-                    && close(p.d1, 2.0)
-                    && close(p.b_h, 0.7)
-                    && close(p.gamma, 90f64.to_radians()) =>
-            {
-                Some((2.47, 2.64))
-            }
+            Setup::Occlusion(p) if p == paper_occlusion() => Some((-0.73, -0.71)),
+            Setup::Foreshortening(p) if p == paper_foreshortening() => Some((2.47, 2.64)),
             _ => None,
         }
     }
@@ -230,14 +213,8 @@ pub fn build_scene(setup: &Setup, width: u32) -> Result<Scene> {
             intensity: 1.5,
         },
         sky: Sky {
-            zenith_color: [0.3, 0.5, 0.9],
-            horizon_color: [0.8, 0.9, 1.0],
-            ground_color: [0.4; 3],
-            ambient: 0.6,
             cloud_cover: 0.0,
-            cloud_height: 1500.0,
-            cloud_size: 900.0,
-            cloud_seed: 1,
+            ..Sky::default()
         },
         materials,
         objects,

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use serde_json::json;
 
 use crate::accel::BvhKind;
-use crate::analysis::{ForeshorteningParams, OcclusionParams};
+use crate::claims::{paper_foreshortening, paper_occlusion};
 use crate::color::encode_srgb8;
 use crate::frame::Frame;
 use crate::metrics::{heatmap_rgb, measure};
@@ -158,25 +158,12 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
         (
             "occlusion (L=5, b1=−0.35, d2=6.3, d1=2.5, b_h=1.75)",
             "occlusion",
-            Setup::Occlusion(OcclusionParams {
-                l: 5.0,
-                b1: -0.35,
-                d2: 6.3,
-                d1: 2.5,
-                b_h: 1.75,
-            }),
+            Setup::Occlusion(paper_occlusion()),
         ),
         (
             "foreshortening (l=5, b1=−1.5, d2=1.3, d1=2, b_h=0.7, γ=90°)",
             "foreshortening",
-            Setup::Foreshortening(ForeshorteningParams {
-                l: 5.0,
-                b1: -1.5,
-                d2: 1.3,
-                d1: 2.0,
-                b_h: 0.7,
-                gamma: 90f64.to_radians(),
-            }),
+            Setup::Foreshortening(paper_foreshortening()),
         ),
     ];
     let mut ratios: Vec<(String, String, RatioResult)> = Vec::new();

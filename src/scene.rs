@@ -239,31 +239,19 @@ fn dvec3(a: [f64; 3]) -> DVec3 {
     DVec3::from_array(a)
 }
 
-fn read_sun(root: &TableReader) -> Result<Sun, SceneError> {
-    let Some(t) = root.table("sun")? else {
-        return Ok(Sun {
+impl Default for Sun {
+    fn default() -> Self {
+        Sun {
             direction: DVec3::new(-0.4, 0.8, 0.45).normalize(),
             color: [1.0, 0.96, 0.9],
             intensity: 2.6,
-        });
-    };
-    let direction = dvec3(t.array_or("direction", [-0.4, 0.8, 0.45])?);
-    if direction.length() < 1e-9 {
-        return Err(t.error("direction", "must not be the zero vector"));
+        }
     }
-    let sun = Sun {
-        direction: direction.normalize(),
-        color: t.color("color", [1.0, 0.96, 0.9])?,
-        intensity: t.f64_in("intensity", 2.6, 0.0, 1000.0)?,
-    };
-    t.finish()?;
-    Ok(sun)
 }
 
-fn read_sky(root: &TableReader) -> Result<Sky, SceneError> {
-    let table = root.table("sky")?;
-    let sky = match &table {
-        None => Sky {
+impl Default for Sky {
+    fn default() -> Self {
+        Sky {
             zenith_color: [0.28, 0.48, 0.85],
             horizon_color: [0.78, 0.86, 0.95],
             ground_color: [0.36, 0.34, 0.3],
@@ -272,21 +260,44 @@ fn read_sky(root: &TableReader) -> Result<Sky, SceneError> {
             cloud_height: 1500.0,
             cloud_size: 900.0,
             cloud_seed: 1,
-        },
-        Some(t) => Sky {
-            zenith_color: t.color("zenith_color", [0.28, 0.48, 0.85])?,
-            horizon_color: t.color("horizon_color", [0.78, 0.86, 0.95])?,
-            ground_color: t.color("ground_color", [0.36, 0.34, 0.3])?,
-            ambient: t.f64_in("ambient", 0.55, 0.0, 1000.0)?,
-            cloud_cover: t.f64_in("cloud_cover", 0.45, 0.0, 1.0)?,
-            cloud_height: t.positive("cloud_height", 1500.0, MAX_LENGTH)?,
-            cloud_size: t.positive("cloud_size", 900.0, MAX_LENGTH)?,
-            cloud_seed: t.usize_in("cloud_seed", 1, 0, u32::MAX as usize)? as u32,
-        },
-    };
-    if let Some(t) = table {
-        t.finish()?;
+        }
     }
+}
+
+fn read_sun(root: &TableReader) -> Result<Sun, SceneError> {
+    let d = Sun::default();
+    let Some(t) = root.table("sun")? else {
+        return Ok(d);
+    };
+    let direction = dvec3(t.array_or("direction", d.direction.to_array())?);
+    if direction.length() < 1e-9 {
+        return Err(t.error("direction", "must not be the zero vector"));
+    }
+    let sun = Sun {
+        direction: direction.normalize(),
+        color: t.color("color", d.color)?,
+        intensity: t.f64_in("intensity", d.intensity, 0.0, 1000.0)?,
+    };
+    t.finish()?;
+    Ok(sun)
+}
+
+fn read_sky(root: &TableReader) -> Result<Sky, SceneError> {
+    let d = Sky::default();
+    let Some(t) = root.table("sky")? else {
+        return Ok(d);
+    };
+    let sky = Sky {
+        zenith_color: t.color("zenith_color", d.zenith_color)?,
+        horizon_color: t.color("horizon_color", d.horizon_color)?,
+        ground_color: t.color("ground_color", d.ground_color)?,
+        ambient: t.f64_in("ambient", d.ambient, 0.0, 1000.0)?,
+        cloud_cover: t.f64_in("cloud_cover", d.cloud_cover, 0.0, 1.0)?,
+        cloud_height: t.positive("cloud_height", d.cloud_height, MAX_LENGTH)?,
+        cloud_size: t.positive("cloud_size", d.cloud_size, MAX_LENGTH)?,
+        cloud_seed: t.usize_in("cloud_seed", d.cloud_seed as usize, 0, u32::MAX as usize)? as u32,
+    };
+    t.finish()?;
     Ok(sky)
 }
 
