@@ -4,10 +4,7 @@ use anyhow::{Result, bail};
 
 use crate::camera::Camera;
 use crate::render::MAX_SPP;
-use crate::scene_file::MAX_RESOLUTION;
-
-/// Largest image accepted, in pixels (a 16k × 8k frame): beyond it the AOVs would not fit in memory.
-pub const MAX_PIXELS: u64 = 16384 * 8192;
+use crate::scene_file::{MAX_PIXELS, MAX_RESOLUTION};
 
 /// Output size of a camera after optional `--width`/`--height` overrides. Given one side
 /// only, the other follows the camera's aspect ratio.

@@ -448,17 +448,21 @@ impl<'a> TableReader<'a> {
         match values.as_deref() {
             Some(&[w, h])
                 if (1..=MAX_RESOLUTION as i64).contains(&w)
-                    && (1..=MAX_RESOLUTION as i64).contains(&h) =>
+                    && (1..=MAX_RESOLUTION as i64).contains(&h)
+                    && w * h <= MAX_PIXELS as i64 =>
             {
                 Ok([w as u32, h as u32])
             }
             _ => Err(self.error(
                 key,
-                format!("expected [width, height], integers in [1, {MAX_RESOLUTION}]"),
+                format!("expected [width, height], integers in [1, {MAX_RESOLUTION}], at most {MAX_PIXELS} pixels"),
             )),
         }
     }
 }
 
-/// Largest image side accepted anywhere, in pixels: beyond it a render would not fit in memory.
+/// Largest image side accepted anywhere, in pixels.
 pub const MAX_RESOLUTION: u32 = 16384;
+/// Largest image accepted anywhere, in pixels (16k × 8k): beyond it the AOVs of one frame
+/// would not fit in memory.
+pub const MAX_PIXELS: u64 = 16384 * 8192;

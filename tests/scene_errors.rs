@@ -98,6 +98,12 @@ fn errors_name_file_line_and_key() {
             "integers in [1, 16384]",
         ),
         (
+            "resolution = [64, 36]",
+            "resolution = [16384, 16384]",
+            "camera.driver.resolution",
+            "at most 134217728 pixels",
+        ),
+        (
             "position = [0.0, 1.2, 0.0]",
             "position = [0.0, 1.2, -2.0]",
             "camera.driver.position",
