@@ -244,7 +244,8 @@ impl World {
         });
         self.obstacle_id = self.objects.len() as u32;
         let body = self.materials.len() as u32;
-        for (color, _) in [(obstacle.body_color, 0), (obstacle.display_off_color, 1)] {
+        // Two materials: the body, then the switched-off display.
+        for color in [obstacle.body_color, obstacle.display_off_color] {
             self.materials.push(SurfaceMaterial {
                 albedo: srgb_to_linear3(color),
                 texture: None,
