@@ -3,7 +3,6 @@
 
 mod common;
 
-use seethru::accel::BvhKind;
 use seethru::analysis::{ForeshorteningParams, OcclusionParams, physical};
 use seethru::metrics::measure;
 use seethru::pipeline::{RunOptions, WorkingDistance, run};
@@ -106,35 +105,16 @@ fn impossible_setups_are_rejected() {
 
 /// A wall at `wall` metres behind a display at the origin; the model plane at `d2`.
 fn wall_run(wall: f64, d2: f64) -> (RenderContext, seethru::pipeline::RunResult) {
-    let text = format!(
-        r#"
-[obstacle]
-center = [0.0, 0.0, 0.0]
-width = 0.3
-height = 0.2
-display_resolution = [300, 200]
-[camera.driver]
-position = [0.0, 0.0, 0.7]
-look_at = [0.0, 0.0, -6.0]
-half_angle_deg = 15.0
-resolution = [240, 160]
-[camera.frontal]
-resolution = [1280, 720]
-[camera.back]
-resolution = [32, 24]
-[[material]]
-name = "wall"
-texture = "../assets/street.png"
-uv_repeat = [6.0, 2.0]
-[[object]]
-kind = "quad"
-material = "wall"
-size = [80.0, 60.0]
-translate = [0.0, 0.0, -{wall}]
-"#
-    );
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
-    let ctx = RenderContext::new(scene, BvhKind::Cwbvh).unwrap();
+    let setup = common::WallScene {
+        wall,
+        eye: [0.0, 0.0, 0.7],
+        driver_half_angle: 15.0,
+        driver_resolution: [240, 160],
+        display_resolution: [300, 200],
+        frontal_resolution: [1280, 720],
+        ..common::WallScene::default()
+    };
+    let ctx = setup.context();
     let result = run(
         &ctx,
         &RunOptions {

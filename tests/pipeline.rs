@@ -13,47 +13,14 @@ use seethru::render::{RenderContext, RenderSettings};
 use seethru::shapes::box_face;
 use seethru::views::View;
 
-/// A wall (textured quad) that *is* the model plane at `d2` behind a display at the origin.
-fn wall_scene(d2: f64, frontal_half_angle: f64) -> String {
-    format!(
-        r#"
-[obstacle]
-center = [0.0, 0.0, 0.0]
-width = 0.3
-height = 0.2
-display_resolution = [150, 100]
-
-[camera.driver]
-position = [0.08, 0.03, 0.7]
-look_at = [0.0, 0.0, -6.0]
-half_angle_deg = 20.0
-resolution = [200, 150]
-
-[camera.frontal]
-half_angle_deg = {frontal_half_angle}
-resolution = [640, 480]
-
-[camera.back]
-resolution = [64, 48]
-
-[[material]]
-name = "wall"
-texture = "../assets/street.png"
-uv_repeat = [6.0, 2.0]
-
-[[object]]
-name = "wall"
-kind = "quad"
-material = "wall"
-size = [60.0, 40.0]
-translate = [0.0, 0.0, -{d2}]
-"#
-    )
-}
-
-fn context(text: &str) -> RenderContext {
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", text).unwrap();
-    RenderContext::new(scene, BvhKind::Cwbvh).unwrap()
+/// The wall scene with the wall at `d2` and the frontal half angle `frontal_half_angle`.
+fn context(d2: f64, frontal_half_angle: f64) -> RenderContext {
+    common::WallScene {
+        wall: d2,
+        frontal_half_angle,
+        ..common::WallScene::default()
+    }
+    .context()
 }
 
 /// Pixels of the driver's view where the display is (from the `occluded` frame's ids).
@@ -69,7 +36,7 @@ fn display_mask(ctx: &RenderContext, occluded: &seethru::frame::Frame) -> Vec<bo
 #[test]
 fn a_scene_that_is_the_model_plane_comes_out_registered() {
     let d2 = 6.0;
-    let ctx = context(&wall_scene(d2, 45.0));
+    let ctx = context(d2, 45.0);
     let options = RunOptions {
         d2: WorkingDistance::Metres(d2),
         spp: 1,
@@ -143,7 +110,7 @@ fn a_scene_that_is_the_model_plane_comes_out_registered() {
 
 #[test]
 fn run_json_reports_the_crop_of_eq_ratio1() {
-    let ctx = context(&wall_scene(6.0, 45.0));
+    let ctx = context(6.0, 45.0);
     let r = run(
         &ctx,
         &RunOptions {
@@ -179,7 +146,7 @@ fn run_json_reports_the_crop_of_eq_ratio1() {
 #[test]
 fn out_of_view_crops_error_or_show_black() {
     // θ_F = 8°: the display's view from the eye needs more than the frontal camera sees.
-    let ctx = context(&wall_scene(6.0, 8.0));
+    let ctx = context(6.0, 8.0);
     let err = run(
         &ctx,
         &RunOptions {
@@ -323,7 +290,7 @@ fn estimated_head_and_injected_errors_move_the_eye() {
 
 #[test]
 fn d2_auto_finds_the_wall() {
-    let ctx = context(&wall_scene(6.0, 45.0));
+    let ctx = context(6.0, 45.0);
     let r = run(
         &ctx,
         &RunOptions {
@@ -340,7 +307,7 @@ fn d2_auto_finds_the_wall() {
 
 #[test]
 fn a_back_image_without_a_face_is_a_clear_error() {
-    let ctx = context(&wall_scene(6.0, 45.0));
+    let ctx = context(6.0, 45.0);
     let err = run(
         &ctx,
         &RunOptions {

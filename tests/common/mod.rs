@@ -60,3 +60,83 @@ pub fn parse_in(dir: &Path, name: &str, text: &str) -> Result<Scene, SceneError>
 pub fn parse(text: &str) -> Result<Scene, SceneError> {
     parse_in(Path::new("test-scenes"), "scene.toml", text)
 }
+
+/// A textured wall (quad) `wall` metres behind a 0.3 × 0.2 m display at the origin facing +z.
+pub struct WallScene {
+    pub wall: f64,
+    /// The eye (driver camera), world = obstacle frame.
+    pub eye: [f64; 3],
+    pub driver_half_angle: f64,
+    pub driver_resolution: [u32; 2],
+    pub display_resolution: [u32; 2],
+    pub frontal_half_angle: f64,
+    pub frontal_resolution: [u32; 2],
+}
+
+impl Default for WallScene {
+    fn default() -> Self {
+        Self {
+            wall: 6.0,
+            eye: [0.08, 0.03, 0.7],
+            driver_half_angle: 20.0,
+            driver_resolution: [200, 150],
+            display_resolution: [150, 100],
+            frontal_half_angle: 45.0,
+            frontal_resolution: [640, 480],
+        }
+    }
+}
+
+impl WallScene {
+    pub fn text(&self) -> String {
+        let Self {
+            wall,
+            eye,
+            driver_half_angle,
+            driver_resolution: dr,
+            display_resolution: sr,
+            frontal_half_angle,
+            frontal_resolution: fr,
+        } = self;
+        format!(
+            r#"
+[obstacle]
+center = [0.0, 0.0, 0.0]
+width = 0.3
+height = 0.2
+display_resolution = [{}, {}]
+
+[camera.driver]
+position = [{}, {}, {}]
+look_at = [0.0, 0.0, -6.0]
+half_angle_deg = {driver_half_angle}
+resolution = [{}, {}]
+
+[camera.frontal]
+half_angle_deg = {frontal_half_angle}
+resolution = [{}, {}]
+
+[camera.back]
+resolution = [32, 24]
+
+[[material]]
+name = "wall"
+texture = "../assets/street.png"
+uv_repeat = [6.0, 2.0]
+
+[[object]]
+name = "wall"
+kind = "quad"
+material = "wall"
+size = [80.0, 60.0]
+translate = [0.0, 0.0, -{wall}]
+"#,
+            sr[0], sr[1], eye[0], eye[1], eye[2], dr[0], dr[1], fr[0], fr[1]
+        )
+    }
+
+    pub fn context(&self) -> seethru::render::RenderContext {
+        let scene = parse_in(&repo_path("scenes"), "wall.toml", &self.text()).unwrap();
+        seethru::render::RenderContext::new(scene, seethru::accel::BvhKind::Cwbvh).unwrap()
+    }
+}
