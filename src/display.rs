@@ -3,6 +3,7 @@
 
 use glam::{DAffine3, DVec2, Vec3};
 
+use crate::camera::Camera;
 use crate::compensation::Crop;
 use crate::frame::{Frame, Pixel};
 use crate::scene::Obstacle;
@@ -94,35 +95,101 @@ fn bicubic(frame: &Frame, p: DVec2) -> Vec3 {
     sum.max(Vec3::ZERO)
 }
 
-/// The display as the `seethru` view sees it: its image and where it is.
-pub struct DisplayImage {
-    pub image: Frame,
+/// Where the display is: world points on its face to continuous display pixel coordinates.
+#[derive(Clone, Debug)]
+pub struct DisplayPlacement {
     obstacle_from_world: DAffine3,
     /// Display size, metres.
     width: f64,
     height: f64,
+    resolution: [u32; 2],
 }
 
-impl DisplayImage {
-    pub fn new(image: Frame, obstacle: &Obstacle) -> Self {
+impl DisplayPlacement {
+    pub fn new(obstacle: &Obstacle) -> Self {
         Self {
-            image,
             obstacle_from_world: obstacle.world_from_obstacle.inverse(),
             width: obstacle.width,
             height: obstacle.height,
+            resolution: obstacle.display_resolution,
         }
     }
 
-    /// The display pixel at a world point on the display face: a physical display shows one
-    /// colour per pixel, so the lookup is the nearest pixel, all AOVs alike.
-    pub fn lookup(&self, world: Vec3) -> Pixel {
+    /// Continuous display pixel coordinates (x right, y down) of a world point on the display.
+    pub fn pixel_coords(&self, world: Vec3) -> DVec2 {
         let p = self.obstacle_from_world.transform_point3(world.as_dvec3());
-        let u = (p.x / self.width + 0.5) * self.image.width as f64;
-        let v = (0.5 - p.y / self.height) * self.image.height as f64;
-        let x = (u.max(0.0) as u32).min(self.image.width - 1);
-        let y = (v.max(0.0) as u32).min(self.image.height - 1);
-        self.image.pixel(x, y)
+        DVec2::new(
+            (p.x / self.width + 0.5) * self.resolution[0] as f64,
+            (0.5 - p.y / self.height) * self.resolution[1] as f64,
+        )
     }
+}
+
+/// What the display shows where the `seethru` view meets it.
+pub enum DisplaySurface {
+    /// A physical display: the nearest of its pixels — one colour per pixel, all AOVs alike.
+    Pixels {
+        image: Frame,
+        placement: DisplayPlacement,
+    },
+    /// An ideal display and frontal camera of unlimited resolution: the exact point hit is
+    /// mapped through the crop into the frontal camera, and a ray from there finds what it
+    /// sees. This isolates the planar model's error from resampling.
+    Ideal {
+        crop: Crop,
+        frontal: Camera,
+        placement: DisplayPlacement,
+    },
+}
+
+/// The display content at a world point on the display face.
+pub enum Shown {
+    /// A finished pixel (colour and AOVs).
+    Pixel(Pixel),
+    /// Trace this frontal-camera ray (origin, unit direction) to find it.
+    FrontalRay(Vec3, Vec3),
+}
+
+impl DisplaySurface {
+    pub fn at(&self, world: Vec3) -> Shown {
+        match self {
+            DisplaySurface::Pixels { image, placement } => {
+                let c = placement.pixel_coords(world);
+                let x = (c.x.max(0.0) as u32).min(image.width - 1);
+                let y = (c.y.max(0.0) as u32).min(image.height - 1);
+                Shown::Pixel(image.pixel(x, y))
+            }
+            DisplaySurface::Ideal {
+                crop,
+                frontal,
+                placement,
+            } => {
+                let p = crop.frontal_point(placement.pixel_coords(world));
+                if !(p.x >= 0.0
+                    && p.y >= 0.0
+                    && p.x < frontal.width as f64
+                    && p.y < frontal.height as f64)
+                {
+                    return Shown::Pixel(Pixel {
+                        object_id: MISSING_ID,
+                        ..Pixel::SKY
+                    });
+                }
+                let (origin, dir) = frontal.world_ray(p);
+                Shown::FrontalRay(origin.as_vec3(), dir.as_vec3())
+            }
+        }
+    }
+}
+
+/// How the `seethru` view models the display.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DisplayModel {
+    /// The physical display's pixels, resampled from the frontal image.
+    Pixels,
+    /// Unlimited display and frontal resolution: only the planar model's error remains.
+    Ideal,
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ use seethru::analysis::{ForeshorteningParams, OcclusionParams};
 use seethru::bench::{BenchOptions, bench};
 use seethru::claims::{AnalyzeParams, claims_table, evaluate, paper_claims};
 use seethru::commands::{RenderOptions, export_scene, render_views};
-use seethru::display::Filter;
+use seethru::display::{DisplayModel, Filter};
 use seethru::options::{check_resolution, with_threads};
 use seethru::pipeline::{
     HeadSource, Method, Outside, RunOptions, WorkingDistance, measure_command, run_command,
@@ -91,6 +91,10 @@ enum Command {
         /// Colour resampling of the display image.
         #[arg(long, value_enum, default_value_t = Filter::Bilinear)]
         filter: Filter,
+        /// pixels: the physical display; ideal: unlimited display and frontal resolution, so
+        /// that only the planar model's error remains.
+        #[arg(long, value_enum, default_value_t = DisplayModel::Pixels)]
+        display: DisplayModel,
         /// Driver-view width in pixels (truth, occluded, seethru).
         #[arg(long)]
         width: Option<u32>,
@@ -406,6 +410,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             feature_width,
             outside,
             filter,
+            display,
             width,
             height,
             frontal_width,
@@ -430,6 +435,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 spp,
                 outside,
                 filter,
+                display,
                 progress: true,
             };
             with_threads(threads, || run_command(&scene, &out, &options, band, bvh))?

@@ -12,7 +12,9 @@ use serde_json::json;
 use crate::analysis::k_px;
 use crate::camera::Camera;
 use crate::compensation::{Crop, ModelPlane, compute_crop, homography};
-use crate::display::{DisplayImage, Filter, MISSING_ID, resample};
+use crate::display::{
+    DisplayModel, DisplayPlacement, DisplaySurface, Filter, MISSING_ID, resample,
+};
 use crate::frame::Frame;
 use crate::head::{FaceDetection, detect, eye_from_detection, gaussian};
 use crate::options::resized;
@@ -100,6 +102,8 @@ pub struct RunOptions {
     pub spp: u32,
     pub outside: Outside,
     pub filter: Filter,
+    /// How the `seethru` view models the display.
+    pub display: DisplayModel,
     pub progress: bool,
 }
 
@@ -120,6 +124,7 @@ impl Default for RunOptions {
             spp: 4,
             outside: Outside::Error,
             filter: Filter::Bilinear,
+            display: DisplayModel::Pixels,
             progress: false,
         }
     }
@@ -362,8 +367,19 @@ pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
         / display.object_id.len() as f64;
     let truth = timed(&mut timings, &driver, View::Truth);
     let occluded = timed(&mut timings, &driver, View::Occluded);
-    let display_image = DisplayImage::new(display, &scene.obstacle);
-    let (seethru, stats) = ctx.render_seethru(&driver, &display_image, settings);
+    let placement = DisplayPlacement::new(&scene.obstacle);
+    let surface = match options.display {
+        DisplayModel::Pixels => DisplaySurface::Pixels {
+            image: display.clone(),
+            placement,
+        },
+        DisplayModel::Ideal => DisplaySurface::Ideal {
+            crop,
+            frontal: scene.frontal,
+            placement,
+        },
+    };
+    let (seethru, stats) = ctx.render_seethru(&driver, &surface, settings);
     timings.insert("seethru".into(), json!(stats.seconds));
 
     let report = report(
@@ -382,7 +398,7 @@ pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
         occluded,
         frontal,
         back,
-        display: display_image.image,
+        display,
         seethru,
         crop,
         eye_used,
@@ -421,6 +437,7 @@ fn report(
             "spp": options.spp,
             "outside": options.outside,
             "filter": options.filter,
+            "display": options.display,
         },
         "conventions": "obstacle frame: origin at the display centre, +z towards the driver; paper's b_h = −x (eye on the side of R1 for b_h > 0), b_v = y",
         "eye_true": {"world_m": scene.eye().to_array(), "obstacle_m": true_o.to_array(), "paper": paper(true_o)},

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use crate::accel::{Accel, BvhKind, make_ray};
 use crate::camera::Camera;
-use crate::display::DisplayImage;
+use crate::display::{DisplaySurface, Shown};
 use crate::frame::{Frame, Pixel};
 use crate::progress::Progress;
 use crate::sampling::pixel_offset;
@@ -86,7 +86,7 @@ impl RenderContext {
     pub fn render_seethru(
         &self,
         camera: &Camera,
-        display: &DisplayImage,
+        display: &DisplaySurface,
         settings: RenderSettings,
     ) -> (Frame, RenderStats) {
         self.render_with_display(
@@ -102,7 +102,7 @@ impl RenderContext {
         &self,
         camera: &Camera,
         view: u8,
-        display: Option<&DisplayImage>,
+        display: Option<&DisplaySurface>,
         settings: RenderSettings,
         label: &str,
     ) -> (Frame, RenderStats) {
@@ -150,7 +150,7 @@ impl RenderContext {
                 (Some(s), Some(d))
                     if s.object == self.world.obstacle_id && s.part == box_face::POS_Z =>
                 {
-                    Some(d.lookup(s.position))
+                    Some(self.display_content(d, s.position, shadows))
                 }
                 _ => None,
             };
@@ -202,6 +202,29 @@ impl RenderContext {
         pixel
     }
 
+    /// What the display shows at a world point on its face: a display pixel, or — for the
+    /// ideal display — what the frontal camera's ray through the exact crop point meets.
+    fn display_content(&self, display: &DisplaySurface, at: Vec3, shadows: &mut u64) -> Pixel {
+        match display.at(at) {
+            Shown::Pixel(p) => p,
+            Shown::FrontalRay(origin, dir) => match self.trace(origin, dir, view_bit::FRONTAL) {
+                Some(s) => Pixel {
+                    color: self.shade(&s, view_bit::FRONTAL, shadows),
+                    depth: s.t,
+                    camera_z: s.t,
+                    position: s.position,
+                    normal: s.normal,
+                    object_id: s.object,
+                    part_id: s.part,
+                },
+                None => Pixel {
+                    color: self.sky.radiance(dir),
+                    ..Pixel::SKY
+                },
+            },
+        }
+    }
+
     /// The closest surface visible in `view` along a ray from `origin` (unit `dir`).
     pub fn trace(&self, origin: Vec3, dir: Vec3, view: u8) -> Option<SurfaceHit> {
         let hit =
@@ -243,7 +266,7 @@ struct PixelJob<'a> {
     rays: &'a RayGenerator,
     camera_from_world: &'a DAffine3,
     view: u8,
-    display: Option<&'a DisplayImage>,
+    display: Option<&'a DisplaySurface>,
 }
 
 /// Primary rays of a camera in f32, with the per-camera constants hoisted out of the pixel loop.

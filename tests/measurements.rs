@@ -4,6 +4,7 @@
 mod common;
 
 use seethru::analysis::{ForeshorteningParams, OcclusionParams, physical};
+use seethru::display::DisplayModel;
 use seethru::metrics::measure;
 use seethru::pipeline::{RunOptions, WorkingDistance, run};
 use seethru::ratio::{RatioResult, Setup, measure_ratio};
@@ -195,4 +196,64 @@ fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
         checked += 1;
     }
     assert!(checked > 1000);
+}
+
+#[test]
+fn with_an_ideal_display_the_model_plane_has_zero_misregistration() {
+    // Unlimited display and frontal resolution: only float error is left on the model plane.
+    let ctx = common::WallScene {
+        eye: [0.05, -0.02, 0.7],
+        ..common::WallScene::default()
+    }
+    .context();
+    let ideal = RunOptions {
+        d2: WorkingDistance::Metres(6.0),
+        spp: 1,
+        display: DisplayModel::Ideal,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &ideal).unwrap();
+    let (_, json) = measure(
+        &ctx,
+        &ctx.scene,
+        ctx.scene.eye(),
+        [&r.truth, &r.seethru, &r.occluded],
+        5,
+    );
+    let stats = &json["display"]["misregistration_arcmin"];
+    assert!(stats["count"].as_u64().unwrap() > 1000);
+    assert!(stats["max"].as_f64().unwrap() < 0.01, "{stats}");
+    // Off the plane, the ideal display shows exactly the planar model's error: the analytic
+    // value, with no quantum to allow for.
+    let ctx = common::WallScene {
+        wall: 12.0,
+        eye: [0.0, 0.0, 0.7],
+        ..common::WallScene::default()
+    }
+    .context();
+    let r = run(&ctx, &ideal).unwrap();
+    let (maps, _) = measure(
+        &ctx,
+        &ctx.scene,
+        ctx.scene.eye(),
+        [&r.truth, &r.seethru, &r.occluded],
+        5,
+    );
+    let obstacle_from_world = ctx.scene.obstacle.world_from_obstacle.inverse();
+    for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
+        // The shown point is off by x·(12/6 − 1)·(0.7 + 6)/0.7… exactly: on the wall at 12 m the
+        // camera ray through the model point lands at (6.7/0.7)·x·2, the truth at (12.7/0.7)·x.
+        let x = obstacle_from_world
+            .transform_point3(r.occluded.position[i].as_dvec3())
+            .truncate();
+        let (shown, truth) = (x * (6.7 / 0.7) * 2.0, x * (12.7 / 0.7));
+        let eye = glam::DVec3::new(0.0, 0.0, 0.7);
+        let (a, b) = (shown.extend(-12.0) - eye, truth.extend(-12.0) - eye);
+        let expected = a.cross(b).length().atan2(a.dot(b)) * physical::ARCMIN_PER_RAD;
+        let got = maps.misregistration[i] as f64;
+        assert!(
+            (got - expected).abs() < 0.01,
+            "pixel {i}: {got} vs {expected}"
+        );
+    }
 }
