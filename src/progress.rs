@@ -1,6 +1,6 @@
 //! A progress line on stderr for work that takes longer than about a second.
 
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
@@ -19,7 +19,9 @@ const QUIET_START: Duration = Duration::from_secs(1);
 const REFRESH: Duration = Duration::from_millis(200);
 
 impl Progress {
+    /// `enabled` is further limited to a terminal on stderr: logs get no carriage returns.
     pub fn new(label: impl Into<String>, total: usize, enabled: bool) -> Self {
+        let enabled = enabled && std::io::stderr().is_terminal();
         Self {
             label: label.into(),
             total,
