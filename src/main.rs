@@ -238,15 +238,8 @@ enum RatioSetup {
     Occlusion {
         #[arg(long = "L")]
         l: f64,
-        #[arg(long, allow_hyphen_values = true)]
-        b1: f64,
-        #[arg(long)]
-        d2: f64,
-        #[arg(long)]
-        d1: f64,
-        /// Eye offset b_h (the eye at lateral −b_h).
-        #[arg(long = "bh", allow_hyphen_values = true)]
-        b_h: f64,
+        #[command(flatten)]
+        at: RatioGeometry,
         #[command(flatten)]
         common: RatioCommon,
     },
@@ -254,20 +247,31 @@ enum RatioSetup {
     Foreshortening {
         #[arg(long = "l")]
         l: f64,
-        #[arg(long, allow_hyphen_values = true)]
-        b1: f64,
-        #[arg(long)]
-        d2: f64,
-        #[arg(long)]
-        d1: f64,
-        #[arg(long = "bh", allow_hyphen_values = true)]
-        b_h: f64,
         /// Angle between the surface and the plane, degrees, in (0, 90].
         #[arg(long)]
         gamma: f64,
         #[command(flatten)]
+        at: RatioGeometry,
+        #[command(flatten)]
         common: RatioCommon,
     },
+}
+
+/// Where the object and the eye are (the paper's §4.2 parameters), metres.
+#[derive(clap::Args)]
+struct RatioGeometry {
+    /// Lateral position of the object's corner.
+    #[arg(long, allow_hyphen_values = true)]
+    b1: f64,
+    /// Distance of the scene plane from the display.
+    #[arg(long)]
+    d2: f64,
+    /// Distance of the eye from the display.
+    #[arg(long)]
+    d1: f64,
+    /// Eye offset b_h (the eye at lateral −b_h).
+    #[arg(long = "bh", allow_hyphen_values = true)]
+    b_h: f64,
 }
 
 #[derive(clap::Args)]
@@ -313,10 +317,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let (setup, common) = match setup {
                 RatioSetup::Occlusion {
                     l,
-                    b1,
-                    d2,
-                    d1,
-                    b_h,
+                    at: RatioGeometry { b1, d2, d1, b_h },
                     common,
                 } => (
                     Setup::Occlusion(OcclusionParams { l, b1, d2, d1, b_h }),
@@ -324,23 +325,23 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 ),
                 RatioSetup::Foreshortening {
                     l,
-                    b1,
-                    d2,
-                    d1,
-                    b_h,
                     gamma,
+                    at: RatioGeometry { b1, d2, d1, b_h },
                     common,
-                } => (
-                    Setup::Foreshortening(ForeshorteningParams {
-                        l,
-                        b1,
-                        d2,
-                        d1,
-                        b_h,
-                        gamma: gamma.to_radians(),
-                    }),
-                    common,
-                ),
+                } => {
+                    let gamma = gamma.to_radians();
+                    (
+                        Setup::Foreshortening(ForeshorteningParams {
+                            l,
+                            b1,
+                            d2,
+                            d1,
+                            b_h,
+                            gamma,
+                        }),
+                        common,
+                    )
+                }
             };
             check_resolution(common.width, common.width)?;
             let result = with_threads(common.threads, || measure_ratio(&setup, common.width))??;
