@@ -42,20 +42,8 @@ enum Command {
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
-        /// Image width in pixels (default: the camera's; height follows the aspect ratio if not given).
-        #[arg(long)]
-        width: Option<u32>,
-        /// Image height in pixels.
-        #[arg(long)]
-        height: Option<u32>,
-        /// Samples per pixel (anti-aliasing of the colour; AOVs are at pixel centres).
-        #[arg(long, default_value_t = 4)]
-        spp: u32,
-        /// Worker threads (default: all cores). Images are identical for any value.
-        #[arg(long)]
-        threads: Option<usize>,
-        #[arg(long, value_enum, default_value_t = BvhKind::Cwbvh)]
-        bvh: BvhKind,
+        #[command(flatten)]
+        render: RenderArgs,
     },
     /// Run the see-through system: truth, occluded, frontal, back, display and seethru views,
     /// each as PNG, ids PNG and EXR, and run.json with every parameter and the crop.
@@ -95,11 +83,6 @@ enum Command {
         /// that only the planar model's error remains.
         #[arg(long, value_enum, default_value_t = DisplayModel::Pixels)]
         display: DisplayModel,
-        /// Driver-view width in pixels (truth, occluded, seethru).
-        #[arg(long)]
-        width: Option<u32>,
-        #[arg(long)]
-        height: Option<u32>,
         /// Frontal camera width in pixels (aspect ratio kept).
         #[arg(long = "frontal-width")]
         frontal_width: Option<u32>,
@@ -109,12 +92,9 @@ enum Command {
         /// Width of the border band of the mismatch metrics, display pixels.
         #[arg(long, default_value_t = 5)]
         band: u32,
-        #[arg(long, default_value_t = 4)]
-        spp: u32,
-        #[arg(long)]
-        threads: Option<usize>,
-        #[arg(long, value_enum, default_value_t = BvhKind::Cwbvh)]
-        bvh: BvhKind,
+        /// Sizes (width and height: the driver views truth, occluded, seethru), samples, threads.
+        #[command(flatten)]
+        render: RenderArgs,
     },
     /// Observed p_cam/p_user of the paper's occlusion or foreshortening setup: predicted,
     /// observed and the uncertainty pixel quantisation leaves.
@@ -232,6 +212,25 @@ enum Command {
     },
 }
 
+/// Image size, samples, threads and hierarchy: shared by `render` and `run`.
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// Image width in pixels (default: the camera's; height follows the aspect ratio if not given).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels.
+    #[arg(long)]
+    height: Option<u32>,
+    /// Samples per pixel (anti-aliasing of the colour; AOVs are at pixel centres).
+    #[arg(long, default_value_t = 4)]
+    spp: u32,
+    /// Worker threads (default: all cores). Images are identical for any value.
+    #[arg(long)]
+    threads: Option<usize>,
+    #[arg(long, value_enum, default_value_t = BvhKind::Cwbvh)]
+    bvh: BvhKind,
+}
+
 #[derive(Subcommand)]
 enum RatioSetup {
     /// A box of depth L standing on the scene plane at d2, its near edge at lateral b1.
@@ -292,11 +291,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             scene,
             views,
             out,
-            width,
-            height,
-            spp,
-            threads,
-            bvh,
+            render:
+                RenderArgs {
+                    width,
+                    height,
+                    spp,
+                    threads,
+                    bvh,
+                },
         } => {
             let views = if views.is_empty() {
                 View::ALL.to_vec()
@@ -412,14 +414,17 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             outside,
             filter,
             display,
-            width,
-            height,
             frontal_width,
             back_width,
             band,
-            spp,
-            threads,
-            bvh,
+            render:
+                RenderArgs {
+                    width,
+                    height,
+                    spp,
+                    threads,
+                    bvh,
+                },
         } => {
             let options = RunOptions {
                 method,
