@@ -2,8 +2,8 @@
 
 use std::path::Path;
 
-use seethru::output::{write_atomically, write_text};
-use seethru::procedural::{car_mtl, car_obj, street_texture};
+use seethru::io::atomic::{write_atomically, write_text};
+use seethru::scene::procedural::{car_mtl, car_obj, street_texture};
 
 fn main() -> anyhow::Result<()> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");

@@ -1,35 +1,24 @@
 //! seethru: a ray-traced simulator of video see-through displays for driver assistance.
+//!
+//! The modules follow the data, from the bottom up (each imports only from those above it in
+//! this list); `docs/ARCHITECTURE.md` walks one `run` through them.
 #![forbid(unsafe_code)]
 
-pub mod accel;
+/// Closed forms: the paper's equations and the physical-unit sensitivities.
 pub mod analysis;
-pub mod bench;
-pub mod camera;
-pub mod claims;
-pub mod color;
-pub mod commands;
-pub mod compensation;
-pub mod display;
-pub mod export;
-pub mod figures;
-pub mod frame;
-pub mod head;
-pub mod mesh_io;
-pub mod metrics;
-pub mod options;
-pub mod output;
-pub mod pipeline;
-pub mod procedural;
-pub mod progress;
-pub mod ratio;
+/// Cameras (pose, intrinsics, rays, projection) and homographies.
+pub mod geometry;
+/// Files written and read back: frames (PNG, EXR), plots, scene exports, atomic writes.
+pub mod io;
+/// Measurements against the ground truth: metrics, observed ratios, sweeps.
+pub mod measure;
+/// The paper: its claims, its figures and the reproduction of its §5.
+pub mod paper;
+/// The BVH, the integrator, the sky and the frames of AOVs it renders for each view.
 pub mod render;
-pub mod reproduce;
-pub mod sampling;
+/// Scene files → a typed `Scene` → a `World` of triangles and ellipsoids.
 pub mod scene;
-pub mod scene_file;
-pub mod shapes;
-pub mod sky;
-pub mod sweep;
-pub mod texture;
-pub mod views;
-pub mod world;
+/// The see-through system: head estimation, compensation, the display, the run pipeline.
+pub mod system;
+/// sRGB transfer, deterministic hashing for sampling, the progress line.
+pub mod util;

@@ -3,9 +3,9 @@
 mod common;
 
 use glam::Vec3;
-use seethru::accel::{Accel, BvhKind, closest_brute_force, make_ray, occluded_brute_force};
-use seethru::sampling::{hash_words, unit_float};
-use seethru::world::{World, view_bit};
+use seethru::render::accel::{Accel, BvhKind, closest_brute_force, make_ray, occluded_brute_force};
+use seethru::scene::world::{World, view_bit};
+use seethru::util::sampling::{hash_words, unit_float};
 
 fn random_unit(seed: u32) -> Vec3 {
     // Uniform on the sphere from two hashed uniforms.

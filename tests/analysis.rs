@@ -2,13 +2,13 @@
 //! ray–plane intersections of each setup, and the 3-D compensation code.
 
 use glam::{DAffine3, DVec2, DVec3};
-use seethru::analysis::{
+use seethru::analysis::paper::{
     CropParams, ForeshorteningParams, OcclusionParams, Side, head_distance, head_offset, k_px,
-    physical,
 };
-use seethru::camera::Camera;
-use seethru::compensation::{ModelPlane, compute_crop};
+use seethru::analysis::physical;
+use seethru::geometry::camera::Camera;
 use seethru::scene::Obstacle;
+use seethru::system::compensation::{ModelPlane, compute_crop};
 
 const SIDES: [Side; 2] = [Side::Left, Side::Right];
 

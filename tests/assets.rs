@@ -2,8 +2,8 @@
 
 mod common;
 
-use seethru::mesh_io::load_mesh;
-use seethru::procedural::{car_mtl, car_obj, street_texture};
+use seethru::scene::mesh_io::load_mesh;
+use seethru::scene::procedural::{car_mtl, car_obj, street_texture};
 
 #[test]
 fn committed_assets_match_their_generators() {

@@ -2,9 +2,9 @@
 
 mod common;
 
-use seethru::export::{export, object_triangles};
-use seethru::mesh_io::load_mesh;
-use seethru::world::World;
+use seethru::io::export::{export, object_triangles};
+use seethru::scene::mesh_io::load_mesh;
+use seethru::scene::world::World;
 
 #[test]
 fn obj_and_glb_exports_reload_to_the_same_triangles() {

@@ -1,6 +1,6 @@
 //! The figures' data (CSV) carry the paper's numbers; the PNGs are real plots.
 
-use seethru::figures::write_all;
+use seethru::paper::figures::write_all;
 
 fn read_csv(path: &std::path::Path) -> (Vec<String>, Vec<Vec<f64>>) {
     let text = std::fs::read_to_string(path).unwrap();

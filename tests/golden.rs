@@ -5,11 +5,11 @@ mod common;
 
 use common::golden;
 
-use seethru::accel::BvhKind;
-use seethru::color::encode_srgb8;
-use seethru::pipeline::{RunOptions, run};
-use seethru::render::{RenderContext, RenderSettings};
-use seethru::views::View;
+use seethru::render::accel::BvhKind;
+use seethru::render::views::View;
+use seethru::render::{integrator::RenderContext, settings::RenderSettings};
+use seethru::system::{options::RunOptions, pipeline::run};
+use seethru::util::color::encode_srgb8;
 
 #[test]
 fn views_match_their_goldens() {
@@ -37,7 +37,7 @@ fn views_match_their_goldens() {
     }
 }
 
-fn to_image(frame: &seethru::frame::Frame) -> image::RgbImage {
+fn to_image(frame: &seethru::render::frame::Frame) -> image::RgbImage {
     image::RgbImage::from_fn(frame.width, frame.height, |x, y| {
         image::Rgb(encode_srgb8(frame.color[frame.index(x, y)]))
     })

@@ -3,12 +3,21 @@
 
 mod common;
 
-use seethru::analysis::{ForeshorteningParams, OcclusionParams, physical};
-use seethru::display::DisplayModel;
-use seethru::metrics::measure;
-use seethru::pipeline::{RunOptions, WorkingDistance, run};
-use seethru::ratio::{RatioResult, Setup, measure_ratio};
-use seethru::render::RenderContext;
+use seethru::analysis::{
+    paper::{ForeshorteningParams, OcclusionParams},
+    physical,
+};
+use seethru::measure::metrics::measure;
+use seethru::measure::{
+    ratio::{RatioResult, measure_ratio},
+    ratio_setup::Setup,
+};
+use seethru::render::integrator::RenderContext;
+use seethru::system::display::DisplayModel;
+use seethru::system::{
+    options::{RunOptions, WorkingDistance},
+    pipeline::run,
+};
 
 fn occlusion(l: f64, b1: f64, d2: f64, d1: f64, b_h: f64) -> Setup {
     Setup::Occlusion(OcclusionParams { l, b1, d2, d1, b_h })
@@ -105,7 +114,7 @@ fn impossible_setups_are_rejected() {
 }
 
 /// A wall at `wall` metres behind a display at the origin; the model plane at `d2`.
-fn wall_run(wall: f64, d2: f64) -> (RenderContext, seethru::pipeline::RunResult) {
+fn wall_run(wall: f64, d2: f64) -> (RenderContext, seethru::system::pipeline::RunResult) {
     let setup = common::WallScene {
         wall,
         eye: [0.0, 0.0, 0.7],

@@ -4,14 +4,17 @@
 mod common;
 
 use glam::DVec3;
-use seethru::accel::BvhKind;
-use seethru::analysis::{CropParams, Side};
-use seethru::display::MISSING_ID;
-use seethru::head::{detect, eye_from_detection};
-use seethru::pipeline::{HeadSource, Outside, RunOptions, WorkingDistance, run};
-use seethru::render::{RenderContext, RenderSettings};
-use seethru::shapes::box_face;
-use seethru::views::View;
+use seethru::analysis::paper::{CropParams, Side};
+use seethru::render::accel::BvhKind;
+use seethru::render::views::View;
+use seethru::render::{integrator::RenderContext, settings::RenderSettings};
+use seethru::scene::shapes::box_face;
+use seethru::system::display::MISSING_ID;
+use seethru::system::head::{detect, eye_from_detection};
+use seethru::system::{
+    options::{HeadSource, Outside, RunOptions, WorkingDistance},
+    pipeline::run,
+};
 
 /// The wall scene with the wall at `d2` and the frontal half angle `frontal_half_angle`.
 fn context(d2: f64, frontal_half_angle: f64) -> RenderContext {
@@ -24,7 +27,7 @@ fn context(d2: f64, frontal_half_angle: f64) -> RenderContext {
 }
 
 /// Pixels of the driver's view where the display is (from the `occluded` frame's ids).
-fn display_mask(ctx: &RenderContext, occluded: &seethru::frame::Frame) -> Vec<bool> {
+fn display_mask(ctx: &RenderContext, occluded: &seethru::render::frame::Frame) -> Vec<bool> {
     occluded
         .object_id
         .iter()
@@ -192,7 +195,8 @@ fn the_head_tracker_recovers_the_eye_better_at_higher_resolution() {
     let ctx = RenderContext::new(scene, BvhKind::Cwbvh).unwrap();
     let truth = ctx.scene.eye();
     let obstacle_from_world = ctx.scene.obstacle.world_from_obstacle.inverse();
-    let back_from_world = |back: &seethru::camera::Camera| back.world_from_camera.inverse();
+    let back_from_world =
+        |back: &seethru::geometry::camera::Camera| back.world_from_camera.inverse();
     let mut errors = Vec::new();
     for (w, h) in [(320, 240), (640, 480), (1280, 960)] {
         let back = ctx.scene.back.with_resolution(w, h);

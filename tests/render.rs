@@ -3,12 +3,12 @@
 mod common;
 
 use glam::{DVec2, DVec3};
-use seethru::accel::BvhKind;
-use seethru::frame::Frame;
-use seethru::output::{read_exr, write_exr};
-use seethru::render::{RenderContext, RenderSettings};
-use seethru::views::View;
-use seethru::world::view_bit;
+use seethru::io::frame_files::{read_exr, write_exr};
+use seethru::render::accel::BvhKind;
+use seethru::render::frame::Frame;
+use seethru::render::views::View;
+use seethru::render::{integrator::RenderContext, settings::RenderSettings};
+use seethru::scene::world::view_bit;
 
 fn minimal_context() -> RenderContext {
     RenderContext::new(common::parse(common::MINIMAL).unwrap(), BvhKind::Cwbvh).unwrap()

@@ -5,9 +5,12 @@ mod common;
 #[test]
 fn quick_reproduction_reports_the_papers_experiments() {
     let dir = tempfile::tempdir().unwrap();
-    let report =
-        seethru::reproduce::reproduce(&common::repo_path("scenes/das.toml"), dir.path(), true)
-            .unwrap();
+    let report = seethru::paper::reproduce::reproduce(
+        &common::repo_path("scenes/das.toml"),
+        dir.path(),
+        true,
+    )
+    .unwrap();
     let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
     let html = std::fs::read_to_string(dir.path().join("report.html")).unwrap();
     // Four das cases; θ_F = 30° with D = 1 m cannot cover the display, 63.5° nearly can.

@@ -2,8 +2,11 @@
 
 mod common;
 
-use seethru::pipeline::HeadSource;
-use seethru::sweep::{SweepOptions, parse_param, sweep};
+use seethru::measure::{
+    sweep::{SweepOptions, sweep},
+    sweep_grid::parse_param,
+};
+use seethru::system::options::HeadSource;
 
 #[test]
 fn sweeps_write_every_row_and_resume() {

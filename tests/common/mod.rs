@@ -6,7 +6,7 @@ pub mod golden;
 use std::path::{Path, PathBuf};
 
 use seethru::scene::Scene;
-use seethru::scene_file::{SceneError, SourceFile};
+use seethru::scene::source::{SceneError, SourceFile};
 
 pub fn repo_path(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
@@ -135,8 +135,12 @@ translate = [0.0, 0.0, -{wall}]
         )
     }
 
-    pub fn context(&self) -> seethru::render::RenderContext {
+    pub fn context(&self) -> seethru::render::integrator::RenderContext {
         let scene = parse_in(&repo_path("scenes"), "wall.toml", &self.text()).unwrap();
-        seethru::render::RenderContext::new(scene, seethru::accel::BvhKind::Cwbvh).unwrap()
+        seethru::render::integrator::RenderContext::new(
+            scene,
+            seethru::render::accel::BvhKind::Cwbvh,
+        )
+        .unwrap()
     }
 }

@@ -1,0 +1,81 @@
+//! `seethru analyze`: the paper's claims beside seethru's values, and every closed form at a
+//! parameter set.
+
+use anyhow::Result;
+use seethru::paper::claims::{AnalyzeParams, claims_table, evaluate, paper_claims};
+
+#[derive(clap::Args)]
+pub struct Analyze {
+    /// Print JSON instead of tables.
+    #[arg(long)]
+    json: bool,
+    /// Eye distance from the display d1 [m].
+    #[arg(long, default_value_t = 1.0)]
+    d1: f64,
+    /// Working distance d2 [m] (use inf for the d2 → ∞ model).
+    #[arg(long, default_value_t = 1.0)]
+    d2: f64,
+    /// Lateral eye offset b_h [m] (> 0: the eye on the side of the left crop R1).
+    #[arg(long = "bh", default_value_t = 0.125, allow_hyphen_values = true)]
+    b_h: f64,
+    /// Display width D [m].
+    #[arg(long, default_value_t = 0.5)]
+    width: f64,
+    /// Frontal half angle θ_F [degrees].
+    #[arg(long = "theta-f", default_value_t = 80.0)]
+    theta_f: f64,
+    /// Frontal image width [pixels].
+    #[arg(long = "frontal-px", default_value_t = 1280)]
+    frontal_px: u32,
+    /// Occluder depth L [m].
+    #[arg(long = "L", default_value_t = 1.0)]
+    occluder_depth: f64,
+    /// Lateral position of the object's corner b1 [m].
+    #[arg(long, default_value_t = 0.25, allow_hyphen_values = true)]
+    b1: f64,
+    /// Length of the angled surface l [m].
+    #[arg(long = "l", default_value_t = 1.0)]
+    surface_length: f64,
+    /// Angle of the surface γ [degrees].
+    #[arg(long, default_value_t = 45.0, allow_hyphen_values = true)]
+    gamma: f64,
+    /// Tolerance of the d2_min bound, as a fraction of R(∞).
+    #[arg(long, default_value_t = 0.05)]
+    tolerance: f64,
+}
+
+impl Analyze {
+    pub fn run(self) -> Result<()> {
+        let params = AnalyzeParams {
+            d1: self.d1,
+            d2: self.d2,
+            b_h: self.b_h,
+            width: self.width,
+            theta_f_deg: self.theta_f,
+            frontal_px: self.frontal_px,
+            occluder_depth: self.occluder_depth,
+            b1: self.b1,
+            surface_length: self.surface_length,
+            gamma_deg: self.gamma,
+            tolerance: self.tolerance,
+        };
+        params.validate().map_err(anyhow::Error::msg)?;
+        let claims = paper_claims();
+        let values = evaluate(&params);
+        if self.json {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(
+                    &serde_json::json!({"claims": claims, "evaluation": values})
+                )?
+            );
+        } else {
+            print!("{}", claims_table(&claims));
+            println!(
+                "\nEvery closed form at the given parameters:\n{}",
+                serde_json::to_string_pretty(&values)?
+            );
+        }
+        Ok(())
+    }
+}

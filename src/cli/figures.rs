@@ -1,0 +1,23 @@
+//! `seethru figures`: the paper's Fig. 3–5 and the physical-unit sensitivity figure.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+
+#[derive(clap::Args)]
+pub struct Figures {
+    #[arg(long)]
+    out: PathBuf,
+}
+
+impl Figures {
+    pub fn run(self) -> Result<()> {
+        let names = seethru::paper::figures::write_all(&self.out)?;
+        eprintln!(
+            "wrote {} figures (PNG + CSV) to {}",
+            names.len(),
+            self.out.display()
+        );
+        Ok(())
+    }
+}

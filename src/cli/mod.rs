@@ -1,0 +1,71 @@
+//! The commands: each file holds one command's arguments and runs it through the library.
+
+mod analyze;
+mod args;
+mod bench;
+mod export;
+mod figures;
+mod measure;
+mod ratio;
+mod render;
+mod reproduce;
+mod run;
+mod sweep;
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(
+    name = "seethru",
+    version,
+    about = "Simulates video see-through displays for driver assistance and measures how well they work"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Render views of a scene: colour PNG, id PNG and an EXR with every AOV per view.
+    Render(render::Render),
+    /// Run the see-through system: truth, occluded, frontal, back, display and seethru views,
+    /// each as PNG, ids PNG and EXR, and run.json with every parameter and the crop.
+    Run(run::Run),
+    /// Observed p_cam/p_user of the paper's occlusion or foreshortening setup: predicted,
+    /// observed and the uncertainty pixel quantisation leaves.
+    Ratio(ratio::Ratio),
+    /// Reproduce the paper's §5: report.md, a self-contained report.html and report.json.
+    Reproduce(reproduce::Reproduce),
+    /// Metrics for every combination of parameter values, as CSV and a plot; resumable.
+    /// Parameters: theta_f, d2, display_width, eye_x, eye_z, head_bias_x_cm, frontal_width.
+    Sweep(sweep::Sweep),
+    /// Recompute metrics.json and the misregistration maps of a `run` directory from its EXRs.
+    Measure(measure::Measure),
+    /// Write the scene's triangles (.obj or .glb) and its cameras (<name>.cameras.json).
+    Export(export::Export),
+    /// Regenerate the paper's Fig. 3–5 and the physical-unit sensitivity figure (PNG + CSV).
+    Figures(figures::Figures),
+    /// The paper's numerical claims beside seethru's values; every closed form at a parameter set.
+    Analyze(analyze::Analyze),
+    /// Benchmark: BVH build time, rays per second, frame times; ends with one JSON line.
+    Bench(bench::Bench),
+}
+
+impl Command {
+    pub fn run(self) -> Result<()> {
+        match self {
+            Command::Render(c) => c.run(),
+            Command::Run(c) => c.run(),
+            Command::Ratio(c) => c.run(),
+            Command::Reproduce(c) => c.run(),
+            Command::Sweep(c) => c.run(),
+            Command::Measure(c) => c.run(),
+            Command::Export(c) => c.run(),
+            Command::Figures(c) => c.run(),
+            Command::Analyze(c) => c.run(),
+            Command::Bench(c) => c.run(),
+        }
+    }
+}

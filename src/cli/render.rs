@@ -1,0 +1,70 @@
+//! `seethru render`: views of a scene as colour PNG, id PNG and an EXR with every AOV.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use seethru::io::frame_files::write_frame;
+use seethru::render::integrator::RenderContext;
+use seethru::render::settings::{RenderSettings, check_spp, resized};
+use seethru::render::views::View;
+use seethru::scene::Scene;
+
+use crate::cli::args::{RenderArgs, with_threads};
+
+#[derive(clap::Args)]
+pub struct Render {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    /// View to render; repeat for several. Default: all four.
+    #[arg(long = "view", value_enum)]
+    views: Vec<View>,
+    /// Output directory.
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    render: RenderArgs,
+}
+
+impl Render {
+    pub fn run(self) -> Result<()> {
+        let views = if self.views.is_empty() {
+            View::ALL.to_vec()
+        } else {
+            self.views.clone()
+        };
+        with_threads(self.render.threads, || {
+            render_views(&self.scene, &views, &self.out, &self.render)
+        })?
+    }
+}
+
+/// Renders `views` of the scene into `out` (created if needed).
+fn render_views(scene_path: &Path, views: &[View], out: &Path, options: &RenderArgs) -> Result<()> {
+    check_spp(options.spp)?;
+    let scene = Scene::load(scene_path)?;
+    // Check every camera before the first (possibly long) render.
+    let cameras = views
+        .iter()
+        .map(|v| resized(v.camera(&scene), options.width, options.height))
+        .collect::<Result<Vec<_>>>()?;
+    let context = RenderContext::new(scene, options.bvh)?;
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create output directory {}", out.display()))?;
+    let settings = RenderSettings {
+        spp: options.spp,
+        progress: true,
+    };
+    for (view, camera) in views.iter().zip(&cameras) {
+        let (frame, stats) = context.render(camera, view.bit(), settings, view.name());
+        write_frame(&frame, out, view.name())?;
+        eprintln!(
+            "{}: {}×{} in {:.2} s → {}",
+            view.name(),
+            camera.width,
+            camera.height,
+            stats.seconds,
+            out.join(format!("{}.png", view.name())).display()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,34 @@
+//! `seethru reproduce`: the paper's §5 as report.md, report.html and report.json.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+
+use crate::cli::args::with_threads;
+
+#[derive(clap::Args)]
+pub struct Reproduce {
+    #[arg(long)]
+    out: PathBuf,
+    /// Small renders (CI-sized).
+    #[arg(long)]
+    quick: bool,
+    /// The driver-assistance scene.
+    #[arg(long, default_value = "scenes/das.toml")]
+    scene: PathBuf,
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+impl Reproduce {
+    pub fn run(self) -> Result<()> {
+        with_threads(self.threads, || {
+            seethru::paper::reproduce::reproduce(&self.scene, &self.out, self.quick)
+        })??;
+        eprintln!(
+            "wrote report.md, report.html and report.json to {}",
+            self.out.display()
+        );
+        Ok(())
+    }
+}

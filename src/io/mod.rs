@@ -1,0 +1,7 @@
+//! Files the simulator writes (and reads back): frames as PNG and EXR, plots, scene exports,
+//! all written atomically.
+
+pub mod atomic;
+pub mod export;
+pub mod frame_files;
+pub mod plot;

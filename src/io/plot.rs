@@ -1,0 +1,182 @@
+//! Line plots (PNG, with their data as CSV beside them) drawn with plotters and the bundled
+//! font.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::{Context, Result, anyhow};
+use plotters::prelude::*;
+
+use crate::io::atomic::{write_atomically, write_text};
+
+/// One curve of a figure.
+pub struct Series {
+    pub label: String,
+    pub points: Vec<(f64, f64)>,
+    /// Drawn dashed (bounds that vary per curve).
+    pub dashed: bool,
+}
+
+impl Series {
+    pub fn new(label: String, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            label,
+            points,
+            dashed: false,
+        }
+    }
+}
+
+/// A line plot: curves, dashed horizontal bounds and marked points.
+pub struct Figure {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub x_range: (f64, f64),
+    pub y_range: (f64, f64),
+    pub series: Vec<Series>,
+    /// Horizontal dashed lines: (y, label).
+    pub bounds: Vec<(f64, String)>,
+    /// Points marked on the curves (e.g. the admissible d2): (x, y, curve index).
+    pub marks: Vec<(f64, f64, usize)>,
+    pub legend: SeriesLabelPosition,
+}
+
+const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+const SIZE: (u32, u32) = (900, 600);
+
+pub fn register_font() -> Result<()> {
+    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+        .map_err(|_| anyhow!("the bundled font is invalid"))
+}
+
+fn color(i: usize) -> RGBColor {
+    const PALETTE: [RGBColor; 6] = [
+        RGBColor(31, 119, 180),
+        RGBColor(255, 127, 14),
+        RGBColor(44, 160, 44),
+        RGBColor(214, 39, 40),
+        RGBColor(148, 103, 189),
+        RGBColor(140, 86, 75),
+    ];
+    PALETTE[i % PALETTE.len()]
+}
+
+impl Figure {
+    /// The data as CSV: one row per x of the first series, one column per series.
+    pub fn csv(&self) -> String {
+        let mut s = String::from("x");
+        for series in &self.series {
+            let _ = write!(s, ",{}", series.label.replace(',', ";"));
+        }
+        s.push('\n');
+        let rows = self.series.first().map_or(0, |f| f.points.len());
+        for i in 0..rows {
+            let _ = write!(s, "{}", self.series[0].points[i].0);
+            for series in &self.series {
+                let _ = write!(s, ",{}", series.points[i].1);
+            }
+            s.push('\n');
+        }
+        s
+    }
+
+    /// Renders the figure to an RGB buffer.
+    pub fn render(&self) -> Result<Vec<u8>> {
+        register_font()?;
+        let mut buffer = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut buffer, SIZE).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+            let mut chart = ChartBuilder::on(&root)
+                .caption(&self.title, ("sans-serif", 22))
+                .margin(15)
+                .x_label_area_size(45)
+                .y_label_area_size(65)
+                .build_cartesian_2d(
+                    self.x_range.0..self.x_range.1,
+                    self.y_range.0..self.y_range.1,
+                )
+                .map_err(|e| anyhow!("{e}"))?;
+            chart
+                .configure_mesh()
+                .x_desc(&self.x_label)
+                .y_desc(&self.y_label)
+                .label_style(("sans-serif", 15))
+                .axis_desc_style(("sans-serif", 17))
+                .draw()
+                .map_err(|e| anyhow!("{e}"))?;
+            let mut curve = 0;
+            for series in &self.series {
+                let (lo, hi) = self.y_range;
+                let visible: Vec<(f64, f64)> = series
+                    .points
+                    .iter()
+                    .copied()
+                    .filter(|(_, y)| (lo..=hi).contains(y))
+                    .collect();
+                if series.dashed {
+                    // Same colour as the curve before it, short dashes, no legend entry.
+                    let c = color(curve.max(1) - 1);
+                    let dashes = visible
+                        .chunks(6)
+                        .map(|w| PathElement::new(w[..w.len().min(3)].to_vec(), c.stroke_width(1)));
+                    chart.draw_series(dashes).map_err(|e| anyhow!("{e}"))?;
+                    continue;
+                }
+                let c = color(curve);
+                curve += 1;
+                chart
+                    .draw_series(LineSeries::new(visible, c.stroke_width(2)))
+                    .map_err(|e| anyhow!("{e}"))?
+                    .label(&series.label)
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                    });
+            }
+            for (y, label) in &self.bounds {
+                let dashes = (0..200).map(|k| {
+                    let x0 = self.x_range.0 + (self.x_range.1 - self.x_range.0) * k as f64 / 200.0;
+                    let x1 = x0 + (self.x_range.1 - self.x_range.0) / 400.0;
+                    PathElement::new(vec![(x0, *y), (x1, *y)], BLACK.stroke_width(1))
+                });
+                chart
+                    .draw_series(dashes)
+                    .map_err(|e| anyhow!("{e}"))?
+                    .label(label)
+                    .legend(|(x, y)| {
+                        PathElement::new(
+                            vec![(x, y), (x + 6, y), (x + 12, y)],
+                            BLACK.stroke_width(1),
+                        )
+                    });
+            }
+            let inside = |x: f64| (self.x_range.0..=self.x_range.1).contains(&x);
+            for &(x, y, i) in self.marks.iter().filter(|m| inside(m.0)) {
+                chart
+                    .draw_series(std::iter::once(Circle::new((x, y), 6, color(i).filled())))
+                    .map_err(|e| anyhow!("{e}"))?;
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 15))
+                .position(self.legend.clone())
+                .draw()
+                .map_err(|e| anyhow!("{e}"))?;
+            root.present().map_err(|e| anyhow!("{e}"))?;
+        }
+        Ok(buffer)
+    }
+
+    /// Writes `<dir>/<name>.png` and `<dir>/<name>.csv`.
+    pub fn write(&self, dir: &Path, name: &str) -> Result<()> {
+        let rgb = self.render()?;
+        let img = image::RgbImage::from_raw(SIZE.0, SIZE.1, rgb).context("plot buffer size")?;
+        write_atomically(&dir.join(format!("{name}.png")), |tmp| {
+            Ok(img.save_with_format(tmp, image::ImageFormat::Png)?)
+        })?;
+        write_text(&dir.join(format!("{name}.csv")), &self.csv())
+    }
+}

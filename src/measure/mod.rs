@@ -1,0 +1,9 @@
+//! Measurements of the see-through display against the ground truth: per-pixel metrics,
+//! the observed p_cam/p_user of the paper's setups, and sweeps over parameters.
+
+pub mod maps;
+pub mod metrics;
+pub mod ratio;
+pub mod ratio_setup;
+pub mod sweep;
+pub mod sweep_grid;

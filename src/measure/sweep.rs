@@ -1,0 +1,239 @@
+//! `seethru sweep`: the metrics of every combination of parameter values, as CSV and a plot.
+//! Configurations render in parallel; the CSV is rewritten whole after every finished
+//! configuration, so an interrupted sweep resumes without redoing finished rows.
+
+use std::collections::HashSet;
+use std::path::Path;
+use std::sync::Mutex;
+
+use anyhow::{Context, Result, bail};
+use rayon::prelude::*;
+
+use crate::io::atomic::write_text;
+use crate::io::plot::{Figure, Series};
+use crate::measure::metrics::measure;
+use crate::measure::sweep_grid::{Param, combinations, configure};
+use crate::render::accel::BvhKind;
+use crate::render::integrator::RenderContext;
+use crate::scene::Scene;
+use crate::system::options::{HeadSource, Outside, RunOptions};
+use crate::system::pipeline::run;
+
+const METRIC_COLUMNS: [&str; 11] = [
+    "misregistration_mean_arcmin",
+    "misregistration_p95_arcmin",
+    "misregistration_max_arcmin",
+    "border_mean_arcmin",
+    "border_p95_arcmin",
+    "psnr_db",
+    "ssim",
+    "missing_fraction",
+    "display_outside_frontal_fraction",
+    "R1",
+    "R2",
+];
+
+fn metric_row(metrics: &serde_json::Value, report: &serde_json::Value) -> Vec<f64> {
+    let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+    let d = &metrics["display"];
+    let b = &metrics["border"];
+    vec![
+        f(&d["misregistration_arcmin"]["mean"]),
+        f(&d["misregistration_arcmin"]["p95"]),
+        f(&d["misregistration_arcmin"]["max"]),
+        f(&b["misregistration_arcmin"]["mean"]),
+        f(&b["misregistration_arcmin"]["p95"]),
+        f(&d["psnr_db"]),
+        f(&d["ssim"]),
+        f(&metrics["missing"]["fraction"]),
+        f(&report["missing_fraction"]),
+        f(&report["crop"]["R1_left"]),
+        f(&report["crop"]["R2_right"]),
+    ]
+}
+
+pub struct SweepOptions {
+    pub width: u32,
+    pub spp: u32,
+    pub head: HeadSource,
+    pub band: u32,
+}
+
+/// Runs the sweep; writes `csv` (and `<csv>.png`); returns the number of rows computed now.
+pub fn sweep(
+    scene_path: &Path,
+    params: &[Param],
+    csv: &Path,
+    options: &SweepOptions,
+) -> Result<usize> {
+    if params.is_empty() {
+        bail!("give at least one --param");
+    }
+    let mut names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
+    names.sort_unstable();
+    if names.windows(2).any(|w| w[0] == w[1]) {
+        bail!("a parameter is given twice");
+    }
+    let base = Scene::load(scene_path)?;
+    let base_options = RunOptions {
+        width: Some(options.width),
+        spp: options.spp,
+        head: options.head,
+        outside: Outside::Black,
+        back_width: Some(if options.head == HeadSource::Estimated {
+            base.back.width
+        } else {
+            32
+        }),
+        ..RunOptions::default()
+    };
+    let configs = combinations(params);
+    // Validate every configuration before rendering any.
+    for c in &configs {
+        configure(&base, &base_options, c)?;
+    }
+    let header: Vec<String> = ["index".to_string()]
+        .into_iter()
+        .chain(params.iter().map(|p| p.name.clone()))
+        .chain(METRIC_COLUMNS.iter().map(|s| s.to_string()))
+        .collect();
+    let header_line = header.join(",");
+    // Rows already done (same header, same parameter values at the same index).
+    let mut rows: Vec<(usize, String)> = Vec::new();
+    if let Ok(text) = std::fs::read_to_string(csv) {
+        let mut lines = text.lines();
+        if lines.next() != Some(header_line.as_str()) {
+            bail!(
+                "{} exists with other columns; remove it or choose another --out",
+                csv.display()
+            );
+        }
+        for line in lines {
+            let fields: Vec<&str> = line.split(',').collect();
+            let index: usize = fields
+                .first()
+                .and_then(|i| i.parse().ok())
+                .with_context(|| format!("{}: malformed row `{line}`", csv.display()))?;
+            let matches = configs
+                .get(index)
+                .is_some_and(|c| c.iter().zip(&fields[1..]).all(|((_, v), f)| v == f));
+            if matches && fields.len() == header.len() {
+                rows.push((index, line.to_string()));
+            }
+        }
+    }
+    let done: HashSet<usize> = rows.iter().map(|(i, _)| *i).collect();
+    let todo: Vec<usize> = (0..configs.len()).filter(|i| !done.contains(i)).collect();
+    let rows = Mutex::new(rows);
+    let write = |rows: &mut Vec<(usize, String)>| -> Result<()> {
+        rows.sort_by_key(|(i, _)| *i);
+        let body: String = rows.iter().map(|(_, l)| format!("{l}\n")).collect();
+        write_text(csv, &format!("{header_line}\n{body}"))
+    };
+    todo.par_iter().try_for_each(|&index| -> Result<()> {
+        let config = &configs[index];
+        let (scene, run_options) = configure(&base, &base_options, config)?;
+        let ctx = RenderContext::new(scene, BvhKind::Cwbvh)?;
+        let result =
+            run(&ctx, &run_options).with_context(|| format!("configuration {config:?}"))?;
+        let (_, metrics) = measure(
+            &ctx,
+            &ctx.scene,
+            ctx.scene.eye(),
+            [&result.truth, &result.seethru, &result.occluded],
+            options.band,
+        );
+        let values = metric_row(&metrics, &result.report);
+        let line = std::iter::once(index.to_string())
+            .chain(config.iter().map(|(_, v)| v.clone()))
+            .chain(values.iter().map(|v| format!("{v}")))
+            .collect::<Vec<_>>()
+            .join(",");
+        let mut rows = rows
+            .lock()
+            .map_err(|_| anyhow::anyhow!("a sweep worker panicked"))?;
+        rows.push((index, line));
+        write(&mut rows)
+    })?;
+    let mut rows = rows
+        .into_inner()
+        .map_err(|_| anyhow::anyhow!("a sweep worker panicked"))?;
+    write(&mut rows)?;
+    plot(csv, params, &rows)?;
+    Ok(todo.len())
+}
+
+/// Mean misregistration against the first parameter, one curve per value of the second.
+fn plot(csv: &Path, params: &[Param], rows: &[(usize, String)]) -> Result<()> {
+    let x_of = |s: &str| s.parse::<f64>().ok().filter(|x| x.is_finite());
+    if params[0].values.iter().any(|v| x_of(v).is_none()) {
+        return Ok(()); // A non-numeric axis (d2 = inf, auto): the CSV is the result.
+    }
+    let column = 1 + params.len();
+    let mut series: Vec<Series> = Vec::new();
+    let group_values = params
+        .get(1)
+        .map_or(vec![String::new()], |p| p.values.clone());
+    for g in &group_values {
+        let mut points = Vec::new();
+        for (_, line) in rows {
+            let f: Vec<&str> = line.split(',').collect();
+            if params.len() > 1 && f[2] != g {
+                continue;
+            }
+            if let (Some(x), Ok(y)) = (x_of(f[1]), f[column].parse::<f64>()) {
+                points.push((x, y));
+            }
+        }
+        let label = if g.is_empty() {
+            "mean misregistration".to_string()
+        } else {
+            format!("{} = {g}", params[1].name)
+        };
+        series.push(Series::new(label, points));
+    }
+    let xs: Vec<f64> = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.0))
+        .collect();
+    let ys: Vec<f64> = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .filter(|y| y.is_finite())
+        .collect();
+    if xs.is_empty() || ys.is_empty() {
+        return Ok(());
+    }
+    let (x0, x1) = xs
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    let y1 = ys.iter().copied().fold(0.0, f64::max) * 1.1 + 1e-9;
+    let figure = Figure {
+        title: format!(
+            "Sweep of {}",
+            params
+                .iter()
+                .map(|p| p.name.as_str())
+                .collect::<Vec<_>>()
+                .join(" × ")
+        ),
+        x_label: params[0].name.clone(),
+        y_label: "mean misregistration in the display [arcmin]".into(),
+        x_range: (x0, if x1 > x0 { x1 } else { x0 + 1.0 }),
+        y_range: (0.0, y1),
+        series,
+        bounds: vec![(1.0, "1′".into())],
+        marks: Vec::new(),
+        legend: plotters::prelude::SeriesLabelPosition::UpperRight,
+    };
+    let stem = csv
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| "sweep".into());
+    figure.write(
+        csv.parent().unwrap_or(Path::new(".")),
+        &format!("{stem}_plot"),
+    )
+}

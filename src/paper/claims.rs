@@ -1,0 +1,257 @@
+//! `seethru analyze`: every numerical claim of the paper beside the value the code computes,
+//! and all closed forms evaluated at a parameter set given on the command line.
+
+use serde::Serialize;
+use serde_json::json;
+
+use crate::analysis::examples::{fig3_params, paper_foreshortening, paper_occlusion};
+use crate::analysis::paper::{CropParams, ForeshorteningParams, OcclusionParams, Side, k_px};
+use crate::analysis::physical;
+
+/// One claim of the paper and what seethru computes for it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Claim {
+    /// Where in the paper, and what.
+    pub claim: String,
+    /// The paper's number (NaN where the paper prints a formula, not a number).
+    pub paper: f64,
+    pub seethru: f64,
+    pub note: String,
+}
+
+fn claim(claim: &str, paper: f64, seethru: f64, note: &str) -> Claim {
+    Claim {
+        claim: claim.into(),
+        paper,
+        seethru,
+        note: note.into(),
+    }
+}
+
+pub fn paper_claims() -> Vec<Claim> {
+    let fig3 = fig3_params(80.0);
+    let occ = paper_occlusion();
+    let fore = paper_foreshortening();
+    let small_bh = OcclusionParams {
+        l: 1.0,
+        b1: 0.6,
+        d2: 3.0,
+        d1: 1.0,
+        b_h: 0.0,
+    };
+    let arcmin = physical::ARCMIN_PER_RAD;
+    vec![
+        claim(
+            "§5.1 Fig. 3: θ_F = 80°, R1(d2) > 0.95·R1(∞) for d2 > [m]",
+            0.9,
+            fig3.d2_min(Side::Left, 0.05).unwrap_or(f64::NAN),
+            "closed form d2_min = D / (4·0.05·tan θ_F·R1(∞))",
+        ),
+        claim(
+            "  same bound for the right ratio R2 [m]",
+            f64::NAN,
+            fig3.d2_min(Side::Right, 0.05).unwrap_or(f64::NAN),
+            "not stated in the paper",
+        ),
+        claim(
+            "§5.2 occlusion p_cam/p_user (L=5, b1=−0.35, d2=6.3, d1=2.5, b_h=1.75), eq. OCLUSION",
+            -0.73,
+            occ.ratio(),
+            "the paper measured −0.71 in Unity",
+        ),
+        claim(
+            "§5.2 foreshortening p_cam/p_user (l=5, b1=−1.5, d2=1.3, d1=2, b_h=0.7, γ=90°), eq. FORESH1",
+            2.47,
+            fore.ratio(),
+            "the paper measured 2.64 in Unity",
+        ),
+        claim(
+            "§4.1 φ_d1 = ∂R1/∂d1 at Fig. 3's parameters (θ_F=80°, d2=1)",
+            f64::NAN,
+            fig3.phi_d1(Side::Left),
+            "eq. ANALYSIS_USR1; agrees with finite differences",
+        ),
+        claim(
+            "§4.1 φ_bh = ∂R1/∂b_h",
+            f64::NAN,
+            fig3.phi_bh(Side::Left),
+            "eq. ANALYSIS_USR2; agrees",
+        ),
+        claim(
+            "§4.1 φ_d2 = ∂R/∂d2 (paper's sign)",
+            fig3.phi_d2_as_printed(),
+            fig3.phi_d2(),
+            "erratum 1: eq. ANALYSIS_D2 has the wrong sign; R grows with d2",
+        ),
+        claim(
+            "§4.1 ∂φ_d2/∂d2 (paper's sign)",
+            -fig3.dphi_d2_dd2(),
+            fig3.dphi_d2_dd2(),
+            "erratum 2: follows from erratum 1; |φ_d2| still falls with d2",
+        ),
+        claim(
+            "§4.2 eq. OCLUSION3 at b_h → 0 (L=1, b1=0.6, d2=3, d1=1)",
+            small_bh.ratio_small_bh_as_printed(),
+            small_bh.ratio_small_bh(),
+            "erratum 3: 1 − d1/(d2−L) should read 1 + d1/(d2−L); exact ratio there: see tests",
+        ),
+        claim(
+            "§4.2 lim d2→∞ of FORESH1 for the paper's own γ = 90° case",
+            1.0,
+            fore.ratio_far_limit(),
+            "erratum 4: the limit is b1/(b1+b_h) when cos γ = 0",
+        ),
+        claim(
+            "physical: misregistration per 1 cm lateral head error (d1=0.8, d2=10) [arcmin]",
+            f64::NAN,
+            0.01 * physical::per_lateral_head_error(0.8, 10.0) * arcmin,
+            "independent of θ_F and D",
+        ),
+        claim(
+            "physical: misregistration per 1 m d2 error at the display edge (d1=0.8, d2=10, D=0.5) [arcmin]",
+            f64::NAN,
+            physical::per_d2_error(0.25, 0.8, 10.0) * arcmin,
+            "independent of θ_F",
+        ),
+        claim(
+            "physical: d2 → ∞ model for a scene at 10 m, display edge (d1=0.8, D=0.5) [arcmin]",
+            f64::NAN,
+            physical::infinite_plane_error(0.25, 0.8, 10.0) * arcmin,
+            "independent of θ_F",
+        ),
+    ]
+}
+
+/// A parameter set for evaluating every closed form (lengths in m, angles in degrees).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct AnalyzeParams {
+    pub d1: f64,
+    pub d2: f64,
+    pub b_h: f64,
+    pub width: f64,
+    pub theta_f_deg: f64,
+    /// Frontal image width, pixels (for K_px and the pixel angle).
+    pub frontal_px: u32,
+    pub occluder_depth: f64,
+    pub b1: f64,
+    pub surface_length: f64,
+    pub gamma_deg: f64,
+    /// Tolerance of the d2_min bound, fraction of R(∞).
+    pub tolerance: f64,
+}
+
+impl AnalyzeParams {
+    pub fn validate(&self) -> Result<(), String> {
+        let positive = [
+            ("d1", self.d1),
+            ("d2", self.d2),
+            ("width", self.width),
+            ("L", self.occluder_depth),
+            ("l", self.surface_length),
+            ("tolerance", self.tolerance),
+        ];
+        for (name, v) in positive {
+            if v.is_nan() || v <= 0.0 {
+                return Err(format!("--{name} must be > 0, got {v}"));
+            }
+        }
+        if !(self.theta_f_deg > 0.0 && self.theta_f_deg < 90.0) {
+            return Err(format!(
+                "--theta-f must be in (0, 90) degrees, got {}",
+                self.theta_f_deg
+            ));
+        }
+        if !self.b_h.is_finite() || !self.b1.is_finite() || !self.gamma_deg.is_finite() {
+            return Err("--bh, --b1 and --gamma must be finite".into());
+        }
+        if self.frontal_px == 0 {
+            return Err("--frontal-px must be ≥ 1".into());
+        }
+        Ok(())
+    }
+}
+
+/// Every closed form at `p`, as JSON.
+pub fn evaluate(p: &AnalyzeParams) -> serde_json::Value {
+    let crop = CropParams {
+        d1: p.d1,
+        d2: p.d2,
+        b_h: p.b_h,
+        width: p.width,
+        theta_f: p.theta_f_deg.to_radians(),
+    };
+    let side = |s: Side| {
+        json!({
+            "R": crop.cutting_ratio(s),
+            "R_inf": crop.cutting_ratio_at_infinity(s),
+            "K_m": crop.discarded_width(s),
+            "K_px": k_px(crop.cutting_ratio(s), p.frontal_px),
+            "phi_d1": crop.phi_d1(s),
+            "phi_bh": crop.phi_bh(s),
+            "d2_min_m": crop.d2_min(s, p.tolerance),
+        })
+    };
+    let occ = OcclusionParams {
+        l: p.occluder_depth,
+        b1: p.b1,
+        d2: p.d2,
+        d1: p.d1,
+        b_h: p.b_h,
+    };
+    let fore = ForeshorteningParams {
+        l: p.surface_length,
+        b1: p.b1,
+        d2: p.d2,
+        d1: p.d1,
+        b_h: p.b_h,
+        gamma: p.gamma_deg.to_radians(),
+    };
+    let arcmin = physical::ARCMIN_PER_RAD;
+    json!({
+        "parameters": p,
+        "left": side(Side::Left),
+        "right": side(Side::Right),
+        "phi_d2": crop.phi_d2(),
+        "dphi_d2_dd2": crop.dphi_d2_dd2(),
+        "occlusion": {"p_cam": occ.p_cam(), "p_user": occ.p_user(), "ratio": occ.ratio(), "ratio_far_approx": occ.ratio_far(), "ratio_small_bh_approx": occ.ratio_small_bh()},
+        "foreshortening": {"p_cam": fore.p_cam(), "p_user": fore.p_user(), "ratio": fore.ratio(), "ratio_far_limit": fore.ratio_far_limit()},
+        "physical_arcmin": {
+            "per_cm_lateral_head_error": 0.01 * physical::per_lateral_head_error(p.d1, p.d2) * arcmin,
+            "per_cm_head_distance_error_at_edge": 0.01 * physical::per_head_distance_error(0.5 * p.width + p.b_h.abs(), p.d1, p.d2) * arcmin,
+            "per_m_d2_error_at_edge": physical::per_d2_error(0.5 * p.width, p.d1, p.d2) * arcmin,
+            "infinite_plane_model_at_edge": physical::infinite_plane_error(0.5 * p.width, p.d1, p.d2) * arcmin,
+            "frontal_pixel": physical::frontal_pixel_angle(p.theta_f_deg.to_radians(), p.frontal_px, p.d1, p.d2) * arcmin,
+        },
+    })
+}
+
+fn fmt(v: f64) -> String {
+    if v.is_nan() {
+        "—".into()
+    } else {
+        format!("{v:.4}")
+    }
+}
+
+/// The claims as an aligned text table.
+pub fn claims_table(claims: &[Claim]) -> String {
+    let width = claims
+        .iter()
+        .map(|c| c.claim.chars().count())
+        .max()
+        .unwrap_or(0);
+    let mut out = format!(
+        "{:<width$}  {:>9}  {:>9}  note\n",
+        "claim", "paper", "seethru"
+    );
+    for c in claims {
+        out += &format!(
+            "{:<width$}  {:>9}  {:>9}  {}\n",
+            c.claim,
+            fmt(c.paper),
+            fmt(c.seethru),
+            c.note
+        );
+    }
+    out
+}

@@ -1,0 +1,181 @@
+//! `seethru reproduce`: the paper's §5 end to end — the das scene with the car close and far,
+//! each at θ_F = 30° and 63.5° with d2 → ∞; the occlusion and foreshortening cases; the
+//! figures — as `report.md`, a self-contained `report.html` and `report.json`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use serde_json::json;
+
+use crate::analysis::examples::{paper_foreshortening, paper_occlusion};
+use crate::io::atomic::write_text;
+use crate::io::frame_files::write_png;
+use crate::measure::maps::heatmap_rgb;
+use crate::measure::metrics::measure;
+use crate::measure::ratio::{RatioResult, measure_ratio_with_frames};
+use crate::measure::ratio_setup::Setup;
+use crate::paper::report::{CaseResult, Sizes, render_report};
+use crate::render::accel::BvhKind;
+use crate::render::frame::Frame;
+use crate::render::integrator::RenderContext;
+use crate::scene::Scene;
+use crate::system::options::{Outside, RunOptions};
+use crate::system::pipeline::run;
+use crate::util::color::encode_srgb8;
+
+fn frame_png(frame: &Frame, path: &Path) -> Result<()> {
+    let rgb = frame.color.iter().flat_map(|&c| encode_srgb8(c)).collect();
+    write_png(path, frame.width, frame.height, rgb)
+}
+
+/// The das scene with the car `distance` metres beyond the obstacle, a display of width
+/// `display_width` and the frontal half angle `theta_deg`.
+fn das_case(base: &Scene, distance: f64, display_width: f64, theta_deg: f64) -> Result<Scene> {
+    let mut scene = base.clone();
+    let obstacle_z = scene.obstacle.world_from_obstacle.translation.z;
+    let car = scene
+        .objects
+        .iter_mut()
+        .find(|o| o.name == "car")
+        .context("the scene has no object named `car`")?;
+    car.world_from_object.translation.z = obstacle_z - distance;
+    let car_x = car.world_from_object.translation.x;
+    // Keep the ball clear of a close car.
+    if let Some(ball) = scene.objects.iter_mut().find(|o| o.name == "ball")
+        && (ball.world_from_object.translation.z - (obstacle_z - distance)).abs() < 3.0
+    {
+        ball.world_from_object.translation.x = car_x + 2.6;
+    }
+    let scale = display_width / scene.obstacle.width;
+    scene.obstacle.width = display_width;
+    scene.obstacle.display_resolution[0] =
+        (scene.obstacle.display_resolution[0] as f64 * scale).round() as u32;
+    scene.frontal.half_angle_x = theta_deg.to_radians();
+    Ok(scene)
+}
+
+/// Runs the reproduction into `out`; returns `report.json`'s content.
+pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_json::Value> {
+    let sizes = if quick {
+        Sizes {
+            driver: 256,
+            frontal: 480,
+            ratio: 480,
+            spp: 1,
+        }
+    } else {
+        Sizes {
+            driver: 1280,
+            frontal: 1920,
+            ratio: 1920,
+            spp: 4,
+        }
+    };
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let base = Scene::load(scene_path)?;
+    let mut cases = Vec::new();
+    // §5.2 Figs. 4 and 5: the car close and far, θ_F = 30° and 63.5°, D = 1 m, d2 → ∞.
+    for (car_label, distance) in [("close", 4.0), ("far", 15.0)] {
+        for theta in [30.0, 63.5] {
+            let name = format!("car {car_label} (≈{distance} m), θ_F = {theta}°, D = 1 m");
+            let dir = format!("car_{car_label}_theta{}", theta as u32);
+            std::fs::create_dir_all(out.join(&dir))?;
+            let scene = das_case(&base, distance, 1.0, theta)?;
+            let ctx = RenderContext::new(scene, BvhKind::Cwbvh)?;
+            let options = RunOptions {
+                width: Some(sizes.driver),
+                frontal_width: Some(sizes.frontal),
+                back_width: Some(64),
+                spp: sizes.spp,
+                outside: Outside::Black,
+                ..RunOptions::default()
+            };
+            let result = run(&ctx, &options)?;
+            let (maps, metrics) = measure(
+                &ctx,
+                &ctx.scene,
+                ctx.scene.eye(),
+                [&result.truth, &result.seethru, &result.occluded],
+                5,
+            );
+            frame_png(&result.truth, &out.join(&dir).join("truth.png"))?;
+            frame_png(&result.seethru, &out.join(&dir).join("seethru.png"))?;
+            let (w, h, rgb) = heatmap_rgb(&maps, &result.truth)?;
+            write_png(&out.join(&dir).join("misregistration.png"), w, h, rgb)?;
+            cases.push(CaseResult {
+                name,
+                dir,
+                metrics,
+                run: result.report,
+            });
+        }
+    }
+    // §5.2 Figs. 6 and 7: the occlusion and foreshortening cases with the paper's parameters.
+    let setups = [
+        (
+            "occlusion (L=5, b1=−0.35, d2=6.3, d1=2.5, b_h=1.75)",
+            "occlusion",
+            Setup::Occlusion(paper_occlusion()),
+        ),
+        (
+            "foreshortening (l=5, b1=−1.5, d2=1.3, d1=2, b_h=0.7, γ=90°)",
+            "foreshortening",
+            Setup::Foreshortening(paper_foreshortening()),
+        ),
+    ];
+    let mut ratios: Vec<(String, String, RatioResult)> = Vec::new();
+    for (name, dir, setup) in setups {
+        std::fs::create_dir_all(out.join(dir))?;
+        let (r, frames) = measure_ratio_with_frames(&setup, sizes.ratio)?;
+        frame_png(&frames.truth, &out.join(dir).join("truth.png"))?;
+        frame_png(&frames.seethru, &out.join(dir).join("seethru.png"))?;
+        ratios.push((name.to_string(), dir.to_string(), r));
+    }
+    let figures = crate::paper::figures::write_all(&out.join("figures"))?;
+    let report = json!({
+        "quick": quick,
+        "scene": scene_path.display().to_string(),
+        "cases": cases.iter().map(|c| json!({"name": c.name, "dir": c.dir, "metrics": c.metrics, "run": c.run})).collect::<Vec<_>>(),
+        "ratios": ratios.iter().map(|(n, d, r)| json!({"name": n, "dir": d, "result": r})).collect::<Vec<_>>(),
+        "figures": figures,
+    });
+    write_text(
+        &out.join("report.json"),
+        &serde_json::to_string_pretty(&report)?,
+    )?;
+    write_text(
+        &out.join("report.md"),
+        &render_report(out, &cases, &ratios, &figures, &sizes, false)?,
+    )?;
+    write_text(
+        &out.join("report.html"),
+        &render_report(out, &cases, &ratios, &figures, &sizes, true)?,
+    )?;
+    Ok(report)
+}
+
+/// The default scene path: `scenes/das.toml` of the working directory.
+pub fn default_scene() -> PathBuf {
+    PathBuf::from("scenes/das.toml")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn das_case_moves_the_car_and_resizes_the_display() {
+        let base = Scene::load(Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenes/das.toml"
+        )))
+        .unwrap();
+        let scene = das_case(&base, 15.0, 1.0, 63.5).unwrap();
+        let car = scene.objects.iter().find(|o| o.name == "car").unwrap();
+        let obstacle_z = scene.obstacle.world_from_obstacle.translation.z;
+        assert!((car.world_from_object.translation.z - (obstacle_z - 15.0)).abs() < 1e-12);
+        assert_eq!(scene.obstacle.width, 1.0);
+        assert_eq!(scene.obstacle.display_resolution[0], 1000);
+        assert!((scene.frontal.half_angle_x.to_degrees() - 63.5).abs() < 1e-12);
+    }
+}

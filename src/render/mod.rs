@@ -1,0 +1,10 @@
+//! Rendering: the BVH, the integrator, the sky, and the frames of aligned AOVs it produces
+//! for each view.
+
+pub mod accel;
+pub mod frame;
+pub mod integrator;
+pub mod screen;
+pub mod settings;
+pub mod sky;
+pub mod views;

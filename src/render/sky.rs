@@ -1,0 +1,223 @@
+//! The sky: a horizon-to-zenith gradient with procedural clouds and the sun's disc, and the
+//! ambient light it casts. Everything here is a pure function of the direction, so it is
+//! deterministic and needs no textures.
+
+use glam::{Vec2, Vec3};
+
+use crate::scene::texture::Texture;
+
+use crate::scene::{Sky, Sun};
+use crate::util::color::srgb_to_linear3;
+use crate::util::sampling::{hash_u32, unit_float};
+
+/// Sky and sun in linear RGB, ready for shading.
+#[derive(Clone, Debug)]
+pub struct SkyModel {
+    zenith: Vec3,
+    horizon: Vec3,
+    ground: Vec3,
+    ambient: f32,
+    cloud_cover: f32,
+    cloud_height: f32,
+    cloud_size: f32,
+    /// Cloud noise over one period of the cloud layer, precomputed: evaluating five octaves
+    /// of noise per sky pixel cost more than tracing its ray.
+    clouds: Texture,
+    /// Unit direction towards the sun, world frame.
+    pub sun_direction: Vec3,
+    /// Sun irradiance on a surface facing it, linear RGB.
+    pub sun_irradiance: Vec3,
+}
+
+/// Cosine of the sun disc's angular radius as drawn in the sky (0.5°, twice the real one so
+/// that it shows at small resolutions).
+const SUN_DISC_COS: f32 = 0.999_962;
+
+impl SkyModel {
+    pub fn new(sky: &Sky, sun: &Sun) -> Self {
+        Self {
+            zenith: srgb_to_linear3(sky.zenith_color),
+            horizon: srgb_to_linear3(sky.horizon_color),
+            ground: srgb_to_linear3(sky.ground_color),
+            ambient: sky.ambient as f32,
+            cloud_cover: sky.cloud_cover as f32,
+            cloud_height: sky.cloud_height as f32,
+            cloud_size: sky.cloud_size as f32,
+            clouds: cloud_table(sky.cloud_seed),
+            sun_direction: sun.direction.as_vec3(),
+            sun_irradiance: srgb_to_linear3(sun.color) * sun.intensity as f32,
+        }
+    }
+
+    fn gradient(&self, dir: Vec3) -> Vec3 {
+        if dir.y < 0.0 {
+            return self.horizon.lerp(self.ground, (-dir.y * 8.0).min(1.0));
+        }
+        self.horizon.lerp(self.zenith, dir.y.sqrt())
+    }
+
+    /// Cloud density in [0, 1] seen in direction `dir` (upper hemisphere only).
+    pub fn cloud_density(&self, dir: Vec3) -> f32 {
+        let haze = smoothstep(0.02, 0.18, dir.y);
+        if haze == 0.0 || self.cloud_cover <= 0.0 {
+            return 0.0;
+        }
+        // Where the ray meets the cloud layer, in units of cloud size.
+        let p = Vec2::new(dir.x, dir.z) * (self.cloud_height / dir.y) / self.cloud_size;
+        let n = self.clouds.sample(p / CLOUD_PERIOD as f32).x;
+        let threshold = 0.72 - 0.45 * self.cloud_cover;
+        let density = ((n - threshold) / 0.12).clamp(0.0, 1.0);
+        // Far clouds dissolve into the haze at the horizon.
+        density * haze
+    }
+
+    /// Radiance seen along a ray that leaves the scene in direction `dir` (unit).
+    pub fn radiance(&self, dir: Vec3) -> Vec3 {
+        let base = self.gradient(dir);
+        let cloud = self.cloud_density(dir);
+        let cloud_color = Vec3::splat(0.9) * (0.55 + 0.45 * self.sun_direction.y.max(0.0));
+        let mut c = base.lerp(cloud_color, cloud);
+        if dir.dot(self.sun_direction) > SUN_DISC_COS && cloud < 0.5 {
+            c += self.sun_irradiance * 4.0;
+        }
+        c
+    }
+
+    /// Ambient irradiance on a surface with unit normal `n`: the sky above, the ground below.
+    pub fn ambient(&self, n: Vec3) -> Vec3 {
+        let sky_average = self.horizon.lerp(self.zenith, 0.5);
+        self.ground.lerp(sky_average, 0.5 + 0.5 * n.y) * self.ambient
+    }
+}
+
+fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// Cloud sizes per period of the cloud table; the pattern repeats every `CLOUD_PERIOD` cloud
+/// sizes (kilometres away, where the haze hides it).
+const CLOUD_PERIOD: u32 = 8;
+/// Texels of the cloud table per side.
+const CLOUD_TABLE: u32 = 512;
+
+fn cloud_table(seed: u32) -> Texture {
+    let n = CLOUD_TABLE;
+    let texels = (0..n * n)
+        .map(|i| {
+            let p = Vec2::new((i % n) as f32 + 0.5, (i / n) as f32 + 0.5)
+                * (CLOUD_PERIOD as f32 / n as f32);
+            Vec3::splat(fbm(p, seed))
+        })
+        .collect();
+    Texture {
+        width: n,
+        height: n,
+        texels,
+    }
+}
+
+/// Value noise in [0, 1] on the integer lattice, smoothly interpolated, repeating every
+/// `period` cells.
+fn value_noise(p: Vec2, seed: u32, period: u32) -> f32 {
+    let i = Vec2::new(fast_floor(p.x), fast_floor(p.y));
+    let f = p - i;
+    let corner = |dx: f32, dy: f32| {
+        let wrap = |v: f32| (v as i32).rem_euclid(period as i32) as u32;
+        let (x, y) = (wrap(i.x + dx), wrap(i.y + dy));
+        // One hash of the lattice point: the noise is evaluated ~20 times per sky pixel.
+        let key = x.wrapping_mul(0x8da6_b343) ^ y.wrapping_mul(0xd816_3841) ^ seed;
+        unit_float(hash_u32(key))
+    };
+    let u = f * f * (Vec2::splat(3.0) - 2.0 * f);
+    let top = corner(0.0, 0.0) + (corner(1.0, 0.0) - corner(0.0, 0.0)) * u.x;
+    let bottom = corner(0.0, 1.0) + (corner(1.0, 1.0) - corner(0.0, 1.0)) * u.x;
+    top + (bottom - top) * u.y
+}
+
+/// `floor` without a libm call (the x86-64 baseline has no rounding instruction).
+fn fast_floor(x: f32) -> f32 {
+    let t = x as i32 as f32;
+    if t > x { t - 1.0 } else { t }
+}
+
+/// Fractal sum of five octaves of value noise, in [0, 1], repeating every `CLOUD_PERIOD`.
+fn fbm(p: Vec2, seed: u32) -> f32 {
+    let (mut sum, mut amplitude, mut norm, mut q, mut period) = (0.0, 0.5, 0.0, p, CLOUD_PERIOD);
+    for octave in 0..5 {
+        sum += amplitude * value_noise(q, seed.wrapping_add(octave), period);
+        norm += amplitude;
+        amplitude *= 0.5;
+        // Doubling keeps every octave periodic; the integer shift decorrelates the lattices.
+        q = q * 2.0 + Vec2::new(17.0, 5.0);
+        period *= 2;
+    }
+    sum / norm
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn model(cover: f64) -> SkyModel {
+        let sky = Sky {
+            zenith_color: [0.2, 0.4, 0.9],
+            horizon_color: [0.8, 0.9, 1.0],
+            ground_color: [0.3, 0.3, 0.3],
+            ambient: 0.5,
+            cloud_cover: cover,
+            cloud_height: 1500.0,
+            cloud_size: 900.0,
+            cloud_seed: 7,
+        };
+        let sun = Sun {
+            direction: glam::DVec3::Y,
+            color: [1.0; 3],
+            intensity: 2.0,
+        };
+        SkyModel::new(&sky, &sun)
+    }
+
+    /// Fraction of upward directions (elevation above 30°) that see a cloud.
+    fn covered_fraction(m: &SkyModel) -> f32 {
+        let n = 4000;
+        let mut covered = 0;
+        for i in 0..n {
+            let a = i as f32 * 2.399_963;
+            let r = 0.8 * (i as f32 / n as f32).sqrt();
+            let dir = Vec3::new(r * a.cos(), 1.0, r * a.sin()).normalize();
+            if m.cloud_density(dir) > 0.5 {
+                covered += 1;
+            }
+        }
+        covered as f32 / n as f32
+    }
+
+    #[test]
+    fn cloud_cover_controls_the_cloudy_fraction() {
+        assert_eq!(covered_fraction(&model(0.0)), 0.0);
+        let (low, mid, high) = (
+            covered_fraction(&model(0.2)),
+            covered_fraction(&model(0.5)),
+            covered_fraction(&model(0.9)),
+        );
+        assert!(low < mid && mid < high, "{low} {mid} {high}");
+        assert!(mid > 0.05 && mid < 0.95);
+    }
+
+    #[test]
+    fn gradient_runs_from_horizon_to_zenith() {
+        let m = model(0.0);
+        assert!(
+            m.radiance(Vec3::new(1.0, 0.0, 0.0))
+                .abs_diff_eq(m.horizon, 1e-6)
+        );
+        // Straight up is the sun's disc in this model; look just beside it.
+        let up = Vec3::new(0.02, 1.0, 0.0).normalize();
+        assert!(
+            m.radiance(up)
+                .abs_diff_eq(m.horizon.lerp(m.zenith, up.y.sqrt()), 1e-6)
+        );
+        assert!(m.radiance(Vec3::Y).x > m.zenith.x + 1.0);
+    }
+}

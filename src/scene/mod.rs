@@ -1,0 +1,223 @@
+//! The scene description: what a scene file says, typed, validated and in world units.
+//!
+//! World frame: right-handed, metres, +y up. See `README.md` § "Scene format" for the
+//! parameter table of every object kind; the defaults below are the ones documented there.
+
+pub mod mesh_io;
+pub mod procedural;
+pub mod read;
+pub mod shapes;
+pub mod source;
+pub mod table_reader;
+pub mod texture;
+pub mod world;
+
+use std::path::PathBuf;
+
+use glam::{DAffine3, DVec3};
+
+use crate::geometry::camera::Camera;
+
+/// Which cameras can see an object. A bit set over [`CameraKind`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CameraKind {
+    /// The driver's eye (views `truth`, `occluded`, `seethru`).
+    Driver,
+    /// The frontal camera on the obstacle's far side.
+    Frontal,
+    /// The back camera on the display's top edge, facing the driver.
+    Back,
+}
+
+impl CameraKind {
+    pub const NAMES: [&'static str; 3] = ["driver", "frontal", "back"];
+
+    pub fn bit(self) -> u8 {
+        1 << self as u8
+    }
+
+    fn parse(name: &str) -> Self {
+        match name {
+            "driver" => CameraKind::Driver,
+            "frontal" => CameraKind::Frontal,
+            _ => CameraKind::Back,
+        }
+    }
+}
+
+/// A surface material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    /// Base colour, sRGB-encoded components in [0, 1] (as a colour picker shows them).
+    pub color: [f64; 3],
+    /// Optional image texture (PNG), multiplied with `color`.
+    pub texture: Option<PathBuf>,
+    /// How often the texture repeats across the surface's [0, 1]² UV range, per axis, > 0.
+    pub uv_repeat: [f64; 2],
+}
+
+/// A primitive's shape in its object space.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// Ground plane: a rectangle in the local xz plane, normal +y, `size` = [x, z] metres.
+    Plane { size: [f64; 2] },
+    /// Box centred at the origin, `size` = [x, y, z] metres.
+    Box { size: [f64; 3] },
+    /// Sphere of `radius` metres centred at the origin (intersected analytically).
+    Sphere { radius: f64 },
+    /// Cylinder along +y from y = 0 to `height`, tessellated into `segments` facets.
+    Cylinder {
+        radius: f64,
+        height: f64,
+        segments: usize,
+    },
+    /// Cone along +y, base at y = 0, apex at `height`.
+    Cone {
+        radius: f64,
+        height: f64,
+        segments: usize,
+    },
+    /// Rectangle in the local xy plane facing +z, `size` = [x, y] metres.
+    Quad { size: [f64; 2] },
+    /// Triangle mesh from an OBJ or glTF/GLB file.
+    Mesh { path: PathBuf },
+}
+
+/// One `[[object]]` of the scene file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    pub name: String,
+    pub shape: Shape,
+    /// Index into [`Scene::materials`]; `None` for meshes that bring their own materials.
+    pub material: Option<usize>,
+    /// Object space to world space: translate · rotate · scale.
+    pub world_from_object: DAffine3,
+    /// Bit set of [`CameraKind::bit`]s of the cameras that see the object.
+    pub visible_to: u8,
+    /// Whether the object blocks sunlight.
+    pub casts_shadow: bool,
+}
+
+/// The sun: a directional light that casts hard shadows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sun {
+    /// Unit direction from the scene towards the sun, world frame.
+    pub direction: DVec3,
+    /// sRGB colour in [0, 1].
+    pub color: [f64; 3],
+    /// Irradiance multiplier, ≥ 0.
+    pub intensity: f64,
+}
+
+/// The sky: a gradient with procedural clouds; also the ambient light.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sky {
+    pub zenith_color: [f64; 3],
+    pub horizon_color: [f64; 3],
+    /// Colour below the horizon (seen only where there is no ground).
+    pub ground_color: [f64; 3],
+    /// Ambient light multiplier, ≥ 0.
+    pub ambient: f64,
+    /// Fraction of the sky covered by clouds, in [0, 1].
+    pub cloud_cover: f64,
+    /// Height of the cloud layer above y = 0, metres.
+    pub cloud_height: f64,
+    /// Typical size of a cloud, metres.
+    pub cloud_size: f64,
+    /// Seed of the cloud pattern.
+    pub cloud_seed: u32,
+}
+
+/// The obstacle (A-pillar, panel) and the display on its driver-facing side.
+///
+/// Obstacle frame: origin at the display centre, display in the plane z = 0, the driver on
+/// the +z side, the scene on the −z side.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Obstacle {
+    /// Rigid transform from the obstacle frame to the world frame.
+    pub world_from_obstacle: DAffine3,
+    /// Display width `D`, metres, > 0 (obstacle frame x).
+    pub width: f64,
+    /// Display height `H`, metres, > 0 (obstacle frame y).
+    pub height: f64,
+    /// Depth of the obstacle body behind the display (towards −z), metres, > 0.
+    pub thickness: f64,
+    /// The physical display's resolution, [width, height] pixels.
+    pub display_resolution: [u32; 2],
+    /// Colour of the switched-off display, sRGB in [0, 1].
+    pub display_off_color: [f64; 3],
+    /// Colour of the obstacle body, sRGB in [0, 1].
+    pub body_color: [f64; 3],
+}
+
+impl Obstacle {
+    /// Display corners in world space: top-left, top-right, bottom-right, bottom-left.
+    pub fn display_corners(&self) -> [DVec3; 4] {
+        let (hw, hh) = (self.width / 2.0, self.height / 2.0);
+        [(-hw, hh), (hw, hh), (hw, -hh), (-hw, -hh)].map(|(x, y)| {
+            self.world_from_obstacle
+                .transform_point3(DVec3::new(x, y, 0.0))
+        })
+    }
+
+    /// Obstacle-frame coordinates of a world point.
+    pub fn in_obstacle_frame(&self, world: DVec3) -> DVec3 {
+        self.world_from_obstacle.inverse().transform_point3(world)
+    }
+
+    /// Unit normal of the display, pointing towards the driver (obstacle +z), world frame.
+    pub fn normal(&self) -> DVec3 {
+        self.world_from_obstacle.matrix3.z_axis
+    }
+}
+
+/// A fully read and validated scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// The scene file this was read from.
+    pub path: PathBuf,
+    pub sun: Sun,
+    pub sky: Sky,
+    pub materials: Vec<Material>,
+    pub objects: Vec<Object>,
+    pub obstacle: Obstacle,
+    /// The driver's eye (the paper's user), world frame.
+    pub driver: Camera,
+    /// The frontal camera behind the obstacle, filming the scene.
+    pub frontal: Camera,
+    /// The back camera on the display's top edge, filming the driver.
+    pub back: Camera,
+}
+
+impl Scene {
+    /// The driver's eye position, world frame.
+    pub fn eye(&self) -> DVec3 {
+        self.driver.position()
+    }
+}
+
+impl Default for Sun {
+    fn default() -> Self {
+        Sun {
+            direction: DVec3::new(-0.4, 0.8, 0.45).normalize(),
+            color: [1.0, 0.96, 0.9],
+            intensity: 2.6,
+        }
+    }
+}
+
+impl Default for Sky {
+    fn default() -> Self {
+        Sky {
+            zenith_color: [0.28, 0.48, 0.85],
+            horizon_color: [0.78, 0.86, 0.95],
+            ground_color: [0.36, 0.34, 0.3],
+            ambient: 0.55,
+            cloud_cover: 0.45,
+            cloud_height: 1500.0,
+            cloud_size: 900.0,
+            cloud_seed: 1,
+        }
+    }
+}

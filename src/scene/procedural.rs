@@ -1,0 +1,186 @@
+//! Generators of the bundled assets (`assets/`): the car mesh and the street texture.
+//! `cargo run --example make_assets` writes them; a test checks the committed files are
+//! exactly what these functions produce, so the assets can always be regenerated.
+
+use std::fmt::Write;
+
+use glam::Vec3;
+
+use crate::util::sampling::{hash_words, unit_float};
+
+/// Car body profile: (distance from the front bumper, metres; roof height, metres).
+/// Roughly a compact hatchback, 4.3 m long.
+const CAR_LENGTH: f32 = 4.3;
+const HEIGHT_PROFILE: [(f32, f32); 9] = [
+    (0.0, 0.62),
+    (0.15, 0.82),
+    (0.9, 0.98),
+    (1.6, 1.02),
+    (2.2, 1.44),
+    (3.3, 1.46),
+    (3.95, 1.18),
+    (4.2, 1.0),
+    (4.3, 0.8),
+];
+const HALF_WIDTH: f32 = 0.88;
+const CLEARANCE: f32 = 0.28;
+const BELTLINE: f32 = 1.04;
+
+fn profile_height(s: f32) -> f32 {
+    for w in HEIGHT_PROFILE.windows(2) {
+        let ((s0, h0), (s1, h1)) = (w[0], w[1]);
+        if s <= s1 {
+            let t = ((s - s0) / (s1 - s0)).clamp(0.0, 1.0);
+            let t = t * t * (3.0 - 2.0 * t);
+            return h0 + (h1 - h0) * t;
+        }
+    }
+    HEIGHT_PROFILE[HEIGHT_PROFILE.len() - 1].1
+}
+
+/// Half width at distance `s` from the front, narrower at the bumpers.
+fn profile_half_width(s: f32) -> f32 {
+    let edge = (s.min(CAR_LENGTH - s) / 0.35).clamp(0.0, 1.0);
+    HALF_WIDTH * (0.82 + 0.18 * edge.sqrt())
+}
+
+/// A point of the body surface: station `s` from the front, angle `phi` around the section.
+fn body_point(s: f32, phi: f32) -> Vec3 {
+    let top = profile_height(s);
+    let (c, si) = (phi.cos(), phi.sin());
+    // Superellipse section (exponent 4): a rounded rectangle.
+    let sx = c.signum() * c.abs().sqrt();
+    let sy = si.signum() * si.abs().sqrt();
+    let y = CLEARANCE + (top - CLEARANCE) * (0.5 + 0.5 * sy);
+    // The glasshouse leans in above the beltline.
+    let lean = 1.0 - 0.22 * ((y - BELTLINE) / 0.45).clamp(0.0, 1.0);
+    Vec3::new(profile_half_width(s) * sx * lean, y, s - CAR_LENGTH / 2.0)
+}
+
+const PART_BODY: usize = 0;
+const PART_GLASS: usize = 1;
+const PART_WHEELS: usize = 2;
+
+/// Whether a body facet is a window: the glasshouse between the beltline and the roof.
+fn is_glass(centroid: Vec3) -> bool {
+    let s = centroid.z + CAR_LENGTH / 2.0;
+    let roof = profile_height(s);
+    centroid.y > BELTLINE + 0.04
+        && centroid.y < roof - 0.05
+        && roof > 1.2
+        && (1.75..4.05).contains(&s)
+}
+
+/// The car as OBJ text: objects `body`, `glass`, `wheels`, materials from `car.mtl`. Local
+/// frame: metres, +y up, the car's front towards −z, wheels on y = 0.
+pub fn car_obj() -> String {
+    let (stations, around) = (96usize, 56usize);
+    let mut parts: [Vec<[Vec3; 3]>; 3] = Default::default();
+    let grid = |i: usize, j: usize| {
+        let s = CAR_LENGTH * i as f32 / stations as f32;
+        body_point(s, std::f32::consts::TAU * j as f32 / around as f32)
+    };
+    for i in 0..stations {
+        for j in 0..around {
+            let (a, b, c, d) = (
+                grid(i, j),
+                grid(i + 1, j),
+                grid(i + 1, j + 1),
+                grid(i, j + 1),
+            );
+            let part = if is_glass((a + b + c + d) / 4.0) {
+                PART_GLASS
+            } else {
+                PART_BODY
+            };
+            parts[part].push([a, c, b]);
+            parts[part].push([a, d, c]);
+        }
+    }
+    // Close the ends with fans around the section centre.
+    for (i, flip) in [(0usize, false), (stations, true)] {
+        let s = CAR_LENGTH * i as f32 / stations as f32;
+        let centre = Vec3::new(
+            0.0,
+            (CLEARANCE + profile_height(s)) / 2.0,
+            s - CAR_LENGTH / 2.0,
+        );
+        for j in 0..around {
+            let (a, b) = (grid(i, j), grid(i, j + 1));
+            parts[PART_BODY].push(if flip { [centre, b, a] } else { [centre, a, b] });
+        }
+    }
+    // Wheels: cylinders along x, radius 0.31 m, 0.2 m wide, slightly outside the body.
+    let (radius, width, segments) = (0.31f32, 0.2f32, 40usize);
+    for (x, s) in [(-1.0f32, 0.75f32), (1.0, 0.75), (-1.0, 3.45), (1.0, 3.45)] {
+        let centre = Vec3::new(
+            x * (HALF_WIDTH - width / 2.0 + 0.02),
+            radius,
+            s - CAR_LENGTH / 2.0,
+        );
+        let rim = |k: usize, side: f32| {
+            let a = std::f32::consts::TAU * k as f32 / segments as f32;
+            centre + Vec3::new(side * width / 2.0, radius * a.sin(), radius * a.cos())
+        };
+        for k in 0..segments {
+            let (a0, a1, b0, b1) = (rim(k, -1.0), rim(k + 1, -1.0), rim(k, 1.0), rim(k + 1, 1.0));
+            parts[PART_WHEELS].push([a0, b0, b1]);
+            parts[PART_WHEELS].push([a0, b1, a1]);
+            for (side, p, q) in [(-1.0, a1, a0), (1.0, b0, b1)] {
+                parts[PART_WHEELS].push([centre + Vec3::new(side * width / 2.0, 0.0, 0.0), p, q]);
+            }
+        }
+    }
+    let mut obj = String::from(
+        "# Procedural compact car, generated by seethru::procedural::car_obj\nmtllib car.mtl\n",
+    );
+    let mut base = 1;
+    for (name, tris) in ["body", "glass", "wheels"].iter().zip(&parts) {
+        let _ = writeln!(obj, "o {name}\nusemtl {name}");
+        for t in tris {
+            for v in t {
+                let _ = writeln!(obj, "v {:.5} {:.5} {:.5}", v.x, v.y, v.z);
+            }
+        }
+        for k in 0..tris.len() {
+            let _ = writeln!(
+                obj,
+                "f {} {} {}",
+                base + 3 * k,
+                base + 3 * k + 1,
+                base + 3 * k + 2
+            );
+        }
+        base += 3 * tris.len();
+    }
+    obj
+}
+
+/// Materials of the car (linear RGB diffuse colours).
+pub fn car_mtl() -> String {
+    "# Materials of the procedural car (Kd: linear RGB)\n\
+     newmtl body\nKd 0.55 0.04 0.03\n\n\
+     newmtl glass\nKd 0.02 0.025 0.035\n\n\
+     newmtl wheels\nKd 0.015 0.015 0.015\n"
+        .to_string()
+}
+
+/// Street texture, 64 × 768 texels, sRGB: asphalt with solid edge lines and a dashed centre
+/// line. Across: the 7 m carriageway. Along: one 12 m period (6 m dash, 6 m gap).
+pub fn street_texture() -> image::RgbImage {
+    let (w, h) = (64u32, 768u32);
+    image::RgbImage::from_fn(w, h, |x, y| {
+        let across = (x as f32 + 0.5) / w as f32 * 7.0;
+        let along = (y as f32 + 0.5) / h as f32 * 12.0;
+        let noise = unit_float(hash_words(&[x, y, 11])) * 18.0;
+        let edge = !(0.25..=6.75).contains(&across) && (0.1..=6.9).contains(&across);
+        let centre = (across - 3.5).abs() < 0.08 && along < 6.0;
+        if edge || centre {
+            let v = (225.0 + noise * 0.5) as u8;
+            image::Rgb([v, v, v])
+        } else {
+            let v = 70.0 + noise;
+            image::Rgb([v as u8, v as u8, (v + 3.0) as u8])
+        }
+    })
+}

@@ -1,0 +1,394 @@
+//! The renderable world: every object of a scene flattened into world-space primitives
+//! (triangles and analytic ellipsoids) with their materials, textures and ids.
+
+use anyhow::Result;
+use glam::{Affine3A, DAffine3, DVec3, Mat3A, Vec2, Vec3, Vec3A};
+use obvhs::aabb::Aabb;
+use obvhs::ray::Ray;
+use obvhs::rt_triangle::RtTriangle;
+
+use crate::scene::mesh_io::load_mesh;
+use crate::scene::shapes::{Tri, box_face, cuboid, frustum, plane_xz, quad_xy};
+use crate::scene::texture::Texture;
+use crate::scene::{CameraKind, Obstacle, Scene, Shape};
+use crate::util::color::srgb_to_linear3;
+
+/// The views a primitive can be visible in, as bits of a mask.
+pub mod view_bit {
+    pub const TRUTH: u8 = 1;
+    pub const OCCLUDED: u8 = 2;
+    pub const SEETHRU: u8 = 4;
+    pub const FRONTAL: u8 = 8;
+    pub const BACK: u8 = 16;
+    pub const DRIVER: u8 = TRUTH | OCCLUDED | SEETHRU;
+}
+
+/// Object id of "nothing hit" (the sky) in id AOVs; objects are numbered from 1.
+pub const SKY_ID: u32 = 0;
+
+#[derive(Clone, Debug)]
+pub struct SurfaceMaterial {
+    /// Base colour, linear RGB.
+    pub albedo: Vec3,
+    pub texture: Option<usize>,
+    pub uv_repeat: Vec2,
+}
+
+#[derive(Clone, Debug)]
+pub struct ObjectInfo {
+    pub name: String,
+    /// Bit set of [`view_bit`]s of the views that show the object.
+    pub views: u8,
+    pub casts_shadow: bool,
+}
+
+/// Per-triangle data that the intersection itself does not need.
+#[derive(Clone, Copy, Debug)]
+pub struct TriAttr {
+    pub uv: [Vec2; 3],
+    pub part: u32,
+    /// Object id: index into [`World::objects`] plus one.
+    pub object: u32,
+    pub material: u32,
+}
+
+/// A unit sphere under an affine transform.
+#[derive(Clone, Copy, Debug)]
+pub struct Ellipsoid {
+    pub world_from_object: Affine3A,
+    pub object_from_world: Affine3A,
+    /// Inverse transpose of the linear part, for normals.
+    pub normal_from_object: Mat3A,
+    pub object: u32,
+    pub material: u32,
+}
+
+/// What a ray hit, with everything shading and the AOVs need.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceHit {
+    /// Distance along the (unit) ray, metres.
+    pub t: f32,
+    /// World position, metres.
+    pub position: Vec3,
+    /// Unit geometric normal, world frame, facing the incoming ray.
+    pub normal: Vec3,
+    pub uv: Vec2,
+    pub object: u32,
+    pub part: u32,
+    pub material: u32,
+}
+
+pub struct World {
+    pub triangles: Vec<RtTriangle>,
+    pub tri_attrs: Vec<TriAttr>,
+    pub ellipsoids: Vec<Ellipsoid>,
+    pub objects: Vec<ObjectInfo>,
+    pub materials: Vec<SurfaceMaterial>,
+    pub textures: Vec<Texture>,
+    /// Object id of the obstacle; its `box_face::POS_Z` part is the display.
+    pub obstacle_id: u32,
+}
+
+fn views_of(visible_to: u8) -> u8 {
+    let mut views = 0;
+    if visible_to & CameraKind::Driver.bit() != 0 {
+        views |= view_bit::DRIVER;
+    }
+    if visible_to & CameraKind::Frontal.bit() != 0 {
+        views |= view_bit::FRONTAL;
+    }
+    if visible_to & CameraKind::Back.bit() != 0 {
+        views |= view_bit::BACK;
+    }
+    views
+}
+
+impl World {
+    /// Builds the world of a scene: tessellates shapes, loads meshes and textures.
+    pub fn build(scene: &Scene) -> Result<World> {
+        let mut world = World {
+            triangles: Vec::new(),
+            tri_attrs: Vec::new(),
+            ellipsoids: Vec::new(),
+            objects: Vec::new(),
+            materials: Vec::new(),
+            textures: Vec::new(),
+            obstacle_id: 0,
+        };
+        for m in &scene.materials {
+            let texture = match &m.texture {
+                Some(path) => {
+                    world.textures.push(Texture::load(path)?);
+                    Some(world.textures.len() - 1)
+                }
+                None => None,
+            };
+            world.materials.push(SurfaceMaterial {
+                albedo: srgb_to_linear3(m.color),
+                texture,
+                uv_repeat: Vec2::new(m.uv_repeat[0] as f32, m.uv_repeat[1] as f32),
+            });
+        }
+        for object in &scene.objects {
+            world.objects.push(ObjectInfo {
+                name: object.name.clone(),
+                views: views_of(object.visible_to),
+                casts_shadow: object.casts_shadow,
+            });
+            let id = world.objects.len() as u32;
+            let material = object.material.map(|m| m as u32);
+            let size2 = |s: [f64; 2]| [s[0] as f32, s[1] as f32];
+            let tris = match &object.shape {
+                Shape::Sphere { radius } => {
+                    let scale = DAffine3::from_scale(DVec3::splat(*radius));
+                    world.add_ellipsoid(
+                        object.world_from_object * scale,
+                        id,
+                        material.unwrap_or(0),
+                    );
+                    continue;
+                }
+                Shape::Plane { size } => plane_xz(size2(*size)),
+                Shape::Box { size } => cuboid(size.map(|s| s as f32)),
+                Shape::Cylinder {
+                    radius,
+                    height,
+                    segments,
+                } => frustum(*radius as f32, *radius as f32, *height as f32, *segments),
+                Shape::Cone {
+                    radius,
+                    height,
+                    segments,
+                } => frustum(*radius as f32, 0.0, *height as f32, *segments),
+                Shape::Quad { size } => quad_xy(size2(*size), 0),
+                Shape::Mesh { path } => {
+                    let mesh = load_mesh(path)?;
+                    let first = world.materials.len() as u32;
+                    world
+                        .materials
+                        .extend(mesh.materials.iter().map(|m| SurfaceMaterial {
+                            albedo: Vec3::from_array(m.linear_color),
+                            texture: None,
+                            uv_repeat: Vec2::ONE,
+                        }));
+                    if mesh.materials.is_empty() && material.is_none() {
+                        world.materials.push(SurfaceMaterial {
+                            albedo: Vec3::splat(0.6),
+                            texture: None,
+                            uv_repeat: Vec2::ONE,
+                        });
+                    }
+                    let fallback = world.materials.len() as u32 - 1;
+                    world.add_tris(&mesh.tris, object.world_from_object, id, |t| {
+                        material
+                            .or(t.file_material.map(|m| first + m))
+                            .unwrap_or(fallback)
+                    });
+                    continue;
+                }
+            };
+            world.add_tris(&tris, object.world_from_object, id, |_| {
+                material.unwrap_or(0)
+            });
+        }
+        world.add_obstacle(&scene.obstacle);
+        Ok(world)
+    }
+
+    fn add_tris(
+        &mut self,
+        tris: &[Tri],
+        world_from_object: DAffine3,
+        object: u32,
+        material: impl Fn(&Tri) -> u32,
+    ) {
+        let m = world_from_object;
+        let to_world = |p: Vec3| m.transform_point3(p.as_dvec3()).as_vec3();
+        for tri in tris {
+            let [a, b, c] = tri.p.map(to_world);
+            // Degenerate triangles can never be hit; keeping them would only cost traversal time.
+            if (b - a).cross(c - a).length_squared() == 0.0 {
+                continue;
+            }
+            self.triangles
+                .push(RtTriangle::new(a.into(), b.into(), c.into()));
+            self.tri_attrs.push(TriAttr {
+                uv: tri.uv,
+                part: tri.part,
+                object,
+                material: material(tri),
+            });
+        }
+    }
+
+    fn add_ellipsoid(&mut self, world_from_object: DAffine3, object: u32, material: u32) {
+        let world_from_object =
+            Affine3A::from_cols_array(&world_from_object.to_cols_array().map(|v| v as f32));
+        let object_from_world = world_from_object.inverse();
+        self.ellipsoids.push(Ellipsoid {
+            world_from_object,
+            object_from_world,
+            normal_from_object: object_from_world.matrix3.transpose(),
+            object,
+            material,
+        });
+    }
+
+    fn add_obstacle(&mut self, obstacle: &Obstacle) {
+        self.objects.push(ObjectInfo {
+            name: "obstacle".into(),
+            views: view_bit::OCCLUDED | view_bit::SEETHRU,
+            // The truth has no obstacle; a shadow only the other views had would be a
+            // difference the compensation cannot be blamed for.
+            casts_shadow: false,
+        });
+        self.obstacle_id = self.objects.len() as u32;
+        let body = self.materials.len() as u32;
+        // Two materials: the body, then the switched-off display.
+        for color in [obstacle.body_color, obstacle.display_off_color] {
+            self.materials.push(SurfaceMaterial {
+                albedo: srgb_to_linear3(color),
+                texture: None,
+                uv_repeat: Vec2::ONE,
+            });
+        }
+        let tris = cuboid([
+            obstacle.width as f32,
+            obstacle.height as f32,
+            obstacle.thickness as f32,
+        ]);
+        let obstacle_from_box =
+            DAffine3::from_translation(DVec3::new(0.0, 0.0, -obstacle.thickness / 2.0));
+        self.add_tris(
+            &tris,
+            obstacle.world_from_obstacle * obstacle_from_box,
+            self.obstacle_id,
+            |t| {
+                if t.part == box_face::POS_Z {
+                    body + 1
+                } else {
+                    body
+                }
+            },
+        );
+    }
+
+    pub fn primitive_count(&self) -> usize {
+        self.triangles.len() + self.ellipsoids.len()
+    }
+
+    pub fn object_of(&self, prim: usize) -> u32 {
+        match prim.checked_sub(self.triangles.len()) {
+            None => self.tri_attrs[prim].object,
+            Some(e) => self.ellipsoids[e].object,
+        }
+    }
+
+    /// Views that show primitive `prim` and whether it blocks sunlight.
+    pub fn visibility(&self, prim: usize) -> (u8, bool) {
+        let info = &self.objects[self.object_of(prim) as usize - 1];
+        (info.views, info.casts_shadow)
+    }
+
+    pub fn aabb(&self, prim: usize) -> Aabb {
+        match prim.checked_sub(self.triangles.len()) {
+            None => self.triangles[prim].aabb(),
+            Some(e) => {
+                // The unit sphere's box under an affine map: centre ± the rows' absolute sums.
+                let m = &self.ellipsoids[e].world_from_object;
+                let c = m.translation;
+                let abs = Mat3A::from_cols(
+                    m.matrix3.x_axis.abs(),
+                    m.matrix3.y_axis.abs(),
+                    m.matrix3.z_axis.abs(),
+                );
+                let r = abs * Vec3A::ONE;
+                Aabb::new(c - r, c + r)
+            }
+        }
+    }
+
+    /// Ray parameter of the hit of `ray` (unit direction) with primitive `prim`, in
+    /// [tmin, tmax], or infinity.
+    #[inline(always)]
+    pub fn intersect(&self, prim: usize, ray: &Ray) -> f32 {
+        match prim.checked_sub(self.triangles.len()) {
+            None => self.triangles[prim].intersect(ray),
+            Some(e) => intersect_ellipsoid(&self.ellipsoids[e], ray),
+        }
+    }
+
+    /// Details of the hit of a ray with primitive `prim` at parameter `t`.
+    pub fn surface(&self, prim: usize, origin: Vec3, dir: Vec3, t: f32) -> SurfaceHit {
+        let position = origin + dir * t;
+        let (normal, uv, object, part, material) = match prim.checked_sub(self.triangles.len()) {
+            None => {
+                let tri = &self.triangles[prim];
+                let attr = &self.tri_attrs[prim];
+                let v0 = Vec3::from(tri.v0);
+                let (v1, v2) = (v0 - Vec3::from(tri.e1), v0 + Vec3::from(tri.e2));
+                let [b0, b1, b2] = barycentric(position, v0, v1, v2);
+                let uv = attr.uv[0] * b0 + attr.uv[1] * b1 + attr.uv[2] * b2;
+                let n = (v1 - v0).cross(v2 - v0).normalize();
+                (n, uv, attr.object, attr.part, attr.material)
+            }
+            Some(e) => {
+                let el = &self.ellipsoids[e];
+                let local = el.object_from_world.transform_point3(position);
+                let n = Vec3::from(el.normal_from_object * Vec3A::from(local)).normalize();
+                // Equirectangular UVs: u around +y, v from the north pole down.
+                let u = 0.5 + local.z.atan2(local.x) / std::f32::consts::TAU;
+                let v = (local.y.clamp(-1.0, 1.0)).acos() / std::f32::consts::PI;
+                (n, Vec2::new(u, v), el.object, 0, el.material)
+            }
+        };
+        let normal = if normal.dot(dir) > 0.0 {
+            -normal
+        } else {
+            normal
+        };
+        SurfaceHit {
+            t,
+            position,
+            normal,
+            uv,
+            object,
+            part,
+            material,
+        }
+    }
+}
+
+fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
+    let (e0, e1, ep) = (b - a, c - a, p - a);
+    let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
+    let (d20, d21) = (ep.dot(e0), ep.dot(e1));
+    let denom = d00 * d11 - d01 * d01;
+    let v = (d11 * d20 - d01 * d21) / denom;
+    let w = (d00 * d21 - d01 * d20) / denom;
+    [1.0 - v - w, v, w]
+}
+
+#[inline(always)]
+fn intersect_ellipsoid(el: &Ellipsoid, ray: &Ray) -> f32 {
+    let o = el.object_from_world.transform_point3a(ray.origin);
+    let d = el.object_from_world.transform_vector3a(ray.direction);
+    let a = d.dot(d);
+    let b = o.dot(d);
+    let c = o.dot(o) - 1.0;
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return f32::INFINITY;
+    }
+    let root = disc.sqrt();
+    // The numerically stable pair of roots.
+    let q = -(b + root.copysign(b));
+    let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
+    let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
+    for t in [near, far] {
+        if t >= ray.tmin && t <= ray.tmax {
+            return t;
+        }
+    }
+    f32::INFINITY
+}

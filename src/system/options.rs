@@ -1,0 +1,111 @@
+//! The choices of one run of the see-through system: method, working distance, head source,
+//! injected head errors, sizes, and how the display is modelled.
+
+use crate::system::display::{DisplayModel, Filter};
+
+/// How the display image is made.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// The whole frontal image scaled into the display: the naive baseline.
+    None,
+    /// The paper's planar compensation at working distance `d2`.
+    Planar,
+}
+
+/// The working distance of the planar model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum WorkingDistance {
+    /// `d2 → ∞`, the paper's proposal.
+    Infinity,
+    /// A fixed distance from the display plane, metres, > 0.
+    Metres(f64),
+    /// The median frontal depth of the region the display covers (a range sensor's answer).
+    Auto,
+}
+
+impl std::str::FromStr for WorkingDistance {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "inf" | "infinity" => Ok(WorkingDistance::Infinity),
+            "auto" => Ok(WorkingDistance::Auto),
+            _ => match s.parse::<f64>() {
+                Ok(v) if v.is_finite() && v > 0.0 => Ok(WorkingDistance::Metres(v)),
+                _ => Err(format!(
+                    "`{s}`: expected inf, auto or a distance in metres > 0"
+                )),
+            },
+        }
+    }
+}
+
+/// Where the head position comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum HeadSource {
+    /// The true eye position.
+    Oracle,
+    /// The back camera's image through the face detector and eqs. d1, b_h.
+    Estimated,
+}
+
+/// What to do when the crop needs more than the frontal camera sees.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Outside {
+    /// Stop with an error naming the side, the amount and the admissible head region.
+    Error,
+    /// Show the outside part black and count it as missing.
+    Black,
+}
+
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    pub method: Method,
+    pub d2: WorkingDistance,
+    pub head: HeadSource,
+    /// Head-tracking bias added to the eye, obstacle frame, centimetres.
+    pub head_bias_cm: [f64; 3],
+    /// Standard deviation of Gaussian head-tracking jitter per axis, centimetres.
+    pub head_jitter_cm: f64,
+    /// Seed of the jitter.
+    pub seed: u32,
+    /// Feature width `A` the detector measures (interpupillary distance), metres.
+    pub feature_width: f64,
+    /// Driver-view resolution overrides (truth, occluded, seethru).
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    /// Frontal and back camera width overrides (their aspect ratios are kept).
+    pub frontal_width: Option<u32>,
+    pub back_width: Option<u32>,
+    pub spp: u32,
+    pub outside: Outside,
+    pub filter: Filter,
+    /// How the `seethru` view models the display.
+    pub display: DisplayModel,
+    pub progress: bool,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        Self {
+            method: Method::Planar,
+            d2: WorkingDistance::Infinity,
+            head: HeadSource::Oracle,
+            head_bias_cm: [0.0; 3],
+            head_jitter_cm: 0.0,
+            seed: 1,
+            feature_width: 0.064,
+            width: None,
+            height: None,
+            frontal_width: None,
+            back_width: None,
+            spp: 4,
+            outside: Outside::Error,
+            filter: Filter::Bilinear,
+            display: DisplayModel::Pixels,
+            progress: false,
+        }
+    }
+}

@@ -1,0 +1,294 @@
+//! The see-through system end to end (paper §3): the back camera finds the head, the planar
+//! model crops the frontal render, the display shows it, and the driver's view with the
+//! display in it is rendered beside the ground truth.
+
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use glam::{DVec2, DVec3};
+use serde_json::json;
+
+use crate::geometry::camera::Camera;
+use crate::geometry::homography::homography;
+use crate::render::frame::Frame;
+use crate::render::integrator::RenderContext;
+use crate::render::settings::{RenderSettings, check_spp, resized};
+use crate::render::views::View;
+use crate::scene::{Obstacle, Scene};
+use crate::system::compensation::{Crop, ModelPlane, compute_crop};
+use crate::system::display::{
+    DisplayModel, DisplayPlacement, DisplaySurface, MISSING_ID, resample,
+};
+use crate::system::head::{FaceDetection, detect, eye_from_detection, gaussian};
+use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
+use crate::system::report::report;
+
+/// Everything a run produces.
+pub struct RunResult {
+    pub truth: Frame,
+    pub occluded: Frame,
+    pub frontal: Frame,
+    pub back: Frame,
+    pub display: Frame,
+    pub seethru: Frame,
+    pub crop: Crop,
+    /// The eye the compensation used, world frame.
+    pub eye_used: DVec3,
+    pub detection: Option<FaceDetection>,
+    /// `run.json`.
+    pub report: serde_json::Value,
+}
+
+/// The eye the system believes in: true, or estimated from the back image; plus errors.
+fn eye_for_compensation(
+    scene: &Scene,
+    back: &Frame,
+    options: &RunOptions,
+) -> Result<(DVec3, Option<FaceDetection>)> {
+    let (eye, detection) = match options.head {
+        HeadSource::Oracle => (scene.eye(), None),
+        HeadSource::Estimated => {
+            let detection = detect(back)?;
+            (
+                eye_from_detection(&detection, &scene.back, options.feature_width),
+                Some(detection),
+            )
+        }
+    };
+    let jitter = DVec3::new(
+        gaussian(options.seed, 0),
+        gaussian(options.seed, 1),
+        gaussian(options.seed, 2),
+    ) * options.head_jitter_cm;
+    let error_obstacle = (DVec3::from_array(options.head_bias_cm) + jitter) / 100.0;
+    Ok((
+        eye + scene
+            .obstacle
+            .world_from_obstacle
+            .transform_vector3(error_obstacle),
+        detection,
+    ))
+}
+
+/// The crop that `method` asks for; `frontal` serves the `auto` working distance.
+fn crop_for(
+    scene: &Scene,
+    eye: DVec3,
+    frontal: &Frame,
+    options: &RunOptions,
+) -> Result<(Crop, Option<f64>)> {
+    let display_size = scene.obstacle.display_resolution;
+    if options.method == Method::None {
+        let [w, h] = [scene.frontal.width as f64, scene.frontal.height as f64];
+        let [dw, dh] = display_size.map(f64::from);
+        let corners = [
+            DVec2::ZERO,
+            DVec2::new(w, 0.0),
+            DVec2::new(w, h),
+            DVec2::new(0.0, h),
+        ];
+        let display = [
+            DVec2::ZERO,
+            DVec2::new(dw, 0.0),
+            DVec2::new(dw, dh),
+            DVec2::new(0.0, dh),
+        ];
+        let crop = Crop {
+            corners,
+            frontal_from_display: homography(display, corners),
+            frontal_size: [scene.frontal.width, scene.frontal.height],
+        };
+        return Ok((crop, None));
+    }
+    let plane = |d2: WorkingDistance| match d2 {
+        WorkingDistance::Metres(m) => ModelPlane::At(m),
+        _ => ModelPlane::Infinity,
+    };
+    let mut crop = compute_crop(
+        eye,
+        &scene.obstacle,
+        &scene.frontal,
+        plane(options.d2),
+        display_size,
+    )?;
+    let mut d2_used = match options.d2 {
+        WorkingDistance::Metres(m) => Some(m),
+        _ => None,
+    };
+    if options.d2 == WorkingDistance::Auto {
+        // Two rounds: the region under the d2 = ∞ crop, then under the crop at its median.
+        for _ in 0..2 {
+            let d2 = median_depth_in_crop(frontal, &crop, &scene.obstacle)
+                .context("d2 auto: the frontal camera sees no surface where the display is")?;
+            crop = compute_crop(
+                eye,
+                &scene.obstacle,
+                &scene.frontal,
+                ModelPlane::At(d2),
+                display_size,
+            )?;
+            d2_used = Some(d2);
+        }
+    }
+    Ok((crop, d2_used))
+}
+
+/// Median distance from the display plane of the surfaces the frontal camera sees inside the
+/// crop's bounding box.
+fn median_depth_in_crop(frontal: &Frame, crop: &Crop, obstacle: &Obstacle) -> Option<f64> {
+    let (min, max) = crop.bounds();
+    let mut depths: Vec<f64> = Vec::new();
+    for y in (min.y.max(0.0) as u32)..(max.y.min(frontal.height as f64) as u32) {
+        for x in (min.x.max(0.0) as u32)..(max.x.min(frontal.width as f64) as u32) {
+            let p = frontal.position[frontal.index(x, y)];
+            if p.is_finite() {
+                depths.push(-obstacle.in_obstacle_frame(p.as_dvec3()).z);
+            }
+        }
+    }
+    depths.sort_by(f64::total_cmp);
+    depths.get(depths.len() / 2).copied().filter(|d| *d > 0.0)
+}
+
+/// How far the crop leaves the frontal image on each side, pixels (0 inside).
+fn overflow(crop: &Crop) -> [(&'static str, f64); 4] {
+    let [w, h] = crop.frontal_size.map(f64::from);
+    let (min, max) = crop.bounds();
+    [
+        ("left", (-min.x).max(0.0)),
+        ("right", (max.x - w).max(0.0)),
+        ("top", (-min.y).max(0.0)),
+        ("bottom", (max.y - h).max(0.0)),
+    ]
+}
+
+/// The admissible eye offsets across and up the display (obstacle frame, relative to the
+/// frontal camera's axis) at eye distance `d1`, for a frontal camera perpendicular to the
+/// display: |x| ≤ d1 (tan θx − D/(2 d2)) − D/2, and likewise vertically (from eq. RATIO1 ≥ 0).
+fn admissible_offsets(
+    frontal: &Camera,
+    obstacle: &Obstacle,
+    d1: f64,
+    d2: Option<f64>,
+) -> (f64, f64) {
+    let reach =
+        |tan: f64, size: f64| d1 * (tan - d2.map_or(0.0, |d2| size / (2.0 * d2))) - size / 2.0;
+    (
+        reach(frontal.tan_half_x(), obstacle.width),
+        reach(frontal.tan_half_y(), obstacle.height),
+    )
+}
+
+/// Runs the system on a loaded scene; renders every view.
+pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
+    let mut scene = ctx.scene.clone();
+    scene.frontal = resized(scene.frontal, options.frontal_width, None)?;
+    scene.back = resized(scene.back, options.back_width, None)?;
+    let scene = &scene;
+    check_spp(options.spp)?;
+    if !(options.feature_width > 0.0 && options.feature_width.is_finite()) {
+        bail!(
+            "--feature-width must be > 0 m, got {}",
+            options.feature_width
+        );
+    }
+    if !(options.head_jitter_cm >= 0.0 && options.head_jitter_cm.is_finite())
+        || options.head_bias_cm.iter().any(|v| !v.is_finite())
+    {
+        bail!("head bias must be finite and jitter ≥ 0");
+    }
+    let driver = resized(scene.driver, options.width, options.height)?;
+    let settings = RenderSettings {
+        spp: options.spp,
+        progress: options.progress,
+    };
+    let mut timings = serde_json::Map::new();
+    let timed =
+        |timings: &mut serde_json::Map<String, serde_json::Value>, camera: &Camera, view: View| {
+            let (frame, stats) = ctx.render(camera, view.bit(), settings, view.name());
+            timings.insert(view.name().into(), json!(stats.seconds));
+            frame
+        };
+    let back = timed(&mut timings, &scene.back, View::Back);
+    let frontal = timed(&mut timings, &scene.frontal, View::Frontal);
+    let (eye_used, detection) = eye_for_compensation(scene, &back, options)?;
+    let (crop, d2_used) = crop_for(scene, eye_used, &frontal, options)?;
+
+    let out = overflow(&crop);
+    if options.method == Method::Planar
+        && options.outside == Outside::Error
+        && let Some((side, px)) = out.iter().copied().find(|(_, px)| *px > 1e-9)
+    {
+        let d1 = scene.obstacle.in_obstacle_frame(eye_used).z;
+        let (ax, ay) = admissible_offsets(&scene.frontal, &scene.obstacle, d1, d2_used);
+        let axis = scene.obstacle.in_obstacle_frame(scene.frontal.position());
+        bail!(
+            "the crop leaves the frontal camera's view on the {side} by {px:.1} px ({:.1}% of the image); at d1 = {d1:.3} m the eye must stay within x ∈ [{:.3}, {:.3}] m, y ∈ [{:.3}, {:.3}] m of the obstacle frame (use --outside black to show the rest black)",
+            100.0 * px
+                / if side == "left" || side == "right" {
+                    crop.frontal_size[0]
+                } else {
+                    crop.frontal_size[1]
+                } as f64,
+            axis.x - ax,
+            axis.x + ax,
+            axis.y - ay,
+            axis.y + ay
+        );
+    }
+
+    let start = Instant::now();
+    let display = resample(
+        &frontal,
+        &crop,
+        scene.obstacle.display_resolution,
+        options.filter,
+    );
+    timings.insert("display".into(), json!(start.elapsed().as_secs_f64()));
+    let missing = display
+        .object_id
+        .iter()
+        .filter(|&&i| i == MISSING_ID)
+        .count() as f64
+        / display.object_id.len() as f64;
+    let truth = timed(&mut timings, &driver, View::Truth);
+    let occluded = timed(&mut timings, &driver, View::Occluded);
+    let placement = DisplayPlacement::new(&scene.obstacle);
+    let surface = match options.display {
+        DisplayModel::Pixels => DisplaySurface::Pixels {
+            image: display.clone(),
+            placement,
+        },
+        DisplayModel::Ideal => DisplaySurface::Ideal {
+            crop,
+            frontal: scene.frontal,
+            placement,
+        },
+    };
+    let (seethru, stats) = ctx.render_seethru(&driver, &surface, settings);
+    timings.insert("seethru".into(), json!(stats.seconds));
+
+    let report = report(
+        scene,
+        options,
+        &crop,
+        eye_used,
+        detection.as_ref(),
+        d2_used,
+        missing,
+        &out,
+        timings,
+    );
+    Ok(RunResult {
+        truth,
+        occluded,
+        frontal,
+        back,
+        display,
+        seethru,
+        crop,
+        eye_used,
+        detection,
+        report,
+    })
+}

@@ -1,0 +1,62 @@
+//! `run.json`: every option of a run, the true and the used eye, the head detection, d2, the
+//! crop in the paper's terms, how far it leaves the frontal view, and timings.
+
+use glam::DVec3;
+use serde_json::json;
+
+use crate::analysis::paper::k_px;
+use crate::scene::Scene;
+use crate::system::compensation::Crop;
+use crate::system::head::FaceDetection;
+use crate::system::options::{RunOptions, WorkingDistance};
+
+#[allow(clippy::too_many_arguments)]
+pub fn report(
+    scene: &Scene,
+    options: &RunOptions,
+    crop: &Crop,
+    eye_used: DVec3,
+    detection: Option<&FaceDetection>,
+    d2_used: Option<f64>,
+    missing: f64,
+    overflow: &[(&str, f64); 4],
+    timings: serde_json::Map<String, serde_json::Value>,
+) -> serde_json::Value {
+    let eye_o = |e: DVec3| scene.obstacle.in_obstacle_frame(e);
+    let (true_o, used_o) = (eye_o(scene.eye()), eye_o(eye_used));
+    let paper = |o: DVec3| json!({"d1_m": o.z, "b_h_m": -o.x, "b_v_m": o.y});
+    let ratios = crop.ratios();
+    let [fw, fh] = crop.frontal_size;
+    json!({
+        "scene": scene.path.display().to_string(),
+        "options": {
+            "method": options.method,
+            "d2": match options.d2 { WorkingDistance::Infinity => json!("inf"), WorkingDistance::Auto => json!("auto"), WorkingDistance::Metres(m) => json!(m) },
+            "head": options.head,
+            "head_bias_cm": options.head_bias_cm,
+            "head_jitter_cm": options.head_jitter_cm,
+            "seed": options.seed,
+            "feature_width_m": options.feature_width,
+            "spp": options.spp,
+            "outside": options.outside,
+            "filter": options.filter,
+            "display": options.display,
+        },
+        "conventions": "obstacle frame: origin at the display centre, +z towards the driver; paper's b_h = −x (eye on the side of R1 for b_h > 0), b_v = y",
+        "eye_true": {"world_m": scene.eye().to_array(), "obstacle_m": true_o.to_array(), "paper": paper(true_o)},
+        "eye_used": {"world_m": eye_used.to_array(), "obstacle_m": used_o.to_array(), "paper": paper(used_o), "error_m": (eye_used - scene.eye()).length()},
+        "head_detection": detection.map(|d| json!({"face_box_px": d.face_box, "pupils_px": d.pupils, "feature_px": d.feature_px()})),
+        "d2_m": d2_used.map_or(json!("inf"), |d| json!(d)),
+        "frontal_half_angle_deg": scene.frontal.half_angle_x.to_degrees(),
+        "crop": {
+            "corners_frontal_px_tl_tr_br_bl": crop.corners.map(|c| c.to_array()),
+            "axis_aligned": crop.is_axis_aligned(1e-6),
+            "R1_left": ratios.left, "R2_right": ratios.right, "R_top": ratios.top, "R_bottom": ratios.bottom,
+            "K_px": {"left": k_px(ratios.left, fw), "right": k_px(ratios.right, fw), "top": k_px(ratios.top, fh), "bottom": k_px(ratios.bottom, fh)},
+            "outside_frontal_view_px": overflow.iter().map(|(s, px)| (s.to_string(), json!(px))).collect::<serde_json::Map<_, _>>(),
+        },
+        "display_resolution": scene.obstacle.display_resolution,
+        "missing_fraction": missing,
+        "timings_s": timings,
+    })
+}
