@@ -1,33 +1,46 @@
-//! `seethru export`: the scene's triangles as OBJ or binary glTF, and its cameras as JSON.
+//! `seethru export`: the scene for other renderers — binary glTF, OBJ + MTL, or Mitsuba 3 XML
+//! scenes — and its cameras as JSON.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
+use seethru::io::export::ExportFormat;
 use seethru::scene::Scene;
 use seethru::scene::world::World;
 
 #[derive(clap::Args)]
 pub struct Export {
     scene: PathBuf,
-    /// Output file, .obj or .glb.
+    /// Output file: .glb (glTF), .obj or .xml (Mitsuba 3); <name>.cameras.json goes beside it.
     #[arg(long)]
     out: PathBuf,
+    /// Output format; by default the one --out's extension names.
+    #[arg(long, value_enum)]
+    format: Option<ExportFormat>,
 }
 
 impl Export {
     pub fn run(self) -> Result<()> {
-        export_scene(&self.scene, &self.out)
+        export_scene(&self.scene, &self.out, self.format)
     }
 }
 
-fn export_scene(scene_path: &Path, out: &Path) -> Result<()> {
+fn export_scene(scene_path: &Path, out: &Path, format: Option<ExportFormat>) -> Result<()> {
     let scene = Scene::load(scene_path)?;
     let world = World::build(&scene)?;
-    let count = seethru::io::export::export(&scene, &world, out)?;
+    let exported = seethru::io::export::export(&scene, &world, out, format)?;
     eprintln!(
-        "wrote {count} triangles to {} and cameras to {}",
+        "wrote {} triangles as {} to {} ({} files: {})",
+        exported.triangles,
+        exported.format.name(),
         out.display(),
-        out.with_extension("cameras.json").display()
+        exported.files.len(),
+        exported
+            .files
+            .iter()
+            .map(|f| f.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
     );
     Ok(())
 }

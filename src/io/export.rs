@@ -1,60 +1,478 @@
-//! Exporting a scene's triangles (OBJ or binary glTF) and its cameras (JSON), so that other
-//! renderers can be run on exactly the same scene.
+//! Exporting a scene so that other renderers can be run on exactly the same scene: the traced
+//! triangles (spheres tessellated) with normals, UVs and materials, the three cameras, the
+//! display, the sun and the sky, and every object's seethru id.
+//!
+//! This module gathers that content once ([`ExportScene`]); the writers turn it into binary
+//! glTF (`gltf_export.rs`), OBJ + MTL (`obj_export.rs`) or a Mitsuba 3 scene
+//! (`mitsuba_export.rs`). Every format also gets `<file>.cameras.json`.
 
-use std::path::Path;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
-use anyhow::{Result, bail};
-use glam::{Vec3, Vec3A};
+use anyhow::{Context, Result, bail};
+use glam::{DVec3, Vec2, Vec3, Vec3A};
 use serde_json::json;
 
 use crate::geometry::camera::Camera;
 use crate::io::atomic::{write_atomically, write_text};
-use crate::scene::Scene;
-use crate::scene::world::World;
+use crate::render::sky::SkyModel;
+use crate::scene::mesh_io::load_mesh;
+use crate::scene::shapes::box_face;
+use crate::scene::texture::Texture;
+use crate::scene::world::{Ellipsoid, TriAttr, World, view_bit};
+use crate::scene::{Scene, Shape};
+use crate::util::color::encode_srgb8;
 
 /// Latitude × longitude bands of the spheres' tessellation in exports.
-const SPHERE_BANDS: (usize, usize) = (24, 48);
+pub const SPHERE_BANDS: (usize, usize) = (24, 48);
 
-/// Every object's world-space triangles, spheres tessellated; index = object id − 1.
-pub fn object_triangles(world: &World) -> Vec<Vec<[Vec3; 3]>> {
-    let mut out = vec![Vec::new(); world.objects.len()];
-    for (tri, attr) in world.triangles.iter().zip(&world.tri_attrs) {
-        let v0 = Vec3::from(tri.v0);
-        out[attr.object as usize - 1].push([v0, v0 - Vec3::from(tri.e1), v0 + Vec3::from(tri.e2)]);
+/// Near clipping distance written to the exported cameras, metres. seethru's cameras have no
+/// near plane; rasterisers need one, and nothing a camera sees lies closer than this.
+pub const CAMERA_ZNEAR: f64 = 0.01;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ExportFormat {
+    /// Binary glTF 2.0 (.glb): meshes, materials and texture, cameras, display, sun.
+    Gltf,
+    /// Wavefront OBJ with an MTL material library (.obj).
+    Obj,
+    /// Mitsuba 3 XML scenes with PLY meshes (.xml).
+    Mitsuba,
+}
+
+impl ExportFormat {
+    const ALL: [ExportFormat; 3] = [ExportFormat::Gltf, ExportFormat::Obj, ExportFormat::Mitsuba];
+
+    pub fn extension(self) -> &'static str {
+        match self {
+            ExportFormat::Gltf => "glb",
+            ExportFormat::Obj => "obj",
+            ExportFormat::Mitsuba => "xml",
+        }
     }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ExportFormat::Gltf => "gltf",
+            ExportFormat::Obj => "obj",
+            ExportFormat::Mitsuba => "mitsuba",
+        }
+    }
+
+    /// The format an output file name asks for, by its extension.
+    pub fn of_path(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_string_lossy().to_ascii_lowercase();
+        Self::ALL.into_iter().find(|f| f.extension() == ext)
+    }
+}
+
+/// Triangles of one object that share a part and a material: one glTF primitive.
+#[derive(Clone, Debug)]
+pub struct Primitive {
+    /// Part id, as in the part-id AOV.
+    pub part: u32,
+    /// Index into [`ExportScene::materials`].
+    pub material: usize,
+    /// Vertex positions, world frame, metres.
+    pub positions: Vec<Vec3>,
+    /// Unit shading normals, world frame: the face normal of a flat triangle (the renderer
+    /// shades triangles flat), the ellipsoid's own normal on tessellated spheres.
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates with the material's `uv_repeat` applied: u right, v down from the
+    /// texture's top-left corner, repeating (the glTF convention).
+    pub uvs: Vec<Vec2>,
+    /// Vertex indices, counter-clockwise seen from the side the normals point to.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Primitive {
+    fn new(part: u32, material: usize) -> Self {
+        Self {
+            part,
+            material,
+            positions: Vec::new(),
+            normals: Vec::new(),
+            uvs: Vec::new(),
+            triangles: Vec::new(),
+        }
+    }
+
+    /// Appends `other`'s vertices and triangles.
+    pub fn append(&mut self, other: &Primitive) {
+        let base = self.positions.len() as u32;
+        self.positions.extend(&other.positions);
+        self.normals.extend(&other.normals);
+        self.uvs.extend(&other.uvs);
+        self.triangles
+            .extend(other.triangles.iter().map(|t| t.map(|i| base + i)));
+    }
+
+    /// The triangles' corner positions.
+    pub fn corner_positions(&self) -> impl Iterator<Item = [Vec3; 3]> + '_ {
+        self.triangles
+            .iter()
+            .map(|t| t.map(|i| self.positions[i as usize]))
+    }
+}
+
+/// One node of the export: a scene object, the obstacle, or the display (the obstacle's
+/// driver-facing face, exported on its own so that it can be found and textured).
+#[derive(Clone, Debug)]
+pub struct ExportObject {
+    pub name: String,
+    /// seethru object id as in the id AOV: position in the scene file's object list + 1; the
+    /// obstacle (and its display) last.
+    pub id: u32,
+    /// `plane`, `box`, `sphere`, …, `obstacle` or `display`.
+    pub kind: &'static str,
+    /// Bit set of the [`view_bit`]s of the seethru views that show the object.
+    pub views: u8,
+    pub casts_shadow: bool,
+    pub primitives: Vec<Primitive>,
+}
+
+impl ExportObject {
+    /// Names of the seethru views that show the object.
+    pub fn view_names(&self) -> Vec<&'static str> {
+        VIEWS
+            .iter()
+            .filter(|(_, bit, _)| self.views & bit != 0)
+            .map(|(name, _, _)| *name)
+            .collect()
+    }
+
+    /// The cameras (`driver`, `frontal`, `back`) that never see the object, as the scene
+    /// file's `hidden_from` says (the obstacle: frontal and back; the truth view lacks it too).
+    pub fn hidden_from(&self) -> Vec<&'static str> {
+        [
+            ("driver", view_bit::DRIVER),
+            ("frontal", view_bit::FRONTAL),
+            ("back", view_bit::BACK),
+        ]
+        .into_iter()
+        .filter(|(_, bits)| self.views & bits == 0)
+        .map(|(name, _)| name)
+        .collect()
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.primitives.iter().map(|p| p.triangles.len()).sum()
+    }
+}
+
+/// seethru's views, the view bit of each and the camera that renders it.
+pub const VIEWS: [(&str, u8, &str); 5] = [
+    ("truth", view_bit::TRUTH, "driver"),
+    ("occluded", view_bit::OCCLUDED, "driver"),
+    ("seethru", view_bit::SEETHRU, "driver"),
+    ("frontal", view_bit::FRONTAL, "frontal"),
+    ("back", view_bit::BACK, "back"),
+];
+
+#[derive(Clone, Debug)]
+pub struct ExportMaterial {
+    pub name: String,
+    /// Base colour, linear RGB (the scene file's sRGB colour decoded), multiplied with the
+    /// texture.
+    pub linear_color: Vec3,
+    /// The texture, linear RGB texels as the renderer samples them.
+    pub texture: Option<Texture>,
+    /// Texture repetitions per unit of the surface's own UVs; exported UVs include it.
+    pub uv_repeat: Vec2,
+}
+
+/// Everything an export writes, gathered from the scene and its world.
+pub struct ExportScene<'a> {
+    pub scene: &'a Scene,
+    /// Objects in id order; the display follows the obstacle.
+    pub objects: Vec<ExportObject>,
+    pub materials: Vec<ExportMaterial>,
+    /// The lighting in physical terms (see [`Lighting`]).
+    pub lighting: Lighting,
+}
+
+/// seethru's light as a physically based renderer states it. seethru shades Lambertian
+/// surfaces as albedo × (sun × cos θ × shadow + ambient(n)); a physical renderer computes
+/// albedo / π × irradiance, so the sun's irradiance is π × seethru's. seethru's ambient is
+/// linear in n_y, which is exactly the irradiance an unoccluded surface receives from an
+/// environment of uniform radiance `sky_up` above the horizon and `sky_down` below.
+#[derive(Clone, Copy, Debug)]
+pub struct Lighting {
+    /// Unit direction towards the sun, world frame.
+    pub sun_direction: Vec3,
+    /// Irradiance on a surface facing the sun, linear RGB (π × colour × intensity).
+    pub sun_irradiance: Vec3,
+    /// Radiance of the upper and lower hemispheres of the environment, linear RGB.
+    pub sky_up: Vec3,
+    pub sky_down: Vec3,
+}
+
+impl<'a> ExportScene<'a> {
+    pub fn new(scene: &'a Scene, world: &World) -> Result<Self> {
+        let names = material_names(scene, world)?;
+        let materials = world
+            .materials
+            .iter()
+            .zip(names)
+            .map(|(m, name)| ExportMaterial {
+                name,
+                linear_color: m.albedo,
+                texture: m.texture.map(|t| world.textures[t].clone()),
+                uv_repeat: m.uv_repeat,
+            })
+            .collect::<Vec<_>>();
+
+        // (object index or the display, part, material) → primitive.
+        let display = world.objects.len();
+        let mut groups: BTreeMap<(usize, u32, u32), Primitive> = BTreeMap::new();
+        for (p, attr) in traced_triangles(world) {
+            let owner = if attr.object == world.obstacle_id && attr.part == box_face::POS_Z {
+                display
+            } else {
+                attr.object as usize - 1
+            };
+            let repeat = materials[attr.material as usize].uv_repeat;
+            let n = face_normal(p);
+            let prim = groups
+                .entry((owner, attr.part, attr.material))
+                .or_insert_with(|| Primitive::new(attr.part, attr.material as usize));
+            let base = prim.positions.len() as u32;
+            prim.positions.extend(p);
+            prim.normals.extend([n; 3]);
+            prim.uvs.extend(attr.uv.map(|uv| uv * repeat));
+            prim.triangles.push([base, base + 1, base + 2]);
+        }
+        for el in &world.ellipsoids {
+            let repeat = materials[el.material as usize].uv_repeat;
+            groups
+                .entry((el.object as usize - 1, 0, el.material))
+                .or_insert_with(|| Primitive::new(0, el.material as usize))
+                .append(&ellipsoid_mesh(el, repeat));
+        }
+
+        let mut objects = Vec::new();
+        for (index, info) in world.objects.iter().enumerate() {
+            let id = index as u32 + 1;
+            let primitives_of = |owner: usize| {
+                groups
+                    .range((owner, 0, 0)..=(owner, u32::MAX, u32::MAX))
+                    .map(|(_, p)| p.clone())
+                    .collect::<Vec<_>>()
+            };
+            let kind = match scene.objects.get(index) {
+                Some(o) => shape_kind(&o.shape),
+                None => "obstacle",
+            };
+            objects.push(ExportObject {
+                name: info.name.clone(),
+                id,
+                kind,
+                views: info.views,
+                casts_shadow: info.casts_shadow,
+                primitives: primitives_of(index),
+            });
+            if id == world.obstacle_id {
+                objects.push(ExportObject {
+                    name: "display".into(),
+                    kind: "display",
+                    primitives: primitives_of(display),
+                    ..objects.last().unwrap().clone()
+                });
+            }
+        }
+
+        let sky = SkyModel::new(&scene.sky, &scene.sun);
+        let lighting = Lighting {
+            sun_direction: sky.sun_direction,
+            sun_irradiance: sky.sun_irradiance * std::f32::consts::PI,
+            sky_up: sky.ambient(Vec3::Y),
+            sky_down: sky.ambient(-Vec3::Y),
+        };
+        Ok(Self {
+            scene,
+            objects,
+            materials,
+            lighting,
+        })
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.objects.iter().map(ExportObject::triangle_count).sum()
+    }
+
+    /// The three cameras by name, in the order driver, frontal, back.
+    pub fn cameras(&self) -> [(&'static str, &'a Camera); 3] {
+        let s = self.scene;
+        [
+            ("driver", &s.driver),
+            ("frontal", &s.frontal),
+            ("back", &s.back),
+        ]
+    }
+}
+
+/// The renderer's triangles with their attributes: the one place the export reads the
+/// world's triangle storage.
+fn traced_triangles(world: &World) -> impl Iterator<Item = ([Vec3; 3], &TriAttr)> {
+    world
+        .triangles
+        .iter()
+        .zip(&world.tri_attrs)
+        .map(|(tri, attr)| {
+            let v0 = Vec3::from(tri.v0);
+            ([v0, v0 - Vec3::from(tri.e1), v0 + Vec3::from(tri.e2)], attr)
+        })
+}
+
+/// Unit normal of a counter-clockwise triangle (computed in f64: thin triangles stay unit).
+fn face_normal(p: [Vec3; 3]) -> Vec3 {
+    let [a, b, c] = p.map(Vec3::as_dvec3);
+    let n = (b - a).cross(c - a).normalize_or_zero();
+    if n == DVec3::ZERO {
+        Vec3::Y
+    } else {
+        n.as_vec3()
+    }
+}
+
+/// An ellipsoid as a latitude–longitude mesh: vertices on the exact surface, its normals,
+/// and the renderer's equirectangular UVs (u around +y, v from the north pole down).
+fn ellipsoid_mesh(el: &Ellipsoid, repeat: Vec2) -> Primitive {
     let (lat, lon) = SPHERE_BANDS;
-    for el in &world.ellipsoids {
-        let point = |i: usize, j: usize| {
+    let mut prim = Primitive::new(0, el.material as usize);
+    for i in 0..=lat {
+        for j in 0..=lon {
             let (theta, phi) = (
                 std::f32::consts::PI * i as f32 / lat as f32,
                 std::f32::consts::TAU * j as f32 / lon as f32,
             );
-            let local = Vec3A::new(
+            let local = Vec3::new(
                 theta.sin() * phi.cos(),
                 theta.cos(),
                 -theta.sin() * phi.sin(),
             );
-            Vec3::from(el.world_from_object.transform_point3a(local))
-        };
-        let tris = &mut out[el.object as usize - 1];
-        for i in 0..lat {
-            for j in 0..lon {
-                let (a, b, c, d) = (
-                    point(i, j),
-                    point(i + 1, j),
-                    point(i + 1, j + 1),
-                    point(i, j + 1),
-                );
-                if i > 0 {
-                    tris.push([a, b, d]);
-                }
-                if i + 1 < lat {
-                    tris.push([b, c, d]);
-                }
+            prim.positions
+                .push(el.world_from_object.transform_point3(local));
+            prim.normals
+                .push(Vec3::from(el.normal_from_object * Vec3A::from(local)).normalize());
+            // The renderer's u = 0.5 + atan2(z, x) / 2π is 0.5 − φ / 2π here; unwrapped so
+            // that the seam's triangles do not span the whole texture.
+            prim.uvs
+                .push(Vec2::new(0.5 - j as f32 / lon as f32, i as f32 / lat as f32) * repeat);
+        }
+    }
+    // A mirroring transform turns the winding inside out; keep it counter-clockwise outside.
+    let mirrored = el.world_from_object.matrix3.determinant() < 0.0;
+    let vertex = |i: usize, j: usize| (i * (lon + 1) + j) as u32;
+    let mut push = |t: [u32; 3]| {
+        prim.triangles
+            .push(if mirrored { [t[0], t[2], t[1]] } else { t })
+    };
+    for i in 0..lat {
+        for j in 0..lon {
+            let (a, b, c, d) = (
+                vertex(i, j),
+                vertex(i + 1, j),
+                vertex(i + 1, j + 1),
+                vertex(i, j + 1),
+            );
+            // The poles' degenerate triangles are left out.
+            if i > 0 {
+                push([a, b, d]);
+            }
+            if i + 1 < lat {
+                push([b, c, d]);
             }
         }
     }
-    out
+    prim
+}
+
+fn shape_kind(shape: &Shape) -> &'static str {
+    match shape {
+        Shape::Plane { .. } => "plane",
+        Shape::Box { .. } => "box",
+        Shape::Sphere { .. } => "sphere",
+        Shape::Cylinder { .. } => "cylinder",
+        Shape::Cone { .. } => "cone",
+        Shape::Quad { .. } => "quad",
+        Shape::Mesh { .. } => "mesh",
+    }
+}
+
+/// Names of the world's materials, in its order: the scene file's materials, then each
+/// mesh file's own (`<object>.<material>`, or `<object>.default` for a mesh file without
+/// materials), then the obstacle's body and display.
+fn material_names(scene: &Scene, world: &World) -> Result<Vec<String>> {
+    let mut names: Vec<String> = scene.materials.iter().map(|m| m.name.clone()).collect();
+    for object in &scene.objects {
+        if let Shape::Mesh { path } = &object.shape {
+            let file = load_mesh(path)?;
+            names.extend(
+                file.materials
+                    .iter()
+                    .map(|m| format!("{}.{}", object.name, m.name)),
+            );
+            if file.materials.is_empty() && object.material.is_none() {
+                names.push(format!("{}.default", object.name));
+            }
+        }
+    }
+    names.extend(["obstacle_body".into(), "display".into()]);
+    if names.len() != world.materials.len() {
+        // The world numbers its materials differently from the scene file: plain names.
+        names = (0..world.materials.len())
+            .map(|i| format!("material{i}"))
+            .collect();
+    }
+    Ok(names)
+}
+
+/// A name as a file or identifier part: ASCII letters, digits, `-` and `_`.
+pub fn sanitize(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// A texture as an 8-bit sRGB PNG: exactly the texels the renderer decoded.
+pub fn texture_png(texture: &Texture) -> Result<Vec<u8>> {
+    let bytes = texture
+        .texels
+        .iter()
+        .flat_map(|&t| encode_srgb8(t))
+        .collect();
+    let image = image::RgbImage::from_raw(texture.width, texture.height, bytes)
+        .context("texture size does not match its texels")?;
+    let mut png = std::io::Cursor::new(Vec::new());
+    image.write_to(&mut png, image::ImageFormat::Png)?;
+    Ok(png.into_inner())
+}
+
+/// The folder beside `path` that holds an export's meshes and textures: `<stem>_assets`.
+pub fn assets_dir(path: &Path) -> PathBuf {
+    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+    path.with_file_name(format!("{stem}_assets"))
+}
+
+/// Creates `dir` and writes `bytes` to `dir/name` (atomically); returns the file's path.
+pub fn write_asset(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let path = dir.join(name);
+    write_atomically(&path, |tmp| Ok(std::fs::write(tmp, bytes)?))?;
+    Ok(path)
+}
+
+/// Vertical field of view (full angle, radians) of a camera with square pixels:
+/// 2 atan(tan θx · height / width).
+pub fn vertical_fov(c: &Camera) -> f64 {
+    2.0 * c.tan_half_y().atan()
 }
 
 fn camera_json(c: &Camera) -> serde_json::Value {
@@ -71,121 +489,82 @@ fn camera_json(c: &Camera) -> serde_json::Value {
     })
 }
 
+/// The display rectangle: corners, normal, size and resolution.
+pub fn display_json(scene: &Scene) -> serde_json::Value {
+    let o = &scene.obstacle;
+    json!({
+        "corners_tl_tr_br_bl": o.display_corners().map(|c| c.to_array()),
+        "normal_towards_driver": o.normal().to_array(),
+        "world_from_display_column_major": glam::DMat4::from(o.world_from_obstacle).to_cols_array(),
+        "width_m": o.width,
+        "height_m": o.height,
+        "resolution": o.display_resolution,
+    })
+}
+
 /// The cameras and the display rectangle as JSON.
 pub fn cameras_json(scene: &Scene) -> serde_json::Value {
-    let o = &scene.obstacle;
     json!({
         "units": "metres, world frame right-handed +y up",
         "driver": camera_json(&scene.driver),
         "frontal": camera_json(&scene.frontal),
         "back": camera_json(&scene.back),
-        "display": {
-            "corners_tl_tr_br_bl": o.display_corners().map(|c| c.to_array()),
-            "normal_towards_driver": o.normal().to_array(),
-            "width_m": o.width,
-            "height_m": o.height,
-            "resolution": o.display_resolution,
-        },
+        "display": display_json(scene),
     })
 }
 
-fn obj_text(world: &World, objects: &[Vec<[Vec3; 3]>]) -> String {
-    use std::fmt::Write;
-    let mut s = String::from("# seethru export: world-space triangles, metres, +y up\n");
-    let mut base = 1;
-    for (info, tris) in world.objects.iter().zip(objects) {
-        let _ = writeln!(s, "o {}", info.name.replace(char::is_whitespace, "_"));
-        for t in tris {
-            for v in t {
-                let _ = writeln!(s, "v {} {} {}", v.x, v.y, v.z);
-            }
-        }
-        for i in 0..tris.len() {
-            let _ = writeln!(
-                s,
-                "f {} {} {}",
-                base + 3 * i,
-                base + 3 * i + 1,
-                base + 3 * i + 2
-            );
-        }
-        base += 3 * tris.len();
-    }
-    s
+/// What an export wrote.
+#[derive(Clone, Debug)]
+pub struct Exported {
+    pub format: ExportFormat,
+    pub triangles: usize,
+    /// Every file written, the main one first.
+    pub files: Vec<PathBuf>,
 }
 
-fn glb_bytes(world: &World, objects: &[Vec<[Vec3; 3]>]) -> Vec<u8> {
-    let mut bin: Vec<u8> = Vec::new();
-    let (mut nodes, mut meshes, mut accessors, mut views) = (vec![], vec![], vec![], vec![]);
-    for (info, tris) in world
-        .objects
-        .iter()
-        .zip(objects)
-        .filter(|(_, t)| !t.is_empty())
-    {
-        let count = tris.len() * 3;
-        let (mut min, mut max) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        let start = bin.len();
-        for v in tris.iter().flatten() {
-            (min, max) = (min.min(*v), max.max(*v));
-            bin.extend(v.to_array().iter().flat_map(|f| f.to_le_bytes()));
-        }
-        let index_start = bin.len();
-        bin.extend((0..count as u32).flat_map(|i| i.to_le_bytes()));
-        let a = accessors.len();
-        views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": index_start - start, "target": 34962}));
-        views.push(json!({"buffer": 0, "byteOffset": index_start, "byteLength": 4 * count, "target": 34963}));
-        accessors.push(json!({"bufferView": a, "componentType": 5126, "count": count, "type": "VEC3", "min": min.to_array(), "max": max.to_array()}));
-        accessors.push(
-            json!({"bufferView": a + 1, "componentType": 5125, "count": count, "type": "SCALAR"}),
-        );
-        nodes.push(json!({"mesh": meshes.len(), "name": info.name}));
-        meshes.push(json!({"name": info.name, "primitives": [{"attributes": {"POSITION": a}, "indices": a + 1}]}));
-    }
-    let doc = json!({
-        "asset": {"version": "2.0", "generator": "seethru"},
-        "scene": 0,
-        "scenes": [{"nodes": (0..nodes.len()).collect::<Vec<_>>()}],
-        "nodes": nodes, "meshes": meshes, "accessors": accessors, "bufferViews": views,
-        "buffers": [{"byteLength": bin.len()}],
-    });
-    let mut json_chunk = doc.to_string().into_bytes();
-    while !json_chunk.len().is_multiple_of(4) {
-        json_chunk.push(b' ');
-    }
-    while !bin.len().is_multiple_of(4) {
-        bin.push(0);
-    }
-    let total = 12 + 8 + json_chunk.len() + 8 + bin.len();
-    let mut out = Vec::with_capacity(total);
-    out.extend(b"glTF");
-    out.extend(2u32.to_le_bytes());
-    out.extend((total as u32).to_le_bytes());
-    out.extend((json_chunk.len() as u32).to_le_bytes());
-    out.extend(b"JSON");
-    out.extend(json_chunk);
-    out.extend((bin.len() as u32).to_le_bytes());
-    out.extend(b"BIN\0");
-    out.extend(bin);
-    out
-}
-
-/// Writes the scene's triangles to `path` (.obj or .glb) and the cameras to
-/// `<path without extension>.cameras.json`. Returns the number of triangles written.
-pub fn export(scene: &Scene, world: &World, path: &Path) -> Result<usize> {
-    let objects = object_triangles(world);
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase());
-    match ext.as_deref() {
-        Some("obj") => write_text(path, &obj_text(world, &objects))?,
-        Some("glb") => {
-            let bytes = glb_bytes(world, &objects);
-            write_atomically(path, |tmp| Ok(std::fs::write(tmp, bytes)?))?
-        }
-        _ => bail!("export writes .obj or .glb files, not {}", path.display()),
-    }
-    let cameras = serde_json::to_string_pretty(&cameras_json(scene))?;
-    write_text(&path.with_extension("cameras.json"), &cameras)?;
-    Ok(objects.iter().map(Vec::len).sum())
+/// Exports the scene to `path` in `format` (by default the one `path`'s extension names),
+/// and the cameras to `<path without extension>.cameras.json`.
+pub fn export(
+    scene: &Scene,
+    world: &World,
+    path: &Path,
+    format: Option<ExportFormat>,
+) -> Result<Exported> {
+    let by_name = ExportFormat::of_path(path);
+    let format = match (format, by_name) {
+        (Some(f), Some(g)) if f != g => bail!(
+            "--format {} writes a .{} file, but --out is {}",
+            f.name(),
+            f.extension(),
+            path.display()
+        ),
+        (Some(f), None) => bail!(
+            "--format {} writes a .{} file, but --out is {}",
+            f.name(),
+            f.extension(),
+            path.display()
+        ),
+        (_, Some(f)) => f,
+        (None, None) => bail!(
+            "export writes .obj or .glb (glTF) or .xml (Mitsuba) files, not {}; name the --out file with one of these extensions",
+            path.display()
+        ),
+    };
+    let content = ExportScene::new(scene, world)?;
+    let mut files = match format {
+        ExportFormat::Gltf => crate::io::gltf_export::write_glb(&content, path)?,
+        ExportFormat::Obj => crate::io::obj_export::write_obj(&content, path)?,
+        ExportFormat::Mitsuba => crate::io::mitsuba_export::write_mitsuba(&content, path)?,
+    };
+    let cameras_path = path.with_extension("cameras.json");
+    write_text(
+        &cameras_path,
+        &serde_json::to_string_pretty(&cameras_json(scene))?,
+    )?;
+    files.push(cameras_path);
+    Ok(Exported {
+        format,
+        triangles: content.triangle_count(),
+        files,
+    })
 }
