@@ -571,18 +571,14 @@ fn obj_export_has_linear_colours_in_its_material_library() {
             .iter()
             .find(|g| g.name.ends_with(&format!("_{}", m.name)))
             .unwrap_or_else(|| panic!("no material {}", m.name));
-        let kd = got.diffuse.unwrap();
-        for k in 0..3 {
-            assert!(
-                (kd[k] as f64 - srgb_decode(m.color[k])).abs() < 1e-6,
-                "{}",
-                m.name
-            );
+        for (kd, srgb) in got.diffuse.unwrap().iter().zip(m.color) {
+            assert!((*kd as f64 - srgb_decode(srgb)).abs() < 1e-6, "{}", m.name);
         }
-        if m.texture.is_some() {
+        assert_eq!(got.diffuse_texture.is_some(), m.texture.is_some());
+        if let Some(original) = &m.texture {
             let texture = dir.path().join(got.diffuse_texture.as_ref().unwrap());
             let written = image::open(texture).unwrap().to_rgb8();
-            let original = image::open(m.texture.as_ref().unwrap()).unwrap().to_rgb8();
+            let original = image::open(original).unwrap().to_rgb8();
             assert!(written == original, "{}: texture", m.name);
         }
     }

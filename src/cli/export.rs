@@ -29,18 +29,21 @@ fn export_scene(scene_path: &Path, out: &Path, format: Option<ExportFormat>) -> 
     let scene = Scene::load(scene_path)?;
     let world = World::build(&scene)?;
     let exported = seethru::io::export::export(&scene, &world, out, format)?;
-    eprintln!(
-        "wrote {} triangles as {} to {} ({} files: {})",
+    let assets = seethru::io::export::assets_dir(out);
+    let (in_assets, beside): (Vec<_>, Vec<_>) =
+        exported.files.iter().partition(|f| f.starts_with(&assets));
+    let beside: Vec<String> = beside.iter().map(|f| f.display().to_string()).collect();
+    let mut message = format!(
+        "wrote {} triangles as {}: {}",
         exported.triangles,
         exported.format.name(),
-        out.display(),
-        exported.files.len(),
-        exported
-            .files
-            .iter()
-            .map(|f| f.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", ")
+        beside.join(", ")
     );
+    if !in_assets.is_empty() {
+        let n = in_assets.len();
+        let files = if n == 1 { "file" } else { "files" };
+        message += &format!(" and {n} {files} in {}", assets.display());
+    }
+    eprintln!("{message}");
     Ok(())
 }

@@ -45,7 +45,7 @@ fn triple(v: DVec3) -> String {
 }
 
 fn rgb(v: Vec3) -> String {
-    triple(v.as_dvec3())
+    format!("{}, {}, {}", v.x, v.y, v.z)
 }
 
 fn bsdf_id(index: usize, name: &str) -> String {
@@ -54,8 +54,9 @@ fn bsdf_id(index: usize, name: &str) -> String {
 
 /// A Mitsuba `perspective` sensor with seethru's camera: `fov` is the full horizontal angle,
 /// 2 θx, so the image spans exactly seethru's half angle; a box filter, like seethru's
-/// averaging of samples within a pixel.
-fn sensor_xml(s: &mut String, name: &str, c: &Camera) {
+/// averaging of samples within a pixel. `size` is the film's width and height: numbers, or
+/// `$width`, `$height` parameters.
+fn sensor_xml(s: &mut String, name: &str, c: &Camera, size: [String; 2]) {
     let fov = 2.0 * c.half_angle_x.to_degrees();
     let up = c.world_from_camera.matrix3.y_axis;
     let _ = write!(
@@ -82,8 +83,8 @@ fn sensor_xml(s: &mut String, name: &str, c: &Camera) {
         triple(c.position()),
         triple(c.position() + c.forward()),
         triple(up),
-        c.width,
-        c.height,
+        size[0],
+        size[1],
     );
 }
 
@@ -259,8 +260,21 @@ fn scene_xml(
          <default name=\"spp\" value=\"{DEFAULT_SPP}\"/>\n    <integrator type=\"direct\"/>\n",
         comment.replace("--", "- -")
     );
-    for (name, c) in sensors {
-        sensor_xml(&mut s, name, c);
+    match sensors {
+        // One view: its size is a parameter, `mi.load_file(path, width=…, height=…)`.
+        [(name, c)] => {
+            let _ = write!(
+                s,
+                "    <default name=\"width\" value=\"{}\"/>\n    <default name=\"height\" value=\"{}\"/>\n",
+                c.width, c.height
+            );
+            sensor_xml(&mut s, name, c, ["$width".into(), "$height".into()]);
+        }
+        _ => {
+            for (name, c) in sensors {
+                sensor_xml(&mut s, name, c, [c.width, c.height].map(|v| v.to_string()));
+            }
+        }
     }
     s.push_str(shared);
     for shape in shapes {
