@@ -123,13 +123,36 @@ fn gltf_project(node: &Mat4, yfov: f64, aspect: f64, size: (u32, u32), p: DVec3)
     )
 }
 
-#[test]
-fn gltf_export_has_the_cameras_materials_display_and_ids() {
+/// das exported to `<temp dir>/<name>` in `format` (None: by the extension).
+struct Exported {
+    scene: seethru::scene::Scene,
+    world: World,
+    dir: tempfile::TempDir,
+    path: std::path::PathBuf,
+}
+
+fn export_das(name: &str, format: Option<ExportFormat>) -> Exported {
     let scene = common::das();
     let world = World::build(&scene).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("das.glb");
-    export(&scene, &world, &path, Some(ExportFormat::Gltf)).unwrap();
+    let path = dir.path().join(name);
+    export(&scene, &world, &path, format).unwrap();
+    Exported {
+        scene,
+        world,
+        dir,
+        path,
+    }
+}
+
+#[test]
+fn gltf_export_has_the_cameras_materials_display_and_ids() {
+    let Exported {
+        scene,
+        path,
+        dir: _dir,
+        ..
+    } = export_das("das.glb", Some(ExportFormat::Gltf));
     let (doc, buffers, images) = gltf::import(&path).unwrap();
     let nodes: BTreeMap<String, gltf::Node> = doc
         .nodes()
@@ -372,12 +395,12 @@ fn triple(text: &str) -> DVec3 {
 
 #[test]
 fn mitsuba_export_has_three_sensors_with_the_exact_field_of_view() {
-    let scene = common::das();
-    let world = World::build(&scene).unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("das.xml");
-    let exported = export(&scene, &world, &path, None).unwrap();
-    assert_eq!(exported.format, ExportFormat::Mitsuba);
+    let Exported {
+        scene,
+        world,
+        dir,
+        path,
+    } = export_das("das.xml", None);
 
     let read = |file: &Path| std::fs::read_to_string(file).unwrap();
     let text = read(&path);
@@ -559,11 +582,9 @@ fn two_hemispheres_light_a_surface_as_seethrus_ambient() {
 
 #[test]
 fn obj_export_has_linear_colours_in_its_material_library() {
-    let scene = common::das();
-    let world = World::build(&scene).unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("das.obj");
-    export(&scene, &world, &path, Some(ExportFormat::Obj)).unwrap();
+    let Exported {
+        scene, dir, path, ..
+    } = export_das("das.obj", Some(ExportFormat::Obj));
     let (_, materials) = tobj::load_obj(&path, &tobj::GPU_LOAD_OPTIONS).unwrap();
     let materials = materials.unwrap();
     for m in &scene.materials {
