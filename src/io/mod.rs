@@ -3,6 +3,7 @@
 
 pub mod atomic;
 pub mod export;
+pub mod export_scene;
 pub mod frame_files;
 pub mod gltf_export;
 pub mod mitsuba_export;
