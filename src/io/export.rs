@@ -94,19 +94,14 @@ pub fn export(
 ) -> Result<Exported> {
     let by_name = ExportFormat::of_path(path);
     let format = match (format, by_name) {
-        (Some(f), Some(g)) if f != g => bail!(
+        (None, Some(f)) => f,
+        (Some(f), named) if named == Some(f) => f,
+        (Some(f), _) => bail!(
             "--format {} writes a .{} file, but --out is {}",
             f.name(),
             f.extension(),
             path.display()
         ),
-        (Some(f), None) => bail!(
-            "--format {} writes a .{} file, but --out is {}",
-            f.name(),
-            f.extension(),
-            path.display()
-        ),
-        (_, Some(f)) => f,
         (None, None) => bail!(
             "export writes .obj or .glb (glTF) or .xml (Mitsuba) files, not {}; name the --out file with one of these extensions",
             path.display()

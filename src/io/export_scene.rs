@@ -47,7 +47,8 @@ pub struct Primitive {
 }
 
 impl Primitive {
-    fn new(part: u32, material: usize) -> Self {
+    /// An empty primitive.
+    pub fn new(part: u32, material: usize) -> Self {
         Self {
             part,
             material,
@@ -66,13 +67,6 @@ impl Primitive {
         self.uvs.extend(&other.uvs);
         self.triangles
             .extend(other.triangles.iter().map(|t| t.map(|i| base + i)));
-    }
-
-    /// The triangles' corner positions.
-    pub fn corner_positions(&self) -> impl Iterator<Item = [Vec3; 3]> + '_ {
-        self.triangles
-            .iter()
-            .map(|t| t.map(|i| self.positions[i as usize]))
     }
 }
 

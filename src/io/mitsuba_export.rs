@@ -135,13 +135,7 @@ fn write_meshes(
         for p in &o.primitives {
             by_material
                 .entry(p.material)
-                .or_insert_with(|| Primitive {
-                    positions: vec![],
-                    normals: vec![],
-                    uvs: vec![],
-                    triangles: vec![],
-                    ..p.clone()
-                })
+                .or_insert_with(|| Primitive::new(p.part, p.material))
                 .append(p);
         }
         for (material, mesh) in by_material {
