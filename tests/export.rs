@@ -652,7 +652,8 @@ fn the_format_and_the_file_name_must_agree() {
             "output left behind"
         );
     }
-    let file = out("scene.obj");
+    // A folder that does not exist yet is made.
+    let file = out("new/scene.obj");
     let (ok, err) = seethru(&[
         "export",
         "scenes/das.toml",
@@ -662,5 +663,5 @@ fn the_format_and_the_file_name_must_agree() {
         "obj",
     ]);
     assert!(ok, "{err}");
-    assert!(dir.path().join("scene.mtl").is_file());
+    assert!(dir.path().join("new/scene.mtl").is_file());
 }

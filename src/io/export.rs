@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use serde_json::json;
 
 use crate::geometry::camera::Camera;
@@ -108,6 +108,9 @@ pub fn export(
         ),
     };
     let content = ExportScene::new(scene, world)?;
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
     let mut files = match format {
         ExportFormat::Gltf => crate::io::gltf_export::write_glb(&content, path)?,
         ExportFormat::Obj => crate::io::obj_export::write_obj(&content, path)?,

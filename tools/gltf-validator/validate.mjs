@@ -13,7 +13,14 @@ if (files.length === 0) {
 }
 let failed = false;
 for (const file of files) {
-  const report = await validator.validateBytes(new Uint8Array(await readFile(file)), {
+  let bytes;
+  try {
+    bytes = new Uint8Array(await readFile(file));
+  } catch (e) {
+    console.error(`error: cannot read ${file}: ${e.message}`);
+    process.exit(2);
+  }
+  const report = await validator.validateBytes(bytes, {
     uri: basename(file),
     maxIssues: 0,
   });
