@@ -1,33 +1,49 @@
-//! `seethru export`: the scene's triangles as OBJ or binary glTF, and its cameras as JSON.
+//! `seethru export`: the scene for other renderers — binary glTF, OBJ + MTL, or Mitsuba 3 XML
+//! scenes — and its cameras as JSON.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
+use seethru::io::export::ExportFormat;
 use seethru::scene::Scene;
 use seethru::scene::world::World;
 
 #[derive(clap::Args)]
 pub struct Export {
     scene: PathBuf,
-    /// Output file, .obj or .glb.
+    /// Output file: .glb (glTF), .obj or .xml (Mitsuba 3); <name>.cameras.json goes beside it.
     #[arg(long)]
     out: PathBuf,
+    /// Output format; by default the one --out's extension names.
+    #[arg(long, value_enum)]
+    format: Option<ExportFormat>,
 }
 
 impl Export {
     pub fn run(self) -> Result<()> {
-        export_scene(&self.scene, &self.out)
+        export_scene(&self.scene, &self.out, self.format)
     }
 }
 
-fn export_scene(scene_path: &Path, out: &Path) -> Result<()> {
+fn export_scene(scene_path: &Path, out: &Path, format: Option<ExportFormat>) -> Result<()> {
     let scene = Scene::load(scene_path)?;
     let world = World::build(&scene)?;
-    let count = seethru::io::export::export(&scene, &world, out)?;
-    eprintln!(
-        "wrote {count} triangles to {} and cameras to {}",
-        out.display(),
-        out.with_extension("cameras.json").display()
+    let exported = seethru::io::export::export(&scene, &world, out, format)?;
+    let assets = seethru::io::export_scene::assets_dir(out);
+    let (in_assets, beside): (Vec<_>, Vec<_>) =
+        exported.files.iter().partition(|f| f.starts_with(&assets));
+    let beside: Vec<String> = beside.iter().map(|f| f.display().to_string()).collect();
+    let mut message = format!(
+        "wrote {} triangles as {}: {}",
+        exported.triangles,
+        exported.format.name(),
+        beside.join(", ")
     );
+    if !in_assets.is_empty() {
+        let n = in_assets.len();
+        let files = if n == 1 { "file" } else { "files" };
+        message += &format!(" and {n} {files} in {}", assets.display());
+    }
+    eprintln!("{message}");
     Ok(())
 }

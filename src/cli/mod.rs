@@ -43,7 +43,8 @@ pub enum Command {
     Sweep(sweep::Sweep),
     /// Recompute metrics.json and the misregistration maps of a `run` directory from its EXRs.
     Measure(measure::Measure),
-    /// Write the scene's triangles (.obj or .glb) and its cameras (<name>.cameras.json).
+    /// Export the scene for other renderers: glTF (.glb), OBJ or Mitsuba 3 (.xml), with its
+    /// materials, cameras, display and ids, and the cameras as <name>.cameras.json.
     Export(export::Export),
     /// Regenerate the paper's Fig. 3–5 and the physical-unit sensitivity figure (PNG + CSV).
     Figures(figures::Figures),
