@@ -8,8 +8,8 @@ use std::path::Path;
 use std::process::Command;
 
 use glam::{DVec2, DVec3, Mat4, Vec3};
+use seethru::io::export::content::SPHERE_BANDS;
 use seethru::io::export::{ExportFormat, export};
-use seethru::io::export_scene::SPHERE_BANDS;
 use seethru::render::sky::SkyModel;
 use seethru::scene::mesh_io::load_mesh;
 use seethru::scene::world::World;

@@ -74,16 +74,15 @@ fn imported_paths(text: &str, prefix: &str) -> Vec<Vec<String>> {
     paths
 }
 
-/// `src/<layer>/<module>.rs` (or `mod.rs`) of a path below a layer, if it names a file.
+/// The file a module path names: the longest prefix of it that is `src/a/b.rs` or
+/// `src/a/b/mod.rs`.
 fn file_of(src: &Path, path: &[String]) -> Option<PathBuf> {
-    let layer = path.first()?;
-    if let Some(module) = path.get(1) {
-        let file = src.join(layer).join(format!("{module}.rs"));
-        if file.is_file() {
-            return Some(file);
-        }
-    }
-    Some(src.join(layer).join("mod.rs")).filter(|f| f.is_file())
+    (1..=path.len()).rev().find_map(|k| {
+        let dir: PathBuf = path[..k].iter().collect();
+        let file = src.join(&dir).with_extension("rs");
+        let module = src.join(&dir).join("mod.rs");
+        [file, module].into_iter().find(|f| f.is_file())
+    })
 }
 
 #[test]

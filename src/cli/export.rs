@@ -29,7 +29,7 @@ fn export_scene(scene_path: &Path, out: &Path, format: Option<ExportFormat>) -> 
     let scene = Scene::load(scene_path)?;
     let world = World::build(&scene)?;
     let exported = seethru::io::export::export(&scene, &world, out, format)?;
-    let assets = seethru::io::export_scene::assets_dir(out);
+    let assets = seethru::io::export::content::assets_dir(out);
     let (in_assets, beside): (Vec<_>, Vec<_>) =
         exported.files.iter().partition(|f| f.starts_with(&assets));
     let beside: Vec<String> = beside.iter().map(|f| f.display().to_string()).collect();

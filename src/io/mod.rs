@@ -3,9 +3,5 @@
 
 pub mod atomic;
 pub mod export;
-pub mod export_scene;
 pub mod frame_files;
-pub mod gltf_export;
-pub mod mitsuba_export;
-pub mod obj_export;
 pub mod plot;

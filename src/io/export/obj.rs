@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 
 use crate::io::atomic::write_text;
-use crate::io::export_scene::{ExportScene, assets_dir, sanitize, texture_png, write_asset};
+use crate::io::export::content::{ExportScene, assets_dir, sanitize, texture_png, write_asset};
 
 fn material_name(index: usize, name: &str) -> String {
     format!("m{index}_{}", sanitize(name))

@@ -1,7 +1,7 @@
 //! What a scene export holds, gathered once from the scene and its world: the traced
 //! triangles (spheres tessellated) with normals and UVs per object, part and material; the
-//! materials; the lighting in physical terms. The writers (`gltf_export.rs`, `obj_export.rs`,
-//! `mitsuba_export.rs`) turn it into files.
+//! materials; the lighting in physical terms. The writers (`gltf.rs`, `obj.rs`,
+//! `mitsuba.rs`) turn it into files.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

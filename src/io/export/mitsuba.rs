@@ -5,7 +5,7 @@
 //! sees. Meshes (binary PLY with normals and UVs), textures and the sky map lie in
 //! `<stem>_assets/`.
 //!
-//! Lighting (see [`crate::io::export_scene::Lighting`]): the sun is a `directional` emitter with π ×
+//! Lighting (see [`crate::io::export::content::Lighting`]): the sun is a `directional` emitter with π ×
 //! seethru's irradiance; seethru's ambient term is an `envmap` of two uniform hemispheres,
 //! which gives an unoccluded surface exactly seethru's ambient light. Surfaces are `diffuse`
 //! inside `twosided`; the `direct` integrator, like seethru, adds no interreflections.
@@ -19,7 +19,7 @@ use glam::{DVec3, Vec3};
 
 use crate::geometry::camera::Camera;
 use crate::io::atomic::{write_atomically, write_text};
-use crate::io::export_scene::{
+use crate::io::export::content::{
     CAMERA_ZNEAR, ExportScene, Primitive, VIEWS, assets_dir, sanitize, write_asset,
 };
 

@@ -11,7 +11,7 @@ use serde_json::{Value, json};
 
 use crate::geometry::camera::world_from_camera_rotation;
 use crate::io::atomic::write_atomically;
-use crate::io::export_scene::{
+use crate::io::export::content::{
     CAMERA_ZNEAR, ExportObject, ExportScene, SPHERE_BANDS, display_json, texture_png, vertical_fov,
 };
 

@@ -3,6 +3,11 @@
 //! display, the sun and the sky, and every object's seethru id — as binary glTF, OBJ + MTL or
 //! Mitsuba 3 scenes, and `<file>.cameras.json` beside each.
 
+pub mod content;
+pub mod gltf;
+pub mod mitsuba;
+pub mod obj;
+
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
@@ -10,7 +15,7 @@ use serde_json::json;
 
 use crate::geometry::camera::Camera;
 use crate::io::atomic::write_text;
-use crate::io::export_scene::{ExportScene, display_json};
+use crate::io::export::content::{ExportScene, display_json};
 use crate::scene::Scene;
 use crate::scene::world::World;
 
@@ -112,9 +117,9 @@ pub fn export(
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
     let mut files = match format {
-        ExportFormat::Gltf => crate::io::gltf_export::write_glb(&content, path)?,
-        ExportFormat::Obj => crate::io::obj_export::write_obj(&content, path)?,
-        ExportFormat::Mitsuba => crate::io::mitsuba_export::write_mitsuba(&content, path)?,
+        ExportFormat::Gltf => crate::io::export::gltf::write_glb(&content, path)?,
+        ExportFormat::Obj => crate::io::export::obj::write_obj(&content, path)?,
+        ExportFormat::Mitsuba => crate::io::export::mitsuba::write_mitsuba(&content, path)?,
     };
     let cameras_path = path.with_extension("cameras.json");
     write_text(
