@@ -8,7 +8,7 @@ use seethru::analysis::{
     paper::{ForeshorteningParams, OcclusionParams},
     physical,
 };
-use seethru::measure::metrics::measure;
+use seethru::measure::metrics::{MetricMaps, measure};
 use seethru::measure::{
     ratio::{RatioResult, measure_ratio},
     ratio_setup::{Compensation, Setup},
@@ -196,8 +196,19 @@ fn impossible_setups_are_rejected() {
     }
 }
 
+/// The metrics of a run's own frames, as `run` computes them (border band 5 display pixels).
+fn measured(ctx: &RenderContext, r: &RunResult) -> (MetricMaps, serde_json::Value) {
+    measure(
+        ctx,
+        &ctx.scene,
+        ctx.scene.eye(),
+        [&r.truth, &r.seethru, &r.occluded],
+        5,
+    )
+}
+
 /// A wall at `wall` metres behind a display at the origin; the model plane at `d2`.
-fn wall_run(wall: f64, d2: f64) -> (RenderContext, seethru::system::pipeline::RunResult) {
+fn wall_run(wall: f64, d2: f64) -> (RenderContext, RunResult) {
     let setup = common::WallScene {
         wall,
         eye: [0.0, 0.0, 0.7],
@@ -257,13 +268,7 @@ fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
         let frontal = 0.5 * 2.0 * d2 * ctx.scene.frontal.tan_half_x() / 1280.0 / (0.7 + d2);
         (display + frontal) * std::f64::consts::SQRT_2 * physical::ARCMIN_PER_RAD
     };
-    let (maps, json) = measure(
-        &ctx,
-        &ctx.scene,
-        eye,
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (maps, json) = measured(&ctx, &r);
     let max = json["display"]["misregistration_arcmin"]["max"]
         .as_f64()
         .unwrap();
@@ -275,13 +280,7 @@ fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
     // A wall at 12 m with the model at 6 m: at display point x from the camera axis the
     // shown point is off by x(1/6 − 1/12)·12 on the wall: the analytic angle, ± quantum.
     let (ctx, r) = wall_run(12.0, 6.0);
-    let (maps, off_plane) = measure(
-        &ctx,
-        &ctx.scene,
-        eye,
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (maps, off_plane) = measured(&ctx, &r);
     // The image difference grows with the misregistration.
     assert!(off_plane["display"]["flip_mean"].as_f64().unwrap() > flip_on_plane);
     let obstacle_from_world = ctx.scene.obstacle.world_from_obstacle.inverse();
@@ -321,13 +320,7 @@ fn with_an_ideal_display_the_model_plane_has_zero_misregistration() {
         ..RunOptions::default()
     };
     let r = run(&ctx, &ideal).unwrap();
-    let (_, json) = measure(
-        &ctx,
-        &ctx.scene,
-        ctx.scene.eye(),
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (_, json) = measured(&ctx, &r);
     let stats = &json["display"]["misregistration_arcmin"];
     assert!(stats["count"].as_u64().unwrap() > 1000);
     assert!(stats["max"].as_f64().unwrap() < 0.01, "{stats}");
@@ -340,13 +333,7 @@ fn with_an_ideal_display_the_model_plane_has_zero_misregistration() {
     }
     .context();
     let r = run(&ctx, &ideal).unwrap();
-    let (maps, _) = measure(
-        &ctx,
-        &ctx.scene,
-        ctx.scene.eye(),
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (maps, _) = measured(&ctx, &r);
     let obstacle_from_world = ctx.scene.obstacle.world_from_obstacle.inverse();
     for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
         // The shown point is off by x·(12/6 − 1)·(0.7 + 6)/0.7… exactly: on the wall at 12 m the
@@ -402,13 +389,7 @@ fn sky_pixels_count_with_the_angle_between_directions() {
     };
     let r = run(&ctx, &options).unwrap();
     let eye = ctx.scene.eye();
-    let (maps, json) = measure(
-        &ctx,
-        &ctx.scene,
-        eye,
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (maps, json) = measured(&ctx, &r);
     let on_plane = |from: DVec3, dir: DVec3| from + dir * ((-12.0 - from.z) / dir.z);
     let wall_hit = |from: DVec3, dir: DVec3| {
         let p = on_plane(from, dir);
@@ -487,13 +468,7 @@ fn coverage_counts_the_blank_pixels_and_the_image_metrics_see_them() {
     };
     let r = run(&ctx, &options).unwrap();
     let eye = ctx.scene.eye();
-    let (maps, json) = measure(
-        &ctx,
-        &ctx.scene,
-        eye,
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (maps, json) = measured(&ctx, &r);
     let frontal = &ctx.scene.frontal;
     let (mut display, mut blank, mut ambiguous) = (0usize, 0usize, 0usize);
     for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
@@ -579,13 +554,7 @@ fn scramble_outside(frames: [&Frame; 2], mask: &[bool]) -> [Frame; 2] {
 fn masked_ssim_and_flip_see_only_the_display() {
     let (ctx, r) = wall_run(12.0, 6.0);
     let eye = ctx.scene.eye();
-    let (maps, before) = measure(
-        &ctx,
-        &ctx.scene,
-        eye,
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (maps, before) = measured(&ctx, &r);
     let [truth, seethru] = scramble_outside([&r.truth, &r.seethru], &maps.display);
     let (_, after) = measure(&ctx, &ctx.scene, eye, [&truth, &seethru, &r.occluded], 5);
     for region in ["display", "border"] {
@@ -653,14 +622,7 @@ fn a_head_error_costs_what_analyze_states_whatever_the_frontal_angle() {
         let mut maps_at = Vec::new();
         for theta_f in [30.0, 60.0] {
             let (ctx, r) = biased_run(theta_f, bias);
-            let eye = ctx.scene.eye();
-            let (maps, _) = measure(
-                &ctx,
-                &ctx.scene,
-                eye,
-                [&r.truth, &r.seethru, &r.occluded],
-                5,
-            );
+            let (maps, _) = measured(&ctx, &r);
             let mut checked = 0;
             for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
                 let x = r.occluded.position[i].as_dvec3();
