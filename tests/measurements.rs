@@ -657,3 +657,56 @@ fn a_head_error_costs_what_analyze_states_whatever_the_frontal_angle() {
         assert!(worst < 0.01, "θ_F changes the misregistration by {worst}′");
     }
 }
+
+#[test]
+fn missing_counts_sky_the_frontal_camera_cannot_see() {
+    // A wall below y = 0 at 12 m, sky above; a panel 1 m behind the display that only the
+    // frontal camera sees (x ∈ [−0.6, 0], y ∈ [0.05, 0.45]) hides part of that sky from it.
+    // Missing pixels: those whose true point or sky direction the camera's ray meets the
+    // panel on the way to, found here by ray casting.
+    let text = common::WallScene {
+        wall: 12.0,
+        eye: [0.0, 0.0, 0.7],
+        ..common::WallScene::default()
+    }
+    .text()
+    .replace(
+        "size = [80.0, 60.0]\ntranslate = [0.0, 0.0, -12]",
+        "size = [80.0, 60.0]\ntranslate = [0.0, -30.0, -12]\n\n[[object]]\nname = \"panel\"\nkind = \"quad\"\nmaterial = \"wall\"\nsize = [0.6, 0.4]\ntranslate = [-0.3, 0.25, -1.0]\nhidden_from = [\"driver\"]",
+    );
+    assert!(text.contains("panel"));
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let ctx = RenderContext::new(scene, seethru::render::accel::BvhKind::Cwbvh).unwrap();
+    let options = RunOptions {
+        d2: WorkingDistance::Infinity,
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options).unwrap();
+    let (maps, json) = measured(&ctx, &r);
+    let eye = ctx.scene.eye();
+    let (mut hidden, mut ambiguous) = (0usize, 0usize);
+    for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
+        let through = r.occluded.position[i].as_dvec3();
+        let dir = through - eye;
+        let on_wall = eye + dir * ((-12.0 - eye.z) / dir.z);
+        // The camera (at the origin) looks towards the wall point, or along the sky direction.
+        let towards = if on_wall.y <= 0.0 { on_wall } else { dir };
+        let at_panel = towards * (1.0 / -towards.z);
+        let inside = |v: f64, lo: f64, hi: f64| (v - lo).min(hi - v);
+        let margin = inside(at_panel.x, -0.6, 0.0).min(inside(at_panel.y, 0.05, 0.45));
+        if margin.abs() < 1e-4 || on_wall.y.abs() < 1e-4 {
+            ambiguous += 1;
+        } else if margin > 0.0 {
+            hidden += 1;
+            assert!(maps.missing[i], "pixel {i}");
+        }
+    }
+    let reported = json["missing"]["hidden_from_frontal"].as_u64().unwrap() as usize;
+    assert!(hidden > 500, "{hidden}");
+    assert!(
+        reported.abs_diff(hidden) <= ambiguous,
+        "{reported} vs {hidden} (±{ambiguous})"
+    );
+    assert!(json["sky_pixels_included"]["both"].as_u64().unwrap() > 500);
+}

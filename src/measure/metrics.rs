@@ -263,7 +263,13 @@ pub fn measure(
                     to.normalize().as_vec3(),
                     view_bit::FRONTAL,
                 );
-                if hit.is_some_and(|h| (h.t as f64) < distance - 1e-3 * distance.max(1.0)) {
+                // A surface short of the point (any surface, towards a sky direction).
+                let reach = if distance.is_finite() {
+                    distance - 1e-3 * distance.max(1.0)
+                } else {
+                    f64::INFINITY
+                };
+                if hit.is_some_and(|h| (h.t as f64) < reach) {
                     missing[i] = true;
                     hidden += 1;
                 }
