@@ -687,3 +687,50 @@ fn perceived_widths_equal_ray_casting_under_a_wrong_model_or_eye() {
         }
     }
 }
+
+#[test]
+fn the_resampling_quantum_is_half_a_pixel_of_each_grid_carried_to_the_plane() {
+    // Half a display pixel carried along the eye's ray to the scene plane, plus half a frontal
+    // pixel: two frontal rays a pixel apart (in tangent) meet the model plane, are seen through
+    // the model's eye on the display, and carried along the eye's ray to the scene plane.
+    let (display_px, frontal_tan_px) = (0.002, 0.0015);
+    for (d1, d2, b_h) in [(2.5, 6.3, 1.75), (2.0, 1.3, 0.7), (0.8, 10.0, -0.1)] {
+        let exact = PerceivedGeometry::exact(-b_h, d1, d2);
+        for g in [
+            exact,
+            PerceivedGeometry {
+                model_d2: 0.5 * d2,
+                ..exact
+            },
+            PerceivedGeometry {
+                model_d2: 3.0 * d2,
+                model_eye_x: -b_h + 0.1,
+                ..exact
+            },
+            PerceivedGeometry {
+                model_d2: f64::INFINITY,
+                model_eye_d1: d1 + 0.2,
+                ..exact
+            },
+        ] {
+            let eye = DVec2::new(g.eye_x, -g.eye_d1);
+            let model_eye = DVec2::new(g.model_eye_x, -g.model_eye_d1);
+            let on_plane = |x: f64| hit_plane(eye, DVec2::new(x, 0.0), g.scene_d2);
+            let display = (on_plane(0.1 + display_px) - on_plane(0.1)).abs();
+            let seen_on_display = |tan: f64| {
+                let towards = if g.model_d2.is_infinite() {
+                    model_eye + DVec2::new(tan, 1.0)
+                } else {
+                    DVec2::new(tan * g.model_d2, g.model_d2)
+                };
+                hit_plane(model_eye, towards, 0.0)
+            };
+            let frontal = (on_plane(seen_on_display(0.3 + frontal_tan_px))
+                - on_plane(seen_on_display(0.3)))
+            .abs();
+            let expected = 0.5 * (display + frontal);
+            let got = g.resampling_quantum(display_px, frontal_tan_px);
+            assert!(close(got, expected, 1e-9), "{g:?}: {got} vs {expected}");
+        }
+    }
+}

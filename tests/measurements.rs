@@ -58,6 +58,8 @@ fn observed_ratios_match_the_closed_forms_within_their_uncertainty() {
         foreshortening(1.0, 0.25, 3.0, 1.0, 0.125, 45.0),
         foreshortening(2.0, -0.5, 5.0, 1.5, -0.2, 60.0),
         foreshortening(0.8, 1.0, 2.0, 0.7, 0.3, 20.0),
+        // The far end projects short of the corner: both widths negative.
+        foreshortening(1.0, 1.0, 2.0, 1.0, 0.2, 80.0),
     ];
     for setup in setups {
         let r = measure_ratio(&setup, 640, &Compensation::default()).unwrap();
@@ -260,6 +262,28 @@ fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
     assert_eq!(
         json["display"]["misregistration_arcmin"]["count"],
         json["display_pixels"]
+    );
+    // FLIP's observer: the driver's camera, 240 px over 2 × 15°.
+    assert_eq!(json["flip_pixels_per_degree"].as_f64(), Some(8.0));
+    // A frame with neither a point nor a direction somewhere (an older run's sky): those
+    // pixels are counted as undefined, never dropped silently.
+    let mut blind = turned.clone();
+    let blinded: Vec<usize> = (0..maps.display.len())
+        .filter(|&i| maps.display[i])
+        .take(100)
+        .collect();
+    for &i in &blinded {
+        blind.position[i] = Vec3::NAN;
+        blind.normal[i] = Vec3::ZERO;
+    }
+    let (_, json) = measure(&ctx, &ctx.scene, eye, [&r.truth, &blind, &r.occluded], 5);
+    assert_eq!(json["undefined_pixels"].as_u64(), Some(100));
+    assert_eq!(
+        json["display"]["misregistration_arcmin"]["count"]
+            .as_u64()
+            .unwrap()
+            + 100,
+        json["display_pixels"].as_u64().unwrap()
     );
     // The model plane: zero up to the resampling (half a display pixel plus half a frontal
     // pixel, seen from the eye).
@@ -487,6 +511,25 @@ fn coverage_counts_the_blank_pixels_and_the_image_metrics_see_them() {
         }
     }
     assert!(blank > 300 && blank < display / 2, "{blank} of {display}");
+    // Missing: true wall points outside the frontal view (the wall at 6 m, seen from the eye).
+    let (mut outside, mut unsure) = (0usize, 0usize);
+    for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
+        let x = r.occluded.position[i].as_dvec3();
+        let on_wall = eye + (x - eye) * ((6.0 + eye.z) / eye.z);
+        let q = frontal.project_point(on_wall).unwrap();
+        let margin = q.x.min(640.0 - q.x).min(q.y).min(640.0 - q.y);
+        if margin.abs() < 0.05 {
+            unsure += 1;
+        } else if margin < 0.0 {
+            outside += 1;
+            assert!(maps.missing[i]);
+        }
+    }
+    let reported = json["missing"]["outside_frontal_view"].as_u64().unwrap() as usize;
+    assert!(
+        outside > 300 && reported.abs_diff(outside) <= unsure,
+        "{reported} vs {outside}"
+    );
     let reported = json["blank_pixels"].as_u64().unwrap() as usize;
     assert!(
         reported.abs_diff(blank) <= ambiguous,
@@ -709,4 +752,151 @@ fn missing_counts_sky_the_frontal_camera_cannot_see() {
         "{reported} vs {hidden} (±{ambiguous})"
     );
     assert!(json["sky_pixels_included"]["both"].as_u64().unwrap() > 500);
+}
+
+#[test]
+fn ssim_windows_are_seven_pixels_wide() {
+    // Flat frames that differ in one pixel well inside the display (6 pixels from its edge):
+    // exactly the 49 windows around it see the difference, each with the same statistics (48 pixels at l, one at
+    // l + δ), so the display's mean SSIM is 1 − 49 (1 − s) / N with s from Wang et al.
+    let (ctx, r) = wall_run(6.0, 6.0);
+    let (maps, _) = measured(&ctx, &r);
+    let (w, h) = (maps.width as usize, maps.height as usize);
+    let inner = (0..w * h)
+        .find(|&i| {
+            let (x, y) = ((i % w) as i64, (i / w) as i64);
+            (-6..=6).all(|dy: i64| {
+                (-6..=6).all(|dx: i64| {
+                    let (xx, yy) = (x + dx, y + dy);
+                    xx >= 0
+                        && yy >= 0
+                        && (xx as usize) < w
+                        && (yy as usize) < h
+                        && maps.display[yy as usize * w + xx as usize]
+                })
+            })
+        })
+        .unwrap();
+    let flat = |v: f32| {
+        let mut f = r.truth.clone();
+        f.color.iter_mut().for_each(|c| *c = Vec3::splat(v));
+        f
+    };
+    let (a, mut b) = (flat(0.2), flat(0.2));
+    b.color[inner] = Vec3::splat(0.5);
+    let (_, json) = measure(&ctx, &ctx.scene, ctx.scene.eye(), [&a, &b, &r.occluded], 5);
+    let lum = |v: f32| encode_srgb8(Vec3::splat(v))[0] as f64;
+    let (l, delta) = (lum(0.2), lum(0.5) - lum(0.2));
+    let (c1, c2) = ((0.01f64 * 255.0).powi(2), (0.03f64 * 255.0).powi(2));
+    let mean_b = l + delta / 49.0;
+    let var_b = (48.0 * l * l + (l + delta).powi(2)) / 49.0 - mean_b * mean_b;
+    let s = (2.0 * l * mean_b + c1) * c2 / ((l * l + mean_b * mean_b + c1) * (var_b + c2));
+    let n = json["display"]["pixels"].as_f64().unwrap();
+    let expected = 1.0 - 49.0 * (1.0 - s) / n;
+    let got = json["display"]["ssim"].as_f64().unwrap();
+    assert!((got - expected).abs() < 1e-12, "{got} vs {expected}");
+}
+
+/// Runs the `seethru` binary; (success, stdout, stderr).
+fn seethru(args: &[String]) -> (bool, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_seethru"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+#[test]
+fn the_ratio_command_prints_a_table_and_refuses_bad_compensations() {
+    let paper = [
+        "ratio",
+        "occlusion",
+        "--L",
+        "5",
+        "--b1",
+        "-0.35",
+        "--d2",
+        "6.3",
+        "--d1",
+        "2.5",
+        "--bh",
+        "1.75",
+        "--width",
+        "160",
+    ];
+    let with = |extra: &[&str]| -> Vec<String> {
+        paper.iter().chain(extra).map(|a| a.to_string()).collect()
+    };
+    let (ok, table, err) = seethru(&with(&["--model-d2", "12.6"]));
+    assert!(ok, "{err}");
+    let (ok, json, err) = seethru(&with(&["--model-d2", "12.6", "--json"]));
+    assert!(ok, "{err}");
+    let r: serde_json::Value = serde_json::from_str(&json).unwrap();
+    // The table carries the JSON's numbers, one row per quantity, in the column order
+    // paper, predicted, observed, uncertainty.
+    for (row, key) in [
+        ("p_cam [m]", "p_cam"),
+        ("p_user [m]", "p_user"),
+        ("p_cam/p_user", "ratio"),
+    ] {
+        let line = table.lines().find(|l| l.starts_with(row)).unwrap();
+        let q = &r[key];
+        let expected = format!(
+            "{:+.4} {:+.4} {:+.4} ±{:.4}",
+            q["paper"].as_f64().unwrap(),
+            q["predicted"].as_f64().unwrap(),
+            q["observed"].as_f64().unwrap(),
+            q["uncertainty"].as_f64().unwrap()
+        );
+        let got = line[row.len()..]
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        assert_eq!(got, expected, "{line}");
+    }
+    assert!(
+        table.contains("model plane at 12.6 m (the scene plane is at 6.3 m)"),
+        "{table}"
+    );
+    assert_eq!(r["model_d2"].as_f64(), Some(12.6));
+    let (ok, json, err) = seethru(&with(&[
+        "--model-d2",
+        "inf",
+        "--head-bias-cm",
+        "1,-2,3",
+        "--json",
+    ]));
+    assert!(ok, "{err}");
+    let r: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(r["model_d2"], "inf");
+    assert_eq!(r["head_bias_cm"], serde_json::json!([1.0, -2.0, 3.0]));
+    // Bad compensations: one line naming the flag and its range.
+    for (extra, needle) in [
+        (
+            vec!["--model-d2", "0"],
+            "--model-d2 must be a distance in metres in (0, ∞) or `inf`",
+        ),
+        (vec!["--model-d2", "-3"], "--model-d2 must be"),
+        (vec!["--model-d2", "NaN"], "--model-d2 must be"),
+        (
+            vec!["--head-bias-cm", "0,0,-250"],
+            "z must be in (-250, ∞) cm",
+        ),
+        (
+            vec!["--head-bias-cm", "1,2"],
+            "--head-bias-cm must be three finite numbers",
+        ),
+    ] {
+        let (ok, out, err) = seethru(&with(&extra));
+        assert!(!ok && out.is_empty(), "{extra:?}");
+        assert_eq!(err.lines().count(), 1, "{extra:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && err.contains(needle),
+            "{extra:?}: {err}"
+        );
+    }
 }

@@ -389,3 +389,30 @@ pub fn measure(
         json,
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn statistics_of_one_to_a_hundred() {
+        let mut values: Vec<f64> = (1..=100).rev().map(f64::from).collect();
+        let s = stats(&mut values);
+        assert_eq!(s["count"], 100);
+        assert_eq!(s["mean"], 50.5);
+        // The 95th percentile: the smallest value with 95 % of the values at or below it.
+        assert_eq!(s["p95"], 95.0);
+        assert_eq!(s["max"], 100.0);
+        assert_eq!(stats(&mut [7.0])["p95"], 7.0);
+        assert_eq!(stats(&mut [])["count"], 0);
+    }
+
+    #[test]
+    fn the_bounding_box_of_a_mask() {
+        let mut mask = vec![false; 5 * 4];
+        assert_eq!(bounding_box(&mask, 5), None);
+        mask[5 + 1] = true;
+        mask[2 * 5 + 3] = true;
+        assert_eq!(bounding_box(&mask, 5), Some((1, 1, 4, 3)));
+    }
+}

@@ -15,7 +15,6 @@
 use anyhow::Result;
 use glam::DVec3;
 use serde::Serialize;
-use serde_json::json;
 
 use crate::measure::ratio_setup::{Compensation, Setup, build_scene};
 use crate::render::accel::BvhKind;
@@ -123,7 +122,7 @@ pub fn measure_ratio(
 
 /// The worst-case deviation of c/u from its value over c ± uc and u ± uu (infinite when the
 /// interval of u contains zero).
-fn ratio_uncertainty(c: Measured, u: Measured) -> f64 {
+pub fn ratio_uncertainty(c: Measured, u: Measured) -> f64 {
     if u.value.abs() <= u.uncertainty {
         return f64::INFINITY;
     }
@@ -278,7 +277,43 @@ pub fn describe(r: &RatioResult) -> String {
     s
 }
 
-/// The JSON of a result.
-pub fn to_json(r: &RatioResult) -> serde_json::Value {
-    json!(r)
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_ratio_uncertainty_is_the_worst_corner() {
+        let m = |value, uncertainty| Measured { value, uncertainty };
+        // 1 ± 0.1 over 2 ± 0.2: the worst corner is 1.1 / 1.8 (0.1111 above 0.5); 0.9 / 2.2
+        // is only 0.0909 below.
+        let u = ratio_uncertainty(m(1.0, 0.1), m(2.0, 0.2));
+        assert!((u - (1.1 / 1.8 - 0.5)).abs() < 1e-15, "{u}");
+        // Signs do not matter: −1 ± 0.1 over 2 ± 0.2.
+        assert!((ratio_uncertainty(m(-1.0, 0.1), m(2.0, 0.2)) - u).abs() < 1e-15);
+        // A denominator interval containing zero bounds nothing.
+        assert!(ratio_uncertainty(m(1.0, 0.1), m(0.1, 0.2)).is_infinite());
+        assert_eq!(ratio_uncertainty(m(1.0, 0.0), m(2.0, 0.0)), 0.0);
+    }
+
+    #[test]
+    fn edges_are_bracketed_from_the_side_asked_for() {
+        // Six display pixels along a row at plane coordinates 0..6; the object (id 7) on 1..3.
+        let frame = Frame::from_pixels(
+            6,
+            1,
+            &(0..6)
+                .map(|i| crate::render::frame::Pixel {
+                    object_id: if (1..4).contains(&i) { 7 } else { 1 },
+                    ..crate::render::frame::Pixel::SKY
+                })
+                .collect::<Vec<_>>(),
+        );
+        let q: Vec<Option<f64>> = (0..6).map(|i| Some(i as f64)).collect();
+        let is_object = |id: u32, _: u32| id == 7;
+        assert_eq!(bracket_edge(&frame, &q, is_object, true), Some((3.0, 4.0)));
+        assert_eq!(bracket_edge(&frame, &q, is_object, false), Some((1.0, 0.0)));
+        // Pixels off the display (None) are not brackets; an edge with nothing beyond is none.
+        let q: Vec<Option<f64>> = (0..6).map(|i| (i < 4).then_some(i as f64)).collect();
+        assert_eq!(bracket_edge(&frame, &q, is_object, true), None);
+    }
 }
