@@ -734,3 +734,40 @@ fn the_resampling_quantum_is_half_a_pixel_of_each_grid_carried_to_the_plane() {
         }
     }
 }
+
+#[test]
+fn the_claims_table_reproduces_the_papers_numbers_and_flags_its_errata() {
+    let claims = seethru::paper::claims::paper_claims();
+    let row = |prefix: &str| {
+        claims
+            .iter()
+            .find(|c| c.claim.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no claim `{prefix}`"))
+    };
+    // The paper's numbers that stand, to the paper's printed precision.
+    for prefix in ["§5.1 Fig. 3", "§5.2 occlusion", "§5.2 foreshortening"] {
+        let c = row(prefix);
+        assert!((c.seethru - c.paper).abs() < 0.005, "{c:?}");
+    }
+    // Erratum 6: the lateral head error costs d2/(d1(d1 + d2)) on the axis, so 1 m over 10 m
+    // at d1 = 0.8 is (1/1.8)/(10/10.8) = 0.6, where the paper has a constant error (1); the
+    // table's exact 1 cm geometry differs from this first-order value by about 1e-5.
+    let c = row("§4.1 'sensitivities independent of d2");
+    assert!((c.seethru - 0.6).abs() < 1e-4 && c.paper == 1.0, "{c:?}");
+    // The depth error at the display edge (x = 0.25): x d2/(d1²(d1 + d2)) times the obliquity.
+    let depth = |d2: f64| {
+        let x: f64 = 0.25;
+        x * d2 / (0.64 * (0.8 + d2)) * (x / 0.8).atan().cos().powi(2)
+    };
+    let c = row("  the same for depth");
+    assert!((c.seethru - depth(1.0) / depth(10.0)).abs() < 2e-3, "{c:?}");
+    // Erratum 7: no θ_F in what the driver sees, against the paper's tan 30°/tan 80°.
+    let c = row("§4.1 'a larger θ_F");
+    assert!(c.seethru == 1.0 && (c.paper - 0.1018).abs() < 1e-4, "{c:?}");
+    // The statement on d1 holds: (10/(1.6·11.6)) / (10/(0.8·10.8)).
+    let c = row("§4.1 'less impact");
+    assert!(
+        (c.seethru - (10.0 / (1.6 * 11.6)) / (10.0 / (0.8 * 10.8))).abs() < 1e-4,
+        "{c:?}"
+    );
+}
