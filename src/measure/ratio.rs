@@ -87,7 +87,7 @@ pub struct RatioResult {
     pub setup: String,
     pub parameters: serde_json::Value,
     /// The compensation: model plane (metres, or "inf") and head bias (cm, obstacle frame).
-    #[serde(serialize_with = "metres_or_inf")]
+    #[serde(serialize_with = "crate::util::json::finite_or_inf")]
     pub model_d2: f64,
     pub head_bias_cm: [f64; 3],
     /// Width of the driver view, the frontal image and the display, pixels.
@@ -101,14 +101,6 @@ pub struct RatioResult {
     /// The paper's printed predicted and Unity-measured ratios, for its two examples.
     pub paper_printed: Option<f64>,
     pub paper_unity: Option<f64>,
-}
-
-fn metres_or_inf<S: serde::Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
-    if v.is_finite() {
-        s.serialize_f64(*v)
-    } else {
-        s.serialize_str("inf")
-    }
 }
 
 /// Renders a setup under a compensation and measures the observed widths and ratio.

@@ -205,7 +205,7 @@ impl AnalyzeParams {
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct HeadErrorRow {
     /// Scene (= model plane) distance, m; infinite for d2 → ∞.
-    #[serde(serialize_with = "finite_or_inf")]
+    #[serde(serialize_with = "crate::util::json::finite_or_inf")]
     pub d2: f64,
     /// The largest misregistration over the display per cm of lateral and of depth head
     /// error, arc-minutes, from the exact geometry.
@@ -215,14 +215,6 @@ pub struct HeadErrorRow {
     /// width per metre), which do not change with d2.
     pub paper_phi_bh: f64,
     pub paper_phi_d1: f64,
-}
-
-fn finite_or_inf<S: serde::Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
-    if v.is_finite() {
-        s.serialize_f64(*v)
-    } else {
-        s.serialize_str("inf")
-    }
 }
 
 /// Misregistration per cm of head error against d2 at `p`'s eye, display and θ_F, for a scene
