@@ -78,8 +78,11 @@ fn sensitivities_equal_finite_differences() {
             assert!(close(p.phi_bh(side), fd_bh, 1e-7), "{p:?} {side:?}");
             assert!(close(p.phi_d2(), fd_d2, 1e-7), "{p:?} {side:?}");
             assert!(close(p.dphi_d2_dd2(), fd_dphi, 1e-6), "{p:?}");
-            // Erratum 1: the printed φ_d2 has the opposite sign of the derivative.
-            assert!(fd_d2 > 0.0 && p.phi_d2_as_printed() < 0.0);
+            // Erratum 1: eq. ANALYSIS_D2 as printed, −0.5 D / (2 d2² tan θ_F), has the opposite
+            // sign of the derivative.
+            let printed = -0.5 * p.width / (2.0 * p.d2 * p.d2 * p.theta_f.tan());
+            assert!(close(p.phi_d2_as_printed(), printed, 1e-12));
+            assert!(fd_d2 > 0.0 && printed < 0.0);
         }
     }
 }
@@ -113,6 +116,23 @@ fn d2_min_is_where_the_ratio_reaches_the_bound() {
     };
     let d2 = paper.d2_min(Side::Left, 0.05).unwrap();
     assert!((d2 - 0.9016).abs() < 1e-3, "{d2}");
+    // No bound where R(∞) ≤ 0 (the display's view exceeds the frontal camera's) or for a
+    // tolerance ≤ 0. R(∞) = 1/2 − D/(4 d1 tan θ_F) is exactly 0 for D = 2 d1 tan θ_F, b_h = 0.
+    let t = paper.theta_f.tan();
+    let edge = CropParams {
+        b_h: 0.0,
+        width: 2.0 * t,
+        ..paper
+    };
+    assert_eq!(edge.cutting_ratio_at_infinity(Side::Left), 0.0);
+    assert_eq!(edge.d2_min(Side::Left, 0.05), None);
+    let beyond = CropParams {
+        width: 3.0 * t,
+        ..edge
+    };
+    assert_eq!(beyond.d2_min(Side::Right, 0.05), None);
+    assert_eq!(paper.d2_min(Side::Left, 0.0), None);
+    assert_eq!(paper.d2_min(Side::Left, -0.05), None);
 }
 
 /// An obstacle at the origin facing +z, `width` × `height`, and a frontal camera at its centre
