@@ -391,6 +391,19 @@ fn occlusion_approximations_hold_in_their_regimes() {
         small.ratio_small_bh_as_printed(),
         0.1
     ));
+    // The printed form itself, 1 − d1/(d2 − L): 1 − 1/2 here, 1 − 1.2/2.5 for another box.
+    assert!(close(small.ratio_small_bh_as_printed(), 0.5, 1e-12));
+    let other = OcclusionParams {
+        l: 0.5,
+        d2: 3.0,
+        d1: 1.2,
+        ..small
+    };
+    assert!(close(
+        other.ratio_small_bh_as_printed(),
+        1.0 - 1.2 / 2.5,
+        1e-12
+    ));
 }
 
 fn foreshortening_cases() -> Vec<ForeshorteningParams> {
