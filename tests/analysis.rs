@@ -804,3 +804,43 @@ fn the_claims_table_reproduces_the_papers_numbers_and_flags_its_errata() {
         "{c:?}"
     );
 }
+
+#[test]
+fn a_frontal_pixel_subtends_at_the_eye_what_the_camera_model_gives() {
+    // The two rays through the central pixel's edges of a frontal camera at the display
+    // centre meet the scene plane; the eye on the axis at d1 sees the segment between them
+    // under an angle. For d2 → ∞ it is the angle between the rays.
+    for (theta_deg, px, d1, d2) in [
+        (40.0, 1280u32, 0.8, 10.0),
+        (63.5, 640, 1.2, 2.0),
+        (20.0, 1920, 0.7, f64::INFINITY),
+    ] {
+        let theta: f64 = f64::to_radians(theta_deg);
+        let camera = Camera::new(DAffine3::IDENTITY, theta, px, px / 2).unwrap();
+        let edge = |u: f64| camera.world_ray(DVec2::new(u, px as f64 / 4.0)).1;
+        let (a, b) = (edge(px as f64 / 2.0), edge(px as f64 / 2.0 + 1.0));
+        let angle = if d2.is_infinite() {
+            a.angle_between(b)
+        } else {
+            let eye = DVec3::new(0.0, 0.0, d1);
+            let on_plane = |d: DVec3| d * (d2 / -d.z);
+            (on_plane(a) - eye).angle_between(on_plane(b) - eye)
+        };
+        let got = physical::frontal_pixel_angle(theta, px, d1, d2);
+        assert!(close(got, angle, 1e-6), "θ_F {theta_deg}: {got} vs {angle}");
+    }
+    // The d2 → ∞ limits of the head-error sensitivities are the finite forms far away.
+    for d1 in [0.6, 0.8, 1.5] {
+        let far = 1e9;
+        assert!(close(
+            physical::per_lateral_head_error(d1, f64::INFINITY),
+            physical::per_lateral_head_error(d1, far),
+            1e-8
+        ));
+        assert!(close(
+            physical::per_head_distance_error(0.2, d1, f64::INFINITY),
+            physical::per_head_distance_error(0.2, d1, far),
+            1e-8
+        ));
+    }
+}
