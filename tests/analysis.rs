@@ -829,6 +829,12 @@ fn a_frontal_pixel_subtends_at_the_eye_what_the_camera_model_gives() {
         let got = physical::frontal_pixel_angle(theta, px, d1, d2);
         assert!(close(got, angle, 1e-6), "θ_F {theta_deg}: {got} vs {angle}");
     }
+    // One degree is sixty arc-minutes.
+    assert!(close(
+        physical::ARCMIN_PER_RAD * 1f64.to_radians(),
+        60.0,
+        1e-15
+    ));
     // The d2 → ∞ limits of the head-error sensitivities are the finite forms far away.
     for d1 in [0.6, 0.8, 1.5] {
         let far = 1e9;
