@@ -9,7 +9,7 @@ use seethru::analysis::perceived::PerceivedGeometry;
 use seethru::analysis::physical;
 use seethru::geometry::camera::Camera;
 use seethru::scene::Obstacle;
-use seethru::system::compensation::{ModelPlane, compute_crop};
+use seethru::system::compensation::{Crop, ModelPlane, compute_crop};
 
 const SIDES: [Side; 2] = [Side::Left, Side::Right];
 
@@ -848,5 +848,33 @@ fn a_frontal_pixel_subtends_at_the_eye_what_the_camera_model_gives() {
             physical::per_head_distance_error(0.2, d1, far),
             1e-8
         ));
+    }
+}
+
+#[test]
+fn a_crop_is_axis_aligned_only_when_all_four_edges_are() {
+    let crop = |corners: [DVec2; 4]| Crop {
+        corners,
+        frontal_from_display: glam::DMat3::IDENTITY,
+        frontal_size: [100, 100],
+    };
+    let [tl, tr, br, bl] = [
+        DVec2::new(10.0, 10.0),
+        DVec2::new(90.0, 10.0),
+        DVec2::new(90.0, 80.0),
+        DVec2::new(10.0, 80.0),
+    ];
+    assert!(crop([tl, tr, br, bl]).is_axis_aligned(0.5));
+    // Each edge off on its own makes the crop a general quadrilateral.
+    let off = DVec2::new(0.0, 3.0);
+    let sideways = DVec2::new(3.0, 0.0);
+    for corners in [
+        [tl + off, tr, br, bl],
+        [tl, tr, br + off, bl],
+        [tl + sideways, tr, br, bl],
+        [tl, tr + sideways, br, bl],
+    ] {
+        assert!(!crop(corners).is_axis_aligned(0.5), "{corners:?}");
+        assert!(crop(corners).is_axis_aligned(3.0), "{corners:?}");
     }
 }
