@@ -3,21 +3,24 @@
 
 mod common;
 
+use glam::{DQuat, DVec3, Vec3};
 use seethru::analysis::{
     paper::{ForeshorteningParams, OcclusionParams},
     physical,
 };
-use seethru::measure::metrics::measure;
+use seethru::measure::metrics::{MetricMaps, measure};
 use seethru::measure::{
     ratio::{RatioResult, measure_ratio},
-    ratio_setup::Setup,
+    ratio_setup::{Compensation, Setup},
 };
+use seethru::render::frame::Frame;
 use seethru::render::integrator::RenderContext;
-use seethru::system::display::DisplayModel;
+use seethru::system::display::{DisplayModel, MISSING_ID};
 use seethru::system::{
-    options::{RunOptions, WorkingDistance},
-    pipeline::run,
+    options::{Outside, RunOptions, WorkingDistance},
+    pipeline::{RunResult, run},
 };
+use seethru::util::color::encode_srgb8;
 
 fn occlusion(l: f64, b1: f64, d2: f64, d1: f64, b_h: f64) -> Setup {
     Setup::Occlusion(OcclusionParams { l, b1, d2, d1, b_h })
@@ -34,28 +37,14 @@ fn foreshortening(l: f64, b1: f64, d2: f64, d1: f64, b_h: f64, gamma_deg: f64) -
     })
 }
 
+/// Observed within the stated uncertainty of the prediction, for both widths and the ratio.
 fn assert_within(r: &RatioResult) {
-    let ok = |pred: f64, obs: f64, unc: f64| (pred - obs).abs() <= unc;
-    assert!(
-        ok(
-            r.p_cam_predicted,
-            r.p_cam_observed.value,
-            r.p_cam_observed.uncertainty
-        ),
-        "p_cam: {r:?}"
-    );
-    assert!(
-        ok(
-            r.p_user_predicted,
-            r.p_user_observed.value,
-            r.p_user_observed.uncertainty
-        ),
-        "p_user: {r:?}"
-    );
-    assert!(
-        ok(r.ratio_predicted, r.ratio_observed, r.ratio_uncertainty),
-        "ratio: {r:?}"
-    );
+    for (name, q) in [("p_cam", r.p_cam), ("p_user", r.p_user), ("ratio", r.ratio)] {
+        assert!(
+            (q.predicted - q.observed).abs() <= q.uncertainty,
+            "{name}: {q:?}\n{r:?}"
+        );
+    }
 }
 
 #[test]
@@ -69,9 +58,14 @@ fn observed_ratios_match_the_closed_forms_within_their_uncertainty() {
         foreshortening(1.0, 0.25, 3.0, 1.0, 0.125, 45.0),
         foreshortening(2.0, -0.5, 5.0, 1.5, -0.2, 60.0),
         foreshortening(0.8, 1.0, 2.0, 0.7, 0.3, 20.0),
+        // The far end projects short of the corner: both widths negative.
+        foreshortening(1.0, 1.0, 2.0, 1.0, 0.2, 80.0),
     ];
     for setup in setups {
-        let r = measure_ratio(&setup, 640).unwrap();
+        let r = measure_ratio(&setup, 640, &Compensation::default()).unwrap();
+        // The paper's compensation: the prediction is the closed form.
+        let (pc, pu) = setup.predicted();
+        assert!((r.p_cam.predicted - pc).abs() < 1e-12 && (r.p_user.predicted - pu).abs() < 1e-12);
         assert_within(&r);
     }
 }
@@ -83,38 +77,140 @@ fn the_uncertainty_shrinks_with_resolution() {
         foreshortening(5.0, -1.5, 1.3, 2.0, 0.7, 90.0),
     ] {
         let (low, high) = (
-            measure_ratio(&setup, 320).unwrap(),
-            measure_ratio(&setup, 1280).unwrap(),
+            measure_ratio(&setup, 320, &Compensation::default()).unwrap(),
+            measure_ratio(&setup, 1280, &Compensation::default()).unwrap(),
         );
         assert_within(&low);
         assert_within(&high);
         assert!(
-            high.ratio_uncertainty < 0.5 * low.ratio_uncertainty,
+            high.ratio.uncertainty < 0.5 * low.ratio.uncertainty,
             "{} vs {}",
-            high.ratio_uncertainty,
-            low.ratio_uncertainty
+            high.ratio.uncertainty,
+            low.ratio.uncertainty
         );
-        // At 1280 px the observation is pinned at least twice as tightly as the paper's Unity
-        // measurement missed its prediction (0.02 for occlusion, 0.17 for foreshortening).
-        let paper_miss = (high.paper_measured.unwrap() - high.paper_predicted.unwrap()).abs();
-        assert!(high.ratio_uncertainty < 0.5 * paper_miss, "{high:?}");
+        // At the command's default width the paper's two cases land within 0.5 % of the
+        // closed form, and far closer than the paper's Unity measurements (0.02 and 0.17 off).
+        let closed = setup.predicted().0 / setup.predicted().1;
+        assert!(
+            (high.ratio.observed - closed).abs() < 0.005 * closed.abs(),
+            "{high:?}"
+        );
+        let paper_miss = (high.paper_unity.unwrap() - high.paper_printed.unwrap()).abs();
+        assert!(high.ratio.uncertainty < paper_miss, "{high:?}");
+    }
+}
+
+#[test]
+fn observed_ratios_follow_a_wrong_model_plane_and_a_biased_eye() {
+    // The instrument must see a compensation error: with the model plane at half, twice or
+    // infinitely far from the scene plane, or the eye off, the driver perceives the edge
+    // elsewhere, and the observation follows the geometry's prediction, not the closed form.
+    for setup in [
+        occlusion(5.0, -0.35, 6.3, 2.5, 1.75),
+        foreshortening(5.0, -1.5, 1.3, 2.0, 0.7, 90.0),
+    ] {
+        let (_, _, d2, _) = match setup {
+            Setup::Occlusion(p) => (p.b1, p.d1, p.d2, p.b_h),
+            Setup::Foreshortening(p) => (p.b1, p.d1, p.d2, p.b_h),
+        };
+        let compensations = [
+            Compensation {
+                model_d2: Some(0.5 * d2),
+                ..Compensation::default()
+            },
+            Compensation {
+                model_d2: Some(d2),
+                ..Compensation::default()
+            },
+            Compensation {
+                model_d2: Some(2.0 * d2),
+                ..Compensation::default()
+            },
+            Compensation {
+                model_d2: Some(f64::INFINITY),
+                ..Compensation::default()
+            },
+            Compensation {
+                model_d2: None,
+                head_bias_cm: [30.0, 5.0, -60.0],
+            },
+        ];
+        for c in compensations {
+            let r = measure_ratio(&setup, 640, &c).unwrap();
+            assert_within(&r);
+            let moved = (r.p_cam.predicted - r.p_cam.paper).abs();
+            if c.model_d2 != Some(d2) {
+                // The compensation error is far larger than the measurement's uncertainty, and
+                // the observation shows it.
+                assert!(moved > 3.0 * r.p_cam.uncertainty, "{c:?}: {r:?}");
+                assert!(
+                    (r.p_cam.observed - r.p_cam.paper).abs() > r.p_cam.uncertainty,
+                    "{c:?}: {r:?}"
+                );
+            } else {
+                assert!(moved < 1e-12);
+            }
+        }
     }
 }
 
 #[test]
 fn impossible_setups_are_rejected() {
-    let err = measure_ratio(&occlusion(7.0, 0.5, 6.0, 1.0, 0.2), 64)
-        .unwrap_err()
-        .to_string();
+    let err = measure_ratio(
+        &occlusion(7.0, 0.5, 6.0, 1.0, 0.2),
+        64,
+        &Compensation::default(),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(err.contains("--L must be in (0, d2)"), "{err}");
-    let err = measure_ratio(&foreshortening(1.0, 0.5, 3.0, 1.0, 0.2, 120.0), 64)
-        .unwrap_err()
-        .to_string();
+    let err = measure_ratio(
+        &foreshortening(1.0, 0.5, 3.0, 1.0, 0.2, 120.0),
+        64,
+        &Compensation::default(),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(err.contains("--gamma"), "{err}");
+    let paper = occlusion(5.0, -0.35, 6.3, 2.5, 1.75);
+    for model_d2 in [0.0, -1.0, f64::NAN, f64::NEG_INFINITY] {
+        let c = Compensation {
+            model_d2: Some(model_d2),
+            ..Compensation::default()
+        };
+        let err = measure_ratio(&paper, 64, &c).unwrap_err().to_string();
+        assert!(
+            err.starts_with("--model-d2 must be") && err.contains("(0, ∞)"),
+            "{err}"
+        );
+    }
+    // The eye 2.5 m in front of the display: a bias of −250 cm or more puts it behind.
+    for z in [-250.0, -400.0] {
+        let c = Compensation {
+            model_d2: None,
+            head_bias_cm: [0.0, 0.0, z],
+        };
+        let err = measure_ratio(&paper, 64, &c).unwrap_err().to_string();
+        assert!(
+            err.contains("--head-bias-cm") && err.contains("(-250, ∞) cm"),
+            "{err}"
+        );
+    }
+}
+
+/// The metrics of a run's own frames, as `run` computes them (border band 5 display pixels).
+fn measured(ctx: &RenderContext, r: &RunResult) -> (MetricMaps, serde_json::Value) {
+    measure(
+        ctx,
+        &ctx.scene,
+        ctx.scene.eye(),
+        [&r.truth, &r.seethru, &r.occluded],
+        5,
+    )
 }
 
 /// A wall at `wall` metres behind a display at the origin; the model plane at `d2`.
-fn wall_run(wall: f64, d2: f64) -> (RenderContext, seethru::system::pipeline::RunResult) {
+fn wall_run(wall: f64, d2: f64) -> (RenderContext, RunResult) {
     let setup = common::WallScene {
         wall,
         eye: [0.0, 0.0, 0.7],
@@ -139,17 +235,55 @@ fn wall_run(wall: f64, d2: f64) -> (RenderContext, seethru::system::pipeline::Ru
 
 #[test]
 fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
-    // Identical frames: exactly zero.
+    // A seethru frame that shows every true point turned by 10′ about the eye: the metric
+    // must read 10′ at every display pixel, whatever the point's distance or direction.
     let (ctx, r) = wall_run(6.0, 6.0);
     let eye = ctx.scene.eye();
-    let (maps, same) = measure(&ctx, &ctx.scene, eye, [&r.truth, &r.truth, &r.occluded], 5);
-    assert_eq!(same["display"]["flip_mean"].as_f64().unwrap(), 0.0);
-    assert!((same["display"]["ssim"].as_f64().unwrap() - 1.0).abs() < 1e-12);
+    let mut turned = r.truth.clone();
+    for p in &mut turned.position {
+        let v = p.as_dvec3() - eye;
+        // About an axis perpendicular to the line of sight, so the sight line turns by 10′.
+        let axis = v.cross(DVec3::new(0.3, 1.0, 0.2)).normalize();
+        *p = (eye + DQuat::from_axis_angle(axis, (10.0f64 / 60.0).to_radians()) * v).as_vec3();
+    }
+    let (maps, json) = measure(&ctx, &ctx.scene, eye, [&r.truth, &turned, &r.occluded], 5);
+    let shown: Vec<f32> = maps
+        .misregistration
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .collect();
+    assert!(shown.len() > 1000);
     assert!(
-        maps.misregistration
-            .iter()
-            .filter(|v| v.is_finite())
-            .all(|&v| v == 0.0)
+        shown.iter().all(|&v| (v - 10.0).abs() < 0.01),
+        "{:?}",
+        &shown[..5]
+    );
+    assert_eq!(
+        json["display"]["misregistration_arcmin"]["count"],
+        json["display_pixels"]
+    );
+    // FLIP's observer: the driver's camera, 240 px over 2 × 15°.
+    assert_eq!(json["flip_pixels_per_degree"].as_f64(), Some(8.0));
+    // A frame with neither a point nor a direction somewhere (an older run's sky): those
+    // pixels are counted as undefined, never dropped silently.
+    let mut blind = turned.clone();
+    let blinded: Vec<usize> = (0..maps.display.len())
+        .filter(|&i| maps.display[i])
+        .take(100)
+        .collect();
+    for &i in &blinded {
+        blind.position[i] = Vec3::NAN;
+        blind.normal[i] = Vec3::ZERO;
+    }
+    let (_, json) = measure(&ctx, &ctx.scene, eye, [&r.truth, &blind, &r.occluded], 5);
+    assert_eq!(json["undefined_pixels"].as_u64(), Some(100));
+    assert_eq!(
+        json["display"]["misregistration_arcmin"]["count"]
+            .as_u64()
+            .unwrap()
+            + 100,
+        json["display_pixels"].as_u64().unwrap()
     );
     // The model plane: zero up to the resampling (half a display pixel plus half a frontal
     // pixel, seen from the eye).
@@ -158,13 +292,7 @@ fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
         let frontal = 0.5 * 2.0 * d2 * ctx.scene.frontal.tan_half_x() / 1280.0 / (0.7 + d2);
         (display + frontal) * std::f64::consts::SQRT_2 * physical::ARCMIN_PER_RAD
     };
-    let (maps, json) = measure(
-        &ctx,
-        &ctx.scene,
-        eye,
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (maps, json) = measured(&ctx, &r);
     let max = json["display"]["misregistration_arcmin"]["max"]
         .as_f64()
         .unwrap();
@@ -176,13 +304,7 @@ fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
     // A wall at 12 m with the model at 6 m: at display point x from the camera axis the
     // shown point is off by x(1/6 − 1/12)·12 on the wall: the analytic angle, ± quantum.
     let (ctx, r) = wall_run(12.0, 6.0);
-    let (maps, off_plane) = measure(
-        &ctx,
-        &ctx.scene,
-        eye,
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (maps, off_plane) = measured(&ctx, &r);
     // The image difference grows with the misregistration.
     assert!(off_plane["display"]["flip_mean"].as_f64().unwrap() > flip_on_plane);
     let obstacle_from_world = ctx.scene.obstacle.world_from_obstacle.inverse();
@@ -222,13 +344,7 @@ fn with_an_ideal_display_the_model_plane_has_zero_misregistration() {
         ..RunOptions::default()
     };
     let r = run(&ctx, &ideal).unwrap();
-    let (_, json) = measure(
-        &ctx,
-        &ctx.scene,
-        ctx.scene.eye(),
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (_, json) = measured(&ctx, &r);
     let stats = &json["display"]["misregistration_arcmin"];
     assert!(stats["count"].as_u64().unwrap() > 1000);
     assert!(stats["max"].as_f64().unwrap() < 0.01, "{stats}");
@@ -241,13 +357,7 @@ fn with_an_ideal_display_the_model_plane_has_zero_misregistration() {
     }
     .context();
     let r = run(&ctx, &ideal).unwrap();
-    let (maps, _) = measure(
-        &ctx,
-        &ctx.scene,
-        ctx.scene.eye(),
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (maps, _) = measured(&ctx, &r);
     let obstacle_from_world = ctx.scene.obstacle.world_from_obstacle.inverse();
     for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
         // The shown point is off by x·(12/6 − 1)·(0.7 + 6)/0.7… exactly: on the wall at 12 m the
@@ -263,6 +373,530 @@ fn with_an_ideal_display_the_model_plane_has_zero_misregistration() {
         assert!(
             (got - expected).abs() < 0.01,
             "pixel {i}: {got} vs {expected}"
+        );
+    }
+}
+
+/// The angle between two directions, arc-minutes.
+fn arcmin_between(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length().atan2(a.dot(b)) * physical::ARCMIN_PER_RAD
+}
+
+#[test]
+fn sky_pixels_count_with_the_angle_between_directions() {
+    // A wall at 12 m whose top edge (y = 0.5) crosses the display's view; above it, sky. With
+    // the model plane at 6 m and an ideal display, each display point shows what the frontal
+    // camera sees towards the model point M of the eye's ray: a wall point or a sky direction.
+    // The truth there is the eye's ray: a wall point or a sky direction. Every pixel's
+    // misregistration is the angle between the two, computed here by ray casting alone.
+    let setup = common::WallScene {
+        wall: 12.0,
+        eye: [0.0, 0.0, 0.7],
+        ..common::WallScene::default()
+    };
+    // The wall: a band 0.5 ≤ y ≤ 1.2 and everything below y = −0.5; sky above and in the slit
+    // between. The model at 6 m shows each point from farther out than the truth has it
+    // (1.055×, about the axis): past the top edge seethru shows sky where the truth has wall,
+    // at the slit's edges wall where the truth has sky, in the middle of the slit sky on both.
+    let text = setup.text().replace(
+        "size = [80.0, 60.0]\ntranslate = [0.0, 0.0, -12]",
+        "size = [80.0, 0.7]\ntranslate = [0.0, 0.85, -12]\n\n[[object]]\nname = \"wall below\"\nkind = \"quad\"\nmaterial = \"wall\"\nsize = [80.0, 60.0]\ntranslate = [0.0, -30.5, -12]",
+    );
+    assert!(text.contains("wall below"));
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let ctx = RenderContext::new(scene, seethru::render::accel::BvhKind::Cwbvh).unwrap();
+    let options = RunOptions {
+        d2: WorkingDistance::Metres(6.0),
+        spp: 1,
+        display: DisplayModel::Ideal,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options).unwrap();
+    let eye = ctx.scene.eye();
+    let (maps, json) = measured(&ctx, &r);
+    let on_plane = |from: DVec3, dir: DVec3| from + dir * ((-12.0 - from.z) / dir.z);
+    let wall_hit = |from: DVec3, dir: DVec3| {
+        let p = on_plane(from, dir);
+        ((0.5..=1.2).contains(&p.y) || p.y <= -0.5).then_some(p)
+    };
+    let near_edge = |from: DVec3, dir: DVec3| {
+        let y = on_plane(from, dir).y;
+        [0.5, 1.2, -0.5].iter().any(|e| (y - e).abs() < 1e-4)
+    };
+    let (mut counts, mut ambiguous, mut checked) = ([0usize; 3], 0usize, 0usize);
+    for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
+        let x = r.occluded.position[i].as_dvec3();
+        let model = eye + (x - eye) * (0.7 + 6.0) / 0.7;
+        let (truth_dir, shown_dir) = (x - eye, model);
+        if near_edge(eye, truth_dir) || near_edge(DVec3::ZERO, shown_dir) {
+            ambiguous += 1;
+            continue;
+        }
+        let truth = wall_hit(eye, truth_dir);
+        let shown = wall_hit(DVec3::ZERO, shown_dir);
+        let expected = arcmin_between(
+            shown.map_or(shown_dir, |s| s - eye),
+            truth.map_or(truth_dir, |t| t - eye),
+        );
+        let got = maps.misregistration[i] as f64;
+        assert!(
+            (got - expected).abs() < 0.02,
+            "pixel {i}: {got} vs {expected}"
+        );
+        checked += 1;
+        match (truth.is_none(), shown.is_none()) {
+            (true, false) => counts[0] += 1,
+            (false, true) => counts[1] += 1,
+            (true, true) => counts[2] += 1,
+            _ => {}
+        }
+    }
+    let sky = &json["sky_pixels_included"];
+    for (k, name) in ["truth_only", "seethru_only", "both"].iter().enumerate() {
+        let got = sky[name].as_u64().unwrap() as usize;
+        assert!(
+            got.abs_diff(counts[k]) <= ambiguous && counts[k] > 50,
+            "{name}: {got} vs {} (±{ambiguous})",
+            counts[k]
+        );
+    }
+    assert!(checked > 1000);
+    // Every display pixel has a misregistration: none excluded, coverage 1.
+    assert_eq!(
+        json["display"]["misregistration_arcmin"]["count"],
+        json["display_pixels"]
+    );
+    assert_eq!(json["coverage"].as_f64(), Some(1.0));
+    assert_eq!(json["undefined_pixels"].as_u64(), Some(0));
+}
+
+#[test]
+fn coverage_counts_the_blank_pixels_and_the_image_metrics_see_them() {
+    // A narrow frontal camera (10°) cannot see all the eye sees through the display at
+    // d2 → ∞: with --outside black the rest is blank. Blank where the eye's direction through
+    // the display point leaves the frontal view (ideal display: no pixel rounding).
+    let ctx = common::WallScene {
+        eye: [0.1, 0.0, 0.7],
+        frontal_half_angle: 10.0,
+        // Square, so that only the left of the display leaves the view.
+        frontal_resolution: [640, 640],
+        ..common::WallScene::default()
+    }
+    .context();
+    let options = RunOptions {
+        d2: WorkingDistance::Infinity,
+        spp: 1,
+        outside: Outside::Black,
+        display: DisplayModel::Ideal,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options).unwrap();
+    let eye = ctx.scene.eye();
+    let (maps, json) = measured(&ctx, &r);
+    let frontal = &ctx.scene.frontal;
+    let (mut display, mut blank, mut ambiguous) = (0usize, 0usize, 0usize);
+    for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
+        display += 1;
+        let q = frontal
+            .project_direction(r.occluded.position[i].as_dvec3() - eye)
+            .unwrap();
+        let (w, h) = (frontal.width as f64, frontal.height as f64);
+        let margin = q.x.min(w - q.x).min(q.y).min(h - q.y);
+        if margin.abs() < 1e-3 {
+            ambiguous += 1;
+        } else if margin < 0.0 {
+            blank += 1;
+            assert!(maps.blank[i] && r.seethru.object_id[i] == MISSING_ID);
+            assert!(maps.misregistration[i].is_nan());
+        }
+    }
+    assert!(blank > 300 && blank < display / 2, "{blank} of {display}");
+    // Missing: true wall points outside the frontal view (the wall at 6 m, seen from the eye).
+    let (mut outside, mut unsure) = (0usize, 0usize);
+    for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
+        let x = r.occluded.position[i].as_dvec3();
+        let on_wall = eye + (x - eye) * ((6.0 + eye.z) / eye.z);
+        let q = frontal.project_point(on_wall).unwrap();
+        let margin = q.x.min(640.0 - q.x).min(q.y).min(640.0 - q.y);
+        if margin.abs() < 0.05 {
+            unsure += 1;
+        } else if margin < 0.0 {
+            outside += 1;
+            assert!(maps.missing[i]);
+        }
+    }
+    let reported = json["missing"]["outside_frontal_view"].as_u64().unwrap() as usize;
+    assert!(
+        outside > 300 && reported.abs_diff(outside) <= unsure,
+        "{reported} vs {outside}"
+    );
+    let reported = json["blank_pixels"].as_u64().unwrap() as usize;
+    assert!(
+        reported.abs_diff(blank) <= ambiguous,
+        "{reported} vs {blank}"
+    );
+    let coverage = json["coverage"].as_f64().unwrap();
+    assert!((coverage - (1.0 - reported as f64 / display as f64)).abs() < 1e-12);
+    assert_eq!(json["display"]["coverage"].as_f64(), Some(coverage));
+    // No silent exclusion: every covered pixel has a misregistration.
+    assert_eq!(
+        json["display"]["misregistration_arcmin"]["count"]
+            .as_u64()
+            .unwrap() as usize,
+        display - reported
+    );
+    // The side band that runs into the black part is less covered than the display.
+    let left = json["border_per_side"]["left"]["coverage"]
+        .as_f64()
+        .unwrap();
+    let right = json["border_per_side"]["right"]["coverage"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        left.min(right) < coverage && left.max(right) == 1.0,
+        "{left} {right}"
+    );
+    // The image metrics count the black: the colour error over the display is the mean over
+    // every display pixel, blank ones included.
+    let mean_error = (0..maps.display.len())
+        .filter(|&i| maps.display[i])
+        .map(|i| {
+            let (t, s) = (
+                encode_srgb8(r.truth.color[i]),
+                encode_srgb8(r.seethru.color[i]),
+            );
+            (0..3)
+                .map(|c| (t[c] as f64 - s[c] as f64).abs())
+                .sum::<f64>()
+                / 3.0
+        })
+        .sum::<f64>()
+        / display as f64;
+    let reported = json["display"]["mean_abs_colour_error_8bit"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        (mean_error - reported).abs() < 1e-9,
+        "{mean_error} vs {reported}"
+    );
+}
+
+/// Both frames with every pixel outside `mask` replaced by a pattern unlike anything inside.
+fn scramble_outside(frames: [&Frame; 2], mask: &[bool]) -> [Frame; 2] {
+    frames.map(|f| {
+        let mut f = f.clone();
+        for (i, c) in f.color.iter_mut().enumerate().filter(|(i, _)| !mask[*i]) {
+            let k = (i % 7) as f32 / 6.0;
+            *c = Vec3::new(k, 1.0 - k, (i % 3) as f32 / 2.0);
+        }
+        f
+    })
+}
+
+#[test]
+fn masked_ssim_and_flip_see_only_the_display() {
+    let (ctx, r) = wall_run(12.0, 6.0);
+    let eye = ctx.scene.eye();
+    let (maps, before) = measured(&ctx, &r);
+    let [truth, seethru] = scramble_outside([&r.truth, &r.seethru], &maps.display);
+    let (_, after) = measure(&ctx, &ctx.scene, eye, [&truth, &seethru, &r.occluded], 5);
+    for region in ["display", "border"] {
+        for metric in ["ssim", "flip_mean", "psnr_db"] {
+            let (a, b) = (&before[region][metric], &after[region][metric]);
+            assert!(
+                a.as_f64().is_some_and(f64::is_finite),
+                "{region} {metric}: {a}"
+            );
+            assert_eq!(a, b, "{region} {metric}");
+        }
+    }
+    // Changing the seethru frame outside the mask alone changes nothing either.
+    let (_, one_sided) = measure(&ctx, &ctx.scene, eye, [&r.truth, &seethru, &r.occluded], 5);
+    assert_eq!(
+        before["border"]["flip_mean"],
+        one_sided["border"]["flip_mean"]
+    );
+    assert_eq!(before["border"]["ssim"], one_sided["border"]["ssim"]);
+    // Within the mask SSIM is that of Wang et al.: flat images l and l + c have the luminance
+    // term alone, (2 l (l + c) + C1) / (l² + (l + c)² + C1), whatever the windows.
+    let flat = |f: &Frame, v: f32| {
+        let mut f = f.clone();
+        f.color.iter_mut().for_each(|c| *c = Vec3::splat(v));
+        f
+    };
+    let (a, b) = (flat(&r.truth, 0.2), flat(&r.seethru, 0.3));
+    let (_, json) = measure(&ctx, &ctx.scene, eye, [&a, &b, &r.occluded], 5);
+    let lum = |v: f32| encode_srgb8(Vec3::splat(v))[0] as f64;
+    let (la, lb) = (lum(0.2), lum(0.3));
+    let c1 = (0.01f64 * 255.0).powi(2);
+    let expected = (2.0 * la * lb + c1) / (la * la + lb * lb + c1);
+    let got = json["display"]["ssim"].as_f64().unwrap();
+    assert!((got - expected).abs() < 1e-9, "{got} vs {expected}");
+    let psnr = 10.0 * (255.0f64.powi(2) / (la - lb).powi(2)).log10();
+    assert!((json["display"]["psnr_db"].as_f64().unwrap() - psnr).abs() < 1e-9);
+}
+
+/// A run on the wall scene with the wall at 6 m = the model plane, an ideal display, the
+/// frontal camera at `theta_f` degrees and a head bias.
+fn biased_run(theta_f: f64, bias_cm: [f64; 3]) -> (RenderContext, RunResult) {
+    let ctx = common::WallScene {
+        eye: [0.0, 0.0, 0.7],
+        frontal_half_angle: theta_f,
+        ..common::WallScene::default()
+    }
+    .context();
+    let options = RunOptions {
+        d2: WorkingDistance::Metres(6.0),
+        spp: 1,
+        display: DisplayModel::Ideal,
+        head_bias_cm: bias_cm,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options).unwrap();
+    (ctx, r)
+}
+
+#[test]
+fn a_head_error_costs_what_analyze_states_whatever_the_frontal_angle() {
+    // 1 cm of lateral, then of depth head error, rendered: on the display's middle row the
+    // misregistration is the exact top-view geometry `analyze` tabulates, and it is the same
+    // at θ_F = 30° and 60° (erratum 7: θ_F drops out of what the driver sees).
+    for (bias, lateral) in [([1.0, 0.0, 0.0], true), ([0.0, 0.0, 1.0], false)] {
+        let mut maps_at = Vec::new();
+        for theta_f in [30.0, 60.0] {
+            let (ctx, r) = biased_run(theta_f, bias);
+            let (maps, _) = measured(&ctx, &r);
+            let mut checked = 0;
+            for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
+                let x = r.occluded.position[i].as_dvec3();
+                // A depth error is symmetric about the axis through the eye's foot: the top
+                // view holds at the radial distance. A lateral one, on the middle row.
+                let (ex, ed, across) = if lateral {
+                    (0.01, 0.0, x.x)
+                } else {
+                    (0.0, 0.01, x.truncate().length())
+                };
+                if lateral && x.y.abs() > 2e-3 {
+                    continue;
+                }
+                let expected = physical::head_error_angle(0.0, 0.7, ex, ed, across, 6.0)
+                    * physical::ARCMIN_PER_RAD;
+                let got = maps.misregistration[i] as f64;
+                assert!(
+                    (got - expected).abs() < 0.005 * expected + 0.01,
+                    "θ_F {theta_f}, bias {bias:?}, x {x}: {got} vs {expected}"
+                );
+                checked += 1;
+            }
+            assert!(checked > 50, "{checked}");
+            maps_at.push(maps.misregistration);
+        }
+        let worst = maps_at[0]
+            .iter()
+            .zip(&maps_at[1])
+            .filter(|(a, _)| a.is_finite())
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        assert!(worst < 0.01, "θ_F changes the misregistration by {worst}′");
+    }
+}
+
+#[test]
+fn missing_counts_sky_the_frontal_camera_cannot_see() {
+    // A wall below y = 0 at 12 m, sky above; a panel 1 m behind the display that only the
+    // frontal camera sees (x ∈ [−0.6, 0], y ∈ [0.05, 0.45]) hides part of that sky from it.
+    // Missing pixels: those whose true point or sky direction the camera's ray meets the
+    // panel on the way to, found here by ray casting.
+    let text = common::WallScene {
+        wall: 12.0,
+        eye: [0.0, 0.0, 0.7],
+        ..common::WallScene::default()
+    }
+    .text()
+    .replace(
+        "size = [80.0, 60.0]\ntranslate = [0.0, 0.0, -12]",
+        "size = [80.0, 60.0]\ntranslate = [0.0, -30.0, -12]\n\n[[object]]\nname = \"panel\"\nkind = \"quad\"\nmaterial = \"wall\"\nsize = [0.6, 0.4]\ntranslate = [-0.3, 0.25, -1.0]\nhidden_from = [\"driver\"]",
+    );
+    assert!(text.contains("panel"));
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let ctx = RenderContext::new(scene, seethru::render::accel::BvhKind::Cwbvh).unwrap();
+    let options = RunOptions {
+        d2: WorkingDistance::Infinity,
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options).unwrap();
+    let (maps, json) = measured(&ctx, &r);
+    let eye = ctx.scene.eye();
+    let (mut hidden, mut ambiguous) = (0usize, 0usize);
+    for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
+        let through = r.occluded.position[i].as_dvec3();
+        let dir = through - eye;
+        let on_wall = eye + dir * ((-12.0 - eye.z) / dir.z);
+        // The camera (at the origin) looks towards the wall point, or along the sky direction.
+        let towards = if on_wall.y <= 0.0 { on_wall } else { dir };
+        let at_panel = towards * (1.0 / -towards.z);
+        let inside = |v: f64, lo: f64, hi: f64| (v - lo).min(hi - v);
+        let margin = inside(at_panel.x, -0.6, 0.0).min(inside(at_panel.y, 0.05, 0.45));
+        if margin.abs() < 1e-4 || on_wall.y.abs() < 1e-4 {
+            ambiguous += 1;
+        } else if margin > 0.0 {
+            hidden += 1;
+            assert!(maps.missing[i], "pixel {i}");
+        }
+    }
+    let reported = json["missing"]["hidden_from_frontal"].as_u64().unwrap() as usize;
+    assert!(hidden > 500, "{hidden}");
+    assert!(
+        reported.abs_diff(hidden) <= ambiguous,
+        "{reported} vs {hidden} (±{ambiguous})"
+    );
+    assert!(json["sky_pixels_included"]["both"].as_u64().unwrap() > 500);
+}
+
+#[test]
+fn ssim_windows_are_seven_pixels_wide() {
+    // Flat frames that differ in one pixel well inside the display (6 pixels from its edge):
+    // exactly the 49 windows around it see the difference, each with the same statistics (48 pixels at l, one at
+    // l + δ), so the display's mean SSIM is 1 − 49 (1 − s) / N with s from Wang et al.
+    let (ctx, r) = wall_run(6.0, 6.0);
+    let (maps, _) = measured(&ctx, &r);
+    let (w, h) = (maps.width as usize, maps.height as usize);
+    let inner = (0..w * h)
+        .find(|&i| {
+            let (x, y) = ((i % w) as i64, (i / w) as i64);
+            (-6..=6).all(|dy: i64| {
+                (-6..=6).all(|dx: i64| {
+                    let (xx, yy) = (x + dx, y + dy);
+                    xx >= 0
+                        && yy >= 0
+                        && (xx as usize) < w
+                        && (yy as usize) < h
+                        && maps.display[yy as usize * w + xx as usize]
+                })
+            })
+        })
+        .unwrap();
+    let flat = |v: f32| {
+        let mut f = r.truth.clone();
+        f.color.iter_mut().for_each(|c| *c = Vec3::splat(v));
+        f
+    };
+    let (a, mut b) = (flat(0.2), flat(0.2));
+    b.color[inner] = Vec3::splat(0.5);
+    let (_, json) = measure(&ctx, &ctx.scene, ctx.scene.eye(), [&a, &b, &r.occluded], 5);
+    let lum = |v: f32| encode_srgb8(Vec3::splat(v))[0] as f64;
+    let (l, delta) = (lum(0.2), lum(0.5) - lum(0.2));
+    let (c1, c2) = ((0.01f64 * 255.0).powi(2), (0.03f64 * 255.0).powi(2));
+    let mean_b = l + delta / 49.0;
+    let var_b = (48.0 * l * l + (l + delta).powi(2)) / 49.0 - mean_b * mean_b;
+    let s = (2.0 * l * mean_b + c1) * c2 / ((l * l + mean_b * mean_b + c1) * (var_b + c2));
+    let n = json["display"]["pixels"].as_f64().unwrap();
+    let expected = 1.0 - 49.0 * (1.0 - s) / n;
+    let got = json["display"]["ssim"].as_f64().unwrap();
+    assert!((got - expected).abs() < 1e-12, "{got} vs {expected}");
+}
+
+/// Runs the `seethru` binary; (success, stdout, stderr).
+fn seethru(args: &[String]) -> (bool, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_seethru"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+#[test]
+fn the_ratio_command_prints_a_table_and_refuses_bad_compensations() {
+    let paper = [
+        "ratio",
+        "occlusion",
+        "--L",
+        "5",
+        "--b1",
+        "-0.35",
+        "--d2",
+        "6.3",
+        "--d1",
+        "2.5",
+        "--bh",
+        "1.75",
+        "--width",
+        "160",
+    ];
+    let with = |extra: &[&str]| -> Vec<String> {
+        paper.iter().chain(extra).map(|a| a.to_string()).collect()
+    };
+    let (ok, table, err) = seethru(&with(&["--model-d2", "12.6"]));
+    assert!(ok, "{err}");
+    let (ok, json, err) = seethru(&with(&["--model-d2", "12.6", "--json"]));
+    assert!(ok, "{err}");
+    let r: serde_json::Value = serde_json::from_str(&json).unwrap();
+    // The table carries the JSON's numbers, one row per quantity, in the column order
+    // paper, predicted, observed, uncertainty.
+    for (row, key) in [
+        ("p_cam [m]", "p_cam"),
+        ("p_user [m]", "p_user"),
+        ("p_cam/p_user", "ratio"),
+    ] {
+        let line = table.lines().find(|l| l.starts_with(row)).unwrap();
+        let q = &r[key];
+        let expected = format!(
+            "{:+.4} {:+.4} {:+.4} ±{:.4}",
+            q["paper"].as_f64().unwrap(),
+            q["predicted"].as_f64().unwrap(),
+            q["observed"].as_f64().unwrap(),
+            q["uncertainty"].as_f64().unwrap()
+        );
+        let got = line[row.len()..]
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        assert_eq!(got, expected, "{line}");
+    }
+    assert!(
+        table.contains("model plane at 12.6 m (the scene plane is at 6.3 m)"),
+        "{table}"
+    );
+    assert_eq!(r["model_d2"].as_f64(), Some(12.6));
+    let (ok, json, err) = seethru(&with(&[
+        "--model-d2",
+        "inf",
+        "--head-bias-cm",
+        "1,-2,3",
+        "--json",
+    ]));
+    assert!(ok, "{err}");
+    let r: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(r["model_d2"], "inf");
+    assert_eq!(r["head_bias_cm"], serde_json::json!([1.0, -2.0, 3.0]));
+    // Bad compensations: one line naming the flag and its range.
+    for (extra, needle) in [
+        (
+            vec!["--model-d2", "0"],
+            "--model-d2 must be a distance in metres in (0, ∞) or `inf`",
+        ),
+        (vec!["--model-d2", "-3"], "--model-d2 must be"),
+        (vec!["--model-d2", "NaN"], "--model-d2 must be"),
+        (
+            vec!["--head-bias-cm", "0,0,-250"],
+            "z must be in (-250, ∞) cm",
+        ),
+        (
+            vec!["--head-bias-cm", "1,2"],
+            "--head-bias-cm must be three finite numbers",
+        ),
+    ] {
+        let (ok, out, err) = seethru(&with(&extra));
+        assert!(!ok && out.is_empty(), "{extra:?}");
+        assert_eq!(err.lines().count(), 1, "{extra:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && err.contains(needle),
+            "{extra:?}: {err}"
         );
     }
 }

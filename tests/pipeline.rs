@@ -325,3 +325,111 @@ fn a_back_image_without_a_face_is_a_clear_error() {
     .unwrap();
     assert!(err.to_string().contains("no face found"), "{err}");
 }
+
+#[test]
+fn a_rotated_obstacle_and_a_turned_frontal_camera_stay_within_the_resampling_quantum() {
+    // The homography path end to end: the obstacle turned about two axes (yaw 25°, pitch
+    // −12°), the frontal camera on it turned by yaw 10° and pitch 6°, the wall parallel to
+    // the display at d2 = 6 m (the model plane). Every display pixel's shown point must lie
+    // within the resampling quantum of the truth's: half a display pixel carried from the
+    // display to the wall along the eye's ray, plus half a frontal pixel's footprint on the
+    // wall at that point (both computed here from the cameras, not from the compensation).
+    let d2 = 6.0;
+    let mut scene = common::WallScene::default().context().scene;
+    let world_from_obstacle = glam::DAffine3::from_translation(DVec3::new(0.4, 1.1, -0.3))
+        * glam::DAffine3::from_rotation_y(25f64.to_radians())
+        * glam::DAffine3::from_rotation_x(-12f64.to_radians());
+    scene.obstacle.world_from_obstacle = world_from_obstacle;
+    scene.objects[0].world_from_object =
+        world_from_obstacle * glam::DAffine3::from_translation(DVec3::new(0.0, 0.0, -d2));
+    let (theta_f, [fw, fh]) = (scene.frontal.half_angle_x, [640, 480]);
+    scene.frontal = seethru::geometry::camera::Camera::new(
+        world_from_obstacle
+            * glam::DAffine3::from_rotation_y(10f64.to_radians())
+            * glam::DAffine3::from_rotation_x(6f64.to_radians()),
+        theta_f,
+        fw,
+        fh,
+    )
+    .unwrap();
+    let eye_o = DVec3::new(0.06, 0.04, 0.7);
+    scene.driver = seethru::geometry::camera::Camera::look_at(
+        world_from_obstacle.transform_point3(eye_o),
+        world_from_obstacle.transform_point3(DVec3::ZERO),
+        world_from_obstacle.transform_vector3(DVec3::Y),
+        scene.driver.half_angle_x,
+        scene.driver.width,
+        scene.driver.height,
+    )
+    .unwrap();
+    let ctx = RenderContext::new(scene, BvhKind::Cwbvh).unwrap();
+    let options = |d2| RunOptions {
+        d2: WorkingDistance::Metres(d2),
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options(d2)).unwrap();
+    assert!(
+        !r.crop.is_axis_aligned(0.5),
+        "the homography path is not exercised"
+    );
+    let scene = &ctx.scene;
+    let [dw, dh] = scene.obstacle.display_resolution;
+    let display_px = DVec3::new(
+        scene.obstacle.width / dw as f64,
+        scene.obstacle.height / dh as f64,
+        0.0,
+    );
+    let obstacle_from_world = world_from_obstacle.inverse();
+    let frontal = &scene.frontal;
+    // Where the ray from `from` through `through` (obstacle frame) meets the wall z = −d2.
+    let to_wall = |from: DVec3, through: DVec3| {
+        from + (through - from) * ((-d2 - from.z) / (through.z - from.z))
+    };
+    let origin_o = obstacle_from_world.transform_point3(frontal.position());
+    let mask = display_mask(&ctx, &r.occluded);
+    let (mut checked, mut sum_ratio) = (0, 0.0);
+    for (i, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
+        let t = obstacle_from_world.transform_point3(r.truth.position[i].as_dvec3());
+        let s = obstacle_from_world.transform_point3(r.seethru.position[i].as_dvec3());
+        assert!(
+            (t.z + d2).abs() < 1e-4 && (s.z + d2).abs() < 1e-4,
+            "{t} {s}"
+        );
+        // Half a display pixel, in x and y, carried along the eye's ray to the wall.
+        let x = obstacle_from_world.transform_point3(r.occluded.position[i].as_dvec3());
+        let display = (to_wall(eye_o, x + 0.5 * display_px) - to_wall(eye_o, x)).length();
+        // Half a frontal pixel around the truth's point, on the wall.
+        let q = frontal
+            .project_point(world_from_obstacle.transform_point3(t))
+            .unwrap();
+        let footprint = [(0.5, 0.5), (0.5, -0.5), (-0.5, 0.5), (-0.5, -0.5)]
+            .map(|(du, dv)| {
+                let (_, dir) = frontal.world_ray(q + glam::DVec2::new(du, dv));
+                let through = obstacle_from_world.transform_point3(frontal.position() + dir);
+                (to_wall(origin_o, through) - t).length()
+            })
+            .into_iter()
+            .fold(0.0, f64::max);
+        let bound = display + footprint;
+        let error = (s - t).length();
+        assert!(error <= bound * 1.01 + 1e-5, "pixel {i}: {error} > {bound}");
+        sum_ratio += error / bound;
+        checked += 1;
+    }
+    assert!(checked > 1000, "{checked}");
+    // Quantisation, not a systematic offset: on average well inside the bound.
+    assert!(
+        sum_ratio / (checked as f64) < 0.6,
+        "{}",
+        sum_ratio / checked as f64
+    );
+    // A model plane at the wrong distance leaves it.
+    let wrong = run(&ctx, &options(3.0)).unwrap();
+    let outside = mask
+        .iter()
+        .enumerate()
+        .filter(|(i, m)| **m && (wrong.seethru.position[*i] - r.truth.position[*i]).length() > 0.05)
+        .count();
+    assert!(outside > checked / 2, "{outside} of {checked}");
+}

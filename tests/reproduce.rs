@@ -2,6 +2,8 @@
 
 mod common;
 
+use seethru::render::settings::resized;
+
 #[test]
 fn quick_reproduction_reports_the_papers_experiments() {
     let dir = tempfile::tempdir().unwrap();
@@ -13,36 +15,74 @@ fn quick_reproduction_reports_the_papers_experiments() {
     .unwrap();
     let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
     let html = std::fs::read_to_string(dir.path().join("report.html")).unwrap();
-    // Four das cases; θ_F = 30° with D = 1 m cannot cover the display, 63.5° nearly can.
+    // Four das cases: car close and far, each at θ_F = 30° and 63.5°. Each case's coverage is
+    // what ray casting predicts for its display (driver 256 px and frontal 480 px wide, the
+    // quick sizes): 30° cannot cover a 1 m display at d1 = 0.75 m, 63.5° can.
     let cases = report["cases"].as_array().unwrap();
     assert_eq!(cases.len(), 4);
-    let missing = |i: usize| cases[i]["run"]["missing_fraction"].as_f64().unwrap();
-    assert!(
-        missing(0) > 0.2 && missing(1) < 0.01,
-        "{} {}",
-        missing(0),
-        missing(1)
-    );
-    for case in cases {
+    let base = common::das();
+    for (case, (distance, theta)) in
+        cases
+            .iter()
+            .zip([(4.0, 30.0), (4.0, 63.5), (15.0, 30.0), (15.0, 63.5)])
+    {
+        let scene = seethru::paper::reproduce::das_case(&base, distance, 1.0, theta).unwrap();
+        let driver = resized(scene.driver, Some(256), None).unwrap();
+        let frontal = resized(scene.frontal, Some(480), None).unwrap();
+        let (display, covered, ambiguous) =
+            common::expected_coverage(&scene, &driver, &frontal, None);
+        let expected = covered as f64 / display as f64;
+        let coverage = case["metrics"]["coverage"].as_f64().unwrap();
+        assert!(
+            (coverage - expected).abs() <= (ambiguous + 2) as f64 / display as f64,
+            "{}: coverage {coverage} vs {expected} (±{ambiguous} of {display} pixels)",
+            case["name"]
+        );
+        if theta == 30.0 {
+            assert!(expected < 0.8, "{expected}");
+        } else {
+            assert_eq!(coverage, 1.0);
+        }
+        // The table row carries this case's coverage and mean, marked when not covered.
         let mean = case["metrics"]["display"]["misregistration_arcmin"]["mean"]
             .as_f64()
             .unwrap();
-        assert!(mean > 1.0 && mean < 600.0, "{mean}");
-        // The table row carries this case's number.
+        let row = md
+            .lines()
+            .find(|l| l.starts_with(&format!("| {} |", case["name"].as_str().unwrap())))
+            .unwrap();
+        assert!(row.contains(&format!("| {mean:.2} |")), "{row}");
+        assert!(row.contains(&format!("{:.1}%", 100.0 * coverage)), "{row}");
+        assert_eq!(row.contains('†'), coverage < 1.0, "{row}");
+    }
+    // Equal coverage: each car's two cases over the pixels both cover (those 30° covers).
+    let equal = report["equal_coverage"].as_array().unwrap();
+    assert_eq!(equal.len(), 2);
+    for (e, pair) in equal.iter().zip([[0, 1], [2, 3]]) {
+        let display = cases[pair[0]]["metrics"]["display_pixels"]
+            .as_u64()
+            .unwrap() as f64;
+        let narrow = cases[pair[0]]["metrics"]["coverage"].as_f64().unwrap();
         assert!(
-            md.contains(&format!("{mean:.2}")),
-            "report.md lacks {mean:.2}"
+            (e["coverage"].as_f64().unwrap() - narrow).abs() < 1.5 / display,
+            "{e}"
         );
+        // Over the covered pixels of the 30° case, its mean is its own table mean.
+        let own = cases[pair[0]]["metrics"]["display"]["misregistration_arcmin"]["mean"]
+            .as_f64()
+            .unwrap();
+        let at_equal = e["means"][0][1].as_f64().unwrap();
+        assert!((at_equal - own).abs() < 1e-6 * own, "{at_equal} vs {own}");
     }
     // The ratios: observed within uncertainty of the closed form, and in the report.
     let ratios = report["ratios"].as_array().unwrap();
     assert_eq!(ratios.len(), 2);
     for r in ratios {
-        let r = &r["result"];
+        let r = &r["result"]["ratio"];
         let (pred, obs, unc) = (
-            r["ratio_predicted"].as_f64().unwrap(),
-            r["ratio_observed"].as_f64().unwrap(),
-            r["ratio_uncertainty"].as_f64().unwrap(),
+            r["predicted"].as_f64().unwrap(),
+            r["observed"].as_f64().unwrap(),
+            r["uncertainty"].as_f64().unwrap(),
         );
         assert!((pred - obs).abs() <= unc, "{r}");
         assert!(md.contains(&format!("{obs:.4}")) && md.contains(&format!("±{unc:.4}")));

@@ -6,6 +6,7 @@ use seethru::measure::{
     sweep::{SweepOptions, sweep},
     sweep_grid::parse_param,
 };
+use seethru::render::settings::resized;
 use seethru::system::options::HeadSource;
 
 #[test]
@@ -28,11 +29,48 @@ fn sweeps_write_every_row_and_resume() {
     let lines: Vec<&str> = first.lines().collect();
     assert_eq!(lines.len(), 5);
     assert!(lines[0].starts_with("index,theta_f,d2,misregistration_mean_arcmin"));
+    assert!(lines[0].ends_with(",R1,R2,coverage"), "{}", lines[0]);
     assert!(lines[1].starts_with("0,30,inf,") && lines[4].starts_with("3,60,6,"));
-    // A finite model distance nearer the scene's content changes the misregistration.
-    let mean = |l: &str| l.split(',').nth(3).unwrap().parse::<f64>().unwrap();
-    assert_ne!(mean(lines[3]), mean(lines[4]));
-    assert!(dir.path().join("s_plot.png").exists());
+    // Each row's coverage is what ray casting predicts for its configuration (driver 64 px
+    // wide, the frontal camera at the scene's resolution and the row's θ_F): at 30° the das
+    // display leaves the frontal view, at 60° it does not.
+    let base = common::das();
+    let field = |l: &str, k: usize| l.split(',').nth(k).unwrap().parse::<f64>().unwrap();
+    let columns: Vec<&str> = lines[0].split(',').collect();
+    let coverage_at = columns.iter().position(|c| *c == "coverage").unwrap();
+    for (line, (theta, d2)) in lines[1..].iter().zip([
+        (30.0, None),
+        (30.0, Some(6.0)),
+        (60.0, None),
+        (60.0, Some(6.0)),
+    ]) {
+        let mut scene = base.clone();
+        scene.frontal.half_angle_x = f64::to_radians(theta);
+        let driver = resized(scene.driver, Some(64), None).unwrap();
+        let (display, covered, ambiguous) =
+            common::expected_coverage(&scene, &driver, &scene.frontal, d2);
+        let expected = covered as f64 / display as f64;
+        let coverage = field(line, coverage_at);
+        assert!(
+            (coverage - expected).abs() <= (ambiguous + 1) as f64 / display as f64,
+            "{line}: coverage {coverage} vs {expected} (±{ambiguous} of {display})"
+        );
+        assert_eq!(coverage < 1.0, theta == 30.0, "{line}");
+    }
+    // The plot draws the mean misregistration column against θ_F, one curve per d2.
+    let plot = std::fs::read_to_string(dir.path().join("s_plot.csv")).unwrap();
+    let plot_rows: Vec<Vec<f64>> = plot
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(
+        plot_rows,
+        vec![
+            vec![30.0, field(lines[1], 3), field(lines[2], 3)],
+            vec![60.0, field(lines[3], 3), field(lines[4], 3)],
+        ]
+    );
     // Nothing left to do: nothing recomputed, file unchanged.
     assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 0);
     assert_eq!(std::fs::read_to_string(&csv).unwrap(), first);

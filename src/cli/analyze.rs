@@ -2,7 +2,9 @@
 //! parameter set.
 
 use anyhow::Result;
-use seethru::paper::claims::{AnalyzeParams, claims_table, evaluate, paper_claims};
+use seethru::paper::claims::{
+    AnalyzeParams, claims_table, evaluate, head_error_table, head_error_text, paper_claims,
+};
 
 #[derive(clap::Args)]
 pub struct Analyze {
@@ -71,6 +73,7 @@ impl Analyze {
             );
         } else {
             print!("{}", claims_table(&claims));
+            print!("\n{}", head_error_text(&params, &head_error_table(&params)));
             println!(
                 "\nEvery closed form at the given parameters:\n{}",
                 serde_json::to_string_pretty(&values)?

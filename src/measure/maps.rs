@@ -117,8 +117,12 @@ pub fn heatmap_rgb(maps: &MetricMaps, truth: &Frame) -> Result<(u32, u32, Vec<u8
             RGBColor(255, 0, 255).filled(),
         ))
         .map_err(err)?;
-        root.draw(&Text::new("sky", (x0 + 28, ch as i32 - 32), style.clone()))
-            .map_err(err)?;
+        root.draw(&Text::new(
+            "no direction",
+            (x0 + 28, ch as i32 - 32),
+            style.clone(),
+        ))
+        .map_err(err)?;
         root.draw(&Rectangle::new(
             [(x0, ch as i32 - 14), (x0 + 22, ch as i32 - 2)],
             BLACK.filled(),

@@ -1,7 +1,15 @@
-//! Metrics of a `seethru` frame against the `truth` (DESIGN.md §5), inside the display
-//! region: misregistration, border mismatch, PSNR/SSIM, missing pixels.
+//! Metrics of a `seethru` frame against the `truth` (DESIGN.md §5), over every pixel of the
+//! driver's view where the display is: misregistration, border mismatch, PSNR/SSIM/FLIP and
+//! missing pixels, each mean beside the coverage it was taken over.
+//!
+//! Every display pixel counts. A pixel that shows sky (in the truth, in `seethru`, or both)
+//! has a misregistration like any other: the angle at the eye between the direction shown
+//! and the direction the truth has (a direction at infinity is as well defined as a point).
+//! Only blank pixels — display pixels whose crop point is outside the frontal view — have
+//! none; they are counted, and every region reports its `coverage` beside its means. The
+//! image metrics see them as the black they show.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3, Vec3};
 use serde_json::json;
 
 use crate::analysis::physical::ARCMIN_PER_RAD;
@@ -17,9 +25,10 @@ use crate::util::color::encode_srgb8;
 pub struct MetricMaps {
     pub width: u32,
     pub height: u32,
-    /// Angle at the eye between the shown and the true world point, arc-minutes.
+    /// Angle at the eye between what `seethru` shows and what the truth has, arc-minutes; NaN
+    /// outside the display and on blank pixels.
     pub misregistration: Vec<f32>,
-    /// Display pixels whose truth point the frontal camera cannot see.
+    /// Display pixels whose truth point (or sky direction) the frontal camera cannot see.
     pub missing: Vec<bool>,
     /// Pixels where the driver sees the display.
     pub display: Vec<bool>,
@@ -39,37 +48,114 @@ fn stats(values: &mut [f64]) -> serde_json::Value {
     json!({"count": n, "mean": mean, "p95": p95, "max": values[n - 1]})
 }
 
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 { f64::NAN } else { sum / n as f64 }
+}
+
 fn luminance(c: [u8; 3]) -> f64 {
     0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64
 }
 
-/// SSIM map on 8-bit luminance with 7×7 windows (Wang et al. 2004 constants).
-fn ssim_map(a: &[f64], b: &[f64], w: usize, h: usize) -> Vec<f64> {
+/// The direction from `eye` that a pixel shows: towards its world point, or its sky
+/// direction (carried in the normal, see [`Frame::normal`]); `None` where nothing is shown.
+fn shown_direction(position: Vec3, normal: Vec3, eye: DVec3) -> Option<DVec3> {
+    if position.is_finite() {
+        Some(position.as_dvec3() - eye)
+    } else if normal.is_finite() && normal != Vec3::ZERO {
+        Some(-normal.as_dvec3())
+    } else {
+        None
+    }
+}
+
+/// The angle between two directions, radians, accurate at small angles.
+fn angle_between(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length().atan2(a.dot(b))
+}
+
+/// The bounding box of `mask` as (x0, y0, x1, y1), exclusive ends; `None` when it is empty.
+fn bounding_box(mask: &[bool], w: usize) -> Option<(usize, usize, usize, usize)> {
+    mask.iter()
+        .enumerate()
+        .filter(|(_, m)| **m)
+        .fold(None, |b, (i, _)| {
+            let (x, y) = (i % w, i / w);
+            Some(b.map_or((x, y, x + 1, y + 1), |(x0, y0, x1, y1)| {
+                (x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1))
+            }))
+        })
+}
+
+/// SSIM map on 8-bit luminance with 7×7 windows (Wang et al. 2004 constants) that see only
+/// pixels of `mask`: near the mask's edge a window averages over its pixels inside the mask,
+/// so nothing outside the mask reaches any score. NaN outside the mask.
+fn masked_ssim_map(a: &[f64], b: &[f64], mask: &[bool], w: usize, h: usize) -> Vec<f64> {
     let (c1, c2) = ((0.01f64 * 255.0).powi(2), (0.03f64 * 255.0).powi(2));
     let r = 3i64;
     let mut out = vec![f64::NAN; w * h];
-    for y in 0..h as i64 {
-        for x in 0..w as i64 {
-            let (mut sa, mut sb, mut saa, mut sbb, mut sab, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-            for dy in -r..=r {
-                for dx in -r..=r {
-                    let (xx, yy) = (
-                        (x + dx).clamp(0, w as i64 - 1) as usize,
-                        (y + dy).clamp(0, h as i64 - 1) as usize,
-                    );
-                    let (va, vb) = (a[yy * w + xx], b[yy * w + xx]);
-                    sa += va;
-                    sb += vb;
-                    saa += va * va;
-                    sbb += vb * vb;
-                    sab += va * vb;
-                    n += 1.0;
+    for i in (0..w * h).filter(|&i| mask[i]) {
+        let (x, y) = ((i % w) as i64, (i / w) as i64);
+        let (mut sa, mut sb, mut saa, mut sbb, mut sab, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        for yy in (y - r).max(0)..=(y + r).min(h as i64 - 1) {
+            for xx in (x - r).max(0)..=(x + r).min(w as i64 - 1) {
+                let j = yy as usize * w + xx as usize;
+                if !mask[j] {
+                    continue;
                 }
+                let (va, vb) = (a[j], b[j]);
+                sa += va;
+                sb += vb;
+                saa += va * va;
+                sbb += vb * vb;
+                sab += va * vb;
+                n += 1.0;
             }
-            let (ma, mb) = (sa / n, sb / n);
-            let (va, vb, cov) = (saa / n - ma * ma, sbb / n - mb * mb, sab / n - ma * mb);
-            out[y as usize * w + x as usize] = ((2.0 * ma * mb + c1) * (2.0 * cov + c2))
-                / ((ma * ma + mb * mb + c1) * (va + vb + c2));
+        }
+        let (ma, mb) = (sa / n, sb / n);
+        let (va, vb, cov) = (saa / n - ma * ma, sbb / n - mb * mb, sab / n - ma * mb);
+        out[i] =
+            ((2.0 * ma * mb + c1) * (2.0 * cov + c2)) / ((ma * ma + mb * mb + c1) * (va + vb + c2));
+    }
+    out
+}
+
+/// FLIP map (NVIDIA's ꟻLIP, via nv-flip) of the pixels of `mask` only, at `ppd` pixels per
+/// degree. FLIP filters each image spatially before comparing, so a whole-frame FLIP lets
+/// what lies outside the display leak into the display's border. Here both images are cut to
+/// the mask's bounding box and every pixel outside the mask is set to the same mid grey in
+/// both: the filters see the display's content and a shared, featureless surround, never
+/// anything outside the display. NaN outside the mask.
+fn masked_flip_map(
+    truth: &[[u8; 3]],
+    shown: &[[u8; 3]],
+    mask: &[bool],
+    w: usize,
+    ppd: f32,
+) -> Vec<f64> {
+    let mut out = vec![f64::NAN; mask.len()];
+    let Some((x0, y0, x1, y1)) = bounding_box(mask, w) else {
+        return out;
+    };
+    let (bw, bh) = (x1 - x0, y1 - y0);
+    let cut = |image: &[[u8; 3]]| -> Vec<u8> {
+        (0..bw * bh)
+            .flat_map(|k| {
+                let i = (y0 + k / bw) * w + x0 + k % bw;
+                if mask[i] { image[i] } else { [128; 3] }
+            })
+            .collect()
+    };
+    let flip = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(bw as u32, bh as u32, &cut(truth)),
+        nv_flip::FlipImageRgb8::with_data(bw as u32, bh as u32, &cut(shown)),
+        ppd,
+    )
+    .to_vec();
+    for (k, v) in flip.iter().enumerate() {
+        let i = (y0 + k / bw) * w + x0 + k % bw;
+        if mask[i] {
+            out[i] = *v as f64;
         }
     }
     out
@@ -95,9 +181,20 @@ fn psnr(a: &[[u8; 3]], b: &[[u8; 3]], mask: &[bool]) -> f64 {
     }
 }
 
+/// What one display pixel shows, for the statistics.
+#[derive(Clone, Copy, Default)]
+struct PixelClass {
+    blank: bool,
+    /// Whether the truth / `seethru` shows sky here (the pixel has a misregistration).
+    truth_sky: bool,
+    shown_sky: bool,
+    /// Neither a point nor a direction (a frame without sky directions).
+    undefined: bool,
+}
+
 /// Computes the maps and the metrics JSON. `truth`, `seethru` and `occluded` are frames of the
-/// driver's camera `driver` (as rendered by `run`); `band` is the border band width in display
-/// pixels.
+/// driver's camera at `driver_eye` (as rendered by `run`); `band` is the border band width in
+/// display pixels.
 pub fn measure(
     ctx: &RenderContext,
     scene: &Scene,
@@ -118,10 +215,17 @@ pub fn measure(
         .collect();
     let mut misregistration = vec![f32::NAN; w * h];
     let mut missing = vec![false; w * h];
-    let (mut out_of_view, mut hidden, mut sky) = (0usize, 0usize, 0usize);
+    let mut class = vec![PixelClass::default(); w * h];
+    let (mut out_of_view, mut hidden) = (0usize, 0usize);
     // Which side bands each pixel is in: left, right, top, bottom.
     let mut sides = vec![[false; 4]; w * h];
     let frontal = &scene.frontal;
+    let in_frontal_image = |q: Option<DVec2>| {
+        q.is_some_and(|q| {
+            q.x >= 0.0 && q.y >= 0.0 && q.x < frontal.width as f64 && q.y < frontal.height as f64
+        })
+    };
+    let frontal_origin = frontal.position();
     for i in (0..w * h).filter(|&i| display[i]) {
         let on_display = obstacle_from_world.transform_point3(occluded.position[i].as_dvec3());
         let u = (on_display.x / obstacle.width + 0.5) * dw as f64;
@@ -132,95 +236,94 @@ pub fn measure(
             v < band as f64,
             v >= (dh - band) as f64,
         ];
-        let (t, s) = (truth.position[i], seethru.position[i]);
-        if !t.is_finite() {
-            sky += 1;
-            continue;
-        }
-        // Can the frontal camera see the truth's point?
-        let p = t.as_dvec3();
-        let inside = frontal.project_point(p).is_some_and(|q| {
-            q.x >= 0.0 && q.y >= 0.0 && q.x < frontal.width as f64 && q.y < frontal.height as f64
-        });
-        if !inside {
-            missing[i] = true;
-            out_of_view += 1;
-        } else {
-            let origin = frontal.position().as_vec3();
-            let to = t - origin;
-            let distance = to.length();
-            let hit = ctx.trace(origin, to / distance, view_bit::FRONTAL);
-            if hit.is_some_and(|h| h.t < distance - 1e-3 * distance.max(1.0)) {
+        let t = truth.position[i];
+        let true_dir = shown_direction(t, truth.normal[i], driver_eye);
+        // Can the frontal camera see the truth's point, or its sky direction?
+        if let Some(d) = true_dir {
+            let (inside, to, distance) = if t.is_finite() {
+                let to = t.as_dvec3() - frontal_origin;
+                (
+                    in_frontal_image(frontal.project_point(t.as_dvec3())),
+                    to,
+                    to.length(),
+                )
+            } else {
+                (
+                    in_frontal_image(frontal.project_direction(d)),
+                    d,
+                    f64::INFINITY,
+                )
+            };
+            if !inside {
                 missing[i] = true;
-                hidden += 1;
+                out_of_view += 1;
+            } else {
+                let hit = ctx.trace(
+                    frontal_origin.as_vec3(),
+                    to.normalize().as_vec3(),
+                    view_bit::FRONTAL,
+                );
+                // A surface short of the point (any surface, towards a sky direction).
+                let reach = if distance.is_finite() {
+                    distance - 1e-3 * distance.max(1.0)
+                } else {
+                    f64::INFINITY
+                };
+                if hit.is_some_and(|h| (h.t as f64) < reach) {
+                    missing[i] = true;
+                    hidden += 1;
+                }
             }
         }
-        if s.is_finite() {
-            let (a, b) = ((s.as_dvec3() - driver_eye), (p - driver_eye));
-            misregistration[i] = (a.cross(b).length().atan2(a.dot(b)) * ARCMIN_PER_RAD) as f32;
+        if seethru.object_id[i] == MISSING_ID {
+            class[i].blank = true;
+            continue;
+        }
+        let shown_dir = shown_direction(seethru.position[i], seethru.normal[i], driver_eye);
+        match (shown_dir, true_dir) {
+            (Some(a), Some(b)) => {
+                misregistration[i] = (angle_between(a, b) * ARCMIN_PER_RAD) as f32;
+                class[i].truth_sky = !t.is_finite();
+                class[i].shown_sky = !seethru.position[i].is_finite();
+            }
+            _ => class[i].undefined = true,
         }
     }
     let count = display.iter().filter(|&&m| m).count();
+    let count_where = |keep: &dyn Fn(usize) -> bool| (0..w * h).filter(|&i| keep(i)).count();
     let driver_pixel_arcmin = (2.0 * scene.driver.tan_half_x() / w as f64).atan() * ARCMIN_PER_RAD;
-    let collect = |keep: &dyn Fn(usize) -> bool| -> Vec<f64> {
-        (0..w * h)
-            .filter(|&i| keep(i) && misregistration[i].is_finite())
-            .map(|i| misregistration[i] as f64)
-            .collect()
-    };
     let srgb_t: Vec<[u8; 3]> = truth.color.iter().map(|&c| encode_srgb8(c)).collect();
     let srgb_s: Vec<[u8; 3]> = seethru.color.iter().map(|&c| encode_srgb8(c)).collect();
-    let colour_error = |keep: &dyn Fn(usize) -> bool| {
-        let (mut sum, mut n) = (0.0, 0usize);
-        for i in (0..w * h).filter(|&i| keep(i)) {
-            sum += (0..3)
-                .map(|c| (srgb_t[i][c] as f64 - srgb_s[i][c] as f64).abs())
-                .sum::<f64>()
-                / 3.0;
-            n += 1;
-        }
-        if n == 0 { f64::NAN } else { sum / n as f64 }
-    };
     let lum_t: Vec<f64> = srgb_t.iter().map(|&c| luminance(c)).collect();
     let lum_s: Vec<f64> = srgb_s.iter().map(|&c| luminance(c)).collect();
-    let ssim = ssim_map(&lum_t, &lum_s, w, h);
-    let mean_over = |mask: &dyn Fn(usize) -> bool| {
-        let v: Vec<f64> = (0..w * h).filter(|&i| mask(i)).map(|i| ssim[i]).collect();
-        if v.is_empty() {
-            f64::NAN
-        } else {
-            v.iter().sum::<f64>() / v.len() as f64
-        }
-    };
+    let ssim = masked_ssim_map(&lum_t, &lum_s, &display, w, h);
     // FLIP with the driver's eye as the observer: pixels per degree of the driver's camera.
     let ppd = w as f32 / (2.0 * scene.driver.half_angle_x.to_degrees() as f32);
-    let flat = |c: &[[u8; 3]]| c.iter().flatten().copied().collect::<Vec<u8>>();
-    let flip = nv_flip::flip(
-        nv_flip::FlipImageRgb8::with_data(w as u32, h as u32, &flat(&srgb_t)),
-        nv_flip::FlipImageRgb8::with_data(w as u32, h as u32, &flat(&srgb_s)),
-        ppd,
-    )
-    .to_vec();
-    let flip_mean = |keep: &dyn Fn(usize) -> bool| {
-        let v: Vec<f64> = (0..w * h)
-            .filter(|&i| keep(i))
-            .map(|i| flip[i] as f64)
-            .collect();
-        if v.is_empty() {
-            f64::NAN
-        } else {
-            v.iter().sum::<f64>() / v.len() as f64
-        }
-    };
+    let flip = masked_flip_map(&srgb_t, &srgb_s, &display, w, ppd);
     let region = |keep: &dyn Fn(usize) -> bool| {
         let mask: Vec<bool> = (0..w * h).map(keep).collect();
-        let mut values = collect(keep);
+        let pixels = mask.iter().filter(|&&m| m).count();
+        let blank = count_where(&|i| mask[i] && class[i].blank);
+        let mut values: Vec<f64> = (0..w * h)
+            .filter(|&i| mask[i] && misregistration[i].is_finite())
+            .map(|i| misregistration[i] as f64)
+            .collect();
+        let over = |map: &[f64]| mean((0..w * h).filter(|&i| mask[i]).map(|i| map[i]));
+        let colour_error = mean((0..w * h).filter(|&i| mask[i]).map(|i| {
+            (0..3)
+                .map(|c| (srgb_t[i][c] as f64 - srgb_s[i][c] as f64).abs())
+                .sum::<f64>()
+                / 3.0
+        }));
         json!({
+            "pixels": pixels,
+            "coverage": if pixels == 0 { f64::NAN } else { 1.0 - blank as f64 / pixels as f64 },
+            "blank_pixels": blank,
             "misregistration_arcmin": stats(&mut values),
-            "mean_abs_colour_error_8bit": colour_error(keep),
+            "mean_abs_colour_error_8bit": colour_error,
             "psnr_db": psnr(&srgb_t, &srgb_s, &mask),
-            "ssim": mean_over(keep),
-            "flip_mean": flip_mean(keep),
+            "ssim": over(&ssim),
+            "flip_mean": over(&flip),
         })
     };
     let in_band = |i: usize| display[i] && sides[i].iter().any(|&s| s);
@@ -234,14 +337,31 @@ pub fn measure(
             )
         })
         .collect();
-    let all = collect(&|i| display[i]);
-    let mean_px = if all.is_empty() {
-        f64::NAN
-    } else {
-        all.iter().sum::<f64>() / all.len() as f64 / driver_pixel_arcmin
+    let blank = count_where(&|i| display[i] && class[i].blank);
+    let mean_px = mean(
+        misregistration
+            .iter()
+            .filter(|v| v.is_finite())
+            .map(|&v| v as f64),
+    ) / driver_pixel_arcmin;
+    let sky = |truth_sky: bool, shown_sky: bool| {
+        count_where(&|i| {
+            display[i]
+                && misregistration[i].is_finite()
+                && class[i].truth_sky == truth_sky
+                && class[i].shown_sky == shown_sky
+        })
     };
     let json = json!({
         "display_pixels": count,
+        "coverage": if count == 0 { f64::NAN } else { 1.0 - blank as f64 / count as f64 },
+        "blank_pixels": blank,
+        "sky_pixels_included": {
+            "truth_only": sky(true, false),
+            "seethru_only": sky(false, true),
+            "both": sky(true, true),
+        },
+        "undefined_pixels": count_where(&|i| display[i] && class[i].undefined),
         "driver_pixel_arcmin": driver_pixel_arcmin,
         "display": region(&|i| display[i]),
         "misregistration_mean_driver_px": mean_px,
@@ -253,14 +373,10 @@ pub fn measure(
             "outside_frontal_view": out_of_view,
             "hidden_from_frontal": hidden,
         },
-        "sky_pixels_excluded": sky,
-        "blank_display_fraction": if count == 0 { 0.0 } else { (0..w * h).filter(|&i| display[i] && seethru.object_id[i] == MISSING_ID).count() as f64 / count as f64 },
         "flip_pixels_per_degree": ppd,
-        "notes": "misregistration: angle at the eye between the world point seethru shows and the truth's, over display pixels where both are surfaces; colour metrics on 8-bit sRGB; SSIM on luminance, 7×7 windows; FLIP (NVIDIA, via nv-flip) with the driver's camera as observer, averaged inside the masks",
+        "notes": "every display pixel counts. misregistration: angle at the eye between the direction seethru shows and the truth's (towards a world point, or a sky direction), over the covered pixels; coverage: fraction of the region's pixels that show the scene (blank pixels, outside the frontal view, have no misregistration and count in the image metrics as the black they show); undefined_pixels: neither a point nor a direction (0 for frames of this version). Colour metrics on 8-bit sRGB; SSIM on luminance with 7×7 windows inside the display mask; FLIP (NVIDIA, via nv-flip) with the driver's camera as observer, on the display's bounding box with everything outside the display mask set to the same grey in both images",
     });
-    let blank = (0..w * h)
-        .map(|i| display[i] && seethru.object_id[i] == MISSING_ID)
-        .collect();
+    let blank = (0..w * h).map(|i| class[i].blank).collect();
     (
         MetricMaps {
             width: w as u32,
@@ -272,4 +388,31 @@ pub fn measure(
         },
         json,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn statistics_of_one_to_a_hundred() {
+        let mut values: Vec<f64> = (1..=100).rev().map(f64::from).collect();
+        let s = stats(&mut values);
+        assert_eq!(s["count"], 100);
+        assert_eq!(s["mean"], 50.5);
+        // The 95th percentile: the smallest value with 95 % of the values at or below it.
+        assert_eq!(s["p95"], 95.0);
+        assert_eq!(s["max"], 100.0);
+        assert_eq!(stats(&mut [7.0])["p95"], 7.0);
+        assert_eq!(stats(&mut [])["count"], 0);
+    }
+
+    #[test]
+    fn the_bounding_box_of_a_mask() {
+        let mut mask = vec![false; 5 * 4];
+        assert_eq!(bounding_box(&mask, 5), None);
+        mask[5 + 1] = true;
+        mask[2 * 5 + 3] = true;
+        assert_eq!(bounding_box(&mask, 5), Some((1, 1, 4, 3)));
+    }
 }

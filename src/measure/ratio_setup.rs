@@ -1,12 +1,14 @@
 //! The paper's occlusion and foreshortening setups (§4.2) as scenes: a display at the
 //! origin, the frontal camera at its centre, the eye at (−b_h, 0, d1), the scene plane at
-//! z = −d2 with the box or the angled surface on it.
+//! z = −d2 with the box or the angled surface on it; and the compensation that shows it,
+//! with its model plane and its eye (the paper's case: the scene plane and the true eye).
 
 use anyhow::{Result, bail};
 use glam::{DAffine3, DVec3};
 
 use crate::analysis::examples::{paper_foreshortening, paper_occlusion};
 use crate::analysis::paper::{ForeshorteningParams, OcclusionParams};
+use crate::analysis::perceived::PerceivedGeometry;
 use crate::geometry::camera::Camera;
 use crate::scene::{Material, Object, Obstacle, Scene, Shape, Sky, Sun};
 
@@ -17,6 +19,17 @@ pub enum Setup {
     Foreshortening(ForeshorteningParams),
 }
 
+/// The compensation of a ratio experiment: where its model plane is and which eye it uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Compensation {
+    /// The model plane's distance behind the display, m, in (0, ∞], `f64::INFINITY` for the
+    /// `d2 → ∞` model; `None`: the scene plane (the paper's case).
+    pub model_d2: Option<f64>,
+    /// Head-tracking bias added to the eye the compensation uses, obstacle frame (x across
+    /// the display, y up, z towards the driver), centimetres.
+    pub head_bias_cm: [f64; 3],
+}
+
 impl Setup {
     pub(crate) fn common(&self) -> (f64, f64, f64, f64) {
         match *self {
@@ -25,7 +38,29 @@ impl Setup {
         }
     }
 
-    /// Predicted (p_cam, p_user).
+    /// `occlusion` or `foreshortening`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Setup::Occlusion(_) => "occlusion",
+            Setup::Foreshortening(_) => "foreshortening",
+        }
+    }
+
+    /// The parameters by their names on the command line (metres; γ in degrees).
+    pub fn parameters_json(&self) -> serde_json::Value {
+        match *self {
+            Setup::Occlusion(p) => {
+                serde_json::json!({"L": p.l, "b1": p.b1, "d2": p.d2, "d1": p.d1, "b_h": p.b_h})
+            }
+            Setup::Foreshortening(p) => serde_json::json!({
+                "l": p.l, "b1": p.b1, "d2": p.d2, "d1": p.d1, "b_h": p.b_h,
+                "gamma": p.gamma.to_degrees(),
+            }),
+        }
+    }
+
+    /// The paper's closed forms of (p_cam, p_user): the widths the frontal camera and the eye
+    /// see on the scene plane.
     pub fn predicted(&self) -> (f64, f64) {
         match self {
             Setup::Occlusion(p) => (p.p_cam(), p.p_user()),
@@ -40,6 +75,52 @@ impl Setup {
             Setup::Foreshortening(p) if p == paper_foreshortening() => Some((2.47, 2.64)),
             _ => None,
         }
+    }
+
+    /// The top-view geometry of this setup under `compensation`.
+    pub fn geometry(&self, compensation: &Compensation) -> PerceivedGeometry {
+        let (_, d1, d2, b_h) = self.common();
+        let [bx, _, bz] = compensation.head_bias_cm.map(|c| c / 100.0);
+        PerceivedGeometry {
+            eye_x: -b_h,
+            eye_d1: d1,
+            model_eye_x: -b_h + bx,
+            model_eye_d1: d1 + bz,
+            model_d2: compensation.model_d2.unwrap_or(d2),
+            scene_d2: d2,
+        }
+    }
+
+    /// Predicted (p_cam, p_user) as the driver perceives them under `compensation`: p_cam
+    /// from the true corner b1 to where the driver sees the displayed edge on the scene plane
+    /// (equal to the paper's p_cam for the paper's compensation); p_user as the truth has it.
+    pub fn predicted_perceived(&self, compensation: &Compensation) -> (f64, f64) {
+        let (b1, ..) = self.common();
+        let (pc, pu) = self.predicted();
+        (self.geometry(compensation).perceived_width(b1, pc), pu)
+    }
+
+    /// Checks a compensation against this setup; the messages name the command-line flags.
+    pub fn validate_compensation(&self, compensation: &Compensation) -> Result<()> {
+        let (_, d1, ..) = self.common();
+        if let Some(m) = compensation.model_d2
+            && (m.is_nan() || m <= 0.0)
+        {
+            bail!("--model-d2 must be a distance in metres in (0, ∞) or `inf`, got {m}");
+        }
+        let [bx, by, bz] = compensation.head_bias_cm;
+        if ![bx, by, bz].iter().all(|v| v.is_finite()) {
+            bail!(
+                "--head-bias-cm must be three finite numbers x,y,z in centimetres, got {bx},{by},{bz}"
+            );
+        }
+        if d1 + bz / 100.0 <= 0.0 {
+            bail!(
+                "--head-bias-cm: z = {bz} cm puts the compensation's eye behind the display (d1 = {d1} m); z must be in ({}, ∞) cm",
+                -100.0 * d1
+            );
+        }
+        Ok(())
     }
 
     fn validate(&self) -> Result<()> {
@@ -68,6 +149,14 @@ impl Setup {
     }
 }
 
+/// How far behind the scene plane the setup's object reaches, m.
+fn p_depth(setup: &Setup) -> f64 {
+    match setup {
+        Setup::Occlusion(_) => 0.0,
+        Setup::Foreshortening(p) => p.l * p.gamma.sin(),
+    }
+}
+
 fn material(name: &str, color: [f64; 3]) -> Material {
     Material {
         name: name.into(),
@@ -90,15 +179,32 @@ fn object(name: &str, shape: Shape, material: usize, world_from_object: DAffine3
 
 /// The scene of a setup: display at the origin facing +z, frontal camera at its centre, the
 /// eye at (−b_h, 0, d1) (the paper's convention), the scene plane at z = −d2. `width` is the
-/// driver view's width in pixels; the frontal camera and the display get as many.
-pub fn build_scene(setup: &Setup, width: u32) -> Result<Scene> {
+/// driver view's width in pixels; the frontal camera and the display get as many. The display
+/// is wide enough to show the edges where the driver perceives them under `compensation`, and
+/// the frontal camera wide enough to see every model point the display asks for.
+pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Result<Scene> {
     setup.validate()?;
+    setup.validate_compensation(compensation)?;
     let (b1, d1, d2, b_h) = setup.common();
     let eye = DVec3::new(-b_h, 0.0, d1);
     let (pc, pu) = setup.predicted();
-    // Plane points the display must show, with a margin: the corner and both edges.
-    let span = pc.abs().max(pu.abs());
-    let qs = [b1, b1 + pc, b1 + pu];
+    let (pc_perceived, _) = setup.predicted_perceived(compensation);
+    if pc_perceived.abs() < 1e-6 || !pc_perceived.is_finite() {
+        bail!(
+            "the driver perceives no width for these parameters and this compensation (p_cam = {pc_perceived})"
+        );
+    }
+    let geometry = setup.geometry(compensation);
+    // Plane points the display must show, with a margin: the corner and the edges, where the
+    // camera and the eye see them and where the driver perceives them.
+    let span = pc.abs().max(pu.abs()).max(pc_perceived.abs());
+    let qs = [
+        b1,
+        b1 + pc,
+        b1 + pu,
+        b1 + pc_perceived,
+        geometry.perceived(b1),
+    ];
     let (q_lo, q_hi) = (
         qs.iter().copied().fold(f64::INFINITY, f64::min) - 0.5 * span - 0.05,
         qs.iter().copied().fold(f64::NEG_INFINITY, f64::max) + 0.5 * span + 0.05,
@@ -119,12 +225,27 @@ pub fn build_scene(setup: &Setup, width: u32) -> Result<Scene> {
         display_off_color: [0.0; 3],
         body_color: [0.2; 3],
     };
-    // The frontal camera must see every plane point the display can ask for.
-    let reach = [-half_width, half_width]
-        .map(|x| (eye.x + (x - eye.x) * (d1 + d2) / d1).abs())
+    // The frontal camera (half as tall as wide) must see the direction of every model point
+    // the display can ask for: the model eye's ray through a display corner, continued to the
+    // model plane (or taken as a direction for d2 → ∞).
+    let [bx, by, bz] = compensation.head_bias_cm.map(|c| c / 100.0);
+    let model_eye = eye + DVec3::new(bx, by, bz);
+    let model_d2 = geometry.model_d2;
+    let tangents = |corner: DVec3| {
+        let ray = corner - model_eye;
+        let m = if model_d2.is_infinite() {
+            ray / -ray.z
+        } else {
+            (model_eye + ray * (model_eye.z + model_d2) / model_eye.z) / model_d2
+        };
+        m.x.abs().max(2.0 * m.y.abs())
+    };
+    let tan_needed = [-1.0, 1.0]
         .into_iter()
+        .flat_map(|sx| [-1.0, 1.0].map(|sy| DVec3::new(sx * half_width, sy * height / 2.0, 0.0)))
+        .map(tangents)
         .fold(0.0, f64::max);
-    let theta_f = ((reach * 1.05 / d2).atan()).min(85f64.to_radians());
+    let theta_f = (tan_needed * 1.05).atan().min(85f64.to_radians());
     let frontal = Camera::new(DAffine3::IDENTITY, theta_f, width, (width / 2).max(8))?;
     // The driver looks at the display centre, wide enough to see the whole display.
     let look = -eye.normalize();
@@ -146,8 +267,8 @@ pub fn build_scene(setup: &Setup, width: u32) -> Result<Scene> {
         material("background", [0.6, 0.6, 0.6]),
         material("object", [0.8, 0.2, 0.1]),
     ];
-    // Tall enough that every display row sees the setup.
-    let tall = 4.0 * height * (d1 + d2) / d1 + 2.0;
+    // Tall enough that every display row sees the setup, from the eye and from the camera.
+    let tall = 4.0 * height * (d1 + d2) / d1 + 2.0 * tan_needed * (d2 + p_depth(setup)) + 2.0;
     let far = d2 + 50.0;
     let mut objects = Vec::new();
     match *setup {

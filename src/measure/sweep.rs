@@ -19,7 +19,10 @@ use crate::scene::Scene;
 use crate::system::options::{HeadSource, Outside, RunOptions};
 use crate::system::pipeline::run;
 
-const METRIC_COLUMNS: [&str; 11] = [
+/// The metric columns of a row. `coverage` (the fraction of display pixels that show the
+/// scene, over which the misregistration means are taken) comes last, so that the columns
+/// before it keep their places.
+const METRIC_COLUMNS: [&str; 12] = [
     "misregistration_mean_arcmin",
     "misregistration_p95_arcmin",
     "misregistration_max_arcmin",
@@ -31,6 +34,7 @@ const METRIC_COLUMNS: [&str; 11] = [
     "display_outside_frontal_fraction",
     "R1",
     "R2",
+    "coverage",
 ];
 
 fn metric_row(metrics: &serde_json::Value, report: &serde_json::Value) -> Vec<f64> {
@@ -49,6 +53,7 @@ fn metric_row(metrics: &serde_json::Value, report: &serde_json::Value) -> Vec<f6
         f(&report["missing_fraction"]),
         f(&report["crop"]["R1_left"]),
         f(&report["crop"]["R2_right"]),
+        f(&metrics["coverage"]),
     ]
 }
 
@@ -163,14 +168,18 @@ pub fn sweep(
     Ok(todo.len())
 }
 
-/// Mean misregistration against the first parameter, one curve per value of the second.
+/// Mean misregistration against the first parameter, one curve per value of the second;
+/// configurations whose display is not fully covered (coverage < 1) are marked with a dot,
+/// since their mean is over fewer pixels.
 fn plot(csv: &Path, params: &[Param], rows: &[(usize, String)]) -> Result<()> {
     let x_of = |s: &str| s.parse::<f64>().ok().filter(|x| x.is_finite());
     if params[0].values.iter().any(|v| x_of(v).is_none()) {
         return Ok(()); // A non-numeric axis (d2 = inf, auto): the CSV is the result.
     }
     let column = 1 + params.len();
+    let coverage_column = column + METRIC_COLUMNS.len() - 1;
     let mut series: Vec<Series> = Vec::new();
+    let mut marks = Vec::new();
     let group_values = params
         .get(1)
         .map_or(vec![String::new()], |p| p.values.clone());
@@ -183,6 +192,9 @@ fn plot(csv: &Path, params: &[Param], rows: &[(usize, String)]) -> Result<()> {
             }
             if let (Some(x), Ok(y)) = (x_of(f[1]), f[column].parse::<f64>()) {
                 points.push((x, y));
+                if f[coverage_column].parse::<f64>().is_ok_and(|c| c < 1.0) {
+                    marks.push((x, y, series.len()));
+                }
             }
         }
         let label = if g.is_empty() {
@@ -212,12 +224,17 @@ fn plot(csv: &Path, params: &[Param], rows: &[(usize, String)]) -> Result<()> {
     let y1 = ys.iter().copied().fold(0.0, f64::max) * 1.1 + 1e-9;
     let figure = Figure {
         title: format!(
-            "Sweep of {}",
+            "Sweep of {}{}",
             params
                 .iter()
                 .map(|p| p.name.as_str())
                 .collect::<Vec<_>>()
-                .join(" × ")
+                .join(" × "),
+            if marks.is_empty() {
+                ""
+            } else {
+                " (● coverage < 1: part of the display black)"
+            }
         ),
         x_label: params[0].name.clone(),
         y_label: "mean misregistration in the display [arcmin]".into(),
@@ -225,7 +242,7 @@ fn plot(csv: &Path, params: &[Param], rows: &[(usize, String)]) -> Result<()> {
         y_range: (0.0, y1),
         series,
         bounds: vec![(1.0, "1′".into())],
-        marks: Vec::new(),
+        marks,
         legend: plotters::prelude::SeriesLabelPosition::UpperRight,
     };
     let stem = csv

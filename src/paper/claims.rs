@@ -40,6 +40,12 @@ pub fn paper_claims() -> Vec<Claim> {
         b_h: 0.0,
     };
     let arcmin = physical::ARCMIN_PER_RAD;
+    // Misregistration per cm of head error (the largest over a 0.5 m display, eye on its axis,
+    // d1 = 0.8 m), from the exact geometry.
+    let per_cm = |d1: f64, d2: f64, lateral: bool| {
+        physical::head_error_arcmin_per_cm(0.0, d1, 0.5, d2, lateral)
+    };
+    let tan_ratio = 30f64.to_radians().tan() / 80f64.to_radians().tan();
     vec![
         claim(
             "§5.1 Fig. 3: θ_F = 80°, R1(d2) > 0.95·R1(∞) for d2 > [m]",
@@ -100,6 +106,30 @@ pub fn paper_claims() -> Vec<Claim> {
             1.0,
             fore.ratio_far_limit(),
             "erratum 4: the limit is b1/(b1+b_h) when cos γ = 0",
+        ),
+        claim(
+            "§4.1 'sensitivities independent of d2, a constant error': lateral head error, ′/cm at d2 = 1 m over d2 = 10 m (d1=0.8, D=0.5)",
+            1.0,
+            per_cm(0.8, 1.0, true) / per_cm(0.8, 10.0, true),
+            "erratum 6: what the driver sees grows as d2/(d1+d2) (exact geometry; ′/cm against d2 below)",
+        ),
+        claim(
+            "  the same for depth (d1) head error",
+            1.0,
+            per_cm(0.8, 1.0, false) / per_cm(0.8, 10.0, false),
+            "erratum 6: also grows as d2/(d1+d2)",
+        ),
+        claim(
+            "§4.1 'a larger θ_F reduces errors from d1 and b_h': ′/cm at θ_F = 80° over θ_F = 30° (φ ∝ 1/tan θ_F)",
+            tan_ratio,
+            1.0,
+            "erratum 7: θ_F drops out of what the driver sees (renders at two θ_F agree, test)",
+        ),
+        claim(
+            "§4.1 'less impact if the user is not close': lateral ′/cm at d1 = 1.6 over d1 = 0.8 (d2 = 10)",
+            0.5,
+            per_cm(1.6, 10.0, true) / per_cm(0.8, 10.0, true),
+            "holds: d2/(d1(d1+d2)) falls a little faster than 1/d1",
         ),
         claim(
             "physical: misregistration per 1 cm lateral head error (d1=0.8, d2=10) [arcmin]",
@@ -171,6 +201,81 @@ impl AnalyzeParams {
     }
 }
 
+/// One row of the head-error table: what 1 cm of head error costs at working distance `d2`.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct HeadErrorRow {
+    /// Scene (= model plane) distance, m; infinite for d2 → ∞.
+    #[serde(serialize_with = "crate::util::json::finite_or_inf")]
+    pub d2: f64,
+    /// The largest misregistration over the display per cm of lateral and of depth head
+    /// error, arc-minutes, from the exact geometry.
+    pub lateral_arcmin_per_cm: f64,
+    pub depth_arcmin_per_cm: f64,
+    /// The paper's sensitivities of the left cutting ratio (fractions of the frontal image
+    /// width per metre), which do not change with d2.
+    pub paper_phi_bh: f64,
+    pub paper_phi_d1: f64,
+}
+
+/// Misregistration per cm of head error against d2 at `p`'s eye, display and θ_F, for a scene
+/// on the model plane: the exact geometry beside the paper's crop sensitivities.
+pub fn head_error_table(p: &AnalyzeParams) -> Vec<HeadErrorRow> {
+    let mut d2s = vec![0.25, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, f64::INFINITY];
+    if !d2s.contains(&p.d2) {
+        d2s.push(p.d2);
+        d2s.sort_by(f64::total_cmp);
+    }
+    d2s.into_iter()
+        .map(|d2| {
+            let crop = CropParams {
+                d1: p.d1,
+                d2,
+                b_h: p.b_h,
+                width: p.width,
+                theta_f: p.theta_f_deg.to_radians(),
+            };
+            HeadErrorRow {
+                d2,
+                lateral_arcmin_per_cm: physical::head_error_arcmin_per_cm(
+                    -p.b_h, p.d1, p.width, d2, true,
+                ),
+                depth_arcmin_per_cm: physical::head_error_arcmin_per_cm(
+                    -p.b_h, p.d1, p.width, d2, false,
+                ),
+                paper_phi_bh: crop.phi_bh(Side::Left),
+                paper_phi_d1: crop.phi_d1(Side::Left),
+            }
+        })
+        .collect()
+}
+
+/// The head-error table as aligned text.
+pub fn head_error_text(p: &AnalyzeParams, rows: &[HeadErrorRow]) -> String {
+    let mut out = format!(
+        "Misregistration per cm of head error (largest over the display; d1 = {} m, b_h = {} m, D = {} m; a scene on the model plane; exact geometry), beside the paper's sensitivities of R1 at θ_F = {}°:\n",
+        p.d1, p.b_h, p.width, p.theta_f_deg
+    );
+    out += &format!(
+        "{:>8}  {:>14}  {:>12}  {:>10}  {:>10}\n",
+        "d2 [m]", "lateral ′/cm", "depth ′/cm", "φ_bh [/m]", "φ_d1 [/m]"
+    );
+    for r in rows {
+        out += &format!(
+            "{:>8}  {:>14.3}  {:>12.3}  {:>10.4}  {:>10.4}\n",
+            if r.d2.is_finite() {
+                format!("{}", r.d2)
+            } else {
+                "inf".into()
+            },
+            r.lateral_arcmin_per_cm,
+            r.depth_arcmin_per_cm,
+            r.paper_phi_bh,
+            r.paper_phi_d1
+        );
+    }
+    out
+}
+
 /// Every closed form at `p`, as JSON.
 pub fn evaluate(p: &AnalyzeParams) -> serde_json::Value {
     let crop = CropParams {
@@ -222,6 +327,7 @@ pub fn evaluate(p: &AnalyzeParams) -> serde_json::Value {
             "infinite_plane_model_at_edge": physical::infinite_plane_error(0.5 * p.width, p.d1, p.d2) * arcmin,
             "frontal_pixel": physical::frontal_pixel_angle(p.theta_f_deg.to_radians(), p.frontal_px, p.d1, p.d2) * arcmin,
         },
+        "head_error_vs_d2": head_error_table(p),
     })
 }
 

@@ -23,6 +23,17 @@ pub struct CaseResult {
     pub run: serde_json::Value,
 }
 
+/// Cases compared over the same display pixels: those that every one of them covers.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct EqualCoverage {
+    pub label: String,
+    /// Display pixels every case covers, and their fraction of the display.
+    pub pixels: usize,
+    pub coverage: f64,
+    /// (case name, mean misregistration over those pixels in arc-minutes).
+    pub means: Vec<(String, f64)>,
+}
+
 fn img_tag(html: bool, dir: &Path, rel: &str) -> Result<String> {
     if !html {
         return Ok(format!("![{rel}]({rel})"));
@@ -62,6 +73,7 @@ fn num(v: &serde_json::Value) -> String {
 pub fn render_report(
     out: &Path,
     cases: &[CaseResult],
+    equal: &[EqualCoverage],
     ratios: &[(String, String, RatioResult)],
     figures: &[String],
     sizes: &Sizes,
@@ -83,16 +95,19 @@ pub fn render_report(
     );
     let _ = writeln!(
         md,
-        "| case | mean ′ | p95 ′ | max ′ | border mean ′ | border p95 ′ | PSNR dB | SSIM | missing |"
+        "| case | coverage | mean ′ | p95 ′ | max ′ | border mean ′ | border p95 ′ | PSNR dB | SSIM | missing |"
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
     for c in cases {
         let d = &c.metrics["display"];
         let b = &c.metrics["border"];
+        let coverage = c.metrics["coverage"].as_f64().unwrap_or(f64::NAN);
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {:.1}% |",
+            "| {} | {:.1}%{} | {} | {} | {} | {} | {} | {} | {} | {:.1}% |",
             c.name,
+            100.0 * coverage,
+            if coverage < 1.0 { " †" } else { "" },
             num(&d["misregistration_arcmin"]["mean"]),
             num(&d["misregistration_arcmin"]["p95"]),
             num(&d["misregistration_arcmin"]["max"]),
@@ -102,6 +117,33 @@ pub fn render_report(
             num(&d["ssim"]),
             100.0 * c.metrics["missing"]["fraction"].as_f64().unwrap_or(0.0)
         );
+    }
+    let _ = writeln!(
+        md,
+        "\nCoverage: the fraction of the display's pixels that show the scene. † Part of the display is black (the crop leaves the frontal view): its misregistration statistics are over the covered part only, so they are not comparable with a fully covered row; PSNR and SSIM count the black part as the black it shows.\n"
+    );
+    if !equal.is_empty() {
+        let _ = writeln!(
+            md,
+            "At equal coverage — each car position's cases over the display pixels that all of them cover:\n"
+        );
+        let _ = writeln!(md, "| pixels compared | coverage | mean ′ per case |");
+        let _ = writeln!(md, "|---|---|---|");
+        for e in equal {
+            let means: Vec<String> = e
+                .means
+                .iter()
+                .map(|(name, m)| format!("{name}: {m:.2}"))
+                .collect();
+            let _ = writeln!(
+                md,
+                "| {}: {} | {:.1}% | {} |",
+                e.label,
+                e.pixels,
+                100.0 * e.coverage,
+                means.join("; ")
+            );
+        }
     }
     let _ = writeln!(
         md,
@@ -141,14 +183,17 @@ pub fn render_report(
         let _ = writeln!(
             md,
             "| {name} | {:.4} | {:.4} | ±{:.4} | {} | {} |",
-            r.ratio_predicted,
-            r.ratio_observed,
-            r.ratio_uncertainty,
-            opt(r.paper_predicted),
-            opt(r.paper_measured)
+            r.ratio.predicted,
+            r.ratio.observed,
+            r.ratio.uncertainty,
+            opt(r.paper_printed),
+            opt(r.paper_unity)
         );
     }
-    let _ = writeln!(md, "\nWidths on the scene plane (m):\n");
+    let _ = writeln!(
+        md,
+        "\nWidths on the scene plane (m), where the driver perceives the edges (along the line of sight through each display pixel):\n"
+    );
     let _ = writeln!(
         md,
         "| case | p_cam predicted | p_cam observed | p_user predicted | p_user observed |"
@@ -158,12 +203,12 @@ pub fn render_report(
         let _ = writeln!(
             md,
             "| {name} | {:.4} | {:.4} ± {:.4} | {:.4} | {:.4} ± {:.4} |",
-            r.p_cam_predicted,
-            r.p_cam_observed.value,
-            r.p_cam_observed.uncertainty,
-            r.p_user_predicted,
-            r.p_user_observed.value,
-            r.p_user_observed.uncertainty
+            r.p_cam.predicted,
+            r.p_cam.observed,
+            r.p_cam.uncertainty,
+            r.p_user.predicted,
+            r.p_user.observed,
+            r.p_user.uncertainty
         );
     }
     let _ = writeln!(md);
@@ -180,7 +225,7 @@ pub fn render_report(
     }
     let _ = writeln!(
         md,
-        "## Notes\n\n- The occlusion and foreshortening ratios are measured from the renders' id and position buffers; the uncertainty is the pixel quantisation, and it shrinks with resolution. The paper's Unity measurements missed their predictions by 0.02 and 0.17.\n- With D = 1 m at d1 = 0.75 m, θ_F = 30° cannot cover the display's view: the part outside the frontal camera's view is black and counted as missing.\n- See the README for the errata of the paper's formulas."
+        "## Notes\n\n- The occlusion and foreshortening ratios are measured from the renders' id and position buffers; the model plane is the scene plane (the paper's case), so the prediction is the closed form; the uncertainty is the pixel quantisation (the driver's pixels, and for p_cam the display's and the frontal camera's), and it shrinks with resolution. The paper's Unity measurements missed their predictions by 0.02 and 0.17.\n- With D = 1 m at d1 = 0.75 m, θ_F = 30° cannot cover the display's view: the part outside the frontal camera's view is black and counted as missing; compare it with 63.5° only at equal coverage (above).\n- See the README for the errata of the paper's formulas."
     );
     if !html {
         return Ok(md);

@@ -11,10 +11,11 @@ use crate::analysis::examples::{paper_foreshortening, paper_occlusion};
 use crate::io::atomic::write_text;
 use crate::io::frame_files::write_png;
 use crate::measure::maps::heatmap_rgb;
+use crate::measure::metrics::MetricMaps;
 use crate::measure::metrics::measure;
 use crate::measure::ratio::{RatioResult, measure_ratio_with_frames};
-use crate::measure::ratio_setup::Setup;
-use crate::paper::report::{CaseResult, Sizes, render_report};
+use crate::measure::ratio_setup::{Compensation, Setup};
+use crate::paper::report::{CaseResult, EqualCoverage, Sizes, render_report};
 use crate::render::accel::BvhKind;
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
@@ -30,7 +31,7 @@ fn frame_png(frame: &Frame, path: &Path) -> Result<()> {
 
 /// The das scene with the car `distance` metres beyond the obstacle, a display of width
 /// `display_width` and the frontal half angle `theta_deg`.
-fn das_case(base: &Scene, distance: f64, display_width: f64, theta_deg: f64) -> Result<Scene> {
+pub fn das_case(base: &Scene, distance: f64, display_width: f64, theta_deg: f64) -> Result<Scene> {
     let mut scene = base.clone();
     let obstacle_z = scene.obstacle.world_from_obstacle.translation.z;
     let car = scene
@@ -74,8 +75,10 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let base = Scene::load(scene_path)?;
     let mut cases = Vec::new();
+    let mut equal = Vec::new();
     // §5.2 Figs. 4 and 5: the car close and far, θ_F = 30° and 63.5°, D = 1 m, d2 → ∞.
     for (car_label, distance) in [("close", 4.0), ("far", 15.0)] {
+        let mut compared: Vec<(String, MetricMaps)> = Vec::new();
         for theta in [30.0, 63.5] {
             let name = format!("car {car_label} (≈{distance} m), θ_F = {theta}°, D = 1 m");
             let dir = format!("car_{car_label}_theta{}", theta as u32);
@@ -102,6 +105,7 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
             frame_png(&result.seethru, &out.join(&dir).join("seethru.png"))?;
             let (w, h, rgb) = heatmap_rgb(&maps, &result.truth)?;
             write_png(&out.join(&dir).join("misregistration.png"), w, h, rgb)?;
+            compared.push((format!("θ_F = {theta}°"), maps));
             cases.push(CaseResult {
                 name,
                 dir,
@@ -109,6 +113,10 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
                 run: result.report,
             });
         }
+        equal.push(equal_coverage(
+            &format!("car {car_label} (≈{distance} m)"),
+            &compared,
+        ));
     }
     // §5.2 Figs. 6 and 7: the occlusion and foreshortening cases with the paper's parameters.
     let setups = [
@@ -126,7 +134,7 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
     let mut ratios: Vec<(String, String, RatioResult)> = Vec::new();
     for (name, dir, setup) in setups {
         std::fs::create_dir_all(out.join(dir))?;
-        let (r, frames) = measure_ratio_with_frames(&setup, sizes.ratio)?;
+        let (r, frames) = measure_ratio_with_frames(&setup, sizes.ratio, &Compensation::default())?;
         frame_png(&frames.truth, &out.join(dir).join("truth.png"))?;
         frame_png(&frames.seethru, &out.join(dir).join("seethru.png"))?;
         ratios.push((name.to_string(), dir.to_string(), r));
@@ -136,6 +144,7 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
         "quick": quick,
         "scene": scene_path.display().to_string(),
         "cases": cases.iter().map(|c| json!({"name": c.name, "dir": c.dir, "metrics": c.metrics, "run": c.run})).collect::<Vec<_>>(),
+        "equal_coverage": equal,
         "ratios": ratios.iter().map(|(n, d, r)| json!({"name": n, "dir": d, "result": r})).collect::<Vec<_>>(),
         "figures": figures,
     });
@@ -145,13 +154,35 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
     )?;
     write_text(
         &out.join("report.md"),
-        &render_report(out, &cases, &ratios, &figures, &sizes, false)?,
+        &render_report(out, &cases, &equal, &ratios, &figures, &sizes, false)?,
     )?;
     write_text(
         &out.join("report.html"),
-        &render_report(out, &cases, &ratios, &figures, &sizes, true)?,
+        &render_report(out, &cases, &equal, &ratios, &figures, &sizes, true)?,
     )?;
     Ok(report)
+}
+
+/// The mean misregistration of each case over the display pixels that every case covers.
+/// The cases must share the driver's view of the display (same eye, display and resolution).
+fn equal_coverage(label: &str, cases: &[(String, MetricMaps)]) -> EqualCoverage {
+    let display = &cases[0].1.display;
+    let common: Vec<usize> = (0..display.len())
+        .filter(|&i| display[i] && cases.iter().all(|(_, m)| m.display[i] && !m.blank[i]))
+        .collect();
+    let means = cases
+        .iter()
+        .map(|(name, m)| {
+            let values = common.iter().map(|&i| m.misregistration[i] as f64);
+            (name.clone(), values.sum::<f64>() / common.len() as f64)
+        })
+        .collect();
+    EqualCoverage {
+        label: label.to_string(),
+        pixels: common.len(),
+        coverage: common.len() as f64 / display.iter().filter(|&&d| d).count().max(1) as f64,
+        means,
+    }
 }
 
 /// The default scene path: `scenes/das.toml` of the working directory.

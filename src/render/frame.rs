@@ -17,7 +17,9 @@ pub struct Frame {
     pub camera_z: Vec<f32>,
     /// World position of the visible point, metres; NaN for sky.
     pub position: Vec<Vec3>,
-    /// Unit geometric normal of the visible surface, world frame, facing the camera; zero for sky.
+    /// Unit geometric normal of the visible surface, world frame, facing the camera. For sky,
+    /// the unit vector back along the pixel-centre ray (a sky at infinity facing the camera), so
+    /// that the direction a display pixel shows travels with it; zero where nothing is shown.
     pub normal: Vec<Vec3>,
     /// Object id (index in the scene's object list + 1; the obstacle last); 0 for sky.
     pub object_id: Vec<u32>,

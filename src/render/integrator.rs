@@ -175,7 +175,11 @@ impl RenderContext {
                     object_id: s.object,
                     part_id: s.part,
                 },
-                (None, None) => Pixel::SKY,
+                // The sky direction travels with the pixel, as a world point does.
+                (None, None) => Pixel {
+                    normal: -dir,
+                    ..Pixel::SKY
+                },
             };
         }
         pixel.color = sum / spp as f32;
@@ -199,6 +203,7 @@ impl RenderContext {
                 },
                 None => Pixel {
                     color: self.sky.radiance(dir),
+                    normal: -dir,
                     ..Pixel::SKY
                 },
             },

@@ -144,3 +144,60 @@ translate = [0.0, 0.0, -{wall}]
         .unwrap()
     }
 }
+
+/// The coverage the planar model predicts for the driver's view of the display, by ray
+/// casting alone: a display point is covered when the frontal camera sees the model point of
+/// the eye's ray through it (or, for `model_d2 = None`, the direction d2 → ∞). Returns
+/// (display pixels, covered, ambiguous): ambiguous pixels lie within one display pixel of the
+/// coverage boundary, where the display's own pixels may round either way.
+pub fn expected_coverage(
+    scene: &Scene,
+    driver: &seethru::geometry::camera::Camera,
+    frontal: &seethru::geometry::camera::Camera,
+    model_d2: Option<f64>,
+) -> (usize, usize, usize) {
+    use glam::{DVec2, DVec3};
+    let obstacle = &scene.obstacle;
+    let to_obstacle = obstacle.world_from_obstacle.inverse();
+    let eye = to_obstacle.transform_point3(driver.position());
+    let camera = to_obstacle.transform_point3(frontal.position());
+    let covered = |x: DVec3| {
+        let dir = match model_d2 {
+            Some(d2) => eye + (x - eye) * (eye.z + d2) / eye.z - camera,
+            None => x - eye,
+        };
+        frontal
+            .project_direction(obstacle.world_from_obstacle.transform_vector3(dir))
+            .is_some_and(|q| {
+                q.x >= 0.0
+                    && q.y >= 0.0
+                    && q.x < frontal.width as f64
+                    && q.y < frontal.height as f64
+            })
+    };
+    let [dw, dh] = obstacle.display_resolution.map(f64::from);
+    let step = DVec2::new(obstacle.width / dw, obstacle.height / dh);
+    let (mut display, mut inside, mut ambiguous) = (0, 0, 0);
+    for y in 0..driver.height {
+        for x in 0..driver.width {
+            let (origin, dir) = driver.world_ray(DVec2::new(x as f64 + 0.5, y as f64 + 0.5));
+            let (o, d) = (
+                to_obstacle.transform_point3(origin),
+                to_obstacle.transform_vector3(dir),
+            );
+            let t = -o.z / d.z;
+            let p = o + d * t;
+            if !(t > 0.0 && p.x.abs() <= obstacle.width / 2.0 && p.y.abs() <= obstacle.height / 2.0)
+            {
+                continue;
+            }
+            display += 1;
+            let here = covered(p);
+            inside += here as usize;
+            let neighbours = [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)]
+                .map(|(a, b)| covered(p + DVec3::new(a * step.x, b * step.y, 0.0)));
+            ambiguous += neighbours.iter().any(|&n| n != here) as usize;
+        }
+    }
+    (display, inside, ambiguous)
+}
