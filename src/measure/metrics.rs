@@ -1,4 +1,4 @@
-//! Metrics of a `seethru` frame against the `truth` (DESIGN.md §5), over every pixel of the
+//! Metrics of a `seethru` frame against the `truth` (docs/DESIGN.md §6), over every pixel of the
 //! driver's view where the display is: misregistration, border mismatch, PSNR/SSIM/FLIP and
 //! missing pixels, each mean beside the coverage it was taken over.
 //!

@@ -1,4 +1,4 @@
-//! The views the simulator renders (DESIGN.md §4) and the camera and visibility of each.
+//! The views the simulator renders (docs/DESIGN.md §5) and the camera and visibility of each.
 
 use crate::geometry::camera::Camera;
 use crate::scene::Scene;

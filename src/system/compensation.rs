@@ -1,4 +1,4 @@
-//! Planar parallax compensation in 3-D (DESIGN.md §3): which part of the frontal image the
+//! Planar parallax compensation in 3-D (docs/DESIGN.md §4): which part of the frontal image the
 //! display must show so that it looks transparent from a given eye, under a planar scene
 //! model at working distance `d2` (or `d2 → ∞`).
 
