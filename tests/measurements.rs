@@ -95,6 +95,11 @@ fn the_uncertainty_shrinks_with_resolution() {
             (high.ratio.observed - closed).abs() < 0.005 * closed.abs(),
             "{high:?}"
         );
+        // The closed form reported as `paper` is the number the paper prints.
+        assert!(
+            (high.ratio.paper - high.paper_printed.unwrap()).abs() < 0.005,
+            "{high:?}"
+        );
         let paper_miss = (high.paper_unity.unwrap() - high.paper_printed.unwrap()).abs();
         assert!(high.ratio.uncertainty < paper_miss, "{high:?}");
     }
