@@ -5,7 +5,6 @@ mod common;
 
 use glam::DVec3;
 use seethru::analysis::paper::{CropParams, Side};
-use seethru::render::accel::BvhKind;
 use seethru::render::views::View;
 use seethru::render::{integrator::RenderContext, settings::RenderSettings};
 use seethru::scene::shapes::box_face;
@@ -192,7 +191,7 @@ fn out_of_view_crops_error_or_show_black() {
 #[test]
 fn the_head_tracker_recovers_the_eye_better_at_higher_resolution() {
     let scene = common::das();
-    let ctx = RenderContext::new(scene, BvhKind::Cwbvh).unwrap();
+    let ctx = RenderContext::new(scene).unwrap();
     let truth = ctx.scene.eye();
     let obstacle_from_world = ctx.scene.obstacle.world_from_obstacle.inverse();
     let back_from_world =
@@ -241,7 +240,7 @@ fn the_head_tracker_recovers_the_eye_better_at_higher_resolution() {
 
 #[test]
 fn estimated_head_and_injected_errors_move_the_eye() {
-    let ctx = RenderContext::new(common::das(), BvhKind::Cwbvh).unwrap();
+    let ctx = RenderContext::new(common::das()).unwrap();
     let base = RunOptions {
         spp: 1,
         width: Some(64),

@@ -14,7 +14,6 @@ use glam::DVec3;
 use serde_json::json;
 
 use crate::measure::ratio_setup::{Setup, build_scene};
-use crate::render::accel::BvhKind;
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::scene::shapes::box_face;
@@ -122,7 +121,7 @@ pub fn measure_ratio_with_frames(setup: &Setup, width: u32) -> Result<(RatioResu
     let (b1, _, d2, _) = setup.common();
     let eye = scene.eye();
     let camera = scene.frontal.position();
-    let ctx = RenderContext::new(scene, BvhKind::Cwbvh)?;
+    let ctx = RenderContext::new(scene)?;
     let options = RunOptions {
         d2: WorkingDistance::Metres(d2),
         spp: 1,

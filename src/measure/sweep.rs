@@ -13,7 +13,6 @@ use crate::io::atomic::write_text;
 use crate::io::plot::{Figure, Series};
 use crate::measure::metrics::measure;
 use crate::measure::sweep_grid::{Param, combinations, configure};
-use crate::render::accel::BvhKind;
 use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
 use crate::system::options::{HeadSource, Outside, RunOptions};
@@ -133,7 +132,7 @@ pub fn sweep(
     todo.par_iter().try_for_each(|&index| -> Result<()> {
         let config = &configs[index];
         let (scene, run_options) = configure(&base, &base_options, config)?;
-        let ctx = RenderContext::new(scene, BvhKind::Cwbvh)?;
+        let ctx = RenderContext::new(scene)?;
         let result =
             run(&ctx, &run_options).with_context(|| format!("configuration {config:?}"))?;
         let (_, metrics) = measure(

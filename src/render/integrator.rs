@@ -5,11 +5,13 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use anyhow::Result;
-use glam::{DAffine3, Mat3, Vec3};
+use glam::{DAffine3, Vec3};
 use rayon::prelude::*;
 
 use crate::geometry::camera::Camera;
-use crate::render::accel::{Accel, BvhKind, make_ray};
+use crate::render::accel::{Accel, make_ray};
+use crate::render::bvh::TraceRay;
+use crate::render::camera_rays::CameraRays;
 use crate::render::frame::{Frame, Pixel};
 use crate::render::screen::{Screen, Shown};
 use crate::render::settings::RenderSettings;
@@ -36,9 +38,9 @@ pub struct RenderContext {
 }
 
 impl RenderContext {
-    pub fn new(scene: Scene, bvh: BvhKind) -> Result<Self> {
+    pub fn new(scene: Scene) -> Result<Self> {
         let world = World::build(&scene)?;
-        let accel = Accel::build(&world, bvh);
+        let accel = Accel::build(&world)?;
         let sky = SkyModel::new(&scene.sky, &scene.sun);
         Ok(Self {
             scene,
@@ -92,7 +94,7 @@ impl RenderContext {
         let shadow_rays = AtomicU64::new(0);
         let progress = Progress::new(format!("rendering {label}"), h, settings.progress);
         let camera_from_world = camera.world_from_camera.inverse();
-        let rays = RayGenerator::new(camera);
+        let rays = CameraRays::new(camera);
         pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
             let mut shadows = 0;
             for (x, out) in row.iter_mut().enumerate() {
@@ -124,7 +126,10 @@ impl RenderContext {
         let mut sum = Vec3::ZERO;
         for sample in 0..spp {
             let (dx, dy) = pixel_offset(x, y, sample);
-            let (origin, dir) = job.rays.world_ray(x as f32 + dx, y as f32 + dy);
+            let (origin, dir) = (
+                job.rays.origin,
+                job.rays.direction(x as f32 + dx, y as f32 + dy),
+            );
             let hit = self.trace(origin, dir, job.view);
             let shown = match (&hit, job.display) {
                 (Some(s), Some(d))
@@ -207,9 +212,9 @@ impl RenderContext {
 
     /// The closest surface visible in `view` along a ray from `origin` (unit `dir`).
     pub fn trace(&self, origin: Vec3, dir: Vec3, view: u8) -> Option<SurfaceHit> {
-        let hit =
-            self.accel
-                .closest(&self.world, make_ray(origin, dir, 0.0, f32::INFINITY), view)?;
+        let hit = self
+            .accel
+            .closest(&make_ray(origin, dir, 0.0, f32::INFINITY), view)?;
         Some(self.world.surface(hit.prim, origin, dir, hit.t))
     }
 
@@ -224,16 +229,8 @@ impl RenderContext {
         let cos = s.normal.dot(self.sky.sun_direction);
         if cos > 0.0 {
             *shadows += 1;
-            // Offset along the normal, scaled with the coordinates' magnitude to stay above
-            // f32 rounding of the hit point.
-            let eps = 2e-4 * (1.0 + s.position.abs().max_element());
-            let ray = make_ray(
-                s.position + s.normal * eps,
-                self.sky.sun_direction,
-                0.0,
-                f32::INFINITY,
-            );
-            if !self.accel.occluded(&self.world, ray, view) {
+            let ray = shadow_ray(s.position, s.normal, self.sky.sun_direction);
+            if !self.accel.occluded(&ray, view) {
                 light += self.sky.sun_irradiance * cos;
             }
         }
@@ -243,37 +240,16 @@ impl RenderContext {
 
 /// What every pixel of one render shares.
 struct PixelJob<'a> {
-    rays: &'a RayGenerator,
+    rays: &'a CameraRays,
     camera_from_world: &'a DAffine3,
     view: u8,
     display: Option<&'a dyn Screen>,
 }
 
-/// Primary rays of a camera in f32, with the per-camera constants hoisted out of the pixel loop.
-struct RayGenerator {
-    origin: Vec3,
-    world_from_camera: Mat3,
-    /// Camera-space direction of the pixel coordinates (0, 0), and its change per pixel.
-    corner: Vec3,
-    step_x: f32,
-    step_y: f32,
-}
-
-impl RayGenerator {
-    fn new(camera: &Camera) -> Self {
-        let (tx, ty) = (camera.tan_half_x() as f32, camera.tan_half_y() as f32);
-        Self {
-            origin: camera.position().as_vec3(),
-            world_from_camera: camera.world_from_camera.matrix3.as_mat3(),
-            corner: Vec3::new(-tx, ty, -1.0),
-            step_x: 2.0 * tx / camera.width as f32,
-            step_y: -2.0 * ty / camera.height as f32,
-        }
-    }
-
-    /// Ray through continuous pixel coordinates (as [`Camera::world_ray`], in f32).
-    fn world_ray(&self, px: f32, py: f32) -> (Vec3, Vec3) {
-        let local = self.corner + Vec3::new(px * self.step_x, py * self.step_y, 0.0);
-        (self.origin, (self.world_from_camera * local).normalize())
-    }
+/// A ray leaving a surface point `position` (unit normal `normal`) in direction `dir`: its
+/// origin is offset along the normal, scaled with the coordinates' magnitude to stay above
+/// the f32 rounding of the hit point.
+pub fn shadow_ray(position: Vec3, normal: Vec3, dir: Vec3) -> TraceRay {
+    let eps = 2e-4 * (1.0 + position.abs().max_element());
+    make_ray(position + normal * eps, dir, 0.0, f32::INFINITY)
 }

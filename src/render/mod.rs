@@ -2,9 +2,13 @@
 //! for each view.
 
 pub mod accel;
+pub mod bvh;
+pub mod camera_rays;
 pub mod frame;
 pub mod integrator;
+pub mod packets;
 pub mod screen;
 pub mod settings;
 pub mod sky;
+pub mod throughput;
 pub mod views;

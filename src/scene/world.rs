@@ -314,7 +314,7 @@ impl World {
     pub fn intersect(&self, prim: usize, ray: &Ray) -> f32 {
         match prim.checked_sub(self.triangles.len()) {
             None => self.triangles[prim].intersect(ray),
-            Some(e) => intersect_ellipsoid(&self.ellipsoids[e], ray),
+            Some(e) => self.ellipsoids[e].intersect(ray.origin, ray.direction, ray.tmin, ray.tmax),
         }
     }
 
@@ -369,26 +369,30 @@ fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
     [1.0 - v - w, v, w]
 }
 
-#[inline(always)]
-fn intersect_ellipsoid(el: &Ellipsoid, ray: &Ray) -> f32 {
-    let o = el.object_from_world.transform_point3a(ray.origin);
-    let d = el.object_from_world.transform_vector3a(ray.direction);
-    let a = d.dot(d);
-    let b = o.dot(d);
-    let c = o.dot(o) - 1.0;
-    let disc = b * b - a * c;
-    if disc < 0.0 {
-        return f32::INFINITY;
-    }
-    let root = disc.sqrt();
-    // The numerically stable pair of roots.
-    let q = -(b + root.copysign(b));
-    let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
-    let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
-    for t in [near, far] {
-        if t >= ray.tmin && t <= ray.tmax {
-            return t;
+impl Ellipsoid {
+    /// Ray parameter of the first hit of the ray `origin + t dir` (unit `dir`, world frame)
+    /// with the ellipsoid's surface in [tmin, tmax], or infinity.
+    #[inline(always)]
+    pub fn intersect(&self, origin: Vec3A, dir: Vec3A, tmin: f32, tmax: f32) -> f32 {
+        let o = self.object_from_world.transform_point3a(origin);
+        let d = self.object_from_world.transform_vector3a(dir);
+        let a = d.dot(d);
+        let b = o.dot(d);
+        let c = o.dot(o) - 1.0;
+        let disc = b * b - a * c;
+        if disc < 0.0 {
+            return f32::INFINITY;
         }
+        let root = disc.sqrt();
+        // The numerically stable pair of roots.
+        let q = -(b + root.copysign(b));
+        let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
+        let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
+        for t in [near, far] {
+            if t >= tmin && t <= tmax {
+                return t;
+            }
+        }
+        f32::INFINITY
     }
-    f32::INFINITY
 }

@@ -1,6 +1,7 @@
 //! Small pieces every layer uses: sRGB transfer functions, deterministic hashing for
-//! sampling, and the progress line.
+//! sampling, the progress line and the process's peak memory.
 
 pub mod color;
+pub mod memory;
 pub mod progress;
 pub mod sampling;
