@@ -8,7 +8,7 @@ use seethru::analysis::paper::{CropParams, Side};
 use seethru::render::views::View;
 use seethru::render::{integrator::RenderContext, settings::RenderSettings};
 use seethru::scene::shapes::box_face;
-use seethru::system::display::MISSING_ID;
+use seethru::system::display::{DisplayModel, DisplayPlacement, DisplaySurface, MISSING_ID};
 use seethru::system::head::{detect, eye_from_detection};
 use seethru::system::{
     options::{HeadSource, Outside, RunOptions, WorkingDistance},
@@ -323,4 +323,59 @@ fn a_back_image_without_a_face_is_a_clear_error() {
     .err()
     .unwrap();
     assert!(err.to_string().contains("no face found"), "{err}");
+}
+
+#[test]
+fn driver_views_rendered_over_the_truth_equal_separate_renders() {
+    // `run` traces `occluded` and `seethru` again only where the obstacle can be seen; every
+    // pixel must come out exactly as a render of the whole view gives it, for both displays.
+    let ctx = RenderContext::new(common::das()).unwrap();
+    for display in [DisplayModel::Pixels, DisplayModel::Ideal] {
+        let options = RunOptions {
+            width: Some(160),
+            spp: 2,
+            display,
+            back_width: Some(32),
+            frontal_width: Some(320),
+            ..RunOptions::default()
+        };
+        let r = run(&ctx, &options).unwrap();
+        let driver = ctx.scene.driver.with_resolution(160, 90);
+        let settings = RenderSettings {
+            spp: 2,
+            progress: false,
+        };
+        let (truth, _) = ctx.render(&driver, View::Truth.bit(), settings, "truth");
+        let (occluded, _) = ctx.render(&driver, View::Occluded.bit(), settings, "occluded");
+        assert!(r.truth.bit_identical(&truth), "{display:?} truth");
+        assert!(r.occluded.bit_identical(&occluded), "{display:?} occluded");
+        let mut frontal = ctx.scene.frontal;
+        frontal = frontal.with_resolution(320, 320 * frontal.height / frontal.width);
+        let placement = DisplayPlacement::new(&ctx.scene.obstacle);
+        let surface = match display {
+            DisplayModel::Pixels => DisplaySurface::Pixels {
+                image: r.display.clone(),
+                placement,
+            },
+            DisplayModel::Ideal => DisplaySurface::Ideal {
+                crop: r.crop,
+                frontal,
+                placement,
+            },
+        };
+        let (seethru, _) = ctx.render_seethru(&driver, &surface, settings);
+        assert!(r.seethru.bit_identical(&seethru), "{display:?} seethru");
+        // The views do differ, and only inside the display's neighbourhood was traced again.
+        assert!(!truth.bit_identical(&occluded) && !occluded.bit_identical(&seethru));
+        let (_, stats) = ctx.render_over(
+            &driver,
+            &truth,
+            View::Truth.bit(),
+            View::Occluded.bit(),
+            None,
+            settings,
+            "occluded",
+        );
+        assert!(stats.primary_rays < 160 * 90 * 2 / 4, "{stats:?}");
+    }
 }

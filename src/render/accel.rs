@@ -33,7 +33,21 @@ struct Group {
     /// Views that show the group ([`crate::scene::world::view_bit`]).
     views: u8,
     casts_shadow: bool,
+    /// World box of the group's primitives.
+    bounds: Aabb,
     bvh: Bvh,
+}
+
+/// Where the images of two views of one camera can differ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Difference {
+    /// Nowhere: the views show the same primitives.
+    None,
+    /// Only where rays can meet this world box: the primitives one view shows and the other
+    /// does not, none of which casts a shadow.
+    Within(Aabb),
+    /// Anywhere: a primitive only one view shows casts shadows.
+    Everywhere,
 }
 
 thread_local! {
@@ -100,9 +114,14 @@ impl Accel {
         let mut groups = Vec::new();
         for ((views, casts_shadow), prims) in classes {
             let (boxes, indices) = primitive_boxes(world, &prims);
+            let mut bounds = Aabb::empty();
+            for b in &boxes {
+                bounds = bounds.union(b);
+            }
             groups.push(Group {
                 views,
                 casts_shadow,
+                bounds,
                 bvh: Bvh::build(world, &boxes, indices)?,
             });
         }
@@ -148,6 +167,24 @@ impl Accel {
             .iter()
             .filter(|g| g.views & view != 0 && g.casts_shadow)
             .any(|g| g.bvh.any(ray, stack))
+    }
+
+    /// Where images of views `a` and `b` (from one camera) can differ.
+    pub fn difference(&self, a: u8, b: u8) -> Difference {
+        let mut bounds = Aabb::empty();
+        for group in &self.groups {
+            if (group.views & a != 0) != (group.views & b != 0) {
+                if group.casts_shadow {
+                    return Difference::Everywhere;
+                }
+                bounds = bounds.union(&group.bounds);
+            }
+        }
+        if bounds.min.cmple(bounds.max).all() {
+            Difference::Within(bounds)
+        } else {
+            Difference::None
+        }
     }
 
     /// Bytes held by the hierarchies.

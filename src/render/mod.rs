@@ -4,6 +4,7 @@
 pub mod accel;
 pub mod bvh;
 pub mod camera_rays;
+pub mod footprint;
 pub mod frame;
 pub mod integrator;
 pub mod packets;

@@ -14,6 +14,7 @@ use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::render::settings::{RenderSettings, check_spp, resized};
 use crate::render::views::View;
+use crate::scene::world::view_bit;
 use crate::scene::{Obstacle, Scene};
 use crate::system::compensation::{Crop, ModelPlane, compute_crop};
 use crate::system::display::{
@@ -251,8 +252,19 @@ pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
         .filter(|&&i| i == MISSING_ID)
         .count() as f64
         / display.object_id.len() as f64;
+    // `occluded` and `seethru` differ from `truth` only where the obstacle can be seen:
+    // only those pixels are traced again.
     let truth = timed(&mut timings, &driver, View::Truth);
-    let occluded = timed(&mut timings, &driver, View::Occluded);
+    let (occluded, stats) = ctx.render_over(
+        &driver,
+        &truth,
+        view_bit::TRUTH,
+        view_bit::OCCLUDED,
+        None,
+        settings,
+        "occluded",
+    );
+    timings.insert("occluded".into(), json!(stats.seconds));
     let placement = DisplayPlacement::new(&scene.obstacle);
     let surface = match options.display {
         DisplayModel::Pixels => DisplaySurface::Pixels {
@@ -265,7 +277,15 @@ pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
             placement,
         },
     };
-    let (seethru, stats) = ctx.render_seethru(&driver, &surface, settings);
+    let (seethru, stats) = ctx.render_over(
+        &driver,
+        &truth,
+        view_bit::TRUTH,
+        view_bit::SEETHRU,
+        Some(&surface),
+        settings,
+        "seethru",
+    );
     timings.insert("seethru".into(), json!(stats.seconds));
 
     let report = report(
