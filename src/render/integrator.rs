@@ -7,6 +7,7 @@
 //! (`truth`, `occluded`, `seethru`) are rendered once and re-rendered only where those
 //! primitives can be seen ([`RenderContext::render_over`]).
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Result;
@@ -38,12 +39,14 @@ pub struct RenderStats {
     pub seconds: f64,
 }
 
-/// Everything needed to render a scene from any camera.
+/// Everything needed to render a scene from any camera. The world, its hierarchy and the
+/// sky are shared between contexts of scenes that differ only in their cameras
+/// ([`RenderContext::with_scene`]).
 pub struct RenderContext {
     pub scene: Scene,
-    pub world: World,
-    pub accel: Accel,
-    pub sky: SkyModel,
+    pub world: Arc<World>,
+    pub accel: Arc<Accel>,
+    pub sky: Arc<SkyModel>,
 }
 
 /// What every pixel of one render shares.
@@ -60,6 +63,29 @@ impl RenderContext {
         let world = World::build(&scene)?;
         let accel = Accel::build(&world)?;
         let sky = SkyModel::new(&scene.sky, &scene.sun);
+        Ok(Self {
+            scene,
+            world: Arc::new(world),
+            accel: Arc::new(accel),
+            sky: Arc::new(sky),
+        })
+    }
+
+    /// A context for `scene`, reusing this one's world and hierarchy when `scene` differs
+    /// from this context's only in its cameras, and its sky when sky and sun are the same.
+    pub fn with_scene(&self, scene: Scene) -> Result<Self> {
+        let sky = if (&scene.sky, &scene.sun) == (&self.scene.sky, &self.scene.sun) {
+            self.sky.clone()
+        } else {
+            Arc::new(SkyModel::new(&scene.sky, &scene.sun))
+        };
+        let (world, accel) = if same_geometry(&scene, &self.scene) {
+            (self.world.clone(), self.accel.clone())
+        } else {
+            let world = World::build(&scene)?;
+            let accel = Accel::build(&world)?;
+            (Arc::new(world), Arc::new(accel))
+        };
         Ok(Self {
             scene,
             world,
@@ -339,6 +365,15 @@ impl RenderContext {
         }
         albedo * light
     }
+}
+
+/// Whether two scenes have the same world (objects, materials, obstacle): they may differ
+/// in their cameras, sky and sun.
+pub fn same_geometry(a: &Scene, b: &Scene) -> bool {
+    let mut a = a.clone();
+    (a.driver, a.frontal, a.back) = (b.driver, b.frontal, b.back);
+    (a.sky, a.sun) = (b.sky.clone(), b.sun.clone());
+    a == *b
 }
 
 /// Depth along the camera's viewing axis of a world point: the z row of `camera_from_world`,

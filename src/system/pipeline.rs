@@ -182,6 +182,22 @@ fn admissible_offsets(
 
 /// Runs the system on a loaded scene; renders every view.
 pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
+    run_with_truth(ctx, options, None)
+}
+
+/// The driver's camera a run renders at: the scene's, resized by the options.
+pub fn driver_camera(scene: &Scene, options: &RunOptions) -> Result<Camera> {
+    resized(scene.driver, options.width, options.height)
+}
+
+/// [`run`], given the `truth` frame when it is already rendered (a sweep renders it once for
+/// all configurations that share the eye): it must be what [`run`] would render, the
+/// [`driver_camera`]'s `truth` view at the options' samples per pixel.
+pub fn run_with_truth(
+    ctx: &RenderContext,
+    options: &RunOptions,
+    truth: Option<&Frame>,
+) -> Result<RunResult> {
     let mut scene = ctx.scene.clone();
     scene.frontal = resized(scene.frontal, options.frontal_width, None)?;
     scene.back = resized(scene.back, options.back_width, None)?;
@@ -198,7 +214,7 @@ pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
     {
         bail!("head bias must be finite and jitter ≥ 0");
     }
-    let driver = resized(scene.driver, options.width, options.height)?;
+    let driver = driver_camera(scene, options)?;
     let settings = RenderSettings {
         spp: options.spp,
         progress: options.progress,
@@ -254,7 +270,13 @@ pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
         / display.object_id.len() as f64;
     // `occluded` and `seethru` differ from `truth` only where the obstacle can be seen:
     // only those pixels are traced again.
-    let truth = timed(&mut timings, &driver, View::Truth);
+    let truth = match truth {
+        Some(t) => {
+            assert_eq!((t.width, t.height), (driver.width, driver.height));
+            t.clone()
+        }
+        None => timed(&mut timings, &driver, View::Truth),
+    };
     let (occluded, stats) = ctx.render_over(
         &driver,
         &truth,
