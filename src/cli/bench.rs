@@ -13,6 +13,7 @@ use seethru::render::throughput::{
 };
 use seethru::render::views::View;
 use seethru::scene::Scene;
+use seethru::scene::grow::grow;
 use seethru::util::memory::peak_rss_bytes;
 use serde_json::json;
 
@@ -30,6 +31,10 @@ pub struct Bench {
     repeat: usize,
     #[arg(long)]
     threads: Option<usize>,
+    /// Grow the scene procedurally to about this many times its triangles (parked cars,
+    /// trees, buildings), to see how the cost scales with scene size.
+    #[arg(long, default_value_t = 1.0)]
+    grow: f64,
     /// Print only the JSON line.
     #[arg(long)]
     json: bool,
@@ -104,13 +109,14 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         }
     };
     let load = Instant::now();
-    let scene = Scene::load(&options.scene)?;
+    let scene = grow(&Scene::load(&options.scene)?, options.grow)?;
     let ctx = RenderContext::new(scene)?;
     let load_s = load.elapsed().as_secs_f64();
     let world = &ctx.world;
     say(format!(
-        "scene        {}: {} triangles, {} ellipsoids; loaded and built in {load_s:.3} s",
+        "scene        {} (grown {}×): {} triangles, {} ellipsoids; loaded and built in {load_s:.3} s",
         options.scene.display(),
+        options.grow,
         world.triangles.len(),
         world.ellipsoids.len()
     ));
@@ -225,6 +231,7 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
     ));
     let report = json!({
         "scene": options.scene.display().to_string(),
+        "grow": options.grow,
         "triangles": world.triangles.len(),
         "ellipsoids": world.ellipsoids.len(),
         "bvh_build_ms": build.json(),

@@ -1,13 +1,16 @@
 //! The renderable world: every object of a scene flattened into world-space primitives
 //! (triangles and analytic ellipsoids) with their materials, textures and ids.
 
+use std::collections::HashMap;
+use std::path::PathBuf;
+
 use anyhow::Result;
 use glam::{Affine3A, DAffine3, DVec3, Mat3A, Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::ray::Ray;
 use obvhs::rt_triangle::RtTriangle;
 
-use crate::scene::mesh_io::load_mesh;
+use crate::scene::mesh_io::{LoadedMesh, load_mesh};
 use crate::scene::shapes::{Tri, box_face, cuboid, frustum, plane_xz, quad_xy};
 use crate::scene::texture::Texture;
 use crate::scene::{CameraKind, Obstacle, Scene, Shape};
@@ -129,6 +132,7 @@ impl World {
                 uv_repeat: Vec2::new(m.uv_repeat[0] as f32, m.uv_repeat[1] as f32),
             });
         }
+        let mut meshes: HashMap<PathBuf, LoadedMesh> = HashMap::new();
         for object in &scene.objects {
             world.objects.push(ObjectInfo {
                 name: object.name.clone(),
@@ -162,7 +166,11 @@ impl World {
                 } => frustum(*radius as f32, 0.0, *height as f32, *segments),
                 Shape::Quad { size } => quad_xy(size2(*size), 0),
                 Shape::Mesh { path } => {
-                    let mesh = load_mesh(path)?;
+                    // Each file is read once, however many objects place it.
+                    if !meshes.contains_key(path) {
+                        meshes.insert(path.clone(), load_mesh(path)?);
+                    }
+                    let mesh = &meshes[path];
                     let first = world.materials.len() as u32;
                     world
                         .materials
