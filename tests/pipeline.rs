@@ -377,5 +377,9 @@ fn driver_views_rendered_over_the_truth_equal_separate_renders() {
             "occluded",
         );
         assert!(stats.primary_rays < 160 * 90 * 2 / 4, "{stats:?}");
+        // run.json's peak memory holds at least the three driver frames.
+        let frame_bytes = (truth.color.len() * 52) as u64;
+        let peak = r.report["peak_rss_bytes"].as_u64().unwrap();
+        assert!(peak > 3 * frame_bytes, "{peak}");
     }
 }

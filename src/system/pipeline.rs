@@ -23,6 +23,7 @@ use crate::system::display::{
 use crate::system::head::{FaceDetection, detect, eye_from_detection, gaussian};
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use crate::system::report::report;
+use crate::util::memory::peak_rss_bytes;
 
 /// Everything a run produces.
 pub struct RunResult {
@@ -310,7 +311,7 @@ pub fn run_with_truth(
     );
     timings.insert("seethru".into(), json!(stats.seconds));
 
-    let report = report(
+    let mut report = report(
         scene,
         options,
         &crop,
@@ -321,6 +322,8 @@ pub fn run_with_truth(
         &out,
         timings,
     );
+    // The renders are the run's memory peak.
+    report["peak_rss_bytes"] = json!(peak_rss_bytes());
     Ok(RunResult {
         truth,
         occluded,
