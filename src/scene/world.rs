@@ -49,6 +49,8 @@ pub struct ObjectInfo {
 #[derive(Clone, Copy, Debug)]
 pub struct TriAttr {
     pub uv: [Vec2; 3],
+    /// Unit geometric normal, world frame (counter-clockwise front).
+    pub normal: Vec3,
     pub part: u32,
     /// Object id: index into [`World::objects`] plus one.
     pub object: u32,
@@ -75,6 +77,7 @@ pub struct SurfaceHit {
     pub position: Vec3,
     /// Unit geometric normal, world frame, facing the incoming ray.
     pub normal: Vec3,
+    /// Texture coordinates; computed for textured materials only (zero otherwise).
     pub uv: Vec2,
     pub object: u32,
     pub part: u32,
@@ -218,10 +221,11 @@ impl World {
             if (b - a).cross(c - a).length_squared() == 0.0 {
                 continue;
             }
-            self.triangles
-                .push(RtTriangle::new(a.into(), b.into(), c.into()));
+            let rt = RtTriangle::new(a.into(), b.into(), c.into());
+            self.triangles.push(rt);
             self.tri_attrs.push(TriAttr {
                 uv: tri.uv,
+                normal: geometric_normal(&rt),
                 part: tri.part,
                 object,
                 material: material(tri),
@@ -329,25 +333,32 @@ impl World {
     /// Details of the hit of a ray with primitive `prim` at parameter `t`.
     pub fn surface(&self, prim: usize, origin: Vec3, dir: Vec3, t: f32) -> SurfaceHit {
         let position = origin + dir * t;
+        let textured = |material: u32| self.materials[material as usize].texture.is_some();
         let (normal, uv, object, part, material) = match prim.checked_sub(self.triangles.len()) {
             None => {
-                let tri = &self.triangles[prim];
                 let attr = &self.tri_attrs[prim];
-                let v0 = Vec3::from(tri.v0);
-                let (v1, v2) = (v0 - Vec3::from(tri.e1), v0 + Vec3::from(tri.e2));
-                let [b0, b1, b2] = barycentric(position, v0, v1, v2);
-                let uv = attr.uv[0] * b0 + attr.uv[1] * b1 + attr.uv[2] * b2;
-                let n = (v1 - v0).cross(v2 - v0).normalize();
-                (n, uv, attr.object, attr.part, attr.material)
+                let uv = if textured(attr.material) {
+                    let [v0, v1, v2] = vertices(&self.triangles[prim]);
+                    let [b0, b1, b2] = barycentric(position, v0, v1, v2);
+                    attr.uv[0] * b0 + attr.uv[1] * b1 + attr.uv[2] * b2
+                } else {
+                    Vec2::ZERO
+                };
+                (attr.normal, uv, attr.object, attr.part, attr.material)
             }
             Some(e) => {
                 let el = &self.ellipsoids[e];
                 let local = el.object_from_world.transform_point3(position);
                 let n = Vec3::from(el.normal_from_object * Vec3A::from(local)).normalize();
-                // Equirectangular UVs: u around +y, v from the north pole down.
-                let u = 0.5 + local.z.atan2(local.x) / std::f32::consts::TAU;
-                let v = (local.y.clamp(-1.0, 1.0)).acos() / std::f32::consts::PI;
-                (n, Vec2::new(u, v), el.object, 0, el.material)
+                let uv = if textured(el.material) {
+                    // Equirectangular UVs: u around +y, v from the north pole down.
+                    let u = 0.5 + local.z.atan2(local.x) / std::f32::consts::TAU;
+                    let v = (local.y.clamp(-1.0, 1.0)).acos() / std::f32::consts::PI;
+                    Vec2::new(u, v)
+                } else {
+                    Vec2::ZERO
+                };
+                (n, uv, el.object, 0, el.material)
             }
         };
         let normal = if normal.dot(dir) > 0.0 {
@@ -365,6 +376,18 @@ impl World {
             material,
         }
     }
+}
+
+/// The corners of a triangle as the intersection test's edges give them back.
+fn vertices(tri: &RtTriangle) -> [Vec3; 3] {
+    let v0 = Vec3::from(tri.v0);
+    [v0, v0 - Vec3::from(tri.e1), v0 + Vec3::from(tri.e2)]
+}
+
+/// Unit geometric normal of a triangle (counter-clockwise front), from its stored corners.
+fn geometric_normal(tri: &RtTriangle) -> Vec3 {
+    let [v0, v1, v2] = vertices(tri);
+    (v1 - v0).cross(v2 - v0).normalize()
 }
 
 fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
