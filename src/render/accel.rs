@@ -18,7 +18,8 @@ use obvhs::triangle::Triangle;
 
 use std::cell::RefCell;
 
-use crate::render::bvh::{Bvh, Stack, TraceRay};
+use crate::render::bvh::{Bvh, Stack};
+use crate::render::ray::TraceRay;
 use crate::scene::world::World;
 
 /// A closest-hit answer: which primitive of the [`World`], at which distance (metres).

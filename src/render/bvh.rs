@@ -13,15 +13,15 @@
 //! query to the same distance, bit for bit.
 
 use anyhow::{Result, bail};
-use glam::{Vec3A, Vec4};
+use glam::Vec4;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::ploc::PlocBuilder;
-use obvhs::ray::Ray;
 
 use crate::render::packets::{EllipsoidLeaf, TRI_LANES, Triangles4};
+use crate::render::ray::TraceRay;
 use crate::scene::world::World;
 
 /// Children per node: one per lane of a `Vec4`.
@@ -44,40 +44,6 @@ const STACK: usize = 512;
 /// Box exits are scaled by this before comparison: 8 ulps of headroom for the rounding of
 /// the slab distances against the exact primitive tests.
 const EXIT_ROUND_UP: f32 = 1.0 + 8.0 * f32::EPSILON;
-
-/// A ray prepared for traversal, with its reciprocal direction.
-#[derive(Clone, Copy, Debug)]
-pub struct TraceRay {
-    /// Origin, world frame, metres.
-    pub origin: Vec3A,
-    /// Unit direction, world frame.
-    pub dir: Vec3A,
-    inv_dir: Vec3A,
-    /// Distance interval searched, metres; `tmax` shrinks to the closest hit found.
-    pub tmin: f32,
-    pub tmax: f32,
-}
-
-impl TraceRay {
-    pub fn new(origin: Vec3A, dir: Vec3A, tmin: f32, tmax: f32) -> TraceRay {
-        // A zero component would give 0 · ∞ = NaN in the slab test; a tiny one gives the
-        // same answer (the slab is entered everywhere or nowhere) without NaN.
-        let tiny = dir.abs().cmplt(Vec3A::splat(1e-20));
-        let inv_dir = Vec3A::ONE / Vec3A::select(tiny, Vec3A::splat(1e-20).copysign(dir), dir);
-        TraceRay {
-            origin,
-            dir,
-            inv_dir,
-            tmin,
-            tmax,
-        }
-    }
-
-    /// The ray as obvhs' type, for the world's own (brute-force) intersection tests.
-    pub fn as_obvhs(&self) -> Ray {
-        Ray::new(self.origin, self.dir, self.tmin, self.tmax)
-    }
-}
 
 /// What the box test needs of a ray, in every lane: computed once per traversal.
 struct RayLanes {

@@ -16,10 +16,11 @@ use rayon::prelude::*;
 
 use crate::geometry::camera::Camera;
 use crate::render::accel::{Accel, Difference, make_ray};
-use crate::render::bvh::{Stack, TraceRay};
+use crate::render::bvh::Stack;
 use crate::render::camera_rays::CameraRays;
 use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::{Frame, Pixel};
+use crate::render::ray::TraceRay;
 use crate::render::screen::{Screen, Shown};
 use crate::render::settings::RenderSettings;
 use crate::render::sky::SkyModel;

@@ -8,6 +8,7 @@ pub mod footprint;
 pub mod frame;
 pub mod integrator;
 pub mod packets;
+pub mod ray;
 pub mod screen;
 pub mod settings;
 pub mod sky;

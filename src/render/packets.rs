@@ -8,7 +8,7 @@
 use glam::Vec4;
 use obvhs::rt_triangle::RtTriangle;
 
-use crate::render::bvh::TraceRay;
+use crate::render::ray::TraceRay;
 use crate::scene::world::Ellipsoid;
 
 /// Triangles per packet.

@@ -7,9 +7,10 @@ use rayon::prelude::*;
 
 use crate::geometry::camera::Camera;
 use crate::render::accel::{Accel, Hit, make_ray};
-use crate::render::bvh::{Stack, TraceRay};
+use crate::render::bvh::Stack;
 use crate::render::camera_rays::CameraRays;
 use crate::render::integrator::shadow_ray;
+use crate::render::ray::TraceRay;
 use crate::scene::world::World;
 use crate::util::sampling::{hash_words, unit_float};
 
