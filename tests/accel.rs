@@ -1,9 +1,14 @@
-//! Every accelerated query against its brute-force twin, on the das scene, for both BVH kinds.
+//! Every accelerated query against its brute-force twin: random rays over the das scene,
+//! rays along the axes and grazing the ground (zero direction components, flat boxes), the
+//! cameras' own rays, and finite `tmax`.
 
 mod common;
 
 use glam::Vec3;
-use seethru::render::accel::{Accel, BvhKind, closest_brute_force, make_ray, occluded_brute_force};
+use seethru::geometry::camera::Camera;
+use seethru::render::accel::{Accel, closest_brute_force, make_ray, occluded_brute_force};
+use seethru::render::camera_rays::CameraRays;
+use seethru::render::views::View;
 use seethru::scene::world::{World, view_bit};
 use seethru::util::sampling::{hash_words, unit_float};
 
@@ -15,10 +20,8 @@ fn random_unit(seed: u32) -> Vec3 {
     Vec3::new(r * a.cos(), z, r * a.sin())
 }
 
-/// Rays from points around the street (and from the cameras) in random directions.
-fn rays(n: u32) -> Vec<(Vec3, Vec3)> {
-    let scene = common::das();
-    let eye = scene.eye().as_vec3();
+/// Rays from points around the street (and from the eye) in random directions.
+fn random_rays(eye: Vec3, n: u32) -> Vec<(Vec3, Vec3)> {
     (0..n)
         .map(|i| {
             let origin = if i % 4 == 0 {
@@ -37,53 +40,107 @@ fn rays(n: u32) -> Vec<(Vec3, Vec3)> {
         .collect()
 }
 
+/// Rays along the six axes, and rays grazing the street and the ground (direction y of 0
+/// and ±1e-7), from origins on and just above those planes and on box faces.
+fn special_rays() -> Vec<(Vec3, Vec3)> {
+    let origins = [
+        Vec3::new(0.3, 0.0, -10.0),   // on the street plane
+        Vec3::new(2.0, -0.01, -40.0), // on the ground plane
+        Vec3::new(-3.5, 0.12, -20.0), // on a kerb's top face and side
+        Vec3::new(1.4, 1e-4, -5.0),
+        Vec3::new(-1.75, 0.6, -2.0), // in front of the car
+        Vec3::new(-0.9, 0.35, -3.0), // level with the ball's centre
+    ];
+    let mut dirs: Vec<Vec3> = vec![Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+    for y in [0.0, 1e-7, -1e-7] {
+        for a in 0..8 {
+            let a = a as f32 * std::f32::consts::FRAC_PI_4;
+            dirs.push(Vec3::new(a.cos(), y, a.sin()).normalize());
+        }
+    }
+    origins
+        .iter()
+        .flat_map(|&o| dirs.iter().map(move |&d| (o, d)))
+        .collect()
+}
+
+/// Every 5th pixel's ray (columns and rows) of `camera` at 192 px wide.
+fn camera_rays(camera: &Camera) -> Vec<(Vec3, Vec3)> {
+    let camera = camera.with_resolution(192, (192 * camera.height / camera.width).max(1));
+    let rays = CameraRays::new(&camera);
+    (0..camera.height)
+        .step_by(5)
+        .flat_map(|y| (0..camera.width).step_by(5).map(move |x| (x, y)))
+        .map(|(x, y)| (rays.origin, rays.direction(x as f32 + 0.5, y as f32 + 0.5)))
+        .collect()
+}
+
+/// Checks `closest` and `occluded` against the brute force for each ray in each given view
+/// (cycling), every fifth with a finite `tmax`; returns how many rays hit.
+fn compare(world: &World, accel: &Accel, rays: &[(Vec3, Vec3)], views: &[u8]) -> usize {
+    let mut hits = 0;
+    for (i, &(origin, dir)) in rays.iter().enumerate() {
+        let view = views[i % views.len()];
+        let tmax = if i % 5 == 0 { 7.5 } else { f32::INFINITY };
+        let ray = make_ray(origin, dir, 0.0, tmax);
+        let fast = accel.closest(&ray, view);
+        let slow = closest_brute_force(world, &ray, view);
+        match (fast, slow) {
+            (None, None) => {}
+            (Some(f), Some(s)) => {
+                hits += 1;
+                // The same distance, bit for bit; at an exact tie (a shared edge) either
+                // primitive is a correct answer.
+                assert_eq!(f.t.to_bits(), s.t.to_bits(), "ray {i}: {f:?} vs {s:?}");
+                if f.prim != s.prim {
+                    assert_eq!(world.intersect(f.prim, &ray.as_obvhs()), s.t, "ray {i}");
+                }
+            }
+            _ => panic!("ray {i} ({origin}, {dir}): accelerated {fast:?}, brute force {slow:?}"),
+        }
+        assert_eq!(
+            accel.occluded(&ray, view),
+            occluded_brute_force(world, &ray, view),
+            "ray {i} ({origin}, {dir})"
+        );
+    }
+    hits
+}
+
+const ALL_VIEWS: [u8; 4] = [
+    view_bit::TRUTH,
+    view_bit::OCCLUDED,
+    view_bit::FRONTAL,
+    view_bit::BACK,
+];
+
 #[test]
 fn closest_and_occluded_equal_brute_force() {
-    let world = World::build(&common::das()).unwrap();
-    let rays = rays(3000);
-    for kind in [BvhKind::Cwbvh, BvhKind::Bvh2] {
-        let accel = Accel::build(&world, kind);
-        let mut hits = 0;
-        for (i, &(origin, dir)) in rays.iter().enumerate() {
-            let view = [
-                view_bit::TRUTH,
-                view_bit::OCCLUDED,
-                view_bit::FRONTAL,
-                view_bit::BACK,
-            ][i % 4];
-            let tmax = if i % 5 == 0 { 7.5 } else { f32::INFINITY };
-            let ray = make_ray(origin, dir, 0.0, tmax);
-            let fast = accel.closest(&world, ray, view);
-            let slow = closest_brute_force(&world, ray, view);
-            match (fast, slow) {
-                (None, None) => {}
-                (Some(f), Some(s)) => {
-                    hits += 1;
-                    // The same distance, bit for bit; at an exact tie (a shared edge) either
-                    // primitive is a correct answer.
-                    assert_eq!(
-                        f.t.to_bits(),
-                        s.t.to_bits(),
-                        "{kind:?} ray {i}: {f:?} vs {s:?}"
-                    );
-                    if f.prim != s.prim {
-                        assert_eq!(world.intersect(f.prim, &ray), s.t, "{kind:?} ray {i}");
-                    }
-                }
-                _ => panic!("{kind:?} ray {i}: accelerated {fast:?}, brute force {slow:?}"),
-            }
-            assert_eq!(
-                accel.occluded(&world, ray, view),
-                occluded_brute_force(&world, ray, view),
-                "{kind:?} ray {i}"
-            );
-        }
-        // The comparison means something only if many rays hit something and many miss.
-        assert!(
-            hits > rays.len() / 3 && hits < rays.len(),
-            "{kind:?}: {hits} hits of {}",
-            rays.len()
-        );
+    let scene = common::das();
+    let world = World::build(&scene).unwrap();
+    let accel = Accel::build(&world).unwrap();
+    let rays = random_rays(scene.eye().as_vec3(), 3000);
+    let hits = compare(&world, &accel, &rays, &ALL_VIEWS);
+    // The comparison means something only if many rays hit something and many miss.
+    assert!(
+        hits > rays.len() / 3 && hits < rays.len(),
+        "{hits} hits of {}",
+        rays.len()
+    );
+    let rays = special_rays();
+    let hits = compare(&world, &accel, &rays, &ALL_VIEWS);
+    assert!(hits > rays.len() / 4, "{hits} hits of {}", rays.len());
+}
+
+#[test]
+fn camera_rays_of_every_view_equal_brute_force() {
+    let scene = common::das();
+    let world = World::build(&scene).unwrap();
+    let accel = Accel::build(&world).unwrap();
+    for view in View::ALL {
+        let rays = camera_rays(&view.camera(&scene));
+        let hits = compare(&world, &accel, &rays, &[view.bit()]);
+        assert!(hits > rays.len() / 3, "{view:?}: {hits} of {}", rays.len());
     }
 }
 
@@ -91,21 +148,21 @@ fn closest_and_occluded_equal_brute_force() {
 fn hidden_objects_are_invisible_only_in_their_views() {
     let scene = common::das();
     let world = World::build(&scene).unwrap();
-    let accel = Accel::build(&world, BvhKind::Cwbvh);
+    let accel = Accel::build(&world).unwrap();
     // From the eye towards the display centre: the obstacle in `occluded`, not in `truth`.
     let eye = scene.eye().as_vec3();
     let centre = scene.obstacle.world_from_obstacle.translation.as_vec3();
     let ray = make_ray(eye, (centre - eye).normalize(), 0.0, f32::INFINITY);
-    let occluded = accel.closest(&world, ray, view_bit::OCCLUDED).unwrap();
+    let occluded = accel.closest(&ray, view_bit::OCCLUDED).unwrap();
     assert_eq!(world.object_of(occluded.prim), world.obstacle_id);
     let truth = accel
-        .closest(&world, ray, view_bit::TRUTH)
+        .closest(&ray, view_bit::TRUTH)
         .map(|h| world.object_of(h.prim));
     assert_ne!(truth, Some(world.obstacle_id));
     // From the back camera towards the eye: the head in `back`; the driver never sees it.
     let back = scene.back.position().as_vec3();
     let ray = make_ray(back, (eye - back).normalize(), 0.0, f32::INFINITY);
-    let head = accel.closest(&world, ray, view_bit::BACK).unwrap();
+    let head = accel.closest(&ray, view_bit::BACK).unwrap();
     let head_id = scene.objects.iter().position(|o| o.name == "head").unwrap() as u32 + 1;
     assert_eq!(world.object_of(head.prim), head_id);
     let ray = make_ray(
@@ -115,7 +172,7 @@ fn hidden_objects_are_invisible_only_in_their_views() {
         f32::INFINITY,
     );
     let seen = accel
-        .closest(&world, ray, view_bit::TRUTH)
+        .closest(&ray, view_bit::TRUTH)
         .map(|h| world.object_of(h.prim));
     assert_ne!(seen, Some(head_id));
 }

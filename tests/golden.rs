@@ -5,7 +5,6 @@ mod common;
 
 use common::golden;
 
-use seethru::render::accel::BvhKind;
 use seethru::render::views::View;
 use seethru::render::{integrator::RenderContext, settings::RenderSettings};
 use seethru::system::{options::RunOptions, pipeline::run};
@@ -13,7 +12,7 @@ use seethru::util::color::encode_srgb8;
 
 #[test]
 fn views_match_their_goldens() {
-    let ctx = RenderContext::new(common::das(), BvhKind::Cwbvh).unwrap();
+    let ctx = RenderContext::new(common::das()).unwrap();
     for view in View::ALL {
         let camera = view.camera(&ctx.scene);
         let camera = if view == View::Back {
@@ -45,7 +44,7 @@ fn to_image(frame: &seethru::render::frame::Frame) -> image::RgbImage {
 
 #[test]
 fn display_and_seethru_match_their_goldens() {
-    let ctx = RenderContext::new(common::das(), BvhKind::Cwbvh).unwrap();
+    let ctx = RenderContext::new(common::das()).unwrap();
     let options = RunOptions {
         width: Some(192),
         frontal_width: Some(320),

@@ -409,7 +409,7 @@ fn sky_pixels_count_with_the_angle_between_directions() {
     );
     assert!(text.contains("wall below"));
     let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
-    let ctx = RenderContext::new(scene, seethru::render::accel::BvhKind::Cwbvh).unwrap();
+    let ctx = RenderContext::new(scene).unwrap();
     let options = RunOptions {
         d2: WorkingDistance::Metres(6.0),
         spp: 1,
@@ -724,7 +724,7 @@ fn missing_counts_sky_the_frontal_camera_cannot_see() {
     );
     assert!(text.contains("panel"));
     let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
-    let ctx = RenderContext::new(scene, seethru::render::accel::BvhKind::Cwbvh).unwrap();
+    let ctx = RenderContext::new(scene).unwrap();
     let options = RunOptions {
         d2: WorkingDistance::Infinity,
         spp: 1,

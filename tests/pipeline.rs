@@ -5,11 +5,10 @@ mod common;
 
 use glam::DVec3;
 use seethru::analysis::paper::{CropParams, Side};
-use seethru::render::accel::BvhKind;
 use seethru::render::views::View;
 use seethru::render::{integrator::RenderContext, settings::RenderSettings};
 use seethru::scene::shapes::box_face;
-use seethru::system::display::MISSING_ID;
+use seethru::system::display::{DisplayModel, DisplayPlacement, DisplaySurface, MISSING_ID};
 use seethru::system::head::{detect, eye_from_detection};
 use seethru::system::{
     options::{HeadSource, Outside, RunOptions, WorkingDistance},
@@ -192,7 +191,7 @@ fn out_of_view_crops_error_or_show_black() {
 #[test]
 fn the_head_tracker_recovers_the_eye_better_at_higher_resolution() {
     let scene = common::das();
-    let ctx = RenderContext::new(scene, BvhKind::Cwbvh).unwrap();
+    let ctx = RenderContext::new(scene).unwrap();
     let truth = ctx.scene.eye();
     let obstacle_from_world = ctx.scene.obstacle.world_from_obstacle.inverse();
     let back_from_world =
@@ -241,7 +240,7 @@ fn the_head_tracker_recovers_the_eye_better_at_higher_resolution() {
 
 #[test]
 fn estimated_head_and_injected_errors_move_the_eye() {
-    let ctx = RenderContext::new(common::das(), BvhKind::Cwbvh).unwrap();
+    let ctx = RenderContext::new(common::das()).unwrap();
     let base = RunOptions {
         spp: 1,
         width: Some(64),
@@ -362,7 +361,7 @@ fn a_rotated_obstacle_and_a_turned_frontal_camera_stay_within_the_resampling_qua
         scene.driver.height,
     )
     .unwrap();
-    let ctx = RenderContext::new(scene, BvhKind::Cwbvh).unwrap();
+    let ctx = RenderContext::new(scene).unwrap();
     let options = |d2| RunOptions {
         d2: WorkingDistance::Metres(d2),
         spp: 1,
@@ -432,4 +431,63 @@ fn a_rotated_obstacle_and_a_turned_frontal_camera_stay_within_the_resampling_qua
         .filter(|(i, m)| **m && (wrong.seethru.position[*i] - r.truth.position[*i]).length() > 0.05)
         .count();
     assert!(outside > checked / 2, "{outside} of {checked}");
+}
+
+#[test]
+fn driver_views_rendered_over_the_truth_equal_separate_renders() {
+    // `run` traces `occluded` and `seethru` again only where the obstacle can be seen; every
+    // pixel must come out exactly as a render of the whole view gives it, for both displays.
+    let ctx = RenderContext::new(common::das()).unwrap();
+    for display in [DisplayModel::Pixels, DisplayModel::Ideal] {
+        let options = RunOptions {
+            width: Some(160),
+            spp: 2,
+            display,
+            back_width: Some(32),
+            frontal_width: Some(320),
+            ..RunOptions::default()
+        };
+        let r = run(&ctx, &options).unwrap();
+        let driver = ctx.scene.driver.with_resolution(160, 90);
+        let settings = RenderSettings {
+            spp: 2,
+            progress: false,
+        };
+        let (truth, _) = ctx.render(&driver, View::Truth.bit(), settings, "truth");
+        let (occluded, _) = ctx.render(&driver, View::Occluded.bit(), settings, "occluded");
+        assert!(r.truth.bit_identical(&truth), "{display:?} truth");
+        assert!(r.occluded.bit_identical(&occluded), "{display:?} occluded");
+        let mut frontal = ctx.scene.frontal;
+        frontal = frontal.with_resolution(320, 320 * frontal.height / frontal.width);
+        let placement = DisplayPlacement::new(&ctx.scene.obstacle);
+        let surface = match display {
+            DisplayModel::Pixels => DisplaySurface::Pixels {
+                image: r.display.clone(),
+                placement,
+            },
+            DisplayModel::Ideal => DisplaySurface::Ideal {
+                crop: r.crop,
+                frontal,
+                placement,
+            },
+        };
+        let (seethru, _) = ctx.render_seethru(&driver, &surface, settings);
+        assert!(r.seethru.bit_identical(&seethru), "{display:?} seethru");
+        // The views do differ, and only inside the display's neighbourhood was traced again.
+        assert!(!truth.bit_identical(&occluded) && !occluded.bit_identical(&seethru));
+        let (_, stats) = ctx.render_over(
+            &driver,
+            &truth,
+            View::Truth.bit(),
+            View::Occluded.bit(),
+            None,
+            settings,
+            "occluded",
+        );
+        assert!(stats.primary_rays < 160 * 90 * 2 / 4, "{stats:?}");
+        // run.json's peak memory holds at least the three driver frames.
+        let frame_bytes = (truth.color.len() * 52) as u64;
+        let peak = r.report["peak_rss_bytes"].as_u64().unwrap();
+        assert!(peak > 3 * frame_bytes, "{peak}");
+    }
 }

@@ -4,14 +4,13 @@ mod common;
 
 use glam::{DVec2, DVec3};
 use seethru::io::frame_files::{read_exr, write_exr};
-use seethru::render::accel::BvhKind;
 use seethru::render::frame::Frame;
 use seethru::render::views::View;
 use seethru::render::{integrator::RenderContext, settings::RenderSettings};
 use seethru::scene::world::view_bit;
 
 fn minimal_context() -> RenderContext {
-    RenderContext::new(common::parse(common::MINIMAL).unwrap(), BvhKind::Cwbvh).unwrap()
+    RenderContext::new(common::parse(common::MINIMAL).unwrap()).unwrap()
 }
 
 /// Ray–sphere distance in f64, or None.
@@ -77,7 +76,7 @@ fn sphere_and_plane_depths_are_analytic() {
 
 #[test]
 fn images_do_not_depend_on_the_thread_count() {
-    let ctx = RenderContext::new(common::das(), BvhKind::Cwbvh).unwrap();
+    let ctx = RenderContext::new(common::das()).unwrap();
     let settings = RenderSettings {
         spp: 3,
         progress: false,

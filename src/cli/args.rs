@@ -1,9 +1,8 @@
 //! Argument groups that several commands share, and the thread pool they run on.
 
 use anyhow::{Result, bail};
-use seethru::render::accel::BvhKind;
 
-/// Image size, samples, threads and hierarchy: shared by `render` and `run`.
+/// Image size, samples and threads: shared by `render` and `run`.
 #[derive(clap::Args)]
 pub struct RenderArgs {
     /// Image width in pixels (default: the camera's; height follows the aspect ratio if not given).
@@ -18,8 +17,6 @@ pub struct RenderArgs {
     /// Worker threads (default: all cores). Images are identical for any value.
     #[arg(long)]
     pub threads: Option<usize>,
-    #[arg(long, value_enum, default_value_t = BvhKind::Cwbvh)]
-    pub bvh: BvhKind,
 }
 
 /// Runs `job` on a pool of `threads` workers (all cores if `None`). Images do not depend on it.

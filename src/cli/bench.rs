@@ -1,14 +1,20 @@
-//! `seethru bench`: BVH build time, rays per second and frame times on a scene.
+//! `seethru bench`: BVH build time, trace-only ray throughput (coherent and incoherent,
+//! closest and any hit), shaded frame times and peak memory on a scene.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Result;
-use seethru::render::accel::BvhKind;
+use seethru::render::accel::Accel;
 use seethru::render::integrator::RenderContext;
 use seethru::render::settings::{RenderSettings, check_resolution};
+use seethru::render::throughput::{
+    Batch, camera_batch, cosine_batch, shadow_batch, trace_any, trace_closest,
+};
 use seethru::render::views::View;
 use seethru::scene::Scene;
+use seethru::scene::grow::grow;
+use seethru::util::memory::peak_rss_bytes;
 use serde_json::json;
 
 use crate::cli::args::with_threads;
@@ -20,98 +26,223 @@ pub struct Bench {
     width: u32,
     #[arg(long, default_value_t = 720)]
     height: u32,
-    /// Renders per view; the fastest counts.
-    #[arg(long, default_value_t = 3)]
+    /// Timed repeats of every measurement (min, median and max are reported).
+    #[arg(long, default_value_t = 5)]
     repeat: usize,
     #[arg(long)]
     threads: Option<usize>,
-    #[arg(long, value_enum, default_value_t = BvhKind::Cwbvh)]
-    bvh: BvhKind,
+    /// Grow the scene procedurally to about this many times its triangles (parked cars,
+    /// trees, buildings), to see how the cost scales with scene size.
+    #[arg(long, default_value_t = 1.0)]
+    grow: f64,
+    /// Print only the JSON line.
+    #[arg(long)]
+    json: bool,
 }
 
 impl Bench {
     pub fn run(self) -> Result<()> {
         check_resolution(self.width, self.height)?;
+        if !(1..=1000).contains(&self.repeat) {
+            anyhow::bail!("--repeat {} is out of range [1, 1000]", self.repeat);
+        }
         with_threads(self.threads, || bench(&self).map(|_| ()))?
     }
 }
 
-/// Runs the benchmark, prints a human-readable report and ends with one JSON line.
+/// Minimum, median and maximum of some measurements.
+#[derive(Clone, Copy, Debug)]
+struct Spread {
+    min: f64,
+    median: f64,
+    max: f64,
+}
+
+impl Spread {
+    fn of(values: &[f64]) -> Spread {
+        let mut v = values.to_vec();
+        v.sort_by(f64::total_cmp);
+        Spread {
+            min: v[0],
+            median: v[v.len() / 2],
+            max: v[v.len() - 1],
+        }
+    }
+
+    fn json(&self) -> serde_json::Value {
+        json!({"min": self.min, "median": self.median, "max": self.max})
+    }
+}
+
+impl std::fmt::Display for Spread {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{:7.2} / {:7.2} / {:7.2}",
+            self.min, self.median, self.max
+        )
+    }
+}
+
+/// Seconds of each of `repeat` runs of `job`, after one untimed warm-up run.
+fn timed(repeat: usize, mut job: impl FnMut()) -> Vec<f64> {
+    job();
+    (0..repeat)
+        .map(|_| {
+            let start = Instant::now();
+            job();
+            start.elapsed().as_secs_f64()
+        })
+        .collect()
+}
+
+/// Million rays per second of each run.
+fn mrays(rays: usize, seconds: &[f64]) -> Vec<f64> {
+    seconds.iter().map(|s| rays as f64 / s / 1e6).collect()
+}
+
+/// Runs the benchmark, prints a report (unless `--json`) and ends with one JSON line.
 fn bench(options: &Bench) -> Result<serde_json::Value> {
-    let scene_path: &Path = &options.scene;
+    let say = |line: String| {
+        if !options.json {
+            println!("{line}");
+        }
+    };
     let load = Instant::now();
-    let scene = Scene::load(scene_path)?;
-    let context = RenderContext::new(scene, options.bvh)?;
+    let scene = grow(&Scene::load(&options.scene)?, options.grow)?;
+    let ctx = RenderContext::new(scene)?;
     let load_s = load.elapsed().as_secs_f64();
-    let prims = context.world.primitive_count();
-    println!(
-        "scene        {} ({prims} primitives, loaded in {load_s:.3} s)",
-        scene_path.display()
+    let world = &ctx.world;
+    say(format!(
+        "scene        {} (grown {}×): {} triangles, {} ellipsoids; loaded and built in {load_s:.3} s",
+        options.scene.display(),
+        options.grow,
+        world.triangles.len(),
+        world.ellipsoids.len()
+    ));
+    let builds: Vec<f64> = (0..options.repeat)
+        .map(|_| Accel::build(world).map(|a| a.build_time.as_secs_f64() * 1e3))
+        .collect::<Result<_>>()?;
+    let build = Spread::of(&builds);
+    say(format!(
+        "bvh          build {build} ms (min / median / max), {:.1} MB",
+        ctx.accel.bytes() as f64 / 1e6
+    ));
+    let threads = rayon::current_num_threads();
+    say(format!("threads      {threads}"));
+
+    let camera = View::Truth
+        .camera(&ctx.scene)
+        .with_resolution(options.width, options.height);
+    let primary = camera_batch(&camera, View::Truth.bit());
+    let mut hits = vec![None; primary.rays.len()];
+    let primary_s = timed(options.repeat, || {
+        trace_closest(&ctx.accel, &primary, &mut hits)
+    });
+    let shadow = shadow_batch(world, &primary, &hits, ctx.sky.sun_direction);
+    let any_hit = |batch: &Batch| {
+        let mut blocked = vec![false; batch.rays.len()];
+        timed(options.repeat, || {
+            trace_any(&ctx.accel, batch, &mut blocked)
+        })
+    };
+    let shadow_s = any_hit(&shadow);
+    let incoherent = cosine_batch(world, &primary, &hits);
+    let mut incoherent_hits = vec![None; incoherent.rays.len()];
+    let incoherent_closest_s = timed(options.repeat, || {
+        trace_closest(&ctx.accel, &incoherent, &mut incoherent_hits)
+    });
+    let incoherent_any_s = any_hit(&incoherent);
+    let both: Vec<f64> = primary_s
+        .iter()
+        .zip(&shadow_s)
+        .map(|(a, b)| a + b)
+        .collect();
+    let rows = [
+        (
+            "primary",
+            "primary closest hit",
+            primary.rays.len(),
+            primary_s,
+        ),
+        (
+            "shadow",
+            "shadow any hit (sun)",
+            shadow.rays.len(),
+            shadow_s,
+        ),
+        (
+            "primary_shadow",
+            "primary + shadow",
+            primary.rays.len() + shadow.rays.len(),
+            both,
+        ),
+        (
+            "incoherent_closest",
+            "incoherent closest hit",
+            incoherent.rays.len(),
+            incoherent_closest_s,
+        ),
+        (
+            "incoherent_any",
+            "incoherent any hit",
+            incoherent.rays.len(),
+            incoherent_any_s,
+        ),
+    ];
+    say(format!(
+        "rays         {}×{} from the driver's eye (`truth`); M rays/s min / median / max",
+        options.width, options.height
+    ));
+    let mut rays_json = serde_json::Map::new();
+    for (key, label, n, seconds) in rows {
+        let spread = Spread::of(&mrays(n, &seconds));
+        say(format!("  {label:<24} {n:>8} rays  {spread}"));
+        rays_json.insert(key.into(), json!({"rays": n, "mrays_per_s": spread.json()}));
+    }
+    say(
+        "  (incoherent: one cosine-distributed direction about the normal at each primary hit)"
+            .into(),
     );
-    println!(
-        "bvh          {:?} built in {:.1} ms",
-        options.bvh,
-        context.accel.build_time.as_secs_f64() * 1e3
-    );
-    println!("threads      {}", rayon::current_num_threads());
-    let mut views = serde_json::Map::new();
-    let (mut total_rays, mut total_s) = (0u64, 0.0);
+
+    say("frame        shaded, 1 spp (primary + shadow + shading); ms min / median / max".into());
+    let mut frames = serde_json::Map::new();
     for view in [View::Truth, View::Frontal] {
         let camera = view
-            .camera(&context.scene)
+            .camera(&ctx.scene)
             .with_resolution(options.width, options.height);
-        let runs: Vec<_> = (0..options.repeat.max(1))
-            .map(|_| {
-                context
-                    .render(&camera, view.bit(), RenderSettings::default(), view.name())
-                    .1
-            })
-            .collect();
-        let best = runs
-            .iter()
-            .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
-            .copied()
-            .unwrap_or_default();
-        let rays = best.primary_rays + best.shadow_rays;
-        total_rays += rays;
-        total_s += best.seconds;
-        println!(
-            "{:<12} {}×{}: frame {:7.1} ms  primary {:6.2} Mrays/s  primary+shadow {:6.2} Mrays/s ({} + {} rays)",
+        let seconds = timed(options.repeat, || {
+            ctx.render(&camera, view.bit(), RenderSettings::default(), view.name());
+        });
+        let ms: Vec<f64> = seconds.iter().map(|s| s * 1e3).collect();
+        let spread = Spread::of(&ms);
+        say(format!(
+            "  {:<24} {}×{}  {spread}",
             view.name(),
             options.width,
-            options.height,
-            best.seconds * 1e3,
-            best.primary_rays as f64 / best.seconds / 1e6,
-            rays as f64 / best.seconds / 1e6,
-            best.primary_rays,
-            best.shadow_rays,
-        );
-        views.insert(
-            view.name().into(),
-            json!({
-                "frame_ms": best.seconds * 1e3,
-                "frame_ms_all_runs": runs.iter().map(|r| r.seconds * 1e3).collect::<Vec<_>>(),
-                "primary_rays": best.primary_rays,
-                "shadow_rays": best.shadow_rays,
-                "primary_rays_per_s": best.primary_rays as f64 / best.seconds,
-                "rays_per_s": rays as f64 / best.seconds,
-            }),
-        );
+            options.height
+        ));
+        frames.insert(view.name().into(), json!({"ms": spread.json()}));
     }
-    println!(
-        "overall      {:.2} Mrays/s primary+shadow",
-        total_rays as f64 / total_s / 1e6
-    );
+    let peak = peak_rss_bytes();
+    say(format!(
+        "peak RSS     {}",
+        peak.map_or("unknown".into(), |b| format!("{:.0} MB", b as f64 / 1e6))
+    ));
     let report = json!({
-        "scene": scene_path.display().to_string(),
-        "primitives": prims,
-        "bvh": format!("{:?}", options.bvh).to_lowercase(),
-        "bvh_build_ms": context.accel.build_time.as_secs_f64() * 1e3,
-        "threads": rayon::current_num_threads(),
+        "scene": options.scene.display().to_string(),
+        "grow": options.grow,
+        "triangles": world.triangles.len(),
+        "ellipsoids": world.ellipsoids.len(),
+        "bvh_build_ms": build.json(),
+        "bvh_bytes": ctx.accel.bytes(),
+        "threads": threads,
+        "repeat": options.repeat,
         "width": options.width,
         "height": options.height,
-        "views": views,
-        "rays_per_s": total_rays as f64 / total_s,
+        "rays": rays_json,
+        "frame": frames,
+        "peak_rss_bytes": peak,
     });
     println!("{report}");
     Ok(report)

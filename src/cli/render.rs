@@ -47,7 +47,7 @@ fn render_views(scene_path: &Path, views: &[View], out: &Path, options: &RenderA
         .iter()
         .map(|v| resized(v.camera(&scene), options.width, options.height))
         .collect::<Result<Vec<_>>>()?;
-    let context = RenderContext::new(scene, options.bvh)?;
+    let context = RenderContext::new(scene)?;
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create output directory {}", out.display()))?;
     let settings = RenderSettings {

@@ -8,7 +8,6 @@ use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_frame;
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
-use seethru::render::accel::BvhKind;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::system::display::{DisplayModel, Filter};
@@ -92,23 +91,17 @@ impl Run {
             display: self.display,
             progress: true,
         };
-        let (scene, out, band, bvh) = (&self.scene, &self.out, self.band, self.render.bvh);
+        let (scene, out, band) = (&self.scene, &self.out, self.band);
         with_threads(self.render.threads, || {
-            run_command(scene, out, &options, band, bvh)
+            run_command(scene, out, &options, band)
         })?
     }
 }
 
 /// `seethru run`: renders the six views into `out` with `run.json` and the metrics.
-fn run_command(
-    scene_path: &Path,
-    out: &Path,
-    options: &RunOptions,
-    band: u32,
-    bvh: BvhKind,
-) -> Result<()> {
+fn run_command(scene_path: &Path, out: &Path, options: &RunOptions, band: u32) -> Result<()> {
     let scene = Scene::load(scene_path)?;
-    let ctx = RenderContext::new(scene, bvh)?;
+    let ctx = RenderContext::new(scene)?;
     let result = run(&ctx, options)?;
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create output directory {}", out.display()))?;

@@ -17,7 +17,6 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::measure::ratio_setup::{Compensation, Setup, build_scene};
-use crate::render::accel::BvhKind;
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::scene::shapes::box_face;
@@ -140,7 +139,7 @@ pub fn measure_ratio_with_frames(
         scene.obstacle.width / scene.obstacle.display_resolution[0] as f64,
         2.0 * scene.frontal.tan_half_x() / scene.frontal.width as f64,
     );
-    let ctx = RenderContext::new(scene, BvhKind::Cwbvh)?;
+    let ctx = RenderContext::new(scene)?;
     let options = RunOptions {
         d2: if geometry.model_d2.is_finite() {
             WorkingDistance::Metres(geometry.model_d2)

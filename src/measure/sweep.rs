@@ -1,6 +1,8 @@
 //! `seethru sweep`: the metrics of every combination of parameter values, as CSV and a plot.
-//! Configurations render in parallel; the CSV is rewritten whole after every finished
-//! configuration, so an interrupted sweep resumes without redoing finished rows.
+//! Configurations render in parallel; the scene's world and BVH are built once per distinct
+//! geometry and the truth once per driver's eye, shared by the configurations that have them.
+//! The CSV is rewritten whole after every finished configuration, so an interrupted sweep
+//! resumes without redoing finished rows.
 
 use std::collections::HashSet;
 use std::path::Path;
@@ -13,11 +15,12 @@ use crate::io::atomic::write_text;
 use crate::io::plot::{Figure, Series};
 use crate::measure::metrics::measure;
 use crate::measure::sweep_grid::{Param, combinations, configure};
-use crate::render::accel::BvhKind;
-use crate::render::integrator::RenderContext;
+use crate::render::integrator::{RenderContext, same_geometry};
+use crate::render::settings::RenderSettings;
 use crate::scene::Scene;
+use crate::scene::world::view_bit;
 use crate::system::options::{HeadSource, Outside, RunOptions};
-use crate::system::pipeline::run;
+use crate::system::pipeline::{driver_camera, run_with_truth};
 
 /// The metric columns of a row. `coverage` (the fraction of display pixels that show the
 /// scene, over which the misregistration means are taken) comes last, so that the columns
@@ -135,31 +138,82 @@ pub fn sweep(
         let body: String = rows.iter().map(|(_, l)| format!("{l}\n")).collect();
         write_text(csv, &format!("{header_line}\n{body}"))
     };
-    todo.par_iter().try_for_each(|&index| -> Result<()> {
-        let config = &configs[index];
-        let (scene, run_options) = configure(&base, &base_options, config)?;
-        let ctx = RenderContext::new(scene, BvhKind::Cwbvh)?;
-        let result =
-            run(&ctx, &run_options).with_context(|| format!("configuration {config:?}"))?;
-        let (_, metrics) = measure(
-            &ctx,
-            &ctx.scene,
-            ctx.scene.eye(),
-            [&result.truth, &result.seethru, &result.occluded],
-            options.band,
-        );
-        let values = metric_row(&metrics, &result.report);
-        let line = std::iter::once(index.to_string())
-            .chain(config.iter().map(|(_, v)| v.clone()))
-            .chain(values.iter().map(|v| format!("{v}")))
-            .collect::<Vec<_>>()
-            .join(",");
-        let mut rows = rows
-            .lock()
-            .map_err(|_| anyhow::anyhow!("a sweep worker panicked"))?;
-        rows.push((index, line));
-        write(&mut rows)
-    })?;
+    // The configurations still to compute; one world and hierarchy per distinct geometry
+    // (only `display_width` changes it), shared by every configuration that has it.
+    let jobs: Vec<(usize, Scene, RunOptions)> = todo
+        .iter()
+        .map(|&index| {
+            let (scene, options) = configure(&base, &base_options, &configs[index])?;
+            Ok((index, scene, options))
+        })
+        .collect::<Result<_>>()?;
+    let mut worlds: Vec<RenderContext> = Vec::new();
+    let mut world_of = Vec::with_capacity(jobs.len());
+    for (_, scene, _) in &jobs {
+        let found = worlds.iter().position(|c| same_geometry(&c.scene, scene));
+        world_of.push(match found {
+            Some(w) => w,
+            None => {
+                worlds.push(match worlds.first() {
+                    Some(first) => first.with_scene(scene.clone())?,
+                    None => RenderContext::new(scene.clone())?,
+                });
+                worlds.len() - 1
+            }
+        });
+    }
+    // Configurations that share the driver's eye share its truth: the obstacle, the frontal
+    // and back cameras and the compensation do not change what the truth shows.
+    let truth_key = |scene: &Scene| {
+        let mut key = scene.clone();
+        (key.obstacle, key.frontal, key.back) = (base.obstacle.clone(), base.frontal, base.back);
+        key
+    };
+    let mut groups: Vec<(Scene, Vec<usize>)> = Vec::new();
+    for (j, (_, scene, _)) in jobs.iter().enumerate() {
+        let key = truth_key(scene);
+        match groups.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, members)) => members.push(j),
+            None => groups.push((key, vec![j])),
+        }
+    }
+    groups
+        .par_iter()
+        .try_for_each(|(_, members)| -> Result<()> {
+            let (_, scene, run_options) = &jobs[members[0]];
+            let settings = RenderSettings {
+                spp: run_options.spp,
+                progress: false,
+            };
+            let driver = driver_camera(scene, run_options)?;
+            let (truth, _) =
+                worlds[world_of[members[0]]].render(&driver, view_bit::TRUTH, settings, "truth");
+            members.par_iter().try_for_each(|&j| -> Result<()> {
+                let (index, scene, run_options) = &jobs[j];
+                let config = &configs[*index];
+                let ctx = worlds[world_of[j]].with_scene(scene.clone())?;
+                let result = run_with_truth(&ctx, run_options, Some(&truth))
+                    .with_context(|| format!("configuration {config:?}"))?;
+                let (_, metrics) = measure(
+                    &ctx,
+                    &ctx.scene,
+                    ctx.scene.eye(),
+                    [&result.truth, &result.seethru, &result.occluded],
+                    options.band,
+                );
+                let values = metric_row(&metrics, &result.report);
+                let line = std::iter::once(index.to_string())
+                    .chain(config.iter().map(|(_, v)| v.clone()))
+                    .chain(values.iter().map(|v| format!("{v}")))
+                    .collect::<Vec<_>>()
+                    .join(",");
+                let mut rows = rows
+                    .lock()
+                    .map_err(|_| anyhow::anyhow!("a sweep worker panicked"))?;
+                rows.push((*index, line));
+                write(&mut rows)
+            })
+        })?;
     let mut rows = rows
         .into_inner()
         .map_err(|_| anyhow::anyhow!("a sweep worker panicked"))?;

@@ -16,7 +16,6 @@ use crate::measure::metrics::measure;
 use crate::measure::ratio::{RatioResult, measure_ratio_with_frames};
 use crate::measure::ratio_setup::{Compensation, Setup};
 use crate::paper::report::{CaseResult, EqualCoverage, Sizes, render_report};
-use crate::render::accel::BvhKind;
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
@@ -84,7 +83,7 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
             let dir = format!("car_{car_label}_theta{}", theta as u32);
             std::fs::create_dir_all(out.join(&dir))?;
             let scene = das_case(&base, distance, 1.0, theta)?;
-            let ctx = RenderContext::new(scene, BvhKind::Cwbvh)?;
+            let ctx = RenderContext::new(scene)?;
             let options = RunOptions {
                 width: Some(sizes.driver),
                 frontal_width: Some(sizes.frontal),

@@ -1,94 +1,89 @@
-//! Ray queries accelerated by a compressed wide BVH (obvhs `CwBvh`), with brute-force twins
-//! that the tests hold the accelerated queries to.
+//! Ray queries of a world: closest hit and shadow (any hit) per view, accelerated by wide
+//! BVHs ([`crate::render::bvh`]), with brute-force twins that the tests hold them to.
 //!
-//! CWBVH was chosen over BVH2 by measurement (`seethru bench --bvh bvh2`, README §Benchmark):
-//! its 8-wide nodes traverse faster on this CPU's SIMD for the same build presets.
+//! Primitives are grouped by visibility — which views show them, whether they cast shadows —
+//! and each group gets its own hierarchies (one over triangle packets, one over ellipsoids).
+//! A query traverses only the groups its view shows, so no leaf test asks "is this visible
+//! here?": in das the big shared group holds everything but the obstacle (driver views only,
+//! no shadow) and the head (hidden from the driver), which are tiny groups of their own.
 
+use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
+use anyhow::Result;
 use glam::{Vec3, Vec3A};
-use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
-use obvhs::bvh2::Bvh2;
-use obvhs::bvh2::leaf_collapser::collapse;
-use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
-use obvhs::cwbvh::CwBvh;
-use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
-use obvhs::ploc::PlocBuilder;
-use obvhs::ray::{Ray, RayHit};
-use obvhs::rt_triangle::RtTriangle;
 use obvhs::splits::split_aabbs_preset;
 use obvhs::triangle::Triangle;
 
+use std::cell::RefCell;
+
+use crate::render::bvh::{Bvh, Stack};
+use crate::render::ray::TraceRay;
 use crate::scene::world::World;
 
-/// Which obvhs hierarchy to build.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum BvhKind {
-    /// Binary BVH (PLOC + reinsertion).
-    Bvh2,
-    /// 8-wide compressed BVH (the default; faster to traverse).
-    Cwbvh,
-}
-
-enum Hierarchy {
-    Bvh2(Bvh2),
-    Cwbvh(CwBvh),
-}
-
-/// A primitive in BVH order: the leaf data a traversal touches, kept together for locality.
-#[derive(Clone, Copy)]
-struct Leaf {
-    /// Copy of the primitive's triangle (unused for ellipsoids): traversal reads leaves in
-    /// BVH order, and the copy saves a cache miss into the world's own array.
-    tri: RtTriangle,
-    /// Index of the primitive in the [`World`].
-    prim: u32,
-    is_triangle: bool,
-    /// Views that show the primitive ([`crate::scene::world::view_bit`]).
-    views: u8,
-    casts_shadow: bool,
-}
-
-impl Leaf {
-    #[inline(always)]
-    fn intersect(&self, world: &World, ray: &Ray) -> f32 {
-        if self.is_triangle {
-            self.tri.intersect(ray)
-        } else {
-            world.intersect(self.prim as usize, ray)
-        }
-    }
-}
-
-/// A closest-hit answer: which primitive, at which distance.
+/// A closest-hit answer: which primitive of the [`World`], at which distance (metres).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
     pub prim: usize,
     pub t: f32,
 }
 
+/// The primitives of one visibility class and their hierarchy.
+struct Group {
+    /// Views that show the group ([`crate::scene::world::view_bit`]).
+    views: u8,
+    casts_shadow: bool,
+    /// World box of the group's primitives.
+    bounds: Aabb,
+    bvh: Bvh,
+}
+
+/// Where the images of two views of one camera can differ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Difference {
+    /// Nowhere: the views show the same primitives.
+    None,
+    /// Only where rays can meet this world box: the primitives one view shows and the other
+    /// does not, none of which casts a shadow.
+    Within(Aabb),
+    /// Anywhere: a primitive only one view shows casts shadows.
+    Everywhere,
+}
+
+thread_local! {
+    /// The traversal stack of the queries that bring none.
+    static STACK: RefCell<Stack> = RefCell::new(Stack::new());
+}
+
 pub struct Accel {
-    hierarchy: Hierarchy,
-    leaves: Vec<Leaf>,
+    /// Largest group first, so that the others are searched with a short `tmax`.
+    groups: Vec<Group>,
     /// Wall time of the hierarchy build.
     pub build_time: Duration,
 }
 
-/// Boxes to build the hierarchy over, and the primitive each belongs to. Large triangles (the
-/// ground, the street, long kerbs) get several tight boxes instead of one that overlaps
-/// everything (obvhs' spatial pre-splits); a primitive may then appear in several leaves.
-fn split_primitive_boxes(world: &World) -> (Vec<Aabb>, Vec<u32>) {
-    let tris: Vec<Triangle> = world
-        .triangles
+/// Boxes to build a hierarchy over `prims`, and the primitive each belongs to. Large
+/// triangles (the ground, the street, long kerbs) get several tight boxes instead of one that
+/// overlaps everything (obvhs' spatial pre-splits); a primitive may then be in several leaves.
+/// Ellipsoids keep one box: it is tight enough.
+fn primitive_boxes(world: &World, prims: &[u32]) -> (Vec<Aabb>, Vec<u32>) {
+    let (triangles, ellipsoids): (Vec<u32>, Vec<u32>) = prims
         .iter()
-        .map(|t| Triangle {
-            v0: t.v0,
-            v1: t.v0 - t.e1,
-            v2: t.v0 + t.e2,
+        .partition(|&&p| (p as usize) < world.triangles.len());
+    let tris: Vec<Triangle> = triangles
+        .iter()
+        .map(|&p| {
+            let t = &world.triangles[p as usize];
+            Triangle {
+                v0: t.v0,
+                v1: t.v0 - t.e1,
+                v2: t.v0 + t.e2,
+            }
         })
         .collect();
     let mut aabbs: Vec<Aabb> = tris.iter().map(Triangle::aabb).collect();
+    // Indices into `tris` while splitting (the preset reads the triangles through them).
     let mut indices: Vec<u32> = (0..tris.len() as u32).collect();
     if !tris.is_empty() {
         let areas: Vec<f32> = aabbs.iter().map(Aabb::half_area).collect();
@@ -96,123 +91,112 @@ fn split_primitive_boxes(world: &World) -> (Vec<Aabb>, Vec<u32>) {
         let largest = areas.iter().copied().fold(0.0, f32::max);
         split_aabbs_preset(&mut aabbs, &mut indices, &tris, average, largest);
     }
-    // Ellipsoids are never split: their boxes are already tight enough.
-    for prim in tris.len()..world.primitive_count() {
-        aabbs.push(world.aabb(prim));
-        indices.push(prim as u32);
-    }
+    let mut indices: Vec<u32> = indices.iter().map(|&i| triangles[i as usize]).collect();
+    aabbs.extend(ellipsoids.iter().map(|&p| world.aabb(p as usize)));
+    indices.extend(ellipsoids);
     (aabbs, indices)
 }
 
-pub fn make_ray(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Ray {
-    Ray::new(Vec3A::from(origin), Vec3A::from(dir), tmin, tmax)
+pub fn make_ray(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> TraceRay {
+    TraceRay::new(Vec3A::from(origin), Vec3A::from(dir), tmin, tmax)
 }
 
 impl Accel {
-    pub fn build(world: &World, kind: BvhKind) -> Accel {
+    pub fn build(world: &World) -> Result<Accel> {
         let start = Instant::now();
-        let params = BvhBuildParams::medium_build();
-        let (aabbs, indices) = split_primitive_boxes(world);
-        let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
-            params.ploc_search_distance,
-            &aabbs,
-            indices,
-            params.sort_precision,
-            params.search_depth_threshold,
-        );
-        bvh2.uses_spatial_splits = true;
-        let mut optimizer = ReinsertionOptimizer::default();
-        optimizer.run(&mut bvh2, params.reinsertion_batch_ratio, None);
-        let hierarchy = match kind {
-            BvhKind::Cwbvh => Hierarchy::Cwbvh(bvh2_to_cwbvh(
-                &bvh2,
-                params.max_prims_per_leaf.clamp(1, 3),
-                true,
-                false,
-            )),
-            BvhKind::Bvh2 => {
-                collapse(
-                    &mut bvh2,
-                    params.max_prims_per_leaf,
-                    params.collapse_traversal_cost,
-                );
-                let ratio = params.reinsertion_batch_ratio
-                    * params.post_collapse_reinsertion_batch_ratio_multiplier;
-                optimizer.run(&mut bvh2, ratio, None);
-                Hierarchy::Bvh2(bvh2)
-            }
-        };
-        let order = match &hierarchy {
-            Hierarchy::Cwbvh(b) => &b.primitive_indices,
-            Hierarchy::Bvh2(b) => &b.primitive_indices,
-        };
-        let leaves = order
-            .iter()
-            .map(|&p| {
-                let (views, casts_shadow) = world.visibility(p as usize);
-                let is_triangle = (p as usize) < world.triangles.len();
-                let tri = if is_triangle {
-                    world.triangles[p as usize]
-                } else {
-                    RtTriangle::default()
-                };
-                Leaf {
-                    tri,
-                    prim: p,
-                    is_triangle,
-                    views,
-                    casts_shadow,
-                }
-            })
-            .collect();
-        Accel {
-            hierarchy,
-            leaves,
-            build_time: start.elapsed(),
+        // Primitives of each visibility class, in world order.
+        let mut classes: BTreeMap<(u8, bool), Vec<u32>> = BTreeMap::new();
+        for prim in 0..world.primitive_count() {
+            classes
+                .entry(world.visibility(prim))
+                .or_default()
+                .push(prim as u32);
         }
+        let mut groups = Vec::new();
+        for ((views, casts_shadow), prims) in classes {
+            let (boxes, indices) = primitive_boxes(world, &prims);
+            let mut bounds = Aabb::empty();
+            for b in &boxes {
+                bounds = bounds.union(b);
+            }
+            groups.push(Group {
+                views,
+                casts_shadow,
+                bounds,
+                bvh: Bvh::build(world, &boxes, indices)?,
+            });
+        }
+        groups.sort_by_key(|g| std::cmp::Reverse(g.bvh.bytes()));
+        Ok(Accel {
+            groups,
+            build_time: start.elapsed(),
+        })
     }
 
-    /// Closest primitive visible in `view` that `ray` hits in [tmin, tmax].
-    pub fn closest(&self, world: &World, ray: Ray, view: u8) -> Option<Hit> {
-        let mut hit = RayHit::none();
-        let test = |r: &Ray, id: usize| {
-            let leaf = &self.leaves[id];
-            if leaf.views & view == 0 {
-                f32::INFINITY
-            } else {
-                leaf.intersect(world, r)
+    /// Closest primitive visible in `view` that `ray` hits in [tmin, tmax).
+    #[inline]
+    pub fn closest(&self, ray: &TraceRay, view: u8) -> Option<Hit> {
+        STACK.with_borrow_mut(|stack| self.closest_with(ray, view, stack))
+    }
+
+    /// [`Accel::closest`] with a traversal stack of the caller's.
+    #[inline]
+    pub fn closest_with(&self, ray: &TraceRay, view: u8, stack: &mut Stack) -> Option<Hit> {
+        let mut ray = *ray;
+        let mut prim = None;
+        for group in self.groups.iter().filter(|g| g.views & view != 0) {
+            if let Some(p) = group.bvh.closest(&mut ray, stack) {
+                prim = Some(p);
             }
-        };
-        let found = match &self.hierarchy {
-            Hierarchy::Cwbvh(b) => b.ray_traverse(ray, &mut hit, test),
-            Hierarchy::Bvh2(b) => b.ray_traverse(ray, &mut hit, test),
-        };
-        found.then(|| Hit {
-            prim: self.leaves[hit.primitive_id as usize].prim as usize,
-            t: hit.t,
+        }
+        prim.map(|p| Hit {
+            prim: p as usize,
+            t: ray.tmax,
         })
     }
 
     /// Whether any shadow-casting primitive visible in `view` blocks `ray` in [tmin, tmax].
-    pub fn occluded(&self, world: &World, ray: Ray, view: u8) -> bool {
-        let test = |r: &Ray, id: usize| {
-            let leaf = &self.leaves[id];
-            if leaf.views & view == 0 || !leaf.casts_shadow {
-                f32::INFINITY
-            } else {
-                leaf.intersect(world, r)
+    #[inline]
+    pub fn occluded(&self, ray: &TraceRay, view: u8) -> bool {
+        STACK.with_borrow_mut(|stack| self.occluded_with(ray, view, stack))
+    }
+
+    /// [`Accel::occluded`] with a traversal stack of the caller's.
+    #[inline]
+    pub fn occluded_with(&self, ray: &TraceRay, view: u8, stack: &mut Stack) -> bool {
+        self.groups
+            .iter()
+            .filter(|g| g.views & view != 0 && g.casts_shadow)
+            .any(|g| g.bvh.any(ray, stack))
+    }
+
+    /// Where images of views `a` and `b` (from one camera) can differ.
+    pub fn difference(&self, a: u8, b: u8) -> Difference {
+        let mut bounds = Aabb::empty();
+        for group in &self.groups {
+            if (group.views & a != 0) != (group.views & b != 0) {
+                if group.casts_shadow {
+                    return Difference::Everywhere;
+                }
+                bounds = bounds.union(&group.bounds);
             }
-        };
-        let miss = match &self.hierarchy {
-            Hierarchy::Cwbvh(b) => b.ray_traverse_miss(ray, test),
-            Hierarchy::Bvh2(b) => b.ray_traverse_miss(ray, test),
-        };
-        !miss
+        }
+        if bounds.min.cmple(bounds.max).all() {
+            Difference::Within(bounds)
+        } else {
+            Difference::None
+        }
+    }
+
+    /// Bytes held by the hierarchies.
+    pub fn bytes(&self) -> usize {
+        self.groups.iter().map(|g| g.bvh.bytes()).sum()
     }
 }
 
 /// Brute-force twin of [`Accel::closest`]: every primitive, in order.
-pub fn closest_brute_force(world: &World, ray: Ray, view: u8) -> Option<Hit> {
+pub fn closest_brute_force(world: &World, ray: &TraceRay, view: u8) -> Option<Hit> {
+    let ray = ray.as_obvhs();
     let mut best: Option<Hit> = None;
     for prim in 0..world.primitive_count() {
         if world.visibility(prim).0 & view == 0 {
@@ -227,7 +211,8 @@ pub fn closest_brute_force(world: &World, ray: Ray, view: u8) -> Option<Hit> {
 }
 
 /// Brute-force twin of [`Accel::occluded`].
-pub fn occluded_brute_force(world: &World, ray: Ray, view: u8) -> bool {
+pub fn occluded_brute_force(world: &World, ray: &TraceRay, view: u8) -> bool {
+    let ray = ray.as_obvhs();
     (0..world.primitive_count()).any(|prim| {
         let (views, casts) = world.visibility(prim);
         views & view != 0 && casts && world.intersect(prim, &ray).is_finite()

@@ -51,7 +51,93 @@ impl Pixel {
     };
 }
 
+/// A band of whole rows of a frame, writable on its own (one per worker task).
+pub struct Rows<'a> {
+    /// Index of the band's first row in the frame.
+    pub y: u32,
+    width: usize,
+    color: &'a mut [Vec3],
+    depth: &'a mut [f32],
+    camera_z: &'a mut [f32],
+    position: &'a mut [Vec3],
+    normal: &'a mut [Vec3],
+    object_id: &'a mut [u32],
+    part_id: &'a mut [u32],
+}
+
+impl Rows<'_> {
+    /// Number of rows in the band.
+    pub fn len(&self) -> u32 {
+        (self.depth.len() / self.width) as u32
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.depth.is_empty()
+    }
+
+    /// Writes pixel `x` of the band's row `row` (counted from the band's first).
+    #[inline]
+    pub fn set(&mut self, x: u32, row: u32, p: Pixel) {
+        let i = row as usize * self.width + x as usize;
+        self.color[i] = p.color;
+        self.depth[i] = p.depth;
+        self.camera_z[i] = p.camera_z;
+        self.position[i] = p.position;
+        self.normal[i] = p.normal;
+        self.object_id[i] = p.object_id;
+        self.part_id[i] = p.part_id;
+    }
+}
+
 impl Frame {
+    /// A `width`×`height` frame of sky pixels.
+    pub fn new(width: u32, height: u32) -> Frame {
+        let n = width as usize * height as usize;
+        let p = Pixel::SKY;
+        Frame {
+            width,
+            height,
+            color: vec![p.color; n],
+            depth: vec![p.depth; n],
+            camera_z: vec![p.camera_z; n],
+            position: vec![p.position; n],
+            normal: vec![p.normal; n],
+            object_id: vec![p.object_id; n],
+            part_id: vec![p.part_id; n],
+        }
+    }
+
+    /// The frame as bands of `rows` rows (the last may be shorter), top to bottom.
+    pub fn bands_mut(&mut self, rows: u32) -> Vec<Rows<'_>> {
+        let width = self.width as usize;
+        let n = width * rows.max(1) as usize;
+        self.color
+            .chunks_mut(n)
+            .zip(self.depth.chunks_mut(n))
+            .zip(self.camera_z.chunks_mut(n))
+            .zip(self.position.chunks_mut(n))
+            .zip(self.normal.chunks_mut(n))
+            .zip(self.object_id.chunks_mut(n))
+            .zip(self.part_id.chunks_mut(n))
+            .enumerate()
+            .map(
+                |(i, ((((((color, depth), camera_z), position), normal), object_id), part_id))| {
+                    Rows {
+                        y: i as u32 * rows.max(1),
+                        width,
+                        color,
+                        depth,
+                        camera_z,
+                        position,
+                        normal,
+                        object_id,
+                        part_id,
+                    }
+                },
+            )
+            .collect()
+    }
+
     pub fn from_pixels(width: u32, height: u32, pixels: &[Pixel]) -> Frame {
         assert_eq!(pixels.len(), width as usize * height as usize);
         let n = pixels.len();

@@ -1,16 +1,26 @@
 //! The integrator: primary rays per pixel, Lambert shading with the sun (hard shadow ray)
 //! and sky ambient, textures, and the AOVs of the pixel-centre ray.
+//!
+//! Frames are rendered in bands of rows on the rayon pool, each band written straight into
+//! the frame's buffers; every pixel depends only on its own coordinates, so images are the
+//! same for any number of threads. Views of one camera that differ only by a few primitives
+//! (`truth`, `occluded`, `seethru`) are rendered once and re-rendered only where those
+//! primitives can be seen ([`RenderContext::render_over`]).
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Result;
-use glam::{DAffine3, Mat3, Vec3};
+use glam::{DAffine3, Vec3};
 use rayon::prelude::*;
 
 use crate::geometry::camera::Camera;
-use crate::render::accel::{Accel, BvhKind, make_ray};
+use crate::render::accel::{Accel, Difference, make_ray};
+use crate::render::bvh::Stack;
+use crate::render::camera_rays::CameraRays;
+use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::{Frame, Pixel};
+use crate::render::ray::TraceRay;
 use crate::render::screen::{Screen, Shown};
 use crate::render::settings::RenderSettings;
 use crate::render::sky::SkyModel;
@@ -20,6 +30,9 @@ use crate::scene::world::{SurfaceHit, World, view_bit};
 use crate::util::progress::Progress;
 use crate::util::sampling::pixel_offset;
 
+/// Rows per rayon task: small enough to balance many threads, large enough to amortise.
+const BAND_ROWS: u32 = 4;
+
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RenderStats {
     pub primary_rays: u64,
@@ -27,19 +40,53 @@ pub struct RenderStats {
     pub seconds: f64,
 }
 
-/// Everything needed to render a scene from any camera.
+/// Everything needed to render a scene from any camera. The world, its hierarchy and the
+/// sky are shared between contexts of scenes that differ only in their cameras
+/// ([`RenderContext::with_scene`]).
 pub struct RenderContext {
     pub scene: Scene,
-    pub world: World,
-    pub accel: Accel,
-    pub sky: SkyModel,
+    pub world: Arc<World>,
+    pub accel: Arc<Accel>,
+    pub sky: Arc<SkyModel>,
+}
+
+/// What every pixel of one render shares.
+struct PixelJob<'a> {
+    rays: CameraRays,
+    camera_from_world: DAffine3,
+    view: u8,
+    display: Option<&'a dyn Screen>,
+    spp: u32,
 }
 
 impl RenderContext {
-    pub fn new(scene: Scene, bvh: BvhKind) -> Result<Self> {
+    pub fn new(scene: Scene) -> Result<Self> {
         let world = World::build(&scene)?;
-        let accel = Accel::build(&world, bvh);
+        let accel = Accel::build(&world)?;
         let sky = SkyModel::new(&scene.sky, &scene.sun);
+        Ok(Self {
+            scene,
+            world: Arc::new(world),
+            accel: Arc::new(accel),
+            sky: Arc::new(sky),
+        })
+    }
+
+    /// A context for `scene`, reusing this one's world and hierarchy when `scene` differs
+    /// from this context's only in its cameras, and its sky when sky and sun are the same.
+    pub fn with_scene(&self, scene: Scene) -> Result<Self> {
+        let sky = if (&scene.sky, &scene.sun) == (&self.scene.sky, &self.scene.sun) {
+            self.sky.clone()
+        } else {
+            Arc::new(SkyModel::new(&scene.sky, &scene.sun))
+        };
+        let (world, accel) = if same_geometry(&scene, &self.scene) {
+            (self.world.clone(), self.accel.clone())
+        } else {
+            let world = World::build(&scene)?;
+            let accel = Accel::build(&world)?;
+            (Arc::new(world), Arc::new(accel))
+        };
         Ok(Self {
             scene,
             world,
@@ -57,7 +104,23 @@ impl RenderContext {
         settings: RenderSettings,
         label: &str,
     ) -> (Frame, RenderStats) {
-        self.render_with_display(camera, view, None, settings, label)
+        let mut frame = Frame::new(camera.width, camera.height);
+        let stats = self.render_into(camera, view, settings, &mut frame, label);
+        (frame, stats)
+    }
+
+    /// [`RenderContext::render`] into an existing frame of the camera's size, so that a
+    /// sequence of renders reuses its buffers.
+    pub fn render_into(
+        &self,
+        camera: &Camera,
+        view: u8,
+        settings: RenderSettings,
+        frame: &mut Frame,
+        label: &str,
+    ) -> RenderStats {
+        let region = PixelRect::full(camera);
+        self.render_region(camera, view, None, settings, region, frame, label)
     }
 
     /// The `seethru` view: the driver's eye with the obstacle present and its display showing
@@ -69,75 +132,131 @@ impl RenderContext {
         display: &dyn Screen,
         settings: RenderSettings,
     ) -> (Frame, RenderStats) {
-        self.render_with_display(
+        let mut frame = Frame::new(camera.width, camera.height);
+        let region = PixelRect::full(camera);
+        let stats = self.render_region(
             camera,
             view_bit::SEETHRU,
             Some(display),
             settings,
+            region,
+            &mut frame,
             "seethru",
-        )
+        );
+        (frame, stats)
     }
 
-    fn render_with_display(
+    /// Renders `view` (with `display` for the `seethru` view) from `camera`, given `base`, the
+    /// same camera's frame in `base_view` with the same settings: only the pixels where the
+    /// two views can differ are traced, the others are copied. The result is bit for bit
+    /// the frame [`RenderContext::render`] (or [`RenderContext::render_seethru`]) gives.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_over(
         &self,
         camera: &Camera,
+        base: &Frame,
+        base_view: u8,
         view: u8,
         display: Option<&dyn Screen>,
         settings: RenderSettings,
         label: &str,
     ) -> (Frame, RenderStats) {
-        let start = Instant::now();
-        let (w, h) = (camera.width as usize, camera.height as usize);
-        let mut pixels = vec![Pixel::SKY; w * h];
-        let shadow_rays = AtomicU64::new(0);
-        let progress = Progress::new(format!("rendering {label}"), h, settings.progress);
-        let camera_from_world = camera.world_from_camera.inverse();
-        let rays = RayGenerator::new(camera);
-        pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            let mut shadows = 0;
-            for (x, out) in row.iter_mut().enumerate() {
-                let job = PixelJob {
-                    rays: &rays,
-                    camera_from_world: &camera_from_world,
-                    view,
-                    display,
-                };
-                *out = self.render_pixel(&job, x as u32, y as u32, settings.spp, &mut shadows);
-            }
-            shadow_rays.fetch_add(shadows, Ordering::Relaxed);
-            progress.advance(1);
-        });
-        progress.finish();
-        let stats = RenderStats {
-            primary_rays: (w * h) as u64 * settings.spp as u64,
-            shadow_rays: shadow_rays.into_inner(),
-            seconds: start.elapsed().as_secs_f64(),
+        assert_eq!((base.width, base.height), (camera.width, camera.height));
+        let region = match self.accel.difference(base_view, view) {
+            Difference::None => PixelRect {
+                x0: 0,
+                y0: 0,
+                x1: 0,
+                y1: 0,
+            },
+            Difference::Within(bounds) => footprint(camera, &bounds),
+            Difference::Everywhere => PixelRect::full(camera),
         };
-        (
-            Frame::from_pixels(camera.width, camera.height, &pixels),
-            stats,
-        )
+        let mut frame = base.clone();
+        let stats = self.render_region(camera, view, display, settings, region, &mut frame, label);
+        (frame, stats)
     }
 
-    fn render_pixel(&self, job: &PixelJob, x: u32, y: u32, spp: u32, shadows: &mut u64) -> Pixel {
+    /// Renders the pixels of `region` into `frame`.
+    #[allow(clippy::too_many_arguments)]
+    fn render_region(
+        &self,
+        camera: &Camera,
+        view: u8,
+        display: Option<&dyn Screen>,
+        settings: RenderSettings,
+        region: PixelRect,
+        frame: &mut Frame,
+        label: &str,
+    ) -> RenderStats {
+        assert_eq!((frame.width, frame.height), (camera.width, camera.height));
+        let start = Instant::now();
+        let job = PixelJob {
+            rays: CameraRays::new(camera),
+            camera_from_world: camera.world_from_camera.inverse(),
+            view,
+            display,
+            spp: settings.spp,
+        };
+        let bands: Vec<_> = frame
+            .bands_mut(BAND_ROWS)
+            .into_iter()
+            .filter(|b| b.y < region.y1 && b.y + b.len() > region.y0)
+            .collect();
+        let progress = Progress::new(format!("rendering {label}"), bands.len(), settings.progress);
+        let shadow_rays: u64 = bands
+            .into_par_iter()
+            .map_init(Stack::new, |stack, mut band| {
+                let mut shadows = 0;
+                for row in 0..band.len() {
+                    let y = band.y + row;
+                    if y < region.y0 || y >= region.y1 {
+                        continue;
+                    }
+                    for x in region.x0..region.x1 {
+                        let pixel = self.render_pixel(&job, x, y, stack, &mut shadows);
+                        band.set(x, row, pixel);
+                    }
+                }
+                progress.advance(1);
+                shadows
+            })
+            .sum();
+        progress.finish();
+        RenderStats {
+            primary_rays: region.pixels() * u64::from(settings.spp),
+            shadow_rays,
+            seconds: start.elapsed().as_secs_f64(),
+        }
+    }
+
+    fn render_pixel(
+        &self,
+        job: &PixelJob,
+        x: u32,
+        y: u32,
+        stack: &mut Stack,
+        shadows: &mut u64,
+    ) -> Pixel {
         let mut pixel = Pixel::SKY;
         let mut sum = Vec3::ZERO;
-        for sample in 0..spp {
+        for sample in 0..job.spp {
             let (dx, dy) = pixel_offset(x, y, sample);
-            let (origin, dir) = job.rays.world_ray(x as f32 + dx, y as f32 + dy);
-            let hit = self.trace(origin, dir, job.view);
+            let origin = job.rays.origin;
+            let dir = job.rays.direction(x as f32 + dx, y as f32 + dy);
+            let hit = self.trace_with(origin, dir, job.view, stack);
             let shown = match (&hit, job.display) {
                 (Some(s), Some(d))
                     if s.object == self.world.obstacle_id && s.part == box_face::POS_Z =>
                 {
-                    Some(self.display_content(d, s.position, shadows))
+                    Some(self.display_content(d, s.position, stack, shadows))
                 }
                 _ => None,
             };
             // A display emits its image: no shading.
             sum += match (&hit, &shown) {
                 (_, Some(d)) => d.color,
-                (Some(s), None) => self.shade(s, job.view, shadows),
+                (Some(s), None) => self.shade(s, job.view, stack, shadows),
                 (None, None) => self.sky.radiance(dir),
             };
             if sample != 0 {
@@ -154,9 +273,7 @@ impl RenderContext {
                             f32::INFINITY
                         },
                         camera_z: if finite {
-                            -job.camera_from_world
-                                .transform_point3(d.position.as_dvec3())
-                                .z as f32
+                            axial_depth(&job.camera_from_world, d.position)
                         } else {
                             f32::INFINITY
                         },
@@ -166,10 +283,7 @@ impl RenderContext {
                 (Some(s), None) => Pixel {
                     color: Vec3::ZERO,
                     depth: s.t,
-                    camera_z: -job
-                        .camera_from_world
-                        .transform_point3(s.position.as_dvec3())
-                        .z as f32,
+                    camera_z: axial_depth(&job.camera_from_world, s.position),
                     position: s.position,
                     normal: s.normal,
                     object_id: s.object,
@@ -182,44 +296,65 @@ impl RenderContext {
                 },
             };
         }
-        pixel.color = sum / spp as f32;
+        pixel.color = sum / job.spp as f32;
         pixel
     }
 
     /// What the display shows at a world point on its face: a display pixel, or — for the
     /// ideal display — what the frontal camera's ray through the exact crop point meets.
-    fn display_content(&self, display: &dyn Screen, at: Vec3, shadows: &mut u64) -> Pixel {
+    fn display_content(
+        &self,
+        display: &dyn Screen,
+        at: Vec3,
+        stack: &mut Stack,
+        shadows: &mut u64,
+    ) -> Pixel {
         match display.shown_at(at) {
             Shown::Pixel(p) => p,
-            Shown::FrontalRay(origin, dir) => match self.trace(origin, dir, view_bit::FRONTAL) {
-                Some(s) => Pixel {
-                    color: self.shade(&s, view_bit::FRONTAL, shadows),
-                    depth: s.t,
-                    camera_z: s.t,
-                    position: s.position,
-                    normal: s.normal,
-                    object_id: s.object,
-                    part_id: s.part,
-                },
-                None => Pixel {
-                    color: self.sky.radiance(dir),
-                    normal: -dir,
-                    ..Pixel::SKY
-                },
-            },
+            Shown::FrontalRay(origin, dir) => {
+                match self.trace_with(origin, dir, view_bit::FRONTAL, stack) {
+                    Some(s) => Pixel {
+                        color: self.shade(&s, view_bit::FRONTAL, stack, shadows),
+                        depth: s.t,
+                        camera_z: s.t,
+                        position: s.position,
+                        normal: s.normal,
+                        object_id: s.object,
+                        part_id: s.part,
+                    },
+                    None => Pixel {
+                        color: self.sky.radiance(dir),
+                        normal: -dir,
+                        ..Pixel::SKY
+                    },
+                }
+            }
         }
     }
 
     /// The closest surface visible in `view` along a ray from `origin` (unit `dir`).
     pub fn trace(&self, origin: Vec3, dir: Vec3, view: u8) -> Option<SurfaceHit> {
-        let hit =
-            self.accel
-                .closest(&self.world, make_ray(origin, dir, 0.0, f32::INFINITY), view)?;
+        let hit = self
+            .accel
+            .closest(&make_ray(origin, dir, 0.0, f32::INFINITY), view)?;
+        Some(self.world.surface(hit.prim, origin, dir, hit.t))
+    }
+
+    #[inline]
+    fn trace_with(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        view: u8,
+        stack: &mut Stack,
+    ) -> Option<SurfaceHit> {
+        let ray = make_ray(origin, dir, 0.0, f32::INFINITY);
+        let hit = self.accel.closest_with(&ray, view, stack)?;
         Some(self.world.surface(hit.prim, origin, dir, hit.t))
     }
 
     /// Lambert shading: albedo × (sun × cos × visibility + sky ambient).
-    fn shade(&self, s: &SurfaceHit, view: u8, shadows: &mut u64) -> Vec3 {
+    fn shade(&self, s: &SurfaceHit, view: u8, stack: &mut Stack, shadows: &mut u64) -> Vec3 {
         let material = &self.world.materials[s.material as usize];
         let mut albedo = material.albedo;
         if let Some(t) = material.texture {
@@ -229,16 +364,8 @@ impl RenderContext {
         let cos = s.normal.dot(self.sky.sun_direction);
         if cos > 0.0 {
             *shadows += 1;
-            // Offset along the normal, scaled with the coordinates' magnitude to stay above
-            // f32 rounding of the hit point.
-            let eps = 2e-4 * (1.0 + s.position.abs().max_element());
-            let ray = make_ray(
-                s.position + s.normal * eps,
-                self.sky.sun_direction,
-                0.0,
-                f32::INFINITY,
-            );
-            if !self.accel.occluded(&self.world, ray, view) {
+            let ray = shadow_ray(s.position, s.normal, self.sky.sun_direction);
+            if !self.accel.occluded_with(&ray, view, stack) {
                 light += self.sky.sun_irradiance * cos;
             }
         }
@@ -246,39 +373,29 @@ impl RenderContext {
     }
 }
 
-/// What every pixel of one render shares.
-struct PixelJob<'a> {
-    rays: &'a RayGenerator,
-    camera_from_world: &'a DAffine3,
-    view: u8,
-    display: Option<&'a dyn Screen>,
+/// Whether two scenes have the same world (objects, materials, obstacle): they may differ
+/// in their cameras, sky and sun.
+pub fn same_geometry(a: &Scene, b: &Scene) -> bool {
+    let mut a = a.clone();
+    (a.driver, a.frontal, a.back) = (b.driver, b.frontal, b.back);
+    (a.sky, a.sun) = (b.sky.clone(), b.sun.clone());
+    a == *b
 }
 
-/// Primary rays of a camera in f32, with the per-camera constants hoisted out of the pixel loop.
-struct RayGenerator {
-    origin: Vec3,
-    world_from_camera: Mat3,
-    /// Camera-space direction of the pixel coordinates (0, 0), and its change per pixel.
-    corner: Vec3,
-    step_x: f32,
-    step_y: f32,
+/// Depth along the camera's viewing axis of a world point: the z row of `camera_from_world`,
+/// in f64 as `DAffine3::transform_point3` computes it.
+#[inline]
+fn axial_depth(camera_from_world: &DAffine3, p: Vec3) -> f32 {
+    let m = &camera_from_world.matrix3;
+    let p = p.as_dvec3();
+    let z = m.x_axis.z * p.x + m.y_axis.z * p.y + m.z_axis.z * p.z;
+    -(z + camera_from_world.translation.z) as f32
 }
 
-impl RayGenerator {
-    fn new(camera: &Camera) -> Self {
-        let (tx, ty) = (camera.tan_half_x() as f32, camera.tan_half_y() as f32);
-        Self {
-            origin: camera.position().as_vec3(),
-            world_from_camera: camera.world_from_camera.matrix3.as_mat3(),
-            corner: Vec3::new(-tx, ty, -1.0),
-            step_x: 2.0 * tx / camera.width as f32,
-            step_y: -2.0 * ty / camera.height as f32,
-        }
-    }
-
-    /// Ray through continuous pixel coordinates (as [`Camera::world_ray`], in f32).
-    fn world_ray(&self, px: f32, py: f32) -> (Vec3, Vec3) {
-        let local = self.corner + Vec3::new(px * self.step_x, py * self.step_y, 0.0);
-        (self.origin, (self.world_from_camera * local).normalize())
-    }
+/// A ray leaving a surface point `position` (unit normal `normal`) in direction `dir`: its
+/// origin is offset along the normal, scaled with the coordinates' magnitude to stay above
+/// the f32 rounding of the hit point.
+pub fn shadow_ray(position: Vec3, normal: Vec3, dir: Vec3) -> TraceRay {
+    let eps = 2e-4 * (1.0 + position.abs().max_element());
+    make_ray(position + normal * eps, dir, 0.0, f32::INFINITY)
 }

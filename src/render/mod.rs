@@ -2,9 +2,15 @@
 //! for each view.
 
 pub mod accel;
+pub mod bvh;
+pub mod camera_rays;
+pub mod footprint;
 pub mod frame;
 pub mod integrator;
+pub mod packets;
+pub mod ray;
 pub mod screen;
 pub mod settings;
 pub mod sky;
+pub mod throughput;
 pub mod views;

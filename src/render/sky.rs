@@ -3,6 +3,7 @@
 //! deterministic and needs no textures.
 
 use glam::{Vec2, Vec3};
+use rayon::prelude::*;
 
 use crate::scene::texture::Texture;
 
@@ -103,11 +104,13 @@ const CLOUD_TABLE: u32 = 512;
 
 fn cloud_table(seed: u32) -> Texture {
     let n = CLOUD_TABLE;
+    let octaves = Octaves::new(seed);
     let texels = (0..n * n)
+        .into_par_iter()
         .map(|i| {
             let p = Vec2::new((i % n) as f32 + 0.5, (i / n) as f32 + 0.5)
                 * (CLOUD_PERIOD as f32 / n as f32);
-            Vec3::splat(fbm(p, seed))
+            Vec3::splat(octaves.fbm(p))
         })
         .collect();
     Texture {
@@ -117,22 +120,42 @@ fn cloud_table(seed: u32) -> Texture {
     }
 }
 
-/// Value noise in [0, 1] on the integer lattice, smoothly interpolated, repeating every
-/// `period` cells.
-fn value_noise(p: Vec2, seed: u32, period: u32) -> f32 {
-    let i = Vec2::new(fast_floor(p.x), fast_floor(p.y));
-    let f = p - i;
-    let corner = |dx: f32, dy: f32| {
-        let wrap = |v: f32| (v as i32).rem_euclid(period as i32) as u32;
-        let (x, y) = (wrap(i.x + dx), wrap(i.y + dy));
-        // One hash of the lattice point: the noise is evaluated ~20 times per sky pixel.
-        let key = x.wrapping_mul(0x8da6_b343) ^ y.wrapping_mul(0xd816_3841) ^ seed;
-        unit_float(hash_u32(key))
-    };
-    let u = f * f * (Vec2::splat(3.0) - 2.0 * f);
-    let top = corner(0.0, 0.0) + (corner(1.0, 0.0) - corner(0.0, 0.0)) * u.x;
-    let bottom = corner(0.0, 1.0) + (corner(1.0, 1.0) - corner(0.0, 1.0)) * u.x;
-    top + (bottom - top) * u.y
+/// Value noise on the integer lattice, repeating every `period` cells: the lattice values,
+/// hashed once, and their smooth interpolation.
+struct Lattice {
+    period: u32,
+    /// Row-major, `period`² values in [0, 1).
+    values: Vec<f32>,
+}
+
+impl Lattice {
+    fn new(seed: u32, period: u32) -> Lattice {
+        assert!(period.is_power_of_two());
+        let values = (0..period * period)
+            .map(|i| {
+                let (x, y) = (i % period, i / period);
+                let key = x.wrapping_mul(0x8da6_b343) ^ y.wrapping_mul(0xd816_3841) ^ seed;
+                unit_float(hash_u32(key))
+            })
+            .collect();
+        Lattice { period, values }
+    }
+
+    /// Noise in [0, 1] at `p`.
+    fn noise(&self, p: Vec2) -> f32 {
+        let i = Vec2::new(fast_floor(p.x), fast_floor(p.y));
+        let f = p - i;
+        // The period is a power of two: wrapping is a mask (also for negative cells).
+        let wrap = |v: i32| (v & (self.period as i32 - 1)) as usize;
+        let (x0, y0) = (i.x as i32, i.y as i32);
+        let (x, y) = ([wrap(x0), wrap(x0 + 1)], [wrap(y0), wrap(y0 + 1)]);
+        let row = self.period as usize;
+        let corner = |dx: usize, dy: usize| self.values[y[dy] * row + x[dx]];
+        let u = f * f * (Vec2::splat(3.0) - 2.0 * f);
+        let top = corner(0, 0) + (corner(1, 0) - corner(0, 0)) * u.x;
+        let bottom = corner(0, 1) + (corner(1, 1) - corner(0, 1)) * u.x;
+        top + (bottom - top) * u.y
+    }
 }
 
 /// `floor` without a libm call (the x86-64 baseline has no rounding instruction).
@@ -141,18 +164,29 @@ fn fast_floor(x: f32) -> f32 {
     if t > x { t - 1.0 } else { t }
 }
 
-/// Fractal sum of five octaves of value noise, in [0, 1], repeating every `CLOUD_PERIOD`.
-fn fbm(p: Vec2, seed: u32) -> f32 {
-    let (mut sum, mut amplitude, mut norm, mut q, mut period) = (0.0, 0.5, 0.0, p, CLOUD_PERIOD);
-    for octave in 0..5 {
-        sum += amplitude * value_noise(q, seed.wrapping_add(octave), period);
-        norm += amplitude;
-        amplitude *= 0.5;
-        // Doubling keeps every octave periodic; the integer shift decorrelates the lattices.
-        q = q * 2.0 + Vec2::new(17.0, 5.0);
-        period *= 2;
+/// Five octaves of value noise, each of twice the frequency of the one before and all
+/// repeating every `CLOUD_PERIOD`.
+struct Octaves([Lattice; 5]);
+
+impl Octaves {
+    fn new(seed: u32) -> Octaves {
+        Octaves(std::array::from_fn(|octave| {
+            Lattice::new(seed.wrapping_add(octave as u32), CLOUD_PERIOD << octave)
+        }))
     }
-    sum / norm
+
+    /// Their fractal sum at `p`, in [0, 1].
+    fn fbm(&self, p: Vec2) -> f32 {
+        let (mut sum, mut amplitude, mut norm, mut q) = (0.0, 0.5, 0.0, p);
+        for lattice in &self.0 {
+            sum += amplitude * lattice.noise(q);
+            norm += amplitude;
+            amplitude *= 0.5;
+            // The integer shift decorrelates the lattices.
+            q = q * 2.0 + Vec2::new(17.0, 5.0);
+        }
+        sum / norm
+    }
 }
 
 #[cfg(test)]

@@ -37,12 +37,6 @@ impl Texture {
         })
     }
 
-    fn texel(&self, x: i64, y: i64) -> Vec3 {
-        let x = x.rem_euclid(self.width as i64) as usize;
-        let y = y.rem_euclid(self.height as i64) as usize;
-        self.texels[y * self.width as usize + x]
-    }
-
     /// Bilinear lookup at `uv` (u right, v down, repeating with period 1).
     pub fn sample(&self, uv: Vec2) -> Vec3 {
         let x = uv.x * self.width as f32 - 0.5;
@@ -50,13 +44,30 @@ impl Texture {
         if !x.is_finite() || !y.is_finite() {
             return self.texels[0];
         }
-        let (x0, y0) = (x.floor(), y.floor());
+        let (x0, y0) = (floor(x), floor(y));
         let (fx, fy) = (x - x0, y - y0);
-        let (x0, y0) = (x0 as i64, y0 as i64);
-        let top = self.texel(x0, y0).lerp(self.texel(x0 + 1, y0), fx);
-        let bottom = self.texel(x0, y0 + 1).lerp(self.texel(x0 + 1, y0 + 1), fx);
+        // The two columns and rows, wrapped once each (integer division is slow).
+        let wrap = |v: f32, n: u32| {
+            let a = (v as i64).rem_euclid(n as i64) as usize;
+            (a, if a + 1 == n as usize { 0 } else { a + 1 })
+        };
+        let ((c0, c1), (r0, r1)) = (wrap(x0, self.width), wrap(y0, self.height));
+        let row = self.width as usize;
+        let texel = |c: usize, r: usize| self.texels[r * row + c];
+        let top = texel(c0, r0).lerp(texel(c1, r0), fx);
+        let bottom = texel(c0, r1).lerp(texel(c1, r1), fx);
         top.lerp(bottom, fy)
     }
+}
+
+/// `f32::floor` without a libm call (the x86-64 baseline has no rounding instruction);
+/// beyond 2^23 every float is an integer already.
+fn floor(x: f32) -> f32 {
+    if x.abs() >= 8_388_608.0 {
+        return x;
+    }
+    let t = x as i32 as f32;
+    if t > x { t - 1.0 } else { t }
 }
 
 #[cfg(test)]

@@ -1,13 +1,16 @@
 //! The renderable world: every object of a scene flattened into world-space primitives
 //! (triangles and analytic ellipsoids) with their materials, textures and ids.
 
+use std::collections::HashMap;
+use std::path::PathBuf;
+
 use anyhow::Result;
 use glam::{Affine3A, DAffine3, DVec3, Mat3A, Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::ray::Ray;
 use obvhs::rt_triangle::RtTriangle;
 
-use crate::scene::mesh_io::load_mesh;
+use crate::scene::mesh_io::{LoadedMesh, load_mesh};
 use crate::scene::shapes::{Tri, box_face, cuboid, frustum, plane_xz, quad_xy};
 use crate::scene::texture::Texture;
 use crate::scene::{CameraKind, Obstacle, Scene, Shape};
@@ -46,6 +49,8 @@ pub struct ObjectInfo {
 #[derive(Clone, Copy, Debug)]
 pub struct TriAttr {
     pub uv: [Vec2; 3],
+    /// Unit geometric normal, world frame (counter-clockwise front).
+    pub normal: Vec3,
     pub part: u32,
     /// Object id: index into [`World::objects`] plus one.
     pub object: u32,
@@ -72,6 +77,7 @@ pub struct SurfaceHit {
     pub position: Vec3,
     /// Unit geometric normal, world frame, facing the incoming ray.
     pub normal: Vec3,
+    /// Texture coordinates; computed for textured materials only (zero otherwise).
     pub uv: Vec2,
     pub object: u32,
     pub part: u32,
@@ -129,6 +135,7 @@ impl World {
                 uv_repeat: Vec2::new(m.uv_repeat[0] as f32, m.uv_repeat[1] as f32),
             });
         }
+        let mut meshes: HashMap<PathBuf, LoadedMesh> = HashMap::new();
         for object in &scene.objects {
             world.objects.push(ObjectInfo {
                 name: object.name.clone(),
@@ -162,7 +169,11 @@ impl World {
                 } => frustum(*radius as f32, 0.0, *height as f32, *segments),
                 Shape::Quad { size } => quad_xy(size2(*size), 0),
                 Shape::Mesh { path } => {
-                    let mesh = load_mesh(path)?;
+                    // Each file is read once, however many objects place it.
+                    if !meshes.contains_key(path) {
+                        meshes.insert(path.clone(), load_mesh(path)?);
+                    }
+                    let mesh = &meshes[path];
                     let first = world.materials.len() as u32;
                     world
                         .materials
@@ -210,10 +221,11 @@ impl World {
             if (b - a).cross(c - a).length_squared() == 0.0 {
                 continue;
             }
-            self.triangles
-                .push(RtTriangle::new(a.into(), b.into(), c.into()));
+            let rt = RtTriangle::new(a.into(), b.into(), c.into());
+            self.triangles.push(rt);
             self.tri_attrs.push(TriAttr {
                 uv: tri.uv,
+                normal: geometric_normal(&rt),
                 part: tri.part,
                 object,
                 material: material(tri),
@@ -314,32 +326,39 @@ impl World {
     pub fn intersect(&self, prim: usize, ray: &Ray) -> f32 {
         match prim.checked_sub(self.triangles.len()) {
             None => self.triangles[prim].intersect(ray),
-            Some(e) => intersect_ellipsoid(&self.ellipsoids[e], ray),
+            Some(e) => self.ellipsoids[e].intersect(ray.origin, ray.direction, ray.tmin, ray.tmax),
         }
     }
 
     /// Details of the hit of a ray with primitive `prim` at parameter `t`.
     pub fn surface(&self, prim: usize, origin: Vec3, dir: Vec3, t: f32) -> SurfaceHit {
         let position = origin + dir * t;
+        let textured = |material: u32| self.materials[material as usize].texture.is_some();
         let (normal, uv, object, part, material) = match prim.checked_sub(self.triangles.len()) {
             None => {
-                let tri = &self.triangles[prim];
                 let attr = &self.tri_attrs[prim];
-                let v0 = Vec3::from(tri.v0);
-                let (v1, v2) = (v0 - Vec3::from(tri.e1), v0 + Vec3::from(tri.e2));
-                let [b0, b1, b2] = barycentric(position, v0, v1, v2);
-                let uv = attr.uv[0] * b0 + attr.uv[1] * b1 + attr.uv[2] * b2;
-                let n = (v1 - v0).cross(v2 - v0).normalize();
-                (n, uv, attr.object, attr.part, attr.material)
+                let uv = if textured(attr.material) {
+                    let [v0, v1, v2] = vertices(&self.triangles[prim]);
+                    let [b0, b1, b2] = barycentric(position, v0, v1, v2);
+                    attr.uv[0] * b0 + attr.uv[1] * b1 + attr.uv[2] * b2
+                } else {
+                    Vec2::ZERO
+                };
+                (attr.normal, uv, attr.object, attr.part, attr.material)
             }
             Some(e) => {
                 let el = &self.ellipsoids[e];
                 let local = el.object_from_world.transform_point3(position);
                 let n = Vec3::from(el.normal_from_object * Vec3A::from(local)).normalize();
-                // Equirectangular UVs: u around +y, v from the north pole down.
-                let u = 0.5 + local.z.atan2(local.x) / std::f32::consts::TAU;
-                let v = (local.y.clamp(-1.0, 1.0)).acos() / std::f32::consts::PI;
-                (n, Vec2::new(u, v), el.object, 0, el.material)
+                let uv = if textured(el.material) {
+                    // Equirectangular UVs: u around +y, v from the north pole down.
+                    let u = 0.5 + local.z.atan2(local.x) / std::f32::consts::TAU;
+                    let v = (local.y.clamp(-1.0, 1.0)).acos() / std::f32::consts::PI;
+                    Vec2::new(u, v)
+                } else {
+                    Vec2::ZERO
+                };
+                (n, uv, el.object, 0, el.material)
             }
         };
         let normal = if normal.dot(dir) > 0.0 {
@@ -359,6 +378,18 @@ impl World {
     }
 }
 
+/// The corners of a triangle as the intersection test's edges give them back.
+fn vertices(tri: &RtTriangle) -> [Vec3; 3] {
+    let v0 = Vec3::from(tri.v0);
+    [v0, v0 - Vec3::from(tri.e1), v0 + Vec3::from(tri.e2)]
+}
+
+/// Unit geometric normal of a triangle (counter-clockwise front), from its stored corners.
+fn geometric_normal(tri: &RtTriangle) -> Vec3 {
+    let [v0, v1, v2] = vertices(tri);
+    (v1 - v0).cross(v2 - v0).normalize()
+}
+
 fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
     let (e0, e1, ep) = (b - a, c - a, p - a);
     let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
@@ -369,26 +400,30 @@ fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
     [1.0 - v - w, v, w]
 }
 
-#[inline(always)]
-fn intersect_ellipsoid(el: &Ellipsoid, ray: &Ray) -> f32 {
-    let o = el.object_from_world.transform_point3a(ray.origin);
-    let d = el.object_from_world.transform_vector3a(ray.direction);
-    let a = d.dot(d);
-    let b = o.dot(d);
-    let c = o.dot(o) - 1.0;
-    let disc = b * b - a * c;
-    if disc < 0.0 {
-        return f32::INFINITY;
-    }
-    let root = disc.sqrt();
-    // The numerically stable pair of roots.
-    let q = -(b + root.copysign(b));
-    let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
-    let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
-    for t in [near, far] {
-        if t >= ray.tmin && t <= ray.tmax {
-            return t;
+impl Ellipsoid {
+    /// Ray parameter of the first hit of the ray `origin + t dir` (unit `dir`, world frame)
+    /// with the ellipsoid's surface in [tmin, tmax], or infinity.
+    #[inline(always)]
+    pub fn intersect(&self, origin: Vec3A, dir: Vec3A, tmin: f32, tmax: f32) -> f32 {
+        let o = self.object_from_world.transform_point3a(origin);
+        let d = self.object_from_world.transform_vector3a(dir);
+        let a = d.dot(d);
+        let b = o.dot(d);
+        let c = o.dot(o) - 1.0;
+        let disc = b * b - a * c;
+        if disc < 0.0 {
+            return f32::INFINITY;
         }
+        let root = disc.sqrt();
+        // The numerically stable pair of roots.
+        let q = -(b + root.copysign(b));
+        let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
+        let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
+        for t in [near, far] {
+            if t >= tmin && t <= tmax {
+                return t;
+            }
+        }
+        f32::INFINITY
     }
-    f32::INFINITY
 }

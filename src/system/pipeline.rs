@@ -14,6 +14,7 @@ use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::render::settings::{RenderSettings, check_spp, resized};
 use crate::render::views::View;
+use crate::scene::world::view_bit;
 use crate::scene::{Obstacle, Scene};
 use crate::system::compensation::{Crop, ModelPlane, compute_crop};
 use crate::system::display::{
@@ -22,6 +23,7 @@ use crate::system::display::{
 use crate::system::head::{FaceDetection, detect, eye_from_detection, gaussian};
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use crate::system::report::report;
+use crate::util::memory::peak_rss_bytes;
 
 /// Everything a run produces.
 pub struct RunResult {
@@ -181,6 +183,22 @@ fn admissible_offsets(
 
 /// Runs the system on a loaded scene; renders every view.
 pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
+    run_with_truth(ctx, options, None)
+}
+
+/// The driver's camera a run renders at: the scene's, resized by the options.
+pub fn driver_camera(scene: &Scene, options: &RunOptions) -> Result<Camera> {
+    resized(scene.driver, options.width, options.height)
+}
+
+/// [`run`], given the `truth` frame when it is already rendered (a sweep renders it once for
+/// all configurations that share the eye): it must be what [`run`] would render, the
+/// [`driver_camera`]'s `truth` view at the options' samples per pixel.
+pub fn run_with_truth(
+    ctx: &RenderContext,
+    options: &RunOptions,
+    truth: Option<&Frame>,
+) -> Result<RunResult> {
     let mut scene = ctx.scene.clone();
     scene.frontal = resized(scene.frontal, options.frontal_width, None)?;
     scene.back = resized(scene.back, options.back_width, None)?;
@@ -197,7 +215,7 @@ pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
     {
         bail!("head bias must be finite and jitter ≥ 0");
     }
-    let driver = resized(scene.driver, options.width, options.height)?;
+    let driver = driver_camera(scene, options)?;
     let settings = RenderSettings {
         spp: options.spp,
         progress: options.progress,
@@ -251,8 +269,25 @@ pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
         .filter(|&&i| i == MISSING_ID)
         .count() as f64
         / display.object_id.len() as f64;
-    let truth = timed(&mut timings, &driver, View::Truth);
-    let occluded = timed(&mut timings, &driver, View::Occluded);
+    // `occluded` and `seethru` differ from `truth` only where the obstacle can be seen:
+    // only those pixels are traced again.
+    let truth = match truth {
+        Some(t) => {
+            assert_eq!((t.width, t.height), (driver.width, driver.height));
+            t.clone()
+        }
+        None => timed(&mut timings, &driver, View::Truth),
+    };
+    let (occluded, stats) = ctx.render_over(
+        &driver,
+        &truth,
+        view_bit::TRUTH,
+        view_bit::OCCLUDED,
+        None,
+        settings,
+        "occluded",
+    );
+    timings.insert("occluded".into(), json!(stats.seconds));
     let placement = DisplayPlacement::new(&scene.obstacle);
     let surface = match options.display {
         DisplayModel::Pixels => DisplaySurface::Pixels {
@@ -265,10 +300,18 @@ pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
             placement,
         },
     };
-    let (seethru, stats) = ctx.render_seethru(&driver, &surface, settings);
+    let (seethru, stats) = ctx.render_over(
+        &driver,
+        &truth,
+        view_bit::TRUTH,
+        view_bit::SEETHRU,
+        Some(&surface),
+        settings,
+        "seethru",
+    );
     timings.insert("seethru".into(), json!(stats.seconds));
 
-    let report = report(
+    let mut report = report(
         scene,
         options,
         &crop,
@@ -279,6 +322,8 @@ pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
         &out,
         timings,
     );
+    // The renders are the run's memory peak.
+    report["peak_rss_bytes"] = json!(peak_rss_bytes());
     Ok(RunResult {
         truth,
         occluded,

@@ -1,7 +1,8 @@
 //! Small pieces every layer uses: sRGB transfer functions, deterministic hashing for
-//! sampling, the progress line, and JSON for infinite distances.
+//! sampling, the progress line, JSON for infinite distances and the process's peak memory.
 
 pub mod color;
 pub mod json;
+pub mod memory;
 pub mod progress;
 pub mod sampling;

@@ -137,11 +137,7 @@ translate = [0.0, 0.0, -{wall}]
 
     pub fn context(&self) -> seethru::render::integrator::RenderContext {
         let scene = parse_in(&repo_path("scenes"), "wall.toml", &self.text()).unwrap();
-        seethru::render::integrator::RenderContext::new(
-            scene,
-            seethru::render::accel::BvhKind::Cwbvh,
-        )
-        .unwrap()
+        seethru::render::integrator::RenderContext::new(scene).unwrap()
     }
 }
 

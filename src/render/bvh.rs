@@ -1,0 +1,508 @@
+//! A wide bounding volume hierarchy laid out for SIMD traversal of single rays.
+//!
+//! obvhs builds a binary BVH (PLOC, spatial pre-splits, reinsertion); this module collapses it
+//! into nodes of four children whose boxes are stored structure-of-arrays, so that one ray is
+//! tested against all four with a few SSE instructions (glam's `Vec4`, any x86-64), and into
+//! leaves of primitive packets — four triangles tested together, or single ellipsoids
+//! ([`crate::render::packets`]).
+//!
+//! Traversal keeps the ray's `tmax` at the closest hit so far, visits children near to far,
+//! and skips stacked subtrees that start beyond it. Box tests are conservative (the exit
+//! distance is rounded up by a few ulps) so that rounding never drops a box whose primitive
+//! the exact intersection test would hit: the brute-force twins in `tests/accel.rs` hold every
+//! query to the same distance, bit for bit.
+
+use anyhow::{Result, bail};
+use glam::Vec4;
+use obvhs::BvhBuildParams;
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::Bvh2;
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
+use obvhs::ploc::PlocBuilder;
+
+use crate::render::packets::{EllipsoidLeaf, TRI_LANES, Triangles4};
+use crate::render::ray::TraceRay;
+use crate::scene::world::World;
+
+/// Children per node: one per lane of a `Vec4`.
+const WIDTH: usize = 4;
+
+/// Child reference: a leaf (else an inner node's index) ...
+const LEAF: u32 = 1 << 31;
+/// ... of ellipsoids (else of triangle packets) ...
+const ELLIPSOIDS: u32 = 1 << 30;
+/// ... with (packets − 1) in these bits, and the first packet's index below them.
+const COUNT_SHIFT: u32 = 27;
+const COUNT_MASK: u32 = 0b111;
+const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
+/// Most packets in one leaf.
+const MAX_LEAF_PACKETS: usize = COUNT_MASK as usize + 1;
+/// An unused child slot (its box is empty, so it is never entered).
+const EMPTY: u32 = u32::MAX;
+/// Traversal stack entries; a hierarchy that could need more is refused at build time.
+const STACK: usize = 512;
+/// Box exits are scaled by this before comparison: 8 ulps of headroom for the rounding of
+/// the slab distances against the exact primitive tests.
+const EXIT_ROUND_UP: f32 = 1.0 + 8.0 * f32::EPSILON;
+
+/// What the box test needs of a ray, in every lane: computed once per traversal.
+struct RayLanes {
+    origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
+}
+
+impl RayLanes {
+    #[inline(always)]
+    fn new(ray: &TraceRay) -> RayLanes {
+        RayLanes {
+            origin: [ray.origin.x, ray.origin.y, ray.origin.z].map(Vec4::splat),
+            inv_dir: [ray.inv_dir.x, ray.inv_dir.y, ray.inv_dir.z].map(Vec4::splat),
+        }
+    }
+}
+
+/// Four child boxes, structure of arrays, and the child references.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Node {
+    /// Per child: [min x, max x, min y, max y, min z, max z].
+    bounds: [Vec4; 6],
+    children: [u32; WIDTH],
+}
+
+impl Node {
+    /// Unused slots have NaN boxes, which no ray enters.
+    const EMPTY: Node = Node {
+        bounds: [Vec4::NAN; 6],
+        children: [EMPTY; WIDTH],
+    };
+
+    /// Which children the ray enters in [tmin, tmax] (bit i for child i), and where.
+    #[inline(always)]
+    fn intersect(&self, lanes: &RayLanes, tmin: f32, tmax: f32) -> (u32, Vec4) {
+        let b = &self.bounds;
+        let [ox, oy, oz] = lanes.origin;
+        let [ix, iy, iz] = lanes.inv_dir;
+        let (x0, x1) = ((b[0] - ox) * ix, (b[1] - ox) * ix);
+        let (y0, y1) = ((b[2] - oy) * iy, (b[3] - oy) * iy);
+        let (z0, z1) = ((b[4] - oz) * iz, (b[5] - oz) * iz);
+        // SSE min/max return the second operand where either is NaN: an empty slot's NaN
+        // box (last operand) makes its entry NaN, and NaN ≤ anything is false.
+        let entry = Vec4::splat(tmin)
+            .max(z0.min(z1))
+            .max(y0.min(y1))
+            .max(x0.min(x1));
+        let exit = Vec4::splat(tmax)
+            .min(z0.max(z1))
+            .min(y0.max(y1))
+            .min(x0.max(x1));
+        (entry.cmple(exit * EXIT_ROUND_UP).bitmask(), entry)
+    }
+}
+
+/// A traversal stack of (entry distance, child reference) keys, allocated once per thread
+/// and reused: zeroing a fresh array for every ray cost more than the traversal.
+pub struct Stack {
+    entries: Vec<u64>,
+    len: usize,
+}
+
+impl Stack {
+    pub fn new() -> Stack {
+        Stack {
+            entries: vec![0; STACK],
+            len: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, key: u64) {
+        self.entries[self.len] = key;
+        self.len += 1;
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<u64> {
+        self.len = self.len.checked_sub(1)?;
+        Some(self.entries[self.len])
+    }
+}
+
+impl Default for Stack {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Sort key of a child: its entry distance (non-negative floats order as their bits) above
+/// its reference.
+#[inline(always)]
+fn key(entry: f32, child: u32) -> u64 {
+    (u64::from(entry.to_bits()) << 32) | u64::from(child)
+}
+
+/// Orders `keys[i] <= keys[j]`.
+#[inline(always)]
+fn sort_pair(keys: &mut [u64; WIDTH], i: usize, j: usize) {
+    let (a, b) = (keys[i], keys[j]);
+    keys[i] = a.min(b);
+    keys[j] = a.max(b);
+}
+
+#[inline(always)]
+fn key_entry(key: u64) -> f32 {
+    f32::from_bits((key >> 32) as u32)
+}
+
+/// A wide BVH over the triangles and ellipsoids of a world.
+pub struct Bvh {
+    nodes: Vec<Node>,
+    triangles: Vec<Triangles4>,
+    ellipsoids: Vec<EllipsoidLeaf>,
+}
+
+impl Bvh {
+    /// Builds the hierarchy over primitives of `world` with boxes `boxes`, referred to by
+    /// `prims` (a primitive may have several boxes: spatial splits).
+    pub fn build(world: &World, boxes: &[Aabb], prims: Vec<u32>) -> Result<Self> {
+        let mut bvh = Bvh {
+            nodes: Vec::new(),
+            triangles: Vec::new(),
+            ellipsoids: Vec::new(),
+        };
+        if boxes.is_empty() {
+            return Ok(bvh);
+        }
+        let params = BvhBuildParams::medium_build();
+        let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
+            params.ploc_search_distance,
+            boxes,
+            prims,
+            params.sort_precision,
+            params.search_depth_threshold,
+        );
+        bvh2.uses_spatial_splits = true;
+        ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+        let summaries = summarise(&bvh2, world.triangles.len() as u32);
+        let mut builder = Builder {
+            bvh2: &bvh2,
+            summaries: &summaries,
+            world,
+            out: &mut bvh,
+        };
+        // The root is always an inner node, so that traversal starts uniformly.
+        let root = builder.reserve();
+        builder.fill(root, &[0], 1)?;
+        Ok(bvh)
+    }
+
+    /// Tests the primitives of leaf `leaf` for the closest hit; shrinks `ray.tmax`.
+    #[inline(always)]
+    fn leaf_closest(&self, leaf: u32, ray: &mut TraceRay) -> Option<u32> {
+        let first = (leaf & FIRST_MASK) as usize;
+        let count = ((leaf >> COUNT_SHIFT) & COUNT_MASK) as usize + 1;
+        let mut found = None;
+        if leaf & ELLIPSOIDS == 0 {
+            for packet in &self.triangles[first..first + count] {
+                if let Some(prim) = packet.closest(ray) {
+                    found = Some(prim);
+                }
+            }
+        } else {
+            for ellipsoid in &self.ellipsoids[first..first + count] {
+                if let Some(prim) = ellipsoid.closest(ray) {
+                    found = Some(prim);
+                }
+            }
+        }
+        found
+    }
+
+    #[inline(always)]
+    fn leaf_any(&self, leaf: u32, ray: &TraceRay) -> bool {
+        let first = (leaf & FIRST_MASK) as usize;
+        let count = ((leaf >> COUNT_SHIFT) & COUNT_MASK) as usize + 1;
+        if leaf & ELLIPSOIDS == 0 {
+            self.triangles[first..first + count]
+                .iter()
+                .any(|p| p.any(ray))
+        } else {
+            self.ellipsoids[first..first + count]
+                .iter()
+                .any(|p| p.any(ray))
+        }
+    }
+
+    /// Closest primitive hit in [tmin, tmax); shrinks `ray.tmax` to its distance.
+    #[inline]
+    pub fn closest(&self, ray: &mut TraceRay, stack: &mut Stack) -> Option<u32> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let lanes = RayLanes::new(ray);
+        let mut found = None;
+        stack.len = 0;
+        let mut current = 0u32;
+        'visit: loop {
+            // Down the tree, near child first, until a leaf or nothing is hit.
+            while current & LEAF == 0 {
+                let node = &self.nodes[current as usize];
+                let (mut mask, entry) = node.intersect(&lanes, ray.tmin, ray.tmax);
+                if mask == 0 {
+                    break;
+                }
+                let a = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if mask == 0 {
+                    current = node.children[a];
+                    continue;
+                }
+                let b = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let (ka, kb) = (
+                    key(entry[a], node.children[a]),
+                    key(entry[b], node.children[b]),
+                );
+                if mask == 0 {
+                    stack.push(ka.max(kb));
+                    current = ka.min(kb) as u32;
+                    continue;
+                }
+                // Three or four: sort near to far, push all but the nearest.
+                let mut keys = [ka, kb, u64::MAX, u64::MAX];
+                let mut n = 2;
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    keys[n] = key(entry[i], node.children[i]);
+                    n += 1;
+                }
+                // A sorting network for four (absent children sort last, as u64::MAX).
+                sort_pair(&mut keys, 0, 1);
+                sort_pair(&mut keys, 2, 3);
+                sort_pair(&mut keys, 0, 2);
+                sort_pair(&mut keys, 1, 3);
+                sort_pair(&mut keys, 1, 2);
+                for &k in keys[1..n].iter().rev() {
+                    stack.push(k);
+                }
+                current = keys[0] as u32;
+            }
+            if current & LEAF != 0
+                && let Some(prim) = self.leaf_closest(current, ray)
+            {
+                found = Some(prim);
+            }
+            // The next stacked subtree that starts before the closest hit so far.
+            while let Some(k) = stack.pop() {
+                if key_entry(k) <= ray.tmax * EXIT_ROUND_UP {
+                    current = k as u32;
+                    continue 'visit;
+                }
+            }
+            return found;
+        }
+    }
+
+    /// Whether any primitive is hit in [tmin, tmax].
+    #[inline]
+    pub fn any(&self, ray: &TraceRay, stack: &mut Stack) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let lanes = RayLanes::new(ray);
+        stack.len = 0;
+        let mut current = 0u32;
+        loop {
+            if current & LEAF == 0 {
+                let node = &self.nodes[current as usize];
+                let (mut mask, _) = node.intersect(&lanes, ray.tmin, ray.tmax);
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    stack.push(u64::from(node.children[i]));
+                }
+            } else if self.leaf_any(current, ray) {
+                return true;
+            }
+            match stack.pop() {
+                Some(k) => current = k as u32,
+                None => return false,
+            }
+        }
+    }
+
+    /// Bytes held by the hierarchy.
+    pub fn bytes(&self) -> usize {
+        self.nodes.len() * size_of::<Node>()
+            + self.triangles.len() * size_of::<Triangles4>()
+            + self.ellipsoids.len() * size_of::<EllipsoidLeaf>()
+    }
+}
+
+/// What the builder needs to know of a BVH2 subtree.
+#[derive(Clone, Copy, Default)]
+struct Summary {
+    /// Primitive references under the node (a split primitive counts once per box).
+    count: u32,
+    /// Whether they are all triangles, or all ellipsoids.
+    triangles: bool,
+    ellipsoids: bool,
+}
+
+/// Summaries of every BVH2 node; primitives below `triangle_count` are triangles.
+fn summarise(bvh2: &Bvh2, triangle_count: u32) -> Vec<Summary> {
+    let mut summaries = vec![Summary::default(); bvh2.nodes.len()];
+    // Preorder, then children before parents.
+    let mut order: Vec<usize> = Vec::with_capacity(bvh2.nodes.len());
+    let mut todo = vec![0usize];
+    while let Some(i) = todo.pop() {
+        order.push(i);
+        let node = &bvh2.nodes[i];
+        if !node.is_leaf() {
+            todo.push(node.first_index as usize);
+            todo.push(node.first_index as usize + 1);
+        }
+    }
+    for &i in order.iter().rev() {
+        let node = &bvh2.nodes[i];
+        summaries[i] = if node.is_leaf() {
+            // A PLOC leaf holds one box, and `first_index` is that box's primitive.
+            let triangle = node.first_index < triangle_count;
+            Summary {
+                count: node.prim_count,
+                triangles: triangle,
+                ellipsoids: !triangle,
+            }
+        } else {
+            let (a, b) = (
+                summaries[node.first_index as usize],
+                summaries[node.first_index as usize + 1],
+            );
+            Summary {
+                count: a.count + b.count,
+                triangles: a.triangles && b.triangles,
+                ellipsoids: a.ellipsoids && b.ellipsoids,
+            }
+        };
+    }
+    summaries
+}
+
+struct Builder<'a> {
+    bvh2: &'a Bvh2,
+    summaries: &'a [Summary],
+    world: &'a World,
+    out: &'a mut Bvh,
+}
+
+impl Builder<'_> {
+    fn reserve(&mut self) -> usize {
+        self.out.nodes.push(Node::EMPTY);
+        self.out.nodes.len() - 1
+    }
+
+    fn area(&self, node: usize) -> f32 {
+        self.bvh2.nodes[node].aabb().half_area()
+    }
+
+    /// Whether the subtree under a BVH2 node becomes one leaf: one packet of one kind.
+    fn is_leaf(&self, node: usize) -> bool {
+        let s = self.summaries[node];
+        self.bvh2.nodes[node].is_leaf()
+            || (s.triangles && s.count as usize <= TRI_LANES)
+            || (s.ellipsoids && s.count == 1)
+    }
+
+    /// Fills wide node `at` with the subtrees of BVH2 nodes `start`, opened largest first
+    /// until there are `WIDTH`.
+    fn fill(&mut self, at: usize, start: &[usize], depth: usize) -> Result<()> {
+        // A closest-hit query stacks at most WIDTH − 1 entries per level, an any-hit WIDTH.
+        if depth * WIDTH > STACK {
+            bail!(
+                "the scene's hierarchy is deeper than {} levels",
+                STACK / WIDTH
+            );
+        }
+        let mut children: Vec<usize> = start.to_vec();
+        while children.len() < WIDTH {
+            let open = children
+                .iter()
+                .enumerate()
+                .filter(|&(_, &c)| !self.is_leaf(c))
+                .max_by(|a, b| self.area(*a.1).total_cmp(&self.area(*b.1)));
+            let Some((i, &c)) = open else { break };
+            let first = self.bvh2.nodes[c].first_index as usize;
+            children[i] = first;
+            children.insert(i + 1, first + 1);
+        }
+        let mut node = Node::EMPTY;
+        let mut inner = Vec::new();
+        for (slot, &c) in children.iter().enumerate() {
+            // Padded by a few ulps of the coordinates: clipped (spatially split) boxes can
+            // be a rounding short of their triangle, which matters to a ray that runs
+            // exactly along a box face.
+            let aabb = self.bvh2.nodes[c].aabb();
+            let pad = aabb.min.abs().max(aabb.max.abs()) * (4.0 * f32::EPSILON);
+            for axis in 0..3 {
+                node.bounds[2 * axis][slot] = aabb.min[axis] - pad[axis];
+                node.bounds[2 * axis + 1][slot] = aabb.max[axis] + pad[axis];
+            }
+            node.children[slot] = if self.is_leaf(c) {
+                self.leaf(c)?
+            } else {
+                let index = self.reserve();
+                inner.push((index, c));
+                index as u32
+            };
+        }
+        self.out.nodes[at] = node;
+        for (index, c) in inner {
+            let first = self.bvh2.nodes[c].first_index as usize;
+            self.fill(index, &[first, first + 1], depth + 1)?;
+        }
+        Ok(())
+    }
+
+    /// Packs the primitives under BVH2 node `node` into a leaf and returns its reference.
+    fn leaf(&mut self, node: usize) -> Result<u32> {
+        let mut prims = Vec::new();
+        let mut todo = vec![node];
+        while let Some(i) = todo.pop() {
+            let n = &self.bvh2.nodes[i];
+            if n.is_leaf() {
+                prims.extend(n.first_index..n.first_index + n.prim_count);
+            } else {
+                todo.push(n.first_index as usize);
+                todo.push(n.first_index as usize + 1);
+            }
+        }
+        // Spatial splits can put one primitive in several boxes of the same subtree.
+        prims.sort_unstable();
+        prims.dedup();
+        let world = self.world;
+        let (first, count, kind) = if self.summaries[node].triangles {
+            let first = self.out.triangles.len();
+            self.out.triangles.extend(
+                prims
+                    .chunks(TRI_LANES)
+                    .map(|chunk| Triangles4::new(&world.triangles, chunk)),
+            );
+            (first, prims.len().div_ceil(TRI_LANES), 0)
+        } else {
+            let first = self.out.ellipsoids.len();
+            let offset = world.triangles.len();
+            self.out
+                .ellipsoids
+                .extend(prims.iter().map(|&p| EllipsoidLeaf {
+                    ellipsoid: world.ellipsoids[p as usize - offset],
+                    prim: p,
+                }));
+            (first, prims.len(), ELLIPSOIDS)
+        };
+        if count > MAX_LEAF_PACKETS || first + count > FIRST_MASK as usize {
+            bail!("the scene has too many primitives for the BVH's leaf references");
+        }
+        Ok(LEAF | kind | ((count as u32 - 1) << COUNT_SHIFT) | first as u32)
+    }
+}

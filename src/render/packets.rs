@@ -1,0 +1,134 @@
+//! Leaf packets of the wide BVH: four triangles tested against one ray in SIMD lanes, and
+//! single ellipsoids.
+//!
+//! The triangle test is obvhs' `RtTriangle::intersect` (Möller–Trumbore in the layout of
+//! madmann91's bvh), computed lane by lane with the same operations in the same order, so that
+//! it returns the same distance bit for bit: the brute-force twin in `tests/accel.rs` checks it.
+
+use glam::Vec4;
+use obvhs::rt_triangle::RtTriangle;
+
+use crate::render::ray::TraceRay;
+use crate::scene::world::Ellipsoid;
+
+/// Triangles per packet.
+pub const TRI_LANES: usize = 4;
+
+/// Four triangles, structure of arrays: per axis and lane the base vertex, the two edges and
+/// the unnormalised normal of [`RtTriangle`]; and each lane's primitive index.
+#[derive(Clone, Copy, Debug)]
+pub struct Triangles4 {
+    v0: [Vec4; 3],
+    e1: [Vec4; 3],
+    e2: [Vec4; 3],
+    ng: [Vec4; 3],
+    prim: [u32; TRI_LANES],
+}
+
+impl Triangles4 {
+    /// Packs 1 to 4 triangles; unused lanes repeat the first one (a repeated hit never wins).
+    pub fn new(triangles: &[RtTriangle], prims: &[u32]) -> Triangles4 {
+        assert!(!prims.is_empty() && prims.len() <= TRI_LANES);
+        let mut packet = Triangles4 {
+            v0: [Vec4::ZERO; 3],
+            e1: [Vec4::ZERO; 3],
+            e2: [Vec4::ZERO; 3],
+            ng: [Vec4::ZERO; 3],
+            prim: [0; TRI_LANES],
+        };
+        for lane in 0..TRI_LANES {
+            let prim = prims[if lane < prims.len() { lane } else { 0 }];
+            let t = &triangles[prim as usize];
+            for axis in 0..3 {
+                packet.v0[axis][lane] = t.v0[axis];
+                packet.e1[axis][lane] = t.e1[axis];
+                packet.e2[axis][lane] = t.e2[axis];
+                packet.ng[axis][lane] = t.ng[axis];
+            }
+            packet.prim[lane] = prim;
+        }
+        packet
+    }
+
+    /// Each lane's hit distance, and which lanes hit in [tmin, tmax] (bit i for lane i).
+    #[inline(always)]
+    fn hits(&self, ray: &TraceRay) -> (Vec4, u32) {
+        let [ox, oy, oz] = [ray.origin.x, ray.origin.y, ray.origin.z].map(Vec4::splat);
+        let [dx, dy, dz] = [ray.dir.x, ray.dir.y, ray.dir.z].map(Vec4::splat);
+        let [v0x, v0y, v0z] = self.v0;
+        let [e1x, e1y, e1z] = self.e1;
+        let [e2x, e2y, e2z] = self.e2;
+        let [ngx, ngy, ngz] = self.ng;
+        let (cx, cy, cz) = (v0x - ox, v0y - oy, v0z - oz);
+        // r = d × c
+        let rx = dy * cz - dz * cy;
+        let ry = dz * cx - dx * cz;
+        let rz = dx * cy - dy * cx;
+        let inv_det = Vec4::ONE / (ngx * dx + ngy * dy + ngz * dz);
+        let u = (rx * e2x + ry * e2y + rz * e2z) * inv_det;
+        let v = (rx * e1x + ry * e1y + rz * e1z) * inv_det;
+        let w = Vec4::ONE - u - v;
+        let t = (ngx * cx + ngy * cy + ngz * cz) * inv_det;
+        // As obvhs: a -0.0 barycentric is a miss, like a negative one.
+        let outside = u.is_negative_bitmask() | v.is_negative_bitmask() | w.is_negative_bitmask();
+        let valid = (inv_det.cmpne(Vec4::ZERO)
+            & t.cmpge(Vec4::splat(ray.tmin))
+            & t.cmple(Vec4::splat(ray.tmax)))
+        .bitmask()
+            & !outside;
+        (t, valid)
+    }
+}
+
+impl Triangles4 {
+    /// If a lane's triangle is hit in [tmin, tmax), shrinks `ray.tmax` to the closest such
+    /// hit and returns its primitive index.
+    #[inline(always)]
+    pub fn closest(&self, ray: &mut TraceRay) -> Option<u32> {
+        let (t, mut valid) = self.hits(ray);
+        let mut found = None;
+        while valid != 0 {
+            let lane = valid.trailing_zeros() as usize;
+            valid &= valid - 1;
+            if t[lane] < ray.tmax {
+                ray.tmax = t[lane];
+                found = Some(self.prim[lane]);
+            }
+        }
+        found
+    }
+
+    /// Whether any lane's triangle is hit in [tmin, tmax].
+    #[inline(always)]
+    pub fn any(&self, ray: &TraceRay) -> bool {
+        self.hits(ray).1 != 0
+    }
+}
+
+/// One ellipsoid and its primitive index.
+#[derive(Clone, Copy, Debug)]
+pub struct EllipsoidLeaf {
+    pub ellipsoid: Ellipsoid,
+    pub prim: u32,
+}
+
+impl EllipsoidLeaf {
+    /// As [`Triangles4::closest`].
+    #[inline]
+    pub fn closest(&self, ray: &mut TraceRay) -> Option<u32> {
+        let t = self
+            .ellipsoid
+            .intersect(ray.origin, ray.dir, ray.tmin, ray.tmax);
+        (t < ray.tmax).then(|| {
+            ray.tmax = t;
+            self.prim
+        })
+    }
+
+    #[inline]
+    pub fn any(&self, ray: &TraceRay) -> bool {
+        self.ellipsoid
+            .intersect(ray.origin, ray.dir, ray.tmin, ray.tmax)
+            .is_finite()
+    }
+}

@@ -1,0 +1,117 @@
+//! Trace-only workloads for `seethru bench`: batches of rays traced without shading, the way
+//! ray tracing kernels (Embree's `rtcIntersect1`/`rtcOccluded1` over arrays of rays) are
+//! measured. Rays are made before the clock starts; tracing runs on the rayon pool.
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use crate::geometry::camera::Camera;
+use crate::render::accel::{Accel, Hit, make_ray};
+use crate::render::bvh::Stack;
+use crate::render::camera_rays::CameraRays;
+use crate::render::integrator::shadow_ray;
+use crate::render::ray::TraceRay;
+use crate::scene::world::World;
+use crate::util::sampling::{hash_words, unit_float};
+
+/// Rays traced per rayon task.
+const CHUNK: usize = 4096;
+
+/// Rays of one kind, all for one view ([`crate::scene::world::view_bit`]).
+pub struct Batch {
+    pub rays: Vec<TraceRay>,
+    pub view: u8,
+}
+
+/// One ray through each pixel centre, row by row.
+pub fn camera_batch(camera: &Camera, view: u8) -> Batch {
+    let camera_rays = CameraRays::new(camera);
+    let rays = (0..camera.height)
+        .flat_map(|y| (0..camera.width).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let dir = camera_rays.direction(x as f32 + 0.5, y as f32 + 0.5);
+            make_ray(camera_rays.origin, dir, 0.0, f32::INFINITY)
+        })
+        .collect();
+    Batch { rays, view }
+}
+
+/// Closest hits of `batch` into `out` (same length).
+pub fn trace_closest(accel: &Accel, batch: &Batch, out: &mut [Option<Hit>]) {
+    batch
+        .rays
+        .par_chunks(CHUNK)
+        .zip(out.par_chunks_mut(CHUNK))
+        .for_each_init(Stack::new, |stack, (rays, out)| {
+            for (ray, out) in rays.iter().zip(out) {
+                *out = accel.closest_with(ray, batch.view, stack);
+            }
+        });
+}
+
+/// Whether each ray of `batch` is blocked, into `out` (same length).
+pub fn trace_any(accel: &Accel, batch: &Batch, out: &mut [bool]) {
+    batch
+        .rays
+        .par_chunks(CHUNK)
+        .zip(out.par_chunks_mut(CHUNK))
+        .for_each_init(Stack::new, |stack, (rays, out)| {
+            for (ray, out) in rays.iter().zip(out) {
+                *out = accel.occluded_with(ray, batch.view, stack);
+            }
+        });
+}
+
+/// The surface points that `hits` of `batch` found: position and normal facing the ray.
+fn hit_points<'a>(
+    world: &'a World,
+    batch: &'a Batch,
+    hits: &'a [Option<Hit>],
+) -> impl Iterator<Item = (usize, Vec3, Vec3)> + 'a {
+    batch
+        .rays
+        .iter()
+        .zip(hits)
+        .enumerate()
+        .filter_map(|(i, (ray, hit))| {
+            let hit = (*hit)?;
+            let s = world.surface(hit.prim, ray.origin.into(), ray.dir.into(), hit.t);
+            Some((i, s.position, s.normal))
+        })
+}
+
+/// A shadow ray towards the sun (`sun`, unit) from every hit whose surface faces it, as the
+/// integrator casts them.
+pub fn shadow_batch(world: &World, batch: &Batch, hits: &[Option<Hit>], sun: Vec3) -> Batch {
+    let rays = hit_points(world, batch, hits)
+        .filter(|(_, _, n)| n.dot(sun) > 0.0)
+        .map(|(_, p, n)| shadow_ray(p, n, sun))
+        .collect();
+    Batch {
+        rays,
+        view: batch.view,
+    }
+}
+
+/// Incoherent rays: one cosine-distributed direction about the normal at every hit (the rays
+/// of diffuse indirect light), from hashed, reproducible random numbers.
+pub fn cosine_batch(world: &World, batch: &Batch, hits: &[Option<Hit>]) -> Batch {
+    let rays = hit_points(world, batch, hits)
+        .map(|(i, p, n)| {
+            let (u1, u2) = (
+                unit_float(hash_words(&[i as u32, 1])),
+                unit_float(hash_words(&[i as u32, 2])),
+            );
+            // Malley's method: a uniform point on the disc, lifted to the hemisphere.
+            let (r, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
+            let (t, b) = n.any_orthonormal_pair();
+            let dir =
+                (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).sqrt()).normalize();
+            shadow_ray(p, n, dir)
+        })
+        .collect();
+    Batch {
+        rays,
+        view: batch.view,
+    }
+}
