@@ -3,6 +3,7 @@
 //! World frame: right-handed, metres, +y up. See `README.md` § "Scene format" for the
 //! parameter table of every object kind; the defaults below are the ones documented there.
 
+pub mod limits;
 pub mod mesh_io;
 pub mod procedural;
 pub mod read;

@@ -7,6 +7,7 @@ use obvhs::aabb::Aabb;
 use obvhs::ray::Ray;
 use obvhs::rt_triangle::RtTriangle;
 
+use crate::scene::limits::check_placed_mesh;
 use crate::scene::mesh_io::load_mesh;
 use crate::scene::shapes::{Tri, box_face, cuboid, frustum, plane_xz, quad_xy};
 use crate::scene::texture::Texture;
@@ -163,6 +164,13 @@ impl World {
                 Shape::Quad { size } => quad_xy(size2(*size), 0),
                 Shape::Mesh { path } => {
                     let mesh = load_mesh(path)?;
+                    check_placed_mesh(
+                        path,
+                        &object.name,
+                        &mesh.tris,
+                        &object.world_from_object,
+                        world.triangles.len(),
+                    )?;
                     let first = world.materials.len() as u32;
                     world
                         .materials
