@@ -72,7 +72,7 @@ fn bad_input_gives_one_line_and_no_output() {
         (
             vec!["render", scene_arg, "--out", out_arg],
             format!(
-                "error: {scene_arg}:{line}: key `object[1].radius`: must be in (0, 100000], got 0"
+                "error: {scene_arg}:{line}:10: key `object[1].radius`: must be in [1e-6, 100000], got 0"
             ),
         ),
         (

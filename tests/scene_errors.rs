@@ -35,7 +35,7 @@ fn errors_name_file_line_and_key() {
             "radius = 1.0",
             "radius = -1.0",
             "object[1].radius",
-            "must be in (0,",
+            "must be in [1e-6,",
         ),
         (
             "radius = 1.0",
@@ -83,7 +83,7 @@ fn errors_name_file_line_and_key() {
             "width = 0.3",
             "width = 0.0",
             "obstacle.width",
-            "must be in (0,",
+            "must be in [1e-6,",
         ),
         (
             "resolution = [64, 36]",
@@ -119,7 +119,7 @@ fn errors_name_file_line_and_key() {
             "[camera.frontal]\n",
             "[camera.frontal]\nhalf_angle_deg = 95\n",
             "camera.frontal.half_angle_deg",
-            "(0, 89)",
+            "must be in [0.01, 89]",
         ),
         (
             "[camera.frontal]\n",
@@ -137,7 +137,7 @@ fn errors_name_file_line_and_key() {
             "size = [100.0, 100.0]",
             "size = [100.0, -1.0]",
             "object[0].size",
-            "every element must be > 0",
+            "every element must be in [1e-6, 100000], got -1",
         ),
         (
             "[[object]]\nname = \"ground\"",

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use seethru::io::frame_files::read_exr;
+use seethru::io::run_dir::{read_measured_frames, read_run_json};
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
 use seethru::render::integrator::RenderContext;
@@ -26,19 +26,11 @@ impl Measure {
 
 /// `seethru measure`: the metrics of a run directory, from its saved EXRs.
 fn measure_command(dir: &Path, band: u32) -> Result<serde_json::Value> {
-    let text = std::fs::read_to_string(dir.join("run.json")).with_context(|| {
-        format!(
-            "{}: no run.json (not a `seethru run` directory?)",
-            dir.display()
-        )
-    })?;
-    let run_json: serde_json::Value = serde_json::from_str(&text)?;
-    let scene_path = run_json["scene"]
-        .as_str()
-        .context("run.json has no scene path")?;
-    let ctx = RenderContext::new(Scene::load(Path::new(scene_path))?)?;
-    let read = |name: &str| read_exr(&dir.join(format!("{name}.exr")));
-    let (truth, seethru, occluded) = (read("truth")?, read("seethru")?, read("occluded")?);
+    let record = read_run_json(dir)?;
+    let scene = Scene::load(&record.scene)
+        .with_context(|| format!("the scene of {}", dir.join("run.json").display()))?;
+    let ctx = RenderContext::new(scene)?;
+    let [truth, seethru, occluded] = read_measured_frames(dir)?;
     let (maps, metrics) = measure(
         &ctx,
         &ctx.scene,

@@ -9,6 +9,7 @@ use glam::Vec3;
 
 use crate::io::atomic::write_atomically;
 use crate::render::frame::Frame;
+use crate::scene::limits::{MAX_PIXELS, MAX_RESOLUTION};
 use crate::util::color::encode_srgb8;
 use crate::util::sampling::hash_u32;
 
@@ -105,31 +106,99 @@ pub fn write_exr_channels(
     write_atomically(path, |tmp| Ok(image.write().to_file(tmp)?))
 }
 
-/// Reads an EXR written by [`write_exr`] back into a frame.
+/// Most channels an EXR may have to be read as a frame (seethru writes 16).
+const MAX_EXR_CHANNELS: usize = 64;
+
+/// Reads an EXR written by [`write_exr`] back into a frame. Errors name the file and what is
+/// wrong with it: not an EXR, truncated, too large, a channel missing or of the wrong type.
 pub fn read_exr(path: &Path) -> Result<Frame> {
-    let image = read_first_flat_layer_from_file(path)
+    let file =
+        std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    read_exr_from(std::io::BufReader::new(file), MAX_PIXELS)
+        .with_context(|| format!("cannot read {}", path.display()))
+}
+
+/// Width and height of the first layer of an EXR, from its header alone.
+pub fn exr_size(path: &Path) -> Result<(u32, u32)> {
+    let file =
+        std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let size = exr::meta::MetaData::read_from_unbuffered(file, false)
+        .map_err(anyhow::Error::from)
+        .and_then(|meta| {
+            let header = meta.headers.first().context("the file has no layer")?;
+            Ok(header.layer_size)
+        })
         .with_context(|| format!("cannot read {}", path.display()))?;
+    Ok((size.width() as u32, size.height() as u32))
+}
+
+/// Reads an EXR from a reader into a frame, refusing images of more than `max_pixels` before
+/// decoding them.
+pub fn read_exr_from<R: std::io::Read + std::io::Seek + Send>(
+    mut reader: R,
+    max_pixels: u64,
+) -> Result<Frame> {
+    let meta = exr::meta::MetaData::read_from_buffered(&mut reader, false)
+        .map_err(|e| anyhow::anyhow!("not a readable EXR: {e}"))?;
+    let header = meta.headers.first().context("the file has no layer")?;
+    let size = header.layer_size;
+    if size.width() == 0
+        || size.height() == 0
+        || size.width() > MAX_RESOLUTION as usize
+        || size.height() > MAX_RESOLUTION as usize
+        || (size.width() as u64) * (size.height() as u64) > max_pixels
+    {
+        bail!(
+            "the image is {}×{}: each side must be in [1, {MAX_RESOLUTION}], at most {max_pixels} pixels",
+            size.width(),
+            size.height()
+        );
+    }
+    if header.channels.list.len() > MAX_EXR_CHANNELS {
+        bail!(
+            "{} channels, more than the {MAX_EXR_CHANNELS} a frame can have",
+            header.channels.list.len()
+        );
+    }
+    reader.seek(std::io::SeekFrom::Start(0))?;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .non_parallel()
+        .from_buffered(reader)
+        .map_err(|e| anyhow::anyhow!("invalid or truncated EXR: {e}"))?;
     let layer = &image.layer_data;
     let (width, height) = (layer.size.width() as u32, layer.size.height() as u32);
+    let pixels = width as usize * height as usize;
     let find = |name: &str| -> Result<&FlatSamples> {
-        layer
+        let samples = layer
             .channel_data
             .list
             .iter()
             .find(|c| c.name.to_string() == name)
             .map(|c| &c.sample_data)
-            .with_context(|| format!("{}: no channel `{name}`", path.display()))
+            .with_context(|| format!("no channel `{name}` (not written by seethru?)"))?;
+        if samples.len() != pixels {
+            bail!(
+                "channel `{name}` has {} samples for {width}×{height} pixels",
+                samples.len()
+            );
+        }
+        Ok(samples)
     };
     let f32s = |name: &str| -> Result<Vec<f32>> {
         match find(name)? {
             FlatSamples::F32(v) => Ok(v.clone()),
-            _ => bail!("{}: channel `{name}` is not f32", path.display()),
+            other => bail!("channel `{name}` is {}, expected f32", sample_type(other)),
         }
     };
     let u32s = |name: &str| -> Result<Vec<u32>> {
         match find(name)? {
             FlatSamples::U32(v) => Ok(v.clone()),
-            _ => bail!("{}: channel `{name}` is not u32", path.display()),
+            other => bail!("channel `{name}` is {}, expected u32", sample_type(other)),
         }
     };
     let vec3s = |name: &str, axes: [&str; 3]| -> Result<Vec<Vec3>> {
@@ -155,6 +224,14 @@ pub fn read_exr(path: &Path) -> Result<Frame> {
         object_id: u32s("object_id.id")?,
         part_id: u32s("part_id.id")?,
     })
+}
+
+fn sample_type(samples: &FlatSamples) -> &'static str {
+    match samples {
+        FlatSamples::F16(_) => "f16",
+        FlatSamples::F32(_) => "f32",
+        FlatSamples::U32(_) => "u32",
+    }
 }
 
 /// Writes `<name>.png`, `<name>_ids.png` and `<name>.exr` into `dir`.

@@ -5,3 +5,4 @@ pub mod atomic;
 pub mod export;
 pub mod frame_files;
 pub mod plot;
+pub mod run_dir;

@@ -6,4 +6,5 @@ pub mod metrics;
 pub mod ratio;
 pub mod ratio_setup;
 pub mod sweep;
+pub mod sweep_csv;
 pub mod sweep_grid;

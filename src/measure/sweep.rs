@@ -14,6 +14,7 @@ use rayon::prelude::*;
 use crate::io::atomic::write_text;
 use crate::io::plot::{Figure, Series};
 use crate::measure::metrics::measure;
+use crate::measure::sweep_csv::finished_rows;
 use crate::measure::sweep_grid::{Param, combinations, configure};
 use crate::render::integrator::{RenderContext, same_geometry};
 use crate::render::settings::RenderSettings;
@@ -107,29 +108,11 @@ pub fn sweep(
         .collect();
     let header_line = header.join(",");
     // Rows already done (same header, same parameter values at the same index).
-    let mut rows: Vec<(usize, String)> = Vec::new();
-    if let Ok(text) = std::fs::read_to_string(csv) {
-        let mut lines = text.lines();
-        if lines.next() != Some(header_line.as_str()) {
-            bail!(
-                "{} exists with other columns; remove it or choose another --out",
-                csv.display()
-            );
-        }
-        for line in lines {
-            let fields: Vec<&str> = line.split(',').collect();
-            let index: usize = fields
-                .first()
-                .and_then(|i| i.parse().ok())
-                .with_context(|| format!("{}: malformed row `{line}`", csv.display()))?;
-            let matches = configs
-                .get(index)
-                .is_some_and(|c| c.iter().zip(&fields[1..]).all(|((_, v), f)| v == f));
-            if matches && fields.len() == header.len() {
-                rows.push((index, line.to_string()));
-            }
-        }
-    }
+    let rows = match std::fs::read_to_string(csv) {
+        Ok(text) => finished_rows(&text, csv, &header_line, &configs)?,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+        Err(e) => bail!("cannot read {} to resume the sweep: {e}", csv.display()),
+    };
     let done: HashSet<usize> = rows.iter().map(|(i, _)| *i).collect();
     let todo: Vec<usize> = (0..configs.len()).filter(|i| !done.contains(i)).collect();
     let rows = Mutex::new(rows);

@@ -3,13 +3,23 @@
 //! Colours in mesh files (OBJ `Kd`, glTF `baseColorFactor`) are taken as linear RGB, as the
 //! exporters of Blender and most DCC tools write them. Part ids are the OBJ object/group
 //! index or the glTF primitive index, so a measurement can tell a car's body from its wheels.
+//!
+//! Mesh files come from other programs, so nothing in them is trusted: every vertex and colour
+//! must be finite and in range, every index and accessor must point inside its buffer, the glTF
+//! node hierarchy must be a forest, and the triangle count stays within
+//! [`MAX_TRIANGLES`]. The parsers take the file's bytes and a function that reads the files it
+//! refers to (`.mtl`, `.bin`), so that they can be fuzzed without a file system.
 
-use std::path::Path;
+use std::cell::RefCell;
+use std::io::{BufReader, Cursor};
+use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, anyhow, bail};
 use glam::{Mat4, Vec2, Vec3};
 
+use crate::scene::limits::{MAX_MESH_BYTES, MAX_TRIANGLES, first_bad_vertex};
 use crate::scene::shapes::Tri;
+use crate::util::number::short_list;
 
 /// A material that a mesh file defines.
 #[derive(Clone, Debug, PartialEq)]
@@ -26,33 +36,117 @@ pub struct LoadedMesh {
     pub materials: Vec<FileMaterial>,
 }
 
+/// Reads a file that a mesh refers to, within [`MAX_MESH_BYTES`].
+pub fn read_limited(path: &Path) -> std::io::Result<Vec<u8>> {
+    let size = std::fs::metadata(path)?.len();
+    if size > MAX_MESH_BYTES {
+        return Err(std::io::Error::other(format!(
+            "{size} bytes is larger than the limit of {MAX_MESH_BYTES} bytes"
+        )));
+    }
+    std::fs::read(path)
+}
+
+/// Loads an OBJ (with its MTL files) or a glTF/GLB (with its buffers). Errors name the file.
 pub fn load_mesh(path: &Path) -> Result<LoadedMesh> {
     let lower = path.to_string_lossy().to_ascii_lowercase();
-    let mesh = if lower.ends_with(".obj") {
-        load_obj(path)
-    } else if lower.ends_with(".gltf") || lower.ends_with(".glb") {
-        load_gltf(path)
-    } else {
-        bail!("unsupported mesh format (use .obj, .gltf or .glb)")
+    let bytes = read_limited(path).with_context(|| format!("cannot read mesh {}", path.display()));
+    let mesh = bytes.and_then(|bytes| {
+        if lower.ends_with(".obj") {
+            parse_obj(&bytes, path, &read_limited)
+        } else if lower.ends_with(".gltf") || lower.ends_with(".glb") {
+            parse_gltf(&bytes, path, &read_limited)
+        } else {
+            bail!("unsupported mesh format (use .obj, .gltf or .glb)")
+        }
+    });
+    mesh.with_context(|| format!("mesh {}", path.display()))
+}
+
+/// Checks what every loader must deliver: some triangles with an area, within the limits,
+/// finite vertices inside the world, colours in [0, 1].
+fn checked(mesh: LoadedMesh) -> Result<LoadedMesh> {
+    if mesh.tris.len() > MAX_TRIANGLES {
+        bail!(
+            "{} triangles, more than the limit of {MAX_TRIANGLES}",
+            mesh.tris.len()
+        );
     }
-    .with_context(|| format!("cannot load mesh {}", path.display()))?;
-    if mesh.tris.is_empty() {
-        bail!("mesh {} has no triangles", path.display());
+    if let Some((i, p)) = first_bad_vertex(&mesh.tris) {
+        bail!(
+            "triangle {i} has a vertex at {}: coordinates must be finite and within the world, [-1e6, 1e6] m",
+            short_list(&p.to_array().map(f64::from))
+        );
     }
-    if mesh.tris.iter().any(|t| t.p.iter().any(|p| !p.is_finite())) {
-        bail!("mesh {} has non-finite vertex positions", path.display());
+    if let Some(i) = mesh
+        .tris
+        .iter()
+        .position(|t| t.uv.iter().any(|uv| !uv.is_finite()))
+    {
+        bail!("triangle {i} has a texture coordinate that is not finite");
+    }
+    if !mesh.tris.iter().any(|t| {
+        let [a, b, c] = t.p;
+        (b - a).cross(c - a).length_squared() > 0.0
+    }) {
+        bail!(
+            "no faces with an area ({} triangles, all degenerate or none: points and lines are not drawn)",
+            mesh.tris.len()
+        );
+    }
+    for m in &mesh.materials {
+        if m.linear_color.iter().any(|c| !(0.0..=1.0).contains(c)) {
+            bail!(
+                "material `{}` has the colour {}: components must be in [0, 1]",
+                m.name,
+                short_list(&m.linear_color.map(f64::from))
+            );
+        }
     }
     Ok(mesh)
 }
 
-fn load_obj(path: &Path) -> Result<LoadedMesh> {
+/// Parses an OBJ file's bytes; `path` names it and anchors its `mtllib` files, which `read`
+/// reads.
+pub fn parse_obj(
+    bytes: &[u8],
+    path: &Path,
+    read: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
+) -> Result<LoadedMesh> {
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
         ..Default::default()
     };
-    let (models, materials) = tobj::load_obj(path, &options).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let materials = materials.map_err(|e| anyhow::anyhow!("material library: {e}"))?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+    // tobj's material errors carry no path: remember ours.
+    let mtl_error: RefCell<Option<String>> = RefCell::new(None);
+    let load_mtl = |written: &Path| -> tobj::MTLLoadResult {
+        let resolved = dir.join(written);
+        let fail = |why: String| {
+            mtl_error.borrow_mut().get_or_insert(format!(
+                "material library `{}` (resolved against the OBJ's folder: {}): {why}",
+                written.display(),
+                resolved.display()
+            ));
+            Err(tobj::LoadError::OpenFileFailed)
+        };
+        match read(&resolved) {
+            Ok(mtl) => tobj::load_mtl_buf(&mut BufReader::new(Cursor::new(mtl)))
+                .or_else(|e| fail(e.to_string())),
+            Err(e) => fail(e.to_string()),
+        }
+    };
+    let (models, materials) =
+        tobj::load_obj_buf(&mut BufReader::new(Cursor::new(bytes)), &options, load_mtl)
+            .map_err(|e| anyhow!("invalid OBJ: {e}"))?;
+    let materials = match (materials, mtl_error.into_inner()) {
+        (_, Some(why)) => bail!(why),
+        (Err(e), None) => bail!("material library: {e}"),
+        (Ok(m), None) => m,
+    };
     let mut out = LoadedMesh {
         materials: materials
             .iter()
@@ -63,54 +157,69 @@ fn load_obj(path: &Path) -> Result<LoadedMesh> {
             .collect(),
         ..Default::default()
     };
+    let mut triangles = 0usize;
     for (part, model) in models.iter().enumerate() {
         let mesh = &model.mesh;
-        let vertex = |i: u32| {
-            let i = i as usize;
-            Vec3::new(
-                mesh.positions[3 * i],
-                mesh.positions[3 * i + 1],
-                mesh.positions[3 * i + 2],
-            )
+        triangles += mesh.indices.len() / 3;
+        if triangles > MAX_TRIANGLES {
+            bail!("more than the limit of {MAX_TRIANGLES} triangles");
+        }
+        let vertex = |i: usize| -> Option<Vec3> {
+            Some(Vec3::from_slice(mesh.positions.get(3 * i..3 * i + 3)?))
         };
-        let uv = |i: u32| {
-            let i = i as usize;
-            match mesh.texcoords.get(2 * i..2 * i + 2) {
-                // OBJ puts v = 0 at the image's bottom; ours is at the top.
-                Some(t) => Vec2::new(t[0], 1.0 - t[1]),
-                None => Vec2::ZERO,
-            }
+        let uv = |i: usize| match mesh.texcoords.get(2 * i..2 * i + 2) {
+            // OBJ puts v = 0 at the image's bottom; ours is at the top.
+            Some(t) => Vec2::new(t[0], 1.0 - t[1]),
+            None => Vec2::ZERO,
         };
+        if let Some(m) = mesh.material_id
+            && m >= out.materials.len()
+        {
+            bail!(
+                "object `{}` uses material {m}, which is not defined",
+                model.name
+            );
+        }
         for idx in mesh.indices.chunks_exact(3) {
-            if idx
-                .iter()
-                .any(|&i| 3 * i as usize + 2 >= mesh.positions.len())
-            {
+            let idx = [idx[0] as usize, idx[1] as usize, idx[2] as usize];
+            let [Some(a), Some(b), Some(c)] = idx.map(vertex) else {
                 bail!(
                     "object `{}` indexes a vertex that does not exist",
                     model.name
                 );
-            }
+            };
             out.tris.push(Tri {
-                p: [vertex(idx[0]), vertex(idx[1]), vertex(idx[2])],
-                uv: [uv(idx[0]), uv(idx[1]), uv(idx[2])],
+                p: [a, b, c],
+                uv: idx.map(uv),
                 part: part as u32,
                 file_material: mesh.material_id.map(|m| m as u32),
             });
         }
     }
-    Ok(out)
+    checked(out)
 }
 
-fn load_gltf(path: &Path) -> Result<LoadedMesh> {
-    let (doc, buffers, _images) = gltf::import(path)?;
+/// Parses a glTF (JSON) or GLB file's bytes; `path` names it and anchors its external
+/// buffers, which `read` reads. Images are not loaded: only `baseColorFactor` is used.
+pub fn parse_gltf(
+    bytes: &[u8],
+    path: &Path,
+    read: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
+) -> Result<LoadedMesh> {
+    let gltf::Gltf {
+        document: doc,
+        blob,
+    } = gltf::Gltf::from_slice(bytes).map_err(|e| anyhow!("invalid glTF: {e}"))?;
+    let buffers = load_buffers(&doc, blob, path, read)?;
     let mut out = LoadedMesh {
         materials: doc
             .materials()
             .map(|m| {
                 let c = m.pbr_metallic_roughness().base_color_factor();
                 FileMaterial {
-                    name: m.name().unwrap_or("").to_string(),
+                    name: m
+                        .name()
+                        .map_or_else(|| format!("#{}", m.index().unwrap_or(0)), String::from),
                     linear_color: [c[0], c[1], c[2]],
                 }
             })
@@ -121,48 +230,246 @@ fn load_gltf(path: &Path) -> Result<LoadedMesh> {
     let Some(scene) = scene else {
         bail!("the file has no scene")
     };
+    // The node hierarchy must be a forest: a node reached twice is a cycle or a node with two
+    // parents, and following it would loop forever or duplicate geometry.
+    let mut reached = vec![false; doc.nodes().len()];
     let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
     let mut part = 0u32;
     while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut reached[node.index()], true) {
+            bail!(
+                "node {} is reached twice from scene {}: the node hierarchy has a cycle or a node with two parents",
+                node.index(),
+                scene.index()
+            );
+        }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(mesh) = node.mesh() {
             for primitive in mesh.primitives() {
-                if primitive.mode() != gltf::mesh::Mode::Triangles {
-                    bail!(
-                        "mesh `{}` has a primitive that is not a triangle list",
-                        mesh.name().unwrap_or("")
-                    );
-                }
-                let reader = primitive.reader(|b| Some(&buffers[b.index()]));
-                let positions: Vec<Vec3> = reader
-                    .read_positions()
-                    .context("a primitive has no POSITION attribute")?
-                    .map(|p| world.transform_point3(Vec3::from_array(p)))
-                    .collect();
-                let uvs: Vec<Vec2> = match reader.read_tex_coords(0) {
-                    Some(t) => t.into_f32().map(Vec2::from_array).collect(),
-                    None => vec![Vec2::ZERO; positions.len()],
-                };
-                let indices: Vec<u32> = match reader.read_indices() {
-                    Some(i) => i.into_u32().collect(),
-                    None => (0..positions.len() as u32).collect(),
-                };
-                for idx in indices.chunks_exact(3) {
-                    let [a, b, c] = [idx[0] as usize, idx[1] as usize, idx[2] as usize];
-                    if a.max(b).max(c) >= positions.len() {
-                        bail!("a primitive indexes a vertex that does not exist");
-                    }
-                    out.tris.push(Tri {
-                        p: [positions[a], positions[b], positions[c]],
-                        uv: [uvs[a], uvs[b], uvs[c]],
-                        part,
-                        file_material: primitive.material().index().map(|m| m as u32),
-                    });
-                }
+                let name = format!(
+                    "mesh {} (`{}`) primitive {}",
+                    mesh.index(),
+                    mesh.name().unwrap_or(""),
+                    primitive.index()
+                );
+                read_primitive(&primitive, &buffers, world, part, &mut out.tris)
+                    .with_context(|| name)?;
                 part += 1;
             }
         }
         stack.extend(node.children().map(|c| (c, world)));
     }
+    checked(out)
+}
+
+/// The data of every buffer: the GLB chunk, a `data:` URI, or a file next to the glTF.
+fn load_buffers(
+    doc: &gltf::Document,
+    mut blob: Option<Vec<u8>>,
+    path: &Path,
+    read: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
+) -> Result<Vec<Vec<u8>>> {
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let mut out = Vec::new();
+    for buffer in doc.buffers() {
+        let i = buffer.index();
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => blob.take().with_context(|| {
+                format!("buffer {i} refers to a GLB binary chunk the file does not have")
+            })?,
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                gltf::buffer::Data::from_source(buffer.source(), None)
+                    .map_err(|e| anyhow!("buffer {i}: invalid data URI: {e}"))?
+                    .0
+            }
+            gltf::buffer::Source::Uri(uri) => {
+                let resolved = resolve_uri(dir, uri).with_context(|| {
+                    format!(
+                        "buffer {i}: unsupported URI `{uri}` (use a relative path or a data: URI)"
+                    )
+                })?;
+                read(&resolved).with_context(|| {
+                    format!(
+                        "buffer {i}: cannot read `{uri}` (resolved against the glTF file's folder: {})",
+                        resolved.display()
+                    )
+                })?
+            }
+        };
+        if data.len() < buffer.length() {
+            bail!(
+                "buffer {i} has {} bytes, fewer than its byteLength of {}",
+                data.len(),
+                buffer.length()
+            );
+        }
+        out.push(data);
+    }
     Ok(out)
+}
+
+/// A relative URI (percent-encoded) resolved against `dir`; `None` for schemes and absolute
+/// paths.
+fn resolve_uri(dir: &Path, uri: &str) -> Option<PathBuf> {
+    if uri.contains(':') || uri.starts_with('/') {
+        return None;
+    }
+    let bytes = uri.as_bytes();
+    let mut decoded = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
+            decoded.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            decoded.push(bytes[i]);
+            i += 1;
+        }
+    }
+    Some(dir.join(String::from_utf8(decoded).ok()?))
+}
+
+/// Checks that `accessor` has the type a reader of `what` expects and lies inside its buffer,
+/// so that reading it can neither panic nor read garbage.
+fn check_accessor(
+    accessor: &gltf::Accessor,
+    what: &str,
+    dimensions: gltf::accessor::Dimensions,
+    types: &[gltf::accessor::DataType],
+    buffers: &[Vec<u8>],
+) -> Result<()> {
+    let i = accessor.index();
+    if accessor.dimensions() != dimensions || !types.contains(&accessor.data_type()) {
+        bail!(
+            "accessor {i} ({what}) is {:?} of {:?}; expected {dimensions:?} of one of {types:?}",
+            accessor.dimensions(),
+            accessor.data_type()
+        );
+    }
+    if accessor.sparse().is_some() {
+        bail!("accessor {i} ({what}) is sparse, which is not supported");
+    }
+    let view = accessor
+        .view()
+        .with_context(|| format!("accessor {i} ({what}) has no bufferView"))?;
+    let size = accessor.size();
+    let stride = view.stride().unwrap_or(size);
+    if accessor.count() == 0 || stride < size {
+        bail!(
+            "accessor {i} ({what}) has {} elements of {size} bytes with a stride of {stride} bytes",
+            accessor.count()
+        );
+    }
+    let end = (accessor.count() - 1)
+        .checked_mul(stride)
+        .and_then(|n| n.checked_add(accessor.offset()))
+        .and_then(|n| n.checked_add(size));
+    if !end.is_some_and(|end| end <= view.length()) {
+        bail!(
+            "accessor {i} ({what}) reaches beyond the end of bufferView {} ({} bytes)",
+            view.index(),
+            view.length()
+        );
+    }
+    let buffer = &buffers[view.buffer().index()];
+    if !view
+        .offset()
+        .checked_add(view.length())
+        .is_some_and(|end| end <= buffer.len())
+    {
+        bail!(
+            "bufferView {} reaches beyond the end of buffer {} ({} bytes)",
+            view.index(),
+            view.buffer().index(),
+            buffer.len()
+        );
+    }
+    Ok(())
+}
+
+fn read_primitive(
+    primitive: &gltf::Primitive,
+    buffers: &[Vec<u8>],
+    world: Mat4,
+    part: u32,
+    tris: &mut Vec<Tri>,
+) -> Result<()> {
+    use gltf::accessor::{DataType, Dimensions};
+    if primitive.mode() != gltf::mesh::Mode::Triangles {
+        bail!("not a triangle list (mode {:?})", primitive.mode());
+    }
+    let positions = primitive
+        .get(&gltf::Semantic::Positions)
+        .context("no POSITION attribute")?;
+    check_accessor(
+        &positions,
+        "POSITION",
+        Dimensions::Vec3,
+        &[DataType::F32],
+        buffers,
+    )?;
+    let texcoords = primitive.get(&gltf::Semantic::TexCoords(0));
+    if let Some(t) = &texcoords {
+        check_accessor(
+            t,
+            "TEXCOORD_0",
+            Dimensions::Vec2,
+            &[DataType::F32, DataType::U8, DataType::U16],
+            buffers,
+        )?;
+    }
+    let indices = primitive.indices();
+    if let Some(i) = &indices {
+        check_accessor(
+            i,
+            "indices",
+            Dimensions::Scalar,
+            &[DataType::U8, DataType::U16, DataType::U32],
+            buffers,
+        )?;
+    }
+    let count = indices.as_ref().map_or(positions.count(), |i| i.count()) / 3;
+    if tris.len() + count > MAX_TRIANGLES {
+        bail!("more than the limit of {MAX_TRIANGLES} triangles");
+    }
+    let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let positions: Vec<Vec3> = reader
+        .read_positions()
+        .context("cannot read POSITION")?
+        .map(|p| world.transform_point3(Vec3::from_array(p)))
+        .collect();
+    let uvs: Vec<Vec2> = match reader.read_tex_coords(0) {
+        Some(t) => t.into_f32().map(Vec2::from_array).collect(),
+        None => vec![Vec2::ZERO; positions.len()],
+    };
+    if uvs.len() < positions.len() {
+        bail!(
+            "TEXCOORD_0 has {} elements, fewer than POSITION's {}",
+            uvs.len(),
+            positions.len()
+        );
+    }
+    let indices: Vec<u32> = match reader.read_indices() {
+        Some(i) => i.into_u32().collect(),
+        None => (0..positions.len() as u32).collect(),
+    };
+    let material = primitive.material().index().map(|m| m as u32);
+    for idx in indices.chunks_exact(3) {
+        let [a, b, c] = [idx[0] as usize, idx[1] as usize, idx[2] as usize];
+        if a.max(b).max(c) >= positions.len() {
+            bail!(
+                "index {} points past the {} vertices",
+                a.max(b).max(c),
+                positions.len()
+            );
+        }
+        tris.push(Tri {
+            p: [positions[a], positions[b], positions[c]],
+            uv: [uvs[a], uvs[b], uvs[c]],
+            part,
+            file_material: material,
+        });
+    }
+    Ok(())
 }

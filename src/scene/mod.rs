@@ -4,6 +4,7 @@
 //! parameter table of every object kind; the defaults below are the ones documented there.
 
 pub mod grow;
+pub mod limits;
 pub mod mesh_io;
 pub mod procedural;
 pub mod read;

@@ -1,19 +1,23 @@
 //! Reading a scene file into a [`Scene`]: every table and key, typed, range-checked and
 //! defaulted as `scenes/reference.toml` documents.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use glam::{DAffine3, DMat3, DQuat, DVec3, EulerRot};
 
 use crate::geometry::camera::{Camera, world_from_camera_rotation};
+use crate::scene::limits::{
+    MAX_LENGTH, MAX_MATERIALS, MAX_MOUNT_OFFSET, MAX_OBJECTS, MAX_ROTATION_DEG, MAX_TRIANGLES,
+    MAX_UV_REPEAT, MIN_LENGTH, out_of_world,
+};
 use crate::scene::source::{SceneError, SourceFile};
-use crate::scene::table_reader::TableReader;
+use crate::scene::table_reader::{TableReader, range_message};
 use crate::scene::{CameraKind, Material, Object, Obstacle, Scene, Shape, Sky, Sun};
 
 const OBJECT_KINDS: [&str; 7] = ["plane", "box", "sphere", "cylinder", "cone", "quad", "mesh"];
-/// Largest length accepted anywhere in a scene, metres: beyond it f32 ray tracing loses
-/// millimetre precision.
-const MAX_LENGTH: f64 = 100_000.0;
+/// Largest display side, metres.
+const MAX_DISPLAY_SIZE: f64 = 100.0;
 
 impl Scene {
     /// Reads and validates a scene file.
@@ -28,11 +32,7 @@ impl Scene {
         let sun = read_sun(&root)?;
         let sky = read_sky(&root)?;
         let materials = read_materials(&root, file)?;
-        let objects = root
-            .array_of_tables("object")?
-            .into_iter()
-            .map(|t| read_object(t, &materials, file))
-            .collect::<Result<Vec<_>, _>>()?;
+        let objects = read_objects(&root, &materials, file)?;
         let obstacle_table = root
             .table("obstacle")?
             .ok_or_else(|| root.error("obstacle", "the scene needs an [obstacle] table"))?;
@@ -67,17 +67,34 @@ fn dvec3(a: [f64; 3]) -> DVec3 {
     DVec3::from_array(a)
 }
 
+/// A length in [[`MIN_LENGTH`], `max`] metres.
+fn length(t: &TableReader, key: &str, default: f64, max: f64) -> Result<f64, SceneError> {
+    t.f64_in(key, default, MIN_LENGTH, max)
+}
+
+/// The tables of `[[key]]`, at most `limit` of them.
+fn bounded_tables<'a>(
+    root: &TableReader<'a>,
+    key: &str,
+    limit: usize,
+) -> Result<Vec<TableReader<'a>>, SceneError> {
+    let tables = root.array_of_tables(key)?;
+    if tables.len() > limit {
+        return Err(tables[limit].table_error(format!(
+            "the scene has {} [[{key}]] tables, more than the limit of {limit}",
+            tables.len()
+        )));
+    }
+    Ok(tables)
+}
+
 fn read_sun(root: &TableReader) -> Result<Sun, SceneError> {
     let d = Sun::default();
     let Some(t) = root.table("sun")? else {
         return Ok(d);
     };
-    let direction = dvec3(t.array_or("direction", d.direction.to_array())?);
-    if direction.length() < 1e-9 {
-        return Err(t.error("direction", "must not be the zero vector"));
-    }
     let sun = Sun {
-        direction: direction.normalize(),
+        direction: t.direction("direction", d.direction.to_array())?,
         color: t.color("color", d.color)?,
         intensity: t.f64_in("intensity", d.intensity, 0.0, 1000.0)?,
     };
@@ -96,8 +113,8 @@ fn read_sky(root: &TableReader) -> Result<Sky, SceneError> {
         ground_color: t.color("ground_color", d.ground_color)?,
         ambient: t.f64_in("ambient", d.ambient, 0.0, 1000.0)?,
         cloud_cover: t.f64_in("cloud_cover", d.cloud_cover, 0.0, 1.0)?,
-        cloud_height: t.positive("cloud_height", d.cloud_height, MAX_LENGTH)?,
-        cloud_size: t.positive("cloud_size", d.cloud_size, MAX_LENGTH)?,
+        cloud_height: length(&t, "cloud_height", d.cloud_height, MAX_LENGTH)?,
+        cloud_size: length(&t, "cloud_size", d.cloud_size, MAX_LENGTH)?,
         cloud_seed: t.usize_in("cloud_seed", d.cloud_seed as usize, 0, u32::MAX as usize)? as u32,
     };
     t.finish()?;
@@ -106,10 +123,19 @@ fn read_sky(root: &TableReader) -> Result<Sky, SceneError> {
 
 fn read_materials(root: &TableReader, file: &SourceFile) -> Result<Vec<Material>, SceneError> {
     let mut materials: Vec<Material> = Vec::new();
-    for t in root.array_of_tables("material")? {
+    let mut first_line: HashMap<String, Option<usize>> = HashMap::new();
+    for (i, t) in bounded_tables(root, "material", MAX_MATERIALS)?
+        .into_iter()
+        .enumerate()
+    {
         let name = t.required_str("name")?.to_string();
-        if materials.iter().any(|m| m.name == name) {
-            return Err(t.error("name", format!("material `{name}` is defined twice")));
+        let line = t.error("name", "").line;
+        if let Some(first) = first_line.insert(name.clone(), line) {
+            let at = first.map_or(String::new(), |l| format!(" at line {l}"));
+            return Err(t.error(
+                "name",
+                format!("material `{name}` is defined twice: material[{i}] repeats the name of an earlier material{at}"),
+            ));
         }
         let texture = match t.opt_str("texture")? {
             Some(rel) => Some(existing_asset(&t, "texture", rel, file)?),
@@ -119,7 +145,7 @@ fn read_materials(root: &TableReader, file: &SourceFile) -> Result<Vec<Material>
             name,
             color: t.color("color", [0.8, 0.8, 0.8])?,
             texture,
-            uv_repeat: t.positive_array("uv_repeat", [1.0, 1.0])?,
+            uv_repeat: t.array_in("uv_repeat", [1.0, 1.0], MIN_LENGTH, MAX_UV_REPEAT)?,
         });
         t.finish()?;
     }
@@ -135,29 +161,35 @@ fn existing_asset(
 ) -> Result<PathBuf, SceneError> {
     let path = file.dir().join(rel);
     if !path.is_file() {
-        return Err(t.error(key, format!("asset not found: {}", path.display())));
+        return Err(t.error(
+            key,
+            format!(
+                "asset not found: `{rel}` (resolved against the scene's folder: {})",
+                path.display()
+            ),
+        ));
     }
     Ok(path)
 }
 
 fn read_transform(t: &TableReader) -> Result<DAffine3, SceneError> {
-    let translate = dvec3(t.array_or("translate", [0.0; 3])?);
-    let [rx, ry, rz] = t.array_or("rotate_deg", [0.0; 3])?;
+    let translate = t.point("translate", Some([0.0; 3]))?;
+    let [rx, ry, rz] = t.array_in("rotate_deg", [0.0; 3], -MAX_ROTATION_DEG, MAX_ROTATION_DEG)?;
     let scale = match t.opt_f64("scale") {
         Ok(Some(s)) => [s; 3],
         Ok(None) => [1.0; 3],
         Err(_) => t.required_array("scale")?,
     };
-    if scale.iter().any(|&s| !(s > 0.0 && s <= MAX_LENGTH)) {
+    if let Some(&bad) = scale
+        .iter()
+        .find(|s| !(MIN_LENGTH..=MAX_LENGTH).contains(*s))
+    {
         return Err(t.error(
             "scale",
-            format!("every factor must be in (0, {MAX_LENGTH}], got {scale:?}"),
-        ));
-    }
-    if translate.abs().max_element() > MAX_LENGTH {
-        return Err(t.error(
-            "translate",
-            format!("coordinates must be within ±{MAX_LENGTH} m"),
+            format!(
+                "every factor {}",
+                range_message(bad, MIN_LENGTH, MAX_LENGTH)
+            ),
         ));
     }
     // Rotations apply about x, then y, then z (world axes).
@@ -174,9 +206,99 @@ fn read_transform(t: &TableReader) -> Result<DAffine3, SceneError> {
     ))
 }
 
-fn read_object(
-    t: TableReader,
+/// Reads every `[[object]]`, within the limits on objects and triangles.
+fn read_objects(
+    root: &TableReader,
     materials: &[Material],
+    file: &SourceFile,
+) -> Result<Vec<Object>, SceneError> {
+    let by_name: HashMap<&str, usize> = materials
+        .iter()
+        .enumerate()
+        .map(|(i, m)| (m.name.as_str(), i))
+        .collect();
+    let mut triangles = 0usize;
+    let mut objects = Vec::new();
+    for t in bounded_tables(root, "object", MAX_OBJECTS)? {
+        let object = read_object(&t, materials, &by_name, file)?;
+        triangles += triangle_count(&object.shape);
+        if triangles > MAX_TRIANGLES {
+            return Err(t.table_error(format!(
+                "the scene's shapes reach {triangles} triangles here, more than the limit of {MAX_TRIANGLES}"
+            )));
+        }
+        if let Some(why) = object_bounds(&object.shape)
+            .into_iter()
+            .find_map(|corner| out_of_world(object.world_from_object.transform_point3(corner)))
+        {
+            return Err(t.table_error(format!(
+                "the {} `{}` reaches outside the world after its transform: {why} (check translate, scale and size)",
+                kind_name(&object.shape),
+                object.name
+            )));
+        }
+        t.finish()?;
+        objects.push(object);
+    }
+    Ok(objects)
+}
+
+/// Triangles a shape tessellates into (meshes are counted when they are loaded).
+fn triangle_count(shape: &Shape) -> usize {
+    match shape {
+        Shape::Plane { .. } | Shape::Quad { .. } => 2,
+        Shape::Box { .. } => 12,
+        Shape::Sphere { .. } | Shape::Mesh { .. } => 0,
+        Shape::Cylinder { segments, .. } => 4 * segments,
+        Shape::Cone { segments, .. } => 2 * segments,
+    }
+}
+
+fn kind_name(shape: &Shape) -> &'static str {
+    match shape {
+        Shape::Plane { .. } => "plane",
+        Shape::Box { .. } => "box",
+        Shape::Sphere { .. } => "sphere",
+        Shape::Cylinder { .. } => "cylinder",
+        Shape::Cone { .. } => "cone",
+        Shape::Quad { .. } => "quad",
+        Shape::Mesh { .. } => "mesh",
+    }
+}
+
+/// Corners of a box around the shape in object space (empty for meshes: their vertices are
+/// checked when the mesh is loaded).
+fn object_bounds(shape: &Shape) -> Vec<DVec3> {
+    let (lo, hi) = match *shape {
+        Shape::Plane { size: [x, z] } => {
+            (DVec3::new(-x, 0.0, -z) / 2.0, DVec3::new(x, 0.0, z) / 2.0)
+        }
+        Shape::Box { size } => (-dvec3(size) / 2.0, dvec3(size) / 2.0),
+        Shape::Sphere { radius } => (DVec3::splat(-radius), DVec3::splat(radius)),
+        Shape::Cylinder { radius, height, .. } | Shape::Cone { radius, height, .. } => (
+            DVec3::new(-radius, 0.0, -radius),
+            DVec3::new(radius, height, radius),
+        ),
+        Shape::Quad { size: [x, y] } => {
+            (DVec3::new(-x, -y, 0.0) / 2.0, DVec3::new(x, y, 0.0) / 2.0)
+        }
+        Shape::Mesh { .. } => return Vec::new(),
+    };
+    (0..8)
+        .map(|i| {
+            DVec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect()
+}
+
+fn read_object(
+    t: &TableReader,
+    materials: &[Material],
+    by_name: &HashMap<&str, usize>,
     file: &SourceFile,
 ) -> Result<Object, SceneError> {
     let kind = t.choice("kind", "", &OBJECT_KINDS).map_err(|e| {
@@ -194,28 +316,29 @@ fn read_object(
     })?;
     let name = t.opt_str("name")?.unwrap_or(kind).to_string();
     let segments = |t: &TableReader| t.usize_in("segments", 48, 3, 4096);
+    let size = |default| t.array_in("size", default, MIN_LENGTH, MAX_LENGTH);
     let shape = match kind {
         "plane" => Shape::Plane {
-            size: t.positive_array("size", [200.0, 200.0])?,
+            size: size([200.0, 200.0])?,
         },
         "box" => Shape::Box {
-            size: t.positive_array("size", [1.0, 1.0, 1.0])?,
+            size: t.array_in("size", [1.0, 1.0, 1.0], MIN_LENGTH, MAX_LENGTH)?,
         },
         "sphere" => Shape::Sphere {
-            radius: t.positive("radius", 0.5, MAX_LENGTH)?,
+            radius: length(t, "radius", 0.5, MAX_LENGTH)?,
         },
         "cylinder" => Shape::Cylinder {
-            radius: t.positive("radius", 0.5, MAX_LENGTH)?,
-            height: t.positive("height", 1.0, MAX_LENGTH)?,
-            segments: segments(&t)?,
+            radius: length(t, "radius", 0.5, MAX_LENGTH)?,
+            height: length(t, "height", 1.0, MAX_LENGTH)?,
+            segments: segments(t)?,
         },
         "cone" => Shape::Cone {
-            radius: t.positive("radius", 0.5, MAX_LENGTH)?,
-            height: t.positive("height", 1.0, MAX_LENGTH)?,
-            segments: segments(&t)?,
+            radius: length(t, "radius", 0.5, MAX_LENGTH)?,
+            height: length(t, "height", 1.0, MAX_LENGTH)?,
+            segments: segments(t)?,
         },
         "quad" => Shape::Quad {
-            size: t.positive_array("size", [1.0, 1.0])?,
+            size: size([1.0, 1.0])?,
         },
         _ => {
             let rel = t.required_str("path")?;
@@ -230,13 +353,16 @@ fn read_object(
                 ));
             }
             Shape::Mesh {
-                path: existing_asset(&t, "path", rel, file)?,
+                path: existing_asset(t, "path", rel, file)?,
             }
         }
     };
     let material = match t.opt_str("material")? {
-        Some(m) => Some(materials.iter().position(|x| x.name == m).ok_or_else(|| {
-            let names: Vec<&str> = materials.iter().map(|x| x.name.as_str()).collect();
+        Some(m) => Some(*by_name.get(m).ok_or_else(|| {
+            let mut names: Vec<&str> = materials.iter().map(|x| x.name.as_str()).take(20).collect();
+            if materials.len() > names.len() {
+                names.push("…");
+            }
             t.error(
                 "material",
                 format!("no material named `{m}` (defined: {})", names.join(", ")),
@@ -254,45 +380,58 @@ fn read_object(
     let visible_to = hidden
         .iter()
         .fold(0b111u8, |mask, name| mask & !CameraKind::parse(name).bit());
-    let object = Object {
+    Ok(Object {
         name,
         shape,
         material,
-        world_from_object: read_transform(&t)?,
+        world_from_object: read_transform(t)?,
         visible_to,
         casts_shadow: t.bool_or("casts_shadow", true)?,
-    };
-    t.finish()?;
-    Ok(object)
-}
-
-fn read_obstacle(t: &TableReader) -> Result<Obstacle, SceneError> {
-    let center = dvec3(t.required_array("center")?);
-    let facing = dvec3(t.array_or("facing", [0.0, 0.0, 1.0])?);
-    let up = dvec3(t.array_or("up", [0.0, 1.0, 0.0])?);
-    // The display normal is obstacle +z; a camera looking along −facing has the same axes.
-    let rotation = world_from_camera_rotation(-facing, up)
-        .map_err(|_| t.error("facing", "must be non-zero and not parallel to `up`"))?;
-    Ok(Obstacle {
-        world_from_obstacle: DAffine3::from_mat3_translation(rotation, center),
-        width: t.positive("width", 0.3, 100.0)?,
-        height: t.positive("height", 0.4, 100.0)?,
-        thickness: t.positive("thickness", 0.04, 100.0)?,
-        display_resolution: t.resolution("display_resolution", [300, 400])?,
-        display_off_color: t.color("display_off_color", [0.02, 0.02, 0.025])?,
-        body_color: t.color("body_color", [0.18, 0.18, 0.2])?,
     })
 }
 
-fn half_angle(t: &TableReader, default_deg: f64) -> Result<f64, SceneError> {
-    let deg = t.opt_f64("half_angle_deg")?.unwrap_or(default_deg);
-    if !(deg > 0.0 && deg < 89.0) {
-        return Err(t.error(
-            "half_angle_deg",
-            format!("must be in (0, 89) degrees, got {deg}"),
-        ));
+fn read_obstacle(t: &TableReader) -> Result<Obstacle, SceneError> {
+    let center = t.point("center", None)?;
+    let facing = t.direction("facing", [0.0, 0.0, 1.0])?;
+    let up = t.direction("up", [0.0, 1.0, 0.0])?;
+    // The display normal is obstacle +z; a camera looking along −facing has the same axes.
+    let rotation = world_from_camera_rotation(-facing, up)
+        .map_err(|_| t.error("facing", "must not be parallel to `up`"))?;
+    let obstacle = Obstacle {
+        world_from_obstacle: DAffine3::from_mat3_translation(rotation, center),
+        width: length(t, "width", 0.3, MAX_DISPLAY_SIZE)?,
+        height: length(t, "height", 0.4, MAX_DISPLAY_SIZE)?,
+        thickness: length(t, "thickness", 0.04, MAX_DISPLAY_SIZE)?,
+        display_resolution: t.resolution("display_resolution", [300, 400])?,
+        display_off_color: t.color("display_off_color", [0.02, 0.02, 0.025])?,
+        body_color: t.color("body_color", [0.18, 0.18, 0.2])?,
+    };
+    let half = DVec3::new(obstacle.width, obstacle.height, 2.0 * obstacle.thickness) / 2.0;
+    for corner in [-half, half] {
+        if let Some(why) = out_of_world(obstacle.world_from_obstacle.transform_point3(corner)) {
+            return Err(t.error(
+                "center",
+                format!("the obstacle reaches outside the world: {why}"),
+            ));
+        }
     }
-    Ok(deg.to_radians())
+    Ok(obstacle)
+}
+
+/// Narrowest half angle of view, degrees: below it, projections overflow f32 pixel
+/// coordinates.
+pub const MIN_HALF_ANGLE_DEG: f64 = 0.01;
+/// Widest half angle of view, degrees (a pinhole camera cannot reach 90°).
+pub const MAX_HALF_ANGLE_DEG: f64 = 89.0;
+
+fn half_angle(t: &TableReader, default_deg: f64) -> Result<f64, SceneError> {
+    Ok(t.f64_in(
+        "half_angle_deg",
+        default_deg,
+        MIN_HALF_ANGLE_DEG,
+        MAX_HALF_ANGLE_DEG,
+    )?
+    .to_radians())
 }
 
 fn camera_table<'a>(cameras: &TableReader<'a>, name: &str) -> Result<TableReader<'a>, SceneError> {
@@ -303,9 +442,9 @@ fn camera_table<'a>(cameras: &TableReader<'a>, name: &str) -> Result<TableReader
 
 fn read_driver(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, SceneError> {
     let t = camera_table(cameras, "driver")?;
-    let eye = dvec3(t.required_array("position")?);
-    let target = dvec3(t.required_array("look_at")?);
-    let up = dvec3(t.array_or("up", [0.0, 1.0, 0.0])?);
+    let eye = t.point("position", None)?;
+    let target = t.point("look_at", None)?;
+    let up = t.direction("up", [0.0, 1.0, 0.0])?;
     let [w, h] = t.resolution("resolution", [1280, 720])?;
     let camera = Camera::look_at(eye, target, up, half_angle(&t, 40.0)?, w, h)
         .map_err(|e| t.error("look_at", e.to_string()))?;
@@ -317,7 +456,7 @@ fn read_driver(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, Sce
     if d1 <= 0.0 {
         return Err(t.error(
             "position",
-            format!("the driver's eye must be on the display's side of the obstacle (d1 > 0 m along the display normal), got d1 = {d1:.3} m"),
+            format!("the driver's eye must be on the display's side of the obstacle (d1 > 0 m along the display normal), got d1 = {} m", crate::util::number::short(d1)),
         ));
     }
     t.finish()?;
@@ -334,7 +473,12 @@ fn mounted_camera(
     default_half_deg: f64,
     default_res: [u32; 2],
 ) -> Result<Camera, SceneError> {
-    let offset = dvec3(t.array_or("offset", default_offset)?);
+    let offset = dvec3(t.array_in(
+        "offset",
+        default_offset,
+        -MAX_MOUNT_OFFSET,
+        MAX_MOUNT_OFFSET,
+    )?);
     let yaw = t.f64_in("yaw_deg", 0.0, -80.0, 80.0)?.to_radians();
     let pitch = t.f64_in("pitch_deg", 0.0, -80.0, 80.0)?.to_radians();
     let [w, h] = t.resolution("resolution", default_res)?;
@@ -368,7 +512,7 @@ fn read_frontal(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, Sc
         .transform_point3(camera.position())
         .z;
     if z > 1e-9 {
-        return Err(t.error("offset", format!("the frontal camera must be on the scene side of the display (z ≤ 0 in the obstacle frame), got z = {z:.3} m")));
+        return Err(t.error("offset", format!("the frontal camera must be on the scene side of the display (z ≤ 0 in the obstacle frame), got z = {} m", crate::util::number::short(z))));
     }
     t.finish()?;
     Ok(camera)

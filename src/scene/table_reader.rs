@@ -5,10 +5,14 @@
 //! names the file, the line and the key, so that a user can fix the file without guessing.
 
 use std::cell::RefCell;
+use std::collections::HashSet;
 
+use glam::DVec3;
 use toml_edit::{ImDocument, Item, TableLike};
 
-use crate::scene::source::{MAX_PIXELS, MAX_RESOLUTION, SceneError, SourceFile};
+use crate::scene::limits::{MAX_COORDINATE, MAX_PIXELS, MAX_RESOLUTION};
+use crate::scene::source::{SceneError, SourceFile};
+use crate::util::number::{short, short_list};
 
 /// Reads the keys of one TOML table, remembering which were read so that
 /// [`TableReader::finish`] can reject the rest as unknown.
@@ -17,9 +21,9 @@ pub struct TableReader<'a> {
     table: &'a dyn TableLike,
     /// Key path of this table, e.g. `object[2]`; empty for the root.
     prefix: String,
-    /// Line of the table header, for errors about missing keys.
-    line: Option<usize>,
-    read: RefCell<Vec<String>>,
+    /// Line and column of the table header, for errors about missing keys.
+    at: Option<(usize, usize)>,
+    read: RefCell<HashSet<String>>,
 }
 
 impl<'a> TableReader<'a> {
@@ -28,8 +32,8 @@ impl<'a> TableReader<'a> {
             file,
             table: doc.as_table(),
             prefix: String::new(),
-            line: None,
-            read: RefCell::new(Vec::new()),
+            at: None,
+            read: RefCell::new(HashSet::new()),
         }
     }
 
@@ -43,23 +47,42 @@ impl<'a> TableReader<'a> {
 
     /// An error located at `key` of this table (its value's line, else the table's).
     pub fn error(&self, key: &str, message: impl Into<String>) -> SceneError {
-        let line = self
+        let at = self
             .table
             .get_key_value(key)
             .and_then(|(k, item)| item.span().or_else(|| k.span()))
-            .map(|s| self.file.line_of(s.start))
-            .or(self.line);
+            .map(|s| self.file.position_of(s.start))
+            .or(self.at);
+        self.error_at(at, self.full_key(key), message)
+    }
+
+    /// An error about this table as a whole (e.g. an object placed outside the world).
+    pub fn table_error(&self, message: impl Into<String>) -> SceneError {
+        self.error_at(self.at, self.prefix.clone(), message)
+    }
+
+    fn error_at(
+        &self,
+        at: Option<(usize, usize)>,
+        key: String,
+        message: impl Into<String>,
+    ) -> SceneError {
         SceneError {
             path: self.file.path.clone(),
-            line,
-            key: self.full_key(key),
+            line: at.map(|a| a.0),
+            column: at.map(|a| a.1),
+            key,
             message: message.into(),
         }
     }
 
     fn item(&self, key: &str) -> Option<&'a Item> {
-        self.read.borrow_mut().push(key.to_string());
+        self.read.borrow_mut().insert(key.to_string());
         self.table.get(key)
+    }
+
+    fn position(&self, span: Option<std::ops::Range<usize>>) -> Option<(usize, usize)> {
+        span.map(|s| self.file.position_of(s.start)).or(self.at)
     }
 
     pub fn has(&self, key: &str) -> bool {
@@ -78,11 +101,8 @@ impl<'a> TableReader<'a> {
             file: self.file,
             table,
             prefix: self.full_key(key),
-            line: item
-                .span()
-                .map(|s| self.file.line_of(s.start))
-                .or(self.line),
-            read: RefCell::new(Vec::new()),
+            at: self.position(item.span()),
+            read: RefCell::new(HashSet::new()),
         }))
     }
 
@@ -96,8 +116,8 @@ impl<'a> TableReader<'a> {
                 file: self.file,
                 table,
                 prefix: format!("{}[{}]", self.full_key(key), i),
-                line: span.map(|s| self.file.line_of(s.start)).or(self.line),
-                read: RefCell::new(Vec::new()),
+                at: self.position(span),
+                read: RefCell::new(HashSet::new()),
             }
         };
         if let Some(tables) = item.as_array_of_tables() {
@@ -130,10 +150,9 @@ impl<'a> TableReader<'a> {
     pub fn finish(self) -> Result<(), SceneError> {
         let read = self.read.borrow();
         for (key, _) in self.table.iter() {
-            if !read.iter().any(|k| k == key) {
+            if !read.contains(key) {
                 let mut known: Vec<&str> = read.iter().map(String::as_str).collect();
                 known.sort_unstable();
-                known.dedup();
                 return Err(self.error(
                     key,
                     format!("unknown key (known keys here: {})", known.join(", ")),
@@ -157,7 +176,7 @@ impl<'a> TableReader<'a> {
                 )
             })?;
         if !value.is_finite() {
-            return Err(self.error(key, format!("must be finite, got {value}")));
+            return Err(self.error(key, format!("must be finite, got {}", short(value))));
         }
         Ok(Some(value))
     }
@@ -166,34 +185,13 @@ impl<'a> TableReader<'a> {
     pub fn f64_in(&self, key: &str, default: f64, min: f64, max: f64) -> Result<f64, SceneError> {
         let value = self.opt_f64(key)?.unwrap_or(default);
         if !(min..=max).contains(&value) {
-            return Err(self.error(key, format!("must be in [{min}, {max}], got {value}")));
+            return Err(self.error(key, range_message(value, min, max)));
         }
         Ok(value)
-    }
-
-    /// A strictly positive number with a default, at most `max`.
-    pub fn positive(&self, key: &str, default: f64, max: f64) -> Result<f64, SceneError> {
-        let value = self.opt_f64(key)?.unwrap_or(default);
-        if !(value > 0.0 && value <= max) {
-            return Err(self.error(key, format!("must be in (0, {max}], got {value}")));
-        }
-        Ok(value)
-    }
-
-    pub fn required_positive(&self, key: &str, max: f64) -> Result<f64, SceneError> {
-        if !self.has(key) {
-            return Err(self.missing(key));
-        }
-        self.positive(key, 1.0, max)
     }
 
     fn missing(&self, key: &str) -> SceneError {
-        SceneError {
-            path: self.file.path.clone(),
-            line: self.line,
-            key: self.full_key(key),
-            message: "required key is missing".into(),
-        }
+        self.error_at(self.at, self.full_key(key), "required key is missing")
     }
 
     pub fn opt_usize(
@@ -212,7 +210,10 @@ impl<'a> TableReader<'a> {
             )
         })?;
         if value < min as i64 || value > max as i64 {
-            return Err(self.error(key, format!("must be in [{min}, {max}], got {value}")));
+            return Err(self.error(
+                key,
+                format!("must be an integer in [{min}, {max}], got {value}"),
+            ));
         }
         Ok(Some(value as usize))
     }
@@ -315,10 +316,48 @@ impl<'a> TableReader<'a> {
                 .or_else(|| value.as_integer().map(|i| i as f64))
                 .ok_or_else(wrong)?;
             if !slot.is_finite() {
-                return Err(self.error(key, format!("must be finite, got {slot}")));
+                return Err(self.error(key, format!("must be finite, got {}", short(*slot))));
             }
         }
         Ok(Some(out))
+    }
+
+    /// An array whose every element is in [min, max].
+    pub fn array_in<const N: usize>(
+        &self,
+        key: &str,
+        default: [f64; N],
+        min: f64,
+        max: f64,
+    ) -> Result<[f64; N], SceneError> {
+        let value = self.array_or(key, default)?;
+        if let Some(&bad) = value.iter().find(|v| !(min..=max).contains(*v)) {
+            return Err(self.error(
+                key,
+                format!("every element {}", range_message(bad, min, max)),
+            ));
+        }
+        Ok(value)
+    }
+
+    /// A point in the world: three coordinates within ±[`MAX_COORDINATE`] metres.
+    pub fn point(&self, key: &str, default: Option<[f64; 3]>) -> Result<DVec3, SceneError> {
+        let Some(default) = default.or(self.opt_array(key)?) else {
+            return Err(self.missing(key));
+        };
+        let value = self.array_in(key, default, -MAX_COORDINATE, MAX_COORDINATE)?;
+        Ok(DVec3::from_array(value))
+    }
+
+    /// A direction: three finite numbers, not all zero; returned normalised.
+    pub fn direction(&self, key: &str, default: [f64; 3]) -> Result<DVec3, SceneError> {
+        let value = DVec3::from_array(self.array_or(key, default)?);
+        // Scaled first, so that huge components do not overflow the length.
+        let largest = value.abs().max_element();
+        if largest == 0.0 {
+            return Err(self.error(key, "must not be the zero vector"));
+        }
+        Ok((value / largest).normalize())
     }
 
     pub fn array_or<const N: usize>(
@@ -333,26 +372,16 @@ impl<'a> TableReader<'a> {
         self.opt_array(key)?.ok_or_else(|| self.missing(key))
     }
 
-    /// An array whose every element is strictly positive (sizes, scales).
-    pub fn positive_array<const N: usize>(
-        &self,
-        key: &str,
-        default: [f64; N],
-    ) -> Result<[f64; N], SceneError> {
-        let value = self.array_or(key, default)?;
-        if value.iter().any(|&v| v <= 0.0) {
-            return Err(self.error(key, format!("every element must be > 0, got {value:?}")));
-        }
-        Ok(value)
-    }
-
     /// A colour: three components in [0, 1].
     pub fn color(&self, key: &str, default: [f64; 3]) -> Result<[f64; 3], SceneError> {
         let value = self.array_or(key, default)?;
         if value.iter().any(|&v| !(0.0..=1.0).contains(&v)) {
             return Err(self.error(
                 key,
-                format!("colour components must be in [0, 1], got {value:?}"),
+                format!(
+                    "colour components must be in [0, 1], got {}",
+                    short_list(&value)
+                ),
             ));
         }
         Ok(value)
@@ -365,7 +394,7 @@ impl<'a> TableReader<'a> {
         };
         let array = item.as_array().filter(|a| a.len() == 2);
         let values: Option<Vec<i64>> =
-            array.map(|a| a.iter().filter_map(|v| v.as_integer()).collect());
+            array.and_then(|a| a.iter().map(|v| v.as_integer()).collect());
         match values.as_deref() {
             Some(&[w, h])
                 if (1..=MAX_RESOLUTION as i64).contains(&w)
@@ -380,4 +409,14 @@ impl<'a> TableReader<'a> {
             )),
         }
     }
+}
+
+/// `must be in [min, max], got value`, with short numbers.
+pub fn range_message(value: f64, min: f64, max: f64) -> String {
+    format!(
+        "must be in [{}, {}], got {}",
+        short(min),
+        short(max),
+        short(value)
+    )
 }

@@ -5,6 +5,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use glam::{Vec2, Vec3};
 
+use crate::scene::limits::{MAX_PIXELS, MAX_RESOLUTION};
 use crate::util::color::srgb_to_linear;
 
 #[derive(Clone, Debug)]
@@ -16,9 +17,18 @@ pub struct Texture {
 }
 
 impl Texture {
-    /// Loads an sRGB PNG.
+    /// Loads an sRGB PNG of at most [`MAX_RESOLUTION`] pixels per side.
     pub fn load(path: &Path) -> Result<Texture> {
-        let img = image::open(path)
+        let decode = || -> Result<image::DynamicImage> {
+            let mut reader = image::ImageReader::open(path)?.with_guessed_format()?;
+            let mut limits = image::Limits::default();
+            limits.max_image_width = Some(MAX_RESOLUTION);
+            limits.max_image_height = Some(MAX_RESOLUTION);
+            limits.max_alloc = Some(4 * MAX_PIXELS);
+            reader.limits(limits);
+            Ok(reader.decode()?)
+        };
+        let img = decode()
             .with_context(|| format!("cannot load texture {}", path.display()))?
             .to_rgb8();
         Ok(Texture {

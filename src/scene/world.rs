@@ -10,6 +10,7 @@ use obvhs::aabb::Aabb;
 use obvhs::ray::Ray;
 use obvhs::rt_triangle::RtTriangle;
 
+use crate::scene::limits::check_placed_mesh;
 use crate::scene::mesh_io::{LoadedMesh, load_mesh};
 use crate::scene::shapes::{Tri, box_face, cuboid, frustum, plane_xz, quad_xy};
 use crate::scene::texture::Texture;
@@ -174,6 +175,13 @@ impl World {
                         meshes.insert(path.clone(), load_mesh(path)?);
                     }
                     let mesh = &meshes[path];
+                    check_placed_mesh(
+                        path,
+                        &object.name,
+                        &mesh.tris,
+                        &object.world_from_object,
+                        world.triangles.len(),
+                    )?;
                     let first = world.materials.len() as u32;
                     world
                         .materials

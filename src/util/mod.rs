@@ -1,8 +1,10 @@
 //! Small pieces every layer uses: sRGB transfer functions, deterministic hashing for
-//! sampling, the progress line, JSON for infinite distances and the process's peak memory.
+//! sampling, short numbers for messages, the progress line, JSON for infinite distances and
+//! the process's peak memory.
 
 pub mod color;
 pub mod json;
 pub mod memory;
+pub mod number;
 pub mod progress;
 pub mod sampling;

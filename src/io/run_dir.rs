@@ -1,0 +1,95 @@
+//! Reading a `run` directory back: its run.json and the driver-view frames the metrics need.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+
+use crate::io::frame_files::read_exr;
+use crate::render::frame::Frame;
+
+/// What `measure` needs of a run.json.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunRecord {
+    /// The scene file the run rendered, as the run was given it.
+    pub scene: PathBuf,
+}
+
+/// The views the metrics compare, in the order `measure` takes them.
+pub const MEASURED_VIEWS: [&str; 3] = ["truth", "seethru", "occluded"];
+
+/// Parses the text of a run.json; errors say what is wrong (the caller names the file).
+pub fn parse_run_json(text: &str) -> Result<RunRecord> {
+    let value: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| anyhow::anyhow!("invalid JSON: {e}"))?;
+    let object = value
+        .as_object()
+        .context("expected a JSON object, as `seethru run` writes")?;
+    let scene = match object.get("scene") {
+        Some(serde_json::Value::String(s)) if !s.is_empty() => s,
+        Some(other) => bail!("`scene` must be the path of the scene file, got {other}"),
+        None => bail!("no `scene` (the path of the scene file the run rendered)"),
+    };
+    Ok(RunRecord {
+        scene: PathBuf::from(scene),
+    })
+}
+
+/// Reads `dir/run.json`; errors name that file.
+pub fn read_run_json(dir: &Path) -> Result<RunRecord> {
+    let path = dir.join("run.json");
+    let text = std::fs::read_to_string(&path).with_context(|| {
+        format!(
+            "cannot read {} (not a `seethru run` directory?)",
+            path.display()
+        )
+    })?;
+    parse_run_json(&text).with_context(|| format!("{}", path.display()))
+}
+
+/// The EXR files of the measured views in `dir`.
+pub fn measured_exrs(dir: &Path) -> [PathBuf; 3] {
+    MEASURED_VIEWS.map(|v| dir.join(format!("{v}.exr")))
+}
+
+/// Reads truth, seethru and occluded from `dir`; they must have the same size.
+pub fn read_measured_frames(dir: &Path) -> Result<[Frame; 3]> {
+    let [truth, seethru, occluded] = measured_exrs(dir);
+    let frames = [read_exr(&truth)?, read_exr(&seethru)?, read_exr(&occluded)?];
+    let size = |f: &Frame| (f.width, f.height);
+    for (frame, path) in frames.iter().zip([&truth, &seethru, &occluded]).skip(1) {
+        if size(frame) != size(&frames[0]) {
+            bail!(
+                "{} is {}×{} but {} is {}×{}: the views of one run have one size",
+                path.display(),
+                frame.width,
+                frame.height,
+                truth.display(),
+                frames[0].width,
+                frames[0].height
+            );
+        }
+    }
+    Ok(frames)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn run_json_needs_a_scene_path() {
+        let ok = parse_run_json(r#"{"scene": "scenes/das.toml", "x": 1}"#).unwrap();
+        assert_eq!(ok.scene, PathBuf::from("scenes/das.toml"));
+        for (text, words) in [
+            ("", "invalid JSON"),
+            ("[1]", "expected a JSON object"),
+            ("{}", "no `scene`"),
+            (r#"{"scene": 3}"#, "must be the path"),
+            (r#"{"scene": ""}"#, "must be the path"),
+        ] {
+            let err = format!("{:#}", parse_run_json(text).unwrap_err());
+            assert!(err.contains(words), "{text}: {err}");
+            assert!(!err.contains('\n'), "{err}");
+        }
+    }
+}
