@@ -49,7 +49,7 @@ pub fn out_of_world(p: DVec3) -> Option<String> {
         .to_array()
         .into_iter()
         .zip(["x", "y", "z"])
-        .find(|(v, _)| !(v.abs() <= MAX_COORDINATE))?;
+        .find(|(v, _)| !v.is_finite() || v.abs() > MAX_COORDINATE)?;
     Some(format!(
         "{} = {} m is outside the world, [{}, {}] m",
         bad.1,

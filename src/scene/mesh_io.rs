@@ -118,7 +118,6 @@ pub fn parse_obj(
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let dir = path.parent().unwrap_or(Path::new(""));
     // tobj's material errors carry no path: remember ours.
@@ -365,7 +364,7 @@ fn check_accessor(
         .checked_mul(stride)
         .and_then(|n| n.checked_add(accessor.offset()))
         .and_then(|n| n.checked_add(size));
-    if !end.is_some_and(|end| end <= view.length()) {
+    if end.is_none_or(|end| end > view.length()) {
         bail!(
             "accessor {i} ({what}) reaches beyond the end of bufferView {} ({} bytes)",
             view.index(),
@@ -373,10 +372,10 @@ fn check_accessor(
         );
     }
     let buffer = &buffers[view.buffer().index()];
-    if !view
+    if view
         .offset()
         .checked_add(view.length())
-        .is_some_and(|end| end <= buffer.len())
+        .is_none_or(|end| end > buffer.len())
     {
         bail!(
             "bufferView {} reaches beyond the end of buffer {} ({} bytes)",
