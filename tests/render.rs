@@ -122,6 +122,67 @@ fn exr_round_trip_keeps_every_aov_bit_exact() {
 }
 
 #[test]
+fn simple_exr_readers_find_the_colour_as_plain_rgba() {
+    // What OpenCV, imageio and "first RGBA layer" readers do: take R, G, B (and A) of the
+    // first part. They must get the linear colour, bit for bit, and the AOV layers must sit
+    // under the names the README documents.
+    let ctx = minimal_context();
+    let (frame, _) = ctx.render(
+        &ctx.scene.driver,
+        view_bit::TRUTH,
+        RenderSettings::default(),
+        "test",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("frame.exr");
+    write_exr(&frame, &path).unwrap();
+    let width = frame.width as usize;
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        &path,
+        |resolution, _| vec![[0f32; 4]; resolution.width() * resolution.height()],
+        move |pixels, position, (r, g, b, a): (f32, f32, f32, f32)| {
+            pixels[position.y() * width + position.x()] = [r, g, b, a];
+        },
+    )
+    .unwrap();
+    let rgba = &image.layer_data.channel_data.pixels;
+    assert_eq!(rgba.len(), frame.color.len());
+    for (pixel, color) in rgba.iter().zip(&frame.color) {
+        assert_eq!(pixel[..3], color.to_array());
+        assert_eq!(pixel[3], 1.0);
+    }
+    let meta = exr::meta::MetaData::read_from_file(&path, false).unwrap();
+    assert_eq!(meta.headers.len(), 1, "one part");
+    let names: Vec<String> = meta.headers[0]
+        .channels
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    for name in [
+        "R",
+        "G",
+        "B",
+        "A",
+        "Z",
+        "camera_z.Z",
+        "P.X",
+        "P.Y",
+        "P.Z",
+        "N.X",
+        "N.Y",
+        "N.Z",
+        "id.object",
+        "id.part",
+    ] {
+        assert!(
+            names.iter().any(|n| n == name),
+            "{name} missing from {names:?}"
+        );
+    }
+}
+
+#[test]
 fn more_samples_smooth_edges_but_keep_centre_aovs() {
     let ctx = minimal_context();
     let one = ctx

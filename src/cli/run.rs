@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
+use rayon::prelude::*;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_frame;
 use seethru::measure::maps::write_metrics;
@@ -105,22 +106,32 @@ fn run_command(scene_path: &Path, out: &Path, options: &RunOptions, band: u32) -
     let result = run(&ctx, options)?;
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create output directory {}", out.display()))?;
-    for (name, frame) in [
+    let views = [
         ("truth", &result.truth),
         ("occluded", &result.occluded),
         ("frontal", &result.frontal),
         ("back", &result.back),
         ("display", &result.display),
         ("seethru", &result.seethru),
-    ] {
-        write_frame(frame, out, name)?;
-    }
+    ];
+    // Encoding PNGs and EXRs is mostly single-threaded work: the six views are written side
+    // by side, and beside the metrics. The files are the same whatever the order.
+    let (written, (maps, metrics)) = rayon::join(
+        || {
+            views
+                .par_iter()
+                .try_for_each(|(name, frame)| write_frame(frame, out, name))
+        },
+        || {
+            let frames = [&result.truth, &result.seethru, &result.occluded];
+            measure(&ctx, &ctx.scene, ctx.scene.eye(), frames, band)
+        },
+    );
+    written?;
     write_text(
         &out.join("run.json"),
         &serde_json::to_string_pretty(&result.report)?,
     )?;
-    let frames = [&result.truth, &result.seethru, &result.occluded];
-    let (maps, metrics) = measure(&ctx, &ctx.scene, ctx.scene.eye(), frames, band);
     write_metrics(out, &maps, &result.truth, &metrics)?;
     eprintln!(
         "wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",

@@ -135,7 +135,9 @@ pub fn heatmap_rgb(maps: &MetricMaps, truth: &Frame) -> Result<(u32, u32, Vec<u8
     Ok((cw, ch, buffer))
 }
 
-/// Writes `metrics.json`, `misregistration.exr` (`misregistration.arcmin`, `missing.mask`),
+/// Writes `metrics.json`, `misregistration.exr` (`Y`: misregistration, arcmin, NaN outside the
+/// display and on blank pixels;
+/// `missing.mask`: 1 where missing — `Y` so that grey-image readers open it),
 /// `misregistration.png` (heatmap with colour bar) and `missing.png` into `dir`.
 pub fn write_metrics(
     dir: &Path,
@@ -149,7 +151,7 @@ pub fn write_metrics(
     )?;
     let channels = vec![
         AnyChannel::new(
-            "misregistration.arcmin",
+            "Y",
             FlatSamples::F32(maps.misregistration.clone()),
         ),
         AnyChannel::new(

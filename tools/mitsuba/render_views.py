@@ -30,7 +30,9 @@ def seethru_frame(path):
     layers = {name: np.array(b) for name, b in mi.Bitmap(path).split()}
     names = {name.lower(): name for name in layers}
     color = layers[names.get("color", names.get("<root>"))][..., :3]
-    ids = layers[names.get("object_id", names.get("id"))].reshape(color.shape[:2])
+    ids = layers[names.get("id", names.get("object_id"))]
+    # `id` holds `id.object` and `id.part` (in that order); older files had `object_id.id`.
+    ids = (ids[..., 0] if ids.ndim == 3 else ids).reshape(color.shape[:2])
     return color, ids
 
 
