@@ -5,8 +5,14 @@ mod common;
 use std::process::Command;
 
 fn seethru(args: &[&str]) -> (bool, String, String) {
+    seethru_in(std::path::Path::new("."), args)
+}
+
+/// The command run from `dir`, so that an output a test did not expect lands there.
+fn seethru_in(dir: &std::path::Path, args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_seethru"))
         .args(args)
+        .current_dir(dir)
         .output()
         .unwrap();
     (
@@ -88,11 +94,12 @@ fn bad_input_gives_one_line_and_no_output() {
                 "--width",
                 "0",
             ],
-            "error: resolution 0×".into(),
+            "error: invalid value '0' for '--width <WIDTH>': must be an integer in [1, 16384]"
+                .into(),
         ),
         (
             vec!["render", "scenes/das.toml", "--out", out_arg, "--spp", "0"],
-            "error: --spp 0 is out of range".into(),
+            "error: invalid value '0' for '--spp <SPP>': must be an integer in [1, 4096]".into(),
         ),
         (
             vec![
@@ -103,11 +110,13 @@ fn bad_input_gives_one_line_and_no_output() {
                 "--threads",
                 "0",
             ],
-            "error: --threads 0 is out of range".into(),
+            "error: invalid value '0' for '--threads <THREADS>': must be an integer in [1, 1024]"
+                .into(),
         ),
         (
             vec!["bench", "scenes/das.toml", "--width", "99999"],
-            "error: resolution 99999×720".into(),
+            "error: invalid value '99999' for '--width <WIDTH>': must be an integer in [1, 16384]"
+                .into(),
         ),
         (
             vec!["export", "scenes/das.toml", "--out", "x.stl"],
@@ -164,7 +173,10 @@ fn analyze_reports_the_papers_claims_and_any_parameter_set() {
     let r1 = (10.0 * t - 10.8 * (0.25 + 0.05) / 0.8 + 0.05) / (20.0 * t);
     assert!((v["evaluation"]["left"]["R"].as_f64().unwrap() - r1).abs() < 1e-12);
     let (ok, _, err) = seethru(&["analyze", "--d1", "0"]);
-    assert!(!ok && err.starts_with("error: --d1 must be > 0"), "{err}");
+    assert!(
+        !ok && err.starts_with("error: invalid value '0' for '--d1 <D1>': must be a number in (0,"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -221,4 +233,125 @@ fn run_writes_six_views_run_json_and_metrics_and_measure_recomputes_them() {
         std::fs::read_to_string(out.join("metrics.json")).unwrap(),
         metrics
     );
+}
+
+/// Every option that takes a value, per command, read from the command's own `--help`, so
+/// that a flag added later is walked too: `(command words, flag, value name)`.
+fn options_with_values() -> Vec<(Vec<&'static str>, String, String)> {
+    let commands: [&[&str]; 11] = [
+        &["render"],
+        &["run"],
+        &["ratio", "occlusion"],
+        &["ratio", "foreshortening"],
+        &["reproduce"],
+        &["sweep"],
+        &["measure"],
+        &["export"],
+        &["figures"],
+        &["analyze"],
+        &["bench"],
+    ];
+    let mut found = Vec::new();
+    for words in commands {
+        let mut args = words.to_vec();
+        args.push("--help");
+        let (ok, help, err) = seethru(&args);
+        assert!(ok, "{args:?}: {err}");
+        let lines: Vec<&str> = help.lines().collect();
+        for (i, line) in lines.iter().enumerate() {
+            let line = line.trim();
+            let Some(rest) = line.strip_prefix("--") else {
+                continue;
+            };
+            let Some((flag, value)) = rest.split_once(" <") else {
+                continue;
+            };
+            // Options with a fixed list of values (clap checks the names) are not numbers.
+            let listed = lines[i + 1..]
+                .iter()
+                .take_while(|l| !l.trim().starts_with("--"))
+                .any(|l| l.contains("Possible values"));
+            if !listed {
+                found.push((
+                    words.to_vec(),
+                    format!("--{flag}"),
+                    value.split('>').next().unwrap_or_default().to_string(),
+                ));
+            }
+        }
+    }
+    found
+}
+
+#[test]
+fn every_numeric_flag_refuses_values_outside_its_range_in_one_line() {
+    // Paths, names and free-form specs are not numbers; everything else must refuse a NaN,
+    // an infinity, a huge number and an integer beyond 64 bits, naming the flag and its range.
+    let not_numbers = ["OUT", "SCENE", "DIR", "PARAMS"];
+    let options = options_with_values();
+    assert!(options.len() > 40, "{options:?}");
+    let scratch = tempfile::tempdir().unwrap();
+    let mut walked = 0;
+    for (words, flag, value) in options {
+        if not_numbers.contains(&value.as_str()) {
+            continue;
+        }
+        for bad in [
+            "nan",
+            "inf",
+            "-inf",
+            "1e308",
+            "99999999999999999999999",
+            "x",
+        ] {
+            // Distances that take `inf` (d2 → ∞) say so in their value name.
+            if bad == "inf" && value.contains("inf") {
+                continue;
+            }
+            let mut args: Vec<String> = words.iter().map(|w| w.to_string()).collect();
+            args.push(format!("{flag}={bad}"));
+            let args: Vec<&str> = args.iter().map(String::as_str).collect();
+            let (ok, _, err) = seethru_in(scratch.path(), &args);
+            assert!(!ok, "{args:?} was accepted");
+            let err = err.trim_end();
+            assert_eq!(err.lines().count(), 1, "{args:?}: one line, got {err}");
+            assert!(
+                err.starts_with("error: invalid value") && err.contains(&flag),
+                "{args:?}: {err}"
+            );
+            // X,Y,Z lists name their own range per axis; other numbers name [a, b] or (a, b].
+            assert!(
+                err.contains("must be") && (err.contains('[') || err.contains('(')),
+                "{args:?}: no admissible range in {err}"
+            );
+        }
+        walked += 1;
+    }
+    assert!(walked > 30, "{walked}");
+}
+
+#[test]
+fn the_documented_head_bias_form_works_with_signs() {
+    for bias in ["1,0,0", "-1,0.5,-2"] {
+        let (ok, _, err) = seethru(&[
+            "ratio",
+            "occlusion",
+            "--L",
+            "5",
+            "--b1",
+            "-0.35",
+            "--d2",
+            "6.3",
+            "--d1",
+            "2.5",
+            "--bh",
+            "1.75",
+            "--width",
+            "96",
+            "--head-bias-cm",
+            bias,
+            "--json",
+        ]);
+        assert!(ok, "{bias}: {err}");
+    }
 }

@@ -1,48 +1,51 @@
 //! `seethru analyze`: the paper's claims beside seethru's values, and every closed form at a
 //! parameter set.
 
+use crate::cli::args::{pixels, positive, real};
 use anyhow::Result;
 use seethru::paper::claims::{
     AnalyzeParams, claims_table, evaluate, head_error_table, head_error_text, paper_claims,
 };
 
 #[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Analyze {
     /// Print JSON instead of tables.
     #[arg(long)]
     json: bool,
-    /// Eye distance from the display d1 [m].
-    #[arg(long, default_value_t = 1.0)]
+    /// Eye distance from the display d1, metres in (0, 1000].
+    #[arg(long, default_value_t = 1.0, value_parser = positive(1e3))]
     d1: f64,
-    /// Working distance d2 [m] (use inf for the d2 → ∞ model).
-    #[arg(long, default_value_t = 1.0)]
+    /// Working distance d2, metres in (0, 1e6].
+    #[arg(long, default_value_t = 1.0, value_parser = positive(1e6))]
     d2: f64,
-    /// Lateral eye offset b_h [m] (> 0: the eye on the side of the left crop R1).
-    #[arg(long = "bh", default_value_t = 0.125, allow_hyphen_values = true)]
+    /// Lateral eye offset b_h, metres in [-100, 100] (> 0: the eye on the side of the left
+    /// crop R1).
+    #[arg(long = "bh", default_value_t = 0.125, allow_hyphen_values = true, value_parser = real(-100.0, 100.0))]
     b_h: f64,
-    /// Display width D [m].
-    #[arg(long, default_value_t = 0.5)]
+    /// Display width D, metres in (0, 100].
+    #[arg(long, default_value_t = 0.5, value_parser = positive(100.0))]
     width: f64,
-    /// Frontal half angle θ_F [degrees].
-    #[arg(long = "theta-f", default_value_t = 80.0)]
+    /// Frontal half angle θ_F, degrees in [0.01, 89].
+    #[arg(long = "theta-f", default_value_t = 80.0, value_parser = real(0.01, 89.0))]
     theta_f: f64,
-    /// Frontal image width [pixels].
-    #[arg(long = "frontal-px", default_value_t = 1280)]
+    /// Frontal image width, pixels in [1, 16384].
+    #[arg(long = "frontal-px", default_value_t = 1280, value_parser = pixels)]
     frontal_px: u32,
-    /// Occluder depth L [m].
-    #[arg(long = "L", default_value_t = 1.0)]
+    /// Occluder depth L, metres in (0, 1e4].
+    #[arg(long = "L", default_value_t = 1.0, value_parser = positive(1e4))]
     occluder_depth: f64,
-    /// Lateral position of the object's corner b1 [m].
-    #[arg(long, default_value_t = 0.25, allow_hyphen_values = true)]
+    /// Lateral position of the object's corner b1, metres in [-1e4, 1e4].
+    #[arg(long, default_value_t = 0.25, allow_hyphen_values = true, value_parser = real(-1e4, 1e4))]
     b1: f64,
-    /// Length of the angled surface l [m].
-    #[arg(long = "l", default_value_t = 1.0)]
+    /// Length of the angled surface l, metres in (0, 1e4].
+    #[arg(long = "l", default_value_t = 1.0, value_parser = positive(1e4))]
     surface_length: f64,
-    /// Angle of the surface γ [degrees].
-    #[arg(long, default_value_t = 45.0, allow_hyphen_values = true)]
+    /// Angle of the surface γ to the plane, degrees in (0, 90].
+    #[arg(long, default_value_t = 45.0, value_parser = positive(90.0))]
     gamma: f64,
-    /// Tolerance of the d2_min bound, as a fraction of R(∞).
-    #[arg(long, default_value_t = 0.05)]
+    /// Tolerance of the d2_min bound, as a fraction of R(∞) in (0, 1].
+    #[arg(long, default_value_t = 0.05, value_parser = positive(1.0))]
     tolerance: f64,
 }
 

@@ -1,30 +1,107 @@
-//! Argument groups that several commands share, and the thread pool they run on.
+//! Argument groups that several commands share, the value parsers that give every numeric
+//! argument its admissible range, and the thread pool commands run on.
 
 use anyhow::{Result, bail};
+use seethru::render::settings::MAX_SPP;
+use seethru::scene::source::MAX_RESOLUTION;
+
+/// Most worker threads a command accepts.
+pub const MAX_THREADS: u64 = 1024;
+
+/// A finite real number in `[min, max]` (NaN and infinities refused). As a clap value parser
+/// the error reads `invalid value 'X' for '--flag': must be a number in [min, max]`.
+pub fn real(min: f64, max: f64) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync {
+    move |text| match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && (min..=max).contains(&v) => Ok(v),
+        _ => Err(format!("must be a number in [{min}, {max}]")),
+    }
+}
+
+/// A finite real number in `(0, max]`: sizes, distances, widths.
+pub fn positive(max: f64) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync {
+    move |text| match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= max => Ok(v),
+        _ => Err(format!("must be a number in (0, {max}]")),
+    }
+}
+
+/// An integer in `[min, max]` of any unsigned type (no wrapping: `4000000000` is refused, not
+/// read modulo 2³²).
+pub fn integer<T: TryFrom<u64>>(
+    min: u64,
+    max: u64,
+) -> impl Fn(&str) -> Result<T, String> + Clone + Send + Sync {
+    move |text| {
+        text.trim()
+            .parse::<u64>()
+            .ok()
+            .filter(|v| (min..=max).contains(v))
+            .and_then(|v| T::try_from(v).ok())
+            .ok_or_else(|| format!("must be an integer in [{min}, {max}]"))
+    }
+}
+
+/// An image side in pixels, `[1, MAX_RESOLUTION]`.
+pub fn pixels(text: &str) -> Result<u32, String> {
+    integer(1, MAX_RESOLUTION as u64)(text)
+}
+
+/// Samples per pixel, `[1, MAX_SPP]`.
+pub fn samples(text: &str) -> Result<u32, String> {
+    integer(1, MAX_SPP as u64)(text)
+}
+
+/// Worker threads, `[1, MAX_THREADS]`.
+pub fn threads(text: &str) -> Result<usize, String> {
+    integer(1, MAX_THREADS)(text)
+}
+
+/// Width of the border band of the mismatch metrics, display pixels, `[1, 1000]`.
+pub fn band(text: &str) -> Result<u32, String> {
+    integer(1, 1000)(text)
+}
+
+/// Most centimetres of head bias on each axis.
+pub const MAX_HEAD_BIAS_CM: f64 = 500.0;
+
+/// A head bias `x,y,z` in centimetres, each in `[−MAX_HEAD_BIAS_CM, MAX_HEAD_BIAS_CM]`
+/// (`1,0,0`; a leading minus is fine: `-1,0,0`).
+pub fn head_bias_cm(text: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = text.split(',').collect();
+    let axis = real(-MAX_HEAD_BIAS_CM, MAX_HEAD_BIAS_CM);
+    match parts.as_slice() {
+        [x, y, z] => Ok([axis(x)?, axis(y)?, axis(z)?]),
+        _ => Err(format!(
+            "must be x,y,z: three numbers in [{}, {MAX_HEAD_BIAS_CM}] cm separated by commas",
+            -MAX_HEAD_BIAS_CM
+        )),
+    }
+}
 
 /// Image size, samples and threads: shared by `render` and `run`.
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// Image width in pixels (default: the camera's; height follows the aspect ratio if not given).
-    #[arg(long)]
+    /// Image width, pixels in [1, 16384] (default: the camera's; the height follows the aspect
+    /// ratio if not given).
+    #[arg(long, value_parser = pixels)]
     pub width: Option<u32>,
-    /// Image height in pixels.
-    #[arg(long)]
+    /// Image height, pixels in [1, 16384] (default: from the width and the camera's aspect).
+    #[arg(long, value_parser = pixels)]
     pub height: Option<u32>,
-    /// Samples per pixel (anti-aliasing of the colour; AOVs are at pixel centres).
-    #[arg(long, default_value_t = 4)]
+    /// Samples per pixel in [1, 4096] (anti-aliasing of the colour; AOVs are at pixel centres).
+    #[arg(long, default_value_t = 4, value_parser = samples)]
     pub spp: u32,
-    /// Worker threads (default: all cores). Images are identical for any value.
-    #[arg(long)]
+    /// Worker threads in [1, 1024] (default: all cores). Images are identical for any value.
+    #[arg(long, value_parser = threads)]
     pub threads: Option<usize>,
 }
 
 /// Runs `job` on a pool of `threads` workers (all cores if `None`). Images do not depend on it.
 pub fn with_threads<T: Send>(threads: Option<usize>, job: impl FnOnce() -> T + Send) -> Result<T> {
     if let Some(n) = threads
-        && !(1..=1024).contains(&n)
+        && !(1..=MAX_THREADS as usize).contains(&n)
     {
-        bail!("--threads {n} is out of range [1, 1024]");
+        bail!("--threads {n} is out of range [1, {MAX_THREADS}]");
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))

@@ -18,23 +18,28 @@ use seethru::scene::grow::grow;
 use seethru::util::memory::peak_rss_bytes;
 use serde_json::json;
 
-use crate::cli::args::with_threads;
+use crate::cli::args::{integer, pixels, real, threads, with_threads};
 
 #[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Bench {
+    /// Scene file (TOML).
     scene: PathBuf,
-    #[arg(long, default_value_t = 1280)]
+    /// Image width of the ray batches and frames, pixels in [1, 16384].
+    #[arg(long, default_value_t = 1280, value_parser = pixels)]
     width: u32,
-    #[arg(long, default_value_t = 720)]
+    /// Image height, pixels in [1, 16384].
+    #[arg(long, default_value_t = 720, value_parser = pixels)]
     height: u32,
-    /// Timed repeats of every measurement (min, median and max are reported).
-    #[arg(long, default_value_t = 5)]
+    /// Timed repeats of every measurement, in [1, 1000] (min, median and max are reported).
+    #[arg(long, default_value_t = 5, value_parser = integer::<usize>(1, 1000))]
     repeat: usize,
-    #[arg(long)]
+    /// Worker threads in [1, 1024] (default: all cores).
+    #[arg(long, value_parser = threads)]
     threads: Option<usize>,
     /// Grow the scene procedurally to about this many times its triangles (parked cars,
-    /// trees, buildings), to see how the cost scales with scene size.
-    #[arg(long, default_value_t = 1.0)]
+    /// trees, buildings), in [1, 1000], to see how the cost scales with scene size.
+    #[arg(long, default_value_t = 1.0, value_parser = real(1.0, 1000.0))]
     grow: f64,
     /// Print only the JSON line.
     #[arg(long)]

@@ -9,7 +9,9 @@ use seethru::scene::Scene;
 use seethru::scene::world::World;
 
 #[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Export {
+    /// Scene file (TOML).
     scene: PathBuf,
     /// Output file: .glb (glTF), .obj or .xml (Mitsuba 3); <name>.cameras.json goes beside it.
     #[arg(long)]

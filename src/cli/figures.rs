@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use anyhow::Result;
 
 #[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Figures {
+    /// Output directory for the figures (PNG + CSV).
     #[arg(long)]
     out: PathBuf,
 }

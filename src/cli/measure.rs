@@ -9,10 +9,15 @@ use seethru::measure::metrics::measure;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 
+use crate::cli::args::band;
+
 #[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Measure {
+    /// A `seethru run` output directory (its run.json names the scene).
     dir: PathBuf,
-    #[arg(long, default_value_t = 5)]
+    /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
+    #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
 }
 

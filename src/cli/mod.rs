@@ -54,6 +54,31 @@ pub enum Command {
     Bench(bench::Bench),
 }
 
+/// A clap error as one line starting `error:`: the message and its tip, without the usage
+/// block and the pointer to `--help`, so that scripts and logs get one line per failure.
+pub fn one_line(error: &clap::Error) -> String {
+    let text = error.render().to_string();
+    let parts: Vec<&str> = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| {
+            !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("For more information")
+        })
+        .collect();
+    let mut line = String::new();
+    for part in parts {
+        if !line.is_empty() {
+            line.push_str(if line.ends_with(':') { " " } else { "; " });
+        }
+        line.push_str(part);
+    }
+    if line.starts_with("error:") {
+        line
+    } else {
+        format!("error: {line}")
+    }
+}
+
 impl Command {
     pub fn run(self) -> Result<()> {
         match self {

@@ -1,12 +1,12 @@
 //! `seethru ratio`: the observed p_cam/p_user of the paper's occlusion or foreshortening setup.
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use seethru::analysis::paper::{ForeshorteningParams, OcclusionParams};
 use seethru::measure::ratio::{describe, measure_ratio};
 use seethru::measure::ratio_setup::{Compensation, Setup};
 use seethru::render::settings::check_resolution;
 
-use crate::cli::args::with_threads;
+use crate::cli::args::{head_bias_cm, pixels, positive, real, threads, with_threads};
 
 #[derive(clap::Args)]
 pub struct Ratio {
@@ -17,8 +17,10 @@ pub struct Ratio {
 #[derive(clap::Subcommand)]
 enum RatioSetup {
     /// A box of depth L standing on the scene plane at d2, its near edge at lateral b1.
+    #[command(allow_negative_numbers = true)]
     Occlusion {
-        #[arg(long = "L")]
+        /// Depth of the box L, metres in (0, 1e4].
+        #[arg(long = "L", value_parser = positive(1e4))]
         l: f64,
         #[command(flatten)]
         at: RatioGeometry,
@@ -26,11 +28,13 @@ enum RatioSetup {
         common: RatioCommon,
     },
     /// A surface of length l from its corner at b1 on the plane at d2, at angle γ to the plane.
+    #[command(allow_negative_numbers = true)]
     Foreshortening {
-        #[arg(long = "l")]
+        /// Length of the surface l, metres in (0, 1e4].
+        #[arg(long = "l", value_parser = positive(1e4))]
         l: f64,
-        /// Angle between the surface and the plane, degrees, in (0, 90].
-        #[arg(long)]
+        /// Angle between the surface and the plane, degrees in (0, 90].
+        #[arg(long, value_parser = positive(90.0))]
         gamma: f64,
         #[command(flatten)]
         at: RatioGeometry,
@@ -42,17 +46,17 @@ enum RatioSetup {
 /// Where the object and the eye are (the paper's §4.2 parameters), metres.
 #[derive(clap::Args)]
 struct RatioGeometry {
-    /// Lateral position of the object's corner.
-    #[arg(long, allow_hyphen_values = true)]
+    /// Lateral position of the object's corner, in [-1e4, 1e4].
+    #[arg(long, allow_hyphen_values = true, value_parser = real(-1e4, 1e4))]
     b1: f64,
-    /// Distance of the scene plane from the display.
-    #[arg(long)]
+    /// Distance of the scene plane from the display, in (0, 1e4].
+    #[arg(long, value_parser = positive(1e4))]
     d2: f64,
-    /// Distance of the eye from the display.
-    #[arg(long)]
+    /// Distance of the eye from the display, in (0, 1e3].
+    #[arg(long, value_parser = positive(1e3))]
     d1: f64,
-    /// Eye offset b_h (the eye at lateral −b_h).
-    #[arg(long = "bh", allow_hyphen_values = true)]
+    /// Eye offset b_h (the eye at lateral −b_h), in [-1e3, 1e3].
+    #[arg(long = "bh", allow_hyphen_values = true, value_parser = real(-1e3, 1e3))]
     b_h: f64,
 }
 
@@ -63,24 +67,28 @@ struct RatioCommon {
     #[arg(
         long = "model-d2",
         value_name = "METRES|inf",
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = model_d2
     )]
-    model_d2: Option<String>,
-    /// Head-tracking bias of the compensation's eye, obstacle frame, centimetres: x,y,z.
+    model_d2: Option<f64>,
+    /// Head-tracking bias of the compensation's eye, obstacle frame, centimetres: x,y,z, each
+    /// in [-500, 500] (the eye must stay in front of the display).
     #[arg(
         long = "head-bias-cm",
         value_name = "X,Y,Z",
         allow_hyphen_values = true,
-        default_value = "0,0,0"
+        default_value = "0,0,0",
+        value_parser = head_bias_cm
     )]
-    head_bias_cm: String,
-    /// Width of the driver view, the frontal image and the display, pixels.
-    #[arg(long, default_value_t = 1280)]
+    head_bias_cm: [f64; 3],
+    /// Width of the driver view, the frontal image and the display, pixels in [1, 16384].
+    #[arg(long, default_value_t = 1280, value_parser = pixels)]
     width: u32,
     /// Print JSON.
     #[arg(long)]
     json: bool,
-    #[arg(long)]
+    /// Worker threads in [1, 1024] (default: all cores).
+    #[arg(long, value_parser = threads)]
     threads: Option<usize>,
 }
 
@@ -117,8 +125,8 @@ impl Ratio {
         };
         check_resolution(common.width, common.width)?;
         let compensation = Compensation {
-            model_d2: common.model_d2.as_deref().map(parse_model_d2).transpose()?,
-            head_bias_cm: parse_bias(&common.head_bias_cm)?,
+            model_d2: common.model_d2,
+            head_bias_cm: common.head_bias_cm,
         };
         let result = with_threads(common.threads, || {
             measure_ratio(&setup, common.width, &compensation)
@@ -132,28 +140,10 @@ impl Ratio {
     }
 }
 
-/// `--model-d2`: `inf` or a distance in metres in (0, ∞).
-fn parse_model_d2(text: &str) -> Result<f64> {
+/// `--model-d2`: `inf` or a distance in metres in (0, 1e6].
+fn model_d2(text: &str) -> Result<f64, String> {
     match text {
         "inf" | "infinity" => Ok(f64::INFINITY),
-        _ => match text.parse::<f64>() {
-            Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-            _ => bail!("--model-d2 must be a distance in metres in (0, ∞) or `inf`, got `{text}`"),
-        },
-    }
-}
-
-/// `--head-bias-cm`: three finite numbers x,y,z.
-fn parse_bias(text: &str) -> Result<[f64; 3]> {
-    let values: Vec<f64> = text
-        .split(',')
-        .map(|v| v.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .unwrap_or_default();
-    match values[..] {
-        [x, y, z] if values.iter().all(|v| v.is_finite()) => Ok([x, y, z]),
-        _ => bail!(
-            "--head-bias-cm must be three finite numbers x,y,z in centimetres (the eye must stay in front of the display), got `{text}`"
-        ),
+        _ => positive(1e6)(text).map_err(|e| format!("{e} or `inf`")),
     }
 }

@@ -12,6 +12,7 @@ use seethru::scene::Scene;
 use crate::cli::args::{RenderArgs, with_threads};
 
 #[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Render {
     /// Scene file (TOML).
     scene: PathBuf,

@@ -4,10 +4,12 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 
-use crate::cli::args::with_threads;
+use crate::cli::args::{threads, with_threads};
 
 #[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Reproduce {
+    /// Output directory for report.md, report.html, report.json and the figures.
     #[arg(long)]
     out: PathBuf,
     /// Small renders (CI-sized).
@@ -16,7 +18,8 @@ pub struct Reproduce {
     /// The driver-assistance scene.
     #[arg(long, default_value = "scenes/das.toml")]
     scene: PathBuf,
-    #[arg(long)]
+    /// Worker threads in [1, 1024] (default: all cores).
+    #[arg(long, value_parser = threads)]
     threads: Option<usize>,
 }
 

@@ -15,34 +15,40 @@ use seethru::system::display::{DisplayModel, Filter};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use seethru::system::pipeline::run;
 
-use crate::cli::args::{RenderArgs, with_threads};
+use crate::cli::args::{
+    RenderArgs, band, head_bias_cm, integer, pixels, positive, real, with_threads,
+};
 
 #[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Run {
+    /// Scene file (TOML).
     scene: PathBuf,
+    /// Output directory.
     #[arg(long)]
     out: PathBuf,
     /// none: the whole frontal image in the display; planar: the paper's compensation.
     #[arg(long, value_enum, default_value_t = Method::Planar)]
     method: Method,
     /// Working distance of the planar model: inf, auto (median frontal depth behind the
-    /// display) or metres.
-    #[arg(long, default_value = "inf")]
+    /// display) or metres in (0, 1e6].
+    #[arg(long, default_value = "inf", value_name = "METRES|inf|auto")]
     d2: WorkingDistance,
     /// oracle: the true eye; estimated: face detection on the back camera's image.
     #[arg(long, value_enum, default_value_t = HeadSource::Oracle)]
     head: HeadSource,
-    /// Head-tracking bias, obstacle frame, centimetres: x,y,z.
-    #[arg(long = "head-bias-cm", value_delimiter = ',', num_args = 3, allow_hyphen_values = true, default_values_t = [0.0, 0.0, 0.0])]
-    head_bias_cm: Vec<f64>,
-    /// Head-tracking jitter, standard deviation per axis, centimetres.
-    #[arg(long = "head-jitter-cm", default_value_t = 0.0)]
+    /// Head-tracking bias, obstacle frame, centimetres: x,y,z, each in [-500, 500]
+    /// (e.g. `1,0,0` or `-1,0,0`).
+    #[arg(long = "head-bias-cm", value_name = "X,Y,Z", allow_hyphen_values = true, default_value = "0,0,0", value_parser = head_bias_cm)]
+    head_bias_cm: [f64; 3],
+    /// Head-tracking jitter, standard deviation per axis, centimetres in [0, 100].
+    #[arg(long = "head-jitter-cm", default_value_t = 0.0, value_parser = real(0.0, 100.0))]
     head_jitter_cm: f64,
-    /// Seed of the jitter.
-    #[arg(long, default_value_t = 1)]
+    /// Seed of the jitter, an integer in [0, 4294967295].
+    #[arg(long, default_value_t = 1, value_parser = integer::<u32>(0, u32::MAX as u64))]
     seed: u32,
-    /// The detector's known feature width A (interpupillary distance), metres.
-    #[arg(long = "feature-width", default_value_t = 0.064)]
+    /// The detector's known feature width A (interpupillary distance), metres in (0, 1].
+    #[arg(long = "feature-width", default_value_t = 0.064, value_parser = positive(1.0))]
     feature_width: f64,
     /// When the crop leaves the frontal view: error, or black (flagged as missing).
     #[arg(long, value_enum, default_value_t = Outside::Error)]
@@ -54,14 +60,14 @@ pub struct Run {
     /// that only the planar model's error remains.
     #[arg(long, value_enum, default_value_t = DisplayModel::Pixels)]
     display: DisplayModel,
-    /// Frontal camera width in pixels (aspect ratio kept).
-    #[arg(long = "frontal-width")]
+    /// Frontal camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
+    #[arg(long = "frontal-width", value_parser = pixels)]
     frontal_width: Option<u32>,
-    /// Back camera width in pixels (aspect ratio kept).
-    #[arg(long = "back-width")]
+    /// Back camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
+    #[arg(long = "back-width", value_parser = pixels)]
     back_width: Option<u32>,
-    /// Width of the border band of the mismatch metrics, display pixels.
-    #[arg(long, default_value_t = 5)]
+    /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
+    #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
     /// Sizes (width and height: the driver views truth, occluded, seethru), samples, threads.
     #[command(flatten)]
@@ -74,11 +80,7 @@ impl Run {
             method: self.method,
             d2: self.d2,
             head: self.head,
-            head_bias_cm: [
-                self.head_bias_cm[0],
-                self.head_bias_cm[1],
-                self.head_bias_cm[2],
-            ],
+            head_bias_cm: self.head_bias_cm,
             head_jitter_cm: self.head_jitter_cm,
             seed: self.seed,
             feature_width: self.feature_width,

@@ -7,26 +7,33 @@ use seethru::measure::sweep::{SweepOptions, sweep};
 use seethru::measure::sweep_grid::parse_param;
 use seethru::system::options::HeadSource;
 
-use crate::cli::args::with_threads;
+use crate::cli::args::{band, pixels, samples, threads, with_threads};
 
 #[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Sweep {
+    /// Scene file (TOML).
     scene: PathBuf,
     /// name=start:stop:step or name=v1,v2,... (repeat for a grid).
     #[arg(long = "param", required = true)]
     params: Vec<String>,
+    /// Output CSV (a plot goes beside it); an existing one is resumed.
     #[arg(long, default_value = "sweep.csv")]
     out: PathBuf,
-    /// Driver-view width in pixels.
-    #[arg(long, default_value_t = 320)]
+    /// Driver-view width, pixels in [1, 16384].
+    #[arg(long, default_value_t = 320, value_parser = pixels)]
     width: u32,
-    #[arg(long, default_value_t = 1)]
+    /// Samples per pixel in [1, 4096].
+    #[arg(long, default_value_t = 1, value_parser = samples)]
     spp: u32,
+    /// oracle: the true eye; estimated: face detection on the back camera's image.
     #[arg(long, value_enum, default_value_t = HeadSource::Oracle)]
     head: HeadSource,
-    #[arg(long, default_value_t = 5)]
+    /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
+    #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
-    #[arg(long)]
+    /// Worker threads in [1, 1024] (default: all cores).
+    #[arg(long, value_parser = threads)]
     threads: Option<usize>,
 }
 

@@ -150,10 +150,7 @@ pub fn write_metrics(
         &serde_json::to_string_pretty(json)?,
     )?;
     let channels = vec![
-        AnyChannel::new(
-            "Y",
-            FlatSamples::F32(maps.misregistration.clone()),
-        ),
+        AnyChannel::new("Y", FlatSamples::F32(maps.misregistration.clone())),
         AnyChannel::new(
             "missing.mask",
             FlatSamples::F32(maps.missing.iter().map(|&m| m as u8 as f32).collect()),

@@ -1,6 +1,7 @@
 //! The choices of one run of the see-through system: method, working distance, head source,
 //! injected head errors, sizes, and how the display is modelled.
 
+use crate::scene::limits::MAX_COORDINATE;
 use crate::system::display::{DisplayModel, Filter};
 
 /// How the display image is made.
@@ -31,9 +32,11 @@ impl std::str::FromStr for WorkingDistance {
             "inf" | "infinity" => Ok(WorkingDistance::Infinity),
             "auto" => Ok(WorkingDistance::Auto),
             _ => match s.parse::<f64>() {
-                Ok(v) if v.is_finite() && v > 0.0 => Ok(WorkingDistance::Metres(v)),
+                Ok(v) if v.is_finite() && v > 0.0 && v <= MAX_COORDINATE => {
+                    Ok(WorkingDistance::Metres(v))
+                }
                 _ => Err(format!(
-                    "`{s}`: expected inf, auto or a distance in metres > 0"
+                    "`{s}`: must be inf, auto or a distance in metres in (0, {MAX_COORDINATE}]"
                 )),
             },
         }
