@@ -19,6 +19,7 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    seethru::util::progress::set_quiet(cli.quiet);
     match cli.command.run() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

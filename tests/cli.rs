@@ -355,3 +355,24 @@ fn the_documented_head_bias_form_works_with_signs() {
         assert!(ok, "{bias}: {err}");
     }
 }
+
+#[test]
+fn logs_get_one_summary_line_and_quiet_gets_none() {
+    // stderr is a pipe here, as in CI logs: no bar, no carriage returns.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, common::MINIMAL).unwrap();
+    let out = dir.path().join("out");
+    let args = [
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let (ok, _, err) = seethru(&args);
+    assert!(ok, "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!err.contains('\r'), "{err:?}");
+    let (ok, stdout, err) = seethru(&[&args[..], &["--quiet"]].concat());
+    assert!(ok && err.is_empty() && stdout.is_empty(), "{stdout}{err}");
+}

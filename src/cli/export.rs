@@ -46,6 +46,6 @@ fn export_scene(scene_path: &Path, out: &Path, format: Option<ExportFormat>) -> 
         let files = if n == 1 { "file" } else { "files" };
         message += &format!(" and {n} {files} in {}", assets.display());
     }
-    eprintln!("{message}");
+    seethru::util::progress::summary(message);
     Ok(())
 }

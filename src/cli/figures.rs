@@ -15,11 +15,11 @@ pub struct Figures {
 impl Figures {
     pub fn run(self) -> Result<()> {
         let names = seethru::paper::figures::write_all(&self.out)?;
-        eprintln!(
+        seethru::util::progress::summary(format!(
             "wrote {} figures (PNG + CSV) to {}",
             names.len(),
             self.out.display()
-        );
+        ));
         Ok(())
     }
 }

@@ -22,6 +22,9 @@ use clap::{Parser, Subcommand};
     about = "Simulates video see-through displays for driver assistance and measures how well they work"
 )]
 pub struct Cli {
+    /// No progress bars and no summary lines (errors are still printed).
+    #[arg(long, global = true)]
+    pub quiet: bool,
     #[command(subcommand)]
     pub command: Command,
 }

@@ -55,17 +55,22 @@ fn render_views(scene_path: &Path, views: &[View], out: &Path, options: &RenderA
         spp: options.spp,
         progress: true,
     };
+    let mut rendered = Vec::new();
     for (view, camera) in views.iter().zip(&cameras) {
         let (frame, stats) = context.render(camera, view.bit(), settings, view.name());
         write_frame(&frame, out, view.name())?;
-        eprintln!(
-            "{}: {}×{} in {:.2} s → {}",
+        rendered.push(format!(
+            "{} {}×{} in {:.2} s",
             view.name(),
             camera.width,
             camera.height,
-            stats.seconds,
-            out.join(format!("{}.png", view.name())).display()
-        );
+            stats.seconds
+        ));
     }
+    seethru::util::progress::summary(format!(
+        "rendered {} (PNG, ids PNG, EXR each) → {}",
+        rendered.join(", "),
+        out.display()
+    ));
     Ok(())
 }

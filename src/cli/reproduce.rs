@@ -28,10 +28,10 @@ impl Reproduce {
         with_threads(self.threads, || {
             seethru::paper::reproduce::reproduce(&self.scene, &self.out, self.quick)
         })??;
-        eprintln!(
+        seethru::util::progress::summary(format!(
             "wrote report.md, report.html and report.json to {}",
             self.out.display()
-        );
+        ));
         Ok(())
     }
 }

@@ -135,9 +135,9 @@ fn run_command(scene_path: &Path, out: &Path, options: &RunOptions, band: u32) -
         &serde_json::to_string_pretty(&result.report)?,
     )?;
     write_metrics(out, &maps, &result.truth, &metrics)?;
-    eprintln!(
+    seethru::util::progress::summary(format!(
         "wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",
         out.display()
-    );
+    ));
     Ok(())
 }

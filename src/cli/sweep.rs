@@ -53,10 +53,10 @@ impl Sweep {
         let computed = with_threads(self.threads, || {
             sweep(&self.scene, &params, &self.out, &options)
         })??;
-        eprintln!(
+        seethru::util::progress::summary(format!(
             "computed {computed} configurations; results in {}",
             self.out.display()
-        );
+        ));
         Ok(())
     }
 }

@@ -22,6 +22,7 @@ use crate::scene::Scene;
 use crate::scene::world::view_bit;
 use crate::system::options::{HeadSource, Outside, RunOptions};
 use crate::system::pipeline::{driver_camera, run_with_truth};
+use crate::util::progress::Progress;
 
 /// The metric columns of a row. `coverage` (the fraction of display pixels that show the
 /// scene, over which the misregistration means are taken) comes last, so that the columns
@@ -160,6 +161,7 @@ pub fn sweep(
             None => groups.push((key, vec![j])),
         }
     }
+    let progress = Progress::new("sweep", jobs.len(), true);
     groups
         .par_iter()
         .try_for_each(|(_, members)| -> Result<()> {
@@ -194,9 +196,11 @@ pub fn sweep(
                     .lock()
                     .map_err(|_| anyhow::anyhow!("a sweep worker panicked"))?;
                 rows.push((*index, line));
+                progress.advance(1);
                 write(&mut rows)
             })
         })?;
+    progress.finish();
     let mut rows = rows
         .into_inner()
         .map_err(|_| anyhow::anyhow!("a sweep worker panicked"))?;

@@ -22,6 +22,7 @@ use crate::scene::Scene;
 use crate::system::options::{Outside, RunOptions};
 use crate::system::pipeline::run;
 use crate::util::color::encode_srgb8;
+use crate::util::progress::Progress;
 
 fn frame_png(frame: &Frame, path: &Path) -> Result<()> {
     let rgb = frame.color.iter().flat_map(|&c| encode_srgb8(c)).collect();
@@ -75,6 +76,8 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
     let base = Scene::load(scene_path)?;
     let mut cases = Vec::new();
     let mut equal = Vec::new();
+    // Four display cases, then the two ratio setups.
+    let progress = Progress::new("reproduce", 6, true);
     // §5.2 Figs. 4 and 5: the car close and far, θ_F = 30° and 63.5°, D = 1 m, d2 → ∞.
     for (car_label, distance) in [("close", 4.0), ("far", 15.0)] {
         let mut compared: Vec<(String, MetricMaps)> = Vec::new();
@@ -105,6 +108,7 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
             let (w, h, rgb) = heatmap_rgb(&maps, &result.truth)?;
             write_png(&out.join(&dir).join("misregistration.png"), w, h, rgb)?;
             compared.push((format!("θ_F = {theta}°"), maps));
+            progress.advance(1);
             cases.push(CaseResult {
                 name,
                 dir,
@@ -137,7 +141,9 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
         frame_png(&frames.truth, &out.join(dir).join("truth.png"))?;
         frame_png(&frames.seethru, &out.join(dir).join("seethru.png"))?;
         ratios.push((name.to_string(), dir.to_string(), r));
+        progress.advance(1);
     }
+    progress.finish();
     let figures = crate::paper::figures::write_all(&out.join("figures"))?;
     let report = json!({
         "quick": quick,

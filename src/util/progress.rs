@@ -1,66 +1,62 @@
-//! A progress line on stderr for work that takes longer than about a second.
+//! What long jobs say while they work: a progress bar with ETA on a terminal (indicatif),
+//! nothing in logs but the one summary line each command ends with, and silence with
+//! `--quiet`.
 
-use std::io::{IsTerminal, Write};
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::time::{Duration, Instant};
+use std::io::IsTerminal;
+use std::sync::atomic::{AtomicBool, Ordering};
 
-pub struct Progress {
-    label: String,
-    total: usize,
-    done: AtomicUsize,
-    start: Instant,
-    /// Time of the last line printed, if any was.
-    last: Mutex<Option<Instant>>,
-    enabled: bool,
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+/// Set once by the command line's `--quiet`.
+static QUIET: AtomicBool = AtomicBool::new(false);
+
+/// Silences progress bars and summary lines for the rest of the process.
+pub fn set_quiet(quiet: bool) {
+    QUIET.store(quiet, Ordering::Relaxed);
 }
 
-const QUIET_START: Duration = Duration::from_secs(1);
-const REFRESH: Duration = Duration::from_millis(200);
+/// Whether `--quiet` was given.
+pub fn is_quiet() -> bool {
+    QUIET.load(Ordering::Relaxed)
+}
+
+/// The one line a command ends with on stderr (what it wrote, where), unless `--quiet`.
+pub fn summary(line: impl std::fmt::Display) {
+    if !is_quiet() {
+        eprintln!("{line}");
+    }
+}
+
+/// A progress bar over `total` units of work. Hidden unless `enabled`, stderr is a terminal
+/// (logs get no carriage returns) and the process is not quiet. Safe to advance from many
+/// threads; the bar never changes what is computed.
+pub struct Progress {
+    bar: ProgressBar,
+}
 
 impl Progress {
-    /// `enabled` is further limited to a terminal on stderr: logs get no carriage returns.
     pub fn new(label: impl Into<String>, total: usize, enabled: bool) -> Self {
-        let enabled = enabled && std::io::stderr().is_terminal();
-        Self {
-            label: label.into(),
-            total,
-            done: AtomicUsize::new(0),
-            start: Instant::now(),
-            last: Mutex::new(None),
-            enabled,
-        }
+        let shown = enabled && !is_quiet() && std::io::stderr().is_terminal();
+        let bar = if shown {
+            let style = ProgressStyle::with_template(
+                "{msg:>20} {wide_bar} {percent:>3}%  {elapsed_precise} ETA {eta_precise}",
+            )
+            .expect("a valid progress template");
+            ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr())
+                .with_style(style)
+                .with_message(label.into())
+        } else {
+            ProgressBar::hidden()
+        };
+        Self { bar }
     }
 
     pub fn advance(&self, n: usize) {
-        let done = self.done.fetch_add(n, Ordering::Relaxed) + n;
-        if !self.enabled || self.start.elapsed() < QUIET_START {
-            return;
-        }
-        let Ok(mut last) = self.last.try_lock() else {
-            return;
-        };
-        if last.is_some_and(|t| t.elapsed() < REFRESH) {
-            return;
-        }
-        *last = Some(Instant::now());
-        let pct = 100.0 * done as f64 / self.total.max(1) as f64;
-        let _ = write!(
-            std::io::stderr(),
-            "\r{}: {pct:5.1}% ({:.1} s)",
-            self.label,
-            self.start.elapsed().as_secs_f64()
-        );
+        self.bar.inc(n as u64);
     }
 
+    /// Clears the bar: the command's summary line says what was done.
     pub fn finish(&self) {
-        if self.last.lock().map(|l| l.is_some()).unwrap_or(false) {
-            let _ = writeln!(
-                std::io::stderr(),
-                "\r{}: done in {:.2} s     ",
-                self.label,
-                self.start.elapsed().as_secs_f64()
-            );
-        }
+        self.bar.finish_and_clear();
     }
 }
