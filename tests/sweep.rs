@@ -3,8 +3,9 @@
 mod common;
 
 use seethru::measure::{
-    sweep::{SweepOptions, sweep},
+    sweep::{SweepOptions, merge_parts, sweep},
     sweep_grid::parse_param,
+    sweep_shard::Shard,
 };
 use seethru::render::settings::resized;
 use seethru::system::options::HeadSource;
@@ -22,6 +23,7 @@ fn sweeps_write_every_row_and_resume() {
         spp: 1,
         head: HeadSource::Oracle,
         band: 3,
+        shard: None,
     };
     let scene = common::repo_path("scenes/das.toml");
     assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 4);
@@ -112,6 +114,7 @@ fn rows_that_share_an_eye_or_a_world_equal_rows_computed_alone() {
         spp: 1,
         head: HeadSource::Oracle,
         band: 2,
+        shard: None,
     };
     let scene = common::repo_path("scenes/das.toml");
     assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 8);
@@ -126,4 +129,32 @@ fn rows_that_share_an_eye_or_a_world_equal_rows_computed_alone() {
         assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 1);
         assert_eq!(std::fs::read_to_string(&csv).unwrap(), all, "row {row}");
     }
+    // The same sweep in three parts, as three machines would run it: the parts are disjoint,
+    // cover the grid, and merge into the unsharded CSV byte for byte.
+    let parts: Vec<std::path::PathBuf> = (0..3)
+        .map(|k| {
+            let part = dir.path().join(format!("part{k}.csv"));
+            let options = SweepOptions {
+                shard: Some(format!("{k}/3").parse::<Shard>().unwrap()),
+                ..options
+            };
+            sweep(&scene, &params, &part, &options).unwrap();
+            part
+        })
+        .collect();
+    let rows_of = |p: &std::path::Path| std::fs::read_to_string(p).unwrap().lines().count() - 1;
+    assert_eq!(parts.iter().map(|p| rows_of(p)).sum::<usize>(), 8);
+    assert!(
+        parts.iter().all(|p| rows_of(p) < 8),
+        "one part took everything"
+    );
+    let merged = dir.path().join("merged.csv");
+    let paths: Vec<&std::path::Path> = parts.iter().map(|p| p.as_path()).collect();
+    assert_eq!(merge_parts(&paths, &merged).unwrap(), 8);
+    assert_eq!(std::fs::read_to_string(&merged).unwrap(), all);
+    // A part missing is an error that says how many configurations are there.
+    let err = merge_parts(&paths[1..], &dir.path().join("partial.csv"))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("of the grid's 8 configurations"), "{err}");
 }

@@ -44,6 +44,8 @@ pub enum Command {
     /// Metrics for every combination of parameter values, as CSV and a plot; resumable.
     /// Parameters: theta_f, d2, display_width, eye_x, eye_z, head_bias_x_cm, frontal_width.
     Sweep(sweep::Sweep),
+    /// Join the CSVs of a sweep run in parts (`sweep --shard K/N`) into one CSV and its plot.
+    SweepMerge(sweep::SweepMerge),
     /// Recompute metrics.json and the misregistration maps of a `run` directory from its EXRs.
     Measure(measure::Measure),
     /// Export the scene for other renderers: glTF (.glb), OBJ or Mitsuba 3 (.xml), with its
@@ -90,6 +92,7 @@ impl Command {
             Command::Ratio(c) => c.run(),
             Command::Reproduce(c) => c.run(),
             Command::Sweep(c) => c.run(),
+            Command::SweepMerge(c) => c.run(),
             Command::Measure(c) => c.run(),
             Command::Export(c) => c.run(),
             Command::Figures(c) => c.run(),

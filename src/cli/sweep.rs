@@ -3,8 +3,9 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use seethru::measure::sweep::{SweepOptions, sweep};
+use seethru::measure::sweep::{SweepOptions, merge_parts, sweep};
 use seethru::measure::sweep_grid::parse_param;
+use seethru::measure::sweep_shard::Shard;
 use seethru::system::options::HeadSource;
 
 use crate::cli::args::{band, pixels, samples, threads, with_threads};
@@ -35,6 +36,34 @@ pub struct Sweep {
     /// Worker threads in [1, 1024] (default: all cores).
     #[arg(long, value_parser = threads)]
     threads: Option<usize>,
+    /// Compute only part K of N (K in [0, N-1]): the configurations are split by a hash of
+    /// their values, so N machines can share a sweep; `seethru sweep-merge` joins the parts.
+    #[arg(long, value_name = "K/N")]
+    shard: Option<Shard>,
+}
+
+/// `seethru sweep-merge`: the CSVs of a sharded sweep joined into one.
+#[derive(clap::Args)]
+pub struct SweepMerge {
+    /// The parts' CSVs (each written by `seethru sweep --shard K/N`).
+    #[arg(required = true)]
+    parts: Vec<PathBuf>,
+    /// The merged CSV (its plot goes beside it), byte for byte what one unsharded run writes.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+impl SweepMerge {
+    pub fn run(self) -> Result<()> {
+        let parts: Vec<&std::path::Path> = self.parts.iter().map(PathBuf::as_path).collect();
+        let rows = merge_parts(&parts, &self.out)?;
+        seethru::util::progress::summary(format!(
+            "merged {rows} configurations from {} parts into {}",
+            parts.len(),
+            self.out.display()
+        ));
+        Ok(())
+    }
 }
 
 impl Sweep {
@@ -49,6 +78,7 @@ impl Sweep {
             spp: self.spp,
             head: self.head,
             band: self.band,
+            shard: self.shard,
         };
         let computed = with_threads(self.threads, || {
             sweep(&self.scene, &params, &self.out, &options)

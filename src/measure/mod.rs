@@ -8,3 +8,4 @@ pub mod ratio_setup;
 pub mod sweep;
 pub mod sweep_csv;
 pub mod sweep_grid;
+pub mod sweep_shard;

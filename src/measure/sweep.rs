@@ -16,6 +16,7 @@ use crate::io::plot::{Figure, Series};
 use crate::measure::metrics::measure;
 use crate::measure::sweep_csv::finished_rows;
 use crate::measure::sweep_grid::{Param, combinations, configure};
+use crate::measure::sweep_shard::{Shard, merge};
 use crate::render::integrator::{RenderContext, same_geometry};
 use crate::render::settings::RenderSettings;
 use crate::scene::Scene;
@@ -62,11 +63,15 @@ fn metric_row(metrics: &serde_json::Value, report: &serde_json::Value) -> Vec<f6
     ]
 }
 
+#[derive(Clone, Copy)]
 pub struct SweepOptions {
     pub width: u32,
     pub spp: u32,
     pub head: HeadSource,
     pub band: u32,
+    /// Compute only this part of the grid (the CSV then holds that part's rows and no plot
+    /// is drawn; [`merge_parts`] joins the parts).
+    pub shard: Option<Shard>,
 }
 
 /// Runs the sweep; writes `csv` (and `<csv>.png`); returns the number of rows computed now.
@@ -115,7 +120,10 @@ pub fn sweep(
         Err(e) => bail!("cannot read {} to resume the sweep: {e}", csv.display()),
     };
     let done: HashSet<usize> = rows.iter().map(|(i, _)| *i).collect();
-    let todo: Vec<usize> = (0..configs.len()).filter(|i| !done.contains(i)).collect();
+    let todo: Vec<usize> = (0..configs.len())
+        .filter(|i| !done.contains(i))
+        .filter(|&i| options.shard.is_none_or(|s| s.owns(&configs[i])))
+        .collect();
     let rows = Mutex::new(rows);
     let write = |rows: &mut Vec<(usize, String)>| -> Result<()> {
         rows.sort_by_key(|(i, _)| *i);
@@ -205,8 +213,18 @@ pub fn sweep(
         .into_inner()
         .map_err(|_| anyhow::anyhow!("a sweep worker panicked"))?;
     write(&mut rows)?;
-    plot(csv, params, &rows)?;
+    if options.shard.is_none() {
+        plot(csv, params, &rows)?;
+    }
     Ok(todo.len())
+}
+
+/// Joins the CSVs of a sharded sweep into `out` (byte for byte what one unsharded run writes)
+/// and draws its plot; returns the number of rows.
+pub fn merge_parts(parts: &[&Path], out: &Path) -> Result<usize> {
+    let merged = merge(parts, out, METRIC_COLUMNS.len())?;
+    plot(out, &merged.params, &merged.body)?;
+    Ok(merged.rows)
 }
 
 /// Mean misregistration against the first parameter, one curve per value of the second;

@@ -1,0 +1,176 @@
+//! Sweeps beyond one machine: `--shard K/N` computes the configurations whose hash falls in
+//! part K of N, and [`merge`] joins the parts' CSVs into the CSV one unsharded run writes.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+
+use crate::io::atomic::write_text;
+use crate::measure::sweep_grid::Param;
+
+/// Part `index` (0-based, as `SLURM_ARRAY_TASK_ID` with `--array=0-(N-1)` and a Kubernetes
+/// Indexed Job's `JOB_COMPLETION_INDEX` count) of `count` disjoint parts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    pub index: u32,
+    pub count: u32,
+}
+
+/// Most parts a sweep can be cut into.
+pub const MAX_SHARDS: u32 = 100_000;
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    fn from_str(text: &str) -> Result<Self, String> {
+        let parsed = text.split_once('/').and_then(|(k, n)| {
+            Some((k.trim().parse::<u32>().ok()?, n.trim().parse::<u32>().ok()?))
+        });
+        match parsed {
+            Some((index, count)) if (1..=MAX_SHARDS).contains(&count) && index < count => {
+                Ok(Shard { index, count })
+            }
+            _ => Err(format!(
+                "must be K/N with N in [1, {MAX_SHARDS}] and K in [0, N-1] (e.g. 0/3, 1/3, 2/3)"
+            )),
+        }
+    }
+}
+
+impl Shard {
+    /// Whether this part computes `config`. The assignment depends on the configuration's
+    /// parameter names and values only (FNV-1a of `name=value;…`), not on its position in the
+    /// grid or on the machine, so every part agrees on it.
+    pub fn owns(&self, config: &[(String, String)]) -> bool {
+        let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+        for (name, value) in config {
+            for byte in name
+                .bytes()
+                .chain([b'='])
+                .chain(value.bytes())
+                .chain([b';'])
+            {
+                hash ^= u64::from(byte);
+                hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
+            }
+        }
+        hash % u64::from(self.count) == u64::from(self.index)
+    }
+}
+
+/// What [`merge`] wrote.
+pub struct Merged {
+    pub rows: usize,
+    pub params: Vec<Param>,
+    pub body: Vec<(usize, String)>,
+}
+
+/// Joins the CSVs of a sharded sweep into `out`: one header (every part must have the same),
+/// the rows in configuration order. A configuration missing from every part, or given twice
+/// with different values, is an error naming it; the grid is the product of the values each
+/// parameter column takes, so a part that never ran is noticed.
+pub fn merge(parts: &[&Path], out: &Path, metric_columns: usize) -> Result<Merged> {
+    if parts.is_empty() {
+        bail!("give the CSVs of the parts to merge");
+    }
+    let mut header: Option<(String, &Path)> = None;
+    let mut rows: BTreeMap<usize, (String, &Path, usize)> = BTreeMap::new();
+    for &part in parts {
+        let text = std::fs::read_to_string(part)
+            .with_context(|| format!("cannot read {}", part.display()))?;
+        let mut lines = text.lines().enumerate();
+        let first = lines.next().map(|(_, l)| l.to_string()).unwrap_or_default();
+        match &header {
+            None => header = Some((first.clone(), part)),
+            Some((h, from)) if *h != first => bail!(
+                "{}: its header differs from {}'s: not parts of one sweep",
+                part.display(),
+                from.display()
+            ),
+            Some(_) => {}
+        }
+        let columns = first.split(',').count();
+        for (number, line) in lines {
+            if line.is_empty() {
+                continue;
+            }
+            let number = number + 1;
+            let fields: Vec<&str> = line.split(',').collect();
+            let index = fields[0]
+                .parse::<usize>()
+                .ok()
+                .filter(|_| fields.len() == columns);
+            let Some(index) = index else {
+                bail!(
+                    "{}:{number}: not a sweep row ({} columns expected, starting with an index)",
+                    part.display(),
+                    columns
+                );
+            };
+            if let Some((earlier, from, at)) = rows.get(&index) {
+                if earlier != line {
+                    bail!(
+                        "{}:{number}: configuration {index} differs from {}:{at}",
+                        part.display(),
+                        from.display()
+                    );
+                }
+                continue;
+            }
+            rows.insert(index, (line.to_string(), part, number));
+        }
+    }
+    let (header, _) = header.expect("at least one part");
+    let names: Vec<&str> = header.split(',').collect();
+    if names.first() != Some(&"index") || names.len() < 1 + metric_columns + 1 {
+        bail!(
+            "{}: not a seethru sweep CSV (header `{header}`)",
+            parts[0].display()
+        );
+    }
+    let param_names = &names[1..names.len() - metric_columns];
+    // Each parameter's values in grid order: the grid runs the first parameter slowest, so
+    // the order of first appearance by index is the order given on the command line.
+    let mut params: Vec<Param> = param_names
+        .iter()
+        .map(|n| Param {
+            name: n.to_string(),
+            values: Vec::new(),
+        })
+        .collect();
+    for (line, _, _) in rows.values() {
+        for (p, value) in params.iter_mut().zip(line.split(',').skip(1)) {
+            if !p.values.iter().any(|v| v == value) {
+                p.values.push(value.to_string());
+            }
+        }
+    }
+    let expected: usize = params.iter().map(|p| p.values.len()).product();
+    let missing: Vec<String> = (0..expected)
+        .filter(|i| !rows.contains_key(i))
+        .map(|i| i.to_string())
+        .collect();
+    if !missing.is_empty() || rows.keys().any(|&i| i >= expected) {
+        bail!(
+            "the parts hold {} of the grid's {expected} configurations; missing: {} — run their shards (or resume them) and merge again",
+            rows.len(),
+            missing
+                .iter()
+                .take(20)
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    let body: Vec<(usize, String)> = rows.into_iter().map(|(i, (l, _, _))| (i, l)).collect();
+    let text: String = std::iter::once(header)
+        .chain(body.iter().map(|(_, l)| l.clone()))
+        .map(|l| l + "\n")
+        .collect();
+    write_text(out, &text)?;
+    Ok(Merged {
+        rows: body.len(),
+        params,
+        body,
+    })
+}
