@@ -376,3 +376,38 @@ fn logs_get_one_summary_line_and_quiet_gets_none() {
     let (ok, stdout, err) = seethru(&[&args[..], &["--quiet"]].concat());
     assert!(ok && err.is_empty() && stdout.is_empty(), "{stdout}{err}");
 }
+
+#[test]
+fn a_run_the_memory_limit_cannot_hold_is_refused_before_it_starts() {
+    // das at 2560 px estimates about 1.4 GiB (1.18 GiB measured with /usr/bin/time): a
+    // limit of 0.3 GiB refuses it at once, naming the estimate; nothing is written.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let args = |limit: &'static str| {
+        vec![
+            "run".to_string(),
+            "scenes/das.toml".into(),
+            "--out".into(),
+            out.to_str().unwrap().into(),
+            "--width".into(),
+            "2560".into(),
+            "--frontal-width".into(),
+            "2560".into(),
+            "--max-memory".into(),
+            limit.into(),
+        ]
+    };
+    let refused: Vec<String> = args("0.3");
+    let refused: Vec<&str> = refused.iter().map(String::as_str).collect();
+    let (ok, _, err) = seethru(&refused);
+    assert!(!ok && err.lines().count() == 1, "{err}");
+    assert!(
+        err.starts_with("error: this needs about 1.") && err.contains("--max-memory 0.3 GiB"),
+        "{err}"
+    );
+    assert!(
+        start.elapsed().as_secs_f64() < 5.0,
+        "refused only after rendering"
+    );
+    assert!(!out.exists());
+}

@@ -883,17 +883,23 @@ fn the_ratio_command_prints_a_table_and_refuses_bad_compensations() {
     for (extra, needle) in [
         (
             vec!["--model-d2", "0"],
-            "--model-d2 must be a distance in metres in (0, ∞) or `inf`",
+            "'--model-d2 <METRES|inf>': must be a number in (0, 1000000] or `inf`",
         ),
-        (vec!["--model-d2", "-3"], "--model-d2 must be"),
-        (vec!["--model-d2", "NaN"], "--model-d2 must be"),
+        (
+            vec!["--model-d2", "-3"],
+            "'--model-d2 <METRES|inf>': must be",
+        ),
+        (
+            vec!["--model-d2", "NaN"],
+            "'--model-d2 <METRES|inf>': must be",
+        ),
         (
             vec!["--head-bias-cm", "0,0,-250"],
             "z must be in (-250, ∞) cm",
         ),
         (
             vec!["--head-bias-cm", "1,2"],
-            "--head-bias-cm must be three finite numbers",
+            "'--head-bias-cm <X,Y,Z>': must be x,y,z: three numbers",
         ),
     ] {
         let (ok, out, err) = seethru(&with(&extra));

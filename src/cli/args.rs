@@ -4,6 +4,7 @@
 use anyhow::{Result, bail};
 use seethru::render::settings::MAX_SPP;
 use seethru::scene::source::MAX_RESOLUTION;
+use seethru::system::memory::DEFAULT_MAX_MEMORY_GIB;
 
 /// Most worker threads a command accepts.
 pub const MAX_THREADS: u64 = 1024;
@@ -94,6 +95,14 @@ pub struct RenderArgs {
     /// Worker threads in [1, 1024] (default: all cores). Images are identical for any value.
     #[arg(long, value_parser = threads)]
     pub threads: Option<usize>,
+    /// Refuse to start when the estimated memory exceeds this, GiB in (0, 4096].
+    #[arg(long = "max-memory", value_name = "GIB", default_value_t = DEFAULT_MAX_MEMORY_GIB, value_parser = max_memory)]
+    pub max_memory: f64,
+}
+
+/// `--max-memory`, GiB in (0, 4096].
+pub fn max_memory(text: &str) -> Result<f64, String> {
+    positive(4096.0)(text)
 }
 
 /// Runs `job` on a pool of `threads` workers (all cores if `None`). Images do not depend on it.

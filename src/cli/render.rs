@@ -8,6 +8,7 @@ use seethru::render::integrator::RenderContext;
 use seethru::render::settings::{RenderSettings, check_spp, resized};
 use seethru::render::views::View;
 use seethru::scene::Scene;
+use seethru::system::memory::{check_memory, render_estimate};
 
 use crate::cli::args::{RenderArgs, with_threads};
 
@@ -48,6 +49,7 @@ fn render_views(scene_path: &Path, views: &[View], out: &Path, options: &RenderA
         .iter()
         .map(|v| resized(v.camera(&scene), options.width, options.height))
         .collect::<Result<Vec<_>>>()?;
+    check_memory(&render_estimate(&cameras), options.max_memory)?;
     let context = RenderContext::new(scene)?;
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create output directory {}", out.display()))?;

@@ -12,6 +12,7 @@ use seethru::measure::metrics::measure;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::system::display::{DisplayModel, Filter};
+use seethru::system::memory::{check_memory, run_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use seethru::system::pipeline::run;
 
@@ -94,16 +95,24 @@ impl Run {
             display: self.display,
             progress: true,
         };
-        let (scene, out, band) = (&self.scene, &self.out, self.band);
+        let (scene, out, band, max_memory) =
+            (&self.scene, &self.out, self.band, self.render.max_memory);
         with_threads(self.render.threads, || {
-            run_command(scene, out, &options, band)
+            run_command(scene, out, &options, band, max_memory)
         })?
     }
 }
 
 /// `seethru run`: renders the six views into `out` with `run.json` and the metrics.
-fn run_command(scene_path: &Path, out: &Path, options: &RunOptions, band: u32) -> Result<()> {
+fn run_command(
+    scene_path: &Path,
+    out: &Path,
+    options: &RunOptions,
+    band: u32,
+    max_memory: f64,
+) -> Result<()> {
     let scene = Scene::load(scene_path)?;
+    check_memory(&run_estimate(&scene, options)?, max_memory)?;
     let ctx = RenderContext::new(scene)?;
     let result = run(&ctx, options)?;
     std::fs::create_dir_all(out)

@@ -6,9 +6,11 @@ use anyhow::Result;
 use seethru::measure::sweep::{SweepOptions, merge_parts, sweep};
 use seethru::measure::sweep_grid::parse_param;
 use seethru::measure::sweep_shard::Shard;
-use seethru::system::options::HeadSource;
+use seethru::scene::Scene;
+use seethru::system::memory::{DEFAULT_MAX_MEMORY_GIB, MemoryEstimate, check_memory, run_estimate};
+use seethru::system::options::{HeadSource, RunOptions};
 
-use crate::cli::args::{band, pixels, samples, threads, with_threads};
+use crate::cli::args::{band, max_memory, pixels, samples, threads, with_threads};
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -40,6 +42,10 @@ pub struct Sweep {
     /// their values, so N machines can share a sweep; `seethru sweep-merge` joins the parts.
     #[arg(long, value_name = "K/N")]
     shard: Option<Shard>,
+    /// Refuse to start when the estimated memory of the configurations computed at once
+    /// exceeds this, GiB in (0, 4096].
+    #[arg(long = "max-memory", value_name = "GIB", default_value_t = DEFAULT_MAX_MEMORY_GIB, value_parser = max_memory)]
+    max_memory: f64,
 }
 
 /// `seethru sweep-merge`: the CSVs of a sharded sweep joined into one.
@@ -80,7 +86,22 @@ impl Sweep {
             band: self.band,
             shard: self.shard,
         };
-        let computed = with_threads(self.threads, || {
+        let computed = with_threads(self.threads, || -> Result<usize> {
+            // Every worker thread runs a configuration at a time, each holding its frames.
+            let scene = Scene::load(&self.scene)?;
+            let one = run_estimate(
+                &scene,
+                &RunOptions {
+                    width: Some(self.width),
+                    ..RunOptions::default()
+                },
+            )?;
+            let at_once = rayon::current_num_threads() as u64;
+            let all = MemoryEstimate {
+                bytes: one.bytes * at_once,
+                what: format!("{at_once} configurations at once, each with {}", one.what),
+            };
+            check_memory(&all, self.max_memory)?;
             sweep(&self.scene, &params, &self.out, &options)
         })??;
         seethru::util::progress::summary(format!(

@@ -27,6 +27,13 @@ pub struct Frame {
     pub part_id: Vec<u32>,
 }
 
+impl Frame {
+    /// Bytes of one pixel's AOVs across the buffers.
+    pub const BYTES_PER_PIXEL: u64 = (3 * std::mem::size_of::<Vec3>()
+        + 2 * std::mem::size_of::<f32>()
+        + 2 * std::mem::size_of::<u32>()) as u64;
+}
+
 /// All AOVs of one pixel.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pixel {

@@ -4,6 +4,7 @@
 pub mod compensation;
 pub mod display;
 pub mod head;
+pub mod memory;
 pub mod options;
 pub mod pipeline;
 pub mod report;

@@ -1,0 +1,83 @@
+//! How much memory a command will need, estimated from its image sizes before anything is
+//! allocated, so that a resolution the machine cannot hold is refused with numbers instead
+//! of aborting halfway through an allocation.
+
+use anyhow::{Result, bail};
+
+use crate::geometry::camera::Camera;
+use crate::render::frame::Frame;
+use crate::render::settings::resized;
+use crate::scene::Scene;
+use crate::system::options::RunOptions;
+
+/// Bytes of one frame pixel: every AOV of [`Frame`].
+pub const FRAME_BYTES_PER_PIXEL: u64 = Frame::BYTES_PER_PIXEL;
+
+/// Bytes per pixel of the EXR being encoded beside a frame: its channels copied out (17 f32
+/// or u32 channels).
+const EXR_BYTES_PER_PIXEL: u64 = 17 * 4;
+
+/// Bytes per driver-view pixel of the metrics: misregistration, masks, the SSIM and FLIP
+/// working images of the display's bounding box (at most the view).
+const METRICS_BYTES_PER_PIXEL: u64 = 64;
+
+/// Memory a command needs beyond the scene: what the estimate counts, for the error message.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MemoryEstimate {
+    pub bytes: u64,
+    pub what: String,
+}
+
+/// Default limit of `--max-memory`, GiB: a third of a 24 GiB machine.
+pub const DEFAULT_MAX_MEMORY_GIB: f64 = 8.0;
+
+fn pixels(camera: &Camera) -> u64 {
+    camera.width as u64 * camera.height as u64
+}
+
+/// `render`: one view at a time is held and encoded.
+pub fn render_estimate(cameras: &[Camera]) -> MemoryEstimate {
+    let largest = cameras.iter().max_by_key(|c| pixels(c));
+    let bytes = largest.map_or(0, |c| {
+        pixels(c) * (FRAME_BYTES_PER_PIXEL + EXR_BYTES_PER_PIXEL)
+    });
+    MemoryEstimate {
+        bytes,
+        what: largest.map_or(String::new(), |c| {
+            format!("a {}×{} view and its EXR", c.width, c.height)
+        }),
+    }
+}
+
+/// `run`: the six views are held together, written two at a time, and measured.
+pub fn run_estimate(scene: &Scene, options: &RunOptions) -> Result<MemoryEstimate> {
+    let driver = resized(scene.driver, options.width, options.height)?;
+    let frontal = resized(scene.frontal, options.frontal_width, None)?;
+    let back = resized(scene.back, options.back_width, None)?;
+    let [dw, dh] = scene.obstacle.display_resolution;
+    let display = dw as u64 * dh as u64;
+    let frames = 3 * pixels(&driver) + pixels(&frontal) + pixels(&back) + display;
+    let largest = pixels(&driver).max(pixels(&frontal));
+    let bytes = frames * FRAME_BYTES_PER_PIXEL
+        + 2 * largest * EXR_BYTES_PER_PIXEL
+        + pixels(&driver) * METRICS_BYTES_PER_PIXEL;
+    Ok(MemoryEstimate {
+        bytes,
+        what: format!(
+            "three {}×{} driver views, a {}×{} frontal and a {}×{} back view, their EXRs and the metrics",
+            driver.width, driver.height, frontal.width, frontal.height, back.width, back.height
+        ),
+    })
+}
+
+/// Refuses an estimate above `limit_gib`, saying what it counts and how to proceed.
+pub fn check_memory(estimate: &MemoryEstimate, limit_gib: f64) -> Result<()> {
+    let gib = estimate.bytes as f64 / (1u64 << 30) as f64;
+    if gib > limit_gib {
+        bail!(
+            "this needs about {gib:.1} GiB ({}), more than --max-memory {limit_gib} GiB: lower the resolution, or raise --max-memory if the machine has the memory",
+            estimate.what
+        );
+    }
+    Ok(())
+}
