@@ -20,6 +20,12 @@ fn main() -> ExitCode {
         }
     };
     seethru::util::progress::set_quiet(cli.quiet);
+    // Ctrl-C or SIGTERM: no half-written file stays behind (finished files are whole).
+    let _ = ctrlc::set_handler(|| {
+        let removed = seethru::io::atomic::remove_in_flight();
+        eprintln!("error: interrupted; {removed} partly written files removed");
+        std::process::exit(130);
+    });
     match cli.command.run() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -407,3 +407,76 @@ fn a_run_the_memory_limit_cannot_hold_is_refused_before_it_starts() {
     );
     assert!(!out.exists());
 }
+
+/// Files under `dir` whose names mark them as temporaries of an atomic write.
+fn temporaries(dir: &std::path::Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .flatten()
+                .map(|e| e.file_name().to_string_lossy().to_string())
+                .filter(|n| n.contains(".tmp-"))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+#[test]
+#[cfg(unix)]
+fn an_interrupted_run_leaves_no_partial_file() {
+    // SIGINT at several moments of a run (rendering, writing the views, the metrics): the
+    // process ends with 130 and one line, and no temporary stays behind; whatever it
+    // finished is whole.
+    let scratch = tempfile::tempdir().unwrap();
+    let mut interrupted = 0;
+    for (k, delay_ms) in [150u64, 500, 900, 1300, 1700].into_iter().enumerate() {
+        let out = scratch.path().join(format!("out{k}"));
+        let child = Command::new(env!("CARGO_BIN_EXE_seethru"))
+            .args(["run", "scenes/das.toml", "--out", out.to_str().unwrap()])
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let _ = Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status();
+        let output = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&output.stderr);
+        if output.status.code() == Some(130) {
+            interrupted += 1;
+            // (A summary line may precede it when the signal lands as the run ends.)
+            let last = err.lines().last().unwrap_or_default();
+            assert!(last.starts_with("error: interrupted;"), "{err}");
+        }
+        assert_eq!(
+            temporaries(&out),
+            Vec::<String>::new(),
+            "after {delay_ms} ms"
+        );
+    }
+    assert!(interrupted > 0, "no run was interrupted");
+}
+
+#[test]
+#[cfg(target_os = "linux")]
+fn temporaries_of_killed_processes_are_removed_by_the_next_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, common::MINIMAL).unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    // A process id above the kernel's maximum (2²²) never runs.
+    let stale = out.join(".truth.png.tmp-4194305");
+    std::fs::write(&stale, b"half a png").unwrap();
+    let (ok, _, err) = seethru(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--view",
+        "truth",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(!stale.exists());
+    assert!(out.join("truth.png").exists());
+}
