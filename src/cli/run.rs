@@ -139,11 +139,12 @@ fn run_command(
         },
     );
     written?;
+    write_metrics(out, &maps, &result.truth, &metrics)?;
+    // Last: a directory with run.json holds a finished run.
     write_text(
         &out.join("run.json"),
         &serde_json::to_string_pretty(&result.report)?,
     )?;
-    write_metrics(out, &maps, &result.truth, &metrics)?;
     seethru::util::progress::summary(format!(
         "wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",
         out.display()
