@@ -78,6 +78,10 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
         .with_context(|| format!("not a file path: {}", path.display()))?
         .to_string_lossy()
         .to_string();
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent)
+            .with_context(|| format!("cannot create the folder {}", parent.display()))?;
+    }
     remove_stale(path, &name);
     let tmp = temporary(path, &name, std::process::id());
     track(&tmp, true);
