@@ -76,3 +76,34 @@ fn figures_and_their_data() {
     );
     assert!(rows[0][1..].iter().any(|v| (v - 1.0).abs() > 0.3));
 }
+
+#[test]
+fn figures_are_also_svg_with_their_text_as_text() {
+    // Sharp in a browser at any size, and searchable: the caption and axis labels are text
+    // elements, each curve a path of its own.
+    let dir = tempfile::tempdir().unwrap();
+    for name in write_all(dir.path()).unwrap() {
+        let svg = std::fs::read_to_string(dir.path().join(format!("{name}.svg"))).unwrap();
+        let doc = roxmltree::Document::parse(&svg).unwrap();
+        let root = doc.root_element();
+        assert_eq!(root.tag_name().name(), "svg");
+        assert!(root.attribute("width").unwrap().parse::<u32>().unwrap() >= 800);
+        let texts: Vec<String> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("text"))
+            .map(|n| n.text().unwrap_or_default().trim().to_string())
+            .collect();
+        // The curves' legends (dashed companion curves have none: at least half are named).
+        let (header, _) = read_csv(&dir.path().join(format!("{name}.csv")));
+        let series = &header[1..];
+        // (The CSV writes a label's commas as semicolons.)
+        let named = series
+            .iter()
+            .filter(|l| texts.iter().any(|t| t.replace(',', ";") == **l))
+            .count();
+        assert!(
+            2 * named >= series.len() && named > 0,
+            "{name}: {named} of {series:?} among {texts:?}"
+        );
+    }
+}

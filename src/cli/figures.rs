@@ -7,7 +7,7 @@ use anyhow::Result;
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
 pub struct Figures {
-    /// Output directory for the figures (PNG + CSV).
+    /// Output directory for the figures (PNG, SVG and CSV).
     #[arg(long)]
     out: PathBuf,
 }
@@ -16,7 +16,7 @@ impl Figures {
     pub fn run(self) -> Result<()> {
         let names = seethru::paper::figures::write_all(&self.out)?;
         seethru::util::progress::summary(format!(
-            "wrote {} figures (PNG + CSV) to {}",
+            "wrote {} figures (PNG, SVG and CSV) to {}",
             names.len(),
             self.out.display()
         ));

@@ -51,7 +51,7 @@ pub enum Command {
     /// Export the scene for other renderers: glTF (.glb), OBJ or Mitsuba 3 (.xml), with its
     /// materials, cameras, display and ids, and the cameras as <name>.cameras.json.
     Export(export::Export),
-    /// Regenerate the paper's Fig. 3–5 and the physical-unit sensitivity figure (PNG + CSV).
+    /// Regenerate the paper's Fig. 3–5 and the physical-unit sensitivity figure (PNG, SVG and CSV).
     Figures(figures::Figures),
     /// The paper's numerical claims beside seethru's values; every closed form at a parameter set.
     Analyze(analyze::Analyze),

@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result, anyhow};
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::io::atomic::{write_atomically, write_text};
@@ -85,8 +86,24 @@ impl Figure {
     pub fn render(&self) -> Result<Vec<u8>> {
         register_font()?;
         let mut buffer = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+        self.draw(BitMapBackend::with_buffer(&mut buffer, SIZE).into_drawing_area())?;
+        Ok(buffer)
+    }
+
+    /// Renders the figure as SVG (text as text, lines as paths: sharp at any size).
+    pub fn render_svg(&self) -> Result<String> {
+        register_font()?;
+        let mut svg = String::new();
+        self.draw(SVGBackend::with_string(&mut svg, SIZE).into_drawing_area())?;
+        Ok(svg)
+    }
+
+    /// Draws the figure on any plotters backend.
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
         {
-            let root = BitMapBackend::with_buffer(&mut buffer, SIZE).into_drawing_area();
             root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
             let mut chart = ChartBuilder::on(&root)
                 .caption(&self.title, ("sans-serif", 22))
@@ -167,16 +184,17 @@ impl Figure {
                 .map_err(|e| anyhow!("{e}"))?;
             root.present().map_err(|e| anyhow!("{e}"))?;
         }
-        Ok(buffer)
+        Ok(())
     }
 
-    /// Writes `<dir>/<name>.png` and `<dir>/<name>.csv`.
+    /// Writes `<dir>/<name>.png`, `<dir>/<name>.svg` and `<dir>/<name>.csv`.
     pub fn write(&self, dir: &Path, name: &str) -> Result<()> {
         let rgb = self.render()?;
         let img = image::RgbImage::from_raw(SIZE.0, SIZE.1, rgb).context("plot buffer size")?;
         write_atomically(&dir.join(format!("{name}.png")), |tmp| {
             Ok(img.save_with_format(tmp, image::ImageFormat::Png)?)
         })?;
+        write_text(&dir.join(format!("{name}.svg")), &self.render_svg()?)?;
         write_text(&dir.join(format!("{name}.csv")), &self.csv())
     }
 }

@@ -39,8 +39,9 @@ pub fn heat_color(t: f32) -> [u8; 3] {
     [217, 25, 13]
 }
 
-/// The misregistration heatmap beside a colour bar in arc-minutes; outside the display, the
-/// truth in dimmed grey for context.
+/// The misregistration heatmap beside a colour bar in arc-minutes, clipped at the 99th
+/// percentile of the display's values (labelled on the bar); outside the display, the truth
+/// in dimmed grey for context.
 pub fn heatmap_rgb(maps: &MetricMaps, truth: &Frame) -> Result<(u32, u32, Vec<u8>)> {
     use plotters::prelude::*;
     let (w, h) = (maps.width, maps.height);
@@ -58,7 +59,7 @@ pub fn heatmap_rgb(maps: &MetricMaps, truth: &Frame) -> Result<(u32, u32, Vec<u8
             .unwrap_or(1.0)
             .max(1.0)
     };
-    let (cw, ch) = (w + 130, h.max(160));
+    let (cw, ch) = (w + 170, h.max(160));
     let mut buffer = vec![255u8; (cw * ch * 3) as usize];
     {
         register_font()?;
@@ -99,7 +100,7 @@ pub fn heatmap_rgb(maps: &MetricMaps, truth: &Frame) -> Result<(u32, u32, Vec<u8
         }
         let style = ("sans-serif", 14).into_font().color(&BLACK);
         for (frac, label) in [
-            (0.0, format!("{top:.1}′")),
+            (0.0, format!("≥ {top:.1}′ (p99)")),
             (0.5, format!("{:.1}′", top / 2.0)),
             (1.0, "0′".to_string()),
         ] {
@@ -110,8 +111,14 @@ pub fn heatmap_rgb(maps: &MetricMaps, truth: &Frame) -> Result<(u32, u32, Vec<u8
             ))
             .map_err(err)?;
         }
-        root.draw(&Text::new("arcmin", (x0 - 4, 8), style.clone()))
-            .map_err(err)?;
+        // The scale is clipped at the 99th percentile of the display's values, so that a few
+        // extreme pixels do not wash out the rest; the label says so.
+        root.draw(&Text::new(
+            "arcmin, clipped at p99",
+            (x0 - 4, 8),
+            style.clone(),
+        ))
+        .map_err(err)?;
         root.draw(&Rectangle::new(
             [(x0, ch as i32 - 30), (x0 + 22, ch as i32 - 18)],
             RGBColor(255, 0, 255).filled(),
