@@ -34,36 +34,33 @@ pub struct EqualCoverage {
     pub means: Vec<(String, f64)>,
 }
 
-fn img_tag(html: bool, dir: &Path, rel: &str) -> Result<String> {
+/// How wide an embedded image is shown: views side by side, maps and figures full width (a
+/// reader must be able to read their scales).
+#[derive(Clone, Copy)]
+enum Width {
+    Half,
+    Full,
+}
+
+fn img_tag(html: bool, dir: &Path, rel: &str, width: Width) -> Result<String> {
+    use base64::Engine as _;
     if !html {
         return Ok(format!("![{rel}]({rel})"));
     }
     let bytes = std::fs::read(dir.join(rel)).with_context(|| format!("cannot read {rel}"))?;
+    let mime = if rel.ends_with(".svg") {
+        "image/svg+xml"
+    } else {
+        "image/png"
+    };
+    let style = match width {
+        Width::Half => "width:49%",
+        Width::Full => "width:100%;max-width:1200px",
+    };
     Ok(format!(
-        "<img src=\"data:image/png;base64,{}\" alt=\"{rel}\" style=\"max-width:32%\">",
-        base64(&bytes)
+        "<img src=\"data:{mime};base64,{}\" alt=\"{rel}\" style=\"{style}\">",
+        base64::engine::general_purpose::STANDARD.encode(bytes)
     ))
-}
-
-fn base64(bytes: &[u8]) -> String {
-    const TABLE: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
-    for chunk in bytes.chunks(3) {
-        let b = [
-            chunk[0],
-            *chunk.get(1).unwrap_or(&0),
-            *chunk.get(2).unwrap_or(&0),
-        ];
-        let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
-        for k in 0..4 {
-            if k <= chunk.len() {
-                out.push(TABLE[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
 }
 
 fn num(v: &serde_json::Value) -> String {
@@ -95,7 +92,7 @@ pub fn render_report(
     );
     let _ = writeln!(
         md,
-        "| case | coverage | mean ′ | p95 ′ | max ′ | border mean ′ | border p95 ′ | PSNR dB | SSIM | missing |"
+        "| case | coverage | mean ′ | p95 ′ | max ′ | border mean ′ | border p95 ′ | PSNR dB | SSIM | truth unseen by the frontal camera |"
     );
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
     for c in cases {
@@ -147,27 +144,45 @@ pub fn render_report(
     }
     let _ = writeln!(
         md,
-        "\nLeft to right: truth, seethru, misregistration heatmap.\n"
+        "\nPer case: truth and seethru side by side, then the misregistration heatmap (colour scale in arc-minutes, clipped at the 99th percentile of the display; magenta: no direction; black: blank).\n"
     );
     for c in cases {
         let _ = writeln!(md, "### {}\n", c.name);
         let crop = &c.run["crop"];
+        let outside: Vec<String> = ["left", "right", "top", "bottom"]
+            .iter()
+            .filter_map(|side| {
+                let px = crop["outside_frontal_view_px"][side].as_f64()?;
+                (px > 0.0).then(|| format!("{side} by {px:.0} frontal px"))
+            })
+            .collect();
         let _ = writeln!(
             md,
-            "R1 = {}, R2 = {}, missing {:.1}% of the display (crop outside the frontal view: {}).\n",
+            "R1 = {}, R2 = {}. {} Coverage of the display in the driver's view: {:.1}%; {:.1}% of the display image's own pixels are black.\n",
             num(&crop["R1_left"]),
             num(&crop["R2_right"]),
+            if outside.is_empty() {
+                "The crop lies inside the frontal view.".to_string()
+            } else {
+                format!(
+                    "The crop leaves the frontal view on the {}.",
+                    outside.join(", ")
+                )
+            },
+            100.0 * c.metrics["coverage"].as_f64().unwrap_or(f64::NAN),
             100.0 * c.run["missing_fraction"].as_f64().unwrap_or(0.0),
-            crop["outside_frontal_view_px"]
         );
-        for image in ["truth.png", "seethru.png", "misregistration.png"] {
-            let _ = write!(
-                md,
-                "{} ",
-                img_tag(html, out, &format!("{}/{image}", c.dir))?
-            );
+        for image in ["truth.png", "seethru.png"] {
+            let tag = img_tag(html, out, &format!("{}/{image}", c.dir), Width::Half)?;
+            let _ = write!(md, "{tag} ");
         }
-        let _ = writeln!(md, "\n");
+        let heatmap = img_tag(
+            html,
+            out,
+            &format!("{}/misregistration.png", c.dir),
+            Width::Full,
+        )?;
+        let _ = writeln!(md, "\n\n{heatmap}\n");
     }
     let _ = writeln!(
         md,
@@ -215,13 +230,19 @@ pub fn render_report(
     for (name, dir, _) in ratios {
         let _ = writeln!(md, "### {name}\n\nTruth, then seethru.\n");
         for image in ["truth.png", "seethru.png"] {
-            let _ = write!(md, "{} ", img_tag(html, out, &format!("{dir}/{image}"))?);
+            let tag = img_tag(html, out, &format!("{dir}/{image}"), Width::Half)?;
+            let _ = write!(md, "{tag} ");
         }
         let _ = writeln!(md, "\n");
     }
     let _ = writeln!(md, "## The paper's figures (§5.1)\n");
     for f in figures {
-        let _ = writeln!(md, "{}\n", img_tag(html, out, &format!("figures/{f}.png"))?);
+        let figure = if html {
+            format!("figures/{f}.svg")
+        } else {
+            format!("figures/{f}.png")
+        };
+        let _ = writeln!(md, "{}\n", img_tag(html, out, &figure, Width::Full)?);
     }
     let _ = writeln!(
         md,
@@ -233,92 +254,13 @@ pub fn render_report(
     Ok(markdown_to_html(&md))
 }
 
-/// A minimal Markdown subset (headings, tables, paragraphs, list items; inline HTML passes
-/// through) to self-contained HTML.
+/// The Markdown as one self-contained HTML page (pulldown-cmark, with tables; the embedded
+/// images pass through as inline HTML).
 fn markdown_to_html(md: &str) -> String {
-    let mut html = String::from(
-        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>seethru report</title><style>body{font-family:sans-serif;max-width:1400px;margin:2em auto;line-height:1.4}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}td:first-child{text-align:left}img{margin:2px}</style></head><body>\n",
-    );
-    let escape = |s: &str| {
-        if s.trim_start().starts_with("<img") {
-            s.to_string()
-        } else {
-            s.replace('&', "&amp;")
-                .replace('<', "&lt;")
-                .replace('>', "&gt;")
-                .replace('*', "")
-        }
-    };
-    let mut in_table = false;
-    for line in md.lines() {
-        if line.starts_with('|') {
-            if line.contains("|---") {
-                continue;
-            }
-            if !in_table {
-                html += "<table>\n";
-                in_table = true;
-            }
-            let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
-            html += &format!(
-                "<tr>{}</tr>\n",
-                cells
-                    .iter()
-                    .map(|c| format!("<td>{}</td>", escape(c)))
-                    .collect::<String>()
-            );
-            continue;
-        }
-        if in_table {
-            html += "</table>\n";
-            in_table = false;
-        }
-        if let Some(h) = line.strip_prefix("### ") {
-            html += &format!("<h3>{}</h3>\n", escape(h));
-        } else if let Some(h) = line.strip_prefix("## ") {
-            html += &format!("<h2>{}</h2>\n", escape(h));
-        } else if let Some(h) = line.strip_prefix("# ") {
-            html += &format!("<h1>{}</h1>\n", escape(h));
-        } else if let Some(item) = line.strip_prefix("- ") {
-            html += &format!("<p>• {}</p>\n", escape(item));
-        } else if line.contains("<img") {
-            html += &format!("<p>{line}</p>\n");
-        } else if !line.trim().is_empty() {
-            html += &format!("<p>{}</p>\n", escape(line));
-        }
-    }
-    if in_table {
-        html += "</table>\n";
-    }
-    html + "</body></html>\n"
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn base64_matches_the_rfc_examples() {
-        for (input, expected) in [
-            ("", ""),
-            ("f", "Zg=="),
-            ("fo", "Zm8="),
-            ("foo", "Zm9v"),
-            ("foob", "Zm9vYg=="),
-            ("fooba", "Zm9vYmE="),
-            ("foobar", "Zm9vYmFy"),
-        ] {
-            assert_eq!(base64(input.as_bytes()), expected);
-        }
-    }
-
-    #[test]
-    fn tables_and_headings_become_html() {
-        let html = markdown_to_html("# T\n\n| a | b |\n|---|---|\n| 1 | <2 |\n\n- item");
-        assert!(
-            html.contains("<h1>T</h1>")
-                && html.contains("<td>&lt;2</td>")
-                && html.contains("• item")
-        );
-    }
+    use pulldown_cmark::{Options, Parser, html};
+    let mut body = String::new();
+    html::push_html(&mut body, Parser::new_ext(md, Options::ENABLE_TABLES));
+    format!(
+        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>seethru report</title><style>body{{font-family:sans-serif;max-width:1250px;margin:2em auto;line-height:1.4}}table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:4px 8px;text-align:right}}td:first-child,th:first-child{{text-align:left}}img{{margin:2px 0}}</style></head><body>\n{body}</body></html>\n"
+    )
 }
