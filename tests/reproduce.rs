@@ -89,7 +89,9 @@ fn quick_reproduction_reports_the_papers_experiments() {
     }
     assert!(md.contains("| -0.73 | -0.71 |") && md.contains("| 2.47 | 2.64 |"));
     // Self-contained HTML: every picture embedded, none referenced.
-    let embedded = html.matches("data:image/png;base64,").count();
-    assert_eq!(embedded, 4 * 3 + 2 * 2 + 4, "{embedded} embedded images");
+    // The renders and heatmaps as PNG, the paper's figures as SVG.
+    let png = html.matches("data:image/png;base64,").count();
+    let svg = html.matches("data:image/svg+xml;base64,").count();
+    assert_eq!((png, svg), (4 * 3 + 2 * 2, 4), "embedded images");
     assert!(!html.contains("src=\"car_") && !html.contains("src=\"figures/"));
 }

@@ -212,3 +212,30 @@ fn the_shipped_scenes_load() {
         seethru::scene::Scene::load(&repo_path(name)).unwrap_or_else(|e| panic!("{e}"));
     }
 }
+
+#[test]
+fn glb_headers_that_lie_about_their_length_are_errors_not_panics() {
+    use seethru::scene::mesh_io::parse_gltf;
+    let no_files = |p: &std::path::Path| -> std::io::Result<Vec<u8>> {
+        Err(std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            p.display().to_string(),
+        ))
+    };
+    // The first (found by fuzzing the glTF reader): version 8, length 0 — the gltf crate
+    // computed `length − 12` before checking it. Then a version-2 header shorter than its
+    // own chunk header, one longer than the file, and a file cut inside its header.
+    let mut too_long = b"glTF\x02\0\0\0".to_vec();
+    too_long.extend(4096u32.to_le_bytes());
+    for bytes in [
+        b"glTF\x08\0\0\0\0\0\0\0".to_vec(),
+        b"glTF\x02\0\0\0\x04\0\0\0".to_vec(),
+        too_long,
+        b"glTF\x02\0".to_vec(),
+    ] {
+        let err = parse_gltf(&bytes, std::path::Path::new("x.glb"), &no_files)
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("invalid GLB"), "{err}");
+    }
+}

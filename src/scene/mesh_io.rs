@@ -198,6 +198,29 @@ pub fn parse_obj(
     checked(out)
 }
 
+/// A GLB's 12-byte header must declare a length that holds the header and one chunk header
+/// and fits the file: the gltf crate subtracts before it checks (an overflow, found by
+/// fuzzing, that panics where overflow checks are on).
+fn check_glb_header(bytes: &[u8]) -> Result<()> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(()); // glTF JSON
+    }
+    let word = |at: usize| {
+        bytes
+            .get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+    };
+    match (word(4), word(8)) {
+        (Some(2), Some(length)) if (12 + 8..=bytes.len()).contains(&length) => Ok(()),
+        (Some(2), Some(length)) => bail!(
+            "invalid GLB: its header declares {length} bytes; a GLB holds at least 20 and this file has {}",
+            bytes.len()
+        ),
+        (Some(version), Some(_)) => bail!("invalid GLB: version {version}, only 2 is read"),
+        _ => bail!("invalid GLB: the file ends inside its 12-byte header"),
+    }
+}
+
 /// Parses a glTF (JSON) or GLB file's bytes; `path` names it and anchors its external
 /// buffers, which `read` reads. Images are not loaded: only `baseColorFactor` is used.
 pub fn parse_gltf(
@@ -205,6 +228,7 @@ pub fn parse_gltf(
     path: &Path,
     read: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
 ) -> Result<LoadedMesh> {
+    check_glb_header(bytes)?;
     let gltf::Gltf {
         document: doc,
         blob,
