@@ -1,7 +1,7 @@
 //! `seethru analyze`: the paper's claims beside seethru's values, and every closed form at a
 //! parameter set.
 
-use crate::cli::args::{pixels, positive, real};
+use crate::cli::args::{metres_or_inf, pixels, positive, real};
 use anyhow::Result;
 use seethru::paper::claims::{
     AnalyzeParams, claims_table, evaluate, head_error_table, head_error_text, paper_claims,
@@ -16,8 +16,8 @@ pub struct Analyze {
     /// Eye distance from the display d1, metres in (0, 1000].
     #[arg(long, default_value_t = 1.0, value_parser = positive(1e3))]
     d1: f64,
-    /// Working distance d2, metres in (0, 1e6].
-    #[arg(long, default_value_t = 1.0, value_parser = positive(1e6))]
+    /// Working distance d2, metres in (0, 1e6], or inf for the d2 → ∞ model.
+    #[arg(long, default_value_t = 1.0, value_name = "METRES|inf", value_parser = metres_or_inf)]
     d2: f64,
     /// Lateral eye offset b_h, metres in [-100, 100] (> 0: the eye on the side of the left
     /// crop R1).

@@ -26,6 +26,14 @@ pub fn positive(max: f64) -> impl Fn(&str) -> Result<f64, String> + Clone + Send
     }
 }
 
+/// A working distance: `inf` (d2 → ∞) or metres in (0, 1e6].
+pub fn metres_or_inf(text: &str) -> Result<f64, String> {
+    match text.trim() {
+        "inf" | "infinity" => Ok(f64::INFINITY),
+        _ => positive(1e6)(text).map_err(|e| format!("{e} or `inf`")),
+    }
+}
+
 /// An integer in `[min, max]` of any unsigned type (no wrapping: `4000000000` is refused, not
 /// read modulo 2³²).
 pub fn integer<T: TryFrom<u64>>(

@@ -6,7 +6,9 @@ use seethru::measure::ratio::{describe, measure_ratio};
 use seethru::measure::ratio_setup::{Compensation, Setup};
 use seethru::render::settings::check_resolution;
 
-use crate::cli::args::{head_bias_cm, pixels, positive, real, threads, with_threads};
+use crate::cli::args::{
+    head_bias_cm, metres_or_inf, pixels, positive, real, threads, with_threads,
+};
 
 #[derive(clap::Args)]
 pub struct Ratio {
@@ -68,7 +70,7 @@ struct RatioCommon {
         long = "model-d2",
         value_name = "METRES|inf",
         allow_hyphen_values = true,
-        value_parser = model_d2
+        value_parser = metres_or_inf
     )]
     model_d2: Option<f64>,
     /// Head-tracking bias of the compensation's eye, obstacle frame, centimetres: x,y,z, each
@@ -137,13 +139,5 @@ impl Ratio {
             print!("{}", describe(&result));
         }
         Ok(())
-    }
-}
-
-/// `--model-d2`: `inf` or a distance in metres in (0, 1e6].
-fn model_d2(text: &str) -> Result<f64, String> {
-    match text {
-        "inf" | "infinity" => Ok(f64::INFINITY),
-        _ => positive(1e6)(text).map_err(|e| format!("{e} or `inf`")),
     }
 }
