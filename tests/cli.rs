@@ -4,23 +4,7 @@ mod common;
 
 use std::process::Command;
 
-fn seethru(args: &[&str]) -> (bool, String, String) {
-    seethru_in(std::path::Path::new("."), args)
-}
-
-/// The command run from `dir`, so that an output a test did not expect lands there.
-fn seethru_in(dir: &std::path::Path, args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_seethru"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
+use common::{seethru, seethru_in};
 
 #[test]
 fn render_writes_png_ids_and_exr_per_view() {
@@ -328,32 +312,6 @@ fn every_numeric_flag_refuses_values_outside_its_range_in_one_line() {
         walked += 1;
     }
     assert!(walked > 30, "{walked}");
-}
-
-#[test]
-fn the_documented_head_bias_form_works_with_signs() {
-    for bias in ["1,0,0", "-1,0.5,-2"] {
-        let (ok, _, err) = seethru(&[
-            "ratio",
-            "occlusion",
-            "--L",
-            "5",
-            "--b1",
-            "-0.35",
-            "--d2",
-            "6.3",
-            "--d1",
-            "2.5",
-            "--bh",
-            "1.75",
-            "--width",
-            "96",
-            "--head-bias-cm",
-            bias,
-            "--json",
-        ]);
-        assert!(ok, "{bias}: {err}");
-    }
 }
 
 #[test]

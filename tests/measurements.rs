@@ -3,6 +3,8 @@
 
 mod common;
 
+use common::seethru;
+
 use glam::{DQuat, DVec3, Vec3};
 use seethru::analysis::{
     paper::{ForeshorteningParams, OcclusionParams},
@@ -802,19 +804,6 @@ fn ssim_windows_are_seven_pixels_wide() {
     assert!((got - expected).abs() < 1e-12, "{got} vs {expected}");
 }
 
-/// Runs the `seethru` binary; (success, stdout, stderr).
-fn seethru(args: &[String]) -> (bool, String, String) {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_seethru"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
-
 #[test]
 fn the_ratio_command_prints_a_table_and_refuses_bad_compensations() {
     let paper = [
@@ -872,13 +861,13 @@ fn the_ratio_command_prints_a_table_and_refuses_bad_compensations() {
         "--model-d2",
         "inf",
         "--head-bias-cm",
-        "1,-2,3",
+        "-1,-2,3", // a leading minus is a value, not a flag
         "--json",
     ]));
     assert!(ok, "{err}");
     let r: serde_json::Value = serde_json::from_str(&json).unwrap();
     assert_eq!(r["model_d2"], "inf");
-    assert_eq!(r["head_bias_cm"], serde_json::json!([1.0, -2.0, 3.0]));
+    assert_eq!(r["head_bias_cm"], serde_json::json!([-1.0, -2.0, 3.0]));
     // Bad compensations: one line naming the flag and its range.
     for (extra, needle) in [
         (

@@ -86,6 +86,21 @@ pub enum Shape {
     Mesh { path: PathBuf },
 }
 
+impl Shape {
+    /// The `kind` key of the shape in a scene file.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Shape::Plane { .. } => "plane",
+            Shape::Box { .. } => "box",
+            Shape::Sphere { .. } => "sphere",
+            Shape::Cylinder { .. } => "cylinder",
+            Shape::Cone { .. } => "cone",
+            Shape::Quad { .. } => "quad",
+            Shape::Mesh { .. } => "mesh",
+        }
+    }
+}
+
 /// One `[[object]]` of the scene file.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Object {

@@ -233,7 +233,7 @@ fn read_objects(
         {
             return Err(t.table_error(format!(
                 "the {} `{}` reaches outside the world after its transform: {why} (check translate, scale and size)",
-                kind_name(&object.shape),
+                Shape::kind(&object.shape),
                 object.name
             )));
         }
@@ -251,18 +251,6 @@ fn triangle_count(shape: &Shape) -> usize {
         Shape::Sphere { .. } | Shape::Mesh { .. } => 0,
         Shape::Cylinder { segments, .. } => 4 * segments,
         Shape::Cone { segments, .. } => 2 * segments,
-    }
-}
-
-fn kind_name(shape: &Shape) -> &'static str {
-    match shape {
-        Shape::Plane { .. } => "plane",
-        Shape::Box { .. } => "box",
-        Shape::Sphere { .. } => "sphere",
-        Shape::Cylinder { .. } => "cylinder",
-        Shape::Cone { .. } => "cone",
-        Shape::Quad { .. } => "quad",
-        Shape::Mesh { .. } => "mesh",
     }
 }
 

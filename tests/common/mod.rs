@@ -8,6 +8,25 @@ use std::path::{Path, PathBuf};
 use seethru::scene::Scene;
 use seethru::scene::source::{SceneError, SourceFile};
 
+/// Runs the `seethru` binary in `dir`; (success, stdout, stderr).
+pub fn seethru_in<S: AsRef<std::ffi::OsStr>>(dir: &Path, args: &[S]) -> (bool, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_seethru"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+/// Runs the `seethru` binary from the repository root; (success, stdout, stderr).
+pub fn seethru<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> (bool, String, String) {
+    seethru_in(Path::new(env!("CARGO_MANIFEST_DIR")), args)
+}
+
 pub fn repo_path(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
 }

@@ -215,7 +215,7 @@ impl<'a> ExportScene<'a> {
                     .collect::<Vec<_>>()
             };
             let kind = match scene.objects.get(index) {
-                Some(o) => shape_kind(&o.shape),
+                Some(o) => Shape::kind(&o.shape),
                 None => "obstacle",
             };
             objects.push(ExportObject {
@@ -341,18 +341,6 @@ fn ellipsoid_mesh(el: &Ellipsoid, repeat: Vec2) -> Primitive {
         }
     }
     prim
-}
-
-fn shape_kind(shape: &Shape) -> &'static str {
-    match shape {
-        Shape::Plane { .. } => "plane",
-        Shape::Box { .. } => "box",
-        Shape::Sphere { .. } => "sphere",
-        Shape::Cylinder { .. } => "cylinder",
-        Shape::Cone { .. } => "cone",
-        Shape::Quad { .. } => "quad",
-        Shape::Mesh { .. } => "mesh",
-    }
 }
 
 /// Names of the world's materials, in its order: the scene file's materials, then each
