@@ -5,7 +5,6 @@ use std::path::Path;
 
 use anyhow::Result;
 use exr::prelude::{AnyChannel, FlatSamples};
-use glam::Vec3;
 
 use crate::io::atomic::write_text;
 use crate::io::frame_files::{write_exr_channels, write_png};
@@ -14,29 +13,11 @@ use crate::measure::metrics::MetricMaps;
 use crate::render::frame::Frame;
 use crate::util::color::encode_srgb8;
 
-/// A perceptually ordered colour for t in [0, 1] (dark blue → green → yellow → red).
+/// The heatmap's colour for t in [0, 1] (colorous' Turbo: dark blue → green → yellow → dark
+/// red, perceptually ordered and readable by most colour-blind readers); NaN as 0.
 pub fn heat_color(t: f32) -> [u8; 3] {
-    const STOPS: [(f32, [f32; 3]); 5] = [
-        (0.0, [0.05, 0.05, 0.35]),
-        (0.25, [0.1, 0.4, 0.85]),
-        (0.5, [0.2, 0.75, 0.35]),
-        (0.75, [0.95, 0.8, 0.1]),
-        (1.0, [0.85, 0.1, 0.05]),
-    ];
     let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
-    for pair in STOPS.windows(2) {
-        let ((t0, c0), (t1, c1)) = (pair[0], pair[1]);
-        if t <= t1 {
-            let f = (t - t0) / (t1 - t0);
-            let c = Vec3::from(c0).lerp(Vec3::from(c1), f);
-            return [
-                (c.x * 255.0) as u8,
-                (c.y * 255.0) as u8,
-                (c.z * 255.0) as u8,
-            ];
-        }
-    }
-    [217, 25, 13]
+    colorous::TURBO.eval_continuous(f64::from(t)).as_array()
 }
 
 /// The misregistration heatmap beside a colour bar in arc-minutes, clipped at the 99th
