@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use crate::io::atomic::write_text;
 use crate::io::plot::{Figure, Series};
 use crate::measure::metrics::measure;
-use crate::measure::sweep_csv::finished_rows;
+use crate::measure::sweep_csv::{decode, encode, finished_rows};
 use crate::measure::sweep_grid::{Param, combinations, configure};
 use crate::measure::sweep_shard::{Shard, merge};
 use crate::render::integrator::{RenderContext, same_geometry};
@@ -112,7 +112,7 @@ pub fn sweep(
         .chain(params.iter().map(|p| p.name.clone()))
         .chain(METRIC_COLUMNS.iter().map(|s| s.to_string()))
         .collect();
-    let header_line = header.join(",");
+    let header_line = encode(&header);
     // Rows already done (same header, same parameter values at the same index).
     let rows = match std::fs::read_to_string(csv) {
         Ok(text) => finished_rows(&text, csv, &header_line, &configs)?,
@@ -195,11 +195,11 @@ pub fn sweep(
                     options.band,
                 );
                 let values = metric_row(&metrics, &result.report);
-                let line = std::iter::once(index.to_string())
+                let fields: Vec<String> = std::iter::once(index.to_string())
                     .chain(config.iter().map(|(_, v)| v.clone()))
                     .chain(values.iter().map(|v| format!("{v}")))
-                    .collect::<Vec<_>>()
-                    .join(",");
+                    .collect();
+                let line = encode(&fields);
                 let mut rows = rows
                     .lock()
                     .map_err(|_| anyhow::anyhow!("a sweep worker panicked"))?;
@@ -245,11 +245,11 @@ fn plot(csv: &Path, params: &[Param], rows: &[(usize, String)]) -> Result<()> {
     for g in &group_values {
         let mut points = Vec::new();
         for (_, line) in rows {
-            let f: Vec<&str> = line.split(',').collect();
-            if params.len() > 1 && f[2] != g {
+            let f = decode(line);
+            if f.len() <= coverage_column || (params.len() > 1 && f[2] != *g) {
                 continue;
             }
-            if let (Some(x), Ok(y)) = (x_of(f[1]), f[column].parse::<f64>()) {
+            if let (Some(x), Ok(y)) = (x_of(&f[1]), f[column].parse::<f64>()) {
                 points.push((x, y));
                 if f[coverage_column].parse::<f64>().is_ok_and(|c| c < 1.0) {
                     marks.push((x, y, series.len()));

@@ -7,6 +7,7 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 
 use crate::io::atomic::write_text;
+use crate::measure::sweep_csv::{encode, records};
 use crate::measure::sweep_grid::Param;
 
 /// Part `index` (0-based, as `SLURM_ARRAY_TASK_ID` with `--array=0-(N-1)` and a Kubernetes
@@ -73,13 +74,13 @@ pub fn merge(parts: &[&Path], out: &Path, metric_columns: usize) -> Result<Merge
     if parts.is_empty() {
         bail!("give the CSVs of the parts to merge");
     }
-    let mut header: Option<(String, &Path)> = None;
-    let mut rows: BTreeMap<usize, (String, &Path, usize)> = BTreeMap::new();
+    let mut header: Option<(Vec<String>, &Path)> = None;
+    let mut rows: BTreeMap<usize, (Vec<String>, &Path, usize)> = BTreeMap::new();
     for &part in parts {
         let text = std::fs::read_to_string(part)
             .with_context(|| format!("cannot read {}", part.display()))?;
-        let mut lines = text.lines().enumerate();
-        let first = lines.next().map(|(_, l)| l.to_string()).unwrap_or_default();
+        let mut records = records(&text, part)?.into_iter();
+        let first = records.next().map(|(_, r)| r).unwrap_or_default();
         match &header {
             None => header = Some((first.clone(), part)),
             Some((h, from)) if *h != first => bail!(
@@ -89,16 +90,11 @@ pub fn merge(parts: &[&Path], out: &Path, metric_columns: usize) -> Result<Merge
             ),
             Some(_) => {}
         }
-        let columns = first.split(',').count();
-        for (number, line) in lines {
-            if line.is_empty() {
-                continue;
-            }
-            let number = number + 1;
-            let fields: Vec<&str> = line.split(',').collect();
-            let index = fields[0]
-                .parse::<usize>()
-                .ok()
+        let columns = first.len();
+        for (number, fields) in records {
+            let index = fields
+                .first()
+                .and_then(|f| f.parse::<usize>().ok())
                 .filter(|_| fields.len() == columns);
             let Some(index) = index else {
                 bail!(
@@ -108,7 +104,7 @@ pub fn merge(parts: &[&Path], out: &Path, metric_columns: usize) -> Result<Merge
                 );
             };
             if let Some((earlier, from, at)) = rows.get(&index) {
-                if earlier != line {
+                if *earlier != fields {
                     bail!(
                         "{}:{number}: configuration {index} differs from {}:{at}",
                         part.display(),
@@ -117,18 +113,19 @@ pub fn merge(parts: &[&Path], out: &Path, metric_columns: usize) -> Result<Merge
                 }
                 continue;
             }
-            rows.insert(index, (line.to_string(), part, number));
+            rows.insert(index, (fields, part, number));
         }
     }
     let (header, _) = header.expect("at least one part");
-    let names: Vec<&str> = header.split(',').collect();
-    if names.first() != Some(&"index") || names.len() < 1 + metric_columns + 1 {
+    if header.first().map(String::as_str) != Some("index") || header.len() < 1 + metric_columns + 1
+    {
         bail!(
-            "{}: not a seethru sweep CSV (header `{header}`)",
-            parts[0].display()
+            "{}: not a seethru sweep CSV (header `{}`)",
+            parts[0].display(),
+            encode(&header)
         );
     }
-    let param_names = &names[1..names.len() - metric_columns];
+    let param_names = &header[1..header.len() - metric_columns];
     // Each parameter's values in grid order: the grid runs the first parameter slowest, so
     // the order of first appearance by index is the order given on the command line.
     let mut params: Vec<Param> = param_names
@@ -138,8 +135,8 @@ pub fn merge(parts: &[&Path], out: &Path, metric_columns: usize) -> Result<Merge
             values: Vec::new(),
         })
         .collect();
-    for (line, _, _) in rows.values() {
-        for (p, value) in params.iter_mut().zip(line.split(',').skip(1)) {
+    for (fields, _, _) in rows.values() {
+        for (p, value) in params.iter_mut().zip(fields.iter().skip(1)) {
             if !p.values.iter().any(|v| v == value) {
                 p.values.push(value.to_string());
             }
@@ -162,8 +159,11 @@ pub fn merge(parts: &[&Path], out: &Path, metric_columns: usize) -> Result<Merge
                 .join(", ")
         );
     }
-    let body: Vec<(usize, String)> = rows.into_iter().map(|(i, (l, _, _))| (i, l)).collect();
-    let text: String = std::iter::once(header)
+    let body: Vec<(usize, String)> = rows
+        .into_iter()
+        .map(|(i, (fields, _, _))| (i, encode(&fields)))
+        .collect();
+    let text: String = std::iter::once(encode(&header))
         .chain(body.iter().map(|(_, l)| l.clone()))
         .map(|l| l + "\n")
         .collect();
