@@ -12,13 +12,15 @@ use seethru::measure::metrics::measure;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::system::display::{DisplayModel, Filter};
+use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
 use seethru::system::memory::{check_memory, run_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
-use seethru::system::pipeline::run;
+use seethru::system::pipeline::{RunResult, run};
 
 use crate::cli::args::{
     RenderArgs, band, head_bias_cm, integer, pixels, positive, real, with_threads,
 };
+use crate::cli::run_eyes::EyesFlag;
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -67,6 +69,16 @@ pub struct Run {
     /// Back camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
     #[arg(long = "back-width", value_parser = pixels)]
     back_width: Option<u32>,
+    /// mono: the scene's driver camera (the cyclopean eye); left, right: one eye, ipd/2 from
+    /// it; both: each eye's run in OUT/left and OUT/right, and the binocular mismatch.
+    #[arg(long, value_enum, default_value_t = EyesFlag::Mono)]
+    eyes: EyesFlag,
+    /// Interpupillary distance, metres in (0, 0.1].
+    #[arg(long, default_value_t = 0.064, value_parser = positive(MAX_IPD))]
+    ipd: f64,
+    /// The eye the compensation serves.
+    #[arg(long = "target-eye", value_enum, default_value_t = Eye::Cyclopean)]
+    target_eye: Eye,
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
@@ -93,12 +105,22 @@ impl Run {
             outside: self.outside,
             filter: self.filter,
             display: self.display,
+            eyes: Eyes {
+                view: match self.eyes {
+                    EyesFlag::Left => Eye::Left,
+                    EyesFlag::Right => Eye::Right,
+                    _ => Eye::Cyclopean,
+                },
+                target: self.target_eye,
+                ipd: self.ipd,
+            },
             progress: true,
         };
+        let both = self.eyes == EyesFlag::Both;
         let (scene, out, band, max_memory) =
             (&self.scene, &self.out, self.band, self.render.max_memory);
         with_threads(self.render.threads, || {
-            run_command(scene, out, &options, band, max_memory)
+            run_command(scene, out, &options, band, max_memory, both)
         })?
     }
 }
@@ -110,11 +132,27 @@ fn run_command(
     options: &RunOptions,
     band: u32,
     max_memory: f64,
+    both: bool,
 ) -> Result<()> {
     let scene = Scene::load(scene_path)?;
     check_memory(&run_estimate(&scene, options)?, max_memory)?;
     let ctx = RenderContext::new(scene)?;
-    let result = run(&ctx, options)?;
+    if both {
+        return crate::cli::run_eyes::run_both(&ctx, out, options, |options, dir| {
+            write_run(&ctx, dir, options, band)
+        });
+    }
+    write_run(&ctx, out, options, band).map(|_| ())
+}
+
+/// One run into `out`: every view, the metrics and run.json.
+fn write_run(
+    ctx: &RenderContext,
+    out: &Path,
+    options: &RunOptions,
+    band: u32,
+) -> Result<RunResult> {
+    let result = run(ctx, options)?;
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create output directory {}", out.display()))?;
     let views = [
@@ -135,7 +173,9 @@ fn run_command(
         },
         || {
             let frames = [&result.truth, &result.seethru, &result.occluded];
-            measure(&ctx, &ctx.scene, ctx.scene.eye(), frames, band)
+            // The eye the views were rendered from.
+            let eye = options.eyes.view_camera(&ctx.scene.driver).position();
+            measure(ctx, &ctx.scene, eye, frames, band)
         },
     );
     written?;
@@ -149,5 +189,5 @@ fn run_command(
         "wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",
         out.display()
     ));
-    Ok(())
+    Ok(result)
 }
