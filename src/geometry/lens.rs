@@ -368,32 +368,49 @@ impl Lens {
             }
             Distortion::Brown { .. } => {
                 // Along rays from the axis, the Jacobian must stay positive until the
-                // distorted point has left the image's farthest radius.
+                // distorted point has left the image's farthest radius; the fold reported is
+                // the nearest over the rays, bisected to 1e-9.
                 let r_max = MAX_OFF_AXIS.tan();
                 let steps = 4_000;
+                let mut fold: Option<f64> = None;
                 let mut reached_all = true;
                 for ray in 0..64 {
                     let angle = std::f64::consts::TAU * ray as f64 / 64.0;
                     let dir = DVec2::new(angle.cos(), angle.sin());
+                    let folded = |r: f64| {
+                        self.brown_jacobian(dir * r).determinant() <= 0.0
+                            || self.distort(dir * r, None).dot(dir) <= 0.0
+                    };
                     let mut reached = false;
+                    let mut previous = 0.0;
                     for i in 1..=steps {
                         // Finer steps near the axis, where images are.
                         let r = r_max * (i as f64 / steps as f64).powi(3);
-                        let ab = dir * r;
-                        let d = self.distort(ab, None);
-                        if self.brown_jacobian(ab).determinant() <= 0.0 || d.dot(dir) <= 0.0 {
-                            return Err(LensError::Folds {
-                                radius: r,
-                                pixels: d.length() * self.fx,
-                                needed: needed_px,
-                            });
-                        }
-                        if d.length() >= needed {
+                        if folded(r) {
+                            let (mut lo, mut hi) = (previous, r);
+                            while hi - lo > 1e-9 {
+                                let mid = 0.5 * (lo + hi);
+                                if folded(mid) { hi = mid } else { lo = mid }
+                            }
+                            fold = Some(fold.map_or(hi, |f: f64| f.min(hi)));
                             reached = true;
                             break;
                         }
+                        if self.distort(dir * r, None).length() >= needed {
+                            reached = true;
+                            break;
+                        }
+                        previous = r;
                     }
                     reached_all &= reached;
+                }
+                if let Some(radius) = fold {
+                    let d = self.distort(DVec2::new(radius, 0.0), None).length();
+                    return Err(LensError::Folds {
+                        radius,
+                        pixels: d * self.fx,
+                        needed: needed_px,
+                    });
                 }
                 if !reached_all {
                     return Err(LensError::TooWide { needed: needed_px });
