@@ -11,6 +11,7 @@ use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
+use seethru::scene::lens_keys::read_calibration_file;
 use seethru::system::display::{DisplayModel, Filter};
 use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
 use seethru::system::memory::{check_memory, run_estimate};
@@ -30,6 +31,10 @@ pub struct Run {
     /// Output directory.
     #[arg(long)]
     out: PathBuf,
+    /// A TOML file with a [calibration] table (as in a scene file) that replaces the scene's:
+    /// the compensation's own copy of the cameras.
+    #[arg(long, value_name = "FILE")]
+    calibration: Option<PathBuf>,
     /// none: the whole frontal image in the display; planar: the paper's compensation.
     #[arg(long, value_enum, default_value_t = Method::Planar)]
     method: Method,
@@ -119,8 +124,9 @@ impl Run {
         let both = self.eyes == EyesFlag::Both;
         let (scene, out, band, max_memory) =
             (&self.scene, &self.out, self.band, self.render.max_memory);
+        let calibration = self.calibration.as_deref();
         with_threads(self.render.threads, || {
-            run_command(scene, out, &options, band, max_memory, both)
+            run_command(scene, calibration, out, &options, band, max_memory, both)
         })?
     }
 }
@@ -128,13 +134,17 @@ impl Run {
 /// `seethru run`: renders the six views into `out` with `run.json` and the metrics.
 fn run_command(
     scene_path: &Path,
+    calibration: Option<&Path>,
     out: &Path,
     options: &RunOptions,
     band: u32,
     max_memory: f64,
     both: bool,
 ) -> Result<()> {
-    let scene = Scene::load(scene_path)?;
+    let mut scene = Scene::load(scene_path)?;
+    if let Some(path) = calibration {
+        scene.calibration = read_calibration_file(path, &scene.frontal, &scene.back)?;
+    }
     check_memory(&run_estimate(&scene, options)?, max_memory)?;
     let ctx = RenderContext::new(scene)?;
     if both {

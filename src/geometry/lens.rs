@@ -25,7 +25,8 @@ pub const NEWTON_ITERATIONS: usize = 30;
 pub const MAX_OFF_AXIS: f64 = 89.0 * std::f64::consts::PI / 180.0;
 
 /// Distortion, in OpenCV's coefficients (dimensionless, on normalised coordinates).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[serde(tag = "model", rename_all = "lowercase")]
 pub enum Distortion {
     None,
     /// Brown–Conrady: radial `1 + k1 r² + k2 r⁴ + k3 r⁶`, tangential p1, p2.
@@ -65,7 +66,7 @@ impl Distortion {
 }
 
 /// Intrinsics and distortion of a camera, OpenCV's conventions (see the module comment).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Lens {
     /// Focal lengths, pixels, > 0.
     pub fx: f64,

@@ -208,3 +208,18 @@ pub fn read_calibration(
     table.finish()?;
     Ok(calibration)
 }
+
+/// A file holding only a `[calibration]` table (the scene file's format), for
+/// `run --calibration`: it replaces the scene's calibration.
+pub fn read_calibration_file(
+    path: &std::path::Path,
+    frontal: &Camera,
+    back: &Camera,
+) -> Result<Calibration, SceneError> {
+    let file = crate::scene::source::SourceFile::read(path)?;
+    let doc = file.parse()?;
+    let root = TableReader::root(&file, &doc);
+    let calibration = read_calibration(&root, frontal, back)?;
+    root.finish()?;
+    Ok(calibration)
+}

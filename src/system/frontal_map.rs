@@ -57,3 +57,25 @@ impl FrontalMap {
         (min, max)
     }
 }
+
+/// run.json's `lenses`: the true and the believed lens of the frontal and back cameras
+/// (OpenCV's intrinsics; `null`: the ideal pinhole of the half angle), and the calibration.
+pub fn lenses_json(scene: &crate::scene::Scene) -> anyhow::Result<serde_json::Value> {
+    let c = &scene.calibration;
+    let camera = |truth: &crate::geometry::camera::Camera,
+                  calibration: &crate::geometry::calibration::CameraCalibration|
+     -> anyhow::Result<serde_json::Value> {
+        let believed = calibration.apply(truth)?;
+        Ok(serde_json::json!({
+            "true": truth.lens,
+            "believed": believed.lens,
+            "calibration_exact": calibration.is_exact(),
+            "believed_pose_error_m": (believed.position() - truth.position()).length(),
+            "believed_axis_error_deg": believed.forward().angle_between(truth.forward()).to_degrees(),
+        }))
+    };
+    Ok(serde_json::json!({
+        "frontal": camera(&scene.frontal, &c.frontal)?,
+        "back": camera(&scene.back, &c.back)?,
+    }))
+}

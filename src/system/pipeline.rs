@@ -349,6 +349,7 @@ pub fn run_with_truth(
     // The renders are the run's memory peak.
     report["peak_rss_bytes"] = json!(peak_rss_bytes());
     report["eyes"] = json!({"options": options.eyes, "view_world_m": driver.position().to_array()});
+    report["lenses"] = crate::system::frontal_map::lenses_json(scene)?;
     Ok(RunResult {
         truth,
         occluded,
