@@ -47,6 +47,14 @@ pub fn disparity_mismatch(ipd: f64, d1: f64, d2: f64) -> f64 {
     ipd * (1.0 / d1 - 1.0 / (d1 + d2))
 }
 
+/// [`disparity_mismatch`] along a line of sight `alpha` radians off the display normal in the
+/// plane of the eyes (the eyes' baseline parallel to the display): the vergence of a point
+/// at depth z and that angle is `(ipd / z) cos² α`, so the mismatch is
+/// `ipd cos² α (1/d1 − 1/(d1 + d2))`.
+pub fn disparity_mismatch_off_axis(ipd: f64, d1: f64, d2: f64, alpha: f64) -> f64 {
+    disparity_mismatch(ipd, d1, d2) * alpha.cos().powi(2)
+}
+
 /// Vergence of a point: the angle at `point` between the two eyes, radians.
 pub fn vergence(left: DVec3, right: DVec3, point: DVec3) -> f64 {
     (left - point).angle_between(right - point)
@@ -67,6 +75,19 @@ mod tests {
         let closed = disparity_mismatch(ipd, d1, d2);
         // 2 atan(e/2d) = (e/d)(1 − e²/(12 d²) …): 4e-4 relative here.
         assert!((exact - closed).abs() < 1e-3 * closed, "{exact} {closed}");
+    }
+
+    #[test]
+    fn off_axis_the_vergence_falls_as_cos_squared() {
+        let (ipd, d1, d2, alpha) = (0.064, 0.75, 12.0, 25f64.to_radians());
+        let (l, r) = (
+            DVec3::new(-ipd / 2.0, 0.0, d1),
+            DVec3::new(ipd / 2.0, 0.0, d1),
+        );
+        let at = |z: f64| DVec3::new(-alpha.tan() * (d1 - z), 0.0, z);
+        let exact = vergence(l, r, at(0.0)) - vergence(l, r, at(-d2));
+        let closed = disparity_mismatch_off_axis(ipd, d1, d2, alpha);
+        assert!((exact - closed).abs() < 2e-3 * closed, "{exact} {closed}");
     }
 
     #[test]

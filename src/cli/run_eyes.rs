@@ -55,13 +55,16 @@ pub fn run_both(
     .with_context(|| format!("writing the binocular outputs to {}", out.display()))?;
     let m = &stats["mismatch_arcmin"];
     seethru::util::progress::summary(format!(
-        "binocular mismatch: mean {:.1}′, p5 {:.1}′, p95 {:.1}′ over {} display pixels ({} missing); closed form {:.1}′; wrote binocular.json/.exr/.png and anaglyph.png to {}",
+        "binocular mismatch: mean {:.1}′, p5 {:.1}′, p95 {:.1}′ over {} display pixels ({} missing); closed form {:.1}′ straight ahead, {:.1}′ at the display's angle; wrote binocular.json/.exr/.png and anaglyph.png to {}",
         m["mean"].as_f64().unwrap_or(f64::NAN),
         m["p5"].as_f64().unwrap_or(f64::NAN),
         m["p95"].as_f64().unwrap_or(f64::NAN),
         stats["measured_pixels"],
         stats["missing_pixels"],
         stats["closed_form_arcmin"].as_f64().unwrap_or(f64::NAN),
+        stats["closed_form_off_axis_arcmin"]
+            .as_f64()
+            .unwrap_or(f64::NAN),
         out.display()
     ));
     Ok(())

@@ -143,6 +143,9 @@ impl DisplayPlacement {
 }
 
 /// What the display shows where the `seethru` view meets it.
+// One value per run, borrowed by the renderer: the ideal variant's size (a camera with its
+// lens, the crop) costs nothing.
+#[allow(clippy::large_enum_variant)]
 pub enum DisplaySurface {
     /// A physical display: the nearest of its pixels — one colour per pixel, all AOVs alike.
     Pixels {
