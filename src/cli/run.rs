@@ -74,8 +74,7 @@ pub struct Run {
     /// Back camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
     #[arg(long = "back-width", value_parser = pixels)]
     back_width: Option<u32>,
-    /// mono: the scene's driver camera (the cyclopean eye); left, right: one eye, ipd/2 from
-    /// it; both: each eye's run in OUT/left and OUT/right, and the binocular mismatch.
+    /// The eyes the driver's views are rendered from.
     #[arg(long, value_enum, default_value_t = EyesFlag::Mono)]
     eyes: EyesFlag,
     /// Interpupillary distance, metres in (0, 0.1].

@@ -13,9 +13,13 @@ use seethru::system::pipeline::RunResult;
 /// Which eyes `run` looks with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum EyesFlag {
+    /// The scene's driver camera, the cyclopean eye.
     Mono,
+    /// The left eye, ipd/2 left of the cyclopean eye.
     Left,
+    /// The right eye.
     Right,
+    /// Each eye into OUT/left and OUT/right, and the binocular mismatch into OUT.
     Both,
 }
 
