@@ -78,3 +78,56 @@ fn the_ipd_is_checked() {
         assert!(err.contains("--ipd must be in (0, 0.1] m"), "{err}");
     }
 }
+
+#[test]
+fn run_with_both_eyes_writes_each_eye_the_mismatch_and_the_anaglyph_of_their_views() {
+    let out = tempfile::tempdir().unwrap();
+    let (ok, _, err) = common::seethru(&[
+        "run",
+        "scenes/wall_brown.toml",
+        "--out",
+        out.path().to_str().unwrap(),
+        "--d2",
+        "6",
+        "--eyes",
+        "both",
+        "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    let png = |p: &str| image::open(out.path().join(p)).unwrap().to_rgb8();
+    let (left, right, anaglyph) = (
+        png("left/seethru.png"),
+        png("right/seethru.png"),
+        png("anaglyph.png"),
+    );
+    assert_ne!(left, right);
+    for ((l, r), a) in left.pixels().zip(right.pixels()).zip(anaglyph.pixels()) {
+        assert_eq!(a.0, [l.0[0], r.0[1], r.0[2]]);
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.path().join("binocular.json")).unwrap())
+            .unwrap();
+    // Every display pixel is counted: measured or missing.
+    assert_eq!(json["display_pixels"], 300 * 200);
+    assert_eq!(json["measured_pixels"], 300 * 200);
+    // The wall is 6 m behind the display, the eyes 0.8 m before it: the closed form there.
+    let closed = json["closed_form_arcmin"].as_f64().unwrap();
+    assert!((closed - disparity_mismatch(0.064, 0.8, 6.0).to_degrees() * 60.0).abs() < 1.0);
+    let m = &json["mismatch_arcmin"];
+    let off_axis = json["closed_form_off_axis_arcmin"].as_f64().unwrap();
+    assert!(
+        (m["median"].as_f64().unwrap() - off_axis).abs() < 0.03 * off_axis,
+        "{json}"
+    );
+    // Each eye's run is complete: its metrics, measured from that eye.
+    for eye in ["left", "right"] {
+        let run: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(out.path().join(eye).join("run.json")).unwrap(),
+        )
+        .unwrap();
+        let x = run["eyes"]["view_world_m"][0].as_f64().unwrap();
+        let side = if eye == "left" { -1.0 } else { 1.0 };
+        assert!(side * (x - 0.3) > 0.03, "{eye}: {x}");
+        assert!(out.path().join(eye).join("metrics.json").exists());
+    }
+}

@@ -294,3 +294,48 @@ fn ignoring_k1_costs_the_closed_form_at_the_crop_corners() {
         );
     }
 }
+
+#[test]
+fn a_distorted_back_camera_estimates_the_head_through_its_lens() {
+    let estimated = RunOptions {
+        head: seethru::system::options::HeadSource::Estimated,
+        back_width: Some(320),
+        ..small(DisplayModel::Pixels)
+    };
+    let error = |ctx: &RenderContext| {
+        run(ctx, &estimated).unwrap().report["eye_used"]["error_m"]
+            .as_f64()
+            .unwrap()
+    };
+    let back = "[camera.back]\nhalf_angle_deg = 35.0\nmodel = \"brown\"\nk1 = -0.15\nk2 = 0.02\n";
+    let with_back = |extra: &str| {
+        let path = repo_path("scenes/das.toml");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let old = "[camera.back]\nhalf_angle_deg = 35.0\n";
+        assert!(
+            text.contains(old),
+            "test bug: das.toml's back camera changed"
+        );
+        let scene = Scene::from_source(&SourceFile::from_text(
+            &path,
+            text.replacen(old, back, 1) + extra,
+        ))
+        .unwrap();
+        RenderContext::new(scene).unwrap()
+    };
+    let pinhole = error(&RenderContext::new(common::das()).unwrap());
+    let through_lens = error(&with_back(""));
+    let ignoring = error(&with_back(
+        "\n[calibration.back]\nignore_distortion = true\n",
+    ));
+    // Through its lens the estimate is as good as the pinhole's (1 cm at 320 px: one pixel
+    // of the 64 mm feature is about that); believing a pinhole is not.
+    assert!(
+        through_lens < pinhole.max(0.01) * 1.5,
+        "through the lens {through_lens} m, pinhole {pinhole} m"
+    );
+    assert!(
+        ignoring > 2.0 * through_lens.max(0.005),
+        "ignoring the distortion {ignoring} m vs {through_lens} m"
+    );
+}

@@ -47,12 +47,23 @@ pub fn disparity_mismatch(ipd: f64, d1: f64, d2: f64) -> f64 {
     ipd * (1.0 / d1 - 1.0 / (d1 + d2))
 }
 
-/// [`disparity_mismatch`] along a line of sight `alpha` radians off the display normal in the
-/// plane of the eyes (the eyes' baseline parallel to the display): the vergence of a point
-/// at depth z and that angle is `(ipd / z) cos² α`, so the mismatch is
-/// `ipd cos² α (1/d1 − 1/(d1 + d2))`.
-pub fn disparity_mismatch_off_axis(ipd: f64, d1: f64, d2: f64, alpha: f64) -> f64 {
-    disparity_mismatch(ipd, d1, d2) * alpha.cos().powi(2)
+/// [`disparity_mismatch`] along any line of sight: for eyes `baseline` apart (the vector
+/// from the left eye to the right, m), a unit `sight` direction from the cyclopean eye and the
+/// display's unit `normal`, the vergence of a point at distance ρ is `|b⊥| / ρ` (b⊥ the part of
+/// the baseline across the sight line), and the display point and the scene point lie at
+/// ρ = d1 / cos α and (d1 + d2) / cos α: `|b⊥| cos α (1/d1 − 1/(d1 + d2))`. A baseline
+/// parallel to the display in the plane of the sight line gives `ipd cos² α (…)`, one across
+/// the sight line `ipd cos α (…)`.
+pub fn disparity_mismatch_along(
+    baseline: DVec3,
+    sight: DVec3,
+    normal: DVec3,
+    d1: f64,
+    d2: f64,
+) -> f64 {
+    let across = baseline - sight * baseline.dot(sight);
+    let cos_alpha = sight.dot(normal).abs();
+    disparity_mismatch(across.length(), d1, d2) * cos_alpha
 }
 
 /// Vergence of a point: the angle at `point` between the two eyes, radians.
@@ -78,16 +89,25 @@ mod tests {
     }
 
     #[test]
-    fn off_axis_the_vergence_falls_as_cos_squared() {
+    fn off_axis_the_mismatch_follows_the_baseline_across_the_sight_line() {
         let (ipd, d1, d2, alpha) = (0.064, 0.75, 12.0, 25f64.to_radians());
-        let (l, r) = (
-            DVec3::new(-ipd / 2.0, 0.0, d1),
-            DVec3::new(ipd / 2.0, 0.0, d1),
-        );
-        let at = |z: f64| DVec3::new(-alpha.tan() * (d1 - z), 0.0, z);
-        let exact = vergence(l, r, at(0.0)) - vergence(l, r, at(-d2));
-        let closed = disparity_mismatch_off_axis(ipd, d1, d2, alpha);
-        assert!((exact - closed).abs() < 2e-3 * closed, "{exact} {closed}");
+        let sight = DVec3::new(-alpha.sin(), 0.0, -alpha.cos());
+        let eye = DVec3::new(0.0, 0.0, d1);
+        // The point at depth z (display plane z = 0) on the sight line.
+        let at = |z: f64| eye + sight * ((d1 - z) / alpha.cos());
+        // Baseline along the display (cos²) and across the sight line (cos).
+        for baseline in [
+            DVec3::X * ipd,
+            DVec3::new(alpha.cos(), 0.0, -alpha.sin()) * ipd,
+        ] {
+            let (l, r) = (eye - baseline / 2.0, eye + baseline / 2.0);
+            let exact = vergence(l, r, at(0.0)) - vergence(l, r, at(-d2));
+            let closed = disparity_mismatch_along(baseline, sight, DVec3::Z, d1, d2);
+            assert!((exact - closed).abs() < 2e-3 * closed, "{exact} {closed}");
+        }
+        let parallel = disparity_mismatch_along(DVec3::X * ipd, sight, DVec3::Z, d1, d2);
+        let straight = disparity_mismatch(ipd, d1, d2);
+        assert!((parallel - straight * alpha.cos().powi(2)).abs() < 1e-12);
     }
 
     #[test]

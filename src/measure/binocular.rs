@@ -11,7 +11,7 @@ use exr::prelude::{AnyChannel, FlatSamples};
 use glam::DVec3;
 use serde_json::json;
 
-use crate::analysis::binocular::{disparity_mismatch, disparity_mismatch_off_axis, vergence};
+use crate::analysis::binocular::{disparity_mismatch, disparity_mismatch_along, vergence};
 use crate::io::atomic::write_text;
 use crate::io::frame_files::{write_exr_channels, write_png};
 use crate::measure::maps::heat_color;
@@ -111,10 +111,10 @@ pub fn binocular_stats(
     let ipd = (right - left).length();
     let d1 = obstacle.in_obstacle_frame((left + right) / 2.0).z;
     let median_d2 = percentile(&depths, 0.5).map(f64::from);
-    // The cyclopean line of sight to the display centre, off the display normal, in the
-    // plane of the eyes.
-    let eye_o = obstacle.in_obstacle_frame((left + right) / 2.0);
-    let alpha = eye_o.x.atan2(eye_o.z);
+    // The cyclopean line of sight to the display centre.
+    let centre = obstacle.world_from_obstacle.translation;
+    let sight = (centre - (left + right) / 2.0).normalize();
+    let normal = obstacle.normal();
     json!({
         "ipd_m": ipd,
         "d1_m": d1,
@@ -128,9 +128,9 @@ pub fn binocular_stats(
         },
         "scene_depth_median_m": median_d2.map(|d| if d.is_finite() { json!(d) } else { json!("inf") }),
         "closed_form_arcmin": median_d2.map(|d2| disparity_mismatch(ipd, d1, d2) * ARCMIN_PER_RAD),
-        "closed_form_off_axis_arcmin": median_d2.map(|d2| disparity_mismatch_off_axis(ipd, d1, d2, alpha) * ARCMIN_PER_RAD),
-        "display_centre_off_axis_deg": alpha.to_degrees(),
-        "notes": "per display pixel: vergence (angle at the point between the two eyes) of the display point minus that of the scene point the pixel shows (sky: 0), arc-minutes; > 0: the display is seen nearer than what it shows. Missing pixels (outside the frontal view) are counted, not measured. closed_form: ipd (1/d1 − 1/(d1 + d2)) with d1 of the cyclopean eye and d2 the median scene depth shown, straight ahead; closed_form_off_axis: times cos² of the display centre's angle off the display normal (analysis/binocular.rs)",
+        "closed_form_off_axis_arcmin": median_d2.map(|d2| disparity_mismatch_along(right - left, sight, normal, d1, d2) * ARCMIN_PER_RAD),
+        "display_centre_off_axis_deg": sight.angle_between(-normal).to_degrees(),
+        "notes": "per display pixel: vergence (angle at the point between the two eyes) of the display point minus that of the scene point the pixel shows (sky: 0), arc-minutes; > 0: the display is seen nearer than what it shows. Missing pixels (outside the frontal view) are counted, not measured. closed_form: ipd (1/d1 − 1/(d1 + d2)) with d1 of the cyclopean eye and d2 the median scene depth shown, straight ahead; closed_form_off_axis: along the cyclopean line of sight to the display centre, |b⊥| cos α (1/d1 − 1/(d1 + d2)) with b⊥ the eyes' baseline across it and α its angle off the display normal (analysis/binocular.rs)",
     })
 }
 
