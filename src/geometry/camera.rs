@@ -8,7 +8,8 @@
 
 use glam::{DAffine3, DMat3, DVec2, DVec3};
 
-use crate::geometry::lens::{Lens, LensError};
+use crate::geometry::lens::Lens;
+use crate::geometry::lens_check::LensError;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {

@@ -14,15 +14,12 @@
 //!
 //! The inverse (pixel → ray) is Newton's method: at most [`NEWTON_ITERATIONS`] steps, stopped
 //! when a step is below 1e-15 (normalised units); the forward map is checked to be monotonic
-//! over the image ([`Lens::check`]), so the root is unique and Newton converges in a few steps.
+//! over the image (`Lens::check`, geometry/lens_check.rs), so the root is unique and Newton converges in a few steps.
 
 use glam::{DMat2, DVec2, DVec3};
 
-/// Most Newton steps of the inverse map; 5–8 suffice for the lenses [`Lens::check`] admits.
+/// Most Newton steps of the inverse map; 5–8 suffice for the lenses `Lens::check` admits.
 pub const NEWTON_ITERATIONS: usize = 30;
-/// Largest angle off the axis any pixel may see, radians (89°): seethru's cameras see less
-/// than a hemisphere, so every ray they see has camera z < 0.
-pub const MAX_OFF_AXIS: f64 = 89.0 * std::f64::consts::PI / 180.0;
 
 /// Distortion, in OpenCV's coefficients (dimensionless, on normalised coordinates).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -56,7 +53,7 @@ impl Distortion {
         }
     }
 
-    fn coefficients(&self) -> Vec<f64> {
+    pub(crate) fn coefficients(&self) -> Vec<f64> {
         match *self {
             Distortion::None => vec![],
             Distortion::Brown { k1, k2, k3, p1, p2 } => vec![k1, k2, k3, p1, p2],
@@ -76,51 +73,6 @@ pub struct Lens {
     pub cy: f64,
     pub distortion: Distortion,
 }
-
-/// Why a lens cannot be used on an image.
-#[derive(Clone, Debug, PartialEq)]
-pub enum LensError {
-    /// A coefficient or intrinsic is NaN or infinite.
-    NotFinite(&'static str),
-    /// A focal length ≤ 0.
-    FocalNotPositive(&'static str, f64),
-    /// The forward map folds (is not invertible) inside the image.
-    Folds {
-        /// Normalised undistorted radius (fisheye: angle, radians) where it folds.
-        radius: f64,
-        /// The distorted radius there, pixels from the principal point (along x).
-        pixels: f64,
-        /// The distorted radius the image needs, pixels.
-        needed: f64,
-    },
-    /// Some pixel of the image would see 89° or more off the axis.
-    TooWide { needed: f64 },
-}
-
-impl std::fmt::Display for LensError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            LensError::NotFinite(key) => write!(f, "{key} must be a finite number"),
-            LensError::FocalNotPositive(key, v) => {
-                write!(f, "{key} must be > 0 pixels, got {v}")
-            }
-            LensError::Folds {
-                radius,
-                pixels,
-                needed,
-            } => write!(
-                f,
-                "the distortion folds (the lens map is not invertible) at undistorted radius {radius:.4} ({pixels:.1} px from the principal point), inside the image, which reaches {needed:.1} px: the coefficients are not a lens"
-            ),
-            LensError::TooWide { needed } => write!(
-                f,
-                "the image reaches {needed:.1} px from the principal point, where the lens sees 89° or more off its axis; seethru's cameras must see less than a hemisphere"
-            ),
-        }
-    }
-}
-
-impl std::error::Error for LensError {}
 
 impl Lens {
     /// The ideal pinhole of horizontal half angle `half_angle_x` (radians) on a W × H image.
@@ -158,7 +110,7 @@ impl Lens {
     /// Distorted normalised coordinates of undistorted ones (a, b) = (x/z, y/z) in OpenCV's
     /// frame. For the fisheye, `theta` is the angle off the axis (so that it is exact at any
     /// angle); `None` computes it from (a, b).
-    fn distort(&self, ab: DVec2, theta: Option<f64>) -> DVec2 {
+    pub(crate) fn distort(&self, ab: DVec2, theta: Option<f64>) -> DVec2 {
         match self.distortion {
             Distortion::None => ab,
             Distortion::Brown { k1, k2, k3, p1, p2 } => {
@@ -181,7 +133,7 @@ impl Lens {
         }
     }
 
-    fn fisheye_theta_d(&self, theta: f64) -> f64 {
+    pub(crate) fn fisheye_theta_d(&self, theta: f64) -> f64 {
         match self.distortion {
             Distortion::Fisheye { k1, k2, k3, k4 } => {
                 let t2 = theta * theta;
@@ -191,7 +143,7 @@ impl Lens {
         }
     }
 
-    fn fisheye_theta_d_slope(&self, theta: f64) -> f64 {
+    pub(crate) fn fisheye_theta_d_slope(&self, theta: f64) -> f64 {
         match self.distortion {
             Distortion::Fisheye { k1, k2, k3, k4 } => {
                 let t2 = theta * theta;
@@ -202,7 +154,7 @@ impl Lens {
     }
 
     /// Jacobian of the Brown–Conrady map at (a, b).
-    fn brown_jacobian(&self, ab: DVec2) -> DMat2 {
+    pub(crate) fn brown_jacobian(&self, ab: DVec2) -> DMat2 {
         let Distortion::Brown { k1, k2, k3, p1, p2 } = self.distortion else {
             return DMat2::IDENTITY;
         };
@@ -271,7 +223,7 @@ impl Lens {
     }
 
     /// Distorted normalised coordinates (OpenCV's frame) of seethru pixel coordinates.
-    fn normalised(&self, pixel: DVec2) -> DVec2 {
+    pub(crate) fn normalised(&self, pixel: DVec2) -> DVec2 {
         DVec2::new(
             (pixel.x - 0.5 - self.cx) / self.fx,
             (pixel.y - 0.5 - self.cy) / self.fy,
@@ -305,120 +257,6 @@ impl Lens {
     pub fn distort_pixel(&self, pixel: DVec2) -> DVec2 {
         let d = self.distort(self.normalised(pixel), None);
         DVec2::new(self.fx * d.x + self.cx + 0.5, self.fy * d.y + self.cy + 0.5)
-    }
-
-    /// Checks that the lens is a lens on a `width` × `height` image: finite, positive focal
-    /// lengths, less than a hemisphere, and no fold inside the image (radially, and for
-    /// Brown's tangential terms a positive Jacobian along 64 rays from the centre).
-    pub fn check(&self, width: u32, height: u32) -> Result<(), LensError> {
-        for (key, v) in [
-            ("fx", self.fx),
-            ("fy", self.fy),
-            ("cx", self.cx),
-            ("cy", self.cy),
-        ] {
-            if !v.is_finite() {
-                return Err(LensError::NotFinite(key));
-            }
-        }
-        let names: &[&'static str] = match self.distortion {
-            Distortion::Fisheye { .. } => &["k1", "k2", "k3", "k4"],
-            _ => &["k1", "k2", "k3", "p1", "p2"],
-        };
-        for (key, v) in names.iter().zip(self.distortion.coefficients()) {
-            if !v.is_finite() {
-                return Err(LensError::NotFinite(key));
-            }
-        }
-        for (key, v) in [("fx", self.fx), ("fy", self.fy)] {
-            if v <= 0.0 {
-                return Err(LensError::FocalNotPositive(key, v));
-            }
-        }
-        // The largest distorted normalised radius the image needs: its farthest corner.
-        let corners = [(0.0, 0.0), (width as f64, 0.0), (0.0, height as f64)]
-            .into_iter()
-            .chain([(width as f64, height as f64)]);
-        let needed = corners
-            .map(|(x, y)| self.normalised(DVec2::new(x, y)).length())
-            .fold(0.0, f64::max);
-        let needed_px = needed * self.fx;
-        match self.distortion {
-            Distortion::None => {
-                if needed.atan() >= MAX_OFF_AXIS {
-                    return Err(LensError::TooWide { needed: needed_px });
-                }
-            }
-            Distortion::Fisheye { .. } => {
-                // θ_d(θ) must rise from 0 until it covers the image, before 89°.
-                let steps = 20_000;
-                for i in 1..=steps {
-                    let theta = MAX_OFF_AXIS * i as f64 / steps as f64;
-                    if self.fisheye_theta_d_slope(theta) <= 0.0 {
-                        return Err(LensError::Folds {
-                            radius: theta,
-                            pixels: self.fisheye_theta_d(theta) * self.fx,
-                            needed: needed_px,
-                        });
-                    }
-                    if self.fisheye_theta_d(theta) >= needed {
-                        return Ok(());
-                    }
-                }
-                return Err(LensError::TooWide { needed: needed_px });
-            }
-            Distortion::Brown { .. } => {
-                // Along rays from the axis, the Jacobian must stay positive until the
-                // distorted point has left the image's farthest radius; the fold reported is
-                // the nearest over the rays, bisected to 1e-9.
-                let r_max = MAX_OFF_AXIS.tan();
-                let steps = 4_000;
-                let mut fold: Option<f64> = None;
-                let mut reached_all = true;
-                for ray in 0..64 {
-                    let angle = std::f64::consts::TAU * ray as f64 / 64.0;
-                    let dir = DVec2::new(angle.cos(), angle.sin());
-                    let folded = |r: f64| {
-                        self.brown_jacobian(dir * r).determinant() <= 0.0
-                            || self.distort(dir * r, None).dot(dir) <= 0.0
-                    };
-                    let mut reached = false;
-                    let mut previous = 0.0;
-                    for i in 1..=steps {
-                        // Finer steps near the axis, where images are.
-                        let r = r_max * (i as f64 / steps as f64).powi(3);
-                        if folded(r) {
-                            let (mut lo, mut hi) = (previous, r);
-                            while hi - lo > 1e-9 {
-                                let mid = 0.5 * (lo + hi);
-                                if folded(mid) { hi = mid } else { lo = mid }
-                            }
-                            fold = Some(fold.map_or(hi, |f: f64| f.min(hi)));
-                            reached = true;
-                            break;
-                        }
-                        if self.distort(dir * r, None).length() >= needed {
-                            reached = true;
-                            break;
-                        }
-                        previous = r;
-                    }
-                    reached_all &= reached;
-                }
-                if let Some(radius) = fold {
-                    let d = self.distort(DVec2::new(radius, 0.0), None).length();
-                    return Err(LensError::Folds {
-                        radius,
-                        pixels: d * self.fx,
-                        needed: needed_px,
-                    });
-                }
-                if !reached_all {
-                    return Err(LensError::TooWide { needed: needed_px });
-                }
-            }
-        }
-        Ok(())
     }
 
     /// Horizontal half angle of the pinhole with the same fx on a `width`-pixel image:
@@ -525,70 +363,5 @@ mod tests {
             .project(DVec3::new(theta.sin(), 0.0, -theta.cos()))
             .unwrap();
         assert!((p.x - 200.0 - lens.fx * theta).abs() < 1e-9);
-    }
-
-    #[test]
-    fn folding_and_broken_coefficients_are_refused() {
-        let base = Lens::pinhole(0.5, 640, 480);
-        let folding = Lens {
-            distortion: Distortion::Brown {
-                k1: -0.9,
-                k2: 0.0,
-                k3: 0.0,
-                p1: 0.0,
-                p2: 0.0,
-            },
-            ..base
-        };
-        // r (1 − 0.9 r²) has its maximum at r = 1/sqrt(2.7) = 0.6086.
-        match folding.check(640, 480) {
-            Err(LensError::Folds { radius, .. }) => {
-                assert!((radius - 0.6086).abs() < 0.002, "{radius}")
-            }
-            other => panic!("{other:?}"),
-        }
-        // A milder k1 folds (at r = 1.29, 0.86 distorted) outside the image (0.68): admitted.
-        let mild = Lens {
-            distortion: Distortion::Brown {
-                k1: -0.2,
-                k2: 0.0,
-                k3: 0.0,
-                p1: 0.0,
-                p2: 0.0,
-            },
-            ..base
-        };
-        assert_eq!(mild.check(640, 480), Ok(()));
-        let nan = Lens {
-            distortion: Distortion::Fisheye {
-                k1: 0.0,
-                k2: f64::NAN,
-                k3: 0.0,
-                k4: 0.0,
-            },
-            ..base
-        };
-        assert_eq!(nan.check(640, 480), Err(LensError::NotFinite("k2")));
-        let flat = Lens { fy: 0.0, ..base };
-        assert_eq!(
-            flat.check(640, 480),
-            Err(LensError::FocalNotPositive("fy", 0.0))
-        );
-        let fold_fisheye = Lens {
-            distortion: Distortion::Fisheye {
-                k1: -0.5,
-                k2: 0.0,
-                k3: 0.0,
-                k4: 0.0,
-            },
-            fx: 150.0,
-            fy: 150.0,
-            ..base
-        };
-        // 1 − 1.5 θ² = 0 at θ = 0.8165.
-        match fold_fisheye.check(640, 480) {
-            Err(LensError::Folds { radius, .. }) => assert!((radius - 0.8165).abs() < 1e-3),
-            other => panic!("{other:?}"),
-        }
     }
 }

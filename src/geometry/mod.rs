@@ -5,3 +5,4 @@ pub mod calibration;
 pub mod camera;
 pub mod homography;
 pub mod lens;
+pub mod lens_check;

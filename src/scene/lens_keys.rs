@@ -6,7 +6,8 @@ use glam::{DAffine3, DVec3};
 
 use crate::geometry::calibration::{COEFFICIENT_NAMES, Calibration, CameraCalibration};
 use crate::geometry::camera::{Camera, CameraError};
-use crate::geometry::lens::{Distortion, Lens, LensError};
+use crate::geometry::lens::{Distortion, Lens};
+use crate::geometry::lens_check::LensError;
 use crate::scene::source::SceneError;
 use crate::scene::table_reader::TableReader;
 
