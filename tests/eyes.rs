@@ -131,3 +131,72 @@ fn run_with_both_eyes_writes_each_eye_the_mismatch_and_the_anaglyph_of_their_vie
         assert!(out.path().join(eye).join("metrics.json").exists());
     }
 }
+
+#[test]
+fn the_compensation_serves_the_target_eye() {
+    let ctx = common::WallScene::default().context();
+    let driver = &ctx.scene.driver;
+    for target in [Eye::Cyclopean, Eye::Left, Eye::Right] {
+        let eyes = Eyes {
+            target,
+            ..Eyes::default()
+        };
+        let r = run(
+            &ctx,
+            &RunOptions {
+                spp: 1,
+                eyes,
+                ..RunOptions::default()
+            },
+        )
+        .unwrap();
+        let expected = eyes.position(driver, target);
+        assert!((r.eye_used - expected).length() < 1e-12, "{target:?}");
+        // The driver's views are still the cyclopean eye's (`--eyes mono`).
+        assert_eq!(
+            r.report["eyes"]["view_world_m"][0].as_f64().unwrap(),
+            driver.position().x
+        );
+    }
+}
+
+#[test]
+fn analyze_prints_the_mismatch_the_renderer_measures_on_a_plane() {
+    let (ok, stdout, err) = common::seethru(&[
+        "analyze", "--json", "--d1", "1", "--d2", "6", "--ipd", "0.064",
+    ]);
+    assert!(ok, "{err}");
+    let json: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let printed = json["lens_and_eyes"]["disparity_mismatch"]["arcmin"]
+        .as_f64()
+        .unwrap();
+    // The display-centre pixel of the plane scene of the first test, rendered.
+    let ctx = common::WallScene {
+        wall: 6.0,
+        eye: [0.0, 0.0, 1.0],
+        ..Default::default()
+    }
+    .context();
+    let r = run(
+        &ctx,
+        &RunOptions {
+            d2: WorkingDistance::Metres(6.0),
+            spp: 1,
+            ..RunOptions::default()
+        },
+    )
+    .unwrap();
+    let eyes = Eyes::default();
+    let driver = &ctx.scene.driver;
+    let (l, rr) = (
+        eyes.position(driver, Eye::Left),
+        eyes.position(driver, Eye::Right),
+    );
+    let map = binocular_map(&r.display, &ctx.scene.obstacle, l, rr);
+    let centre = (map.height / 2 * map.width + map.width / 2) as usize;
+    let measured = map.mismatch_arcmin[centre] as f64;
+    assert!(
+        (measured - printed).abs() < 1.0,
+        "analyze {printed}′, rendered {measured}′"
+    );
+}
