@@ -200,3 +200,25 @@ fn analyze_prints_the_mismatch_the_renderer_measures_on_a_plane() {
         "analyze {printed}′, rendered {measured}′"
     );
 }
+
+#[test]
+fn measure_recomputes_a_one_eye_run_from_that_eye() {
+    let out = tempfile::tempdir().unwrap();
+    let dir = out.path().to_str().unwrap();
+    let args = ["run", "scenes/wall_brown.toml", "--out", dir, "--d2", "6"];
+    let (ok, _, err) = common::seethru(&[&args[..], &["--eyes", "left", "--quiet"]].concat());
+    assert!(ok, "{err}");
+    let written = std::fs::read_to_string(out.path().join("metrics.json")).unwrap();
+    let (ok, _, err) = common::seethru(&["measure", dir, "--quiet"]);
+    assert!(ok, "{err}");
+    let recomputed = std::fs::read_to_string(out.path().join("metrics.json")).unwrap();
+    assert_eq!(written, recomputed);
+    // From the cyclopean eye the same frames would misregister differently.
+    let json: serde_json::Value = serde_json::from_str(&written).unwrap();
+    assert!(
+        json["display"]["misregistration_arcmin"]["mean"]
+            .as_f64()
+            .unwrap()
+            > 60.0
+    );
+}
