@@ -14,7 +14,7 @@ use seethru::scene::Scene;
 use seethru::scene::lens_keys::read_calibration_file;
 use seethru::system::display::{DisplayModel, Filter};
 use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
-use seethru::system::memory::{check_memory, run_estimate};
+use seethru::system::memory::{both_eyes_estimate, check_memory, run_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use seethru::system::pipeline::{RunResult, run};
 
@@ -144,7 +144,11 @@ fn run_command(
     if let Some(path) = calibration {
         scene.calibration = read_calibration_file(path, &scene.frontal, &scene.back)?;
     }
-    check_memory(&run_estimate(&scene, options)?, max_memory)?;
+    let estimate = match both {
+        true => both_eyes_estimate(&scene, options)?,
+        false => run_estimate(&scene, options)?,
+    };
+    check_memory(&estimate, max_memory)?;
     let ctx = RenderContext::new(scene)?;
     if both {
         return crate::cli::run_eyes::run_both(&ctx, out, options, |options, dir| {

@@ -39,7 +39,9 @@ pub fn run_both(
             },
             ..options.clone()
         };
-        results.push(write_run(&options, &out.join(name))?);
+        // Only what the binocular outputs need is kept while the other eye runs.
+        let result = write_run(&options, &out.join(name))?;
+        results.push((result.display, result.seethru));
     }
     let scene = &ctx.scene;
     let eyes = options.eyes;
@@ -48,15 +50,10 @@ pub fn run_both(
         eyes.position(&scene.driver, Eye::Right),
     );
     // Both runs serve the same eye: their display images are the same.
-    let map = binocular_map(&results[0].display, &scene.obstacle, left, right);
+    let map = binocular_map(&results[0].0, &scene.obstacle, left, right);
     let stats = binocular_stats(&map, &scene.obstacle, left, right);
-    write_binocular(
-        out,
-        &map,
-        &stats,
-        [&results[0].seethru, &results[1].seethru],
-    )
-    .with_context(|| format!("writing the binocular outputs to {}", out.display()))?;
+    write_binocular(out, &map, &stats, [&results[0].1, &results[1].1])
+        .with_context(|| format!("writing the binocular outputs to {}", out.display()))?;
     let m = &stats["mismatch_arcmin"];
     seethru::util::progress::summary(format!(
         "binocular mismatch: mean {:.1}′, p5 {:.1}′, p95 {:.1}′ over {} display pixels ({} missing); closed form {:.1}′ straight ahead, {:.1}′ at the display's angle; wrote binocular.json/.exr/.png and anaglyph.png to {}",
