@@ -77,5 +77,6 @@ pub fn lenses_json(scene: &crate::scene::Scene) -> anyhow::Result<serde_json::Va
     Ok(serde_json::json!({
         "frontal": camera(&scene.frontal, &c.frontal)?,
         "back": camera(&scene.back, &c.back)?,
+        "notes": "lenses in OpenCV's conventions (pixel centres at integers; null: the ideal pinhole of the half angle). With a believed frontal lens, crop.corners_frontal_px and the crop ratios are in the undistorted pixels of its pinhole (same fx, fy, cx, cy); the display maps each pixel on through the lens's distortion",
     }))
 }
