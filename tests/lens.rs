@@ -339,3 +339,39 @@ fn a_distorted_back_camera_estimates_the_head_through_its_lens() {
         "ignoring the distortion {ignoring} m vs {through_lens} m"
     );
 }
+
+#[test]
+fn a_bad_calibration_file_is_one_line_naming_its_file_line_and_key() {
+    let dir = tempfile::tempdir().unwrap();
+    for (text, key, words) in [
+        (
+            "# comment\n[calibration.frontal]\nfocal_error_percent = 99\n",
+            "calibration.frontal.focal_error_percent",
+            ":3:",
+        ),
+        ("[camera.frontal]\nfx = 3\n", "camera", "unknown key"),
+    ] {
+        let file = dir.path().join("cal.toml");
+        std::fs::write(&file, text).unwrap();
+        let out = dir.path().join("out");
+        let (ok, _, err) = common::seethru(&[
+            "run",
+            "scenes/das.toml",
+            "--out",
+            out.to_str().unwrap(),
+            "--calibration",
+            file.to_str().unwrap(),
+            "--width",
+            "32",
+        ]);
+        assert!(!ok);
+        let err = err.trim_end();
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(
+            err.starts_with("error: ") && err.contains("cal.toml"),
+            "{err}"
+        );
+        assert!(err.contains(key) && err.contains(words), "{err}");
+        assert!(!out.exists(), "nothing written");
+    }
+}
