@@ -271,7 +271,7 @@ fn options_with_values() -> Vec<(Vec<&'static str>, String, String)> {
 fn every_numeric_flag_refuses_values_outside_its_range_in_one_line() {
     // Paths, names and free-form specs are not numbers; everything else must refuse a NaN,
     // an infinity, a huge number and an integer beyond 64 bits, naming the flag and its range.
-    let not_numbers = ["OUT", "SCENE", "DIR", "PARAMS"];
+    let not_numbers = ["OUT", "SCENE", "DIR", "PARAMS", "FILE"];
     let options = options_with_values();
     assert!(options.len() > 40, "{options:?}");
     let scratch = tempfile::tempdir().unwrap();

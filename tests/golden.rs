@@ -87,3 +87,45 @@ fn a_missing_golden_fails_and_is_not_written() {
     assert!(!common::repo_path("golden/no-such-view.png").exists());
     assert!(common::repo_path("target/golden-failures/no-such-view-actual.png").exists());
 }
+
+#[test]
+fn a_fisheye_frontal_render_matches_its_golden() {
+    let scene = seethru::scene::Scene::load(&common::repo_path("scenes/das_fisheye.toml")).unwrap();
+    let ctx = RenderContext::new(scene).unwrap();
+    let camera = ctx.scene.frontal.with_resolution(192, 108);
+    let settings = RenderSettings {
+        spp: 4,
+        progress: false,
+    };
+    let (frame, _) = ctx.render(&camera, View::Frontal.bit(), settings, "frontal");
+    // Every pixel's centre ray came through the lens: its world point projects back onto
+    // the pixel's centre through the forward model.
+    for y in 0..frame.height {
+        for x in 0..frame.width {
+            let p = frame.position[frame.index(x, y)];
+            if p.is_finite() {
+                let q = camera.project_point(p.as_dvec3()).unwrap();
+                let centre = glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                assert!((q - centre).length() < 0.01, "({x}, {y}): {q}");
+            }
+        }
+    }
+    // Straight lines are curved: a line across the road 5 m ahead (not through the
+    // principal point, which radial distortion keeps straight) does not project onto one
+    // image line; through a pinhole it does.
+    let across = [-4.0, 1.0, 6.0].map(|x| glam::DVec3::new(x, 0.0, -5.0));
+    let edge = across.map(|p| camera.project_point(p).unwrap());
+    let bend = |[a, b, c]: [glam::DVec2; 3]| (b - a).perp_dot(c - a).abs() / (c - a).length();
+    assert!(
+        bend(edge) > 2.0,
+        "the fisheye bends the edge by {} px",
+        bend(edge)
+    );
+    let pinhole = seethru::geometry::camera::Camera {
+        lens: None,
+        ..camera
+    };
+    let straight = across.map(|p| pinhole.project_point(p).unwrap());
+    assert!(bend(straight) < 1e-6);
+    golden::check("frontal_fisheye", &to_image(&frame));
+}

@@ -469,6 +469,7 @@ fn driver_views_rendered_over_the_truth_equal_separate_renders() {
                 crop: r.crop,
                 frontal,
                 placement,
+                lens: None,
             },
         };
         let (seethru, _) = ctx.render_seethru(&driver, &surface, settings);

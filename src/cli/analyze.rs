@@ -3,6 +3,10 @@
 
 use crate::cli::args::{metres_or_inf, pixels, positive, real};
 use anyhow::Result;
+use glam::DVec3;
+use seethru::analysis::binocular::{
+    disparity_mismatch, display_corners, model_point_normalised, radial_error_px,
+};
 use seethru::paper::claims::{
     AnalyzeParams, claims_table, evaluate, head_error_table, head_error_text, paper_claims,
 };
@@ -47,6 +51,49 @@ pub struct Analyze {
     /// Tolerance of the d2_min bound, as a fraction of R(∞) in (0, 1].
     #[arg(long, default_value_t = 0.05, value_parser = positive(1.0))]
     tolerance: f64,
+    /// Display height H, metres in (0, 100] (for the crop's corners).
+    #[arg(long, default_value_t = 0.45, value_parser = positive(100.0))]
+    height: f64,
+    /// Radial distortion k1 of the frontal lens (Brown–Conrady) that the compensation
+    /// ignores, in [-1, 1].
+    #[arg(long, default_value_t = -0.1, allow_hyphen_values = true, value_parser = real(-1.0, 1.0))]
+    k1: f64,
+    /// Interpupillary distance, metres in (0, 0.1].
+    #[arg(long, default_value_t = 0.064, value_parser = positive(0.1))]
+    ipd: f64,
+}
+
+/// The closed forms of analysis/binocular.rs at the parameters: the frontal pixel error of
+/// ignoring k1 at the crop's corners (frontal camera at the display centre, perpendicular),
+/// and the binocular disparity mismatch of the flat display.
+fn lens_and_eyes(a: &Analyze) -> serde_json::Value {
+    let f_px = a.frontal_px as f64 / (2.0 * a.theta_f.to_radians().tan());
+    let eye = DVec3::new(-a.b_h, 0.0, a.d1);
+    let d2 = a.d2.is_finite().then_some(a.d2);
+    let corners: Vec<serde_json::Value> = display_corners(a.width, a.height)
+        .iter()
+        .map(|&c| {
+            let r = model_point_normalised(eye, c, d2).length();
+            serde_json::json!({
+                "undistorted_radius": r,
+                "error_px": radial_error_px(f_px, [a.k1, 0.0, 0.0], [0.0; 3], r),
+            })
+        })
+        .collect();
+    let arcmin = 60.0 * 180.0 / std::f64::consts::PI;
+    serde_json::json!({
+        "ignoring_k1": {
+            "k1": a.k1,
+            "focal_px": f_px,
+            "formula": "f |k1| r³ at each corner's undistorted normalised radius r",
+            "corners_tl_tr_br_bl": corners,
+        },
+        "disparity_mismatch": {
+            "ipd_m": a.ipd,
+            "formula": "ipd (1/d1 − 1/(d1 + d2)), straight ahead",
+            "arcmin": disparity_mismatch(a.ipd, a.d1, a.d2) * arcmin,
+        },
+    })
 }
 
 impl Analyze {
@@ -65,13 +112,14 @@ impl Analyze {
             tolerance: self.tolerance,
         };
         params.validate().map_err(anyhow::Error::msg)?;
+        let lens_eyes = lens_and_eyes(&self);
         let claims = paper_claims();
         let values = evaluate(&params);
         if self.json {
             println!(
                 "{}",
                 serde_json::to_string_pretty(
-                    &serde_json::json!({"claims": claims, "evaluation": values})
+                    &serde_json::json!({"claims": claims, "evaluation": values, "lens_and_eyes": lens_eyes})
                 )?
             );
         } else {
@@ -80,6 +128,10 @@ impl Analyze {
             println!(
                 "\nEvery closed form at the given parameters:\n{}",
                 serde_json::to_string_pretty(&values)?
+            );
+            println!(
+                "\nReal cameras and two eyes (analysis/binocular.rs):\n{}",
+                serde_json::to_string_pretty(&lens_eyes)?
             );
         }
         Ok(())

@@ -36,13 +36,11 @@ fn measure_command(dir: &Path, band: u32) -> Result<serde_json::Value> {
         .with_context(|| format!("the scene of {}", dir.join("run.json").display()))?;
     let ctx = RenderContext::new(scene)?;
     let [truth, seethru, occluded] = read_measured_frames(dir)?;
-    let (maps, metrics) = measure(
-        &ctx,
-        &ctx.scene,
-        ctx.scene.eye(),
-        [&truth, &seethru, &occluded],
-        band,
-    );
+    // The eye the run's views were rendered from (`--eyes left|right`), else the scene's.
+    let eye = record
+        .view_eye
+        .map_or(ctx.scene.eye(), glam::DVec3::from_array);
+    let (maps, metrics) = measure(&ctx, &ctx.scene, eye, [&truth, &seethru, &occluded], band);
     write_metrics(dir, &maps, &truth, &metrics)?;
     Ok(metrics)
 }

@@ -10,6 +10,7 @@ mod ratio;
 mod render;
 mod reproduce;
 mod run;
+mod run_eyes;
 mod sweep;
 
 use anyhow::Result;

@@ -11,14 +11,17 @@ use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
+use seethru::scene::lens_keys::read_calibration_file;
 use seethru::system::display::{DisplayModel, Filter};
-use seethru::system::memory::{check_memory, run_estimate};
+use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
+use seethru::system::memory::{both_eyes_estimate, check_memory, run_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
-use seethru::system::pipeline::run;
+use seethru::system::pipeline::{RunResult, run};
 
 use crate::cli::args::{
     RenderArgs, band, head_bias_cm, integer, pixels, positive, real, with_threads,
 };
+use crate::cli::run_eyes::EyesFlag;
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -28,6 +31,10 @@ pub struct Run {
     /// Output directory.
     #[arg(long)]
     out: PathBuf,
+    /// A TOML file with a [calibration] table (as in a scene file) that replaces the scene's:
+    /// the compensation's own copy of the cameras.
+    #[arg(long, value_name = "FILE")]
+    calibration: Option<PathBuf>,
     /// none: the whole frontal image in the display; planar: the paper's compensation.
     #[arg(long, value_enum, default_value_t = Method::Planar)]
     method: Method,
@@ -67,6 +74,15 @@ pub struct Run {
     /// Back camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
     #[arg(long = "back-width", value_parser = pixels)]
     back_width: Option<u32>,
+    /// The eyes the driver's views are rendered from.
+    #[arg(long, value_enum, default_value_t = EyesFlag::Mono)]
+    eyes: EyesFlag,
+    /// Interpupillary distance, metres in (0, 0.1].
+    #[arg(long, default_value_t = 0.064, value_parser = positive(MAX_IPD))]
+    ipd: f64,
+    /// The eye the compensation serves.
+    #[arg(long = "target-eye", value_enum, default_value_t = Eye::Cyclopean)]
+    target_eye: Eye,
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
@@ -93,12 +109,23 @@ impl Run {
             outside: self.outside,
             filter: self.filter,
             display: self.display,
+            eyes: Eyes {
+                view: match self.eyes {
+                    EyesFlag::Left => Eye::Left,
+                    EyesFlag::Right => Eye::Right,
+                    _ => Eye::Cyclopean,
+                },
+                target: self.target_eye,
+                ipd: self.ipd,
+            },
             progress: true,
         };
+        let both = self.eyes == EyesFlag::Both;
         let (scene, out, band, max_memory) =
             (&self.scene, &self.out, self.band, self.render.max_memory);
+        let calibration = self.calibration.as_deref();
         with_threads(self.render.threads, || {
-            run_command(scene, out, &options, band, max_memory)
+            run_command(scene, calibration, out, &options, band, max_memory, both)
         })?
     }
 }
@@ -106,15 +133,39 @@ impl Run {
 /// `seethru run`: renders the six views into `out` with `run.json` and the metrics.
 fn run_command(
     scene_path: &Path,
+    calibration: Option<&Path>,
     out: &Path,
     options: &RunOptions,
     band: u32,
     max_memory: f64,
+    both: bool,
 ) -> Result<()> {
-    let scene = Scene::load(scene_path)?;
-    check_memory(&run_estimate(&scene, options)?, max_memory)?;
+    let mut scene = Scene::load(scene_path)?;
+    if let Some(path) = calibration {
+        scene.calibration = read_calibration_file(path, &scene.frontal, &scene.back)?;
+    }
+    let estimate = match both {
+        true => both_eyes_estimate(&scene, options)?,
+        false => run_estimate(&scene, options)?,
+    };
+    check_memory(&estimate, max_memory)?;
     let ctx = RenderContext::new(scene)?;
-    let result = run(&ctx, options)?;
+    if both {
+        return crate::cli::run_eyes::run_both(&ctx, out, options, |options, dir| {
+            write_run(&ctx, dir, options, band)
+        });
+    }
+    write_run(&ctx, out, options, band).map(|_| ())
+}
+
+/// One run into `out`: every view, the metrics and run.json.
+fn write_run(
+    ctx: &RenderContext,
+    out: &Path,
+    options: &RunOptions,
+    band: u32,
+) -> Result<RunResult> {
+    let result = run(ctx, options)?;
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create output directory {}", out.display()))?;
     let views = [
@@ -135,7 +186,9 @@ fn run_command(
         },
         || {
             let frames = [&result.truth, &result.seethru, &result.occluded];
-            measure(&ctx, &ctx.scene, ctx.scene.eye(), frames, band)
+            // The eye the views were rendered from.
+            let eye = options.eyes.view_camera(&ctx.scene.driver).position();
+            measure(ctx, &ctx.scene, eye, frames, band)
         },
     );
     written?;
@@ -149,5 +202,5 @@ fn run_command(
         "wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",
         out.display()
     ));
-    Ok(())
+    Ok(result)
 }

@@ -1,22 +1,31 @@
-//! Pinhole cameras: pose, intrinsics, rays and projection.
+//! Cameras: pose, intrinsics, rays and projection.
 //!
 //! A camera looks down its local −z with +x right and +y up (the glTF convention). Pixel
 //! coordinates are continuous: pixel `(i, j)` covers `[i, i+1) × [j, j+1)`, its centre is at
-//! `(i + 0.5, j + 0.5)`, and `(0, 0)` is the top-left corner of the image. Pixels are square.
+//! `(i + 0.5, j + 0.5)`, and `(0, 0)` is the top-left corner of the image. Without a lens a
+//! camera is the ideal pinhole of its half angle with square pixels, centred; with a
+//! [`Lens`] (OpenCV's intrinsics and distortion) rays and projections go through it.
 
 use glam::{DAffine3, DMat3, DVec2, DVec3};
+
+use crate::geometry::lens::Lens;
+use crate::geometry::lens_check::LensError;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// Rigid transform from camera space to world space (metres). Camera space: the camera
     /// looks down −z, +x is right, +y is up.
     pub world_from_camera: DAffine3,
-    /// Horizontal half angle of view, in radians, in (0, π/2). The paper's θ.
+    /// Horizontal half angle of view, in radians, in (0, π/2). The paper's θ. With a lens,
+    /// that of the pinhole with the lens's fx: `atan(W / (2 fx))`.
     pub half_angle_x: f64,
     /// Image width in pixels, ≥ 1.
     pub width: u32,
     /// Image height in pixels, ≥ 1.
     pub height: u32,
+    /// `None`: the ideal pinhole of `half_angle_x`. Otherwise the intrinsics and distortion
+    /// (OpenCV's conventions, geometry/lens.rs) that rays and projections go through.
+    pub lens: Option<Lens>,
 }
 
 /// Why a camera cannot be built.
@@ -25,6 +34,7 @@ pub enum CameraError {
     /// `look_at` equals the eye, or `up` is parallel to the viewing direction.
     DegenerateOrientation,
     HalfAngleOutOfRange(f64),
+    Lens(LensError),
 }
 
 impl std::fmt::Display for CameraError {
@@ -39,6 +49,7 @@ impl std::fmt::Display for CameraError {
                 "half angle of view must be in (0°, 90°), got {:.3}°",
                 a.to_degrees()
             ),
+            CameraError::Lens(e) => e.fmt(f),
         }
     }
 }
@@ -71,7 +82,58 @@ impl Camera {
             half_angle_x,
             width,
             height,
+            lens: None,
         })
+    }
+
+    /// A camera seeing through `lens` (checked on the image: no fold, less than a
+    /// hemisphere, finite, focal lengths > 0).
+    pub fn with_lens(
+        world_from_camera: DAffine3,
+        lens: Lens,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, CameraError> {
+        lens.check(width, height).map_err(CameraError::Lens)?;
+        Ok(Self {
+            world_from_camera,
+            half_angle_x: lens.equivalent_half_angle(width),
+            width,
+            height,
+            lens: Some(lens),
+        })
+    }
+
+    /// The lens the camera sees through: its own, or the ideal pinhole's in OpenCV's terms.
+    pub fn lens_or_pinhole(&self) -> Lens {
+        self.lens
+            .unwrap_or_else(|| Lens::pinhole(self.half_angle_x, self.width, self.height))
+    }
+
+    /// The same camera with the distortion removed (a pinhole with the lens's intrinsics):
+    /// its projection of a plane into the image is a homography. Itself without a lens.
+    pub fn undistorted(&self) -> Self {
+        Self {
+            lens: self.lens.map(|l| l.undistorted()),
+            ..*self
+        }
+    }
+
+    /// Where the ideal pinhole of `half_angle_x` (square pixels, centred) would see the ray
+    /// that this camera sees at `pixel`: the input of eqs. d1 and b_h for a real lens.
+    /// The identity without a lens.
+    pub fn ideal_pixel(&self, pixel: DVec2) -> DVec2 {
+        match self.lens {
+            None => pixel,
+            Some(_) => {
+                let d = self.camera_direction(pixel);
+                let ideal = Self {
+                    lens: None,
+                    ..*self
+                };
+                ideal.project_camera(d).unwrap_or(pixel)
+            }
+        }
     }
 
     /// A camera at `eye` looking towards `target`, with `up` as the approximate up direction.
@@ -93,6 +155,13 @@ impl Camera {
     }
 
     pub fn with_resolution(mut self, width: u32, height: u32) -> Self {
+        // A lens's pixel intrinsics scale with the image; its distortion does not.
+        self.lens = self.lens.map(|l| {
+            l.scaled(
+                width as f64 / self.width as f64,
+                height as f64 / self.height as f64,
+            )
+        });
         self.width = width;
         self.height = height;
         self
@@ -118,6 +187,9 @@ impl Camera {
 
     /// Camera-space direction (not normalised, z = −1) through continuous pixel coordinates.
     pub fn camera_direction(&self, pixel: DVec2) -> DVec3 {
+        if let Some(lens) = &self.lens {
+            return lens.camera_direction(pixel);
+        }
         let ndc_x = 2.0 * pixel.x / self.width as f64 - 1.0;
         let ndc_y = 1.0 - 2.0 * pixel.y / self.height as f64;
         DVec3::new(ndc_x * self.tan_half_x(), ndc_y * self.tan_half_y(), -1.0)
@@ -134,6 +206,9 @@ impl Camera {
 
     /// Continuous pixel coordinates of a camera-space direction or point; `None` behind the camera.
     pub fn project_camera(&self, p: DVec3) -> Option<DVec2> {
+        if let Some(lens) = &self.lens {
+            return lens.project(p);
+        }
         if p.z >= 0.0 {
             return None;
         }

@@ -1,4 +1,8 @@
-//! The geometry of seeing: cameras (pose, intrinsics, rays, projection) and homographies.
+//! The geometry of seeing: cameras (pose, intrinsics, rays, projection), lens models,
+//! calibration errors and homographies.
 
+pub mod calibration;
 pub mod camera;
 pub mod homography;
+pub mod lens;
+pub mod lens_check;

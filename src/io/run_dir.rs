@@ -12,6 +12,9 @@ use crate::render::frame::Frame;
 pub struct RunRecord {
     /// The scene file the run rendered, as the run was given it.
     pub scene: PathBuf,
+    /// The eye the driver views were rendered from, world, metres (`eyes.view_world_m`;
+    /// `None` in run.json files that predate two eyes: the scene's driver camera).
+    pub view_eye: Option<[f64; 3]>,
 }
 
 /// The views the metrics compare, in the order `measure` takes them.
@@ -29,8 +32,20 @@ pub fn parse_run_json(text: &str) -> Result<RunRecord> {
         Some(other) => bail!("`scene` must be the path of the scene file, got {other}"),
         None => bail!("no `scene` (the path of the scene file the run rendered)"),
     };
+    let view_eye = match object.get("eyes").and_then(|e| e.get("view_world_m")) {
+        None => None,
+        Some(v) => Some(
+            serde_json::from_value::<[f64; 3]>(v.clone())
+                .ok()
+                .filter(|p| p.iter().all(|c| c.is_finite()))
+                .with_context(|| {
+                    format!("`eyes.view_world_m` must be 3 finite numbers, got {v}")
+                })?,
+        ),
+    };
     Ok(RunRecord {
         scene: PathBuf::from(scene),
+        view_eye,
     })
 }
 
@@ -80,7 +95,14 @@ mod tests {
     fn run_json_needs_a_scene_path() {
         let ok = parse_run_json(r#"{"scene": "scenes/das.toml", "x": 1}"#).unwrap();
         assert_eq!(ok.scene, PathBuf::from("scenes/das.toml"));
+        assert_eq!(ok.view_eye, None);
+        let eye = parse_run_json(r#"{"scene": "s.toml", "eyes": {"view_world_m": [1, 2.5, 3]}}"#);
+        assert_eq!(eye.unwrap().view_eye, Some([1.0, 2.5, 3.0]));
         for (text, words) in [
+            (
+                r#"{"scene": "s.toml", "eyes": {"view_world_m": [1, 2]}}"#,
+                "must be 3 finite numbers",
+            ),
             ("", "invalid JSON"),
             ("[1]", "expected a JSON object"),
             ("{}", "no `scene`"),

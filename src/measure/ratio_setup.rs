@@ -330,5 +330,6 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
         driver,
         frontal,
         back,
+        calibration: Default::default(),
     })
 }

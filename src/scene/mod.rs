@@ -4,6 +4,7 @@
 //! parameter table of every object kind; the defaults below are the ones documented there.
 
 pub mod grow;
+pub mod lens_keys;
 pub mod limits;
 pub mod mesh_io;
 pub mod procedural;
@@ -18,6 +19,7 @@ use std::path::PathBuf;
 
 use glam::{DAffine3, DVec3};
 
+use crate::geometry::calibration::Calibration;
 use crate::geometry::camera::Camera;
 
 /// Which cameras can see an object. A bit set over [`CameraKind`].
@@ -205,6 +207,9 @@ pub struct Scene {
     pub frontal: Camera,
     /// The back camera on the display's top edge, filming the driver.
     pub back: Camera,
+    /// The compensation's own copies of the frontal and back cameras (`[calibration]`):
+    /// head estimation and the crop use them, rendering uses the true ones.
+    pub calibration: Calibration,
 }
 
 impl Scene {

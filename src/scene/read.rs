@@ -48,6 +48,7 @@ impl Scene {
         let frontal = read_frontal(&cameras, &obstacle)?;
         let back = read_back(&cameras, &obstacle)?;
         cameras.finish()?;
+        let calibration = crate::scene::lens_keys::read_calibration(&root, &frontal, &back)?;
         root.finish()?;
         Ok(Scene {
             path: file.path.clone(),
@@ -59,6 +60,7 @@ impl Scene {
             driver,
             frontal,
             back,
+            calibration,
         })
     }
 }
@@ -474,13 +476,13 @@ fn mounted_camera(
         base * DMat3::from_rotation_y(yaw) * DMat3::from_rotation_x(pitch),
         offset,
     );
-    Camera::new(
+    crate::scene::lens_keys::read_lens_camera(
+        t,
         obstacle.world_from_obstacle * obstacle_from_camera,
-        half_angle(t, default_half_deg)?,
+        || half_angle(t, default_half_deg),
         w,
         h,
     )
-    .map_err(|e| t.error("half_angle_deg", e.to_string()))
 }
 
 fn read_frontal(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, SceneError> {

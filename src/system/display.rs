@@ -8,6 +8,7 @@ use crate::render::frame::{Frame, Pixel};
 use crate::render::screen::{Screen, Shown};
 use crate::scene::Obstacle;
 use crate::system::compensation::Crop;
+use crate::system::frontal_map::FrontalMap;
 
 /// Object id of display pixels that show nothing because the frontal camera does not see
 /// their model point (outside its view). They are black.
@@ -28,11 +29,26 @@ pub enum Filter {
 /// normal and ids from the nearest frontal pixel, so that every pixel carries the world
 /// point it shows. Pixels mapping outside the frontal image get [`MISSING_ID`].
 pub fn resample(frontal: &Frame, crop: &Crop, display_size: [u32; 2], filter: Filter) -> Frame {
+    resample_with(frontal, display_size, filter, |p| crop.frontal_point(p))
+}
+
+/// [`resample`] through a [`FrontalMap`]: the crop, then the believed lens's distortion.
+pub fn resample_through(frontal: &Frame, map: &FrontalMap, filter: Filter) -> Frame {
+    resample_with(frontal, map.display_size, filter, |p| map.frontal_point(p))
+}
+
+/// The frontal frame resampled at `frontal_point(display pixel centre)` for every pixel.
+fn resample_with(
+    frontal: &Frame,
+    display_size: [u32; 2],
+    filter: Filter,
+    frontal_point: impl Fn(DVec2) -> DVec2,
+) -> Frame {
     let [w, h] = display_size;
     let mut pixels = Vec::with_capacity(w as usize * h as usize);
     for y in 0..h {
         for x in 0..w {
-            let p = crop.frontal_point(DVec2::new(x as f64 + 0.5, y as f64 + 0.5));
+            let p = frontal_point(DVec2::new(x as f64 + 0.5, y as f64 + 0.5));
             pixels.push(sample(frontal, p, filter));
         }
     }
@@ -127,6 +143,9 @@ impl DisplayPlacement {
 }
 
 /// What the display shows where the `seethru` view meets it.
+// One value per run, borrowed by the renderer: the ideal variant's size (a camera with its
+// lens, the crop) costs nothing.
+#[allow(clippy::large_enum_variant)]
 pub enum DisplaySurface {
     /// A physical display: the nearest of its pixels — one colour per pixel, all AOVs alike.
     Pixels {
@@ -140,6 +159,9 @@ pub enum DisplaySurface {
         crop: Crop,
         frontal: Camera,
         placement: DisplayPlacement,
+        /// The believed frontal lens that the crop's point goes through ([`FrontalMap`]);
+        /// `None` for the ideal pinhole.
+        lens: Option<crate::geometry::lens::Lens>,
     },
 }
 
@@ -156,8 +178,10 @@ impl Screen for DisplaySurface {
                 crop,
                 frontal,
                 placement,
+                lens,
             } => {
                 let p = crop.frontal_point(placement.pixel_coords(world));
+                let p = lens.as_ref().map_or(p, |l| l.distort_pixel(p));
                 if !(p.x >= 0.0
                     && p.y >= 0.0
                     && p.x < frontal.width as f64

@@ -219,7 +219,15 @@ pub fn detect(frame: &Frame) -> Result<FaceDetection, DetectError> {
 /// The eye position from a detection: eq. d1 for the distance along the back camera's axis,
 /// eq. b_h (and its vertical counterpart) for the offsets; then the back camera's pose
 /// compensates its offset from the display centre. `feature_width` is `A` in metres.
+/// With a lens, the pupils are first undistorted into the pinhole of the same fx
+/// ([`Camera::ideal_pixel`]), where the equations hold.
 pub fn eye_from_detection(detection: &FaceDetection, back: &Camera, feature_width: f64) -> DVec3 {
+    let detection = &FaceDetection {
+        pupils: detection
+            .pupils
+            .map(|p| back.ideal_pixel(DVec2::from(p)).to_array()),
+        ..*detection
+    };
     let image_px = back.width as f64;
     let d = head_distance(
         feature_width,

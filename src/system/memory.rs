@@ -70,6 +70,22 @@ pub fn run_estimate(scene: &Scene, options: &RunOptions) -> Result<MemoryEstimat
     })
 }
 
+/// `run --eyes both`: one run at a time, plus the first eye's `seethru` and `display` frames
+/// kept for the binocular outputs while the second eye runs.
+pub fn both_eyes_estimate(scene: &Scene, options: &RunOptions) -> Result<MemoryEstimate> {
+    let one = run_estimate(scene, options)?;
+    let driver = resized(scene.driver, options.width, options.height)?;
+    let [dw, dh] = scene.obstacle.display_resolution;
+    let kept = (pixels(&driver) + dw as u64 * dh as u64) * FRAME_BYTES_PER_PIXEL;
+    Ok(MemoryEstimate {
+        bytes: one.bytes + kept,
+        what: format!(
+            "{}, and the first eye's seethru and display views",
+            one.what
+        ),
+    })
+}
+
 /// Refuses an estimate above `limit_gib`, saying what it counts and how to proceed.
 pub fn check_memory(estimate: &MemoryEstimate, limit_gib: f64) -> Result<()> {
     let gib = estimate.bytes as f64 / (1u64 << 30) as f64;

@@ -3,6 +3,8 @@
 
 pub mod compensation;
 pub mod display;
+pub mod eyes;
+pub mod frontal_map;
 pub mod head;
 pub mod memory;
 pub mod options;

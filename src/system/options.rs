@@ -3,6 +3,7 @@
 
 use crate::scene::limits::MAX_COORDINATE;
 use crate::system::display::{DisplayModel, Filter};
+use crate::system::eyes::Eyes;
 
 /// How the display image is made.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
@@ -87,6 +88,8 @@ pub struct RunOptions {
     pub filter: Filter,
     /// How the `seethru` view models the display.
     pub display: DisplayModel,
+    /// Which eye looks and which the compensation serves (system/eyes.rs).
+    pub eyes: Eyes,
     pub progress: bool,
 }
 
@@ -108,6 +111,7 @@ impl Default for RunOptions {
             outside: Outside::Error,
             filter: Filter::Bilinear,
             display: DisplayModel::Pixels,
+            eyes: Eyes::default(),
             progress: false,
         }
     }

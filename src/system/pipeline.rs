@@ -18,8 +18,9 @@ use crate::scene::world::view_bit;
 use crate::scene::{Obstacle, Scene};
 use crate::system::compensation::{Crop, ModelPlane, compute_crop};
 use crate::system::display::{
-    DisplayModel, DisplayPlacement, DisplaySurface, MISSING_ID, resample,
+    DisplayModel, DisplayPlacement, DisplaySurface, MISSING_ID, resample_through,
 };
+use crate::system::frontal_map::FrontalMap;
 use crate::system::head::{FaceDetection, detect, eye_from_detection, gaussian};
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use crate::system::report::report;
@@ -47,12 +48,16 @@ fn eye_for_compensation(
     back: &Frame,
     options: &RunOptions,
 ) -> Result<(DVec3, Option<FaceDetection>)> {
+    let eyes = &options.eyes;
     let (eye, detection) = match options.head {
-        HeadSource::Oracle => (scene.eye(), None),
+        HeadSource::Oracle => (eyes.position(&scene.driver, eyes.target), None),
         HeadSource::Estimated => {
             let detection = detect(back)?;
+            // The believed back camera ([calibration]), not the true one.
+            let believed = scene.calibration.back.apply(&scene.back)?;
+            let cyclopean = eye_from_detection(&detection, &believed, options.feature_width);
             (
-                eye_from_detection(&detection, &scene.back, options.feature_width),
+                eyes.target_from_estimate(cyclopean, &scene.obstacle),
                 Some(detection),
             )
         }
@@ -106,10 +111,14 @@ fn crop_for(
         WorkingDistance::Metres(m) => ModelPlane::At(m),
         _ => ModelPlane::Infinity,
     };
+    // The believed frontal camera ([calibration]) without its distortion: the crop is a
+    // homography into its undistorted pixels (the lens follows in the FrontalMap).
+    let believed = scene.calibration.frontal.apply(&scene.frontal)?;
+    let believed_pinhole = believed.undistorted();
     let mut crop = compute_crop(
         eye,
         &scene.obstacle,
-        &scene.frontal,
+        &believed_pinhole,
         plane(options.d2),
         display_size,
     )?;
@@ -120,12 +129,17 @@ fn crop_for(
     if options.d2 == WorkingDistance::Auto {
         // Two rounds: the region under the d2 = ∞ crop, then under the crop at its median.
         for _ in 0..2 {
-            let d2 = median_depth_in_crop(frontal, &crop, &scene.obstacle)
+            let map = FrontalMap {
+                crop,
+                lens: believed.lens,
+                display_size,
+            };
+            let d2 = median_depth_in_crop(frontal, &map, &scene.obstacle)
                 .context("d2 auto: the frontal camera sees no surface where the display is")?;
             crop = compute_crop(
                 eye,
                 &scene.obstacle,
-                &scene.frontal,
+                &believed_pinhole,
                 ModelPlane::At(d2),
                 display_size,
             )?;
@@ -137,8 +151,8 @@ fn crop_for(
 
 /// Median distance from the display plane of the surfaces the frontal camera sees inside the
 /// crop's bounding box.
-fn median_depth_in_crop(frontal: &Frame, crop: &Crop, obstacle: &Obstacle) -> Option<f64> {
-    let (min, max) = crop.bounds();
+fn median_depth_in_crop(frontal: &Frame, map: &FrontalMap, obstacle: &Obstacle) -> Option<f64> {
+    let (min, max) = map.bounds();
     let mut depths: Vec<f64> = Vec::new();
     for y in (min.y.max(0.0) as u32)..(max.y.min(frontal.height as f64) as u32) {
         for x in (min.x.max(0.0) as u32)..(max.x.min(frontal.width as f64) as u32) {
@@ -153,9 +167,9 @@ fn median_depth_in_crop(frontal: &Frame, crop: &Crop, obstacle: &Obstacle) -> Op
 }
 
 /// How far the crop leaves the frontal image on each side, pixels (0 inside).
-fn overflow(crop: &Crop) -> [(&'static str, f64); 4] {
-    let [w, h] = crop.frontal_size.map(f64::from);
-    let (min, max) = crop.bounds();
+fn overflow(map: &FrontalMap) -> [(&'static str, f64); 4] {
+    let [w, h] = map.crop.frontal_size.map(f64::from);
+    let (min, max) = map.bounds();
     [
         ("left", (-min.x).max(0.0)),
         ("right", (max.x - w).max(0.0)),
@@ -188,7 +202,11 @@ pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
 
 /// The driver's camera a run renders at: the scene's, resized by the options.
 pub fn driver_camera(scene: &Scene, options: &RunOptions) -> Result<Camera> {
-    resized(scene.driver, options.width, options.height)
+    resized(
+        options.eyes.view_camera(&scene.driver),
+        options.width,
+        options.height,
+    )
 }
 
 /// [`run`], given the `truth` frame when it is already rendered (a sweep renders it once for
@@ -215,6 +233,7 @@ pub fn run_with_truth(
     {
         bail!("head bias must be finite and jitter ≥ 0");
     }
+    options.eyes.check().map_err(anyhow::Error::msg)?;
     let driver = driver_camera(scene, options)?;
     let settings = RenderSettings {
         spp: options.spp,
@@ -231,8 +250,17 @@ pub fn run_with_truth(
     let frontal = timed(&mut timings, &scene.frontal, View::Frontal);
     let (eye_used, detection) = eye_for_compensation(scene, &back, options)?;
     let (crop, d2_used) = crop_for(scene, eye_used, &frontal, options)?;
+    let map = FrontalMap {
+        crop,
+        // `--method none` shows the whole frontal image as it is: no lens to go through.
+        lens: match options.method {
+            Method::None => None,
+            _ => scene.calibration.frontal.apply(&scene.frontal)?.lens,
+        },
+        display_size: scene.obstacle.display_resolution,
+    };
 
-    let out = overflow(&crop);
+    let out = overflow(&map);
     if options.method == Method::Planar
         && options.outside == Outside::Error
         && let Some((side, px)) = out.iter().copied().find(|(_, px)| *px > 1e-9)
@@ -256,12 +284,7 @@ pub fn run_with_truth(
     }
 
     let start = Instant::now();
-    let display = resample(
-        &frontal,
-        &crop,
-        scene.obstacle.display_resolution,
-        options.filter,
-    );
+    let display = resample_through(&frontal, &map, options.filter);
     timings.insert("display".into(), json!(start.elapsed().as_secs_f64()));
     let missing = display
         .object_id
@@ -298,6 +321,7 @@ pub fn run_with_truth(
             crop,
             frontal: scene.frontal,
             placement,
+            lens: map.lens,
         },
     };
     let (seethru, stats) = ctx.render_over(
@@ -324,6 +348,8 @@ pub fn run_with_truth(
     );
     // The renders are the run's memory peak.
     report["peak_rss_bytes"] = json!(peak_rss_bytes());
+    report["eyes"] = json!({"options": options.eyes, "view_world_m": driver.position().to_array()});
+    report["lenses"] = crate::system::frontal_map::lenses_json(scene)?;
     Ok(RunResult {
         truth,
         occluded,
