@@ -3,6 +3,7 @@
 mod analyze;
 mod args;
 mod bench;
+mod compare;
 mod export;
 mod figures;
 mod measure;
@@ -10,6 +11,7 @@ mod ratio;
 mod render;
 mod reproduce;
 mod run;
+mod scene_model_args;
 mod sweep;
 
 use anyhow::Result;
@@ -55,6 +57,9 @@ pub enum Command {
     Figures(figures::Figures),
     /// The paper's numerical claims beside seethru's values; every closed form at a parameter set.
     Analyze(analyze::Analyze),
+    /// Compensation methods side by side on one scene: one table (Markdown, JSON, HTML) of
+    /// misregistration, coverage, holes, image metrics and cost, and one image strip each.
+    Compare(compare::Compare),
     /// Benchmark: BVH build time, rays per second, frame times; ends with one JSON line.
     Bench(bench::Bench),
 }
@@ -98,6 +103,7 @@ impl Command {
             Command::Figures(c) => c.run(),
             Command::Analyze(c) => c.run(),
             Command::Bench(c) => c.run(),
+            Command::Compare(c) => c.run(),
         }
     }
 }

@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 use rayon::prelude::*;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_frame;
+use seethru::measure::holes::{attach_holes, write_hole_mask};
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
 use seethru::render::integrator::RenderContext;
@@ -19,6 +20,7 @@ use seethru::system::pipeline::run;
 use crate::cli::args::{
     RenderArgs, band, head_bias_cm, integer, pixels, positive, real, with_threads,
 };
+use crate::cli::scene_model_args::SceneModelArgs;
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -28,7 +30,9 @@ pub struct Run {
     /// Output directory.
     #[arg(long)]
     out: PathBuf,
-    /// none: the whole frontal image in the display; planar: the paper's compensation.
+    /// none: the whole frontal image in the display; planar: the paper's compensation;
+    /// ground: the road plane; plane-fit: a plane fitted to the depth sensor's points; depth:
+    /// per-pixel reprojection with the depth sensor's depth.
     #[arg(long, value_enum, default_value_t = Method::Planar)]
     method: Method,
     /// Working distance of the planar model: inf, auto (median frontal depth behind the
@@ -70,6 +74,9 @@ pub struct Run {
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
+    /// The depth sensor and hole filling of ground, plane-fit and depth.
+    #[command(flatten)]
+    scene_model: SceneModelArgs,
     /// Sizes (width and height: the driver views truth, occluded, seethru), samples, threads.
     #[command(flatten)]
     render: RenderArgs,
@@ -93,6 +100,7 @@ impl Run {
             outside: self.outside,
             filter: self.filter,
             display: self.display,
+            scene_model: self.scene_model.options(),
             progress: true,
         };
         let (scene, out, band, max_memory) =
@@ -127,7 +135,7 @@ fn run_command(
     ];
     // Encoding PNGs and EXRs is mostly single-threaded work: the six views are written side
     // by side, and beside the metrics. The files are the same whatever the order.
-    let (written, (maps, metrics)) = rayon::join(
+    let (written, (maps, mut metrics)) = rayon::join(
         || {
             views
                 .par_iter()
@@ -139,6 +147,16 @@ fn run_command(
         },
     );
     written?;
+    let holes = attach_holes(
+        &mut metrics,
+        &maps,
+        &result,
+        &ctx.scene.obstacle,
+        options.scene_model.fill,
+    );
+    if let Some(holes) = &holes {
+        write_hole_mask(&out.join("holes.png"), &maps, holes)?;
+    }
     write_metrics(out, &maps, &result.truth, &metrics)?;
     // Last: a directory with run.json holds a finished run.
     write_text(

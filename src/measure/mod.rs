@@ -1,6 +1,8 @@
 //! Measurements of the see-through display against the ground truth: per-pixel metrics,
 //! the observed p_cam/p_user of the paper's setups, and sweeps over parameters.
 
+pub mod compare;
+pub mod holes;
 pub mod maps;
 pub mod metrics;
 pub mod ratio;

@@ -2,9 +2,14 @@
 //! compensation, the display, and the pipeline that runs them on rendered frames.
 
 pub mod compensation;
+pub mod depth_search;
+pub mod depth_sensor;
 pub mod display;
 pub mod head;
 pub mod memory;
 pub mod options;
 pub mod pipeline;
 pub mod report;
+pub mod scene_model;
+pub mod scene_model_options;
+pub mod scene_plane;

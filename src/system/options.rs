@@ -3,6 +3,7 @@
 
 use crate::scene::limits::MAX_COORDINATE;
 use crate::system::display::{DisplayModel, Filter};
+use crate::system::scene_model_options::SceneModelOptions;
 
 /// How the display image is made.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
@@ -12,6 +13,13 @@ pub enum Method {
     None,
     /// The paper's planar compensation at working distance `d2`.
     Planar,
+    /// The known road plane (d2 → ∞ above the horizon).
+    Ground,
+    /// A plane fitted to the depth sensor's points where the display is, tilted freely.
+    #[serde(rename = "plane-fit")]
+    PlaneFit,
+    /// Per-pixel reprojection with the depth sensor's depth map.
+    Depth,
 }
 
 /// The working distance of the planar model.
@@ -87,6 +95,8 @@ pub struct RunOptions {
     pub filter: Filter,
     /// How the `seethru` view models the display.
     pub display: DisplayModel,
+    /// The depth sensor and hole filling of `ground`, `plane-fit` and `depth`.
+    pub scene_model: SceneModelOptions,
     pub progress: bool,
 }
 
@@ -108,6 +118,7 @@ impl Default for RunOptions {
             outside: Outside::Error,
             filter: Filter::Bilinear,
             display: DisplayModel::Pixels,
+            scene_model: SceneModelOptions::default(),
             progress: false,
         }
     }

@@ -23,6 +23,7 @@ use crate::system::display::{
 use crate::system::head::{FaceDetection, detect, eye_from_detection, gaussian};
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use crate::system::report::report;
+use crate::system::scene_model::scene_model_display;
 use crate::util::memory::peak_rss_bytes;
 
 /// Everything a run produces.
@@ -37,6 +38,8 @@ pub struct RunResult {
     /// The eye the compensation used, world frame.
     pub eye_used: DVec3,
     pub detection: Option<FaceDetection>,
+    /// Display pixels (row-major) that are disocclusion holes: `--method depth` only.
+    pub holes: Option<Vec<bool>>,
     /// `run.json`.
     pub report: serde_json::Value,
 }
@@ -256,12 +259,33 @@ pub fn run_with_truth(
     }
 
     let start = Instant::now();
-    let display = resample(
-        &frontal,
-        &crop,
-        scene.obstacle.display_resolution,
-        options.filter,
-    );
+    let (display, scene_model) = if options.method.models_the_scene() {
+        if options.display == DisplayModel::Ideal {
+            bail!(
+                "--display ideal works with --method none or planar (a crop); ground, plane-fit and depth model the physical display's pixels"
+            );
+        }
+        let m = scene_model_display(
+            ctx,
+            scene,
+            eye_used,
+            &frontal,
+            &crop,
+            options.method,
+            &options.scene_model,
+            options.filter,
+            options.seed,
+        )?;
+        (m.display.clone(), Some(m))
+    } else {
+        let display = resample(
+            &frontal,
+            &crop,
+            scene.obstacle.display_resolution,
+            options.filter,
+        );
+        (display, None)
+    };
     timings.insert("display".into(), json!(start.elapsed().as_secs_f64()));
     let missing = display
         .object_id
@@ -322,6 +346,9 @@ pub fn run_with_truth(
         &out,
         timings,
     );
+    if let Some(m) = &scene_model {
+        report["scene_model"] = m.report.clone();
+    }
     // The renders are the run's memory peak.
     report["peak_rss_bytes"] = json!(peak_rss_bytes());
     Ok(RunResult {
@@ -334,6 +361,7 @@ pub fn run_with_truth(
         crop,
         eye_used,
         detection,
+        holes: scene_model.map(|m| m.holes),
         report,
     })
 }
