@@ -39,6 +39,9 @@ pub struct Compare {
     /// Frontal camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
     #[arg(long = "frontal-width", value_parser = pixels)]
     frontal_width: Option<u32>,
+    /// Back camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
+    #[arg(long = "back-width", value_parser = pixels)]
+    back_width: Option<u32>,
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
@@ -58,6 +61,7 @@ impl Compare {
             width: self.render.width,
             height: self.render.height,
             frontal_width: self.frontal_width,
+            back_width: self.back_width,
             spp: self.render.spp,
             // A crop past the frontal view is shown black and counted, not an error: every
             // method gets its row.

@@ -3,6 +3,7 @@
 mod analyze;
 mod args;
 mod bench;
+mod bench_methods;
 mod compare;
 mod export;
 mod figures;

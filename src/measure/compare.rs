@@ -9,11 +9,12 @@ use crate::measure::maps::heat_color;
 use crate::measure::metrics::{MetricMaps, measure};
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
-use crate::render::settings::RenderSettings;
+use crate::render::settings::{RenderSettings, resized};
 use crate::render::views::View;
 use crate::system::depth_sensor::SensorKind;
 use crate::system::options::{Method, RunOptions, WorkingDistance};
 use crate::system::pipeline::{driver_camera, run_with_truth};
+use crate::system::scene_model::check_scene_model;
 use crate::util::color::encode_srgb8;
 use crate::util::progress::Progress;
 
@@ -105,6 +106,16 @@ pub fn compare(
         spp: base.spp,
         progress: false,
     };
+    // Every method's inputs are checked before anything is rendered.
+    for &candidate in candidates {
+        let options = candidate.options(base);
+        if options.method.models_the_scene() {
+            let mut scene = scene.clone();
+            scene.frontal = resized(scene.frontal, options.frontal_width, None)?;
+            check_scene_model(&scene, &options)
+                .map_err(|e| anyhow::anyhow!("{}: {e:#}", candidate.name()))?;
+        }
+    }
     let progress = Progress::new("compare", candidates.len() + 1, base.progress);
     let driver = driver_camera(scene, base)?;
     let (truth, _) = ctx.render(&driver, View::Truth.bit(), settings, "truth");

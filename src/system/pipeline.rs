@@ -23,7 +23,7 @@ use crate::system::display::{
 use crate::system::head::{FaceDetection, detect, eye_from_detection, gaussian};
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use crate::system::report::report;
-use crate::system::scene_model::scene_model_display;
+use crate::system::scene_model::{check_scene_model, scene_model_display};
 use crate::util::memory::peak_rss_bytes;
 
 /// Everything a run produces.
@@ -217,6 +217,10 @@ pub fn run_with_truth(
         || options.head_bias_cm.iter().any(|v| !v.is_finite())
     {
         bail!("head bias must be finite and jitter ≥ 0");
+    }
+    if options.method.models_the_scene() {
+        // Bad sensor flags and a scene without a road fail before anything is rendered.
+        check_scene_model(scene, options)?;
     }
     let driver = driver_camera(scene, options)?;
     let settings = RenderSettings {

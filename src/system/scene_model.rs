@@ -16,7 +16,7 @@ use crate::system::compensation::Crop;
 use crate::system::depth_search::{Found, search};
 use crate::system::depth_sensor::{DepthMap, SensorModel, sense};
 use crate::system::display::{Filter, MISSING_ID, sample};
-use crate::system::options::Method;
+use crate::system::options::{Method, RunOptions};
 pub use crate::system::scene_model_options::{Fill, SceneModelOptions};
 use crate::system::scene_plane::{ScenePlane, fit_plane, ground_plane};
 
@@ -26,6 +26,16 @@ impl Method {
     pub fn models_the_scene(self) -> bool {
         matches!(self, Method::Ground | Method::PlaneFit | Method::Depth)
     }
+}
+
+/// Checks the sensor options against the frontal camera, and that `ground` has a road.
+pub fn check_scene_model(scene: &Scene, options: &RunOptions) -> Result<()> {
+    if options.method == Method::Ground {
+        ground_plane(scene)?;
+    } else {
+        SensorModel::resolve(&options.scene_model.sensor, &scene.frontal)?;
+    }
+    Ok(())
 }
 
 /// The display image of a scene-model method, its holes and what it used.
