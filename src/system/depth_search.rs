@@ -64,7 +64,11 @@ pub fn search(map: &DepthMap, frontal: &Camera, eye: DVec3, on_display: DVec3) -
             _ => Found::Outside,
         };
     }
-    let start_depth = (-origin.z).max(NEAREST);
+    // Nothing is nearer than the nearest return: the walk starts there (for a street scene
+    // that skips most of the epipolar line's length, which lies at the nearest depths).
+    // (A hair nearer, so that the first step is in front of the nearest surface itself.)
+    let nearest_return = 0.999 / map.max_inverse_depth().max(1e-12) as f64;
+    let start_depth = (-origin.z).max(NEAREST).max(nearest_return);
     let start = origin + dir * ((start_depth - -origin.z) / rate);
     let (Some(near), Some(far)) = (camera.project_camera(start), camera.project_camera(dir)) else {
         return Found::Outside;
@@ -164,21 +168,14 @@ mod tests {
             noise_1m: 0.0,
             quantum_1m: 0.0,
         };
-        (
-            DepthMap {
-                camera,
-                inverse_depth,
-                model,
-            },
-            camera,
-        )
+        (DepthMap::new(camera, inverse_depth, model), camera)
     }
 
     #[test]
     fn a_ray_finds_the_wall_where_it_meets_it() {
         let (map, camera) = wall_with_square();
         let eye = DVec3::new(0.3, 0.1, 0.7);
-        let on_display = DVec3::new(-0.2, 0.05, 0.0);
+        let on_display = DVec3::new(0.1, 0.05, 0.0);
         let hit = eye + (on_display - eye) * ((5.0 + 0.7) / 0.7);
         let Found::Seen(p) = search(&map, &camera, eye, on_display) else {
             panic!("no hit");

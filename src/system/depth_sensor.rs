@@ -159,9 +159,26 @@ pub struct DepthMap {
     pub camera: Camera,
     pub inverse_depth: Vec<f32>,
     pub model: SensorModel,
+    /// The largest inverse depth of the image (its nearest return), 1/m; 0 with none.
+    max_inverse_depth: f32,
 }
 
 impl DepthMap {
+    pub fn new(camera: Camera, inverse_depth: Vec<f32>, model: SensorModel) -> Self {
+        let max_inverse_depth = inverse_depth.iter().copied().fold(0.0, f32::max);
+        Self {
+            camera,
+            inverse_depth,
+            model,
+            max_inverse_depth,
+        }
+    }
+
+    /// The inverse depth of the nearest return, 1/m (0 when there is none).
+    pub fn max_inverse_depth(&self) -> f32 {
+        self.max_inverse_depth
+    }
+
     /// Inverse depth of sensor pixel (x, y).
     pub fn at(&self, x: u32, y: u32) -> f32 {
         self.inverse_depth[(y * self.camera.width + x) as usize]
@@ -205,11 +222,7 @@ pub fn sense(
                 .map_or(0.0, |z| (1.0 / z) as f32)
         })
         .collect();
-    DepthMap {
-        camera,
-        inverse_depth,
-        model,
-    }
+    DepthMap::new(camera, inverse_depth, model)
 }
 
 #[cfg(test)]
