@@ -49,57 +49,35 @@ pub fn method_costs(ctx: &RenderContext, repeat: usize, quiet: bool) -> Result<s
             ModelPlane::Infinity,
             size,
         )?;
-        let model = |method: Method, kind: SensorKind| -> Result<()> {
+        // Each method by name; `None` is the planar crop and resample.
+        let jobs: [(&str, Option<(Method, SensorKind)>); 5] = [
+            ("planar", None),
+            ("ground", Some((Method::Ground, SensorKind::Ideal))),
+            ("plane-fit", Some((Method::PlaneFit, SensorKind::Ideal))),
+            ("depth-ideal", Some((Method::Depth, SensorKind::Ideal))),
+            ("depth-tof", Some((Method::Depth, SensorKind::Tof))),
+        ];
+        let run = |job: Option<(Method, SensorKind)>| -> Result<()> {
+            let Some((method, kind)) = job else {
+                resample(&frontal, &crop, size, Filter::Bilinear);
+                return Ok(());
+            };
             let mut options = SceneModelOptions::default();
             options.sensor.kind = kind;
-            scene_model_display(
-                &ctx,
-                scene,
-                eye,
-                &frontal,
-                &crop,
-                method,
-                &options,
-                Filter::Bilinear,
-                1,
-            )
-            .map(|_| ())
+            let filter = Filter::Bilinear;
+            scene_model_display(&ctx, scene, eye, &frontal, &crop, method, &options, filter, 1)
+                .map(|_| ())
         };
-        let jobs: [(&str, Box<dyn Fn() -> Result<()>>); 5] = [
-            (
-                "planar",
-                Box::new(|| {
-                    resample(&frontal, &crop, size, Filter::Bilinear);
-                    Ok(())
-                }),
-            ),
-            (
-                "ground",
-                Box::new(|| model(Method::Ground, SensorKind::Ideal)),
-            ),
-            (
-                "plane-fit",
-                Box::new(|| model(Method::PlaneFit, SensorKind::Ideal)),
-            ),
-            (
-                "depth-ideal",
-                Box::new(|| model(Method::Depth, SensorKind::Ideal)),
-            ),
-            (
-                "depth-tof",
-                Box::new(|| model(Method::Depth, SensorKind::Tof)),
-            ),
-        ];
         let mut at_size = serde_json::Map::new();
         for (name, job) in jobs {
-            if job().is_err() {
+            if run(job).is_err() {
                 // A scene without a road has no `ground`; the others need no more than it.
                 continue;
             }
             let mut ms: Vec<f64> = (0..repeat)
                 .map(|_| {
                     let start = Instant::now();
-                    let _ = job();
+                    let _ = run(job);
                     start.elapsed().as_secs_f64() * 1e3
                 })
                 .collect();

@@ -110,7 +110,7 @@ impl SensorModel {
             noise_1m: options.noise_1m.unwrap_or(noise),
             quantum_1m: options.quantum_1m.unwrap_or(quantum),
         };
-        if !(model.range_m > 0.0) {
+        if model.range_m.is_nan() || model.range_m <= 0.0 {
             bail!("--depth-range must be > 0 m, got {}", model.range_m);
         }
         if !(model.noise_1m >= 0.0 && model.noise_1m.is_finite()) {

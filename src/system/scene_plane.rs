@@ -175,7 +175,7 @@ fn least_squares(points: &[[f64; 3]], relative: bool) -> Option<[f64; 3]> {
     let m = glam::DMat3::from_cols_array_2d(&m).transpose();
     let det = m.determinant();
     let scale = m.x_axis.length() * m.y_axis.length() * m.z_axis.length();
-    if !(det.abs() > 1e-12 * scale) {
+    if det.is_nan() || det.abs() <= 1e-12 * scale {
         return None;
     }
     let x = m.inverse() * DVec3::from_array(r);
