@@ -16,6 +16,7 @@ use seethru::scene::world::view_bit;
 use seethru::system::depth_sensor::SensorKind;
 use seethru::system::options::{Method, RunOptions, WorkingDistance};
 use seethru::system::pipeline::{RunResult, run};
+use seethru::system::scene_model::Fill;
 
 /// A scene with an obstacle at the origin facing `facing`, a display of `size` metres at
 /// `resolution`, a 640×480 frontal camera and the given objects (material `tex`: the street
@@ -323,6 +324,53 @@ fn holes_of_a_sideways_eye_are_the_disoccluded_area() {
     // Without a fill the holes are blank; the seen pixels' metrics leave them out.
     assert_eq!(metrics["holes"]["filled"]["coverage"], 0.0);
     assert_eq!(metrics["holes"]["seen"]["coverage"], 1.0);
+    // The background fill shows the farther surface beside the silhouette — the wall (id 1),
+    // never the box (id 2) — in every hole; the seen pixels are unchanged.
+    let mut background = depth(SensorKind::Ideal);
+    background.scene_model.fill = Fill::Background;
+    let filled = run(&ctx, &background).unwrap();
+    let hole_pixels: Vec<usize> = (0..holes.len()).filter(|&i| holes[i]).collect();
+    assert!(
+        hole_pixels
+            .iter()
+            .all(|&i| filled.seethru.object_id[i] == 1)
+    );
+    assert!(
+        (0..holes.len())
+            .filter(|&i| maps.display[i] && !holes[i])
+            .all(|i| filled.seethru.position[i] == r.seethru.position[i])
+    );
+}
+
+#[test]
+fn depth_reprojection_is_the_same_for_any_thread_count() {
+    let ctx = with_eye(
+        wall_and_box([0.6, 0.5, 0.4], [-0.6, 0.0, -2.5]),
+        DVec3::new(0.2, 0.0, 0.7),
+        20.0,
+    );
+    let mut o = depth(SensorKind::Stereo);
+    o.scene_model.fill = Fill::Inpaint;
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| run(&ctx, &o).unwrap())
+    };
+    let (one, three) = (on(1), on(3));
+    assert!(one.display == three.display && one.holes == three.holes);
+    // And plane-fit's RANSAC with it.
+    let fit = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            run(&ctx, &options(Method::PlaneFit)).unwrap().report["scene_model"].clone()
+        })
+    };
+    assert_eq!(fit(1), fit(3));
 }
 
 #[test]

@@ -65,8 +65,10 @@ pub fn method_costs(ctx: &RenderContext, repeat: usize, quiet: bool) -> Result<s
             let mut options = SceneModelOptions::default();
             options.sensor.kind = kind;
             let filter = Filter::Bilinear;
-            scene_model_display(&ctx, scene, eye, &frontal, &crop, method, &options, filter, 1)
-                .map(|_| ())
+            scene_model_display(
+                &ctx, scene, eye, &frontal, &crop, method, &options, filter, 1,
+            )
+            .map(|_| ())
         };
         let mut at_size = serde_json::Map::new();
         for (name, job) in jobs {

@@ -64,7 +64,8 @@ pub struct SensorModel {
     /// Sensor resolution, pixels.
     pub width: u32,
     pub height: u32,
-    /// Farthest return, metres (∞: unlimited).
+    /// Farthest return, metres (∞: unlimited, "inf" in JSON).
+    #[serde(serialize_with = "crate::util::json::finite_or_inf")]
     pub range_m: f64,
     /// σ at 1 m, metres.
     pub noise_1m: f64,
