@@ -654,7 +654,13 @@ fn compare_writes_one_row_and_one_strip_per_method_as_run_measures_them() {
         metrics["display"]["misregistration_arcmin"]["mean"]
     );
     assert_eq!(rows[2]["holes_fraction"], metrics["holes"]["fraction"]);
-    assert!(run_out.join("holes.png").exists());
+    // `measure` recomputes the same holes from the run directory's holes.png.
+    let (ok, _, err) = common::seethru(&["measure", run_out.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let again: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run_out.join("metrics.json")).unwrap())
+            .unwrap();
+    assert_eq!(again["holes"], metrics["holes"]);
     // Per-pixel depth beats the d2 → ∞ plane on a scene of a road and a ball 10 m away.
     let mean = |k: usize| rows[k]["misregistration_mean_arcmin"].as_f64().unwrap();
     assert!(mean(2) < mean(0), "{} vs {}", mean(2), mean(0));

@@ -125,3 +125,23 @@ pub fn attach_holes(
     metrics["holes"] = hole_metrics(&mask, maps, &result.truth, &result.seethru, fill);
     Some(mask)
 }
+
+/// The driver-view hole mask of a run directory's `holes.png` (magenta pixels), if it has
+/// one, for `seethru measure`; it must be `width`×`height`.
+pub fn read_hole_mask(path: &Path, width: u32, height: u32) -> Result<Option<Vec<bool>>> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let image = image::open(path)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?
+        .to_rgb8();
+    if image.dimensions() != (width, height) {
+        anyhow::bail!(
+            "{}: {}×{} pixels, the run's views are {width}×{height}",
+            path.display(),
+            image.width(),
+            image.height()
+        );
+    }
+    Ok(Some(image.pixels().map(|p| p.0 == [255, 0, 255]).collect()))
+}
