@@ -433,9 +433,13 @@ fn the_depth_error_formula_matches_ray_casting() {
 
 #[test]
 fn depth_noise_grows_the_misregistration_as_the_formula_predicts() {
-    // A wall 6 m behind a 1 m × 0.6 m display of 1000 × 600 pixels (so that the resampling
-    // quantum is small beside the noise's effect); the sensor at the frontal camera's
-    // resolution, no quantisation, a range past the wall. For each seen display pixel the
+    // A wall 6 m behind a 1 m × 0.6 m display of 1600 × 960 pixels and a 1920 × 1440
+    // frontal camera (so that the resampling quantum is small beside the noise's effect); no
+    // quantisation, a range past the wall. The sensor is 96 px wide: each line of sight then
+    // crosses the noisy surface inside one sensor tile, and reads one depth — the closed
+    // form's premise. (A sensor of 960 px puts several tiles within the noise band along a
+    // ray, which stops at the first reading nearer than itself: a first-passage bias the
+    // one-reading form does not model, +8 to +13 % here.) For each seen display pixel the
     // closed form gives the mean angle for its ray's crossing c of the camera's plane; the
     // mean over the seen pixels must match the pipeline's within 10 %, for time-of-flight
     // noise (σ/Z = σ₁) at two σ₁ and for stereo noise (σ/Z = σ₁·Z).
