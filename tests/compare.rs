@@ -53,6 +53,19 @@ fn bad_method_inputs_give_one_line_each() {
             "error: --depth-noise does not apply to --depth-sensor ideal".into(),
         ),
         (
+            vec![
+                "run",
+                "scenes/das.toml",
+                "--out",
+                out,
+                "--method",
+                "plane-fit",
+                "--display",
+                "ideal",
+            ],
+            "error: --display ideal works with --method none or planar".into(),
+        ),
+        (
             [vec!["run", wall, "--out", out, "--method", "ground"], small.to_vec()].concat(),
             format!("error: --method ground: the scene {wall} has no ground plane"),
         ),

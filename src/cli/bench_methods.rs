@@ -11,8 +11,8 @@ use seethru::render::views::View;
 use seethru::system::compensation::{ModelPlane, compute_crop};
 use seethru::system::depth_sensor::SensorKind;
 use seethru::system::display::{Filter, resample};
-use seethru::system::options::Method;
-use seethru::system::scene_model::{SceneModelOptions, scene_model_display};
+use seethru::system::options::{Method, RunOptions};
+use seethru::system::scene_model::scene_model_display;
 use serde_json::json;
 
 /// Frontal resolutions the methods are timed at.
@@ -62,13 +62,12 @@ pub fn method_costs(ctx: &RenderContext, repeat: usize, quiet: bool) -> Result<s
                 resample(&frontal, &crop, size, Filter::Bilinear);
                 return Ok(());
             };
-            let mut options = SceneModelOptions::default();
-            options.sensor.kind = kind;
-            let filter = Filter::Bilinear;
-            scene_model_display(
-                &ctx, scene, eye, &frontal, &crop, method, &options, filter, 1,
-            )
-            .map(|_| ())
+            let mut options = RunOptions {
+                method,
+                ..RunOptions::default()
+            };
+            options.scene_model.sensor.kind = kind;
+            scene_model_display(&ctx, scene, eye, &frontal, &crop, &options).map(|_| ())
         };
         let mut at_size = serde_json::Map::new();
         for (name, job) in jobs {

@@ -219,7 +219,8 @@ pub fn run_with_truth(
         bail!("head bias must be finite and jitter ≥ 0");
     }
     if options.method.models_the_scene() {
-        // Bad sensor flags and a scene without a road fail before anything is rendered.
+        // Bad sensor flags, an ideal display and a scene without a road fail before anything
+        // is rendered.
         check_scene_model(scene, options)?;
     }
     let driver = driver_camera(scene, options)?;
@@ -264,22 +265,7 @@ pub fn run_with_truth(
 
     let start = Instant::now();
     let (display, scene_model) = if options.method.models_the_scene() {
-        if options.display == DisplayModel::Ideal {
-            bail!(
-                "--display ideal works with --method none or planar (a crop); ground, plane-fit and depth model the physical display's pixels"
-            );
-        }
-        let m = scene_model_display(
-            ctx,
-            scene,
-            eye_used,
-            &frontal,
-            &crop,
-            options.method,
-            &options.scene_model,
-            options.filter,
-            options.seed,
-        )?;
+        let m = scene_model_display(ctx, scene, eye_used, &frontal, &crop, options)?;
         (m.display.clone(), Some(m))
     } else {
         let display = resample(

@@ -15,7 +15,7 @@ use crate::scene::{Obstacle, Scene};
 use crate::system::compensation::Crop;
 use crate::system::depth_search::{Found, search};
 use crate::system::depth_sensor::{DepthMap, SensorModel, sense};
-use crate::system::display::{Filter, MISSING_ID, sample};
+use crate::system::display::{DisplayModel, MISSING_ID, sample};
 use crate::system::options::{Method, RunOptions};
 pub use crate::system::scene_model_options::{Fill, SceneModelOptions};
 use crate::system::scene_plane::{ScenePlane, fit_plane, ground_plane};
@@ -30,6 +30,11 @@ impl Method {
 
 /// Checks the sensor options against the frontal camera, and that `ground` has a road.
 pub fn check_scene_model(scene: &Scene, options: &RunOptions) -> Result<()> {
+    if options.display == DisplayModel::Ideal {
+        bail!(
+            "--display ideal works with --method none or planar (a crop); ground, plane-fit and depth model the physical display's pixels"
+        );
+    }
     if options.method == Method::Ground {
         ground_plane(scene)?;
     } else {
@@ -64,20 +69,18 @@ fn blank() -> Pixel {
     }
 }
 
-/// The display image for `method` (one of [`Method::models_the_scene`]) at the eye `eye`;
-/// `crop` is the d2 → ∞ crop (its region is where the plane is fitted).
-#[allow(clippy::too_many_arguments)]
+/// The display image for `run.method` (one of [`Method::models_the_scene`]) at the eye
+/// `eye`; `crop` is the d2 → ∞ crop (its region is where the plane is fitted). The sensor,
+/// fill, filter and seed are the run's.
 pub fn scene_model_display(
     ctx: &RenderContext,
     scene: &Scene,
     eye: DVec3,
     frontal: &Frame,
     crop: &Crop,
-    method: Method,
-    options: &SceneModelOptions,
-    filter: Filter,
-    seed: u32,
+    run: &RunOptions,
 ) -> Result<SceneModelDisplay> {
+    let (method, options, filter, seed) = (run.method, &run.scene_model, run.filter, run.seed);
     let camera = &scene.frontal;
     let sensor = || -> Result<DepthMap> {
         let model = SensorModel::resolve(&options.sensor, camera)?;
