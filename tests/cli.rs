@@ -222,7 +222,7 @@ fn run_writes_six_views_run_json_and_metrics_and_measure_recomputes_them() {
 /// Every option that takes a value, per command, read from the command's own `--help`, so
 /// that a flag added later is walked too: `(command words, flag, value name)`.
 fn options_with_values() -> Vec<(Vec<&'static str>, String, String)> {
-    let commands: [&[&str]; 11] = [
+    let commands: [&[&str]; 12] = [
         &["render"],
         &["run"],
         &["ratio", "occlusion"],
@@ -234,6 +234,7 @@ fn options_with_values() -> Vec<(Vec<&'static str>, String, String)> {
         &["figures"],
         &["analyze"],
         &["bench"],
+        &["compare"],
     ];
     let mut found = Vec::new();
     for words in commands {

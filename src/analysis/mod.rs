@@ -4,6 +4,7 @@
 //! and figures, so they sit below all three.
 
 pub mod binocular;
+pub mod depth_error;
 pub mod examples;
 pub mod paper;
 pub mod perceived;

@@ -239,6 +239,7 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         ));
         frames.insert(view.name().into(), json!({"ms": spread.json()}));
     }
+    let methods = crate::cli::bench_methods::method_costs(&ctx, options.repeat, options.json)?;
     let peak = peak_rss_bytes();
     say(format!(
         "peak RSS     {}",
@@ -257,6 +258,7 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         "height": options.height,
         "rays": rays_json,
         "frame": frames,
+        "methods": methods,
         "peak_rss_bytes": peak,
     });
     println!("{report}");

@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use seethru::io::run_dir::{read_measured_frames, read_run_json};
+use seethru::measure::holes::{hole_metrics, read_hole_mask};
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
 use seethru::render::integrator::RenderContext;
@@ -40,7 +41,14 @@ fn measure_command(dir: &Path, band: u32) -> Result<serde_json::Value> {
     let eye = record
         .view_eye
         .map_or(ctx.scene.eye(), glam::DVec3::from_array);
-    let (maps, metrics) = measure(&ctx, &ctx.scene, eye, [&truth, &seethru, &occluded], band);
+    let (maps, mut metrics) = measure(&ctx, &ctx.scene, eye, [&truth, &seethru, &occluded], band);
+    // A depth run's holes, as its holes.png has them.
+    if let Some(holes) = read_hole_mask(&dir.join("holes.png"), truth.width, truth.height)? {
+        let run: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("run.json"))?)?;
+        let fill = run["scene_model"]["holes"]["fill"].clone();
+        metrics["holes"] = hole_metrics(&holes, &maps, &truth, &seethru, fill);
+    }
     write_metrics(dir, &maps, &truth, &metrics)?;
     Ok(metrics)
 }

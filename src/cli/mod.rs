@@ -3,6 +3,8 @@
 mod analyze;
 mod args;
 mod bench;
+mod bench_methods;
+mod compare;
 mod export;
 mod figures;
 mod measure;
@@ -11,6 +13,7 @@ mod render;
 mod reproduce;
 mod run;
 mod run_eyes;
+mod scene_model_args;
 mod sweep;
 
 use anyhow::Result;
@@ -56,6 +59,9 @@ pub enum Command {
     Figures(figures::Figures),
     /// The paper's numerical claims beside seethru's values; every closed form at a parameter set.
     Analyze(analyze::Analyze),
+    /// Compensation methods side by side on one scene: one table (Markdown, JSON, HTML) of
+    /// misregistration, coverage, holes, image metrics and cost, and one image strip each.
+    Compare(compare::Compare),
     /// Benchmark: BVH build time, rays per second, frame times; ends with one JSON line.
     Bench(bench::Bench),
 }
@@ -99,6 +105,7 @@ impl Command {
             Command::Figures(c) => c.run(),
             Command::Analyze(c) => c.run(),
             Command::Bench(c) => c.run(),
+            Command::Compare(c) => c.run(),
         }
     }
 }

@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 use rayon::prelude::*;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_frame;
+use seethru::measure::holes::{attach_holes, write_hole_mask};
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
 use seethru::render::integrator::RenderContext;
@@ -22,6 +23,7 @@ use crate::cli::args::{
     RenderArgs, band, head_bias_cm, integer, pixels, positive, real, with_threads,
 };
 use crate::cli::run_eyes::EyesFlag;
+use crate::cli::scene_model_args::SceneModelArgs;
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -35,7 +37,9 @@ pub struct Run {
     /// the compensation's own copy of the cameras.
     #[arg(long, value_name = "FILE")]
     calibration: Option<PathBuf>,
-    /// none: the whole frontal image in the display; planar: the paper's compensation.
+    /// none: the whole frontal image in the display; planar: the paper's compensation;
+    /// ground: the road plane; plane-fit: a plane fitted to the depth sensor's points; depth:
+    /// per-pixel reprojection with the depth sensor's depth.
     #[arg(long, value_enum, default_value_t = Method::Planar)]
     method: Method,
     /// Working distance of the planar model: inf, auto (median frontal depth behind the
@@ -86,6 +90,9 @@ pub struct Run {
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
+    /// The depth sensor and hole filling of ground, plane-fit and depth.
+    #[command(flatten)]
+    scene_model: SceneModelArgs,
     /// Sizes (width and height: the driver views truth, occluded, seethru), samples, threads.
     #[command(flatten)]
     render: RenderArgs,
@@ -118,6 +125,7 @@ impl Run {
                 target: self.target_eye,
                 ipd: self.ipd,
             },
+            scene_model: self.scene_model.options(),
             progress: true,
         };
         let both = self.eyes == EyesFlag::Both;
@@ -178,7 +186,7 @@ fn write_run(
     ];
     // Encoding PNGs and EXRs is mostly single-threaded work: the six views are written side
     // by side, and beside the metrics. The files are the same whatever the order.
-    let (written, (maps, metrics)) = rayon::join(
+    let (written, (maps, mut metrics)) = rayon::join(
         || {
             views
                 .par_iter()
@@ -192,6 +200,16 @@ fn write_run(
         },
     );
     written?;
+    let holes = attach_holes(
+        &mut metrics,
+        &maps,
+        &result,
+        &ctx.scene.obstacle,
+        options.scene_model.fill,
+    );
+    if let Some(holes) = &holes {
+        write_hole_mask(&out.join("holes.png"), &maps, holes)?;
+    }
     write_metrics(out, &maps, &result.truth, &metrics)?;
     // Last: a directory with run.json holds a finished run.
     write_text(

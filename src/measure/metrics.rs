@@ -34,10 +34,13 @@ pub struct MetricMaps {
     pub display: Vec<bool>,
     /// Display pixels that show nothing (their crop point is outside the frontal image).
     pub blank: Vec<bool>,
+    /// SSIM and FLIP per pixel (NaN outside the display), for statistics over parts of it.
+    pub ssim: Vec<f64>,
+    pub flip: Vec<f64>,
 }
 
 /// Summary statistics of a set of values.
-fn stats(values: &mut [f64]) -> serde_json::Value {
+pub fn stats(values: &mut [f64]) -> serde_json::Value {
     if values.is_empty() {
         return json!({"count": 0});
     }
@@ -162,7 +165,7 @@ fn masked_flip_map(
 }
 
 /// PSNR (dB) of 8-bit sRGB colours over the pixels of `mask`.
-fn psnr(a: &[[u8; 3]], b: &[[u8; 3]], mask: &[bool]) -> f64 {
+pub fn psnr(a: &[[u8; 3]], b: &[[u8; 3]], mask: &[bool]) -> f64 {
     let (mut sum, mut n) = (0.0, 0usize);
     for ((x, y), _) in a.iter().zip(b).zip(mask).filter(|(_, m)| **m) {
         for c in 0..3 {
@@ -385,6 +388,8 @@ pub fn measure(
             missing,
             display,
             blank,
+            ssim,
+            flip,
         },
         json,
     )

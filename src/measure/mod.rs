@@ -2,6 +2,8 @@
 //! the observed p_cam/p_user of the paper's setups, and sweeps over parameters.
 
 pub mod binocular;
+pub mod compare;
+pub mod holes;
 pub mod maps;
 pub mod metrics;
 pub mod ratio;

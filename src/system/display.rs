@@ -55,7 +55,9 @@ fn resample_with(
     Frame::from_pixels(w, h, &pixels)
 }
 
-fn sample(frame: &Frame, p: DVec2, filter: Filter) -> Pixel {
+/// One display pixel's content: the frontal frame at frontal point `p` (colour by `filter`,
+/// the other AOVs from the nearest pixel); [`MISSING_ID`] outside the image.
+pub fn sample(frame: &Frame, p: DVec2, filter: Filter) -> Pixel {
     let (w, h) = (frame.width as f64, frame.height as f64);
     if !(p.x >= 0.0 && p.y >= 0.0 && p.x < w && p.y < h) {
         return Pixel {

@@ -58,9 +58,16 @@ pub fn run_estimate(scene: &Scene, options: &RunOptions) -> Result<MemoryEstimat
     let display = dw as u64 * dh as u64;
     let frames = 3 * pixels(&driver) + pixels(&frontal) + pixels(&back) + display;
     let largest = pixels(&driver).max(pixels(&frontal));
+    // A depth sensor's frame and inverse-depth image, at most at the frontal resolution.
+    let sensor = if options.method.models_the_scene() {
+        pixels(&frontal) * (FRAME_BYTES_PER_PIXEL + 4)
+    } else {
+        0
+    };
     let bytes = frames * FRAME_BYTES_PER_PIXEL
         + 2 * largest * EXR_BYTES_PER_PIXEL
-        + pixels(&driver) * METRICS_BYTES_PER_PIXEL;
+        + pixels(&driver) * METRICS_BYTES_PER_PIXEL
+        + sensor;
     Ok(MemoryEstimate {
         bytes,
         what: format!(

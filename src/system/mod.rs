@@ -2,6 +2,8 @@
 //! compensation, the display, and the pipeline that runs them on rendered frames.
 
 pub mod compensation;
+pub mod depth_search;
+pub mod depth_sensor;
 pub mod display;
 pub mod eyes;
 pub mod frontal_map;
@@ -10,3 +12,6 @@ pub mod memory;
 pub mod options;
 pub mod pipeline;
 pub mod report;
+pub mod scene_model;
+pub mod scene_model_options;
+pub mod scene_plane;

@@ -4,6 +4,7 @@
 use crate::scene::limits::MAX_COORDINATE;
 use crate::system::display::{DisplayModel, Filter};
 use crate::system::eyes::Eyes;
+use crate::system::scene_model_options::SceneModelOptions;
 
 /// How the display image is made.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
@@ -13,6 +14,13 @@ pub enum Method {
     None,
     /// The paper's planar compensation at working distance `d2`.
     Planar,
+    /// The known road plane (d2 → ∞ above the horizon).
+    Ground,
+    /// A plane fitted to the depth sensor's points where the display is, tilted freely.
+    #[serde(rename = "plane-fit")]
+    PlaneFit,
+    /// Per-pixel reprojection with the depth sensor's depth map.
+    Depth,
 }
 
 /// The working distance of the planar model.
@@ -90,6 +98,8 @@ pub struct RunOptions {
     pub display: DisplayModel,
     /// Which eye looks and which the compensation serves (system/eyes.rs).
     pub eyes: Eyes,
+    /// The depth sensor and hole filling of `ground`, `plane-fit` and `depth`.
+    pub scene_model: SceneModelOptions,
     pub progress: bool,
 }
 
@@ -112,6 +122,7 @@ impl Default for RunOptions {
             filter: Filter::Bilinear,
             display: DisplayModel::Pixels,
             eyes: Eyes::default(),
+            scene_model: SceneModelOptions::default(),
             progress: false,
         }
     }

@@ -24,6 +24,7 @@ use crate::system::frontal_map::FrontalMap;
 use crate::system::head::{FaceDetection, detect, eye_from_detection, gaussian};
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use crate::system::report::report;
+use crate::system::scene_model::{check_scene_model, scene_model_display};
 use crate::util::memory::peak_rss_bytes;
 
 /// Everything a run produces.
@@ -38,6 +39,8 @@ pub struct RunResult {
     /// The eye the compensation used, world frame.
     pub eye_used: DVec3,
     pub detection: Option<FaceDetection>,
+    /// Display pixels (row-major) that are disocclusion holes: `--method depth` only.
+    pub holes: Option<Vec<bool>>,
     /// `run.json`.
     pub report: serde_json::Value,
 }
@@ -234,6 +237,11 @@ pub fn run_with_truth(
         bail!("head bias must be finite and jitter ≥ 0");
     }
     options.eyes.check().map_err(anyhow::Error::msg)?;
+    if options.method.models_the_scene() {
+        // Bad sensor flags, an ideal display and a scene without a road fail before anything
+        // is rendered.
+        check_scene_model(scene, options)?;
+    }
     let driver = driver_camera(scene, options)?;
     let settings = RenderSettings {
         spp: options.spp,
@@ -284,7 +292,12 @@ pub fn run_with_truth(
     }
 
     let start = Instant::now();
-    let display = resample_through(&frontal, &map, options.filter);
+    let (display, scene_model) = if options.method.models_the_scene() {
+        let m = scene_model_display(ctx, scene, eye_used, &frontal, &crop, options)?;
+        (m.display.clone(), Some(m))
+    } else {
+        (resample_through(&frontal, &map, options.filter), None)
+    };
     timings.insert("display".into(), json!(start.elapsed().as_secs_f64()));
     let missing = display
         .object_id
@@ -346,6 +359,9 @@ pub fn run_with_truth(
         &out,
         timings,
     );
+    if let Some(m) = &scene_model {
+        report["scene_model"] = m.report.clone();
+    }
     // The renders are the run's memory peak.
     report["peak_rss_bytes"] = json!(peak_rss_bytes());
     report["eyes"] = json!({"options": options.eyes, "view_world_m": driver.position().to_array()});
@@ -360,6 +376,7 @@ pub fn run_with_truth(
         crop,
         eye_used,
         detection,
+        holes: scene_model.map(|m| m.holes),
         report,
     })
 }

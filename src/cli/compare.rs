@@ -1,0 +1,125 @@
+//! `seethru compare`: compensation methods side by side on one scene — one table (Markdown,
+//! JSON, HTML) and one image strip per method.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use seethru::io::atomic::write_text;
+use seethru::io::frame_files::write_png;
+use seethru::measure::compare::{Candidate, compare, html_page, markdown_table};
+use seethru::render::integrator::RenderContext;
+use seethru::scene::Scene;
+use seethru::system::memory::{check_memory, run_estimate};
+use seethru::system::options::{HeadSource, Outside, RunOptions};
+
+use crate::cli::args::{RenderArgs, band, integer, pixels, with_threads};
+use crate::cli::scene_model_args::SceneModelArgs;
+
+#[derive(clap::Args)]
+pub struct Compare {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    /// Methods, comma-separated, in the table's order.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "planar-inf,planar-auto,plane-fit,ground,depth-ideal,depth-tof"
+    )]
+    methods: Vec<Candidate>,
+    /// Output directory: compare.md, compare.json, compare.html and strip_<method>.png.
+    #[arg(long, default_value = "compare")]
+    out: PathBuf,
+    /// oracle: the true eye; estimated: face detection on the back camera's image.
+    #[arg(long, value_enum, default_value_t = HeadSource::Oracle)]
+    head: HeadSource,
+    /// Seed of the depth noise and the plane fit, an integer in [0, 4294967295].
+    #[arg(long, default_value_t = 1, value_parser = integer::<u32>(0, u32::MAX as u64))]
+    seed: u32,
+    /// Frontal camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
+    #[arg(long = "frontal-width", value_parser = pixels)]
+    frontal_width: Option<u32>,
+    /// Back camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
+    #[arg(long = "back-width", value_parser = pixels)]
+    back_width: Option<u32>,
+    /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
+    #[arg(long, default_value_t = 5, value_parser = band)]
+    band: u32,
+    /// The depth sensor (its kind is the method's for depth-tof and depth-stereo) and fill.
+    #[command(flatten)]
+    scene_model: SceneModelArgs,
+    /// Sizes of the driver views, samples, threads.
+    #[command(flatten)]
+    render: RenderArgs,
+}
+
+impl Compare {
+    pub fn run(self) -> Result<()> {
+        let base = RunOptions {
+            head: self.head,
+            seed: self.seed,
+            width: self.render.width,
+            height: self.render.height,
+            frontal_width: self.frontal_width,
+            back_width: self.back_width,
+            spp: self.render.spp,
+            // A crop past the frontal view is shown black and counted, not an error: every
+            // method gets its row.
+            outside: Outside::Black,
+            scene_model: self.scene_model.options(),
+            progress: true,
+            ..RunOptions::default()
+        };
+        with_threads(self.render.threads, || self.write(&base))?
+    }
+
+    fn write(&self, base: &RunOptions) -> Result<()> {
+        let scene = Scene::load(&self.scene)?;
+        check_memory(&run_estimate(&scene, base)?, self.render.max_memory)?;
+        let ctx = RenderContext::new(scene)?;
+        let rows = compare(&ctx, &self.methods, base, self.band)?;
+        let out: &Path = &self.out;
+        std::fs::create_dir_all(out)
+            .with_context(|| format!("cannot create output directory {}", out.display()))?;
+        let mut strips = Vec::new();
+        for r in &rows {
+            let file = format!("strip_{}.png", r.name);
+            let (w, h, rgb) = r.strip.clone();
+            write_png(&out.join(&file), w, h, rgb)?;
+            strips.push((r.name, file));
+        }
+        let table = markdown_table(&rows);
+        let title = format!("Compensation methods compared on {}", self.scene.display());
+        let md = format!(
+            "# {title}\n\nMisregistration in arc-minutes at the true eye over the display (mean, p95, and the border band of {} display pixels); coverage: fraction of display pixels that show the scene; holes: disocclusions of the depth methods (fill: {:?}); ms/frame: the method's own work (sensor, fit or search, resampling).\n\n{table}\n{}",
+            self.band,
+            base.scene_model.fill,
+            strips
+                .iter()
+                .map(|(name, file)| format!("## {name}\n\n![{name}]({file})\n\n"))
+                .collect::<String>()
+        );
+        write_text(&out.join("compare.md"), &md)?;
+        write_text(
+            &out.join("compare.html"),
+            &html_page(&title, &table, &strips),
+        )?;
+        let json = serde_json::json!({
+            "scene": self.scene.display().to_string(),
+            "rows": rows.iter().map(|r| r.row.clone()).collect::<Vec<_>>(),
+        });
+        write_text(
+            &out.join("compare.json"),
+            &serde_json::to_string_pretty(&json)?,
+        )?;
+        seethru::util::progress::summary(format!(
+            "compared {} methods; compare.md, compare.json, compare.html and the strips in {}",
+            rows.len(),
+            out.display()
+        ));
+        if !seethru::util::progress::is_quiet() {
+            print!("{table}");
+        }
+        Ok(())
+    }
+}

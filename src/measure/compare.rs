@@ -1,0 +1,262 @@
+//! Compensation methods side by side on one scene: the same eye, the same truth and the same
+//! metrics for each, as one table (Markdown, JSON, HTML) and one image strip per method.
+
+use anyhow::Result;
+use serde_json::json;
+
+use crate::measure::holes::attach_holes;
+use crate::measure::maps::heat_color;
+use crate::measure::metrics::{MetricMaps, measure};
+use crate::render::frame::Frame;
+use crate::render::integrator::RenderContext;
+use crate::render::settings::{RenderSettings, resized};
+use crate::render::views::View;
+use crate::system::depth_sensor::SensorKind;
+use crate::system::options::{Method, RunOptions, WorkingDistance};
+use crate::system::pipeline::{driver_camera, run_with_truth};
+use crate::system::scene_model::check_scene_model;
+use crate::util::color::encode_srgb8;
+use crate::util::progress::Progress;
+
+/// A method as `compare` names it: the method with its working distance or depth sensor.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Candidate {
+    /// The whole frontal image scaled into the display.
+    None,
+    /// The paper's planar model, d2 → ∞.
+    PlanarInf,
+    /// The planar model at the median frontal depth where the display is.
+    PlanarAuto,
+    /// A plane fitted to the ideal depth sensor's points.
+    PlaneFit,
+    /// The road plane, d2 → ∞ above the horizon.
+    Ground,
+    /// Per-pixel reprojection with the frontal render's exact depth.
+    DepthIdeal,
+    /// Per-pixel reprojection with the time-of-flight sensor's depth.
+    DepthTof,
+    /// Per-pixel reprojection with the stereo sensor's depth.
+    DepthStereo,
+}
+
+impl Candidate {
+    pub fn name(self) -> &'static str {
+        match self {
+            Candidate::None => "none",
+            Candidate::PlanarInf => "planar-inf",
+            Candidate::PlanarAuto => "planar-auto",
+            Candidate::PlaneFit => "plane-fit",
+            Candidate::Ground => "ground",
+            Candidate::DepthIdeal => "depth-ideal",
+            Candidate::DepthTof => "depth-tof",
+            Candidate::DepthStereo => "depth-stereo",
+        }
+    }
+
+    /// `base` with this method (and its working distance or sensor kind).
+    pub fn options(self, base: &RunOptions) -> RunOptions {
+        let mut o = base.clone();
+        let (method, d2, sensor) = match self {
+            Candidate::None => (Method::None, WorkingDistance::Infinity, None),
+            Candidate::PlanarInf => (Method::Planar, WorkingDistance::Infinity, None),
+            Candidate::PlanarAuto => (Method::Planar, WorkingDistance::Auto, None),
+            Candidate::PlaneFit => (Method::PlaneFit, WorkingDistance::Infinity, None),
+            Candidate::Ground => (Method::Ground, WorkingDistance::Infinity, None),
+            Candidate::DepthIdeal => (Method::Depth, WorkingDistance::Infinity, None),
+            Candidate::DepthTof => (
+                Method::Depth,
+                WorkingDistance::Infinity,
+                Some(SensorKind::Tof),
+            ),
+            Candidate::DepthStereo => (
+                Method::Depth,
+                WorkingDistance::Infinity,
+                Some(SensorKind::Stereo),
+            ),
+        };
+        o.method = method;
+        o.d2 = d2;
+        if let Some(kind) = sensor {
+            o.scene_model.sensor.kind = kind;
+        }
+        o
+    }
+}
+
+/// One method's row and its strip.
+pub struct Compared {
+    pub name: &'static str,
+    /// The row: metrics and cost (see [`compare`]).
+    pub row: serde_json::Value,
+    /// The strip: truth | seethru | misregistration | holes over the display's bounding box,
+    /// RGB8, width × height.
+    pub strip: (u32, u32, Vec<u8>),
+}
+
+/// Runs every candidate at `base` on one scene (the truth rendered once, the same for all)
+/// and measures each with a border band of `band` display pixels.
+pub fn compare(
+    ctx: &RenderContext,
+    candidates: &[Candidate],
+    base: &RunOptions,
+    band: u32,
+) -> Result<Vec<Compared>> {
+    let scene = &ctx.scene;
+    let settings = RenderSettings {
+        spp: base.spp,
+        progress: false,
+    };
+    // Every method's inputs are checked before anything is rendered.
+    for &candidate in candidates {
+        let options = candidate.options(base);
+        if options.method.models_the_scene() {
+            let mut scene = scene.clone();
+            scene.frontal = resized(scene.frontal, options.frontal_width, None)?;
+            check_scene_model(&scene, &options)
+                .map_err(|e| anyhow::anyhow!("{}: {e:#}", candidate.name()))?;
+        }
+    }
+    let progress = Progress::new("compare", candidates.len() + 1, base.progress);
+    let driver = driver_camera(scene, base)?;
+    let (truth, _) = ctx.render(&driver, View::Truth.bit(), settings, "truth");
+    progress.advance(1);
+    let mut out = Vec::new();
+    for &candidate in candidates {
+        let mut options = candidate.options(base);
+        options.progress = false;
+        let result = run_with_truth(ctx, &options, Some(&truth))
+            .map_err(|e| anyhow::anyhow!("{}: {e:#}", candidate.name()))?;
+        let frames = [&result.truth, &result.seethru, &result.occluded];
+        let (maps, mut metrics) = measure(ctx, scene, scene.eye(), frames, band);
+        let holes = attach_holes(
+            &mut metrics,
+            &maps,
+            &result,
+            &scene.obstacle,
+            options.scene_model.fill,
+        );
+        let display = &metrics["display"];
+        let misregistration = &display["misregistration_arcmin"];
+        let row = json!({
+            "method": candidate.name(),
+            "misregistration_mean_arcmin": misregistration["mean"],
+            "misregistration_p95_arcmin": misregistration["p95"],
+            "border_mean_arcmin": metrics["border"]["misregistration_arcmin"]["mean"],
+            "coverage": metrics["coverage"],
+            "holes_fraction": metrics.get("holes").map_or(json!(0.0), |h| h["fraction"].clone()),
+            "psnr_db": display["psnr_db"],
+            "ssim": display["ssim"],
+            "flip_mean": display["flip_mean"],
+            "ms_per_frame": result.report["timings_s"]["display"].as_f64().map(|s| s * 1e3),
+            "d2_m": result.report["d2_m"],
+            "scene_model": result.report.get("scene_model"),
+            "metrics": metrics,
+        });
+        let strip = strip(&maps, &result.truth, &result.seethru, holes.as_deref());
+        out.push(Compared {
+            name: candidate.name(),
+            row,
+            strip,
+        });
+        progress.advance(1);
+    }
+    progress.finish();
+    Ok(out)
+}
+
+/// Truth, seethru, the misregistration heatmap (0 to `HEAT_TOP` arc-minutes, one scale for
+/// every method) and the holes, side by side, each cut to the display's bounding box.
+fn strip(
+    maps: &MetricMaps,
+    truth: &Frame,
+    seethru: &Frame,
+    holes: Option<&[bool]>,
+) -> (u32, u32, Vec<u8>) {
+    const HEAT_TOP: f32 = 60.0;
+    const GAP: usize = 4;
+    let w = maps.width as usize;
+    let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+    for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
+        let (x, y) = (i % w, i / w);
+        (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1));
+    }
+    if x0 >= x1 {
+        (x0, y0, x1, y1) = (0, 0, w, maps.height as usize);
+    }
+    let (bw, bh) = (x1 - x0, y1 - y0);
+    let panels = 4;
+    let sw = panels * bw + (panels - 1) * GAP;
+    let mut rgb = vec![255u8; sw * bh * 3];
+    for y in 0..bh {
+        for x in 0..bw {
+            let i = (y0 + y) * w + x0 + x;
+            let heat = if maps.blank[i] {
+                [0, 0, 0]
+            } else if maps.misregistration[i].is_finite() {
+                heat_color(maps.misregistration[i] / HEAT_TOP)
+            } else {
+                [40, 40, 40]
+            };
+            let hole = match holes {
+                Some(h) if h[i] => [255, 0, 255],
+                _ if maps.display[i] => [60, 60, 60],
+                _ => [0, 0, 0],
+            };
+            let colours = [
+                encode_srgb8(truth.color[i]),
+                encode_srgb8(seethru.color[i]),
+                heat,
+                hole,
+            ];
+            for (k, c) in colours.iter().enumerate() {
+                let o = (y * sw + k * (bw + GAP) + x) * 3;
+                rgb[o..o + 3].copy_from_slice(c);
+            }
+        }
+    }
+    (sw as u32, bh as u32, rgb)
+}
+
+/// The table as Markdown: one row per method.
+pub fn markdown_table(rows: &[Compared]) -> String {
+    let mut s = String::from(
+        "| method | mean ′ | p95 ′ | border ′ | coverage | holes | PSNR dB | SSIM | FLIP | ms/frame |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for r in rows {
+        let v = &r.row;
+        let f = |key: &str, digits: usize| {
+            v[key]
+                .as_f64()
+                .map_or("—".to_string(), |x| format!("{x:.digits$}"))
+        };
+        s += &format!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            r.name,
+            f("misregistration_mean_arcmin", 1),
+            f("misregistration_p95_arcmin", 1),
+            f("border_mean_arcmin", 1),
+            f("coverage", 3),
+            f("holes_fraction", 3),
+            f("psnr_db", 1),
+            f("ssim", 3),
+            f("flip_mean", 3),
+            f("ms_per_frame", 1),
+        );
+    }
+    s
+}
+
+/// A self-contained HTML page: the table (from the Markdown) and each strip (by file name).
+pub fn html_page(title: &str, table_md: &str, strips: &[(&str, String)]) -> String {
+    let mut html = String::new();
+    let parser = pulldown_cmark::Parser::new_ext(table_md, pulldown_cmark::Options::ENABLE_TABLES);
+    pulldown_cmark::html::push_html(&mut html, parser);
+    let mut page = format!(
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{title}</title>\n<style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:4px 8px}}img{{max-width:100%}}</style></head><body>\n<h1>{title}</h1>\n{html}<p>Strips: truth | seethru | misregistration (0–60′, Turbo; black: blank) | holes (magenta).</p>\n"
+    );
+    for (name, file) in strips {
+        page += &format!("<h2>{name}</h2>\n<img src=\"{file}\" alt=\"{name}\">\n");
+    }
+    page += "</body></html>\n";
+    page
+}

@@ -1,0 +1,147 @@
+//! Disocclusion holes of `--method depth` in the driver's view: their fraction and mask, and
+//! the metrics over the pixels the display shows from what the frontal camera saw ("seen")
+//! apart from those over the holes it filled ("filled"), so that a fill cannot pass for a
+//! measurement.
+
+use std::path::Path;
+
+use anyhow::Result;
+use serde_json::json;
+
+use crate::io::frame_files::write_png;
+use crate::measure::metrics::{MetricMaps, psnr, stats};
+use crate::render::frame::Frame;
+use crate::scene::Obstacle;
+use crate::system::display::MISSING_ID;
+use crate::util::color::encode_srgb8;
+
+/// The driver-view mask of pixels whose display pixel is a hole: each display-region pixel
+/// of the driver's view is mapped to the display pixel it sees (through the `occluded`
+/// frame's point on the display face), as the metrics map it.
+pub fn driver_hole_mask(
+    obstacle: &Obstacle,
+    occluded: &Frame,
+    maps: &MetricMaps,
+    display_holes: &[bool],
+) -> Vec<bool> {
+    let [dw, dh] = obstacle.display_resolution;
+    let obstacle_from_world = obstacle.world_from_obstacle.inverse();
+    (0..maps.display.len())
+        .map(|i| {
+            if !maps.display[i] {
+                return false;
+            }
+            let p = obstacle_from_world.transform_point3(occluded.position[i].as_dvec3());
+            let u = ((p.x / obstacle.width + 0.5) * dw as f64).floor();
+            let v = ((0.5 - p.y / obstacle.height) * dh as f64).floor();
+            let (u, v) = (
+                (u.max(0.0) as u32).min(dw - 1),
+                (v.max(0.0) as u32).min(dh - 1),
+            );
+            display_holes[(v * dw + u) as usize]
+        })
+        .collect()
+}
+
+/// `metrics.json`'s `holes`: the fraction of display pixels of the driver's view that are
+/// holes, and the metrics over seen and over filled (hole) pixels apart.
+pub fn hole_metrics(
+    holes: &[bool],
+    maps: &MetricMaps,
+    truth: &Frame,
+    seethru: &Frame,
+    fill: impl serde::Serialize,
+) -> serde_json::Value {
+    let n = maps.display.len();
+    let display = maps.display.iter().filter(|&&d| d).count();
+    let hole_count = holes.iter().filter(|&&h| h).count();
+    let srgb_t: Vec<[u8; 3]> = truth.color.iter().map(|&c| encode_srgb8(c)).collect();
+    let srgb_s: Vec<[u8; 3]> = seethru.color.iter().map(|&c| encode_srgb8(c)).collect();
+    let region = |keep: &dyn Fn(usize) -> bool| {
+        let mask: Vec<bool> = (0..n).map(|i| maps.display[i] && keep(i)).collect();
+        let pixels = mask.iter().filter(|&&m| m).count();
+        let blank = (0..n)
+            .filter(|&i| mask[i] && seethru.object_id[i] == MISSING_ID)
+            .count();
+        let mut values: Vec<f64> = (0..n)
+            .filter(|&i| mask[i] && maps.misregistration[i].is_finite())
+            .map(|i| maps.misregistration[i] as f64)
+            .collect();
+        let mean_over = |map: &[f64]| {
+            let v: Vec<f64> = (0..n).filter(|&i| mask[i]).map(|i| map[i]).collect();
+            if v.is_empty() {
+                f64::NAN
+            } else {
+                v.iter().sum::<f64>() / v.len() as f64
+            }
+        };
+        json!({
+            "pixels": pixels,
+            "coverage": if pixels == 0 { f64::NAN } else { 1.0 - blank as f64 / pixels as f64 },
+            "misregistration_arcmin": stats(&mut values),
+            "psnr_db": psnr(&srgb_t, &srgb_s, &mask),
+            "ssim": mean_over(&maps.ssim),
+            "flip_mean": mean_over(&maps.flip),
+        })
+    };
+    json!({
+        "fraction": if display == 0 { 0.0 } else { hole_count as f64 / display as f64 },
+        "pixels": hole_count,
+        "fill": fill,
+        "seen": region(&|i| !holes[i]),
+        "filled": region(&|i| holes[i]),
+        "notes": "holes: display pixels whose line of sight passes behind a silhouette of the depth sensor's image (a disocclusion: what the eye sees there the frontal camera does not); seen: the other display pixels; filled: the holes as --fill shows them (none: black, counted blank). The totals in `display` include both",
+    })
+}
+
+/// `holes.png`: holes magenta, the rest of the display dark grey, outside black.
+pub fn write_hole_mask(path: &Path, maps: &MetricMaps, holes: &[bool]) -> Result<()> {
+    let rgb = holes
+        .iter()
+        .zip(&maps.display)
+        .flat_map(|(&h, &d)| {
+            if h {
+                [255, 0, 255]
+            } else if d {
+                [60, 60, 60]
+            } else {
+                [0, 0, 0]
+            }
+        })
+        .collect();
+    write_png(path, maps.width, maps.height, rgb)
+}
+
+/// Adds `holes` to a run's metrics when its method found holes; returns the driver-view mask.
+pub fn attach_holes(
+    metrics: &mut serde_json::Value,
+    maps: &MetricMaps,
+    result: &crate::system::pipeline::RunResult,
+    obstacle: &Obstacle,
+    fill: impl serde::Serialize,
+) -> Option<Vec<bool>> {
+    let display_holes = result.holes.as_ref()?;
+    let mask = driver_hole_mask(obstacle, &result.occluded, maps, display_holes);
+    metrics["holes"] = hole_metrics(&mask, maps, &result.truth, &result.seethru, fill);
+    Some(mask)
+}
+
+/// The driver-view hole mask of a run directory's `holes.png` (magenta pixels), if it has
+/// one, for `seethru measure`; it must be `width`×`height`.
+pub fn read_hole_mask(path: &Path, width: u32, height: u32) -> Result<Option<Vec<bool>>> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let image = image::open(path)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?
+        .to_rgb8();
+    if image.dimensions() != (width, height) {
+        anyhow::bail!(
+            "{}: {}×{} pixels, the run's views are {width}×{height}",
+            path.display(),
+            image.width(),
+            image.height()
+        );
+    }
+    Ok(Some(image.pixels().map(|p| p.0 == [255, 0, 255]).collect()))
+}

@@ -1,0 +1,256 @@
+//! The compensation methods that model the scene beyond one fronto-parallel plane: the road
+//! plane (`ground`), a plane fitted to the depth sensor's points (`plane-fit`) and per-pixel
+//! reprojection with the sensor's depth (`depth`). Each gives, for every display pixel, the
+//! frontal point to show (or a hole, or nothing); the display image is the frontal frame
+//! sampled there, as the planar crop samples it.
+
+use anyhow::{Result, bail};
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+use serde_json::json;
+
+use crate::render::frame::{Frame, Pixel};
+use crate::render::integrator::RenderContext;
+use crate::scene::{Obstacle, Scene};
+use crate::system::compensation::Crop;
+use crate::system::depth_search::{Found, search};
+use crate::system::depth_sensor::{DepthMap, SensorModel, sense};
+use crate::system::display::{DisplayModel, MISSING_ID, sample};
+use crate::system::options::{Method, RunOptions};
+pub use crate::system::scene_model_options::{Fill, SceneModelOptions};
+use crate::system::scene_plane::{ScenePlane, fit_plane, ground_plane};
+
+impl Method {
+    /// Whether the method models the scene per display pixel (not one crop of the frontal
+    /// image): `ground`, `plane-fit`, `depth`.
+    pub fn models_the_scene(self) -> bool {
+        matches!(self, Method::Ground | Method::PlaneFit | Method::Depth)
+    }
+}
+
+/// Checks the sensor options against the frontal camera, and that `ground` has a road.
+pub fn check_scene_model(scene: &Scene, options: &RunOptions) -> Result<()> {
+    if options.display == DisplayModel::Ideal {
+        bail!(
+            "--display ideal works with --method none or planar (a crop); ground, plane-fit and depth model the physical display's pixels"
+        );
+    }
+    // The plane intersections and the epipolar search assume the frontal camera is a pinhole
+    // the compensation knows exactly; a lens or a calibration error is the planar crop's.
+    let method = clap::ValueEnum::to_possible_value(&options.method)
+        .map_or_else(String::new, |v| v.get_name().to_string());
+    if scene.frontal.lens.is_some() {
+        bail!(
+            "--method {method}: the frontal camera has a lens; ground, plane-fit and depth need a pinhole frontal camera (use --method planar with a lens)"
+        );
+    }
+    if !scene.calibration.frontal.is_exact() {
+        bail!(
+            "--method {method}: the [calibration.frontal] is not exact; ground, plane-fit and depth use the true frontal camera (use --method planar to study calibration error)"
+        );
+    }
+    if options.method == Method::Ground {
+        ground_plane(scene)?;
+    } else {
+        SensorModel::resolve(&options.scene_model.sensor, &scene.frontal)?;
+    }
+    Ok(())
+}
+
+/// The display image of a scene-model method, its holes and what it used.
+pub struct SceneModelDisplay {
+    pub display: Frame,
+    /// Display pixels (row-major) that are disocclusion holes (`depth` only).
+    pub holes: Vec<bool>,
+    /// For `run.json`: the sensor, the plane, the holes.
+    pub report: serde_json::Value,
+}
+
+/// The world point of continuous display pixel coordinates.
+fn display_point(obstacle: &Obstacle, p: DVec2) -> DVec3 {
+    let [dw, dh] = obstacle.display_resolution.map(f64::from);
+    obstacle.world_from_obstacle.transform_point3(DVec3::new(
+        (p.x / dw - 0.5) * obstacle.width,
+        (0.5 - p.y / dh) * obstacle.height,
+        0.0,
+    ))
+}
+
+fn blank() -> Pixel {
+    Pixel {
+        object_id: MISSING_ID,
+        ..Pixel::SKY
+    }
+}
+
+/// The display image for `run.method` (one of [`Method::models_the_scene`]) at the eye
+/// `eye`; `crop` is the d2 → ∞ crop (its region is where the plane is fitted). The sensor,
+/// fill, filter and seed are the run's.
+pub fn scene_model_display(
+    ctx: &RenderContext,
+    scene: &Scene,
+    eye: DVec3,
+    frontal: &Frame,
+    crop: &Crop,
+    run: &RunOptions,
+) -> Result<SceneModelDisplay> {
+    let (method, options, filter, seed) = (run.method, &run.scene_model, run.filter, run.seed);
+    let camera = &scene.frontal;
+    let sensor = || -> Result<DepthMap> {
+        let model = SensorModel::resolve(&options.sensor, camera)?;
+        Ok(sense(ctx, camera, frontal, model, seed))
+    };
+    let mut report = serde_json::Map::new();
+    let found: Box<dyn Fn(DVec3) -> Found + Sync> = match method {
+        Method::Ground | Method::PlaneFit => {
+            let plane = if method == Method::Ground {
+                ground_plane(scene)?
+            } else {
+                let map = sensor()?;
+                // The crop's region in sensor pixels (same field of view, other resolution).
+                let to_sensor = DVec2::new(
+                    map.camera.width as f64 / camera.width as f64,
+                    map.camera.height as f64 / camera.height as f64,
+                );
+                let (min, max) = crop.bounds();
+                let (plane, inliers) = fit_plane(&map, min * to_sensor, max * to_sensor, seed)?;
+                report.insert("sensor".into(), json!(map.model));
+                report.insert("plane_fit_inliers".into(), json!(inliers));
+                plane
+            };
+            report.insert("plane".into(), plane_json(&plane));
+            Box::new(
+                move |on_display| match plane.frontal_point(eye, on_display, camera) {
+                    Some(p) => Found::Seen(p),
+                    None => Found::Outside,
+                },
+            )
+        }
+        Method::Depth => {
+            let map = sensor()?;
+            report.insert("sensor".into(), json!(map.model));
+            report.insert("search".into(), json!("backward search along the epipolar line in half sensor-pixel steps; sensor pixels as fronto-parallel tiles; a jump nearer by more than 25 % in depth is a silhouette"));
+            let camera = *camera;
+            Box::new(move |on_display| search(&map, &camera, eye, on_display))
+        }
+        _ => bail!("{method:?} is not a scene-model method"),
+    };
+    let [dw, dh] = scene.obstacle.display_resolution;
+    let looks: Vec<Found> = (0..dw as usize * dh as usize)
+        .into_par_iter()
+        .map(|i| {
+            let p = DVec2::new(
+                (i % dw as usize) as f64 + 0.5,
+                (i / dw as usize) as f64 + 0.5,
+            );
+            found(display_point(&scene.obstacle, p))
+        })
+        .collect();
+    let holes: Vec<bool> = looks.iter().map(|f| matches!(f, Found::Hole(_))).collect();
+    let mut pixels: Vec<Pixel> = looks
+        .par_iter()
+        .map(|f| match *f {
+            Found::Seen(p) => sample(frontal, p, filter),
+            Found::Hole(p) if options.fill == Fill::Background => sample(frontal, p, filter),
+            _ => blank(),
+        })
+        .collect();
+    if options.fill == Fill::Inpaint {
+        inpaint(&mut pixels, &holes, dw as usize);
+    }
+    let hole_count = holes.iter().filter(|&&h| h).count();
+    if method == Method::Depth {
+        report.insert(
+            "holes".into(),
+            json!({
+                "display_pixels": hole_count,
+                "fraction_of_display": hole_count as f64 / holes.len() as f64,
+                "fill": options.fill,
+            }),
+        );
+    }
+    Ok(SceneModelDisplay {
+        display: Frame::from_pixels(dw, dh, &pixels),
+        holes,
+        report: serde_json::Value::Object(report),
+    })
+}
+
+fn plane_json(plane: &ScenePlane) -> serde_json::Value {
+    json!({
+        "normal_world": plane.normal.to_array(),
+        "offset_m": plane.offset,
+        "tilt_from_horizontal_deg": plane.tilt_from_horizontal_deg(),
+        "convention": "points p (world, metres) with normal · p = offset",
+    })
+}
+
+/// Fills hole pixels layer by layer from their known 4-neighbours (the known pixels of the
+/// previous layer only, so the result does not depend on the scan order): colour their mean,
+/// every other AOV from the farthest of them (the background side of a silhouette).
+fn inpaint(pixels: &mut [Pixel], holes: &[bool], width: usize) {
+    let height = pixels.len() / width;
+    let mut known: Vec<bool> = holes.iter().map(|h| !h).collect();
+    loop {
+        let mut layer: Vec<(usize, Pixel)> = Vec::new();
+        for i in (0..pixels.len()).filter(|&i| !known[i]) {
+            let (x, y) = (i % width, i / width);
+            let neighbours = [
+                (x > 0).then(|| i - 1),
+                (x + 1 < width).then(|| i + 1),
+                (y > 0).then(|| i - width),
+                (y + 1 < height).then(|| i + width),
+            ];
+            let around: Vec<&Pixel> = neighbours
+                .iter()
+                .flatten()
+                .filter(|&&j| known[j] && pixels[j].object_id != MISSING_ID)
+                .map(|&j| &pixels[j])
+                .collect();
+            if let Some(farthest) = around.iter().max_by(|a, b| a.depth.total_cmp(&b.depth)) {
+                let mut p = **farthest;
+                p.color = around.iter().map(|q| q.color).sum::<glam::Vec3>() / around.len() as f32;
+                layer.push((i, p));
+            }
+        }
+        if layer.is_empty() {
+            return;
+        }
+        for (i, p) in layer {
+            pixels[i] = p;
+            known[i] = true;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inpainting_fills_a_hole_from_its_rim_whatever_the_order() {
+        let w = 5;
+        let mut pixels: Vec<Pixel> = (0..25)
+            .map(|i| Pixel {
+                color: glam::Vec3::splat((i % w) as f32),
+                depth: (i % w) as f32,
+                object_id: 1,
+                ..Pixel::SKY
+            })
+            .collect();
+        let mut holes = vec![false; 25];
+        for i in [6, 7, 8, 11, 12, 13, 16, 17, 18] {
+            holes[i] = true;
+            pixels[i] = blank();
+        }
+        inpaint(&mut pixels, &holes, w);
+        assert!(pixels.iter().all(|p| p.object_id == 1));
+        // The first layer: every hole pixel beside the rim, from its rim neighbours only
+        // (pixel 11 has one: colour 0); the second, the centre from the first layer's 0, 4, 2, 2.
+        assert_eq!(pixels[11].color.x, 0.0);
+        assert_eq!(pixels[12].color.x, 2.0);
+        // AOVs come from the farthest known neighbour.
+        assert_eq!(pixels[13].depth, 4.0);
+        assert_eq!(pixels[12].depth, 4.0);
+    }
+}

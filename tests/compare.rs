@@ -1,0 +1,190 @@
+//! `seethru compare` and the scene-model methods on the command line: the table, strips and
+//! rows as `run` and `measure` give them, and one line per bad input.
+
+mod common;
+
+#[test]
+fn bad_method_inputs_give_one_line_each() {
+    let dir = tempfile::tempdir().unwrap();
+    let wall = dir.path().join("wall.toml");
+    std::fs::write(
+        &wall,
+        common::WallScene::default().text().replace(
+            "../assets",
+            &common::repo_path("assets").display().to_string(),
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let (out, wall) = (out.to_str().unwrap(), wall.to_str().unwrap());
+    let small = [
+        "--width",
+        "32",
+        "--frontal-width",
+        "64",
+        "--back-width",
+        "16",
+        "--spp",
+        "1",
+    ];
+    let cases: Vec<(Vec<&str>, String)> = vec![
+        (
+            vec!["run", "scenes/das.toml", "--out", out, "--method", "depth-map"],
+            "error: invalid value 'depth-map' for '--method <METHOD>'".into(),
+        ),
+        (
+            vec!["compare", "scenes/das.toml", "--out", out, "--methods", "planar-inf,planar-9"],
+            "error: invalid value 'planar-9' for '--methods <METHODS>'".into(),
+        ),
+        (
+            vec!["run", "scenes/das.toml", "--out", out, "--method", "depth", "--depth-sensor", "tof", "--depth-resolution", "0"],
+            "error: invalid value '0' for '--depth-resolution <DEPTH_RESOLUTION>': must be an integer in [1, 16384]".into(),
+        ),
+        (
+            [vec!["run", "scenes/das.toml", "--out", out, "--method", "depth", "--depth-sensor", "tof", "--depth-resolution", "65"], small.to_vec()].concat(),
+            "error: --depth-resolution 65 is out of range [1, 64] (the frontal camera's width)".into(),
+        ),
+        (
+            vec!["run", "scenes/das.toml", "--out", out, "--method", "depth", "--depth-sensor", "stereo", "--depth-noise", "-0.01"],
+            "error: invalid value '-0.01' for '--depth-noise <DEPTH_NOISE>': must be a number in [0, 10]".into(),
+        ),
+        (
+            [vec!["run", "scenes/das.toml", "--out", out, "--method", "depth", "--depth-noise", "0.01"], small.to_vec()].concat(),
+            "error: --depth-noise does not apply to --depth-sensor ideal".into(),
+        ),
+        (
+            vec![
+                "run",
+                "scenes/das.toml",
+                "--out",
+                out,
+                "--method",
+                "plane-fit",
+                "--display",
+                "ideal",
+            ],
+            "error: --display ideal works with --method none or planar".into(),
+        ),
+        (
+            [vec!["run", wall, "--out", out, "--method", "ground"], small.to_vec()].concat(),
+            format!("error: --method ground: the scene {wall} has no ground plane"),
+        ),
+        (
+            [vec!["run", "scenes/das_fisheye.toml", "--out", out, "--method", "depth"], small.to_vec()].concat(),
+            "error: --method depth: the frontal camera has a lens".into(),
+        ),
+        (
+            [vec!["run", "scenes/das.toml", "--out", out, "--method", "plane-fit", "--calibration", "scenes/calibration/focal_1pct.toml"], small.to_vec()].concat(),
+            "error: --method plane-fit: the [calibration.frontal] is not exact".into(),
+        ),
+        (
+            [vec!["compare", wall, "--out", out, "--methods", "planar-inf,ground"], small.to_vec()].concat(),
+            format!("error: ground: --method ground: the scene {wall} has no ground plane"),
+        ),
+    ];
+    for (args, expected) in cases {
+        let (ok, _, err) = common::seethru(&args);
+        assert!(!ok, "{args:?} must fail");
+        assert!(
+            err.starts_with(&expected),
+            "{args:?}: `{err}` should start with `{expected}`"
+        );
+        assert_eq!(
+            err.trim_end().lines().count(),
+            1,
+            "{args:?}: one line: {err}"
+        );
+        assert!(!std::path::Path::new(out).exists(), "{args:?} wrote {out}");
+    }
+}
+
+#[test]
+fn compare_writes_one_row_and_one_strip_per_method_as_run_measures_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, common::MINIMAL).unwrap();
+    let out = dir.path().join("cmp");
+    let small = [
+        "--width",
+        "48",
+        "--frontal-width",
+        "64",
+        "--back-width",
+        "16",
+        "--spp",
+        "1",
+        "--threads",
+        "2",
+    ];
+    let scene_arg = scene.to_str().unwrap();
+    let (ok, table, err) = common::seethru(
+        &[
+            vec![
+                "compare",
+                scene_arg,
+                "--out",
+                out.to_str().unwrap(),
+                "--methods",
+                "planar-inf,ground,depth-ideal,depth-tof",
+            ],
+            small.to_vec(),
+        ]
+        .concat(),
+    );
+    assert!(ok, "{err}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("compare.json")).unwrap()).unwrap();
+    let rows = json["rows"].as_array().unwrap();
+    let names: Vec<&str> = rows.iter().map(|r| r["method"].as_str().unwrap()).collect();
+    assert_eq!(names, ["planar-inf", "ground", "depth-ideal", "depth-tof"]);
+    let md = std::fs::read_to_string(out.join("compare.md")).unwrap();
+    let html = std::fs::read_to_string(out.join("compare.html")).unwrap();
+    for name in &names {
+        assert!(
+            md.contains(&format!("| {name} |")) && table.contains(&format!("| {name} |")),
+            "{name}"
+        );
+        assert!(
+            html.contains(&format!("<img src=\"strip_{name}.png\"")),
+            "{name}"
+        );
+        // Four panels of the display's bounding box, three gaps of 4 pixels.
+        let strip = image::open(out.join(format!("strip_{name}.png"))).unwrap();
+        assert_eq!((strip.width() - 12) % 4, 0);
+    }
+    // The rows are the metrics `run` gives for the same method.
+    let run_out = dir.path().join("run");
+    let (ok, _, err) = common::seethru(
+        &[
+            vec![
+                "run",
+                scene_arg,
+                "--out",
+                run_out.to_str().unwrap(),
+                "--method",
+                "depth",
+            ],
+            small.to_vec(),
+        ]
+        .concat(),
+    );
+    assert!(ok, "{err}");
+    let metrics: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run_out.join("metrics.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        rows[2]["misregistration_mean_arcmin"],
+        metrics["display"]["misregistration_arcmin"]["mean"]
+    );
+    assert_eq!(rows[2]["holes_fraction"], metrics["holes"]["fraction"]);
+    // `measure` recomputes the same holes from the run directory's holes.png.
+    let (ok, _, err) = common::seethru(&["measure", run_out.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let again: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run_out.join("metrics.json")).unwrap())
+            .unwrap();
+    assert_eq!(again["holes"], metrics["holes"]);
+    // Per-pixel depth beats the d2 → ∞ plane on a scene of a road and a ball 10 m away.
+    let mean = |k: usize| rows[k]["misregistration_mean_arcmin"].as_f64().unwrap();
+    assert!(mean(2) < mean(0), "{} vs {}", mean(2), mean(0));
+}
