@@ -3,6 +3,7 @@
 //! Used by the system (head equations), the measurements (predictions) and the paper's claims
 //! and figures, so they sit below all three.
 
+pub mod dynamic;
 pub mod examples;
 pub mod paper;
 pub mod perceived;

@@ -10,6 +10,7 @@ mod ratio;
 mod render;
 mod reproduce;
 mod run;
+mod sequence;
 mod sweep;
 
 use anyhow::Result;
@@ -57,6 +58,9 @@ pub enum Command {
     Analyze(analyze::Analyze),
     /// Benchmark: BVH build time, rays per second, frame times; ends with one JSON line.
     Bench(bench::Bench),
+    /// The system over time: vehicle and head motion, latencies and prediction, measured frame
+    /// by frame against the truth (frames.csv, summary.json, plots, an animated preview).
+    Sequence(sequence::Sequence),
 }
 
 /// A clap error as one line starting `error:`: the message and its tip, without the usage
@@ -98,6 +102,7 @@ impl Command {
             Command::Figures(c) => c.run(),
             Command::Analyze(c) => c.run(),
             Command::Bench(c) => c.run(),
+            Command::Sequence(c) => c.run(),
         }
     }
 }

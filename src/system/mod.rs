@@ -8,3 +8,4 @@ pub mod memory;
 pub mod options;
 pub mod pipeline;
 pub mod report;
+pub mod sequence;

@@ -73,7 +73,7 @@ fn eye_for_compensation(
 }
 
 /// The crop that `method` asks for; `frontal` serves the `auto` working distance.
-fn crop_for(
+pub fn crop_for(
     scene: &Scene,
     eye: DVec3,
     frontal: &Frame,
