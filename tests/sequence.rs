@@ -78,8 +78,8 @@ fn the_measured_dynamic_misregistration_follows_the_formula() {
                 tracking_latency: 0.0,
             };
             // A pure yaw turns every direction alike: any distance and bearing.
-            let predicted =
-                dynamic_misregistration(6.0 - eye.z, 0.3, eye.z, 6.0, &motion).abs() * ARCMIN_PER_RAD;
+            let predicted = dynamic_misregistration(6.0 - eye.z, 0.3, eye.z, 6.0, &motion).abs()
+                * ARCMIN_PER_RAD;
             let error = (m.mean_arcmin - predicted).abs() / predicted;
             assert!(
                 error < 0.02,
@@ -89,7 +89,11 @@ fn the_measured_dynamic_misregistration_follows_the_formula() {
             );
         }
         // The held display shows images of two ages.
-        assert_eq!(ages.len(), if display_hz < 60.0 { 2 } else { 1 }, "{ages:?}");
+        assert_eq!(
+            ages.len(),
+            if display_hz < 60.0 { 2 } else { 1 },
+            "{ages:?}"
+        );
     }
 }
 
@@ -126,13 +130,33 @@ fn the_moving_part_renders_as_a_whole_rebuilt_world() {
     ] {
         let (a, _) = layered.render(&camera, view, settings, "layered");
         let (b, _) = whole.render(&camera, view, settings, "whole");
-        let differ = a.object_id.iter().zip(&b.object_id).filter(|(x, y)| x != y).count();
-        assert!(differ * 500 < a.object_id.len(), "view {view}: {differ} ids differ");
-        let colour: f32 = a.color.iter().zip(&b.color).map(|(x, y)| (*x - *y).abs().max_element()).sum::<f32>()
+        let differ = a
+            .object_id
+            .iter()
+            .zip(&b.object_id)
+            .filter(|(x, y)| x != y)
+            .count();
+        assert!(
+            differ * 500 < a.object_id.len(),
+            "view {view}: {differ} ids differ"
+        );
+        let colour: f32 = a
+            .color
+            .iter()
+            .zip(&b.color)
+            .map(|(x, y)| (*x - *y).abs().max_element())
+            .sum::<f32>()
             / a.color.len() as f32;
-        assert!(colour < 2e-3, "view {view}: mean colour difference {colour}");
+        assert!(
+            colour < 2e-3,
+            "view {view}: mean colour difference {colour}"
+        );
         // What moves is seen: the obstacle in the driver's view, the head from the back.
-        let expected = if view == view_bit::OCCLUDED { layered.world.obstacle_id } else { 9 };
+        let expected = if view == view_bit::OCCLUDED {
+            layered.world.obstacle_id
+        } else {
+            9
+        };
         if view != view_bit::FRONTAL {
             assert!(a.object_id.contains(&expected), "view {view}");
         }
@@ -142,7 +166,11 @@ fn the_moving_part_renders_as_a_whole_rebuilt_world() {
 fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
     let mut out = Vec::new();
     for entry in walk(dir) {
-        let name = entry.strip_prefix(dir).unwrap().to_string_lossy().to_string();
+        let name = entry
+            .strip_prefix(dir)
+            .unwrap()
+            .to_string_lossy()
+            .to_string();
         if name.ends_with("summary.json") {
             continue; // holds wall-clock timings
         }
@@ -202,14 +230,25 @@ fn frames_and_csv_are_bit_identical_for_any_thread_count() {
     }
     let names: Vec<&str> = outputs[0].iter().map(|f| f.0.as_str()).collect();
     assert!(names.contains(&"latency_100ms/frames.csv"), "{names:?}");
-    assert!(names.contains(&"latency_0ms/frames/seethru_00002.png"), "{names:?}");
+    assert!(
+        names.contains(&"latency_0ms/frames/seethru_00002.png"),
+        "{names:?}"
+    );
     assert!(names.contains(&"latency.svg") && names.contains(&"latency_0ms/preview.png"));
     assert_eq!(outputs[0].len(), outputs[1].len());
     for (a, b) in outputs[0].iter().zip(&outputs[1]) {
         assert!(a == b, "{} differs between 1 and 3 threads", a.0);
     }
     // Three frames per latency, and more misregistration with 100 ms of latency.
-    let csv = String::from_utf8(outputs[0].iter().find(|f| f.0 == "latency.csv").unwrap().1.clone()).unwrap();
+    let csv = String::from_utf8(
+        outputs[0]
+            .iter()
+            .find(|f| f.0 == "latency.csv")
+            .unwrap()
+            .1
+            .clone(),
+    )
+    .unwrap();
     let rows: Vec<Vec<f64>> = csv
         .lines()
         .skip(1)
@@ -227,13 +266,22 @@ fn bad_input_is_one_line_and_writes_nothing() {
         std::fs::write(&p, text).unwrap();
         p.to_string_lossy().to_string()
     };
-    let decreasing = path("decreasing.csv", "t,x,y,z\n0,0.3,0,0.7\n0.5,0.3,0,0.7\n0.4,0.3,0,0.7\n");
+    let decreasing = path(
+        "decreasing.csv",
+        "t,x,y,z\n0,0.3,0,0.7\n0.5,0.3,0,0.7\n0.4,0.3,0,0.7\n",
+    );
     let nan = path("nan.csv", "0,0.3,0,0.7\n0.5,nan,0,0.7\n");
     let behind = path("behind.csv", "0,0.3,0,0.7\n1,0.3,0,-0.3\n");
     let das = std::fs::read_to_string(common::repo_path("scenes/das.toml")).unwrap();
-    let far = das.replace("translate = [5.1, 0.35, -5.5]", "translate = [999999.9, 0.35, -5.5]");
+    let far = das.replace(
+        "translate = [5.1, 0.35, -5.5]",
+        "translate = [999999.9, 0.35, -5.5]",
+    );
     let far_line = far.lines().position(|l| l.contains("999999.9")).unwrap() + 1;
-    let far = path("far.toml", &far.replace("../assets", &common::repo_path("assets").to_string_lossy()));
+    let far = path(
+        "far.toml",
+        &far.replace("../assets", &common::repo_path("assets").to_string_lossy()),
+    );
     let unknown = path(
         "unknown.toml",
         &das.replace("t = 4.0\n", "t = 4.0\nspeed = 3\n")
@@ -244,16 +292,38 @@ fn bad_input_is_one_line_and_writes_nothing() {
         (vec!["--duration", "-1"], "--duration"),
         (vec!["--fps", "0"], "--fps"),
         (vec!["--display-hz", "0"], "--display-hz"),
-        (vec!["--duration", "0.1", "--latency-camera", "0,200"], "--latency-camera 200 ms must be ≥ 0 and shorter than the sequence (100 ms)"),
-        (vec!["--duration", "0.1", "--latency-tracking", "150"], "--latency-tracking 150 ms"),
+        (
+            vec!["--duration", "0.1", "--latency-camera", "0,200"],
+            "--latency-camera 200 ms must be ≥ 0 and shorter than the sequence (100 ms)",
+        ),
+        (
+            vec!["--duration", "0.1", "--latency-tracking", "150"],
+            "--latency-tracking 150 ms",
+        ),
         (vec!["--latency-camera", "0,nan"], "--latency-camera"),
-        (vec!["--head-path", &decreasing], "decreasing.csv:4: times must increase: t = 0.4 s follows t = 0.5 s"),
-        (vec!["--head-path", &nan], "nan.csv:2: `x` must be a finite number"),
-        (vec!["--head-path", &behind], "behind the display at t = 0.8 s"),
+        (
+            vec!["--head-path", &decreasing],
+            "decreasing.csv:4: times must increase: t = 0.4 s follows t = 0.5 s",
+        ),
+        (
+            vec!["--head-path", &nan],
+            "nan.csv:2: `x` must be a finite number",
+        ),
+        (
+            vec!["--head-path", &behind],
+            "behind the display at t = 0.8 s",
+        ),
     ];
     let out = dir.path().join("out");
     for (extra, expected) in cases {
-        let mut args = vec!["sequence", "scenes/das.toml", "--out", out.to_str().unwrap(), "--width", "32"];
+        let mut args = vec![
+            "sequence",
+            "scenes/das.toml",
+            "--out",
+            out.to_str().unwrap(),
+            "--width",
+            "32",
+        ];
         for (flag, default) in [("--duration", "1"), ("--fps", "5")] {
             if !extra.contains(&flag) {
                 args.extend([flag, default]);
@@ -263,12 +333,23 @@ fn bad_input_is_one_line_and_writes_nothing() {
         let (ok, _, err) = common::seethru(&args);
         assert!(!ok, "{args:?}");
         assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
-        assert!(err.starts_with("error:") && err.contains(expected), "{args:?}: {err}");
+        assert!(
+            err.starts_with("error:") && err.contains(expected),
+            "{args:?}: {err}"
+        );
         assert!(!out.exists(), "{args:?} wrote {}", out.display());
     }
     for (scene, expected) in [
-        (far.as_str(), format!("far.toml:{far_line}:13: key `object[6].keyframe[1].translate`: the path leaves the world at t = 4 s")),
-        (unknown.as_str(), "key `object[6].keyframe[1].speed`: unknown key".to_string()),
+        (
+            far.as_str(),
+            format!(
+                "far.toml:{far_line}:13: key `object[6].keyframe[1].translate`: the path leaves the world at t = 4 s"
+            ),
+        ),
+        (
+            unknown.as_str(),
+            "key `object[6].keyframe[1].speed`: unknown key".to_string(),
+        ),
     ] {
         let (ok, _, err) = common::seethru(&["sequence", scene, "--out", out.to_str().unwrap()]);
         assert!(!ok);

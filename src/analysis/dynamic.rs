@@ -56,15 +56,20 @@ pub fn dynamic_misregistration(z: f64, bearing: f64, d1: f64, d2: f64, m: &Motio
 pub struct BudgetGeometry {
     /// Eye distance from the display, m.
     pub d1: f64,
-    /// Distance of the scene behind the display from the eye, m.
-    pub scene_distance: f64,
+    /// Distance of the scene behind the display from the display plane, m.
+    pub scene_depth: f64,
     /// Bearing of the display centre from the direction of travel, radians (left > 0).
     pub bearing: f64,
     /// Display half width (the largest offset of a display point from the frontal camera's
     /// axis), m.
     pub half_width: f64,
-    /// Working distance of the model plane the budget assumes, m (∞: the paper's proposal).
-    pub d2: f64,
+}
+
+impl BudgetGeometry {
+    /// Distance from the eye of the scene point seen through the display centre, m.
+    pub fn scene_distance(&self) -> f64 {
+        (self.d1 + self.scene_depth) / self.bearing.cos()
+    }
 }
 
 /// Arc-minutes of misregistration per unit of each error source, and the latency at which
@@ -72,16 +77,16 @@ pub struct BudgetGeometry {
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct ErrorBudget {
     pub geometry: BudgetGeometry,
-    /// Per millimetre of lateral head-position error.
+    /// Per millimetre of lateral head-position error (d2 → ∞).
     pub arcmin_per_mm_head: f64,
     /// Per millisecond of latency at 50 km/h straight ahead.
     pub arcmin_per_ms_at_50_kmh: f64,
     /// Per millisecond of latency at 20 °/s of yaw, standing.
     pub arcmin_per_ms_at_20_deg_s: f64,
-    /// Per metre of working-distance error (at the display's edge, for a plane at the scene's
-    /// distance).
+    /// Per metre of working-distance error, at the display's edge, for a model plane at the
+    /// scene's depth.
     pub arcmin_per_m_d2: f64,
-    /// The d2 → ∞ model's error for the scene at its distance, at the display's edge.
+    /// The d2 → ∞ model's error for the scene at its depth, at the display's edge.
     pub static_planar_arcmin: f64,
     /// Latency at which the dynamic error equals the static planar error, ms: at 50 km/h and
     /// at 20 °/s.
@@ -92,20 +97,19 @@ pub struct ErrorBudget {
 /// The error budget at `g`.
 pub fn error_budget(g: &BudgetGeometry) -> ErrorBudget {
     let per_ms = |speed: f64, yaw_rate: f64| {
-        relative_bearing_rate(g.scene_distance, g.bearing, speed, yaw_rate).abs()
+        relative_bearing_rate(g.scene_distance(), g.bearing, speed, yaw_rate).abs()
             * 1e-3
             * ARCMIN_PER_RAD
     };
-    let depth = g.scene_distance - g.d1;
     let at_50 = per_ms(50.0 / 3.6, 0.0);
     let at_20 = per_ms(0.0, 20f64.to_radians());
-    let static_planar = infinite_plane_error(g.half_width, g.d1, depth) * ARCMIN_PER_RAD;
+    let static_planar = infinite_plane_error(g.half_width, g.d1, g.scene_depth) * ARCMIN_PER_RAD;
     ErrorBudget {
         geometry: *g,
-        arcmin_per_mm_head: per_lateral_head_error(g.d1, g.d2) * 1e-3 * ARCMIN_PER_RAD,
+        arcmin_per_mm_head: per_lateral_head_error(g.d1, f64::INFINITY) * 1e-3 * ARCMIN_PER_RAD,
         arcmin_per_ms_at_50_kmh: at_50,
         arcmin_per_ms_at_20_deg_s: at_20,
-        arcmin_per_m_d2: per_d2_error(g.half_width, g.d1, depth) * ARCMIN_PER_RAD,
+        arcmin_per_m_d2: per_d2_error(g.half_width, g.d1, g.scene_depth) * ARCMIN_PER_RAD,
         static_planar_arcmin: static_planar,
         break_even_ms_at_50_kmh: static_planar / at_50,
         break_even_ms_at_20_deg_s: static_planar / at_20,
@@ -116,7 +120,7 @@ pub fn error_budget(g: &BudgetGeometry) -> ErrorBudget {
 pub fn budget_text(b: &ErrorBudget) -> String {
     let g = &b.geometry;
     format!(
-        "Error budget at the das geometry (d1 = {:.2} m, scene {:.1} m from the eye at a bearing of {:.0}°, display half width {:.3} m, d2 → ∞):\n\
+        "Error budget at the das geometry (d1 = {:.2} m, scene {:.1} m behind the display at a bearing of {:.0}°, display half width {:.3} m, d2 → ∞):\n\
          | error source | arc-minutes |\n|---|---|\n\
          | 1 mm of lateral head error | {:.2} |\n\
          | 1 ms of latency at 50 km/h | {:.2} |\n\
@@ -125,7 +129,7 @@ pub fn budget_text(b: &ErrorBudget) -> String {
          | static planar error (d2 → ∞, display edge) | {:.1} |\n\
          Latency at which motion costs the static planar error: {:.1} ms at 50 km/h, {:.1} ms at 20 °/s.\n",
         g.d1,
-        g.scene_distance,
+        g.scene_depth,
         g.bearing.to_degrees(),
         g.half_width,
         b.arcmin_per_mm_head,

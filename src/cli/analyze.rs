@@ -3,6 +3,8 @@
 
 use crate::cli::args::{metres_or_inf, pixels, positive, real};
 use anyhow::Result;
+use seethru::analysis::dynamic::{budget_text, error_budget};
+use seethru::analysis::examples::das_geometry;
 use seethru::paper::claims::{
     AnalyzeParams, claims_table, evaluate, head_error_table, head_error_text, paper_claims,
 };
@@ -67,16 +69,18 @@ impl Analyze {
         params.validate().map_err(anyhow::Error::msg)?;
         let claims = paper_claims();
         let values = evaluate(&params);
+        let budget = error_budget(&das_geometry());
         if self.json {
             println!(
                 "{}",
                 serde_json::to_string_pretty(
-                    &serde_json::json!({"claims": claims, "evaluation": values})
+                    &serde_json::json!({"claims": claims, "evaluation": values, "error_budget_das": budget})
                 )?
             );
         } else {
             print!("{}", claims_table(&claims));
             print!("\n{}", head_error_text(&params, &head_error_table(&params)));
+            print!("\n{}", budget_text(&budget));
             println!(
                 "\nEvery closed form at the given parameters:\n{}",
                 serde_json::to_string_pretty(&values)?

@@ -239,6 +239,8 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         ));
         frames.insert(view.name().into(), json!({"ms": spread.json()}));
     }
+    let (lines, sequence) = crate::cli::bench_sequence::bench_sequence(&ctx.scene)?;
+    lines.into_iter().for_each(say);
     let peak = peak_rss_bytes();
     say(format!(
         "peak RSS     {}",
@@ -257,6 +259,7 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         "height": options.height,
         "rays": rays_json,
         "frame": frames,
+        "sequence": sequence,
         "peak_rss_bytes": peak,
     });
     println!("{report}");

@@ -3,6 +3,7 @@
 mod analyze;
 mod args;
 mod bench;
+mod bench_sequence;
 mod export;
 mod figures;
 mod measure;

@@ -176,6 +176,7 @@ pub fn summary(run: &SequenceRun, timeline: &Timeline) -> serde_json::Value {
             "with_truth_and_metrics": frames / run.total_seconds,
         },
         "frontal_pixels_per_refresh": run.frontal_pixels_per_refresh,
+        "window_px": [run.window.x0, run.window.y0, run.window.x1, run.window.y1],
         "notes": "per-frame statistics over the display pixels that show the scene (coverage beside them); mean_of_frame_means averages the frames' means; eye_error: the compensation's eye against the true eye at display time",
     })
 }

@@ -32,6 +32,9 @@ use crate::system::sequence::predict::{Prediction, Predictor};
 use crate::system::sequence::timeline::{FrameTimes, Rig, Timeline};
 use crate::util::number::short;
 
+/// Fewest samples per pixel of the back camera's image.
+pub const BACK_MIN_SPP: u32 = 4;
+
 /// Frontal pixels rendered around the crop: the bicubic filter reads two beyond it.
 const CROP_MARGIN_PX: f64 = 3.0;
 
@@ -62,7 +65,6 @@ pub struct Shown {
     pub crop: Crop,
     /// The model plane's distance, m (`None`: d2 → ∞ or no model).
     pub d2_used: Option<f64>,
-    pub display: Frame,
     /// The frontal camera at the capture time.
     pub frontal: Camera,
 }
@@ -94,6 +96,8 @@ pub struct SystemLoop {
     predictor: Predictor,
     frontal: Frame,
     shown: Option<Shown>,
+    /// The display showing the image of the last refresh.
+    surface: Option<DisplaySurface>,
     pub seconds: StageSeconds,
     /// Frontal pixels rendered, summed over the refreshes.
     pub frontal_pixels: u64,
@@ -138,6 +142,7 @@ impl SystemLoop {
             options,
             frontal,
             shown: None,
+            surface: None,
             seconds: StageSeconds::default(),
             frontal_pixels: 0,
         })
@@ -175,7 +180,13 @@ impl SystemLoop {
                 let ctx = self.context_at(t)?;
                 let start = Instant::now();
                 let back = ctx.scene.back;
-                let (frame, _) = ctx.render(&back, view_bit::BACK, self.settings(), "back");
+                // A camera's image is anti-aliased: the detector mistakes the aliased edge
+                // of a shadow for a pupil at 1 sample per pixel (das, leaning).
+                let settings = RenderSettings {
+                    spp: self.options.run.spp.max(BACK_MIN_SPP),
+                    progress: false,
+                };
+                let (frame, _) = ctx.render(&back, view_bit::BACK, settings, "back");
                 let detection = detect(&frame)
                     .with_context(|| format!("head estimate at t = {} s", short(t)))?;
                 let world = eye_from_detection(&detection, &back, run.feature_width);
@@ -277,13 +288,16 @@ impl SystemLoop {
             run.filter,
         );
         self.seconds.compensation += start.elapsed().as_secs_f64();
+        self.surface = Some(DisplaySurface::Pixels {
+            image: display,
+            placement: DisplayPlacement::new(&capture.scene.obstacle),
+        });
         self.shown = Some(Shown {
             times,
             eye_estimated,
             eye_used,
             crop,
             d2_used,
-            display,
             frontal: frontal_camera,
         });
         Ok(self.shown.as_ref().expect("just set"))
@@ -296,13 +310,17 @@ impl SystemLoop {
         let start = Instant::now();
         let shown = self.shown.as_ref().expect("show() before render_seethru()");
         let driver = ctx.scene.driver;
+        // The display where it is now, showing the image of its last refresh.
         let placement = DisplayPlacement::new(&ctx.scene.obstacle);
-        let surface = match self.options.run.display {
-            DisplayModel::Pixels => DisplaySurface::Pixels {
-                image: shown.display.clone(),
-                placement,
-            },
-            DisplayModel::Ideal => DisplaySurface::Ideal {
+        let mut surface = self.surface.take().unwrap_or(DisplaySurface::Pixels {
+            image: Frame::new(0, 0),
+            placement: placement.clone(),
+        });
+        surface = match (self.options.run.display, surface) {
+            (DisplayModel::Pixels, DisplaySurface::Pixels { image, .. }) => {
+                DisplaySurface::Pixels { image, placement }
+            }
+            _ => DisplaySurface::Ideal {
                 crop: shown.crop,
                 frontal: shown.frontal,
                 placement,
