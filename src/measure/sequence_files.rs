@@ -255,7 +255,15 @@ pub struct Preview {
     fps: f64,
     step: u32,
     size: (u32, u32),
-    panels: Vec<(Vec<[u8; 3]>, Vec<[u8; 3]>, Vec<f32>)>,
+    panels: Vec<PreviewFrame>,
+}
+
+/// One preview frame's panels, cut to the window: sRGB truth and seethru, and the
+/// misregistration (arc-minutes; NaN on blank display pixels, −∞ outside the display).
+struct PreviewFrame {
+    truth: Vec<[u8; 3]>,
+    shown: Vec<[u8; 3]>,
+    misregistration: Vec<f32>,
 }
 
 impl Preview {
@@ -271,7 +279,7 @@ impl Preview {
     }
 
     pub fn add(&mut self, f: &FrameImages) {
-        if f.record.frame % self.every != 0 {
+        if !f.record.frame.is_multiple_of(self.every) {
             return;
         }
         let w = f.window;
@@ -291,7 +299,11 @@ impl Preview {
                 });
             }
         }
-        self.panels.push((truth, shown, mis));
+        self.panels.push(PreviewFrame {
+            truth,
+            shown,
+            misregistration: mis,
+        });
     }
 
     /// Writes the APNG; the heat scale tops out at the 99th percentile of every frame's
@@ -300,7 +312,7 @@ impl Preview {
         let mut all: Vec<f32> = self
             .panels
             .iter()
-            .flat_map(|p| p.2.iter().copied().filter(|v| v.is_finite()))
+            .flat_map(|p| p.misregistration.iter().copied().filter(|v| v.is_finite()))
             .collect();
         all.sort_by(f32::total_cmp);
         let top = all
@@ -314,28 +326,35 @@ impl Preview {
         let frames: Vec<Vec<u8>> = self
             .panels
             .iter()
-            .map(|(truth, shown, mis)| {
-                let mut rgb = vec![255u8; (width * h * 3) as usize];
-                for y in 0..h {
-                    for x in 0..w {
-                        let i = (y * w + x) as usize;
-                        let heat = match mis[i] {
-                            v if v.is_finite() => heat_color(v / top),
-                            v if v == f32::NEG_INFINITY => {
-                                let g = (truth[i].iter().map(|&c| c as u32).sum::<u32>() / 6) as u8;
-                                [g, g, g]
+            .map(
+                |PreviewFrame {
+                     truth,
+                     shown,
+                     misregistration: mis,
+                 }| {
+                    let mut rgb = vec![255u8; (width * h * 3) as usize];
+                    for y in 0..h {
+                        for x in 0..w {
+                            let i = (y * w + x) as usize;
+                            let heat = match mis[i] {
+                                v if v.is_finite() => heat_color(v / top),
+                                v if v == f32::NEG_INFINITY => {
+                                    let g =
+                                        (truth[i].iter().map(|&c| c as u32).sum::<u32>() / 6) as u8;
+                                    [g, g, g]
+                                }
+                                // A display pixel without a misregistration: blank.
+                                _ => [0, 0, 0],
+                            };
+                            for (panel, c) in [truth[i], shown[i], heat].into_iter().enumerate() {
+                                let o = ((y * width + panel as u32 * (w + gap) + x) * 3) as usize;
+                                rgb[o..o + 3].copy_from_slice(&c);
                             }
-                            // A display pixel without a misregistration: blank.
-                            _ => [0, 0, 0],
-                        };
-                        for (panel, c) in [truth[i], shown[i], heat].into_iter().enumerate() {
-                            let o = ((y * width + panel as u32 * (w + gap) + x) * 3) as usize;
-                            rgb[o..o + 3].copy_from_slice(&c);
                         }
                     }
-                }
-                rgb
-            })
+                    rgb
+                },
+            )
             .collect();
         write_apng(path, width, h, &frames, self.fps)?;
         Ok(top)
