@@ -134,8 +134,10 @@ impl World {
             textures: Vec::new(),
             obstacle_id: 0,
         };
-        // A part loads only the textures its objects use.
-        let mut used = vec![false; scene.materials.len()];
+        // A part loads only the textures its objects use (the whole world loads them all, so
+        // that a broken texture is an error whether or not an object uses it).
+        let whole = (0..scene.objects.len()).all(keep);
+        let mut used = vec![whole; scene.materials.len()];
         for (i, o) in scene.objects.iter().enumerate() {
             if let Some(m) = o.material.filter(|_| keep(i)) {
                 used[m] = true;
