@@ -358,3 +358,30 @@ fn bad_input_is_one_line_and_writes_nothing() {
         assert!(!out.exists());
     }
 }
+
+/// The error budget's das geometry is das's: the eye's distance and bearing from the display
+/// centre, the display's half width, and the depth `--d2 auto` finds behind it.
+#[test]
+fn the_budget_geometry_is_the_das_scene() {
+    let scene = common::das();
+    let g = seethru::analysis::examples::das_geometry();
+    let eye = scene.obstacle.in_obstacle_frame(scene.eye());
+    assert!((eye.z - g.d1).abs() < 1e-9, "{eye}");
+    // The road runs along −z; the display centre is ahead-left of the eye.
+    let to_display = scene.obstacle.world_from_obstacle.translation - scene.eye();
+    let bearing = (-to_display.x).atan2(-to_display.z);
+    assert!((bearing - g.bearing).abs() < 1e-9, "{bearing}");
+    assert!((scene.obstacle.width / 2.0 - g.half_width).abs() < 1e-12);
+    let ctx = RenderContext::new(scene).unwrap();
+    let options = RunOptions {
+        d2: WorkingDistance::Auto,
+        width: Some(64),
+        frontal_width: Some(640),
+        back_width: Some(64),
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let run = seethru::system::pipeline::run(&ctx, &options).unwrap();
+    let d2 = run.report["d2_m"].as_f64().unwrap();
+    assert!((d2 - g.scene_depth).abs() < 0.1, "d2 auto = {d2} m");
+}

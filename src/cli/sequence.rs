@@ -52,15 +52,21 @@ fn latency_list(text: &str) -> Result<Latencies, String> {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 enum HeadPreset {
+    /// The eye stays where the scene puts it.
     Still,
+    /// Lateral sinusoid across the display (--sway-cm, --sway-hz).
     Sway,
+    /// Towards the display centre to look around the pillar (--lean-cm, --lean-s, --lean-at).
     Lean,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 enum FramesFormat {
+    /// No per-frame images.
     None,
+    /// truth_NNNNN.png and seethru_NNNNN.png (colour, sRGB).
     Png,
+    /// truth_NNNNN.exr and seethru_NNNNN.exr (every AOV).
     Exr,
 }
 
