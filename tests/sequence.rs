@@ -385,3 +385,35 @@ fn the_budget_geometry_is_the_das_scene() {
     let d2 = run.report["d2_m"].as_f64().unwrap();
     assert!((d2 - g.scene_depth).abs() < 0.1, "d2 auto = {d2} m");
 }
+
+/// Re-projecting the late frontal image by the known vehicle motion takes the yaw's error
+/// away: on the wall with the model plane on it only the static error (the resampling
+/// quantum) of a sequence without latency is left.
+#[test]
+fn reprojection_by_the_known_yaw_removes_the_dynamic_error() {
+    let wall = common::WallScene::default();
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let how = Measuring {
+        metrics: true,
+        full_frames: false,
+        band: 5,
+        progress: false,
+    };
+    let mut means = Vec::new();
+    for (latency, reproject) in [(0.1, false), (0.1, true), (0.0, false)] {
+        let mut o = options(latency, 30.0, 30.0, 20f64.to_radians());
+        o.reproject = reproject;
+        let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
+        let m: Vec<f64> = run
+            .records
+            .iter()
+            .map(|r| r.metrics.unwrap().mean_arcmin)
+            .collect();
+        means.push(m.iter().sum::<f64>() / m.len() as f64);
+    }
+    assert!((means[0] - 120.0).abs() < 2.4, "{means:?}");
+    assert!(
+        means[2] < 10.0 && means[1] < 1.5 * means[2] + 0.5,
+        "{means:?}"
+    );
+}

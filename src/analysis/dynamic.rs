@@ -51,7 +51,7 @@ pub fn dynamic_misregistration(z: f64, bearing: f64, d1: f64, d2: f64, m: &Motio
         - m.eye_speed * (m.latency + m.tracking_latency) * per_lateral_head_error(d1, d2)
 }
 
-/// The geometry an error budget is taken at (see [`crate::analysis::examples::das_geometry`]).
+/// The geometry an error budget is taken at (`analysis/examples.rs` has das's).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct BudgetGeometry {
     /// Eye distance from the display, m.

@@ -1,7 +1,7 @@
 //! What moves during a sequence, in a world and a hierarchy of its own: built once at the
 //! objects' t = 0 placements, then, at each instant, every primitive carried by its object's
 //! rigid motion and the small hierarchy rebuilt. The static world's hierarchy is never touched;
-//! the integrator traces both ([`crate::render::integrator::RenderContext::moving`]).
+//! the integrator traces both (`RenderContext::moving`).
 
 use anyhow::Result;
 use glam::{Affine3A, DAffine3, Vec3};

@@ -337,6 +337,7 @@ impl SystemLoop {
             frame,
             "seethru",
         );
+        self.surface = Some(surface);
         self.seconds.seethru += start.elapsed().as_secs_f64();
     }
 }
