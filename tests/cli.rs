@@ -222,7 +222,7 @@ fn run_writes_six_views_run_json_and_metrics_and_measure_recomputes_them() {
 /// Every option that takes a value, per command, read from the command's own `--help`, so
 /// that a flag added later is walked too: `(command words, flag, value name)`.
 fn options_with_values() -> Vec<(Vec<&'static str>, String, String)> {
-    let commands: [&[&str]; 12] = [
+    let commands: [&[&str]; 13] = [
         &["render"],
         &["run"],
         &["ratio", "occlusion"],
@@ -235,6 +235,7 @@ fn options_with_values() -> Vec<(Vec<&'static str>, String, String)> {
         &["analyze"],
         &["bench"],
         &["compare"],
+        &["sequence"],
     ];
     let mut found = Vec::new();
     for words in commands {
@@ -272,7 +273,7 @@ fn options_with_values() -> Vec<(Vec<&'static str>, String, String)> {
 fn every_numeric_flag_refuses_values_outside_its_range_in_one_line() {
     // Paths, names and free-form specs are not numbers; everything else must refuse a NaN,
     // an infinity, a huge number and an integer beyond 64 bits, naming the flag and its range.
-    let not_numbers = ["OUT", "SCENE", "DIR", "PARAMS", "FILE"];
+    let not_numbers = ["OUT", "SCENE", "DIR", "PARAMS", "FILE", "CSV"];
     let options = options_with_values();
     assert!(options.len() > 40, "{options:?}");
     let scratch = tempfile::tempdir().unwrap();

@@ -34,3 +34,16 @@ pub fn paper_foreshortening() -> ForeshorteningParams {
         gamma: 90f64.to_radians(),
     }
 }
+
+/// The das scene's geometry for the error budget: the eye 0.75 m in front of the display and
+/// 0.35 m to its right (a bearing of atan(0.35 / 0.75) ≈ 25° left of the road), the display
+/// 0.25 m wide, and the scene behind the display 6.4 m beyond it (the median depth `--d2
+/// auto` finds there). `tests/sequence.rs` checks these against `scenes/das.toml`.
+pub fn das_geometry() -> crate::analysis::dynamic::BudgetGeometry {
+    crate::analysis::dynamic::BudgetGeometry {
+        d1: 0.75,
+        scene_depth: 6.4,
+        bearing: (0.35f64 / 0.75).atan(),
+        half_width: 0.125,
+    }
+}

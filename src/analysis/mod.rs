@@ -5,6 +5,7 @@
 
 pub mod binocular;
 pub mod depth_error;
+pub mod dynamic;
 pub mod examples;
 pub mod paper;
 pub mod perceived;

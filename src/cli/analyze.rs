@@ -7,6 +7,8 @@ use glam::DVec3;
 use seethru::analysis::binocular::{
     disparity_mismatch, display_corners, model_point_normalised, radial_error_px,
 };
+use seethru::analysis::dynamic::{budget_text, error_budget};
+use seethru::analysis::examples::das_geometry;
 use seethru::paper::claims::{
     AnalyzeParams, claims_table, evaluate, head_error_table, head_error_text, paper_claims,
 };
@@ -115,16 +117,18 @@ impl Analyze {
         let lens_eyes = lens_and_eyes(&self);
         let claims = paper_claims();
         let values = evaluate(&params);
+        let budget = error_budget(&das_geometry());
         if self.json {
             println!(
                 "{}",
                 serde_json::to_string_pretty(
-                    &serde_json::json!({"claims": claims, "evaluation": values, "lens_and_eyes": lens_eyes})
+                    &serde_json::json!({"claims": claims, "evaluation": values, "lens_and_eyes": lens_eyes, "error_budget_das": budget})
                 )?
             );
         } else {
             print!("{}", claims_table(&claims));
             print!("\n{}", head_error_text(&params, &head_error_table(&params)));
+            print!("\n{}", budget_text(&budget));
             println!(
                 "\nEvery closed form at the given parameters:\n{}",
                 serde_json::to_string_pretty(&values)?

@@ -240,6 +240,8 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         frames.insert(view.name().into(), json!({"ms": spread.json()}));
     }
     let methods = crate::cli::bench_methods::method_costs(&ctx, options.repeat, options.json)?;
+    let (lines, sequence) = crate::cli::bench_sequence::bench_sequence(&ctx.scene)?;
+    lines.into_iter().for_each(say);
     let peak = peak_rss_bytes();
     say(format!(
         "peak RSS     {}",
@@ -259,6 +261,7 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         "rays": rays_json,
         "frame": frames,
         "methods": methods,
+        "sequence": sequence,
         "peak_rss_bytes": peak,
     });
     println!("{report}");

@@ -4,6 +4,7 @@ mod analyze;
 mod args;
 mod bench;
 mod bench_methods;
+mod bench_sequence;
 mod compare;
 mod export;
 mod figures;
@@ -14,6 +15,7 @@ mod reproduce;
 mod run;
 mod run_eyes;
 mod scene_model_args;
+mod sequence;
 mod sweep;
 
 use anyhow::Result;
@@ -64,6 +66,9 @@ pub enum Command {
     Compare(compare::Compare),
     /// Benchmark: BVH build time, rays per second, frame times; ends with one JSON line.
     Bench(bench::Bench),
+    /// The system over time: vehicle and head motion, latencies and prediction, measured frame
+    /// by frame against the truth (frames.csv, summary.json, plots, an animated preview).
+    Sequence(sequence::Sequence),
 }
 
 /// A clap error as one line starting `error:`: the message and its tip, without the usage
@@ -106,6 +111,7 @@ impl Command {
             Command::Analyze(c) => c.run(),
             Command::Bench(c) => c.run(),
             Command::Compare(c) => c.run(),
+            Command::Sequence(c) => c.run(),
         }
     }
 }

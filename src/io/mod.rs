@@ -1,6 +1,7 @@
 //! Files the simulator writes (and reads back): frames as PNG and EXR, plots, scene exports
 //! (glTF, OBJ, Mitsuba), all written atomically.
 
+pub mod animation;
 pub mod atomic;
 pub mod export;
 pub mod frame_files;

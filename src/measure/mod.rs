@@ -8,6 +8,8 @@ pub mod maps;
 pub mod metrics;
 pub mod ratio;
 pub mod ratio_setup;
+pub mod sequence;
+pub mod sequence_files;
 pub mod sweep;
 pub mod sweep_csv;
 pub mod sweep_grid;

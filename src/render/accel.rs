@@ -51,6 +51,17 @@ pub enum Difference {
     Everywhere,
 }
 
+impl Difference {
+    /// Where either of two differences can differ (of two sets of primitives traced together).
+    pub fn union(self, other: Difference) -> Difference {
+        match (self, other) {
+            (Difference::Everywhere, _) | (_, Difference::Everywhere) => Difference::Everywhere,
+            (Difference::None, d) | (d, Difference::None) => d,
+            (Difference::Within(a), Difference::Within(b)) => Difference::Within(a.union(&b)),
+        }
+    }
+}
+
 thread_local! {
     /// The traversal stack of the queries that bring none.
     static STACK: RefCell<Stack> = RefCell::new(Stack::new());

@@ -20,15 +20,22 @@ use crate::render::bvh::Stack;
 use crate::render::camera_rays::CameraRays;
 use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::{Frame, Pixel};
+use crate::render::moving::MovingLayer;
 use crate::render::ray::TraceRay;
 use crate::render::screen::{Screen, Shown};
 use crate::render::settings::RenderSettings;
 use crate::render::sky::SkyModel;
 use crate::scene::Scene;
 use crate::scene::shapes::box_face;
-use crate::scene::world::{SurfaceHit, World, view_bit};
+use crate::scene::texture::Texture;
+use crate::scene::world::{SurfaceHit, SurfaceMaterial, World, view_bit};
 use crate::util::progress::Progress;
 use crate::util::sampling::pixel_offset;
+
+thread_local! {
+    /// The traversal stack of [`RenderContext::trace`].
+    static STACK: std::cell::RefCell<Stack> = std::cell::RefCell::new(Stack::new());
+}
 
 /// Rows per rayon task: small enough to balance many threads, large enough to amortise.
 const BAND_ROWS: u32 = 4;
@@ -48,6 +55,9 @@ pub struct RenderContext {
     pub world: Arc<World>,
     pub accel: Arc<Accel>,
     pub sky: Arc<SkyModel>,
+    /// What moves, at one instant of a sequence: traced beside `world` (which then holds only
+    /// what stands still); `None` everywhere else.
+    pub moving: Option<Arc<MovingLayer>>,
 }
 
 /// What every pixel of one render shares.
@@ -69,6 +79,7 @@ impl RenderContext {
             world: Arc::new(world),
             accel: Arc::new(accel),
             sky: Arc::new(sky),
+            moving: None,
         })
     }
 
@@ -92,6 +103,7 @@ impl RenderContext {
             world,
             accel,
             sky,
+            moving: None,
         })
     }
 
@@ -162,7 +174,19 @@ impl RenderContext {
         label: &str,
     ) -> (Frame, RenderStats) {
         assert_eq!((base.width, base.height), (camera.width, camera.height));
-        let region = match self.accel.difference(base_view, view) {
+        let region = self.difference_region(camera, base_view, view);
+        let mut frame = base.clone();
+        let stats = self.render_region(camera, view, display, settings, region, &mut frame, label);
+        (frame, stats)
+    }
+
+    /// The pixels of `camera` where views `a` and `b` can differ (see [`Accel::difference`]).
+    pub fn difference_region(&self, camera: &Camera, a: u8, b: u8) -> PixelRect {
+        let difference = match &self.moving {
+            Some(m) => self.accel.difference(a, b).union(m.accel.difference(a, b)),
+            None => self.accel.difference(a, b),
+        };
+        match difference {
             Difference::None => PixelRect {
                 x0: 0,
                 y0: 0,
@@ -171,10 +195,24 @@ impl RenderContext {
             },
             Difference::Within(bounds) => footprint(camera, &bounds),
             Difference::Everywhere => PixelRect::full(camera),
-        };
-        let mut frame = base.clone();
-        let stats = self.render_region(camera, view, display, settings, region, &mut frame, label);
-        (frame, stats)
+        }
+    }
+
+    /// Renders only the pixels of `region` of `view` (with `display` for `seethru`) into
+    /// `frame`, a frame of the camera's size; the other pixels keep what they held. Each
+    /// pixel is what [`RenderContext::render`] gives it.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_rect(
+        &self,
+        camera: &Camera,
+        view: u8,
+        display: Option<&dyn Screen>,
+        settings: RenderSettings,
+        region: PixelRect,
+        frame: &mut Frame,
+        label: &str,
+    ) -> RenderStats {
+        self.render_region(camera, view, display, settings, region, frame, label)
     }
 
     /// Renders the pixels of `region` into `frame`.
@@ -334,10 +372,7 @@ impl RenderContext {
 
     /// The closest surface visible in `view` along a ray from `origin` (unit `dir`).
     pub fn trace(&self, origin: Vec3, dir: Vec3, view: u8) -> Option<SurfaceHit> {
-        let hit = self
-            .accel
-            .closest(&make_ray(origin, dir, 0.0, f32::INFINITY), view)?;
-        Some(self.world.surface(hit.prim, origin, dir, hit.t))
+        STACK.with_borrow_mut(|stack| self.trace_with(origin, dir, view, stack))
     }
 
     #[inline]
@@ -348,24 +383,55 @@ impl RenderContext {
         view: u8,
         stack: &mut Stack,
     ) -> Option<SurfaceHit> {
-        let ray = make_ray(origin, dir, 0.0, f32::INFINITY);
-        let hit = self.accel.closest_with(&ray, view, stack)?;
-        Some(self.world.surface(hit.prim, origin, dir, hit.t))
+        let mut ray = make_ray(origin, dir, 0.0, f32::INFINITY);
+        let hit = self.accel.closest_with(&ray, view, stack);
+        if let Some(m) = &self.moving {
+            if let Some(h) = hit {
+                ray.tmax = h.t;
+            }
+            // A moving primitive only where it is strictly nearer: ties go to the static one.
+            if let Some(h) = m.accel.closest_with(&ray, view, stack)
+                && hit.is_none_or(|s| h.t < s.t)
+            {
+                let mut s = m.world.surface(h.prim, origin, dir, h.t);
+                // The moving world's materials are numbered after the static world's.
+                s.material += self.world.materials.len() as u32;
+                return Some(s);
+            }
+        }
+        hit.map(|h| self.world.surface(h.prim, origin, dir, h.t))
+    }
+
+    /// A material of [`SurfaceHit::material`] and the textures it indexes.
+    fn material(&self, index: u32) -> (&SurfaceMaterial, &[Texture]) {
+        let own = self.world.materials.len() as u32;
+        match &self.moving {
+            Some(m) if index >= own => (
+                &m.world.materials[(index - own) as usize],
+                &m.world.textures,
+            ),
+            _ => (&self.world.materials[index as usize], &self.world.textures),
+        }
     }
 
     /// Lambert shading: albedo × (sun × cos × visibility + sky ambient).
     fn shade(&self, s: &SurfaceHit, view: u8, stack: &mut Stack, shadows: &mut u64) -> Vec3 {
-        let material = &self.world.materials[s.material as usize];
+        let (material, textures) = self.material(s.material);
         let mut albedo = material.albedo;
         if let Some(t) = material.texture {
-            albedo *= self.world.textures[t].sample(s.uv * material.uv_repeat);
+            albedo *= textures[t].sample(s.uv * material.uv_repeat);
         }
         let mut light = self.sky.ambient(s.normal);
         let cos = s.normal.dot(self.sky.sun_direction);
         if cos > 0.0 {
             *shadows += 1;
             let ray = shadow_ray(s.position, s.normal, self.sky.sun_direction);
-            if !self.accel.occluded_with(&ray, view, stack) {
+            let blocked = self.accel.occluded_with(&ray, view, stack)
+                || self
+                    .moving
+                    .as_ref()
+                    .is_some_and(|m| m.accel.occluded_with(&ray, view, stack));
+            if !blocked {
                 light += self.sky.sun_irradiance * cos;
             }
         }

@@ -7,6 +7,7 @@ pub mod camera_rays;
 pub mod footprint;
 pub mod frame;
 pub mod integrator;
+pub mod moving;
 pub mod packets;
 pub mod ray;
 pub mod screen;

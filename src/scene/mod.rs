@@ -4,9 +4,11 @@
 //! parameter table of every object kind; the defaults below are the ones documented there.
 
 pub mod grow;
+pub mod head_path;
 pub mod lens_keys;
 pub mod limits;
 pub mod mesh_io;
+pub mod motion;
 pub mod procedural;
 pub mod read;
 pub mod shapes;
@@ -116,6 +118,8 @@ pub struct Object {
     pub visible_to: u8,
     /// Whether the object blocks sunlight.
     pub casts_shadow: bool,
+    /// How it moves during a `sequence` (nothing else reads it).
+    pub motion: motion::ObjectMotion,
 }
 
 /// The sun: a directional light that casts hard shadows.

@@ -11,6 +11,7 @@ use crate::scene::limits::{
     MAX_LENGTH, MAX_MATERIALS, MAX_MOUNT_OFFSET, MAX_OBJECTS, MAX_ROTATION_DEG, MAX_TRIANGLES,
     MAX_UV_REPEAT, MIN_LENGTH, out_of_world,
 };
+use crate::scene::motion::read_object_motion;
 use crate::scene::source::{SceneError, SourceFile};
 use crate::scene::table_reader::{TableReader, range_message};
 use crate::scene::{CameraKind, Material, Object, Obstacle, Scene, Shape, Sky, Sun};
@@ -175,6 +176,23 @@ fn existing_asset(
 }
 
 fn read_transform(t: &TableReader) -> Result<DAffine3, SceneError> {
+    let (translate, [rx, ry, rz], scale) = read_placement(t)?;
+    // Rotations apply about x, then y, then z (world axes).
+    let rotation = DQuat::from_euler(
+        EulerRot::ZYX,
+        rz.to_radians(),
+        ry.to_radians(),
+        rx.to_radians(),
+    );
+    Ok(DAffine3::from_scale_rotation_translation(
+        dvec3(scale),
+        rotation,
+        translate,
+    ))
+}
+
+/// `translate`, `rotate_deg` and `scale` of an object table.
+fn read_placement(t: &TableReader) -> Result<(DVec3, [f64; 3], [f64; 3]), SceneError> {
     let translate = t.point("translate", Some([0.0; 3]))?;
     let [rx, ry, rz] = t.array_in("rotate_deg", [0.0; 3], -MAX_ROTATION_DEG, MAX_ROTATION_DEG)?;
     let scale = match t.opt_f64("scale") {
@@ -194,18 +212,7 @@ fn read_transform(t: &TableReader) -> Result<DAffine3, SceneError> {
             ),
         ));
     }
-    // Rotations apply about x, then y, then z (world axes).
-    let rotation = DQuat::from_euler(
-        EulerRot::ZYX,
-        rz.to_radians(),
-        ry.to_radians(),
-        rx.to_radians(),
-    );
-    Ok(DAffine3::from_scale_rotation_translation(
-        dvec3(scale),
-        rotation,
-        translate,
-    ))
+    Ok((translate, [rx, ry, rz], scale))
 }
 
 /// Reads every `[[object]]`, within the limits on objects and triangles.
@@ -370,6 +377,7 @@ fn read_object(
     let visible_to = hidden
         .iter()
         .fold(0b111u8, |mask, name| mask & !CameraKind::parse(name).bit());
+    let shape_for_bounds = shape.clone();
     Ok(Object {
         name,
         shape,
@@ -377,6 +385,11 @@ fn read_object(
         world_from_object: read_transform(t)?,
         visible_to,
         casts_shadow: t.bool_or("casts_shadow", true)?,
+        motion: {
+            let (translate, rotate_deg, scale) = read_placement(t)?;
+            let corners = object_bounds(&shape_for_bounds);
+            read_object_motion(t, translate, dvec3(rotate_deg), dvec3(scale), &corners)?
+        },
     })
 }
 

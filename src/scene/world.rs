@@ -113,6 +113,18 @@ fn views_of(visible_to: u8) -> u8 {
 impl World {
     /// Builds the world of a scene: tessellates shapes, loads meshes and textures.
     pub fn build(scene: &Scene) -> Result<World> {
+        Self::build_part(scene, &|_| true, true)
+    }
+
+    /// The world of the objects `keep` selects (by index) and, if `obstacle`, the obstacle.
+    /// Object ids and the obstacle id are those of the whole scene's world, so that two parts
+    /// traced together (a sequence's static and moving parts) name objects alike; material
+    /// indices are the part's own.
+    pub fn build_part(
+        scene: &Scene,
+        keep: &dyn Fn(usize) -> bool,
+        obstacle: bool,
+    ) -> Result<World> {
         let mut world = World {
             triangles: Vec::new(),
             tri_attrs: Vec::new(),
@@ -122,13 +134,22 @@ impl World {
             textures: Vec::new(),
             obstacle_id: 0,
         };
-        for m in &scene.materials {
+        // A part loads only the textures its objects use (the whole world loads them all, so
+        // that a broken texture is an error whether or not an object uses it).
+        let whole = (0..scene.objects.len()).all(keep);
+        let mut used = vec![whole; scene.materials.len()];
+        for (i, o) in scene.objects.iter().enumerate() {
+            if let Some(m) = o.material.filter(|_| keep(i)) {
+                used[m] = true;
+            }
+        }
+        for (index, m) in scene.materials.iter().enumerate() {
             let texture = match &m.texture {
-                Some(path) => {
+                Some(path) if used[index] => {
                     world.textures.push(Texture::load(path)?);
                     Some(world.textures.len() - 1)
                 }
-                None => None,
+                _ => None,
             };
             world.materials.push(SurfaceMaterial {
                 albedo: srgb_to_linear3(m.color),
@@ -137,13 +158,16 @@ impl World {
             });
         }
         let mut meshes: HashMap<PathBuf, LoadedMesh> = HashMap::new();
-        for object in &scene.objects {
+        for (index, object) in scene.objects.iter().enumerate() {
             world.objects.push(ObjectInfo {
                 name: object.name.clone(),
                 views: views_of(object.visible_to),
                 casts_shadow: object.casts_shadow,
             });
             let id = world.objects.len() as u32;
+            if !keep(index) {
+                continue;
+            }
             let material = object.material.map(|m| m as u32);
             let size2 = |s: [f64; 2]| [s[0] as f32, s[1] as f32];
             let tris = match &object.shape {
@@ -210,7 +234,7 @@ impl World {
                 material.unwrap_or(0)
             });
         }
-        world.add_obstacle(&scene.obstacle);
+        world.add_obstacle(&scene.obstacle, obstacle);
         Ok(world)
     }
 
@@ -254,7 +278,7 @@ impl World {
         });
     }
 
-    fn add_obstacle(&mut self, obstacle: &Obstacle) {
+    fn add_obstacle(&mut self, obstacle: &Obstacle, geometry: bool) {
         self.objects.push(ObjectInfo {
             name: "obstacle".into(),
             views: view_bit::OCCLUDED | view_bit::SEETHRU,
@@ -263,6 +287,9 @@ impl World {
             casts_shadow: false,
         });
         self.obstacle_id = self.objects.len() as u32;
+        if !geometry {
+            return;
+        }
         let body = self.materials.len() as u32;
         // Two materials: the body, then the switched-off display.
         for color in [obstacle.body_color, obstacle.display_off_color] {

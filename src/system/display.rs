@@ -42,16 +42,21 @@ fn resample_with(
     frontal: &Frame,
     display_size: [u32; 2],
     filter: Filter,
-    frontal_point: impl Fn(DVec2) -> DVec2,
+    frontal_point: impl Fn(DVec2) -> DVec2 + Sync,
 ) -> Frame {
+    use rayon::prelude::*;
     let [w, h] = display_size;
-    let mut pixels = Vec::with_capacity(w as usize * h as usize);
-    for y in 0..h {
-        for x in 0..w {
-            let p = frontal_point(DVec2::new(x as f64 + 0.5, y as f64 + 0.5));
-            pixels.push(sample(frontal, p, filter));
-        }
-    }
+    // Rows in parallel, collected in order: the same image for any number of threads.
+    let pixels: Vec<Pixel> = (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            let frontal_point = &frontal_point;
+            (0..w).map(move |x| {
+                let p = frontal_point(DVec2::new(x as f64 + 0.5, y as f64 + 0.5));
+                sample(frontal, p, filter)
+            })
+        })
+        .collect();
     Frame::from_pixels(w, h, &pixels)
 }
 

@@ -15,3 +15,4 @@ pub mod report;
 pub mod scene_model;
 pub mod scene_model_options;
 pub mod scene_plane;
+pub mod sequence;

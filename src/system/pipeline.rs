@@ -80,8 +80,21 @@ fn eye_for_compensation(
     ))
 }
 
+/// The display → frontal map of `crop`: through the believed frontal lens ([calibration]),
+/// except for `--method none`, which shows the whole frontal image as it is.
+pub fn frontal_map(scene: &Scene, crop: Crop, options: &RunOptions) -> Result<FrontalMap> {
+    Ok(FrontalMap {
+        crop,
+        lens: match options.method {
+            Method::None => None,
+            _ => scene.calibration.frontal.apply(&scene.frontal)?.lens,
+        },
+        display_size: scene.obstacle.display_resolution,
+    })
+}
+
 /// The crop that `method` asks for; `frontal` serves the `auto` working distance.
-fn crop_for(
+pub fn crop_for(
     scene: &Scene,
     eye: DVec3,
     frontal: &Frame,
@@ -258,15 +271,7 @@ pub fn run_with_truth(
     let frontal = timed(&mut timings, &scene.frontal, View::Frontal);
     let (eye_used, detection) = eye_for_compensation(scene, &back, options)?;
     let (crop, d2_used) = crop_for(scene, eye_used, &frontal, options)?;
-    let map = FrontalMap {
-        crop,
-        // `--method none` shows the whole frontal image as it is: no lens to go through.
-        lens: match options.method {
-            Method::None => None,
-            _ => scene.calibration.frontal.apply(&scene.frontal)?.lens,
-        },
-        display_size: scene.obstacle.display_resolution,
-    };
+    let map = frontal_map(scene, crop, options)?;
 
     let out = overflow(&map);
     if options.method == Method::Planar

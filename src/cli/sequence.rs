@@ -1,0 +1,374 @@
+//! `seethru sequence`: the see-through system over time — vehicle motion, head motion and
+//! latency — measured frame by frame against the truth at the same instant.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use seethru::io::atomic::write_text;
+use seethru::io::frame_files::{write_color_png, write_exr};
+use seethru::measure::sequence::{Measuring, SequenceRun, run_sequence};
+use seethru::measure::sequence_files::{
+    Preview, frames_csv, latency_figure, over_time_figure, summary,
+};
+use seethru::scene::Scene;
+use seethru::scene::head_path::HeadPath;
+use seethru::system::display::{DisplayModel, Filter};
+use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
+use seethru::system::sequence::head_motion::HeadMotion;
+use seethru::system::sequence::predict::Prediction;
+use seethru::system::sequence::system_loop::SequenceOptions;
+use seethru::system::sequence::timeline::Timeline;
+use seethru::util::progress::summary as say;
+use serde_json::json;
+
+use crate::cli::args::{
+    band, head_bias_cm, integer, pixels, positive, real, samples, threads, with_threads,
+};
+
+/// Longest latency, ms.
+const MAX_LATENCY_MS: f64 = 10_000.0;
+/// Most latencies in one `--latency-camera` list.
+const MAX_LATENCIES: usize = 64;
+
+/// Camera latencies, ms: one sequence each.
+#[derive(Clone, Debug)]
+struct Latencies(Vec<f64>);
+
+/// `--latency-camera`: milliseconds in [0, 10000], one value or a comma-separated list.
+fn latency_list(text: &str) -> Result<Latencies, String> {
+    let parts: Vec<&str> = text.split(',').collect();
+    let range = format!(
+        "must be milliseconds in [0, {MAX_LATENCY_MS}], one value or up to {MAX_LATENCIES} separated by commas"
+    );
+    if parts.len() > MAX_LATENCIES {
+        return Err(range);
+    }
+    parts
+        .iter()
+        .map(|p| real(0.0, MAX_LATENCY_MS)(p).map_err(|_| range.clone()))
+        .collect::<Result<Vec<f64>, String>>()
+        .map(Latencies)
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum HeadPreset {
+    /// The eye stays where the scene puts it.
+    Still,
+    /// Lateral sinusoid across the display (--sway-cm, --sway-hz).
+    Sway,
+    /// Towards the display centre to look around the pillar (--lean-cm, --lean-s, --lean-at).
+    Lean,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum FramesFormat {
+    /// No per-frame images.
+    None,
+    /// truth_NNNNN.png and seethru_NNNNN.png (colour, sRGB).
+    Png,
+    /// truth_NNNNN.exr and seethru_NNNNN.exr (every AOV).
+    Exr,
+}
+
+#[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
+pub struct Sequence {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    /// Output directory.
+    #[arg(long)]
+    out: PathBuf,
+    /// Length of the sequence, seconds in (0, 3600].
+    #[arg(long, default_value_t = 4.0, value_parser = positive(3600.0))]
+    duration: f64,
+    /// Frames measured per second, Hz in (0, 1000].
+    #[arg(long, default_value_t = 60.0, value_parser = positive(1000.0))]
+    fps: f64,
+    /// Display refresh rate, Hz in (0, 1000] (sample and hold; default: --fps).
+    #[arg(long = "display-hz", value_parser = positive(1000.0))]
+    display_hz: Option<f64>,
+    /// Vehicle speed along the road (world −z), km/h in [0, 300].
+    #[arg(long, default_value_t = 0.0, value_parser = real(0.0, 300.0))]
+    speed: f64,
+    /// Vehicle yaw rate, degrees per second in [-180, 180] (> 0 turns left).
+    #[arg(long = "yaw-rate", default_value_t = 0.0, allow_hyphen_values = true, value_parser = real(-180.0, 180.0))]
+    yaw_rate: f64,
+    /// Head motion relative to the vehicle: still, sway (lateral sinusoid) or lean (towards
+    /// the pillar to look around it).
+    #[arg(long, value_enum, default_value_t = HeadPreset::Still)]
+    head: HeadPreset,
+    /// A recorded head path instead of --head: CSV of t,x,y,z (seconds; the eye in the
+    /// obstacle frame, metres), times increasing.
+    #[arg(long = "head-path", value_name = "CSV")]
+    head_path: Option<PathBuf>,
+    /// Sway amplitude, centimetres in [0, 50].
+    #[arg(long = "sway-cm", default_value_t = 3.0, value_parser = real(0.0, 50.0))]
+    sway_cm: f64,
+    /// Sway frequency, Hz in (0, 20].
+    #[arg(long = "sway-hz", default_value_t = 0.5, value_parser = positive(20.0))]
+    sway_hz: f64,
+    /// Lean distance, centimetres in [0, 50].
+    #[arg(long = "lean-cm", default_value_t = 10.0, value_parser = real(0.0, 50.0))]
+    lean_cm: f64,
+    /// Lean duration, seconds in (0, 10].
+    #[arg(long = "lean-s", default_value_t = 0.3, value_parser = positive(10.0))]
+    lean_s: f64,
+    /// When the lean starts, seconds in [0, 3600].
+    #[arg(long = "lean-at", default_value_t = 0.5, value_parser = real(0.0, 3600.0))]
+    lean_at: f64,
+    /// Frontal capture to display latency, ms in [0, 10000]; a list (0,16,33,50,100,200)
+    /// runs one sequence per value.
+    #[arg(long = "latency-camera", value_name = "MS[,MS...]", default_value = "0", value_parser = latency_list)]
+    latency_camera: Latencies,
+    /// Back camera to head estimate latency, ms in [0, 10000].
+    #[arg(long = "latency-tracking", default_value_t = 0.0, value_parser = real(0.0, MAX_LATENCY_MS))]
+    latency_tracking: f64,
+    /// Head prediction to display time.
+    #[arg(long, value_enum, default_value_t = Prediction::None)]
+    predict: Prediction,
+    /// Re-project the frontal image by the vehicle's known motion from capture to display.
+    #[arg(long)]
+    reproject: bool,
+    /// Write every frame's truth and seethru views (whole driver views) as PNG or EXR.
+    #[arg(long, value_enum, default_value_t = FramesFormat::None)]
+    frames: FramesFormat,
+    /// none: the whole frontal image in the display; planar: the paper's compensation.
+    #[arg(long, value_enum, default_value_t = Method::Planar)]
+    method: Method,
+    /// Working distance of the planar model: inf, auto or metres in (0, 1e6].
+    #[arg(long, default_value = "inf", value_name = "METRES|inf|auto")]
+    d2: WorkingDistance,
+    /// oracle: the true eye (late by the tracking latency); estimated: face detection on the
+    /// back camera's image of its time.
+    #[arg(long = "head-source", value_enum, default_value_t = HeadSource::Oracle)]
+    head_source: HeadSource,
+    /// Head-tracking bias, obstacle frame, centimetres: x,y,z, each in [-500, 500].
+    #[arg(long = "head-bias-cm", value_name = "X,Y,Z", allow_hyphen_values = true, default_value = "0,0,0", value_parser = head_bias_cm)]
+    head_bias_cm: [f64; 3],
+    /// Head-tracking jitter per estimate, standard deviation per axis, centimetres in [0, 100].
+    #[arg(long = "head-jitter-cm", default_value_t = 0.0, value_parser = real(0.0, 100.0))]
+    head_jitter_cm: f64,
+    /// Seed of the jitter, an integer in [0, 4294967295].
+    #[arg(long, default_value_t = 1, value_parser = integer::<u32>(0, u32::MAX as u64))]
+    seed: u32,
+    /// The detector's known feature width A, metres in (0, 1].
+    #[arg(long = "feature-width", default_value_t = 0.064, value_parser = positive(1.0))]
+    feature_width: f64,
+    /// When the crop leaves the frontal view: black (counted, coverage < 1) or error.
+    #[arg(long, value_enum, default_value_t = Outside::Black)]
+    outside: Outside,
+    /// Colour resampling of the display image.
+    #[arg(long, value_enum, default_value_t = Filter::Bilinear)]
+    filter: Filter,
+    /// pixels: the physical display; ideal: unlimited display and frontal resolution.
+    #[arg(long, value_enum, default_value_t = DisplayModel::Pixels)]
+    display: DisplayModel,
+    /// Driver view width, pixels in [1, 16384] (the height follows the camera's aspect).
+    #[arg(long, default_value_t = 640, value_parser = pixels)]
+    width: u32,
+    /// Driver view height, pixels in [1, 16384] (default: from the width).
+    #[arg(long, value_parser = pixels)]
+    height: Option<u32>,
+    /// Frontal camera width, pixels in [1, 16384] (default: the driver view's width).
+    #[arg(long = "frontal-width", value_parser = pixels)]
+    frontal_width: Option<u32>,
+    /// Back camera width, pixels in [1, 16384] (default: the scene's).
+    #[arg(long = "back-width", value_parser = pixels)]
+    back_width: Option<u32>,
+    /// Samples per pixel in [1, 4096].
+    #[arg(long, default_value_t = 1, value_parser = samples)]
+    spp: u32,
+    /// Border band of the metrics, display pixels in [1, 1000].
+    #[arg(long, default_value_t = 5, value_parser = band)]
+    band: u32,
+    /// Worker threads in [1, 1024] (default: all cores). Output is identical for any value.
+    #[arg(long, value_parser = threads)]
+    threads: Option<usize>,
+}
+
+impl Sequence {
+    fn head_motion(&self) -> Result<HeadMotion> {
+        Ok(match (&self.head_path, self.head) {
+            (Some(path), _) => HeadMotion::Path(HeadPath::load(path)?),
+            (None, HeadPreset::Still) => HeadMotion::Still,
+            (None, HeadPreset::Sway) => HeadMotion::Sway {
+                amplitude: self.sway_cm / 100.0,
+                frequency: self.sway_hz,
+            },
+            (None, HeadPreset::Lean) => HeadMotion::Lean {
+                distance: self.lean_cm / 100.0,
+                duration: self.lean_s,
+                start: self.lean_at,
+            },
+        })
+    }
+
+    /// The options of the sequence at camera latency `latency_ms`.
+    fn options(&self, head: &HeadMotion, latency_ms: f64) -> SequenceOptions {
+        SequenceOptions {
+            run: RunOptions {
+                method: self.method,
+                d2: self.d2,
+                head: self.head_source,
+                head_bias_cm: self.head_bias_cm,
+                head_jitter_cm: self.head_jitter_cm,
+                seed: self.seed,
+                feature_width: self.feature_width,
+                width: Some(self.width),
+                height: self.height,
+                frontal_width: Some(self.frontal_width.unwrap_or(self.width)),
+                back_width: self.back_width,
+                spp: self.spp,
+                outside: self.outside,
+                filter: self.filter,
+                display: self.display,
+                progress: false,
+                // One eye, the scene's driver camera; the scene-model methods are refused.
+                eyes: Default::default(),
+                scene_model: Default::default(),
+            },
+            timeline: Timeline {
+                duration: self.duration,
+                fps: self.fps,
+                display_hz: self.display_hz.unwrap_or(self.fps),
+                latency_camera: latency_ms / 1e3,
+                latency_tracking: self.latency_tracking / 1e3,
+            },
+            speed: self.speed / 3.6,
+            yaw_rate: self.yaw_rate.to_radians(),
+            head: head.clone(),
+            predict: self.predict,
+            reproject: self.reproject,
+        }
+    }
+
+    pub fn run(self) -> Result<()> {
+        let threads = self.threads;
+        with_threads(threads, || self.run_all())?
+    }
+
+    fn run_all(&self) -> Result<()> {
+        let head = self.head_motion()?;
+        let scene = Scene::load(&self.scene)?;
+        // Every latency's timeline is checked before anything is rendered or written.
+        let all: Vec<SequenceOptions> = self
+            .latency_camera
+            .0
+            .iter()
+            .map(|&ms| self.options(&head, ms))
+            .collect();
+        for o in &all {
+            o.timeline.validate()?;
+        }
+        let mut runs: Vec<(f64, SequenceRun)> = Vec::new();
+        for (options, &ms) in all.into_iter().zip(&self.latency_camera.0) {
+            let dir = self.out.join(latency_dir(ms));
+            let timeline = options.timeline;
+            let mut preview = Preview::new(timeline.fps);
+            let frames = self.frames;
+            let how = Measuring {
+                metrics: true,
+                full_frames: frames != FramesFormat::None,
+                band: self.band,
+                progress: true,
+            };
+            let run = run_sequence(&scene, options, how, &mut |f| {
+                preview.add(&f);
+                let name = |view: &str, ext: &str| {
+                    dir.join("frames")
+                        .join(format!("{view}_{:05}.{ext}", f.record.frame))
+                };
+                match frames {
+                    FramesFormat::None => Ok(()),
+                    FramesFormat::Png => {
+                        write_color_png(f.truth, &name("truth", "png"))?;
+                        write_color_png(f.seethru, &name("seethru", "png"))
+                    }
+                    FramesFormat::Exr => {
+                        write_exr(f.truth, &name("truth", "exr"))?;
+                        write_exr(f.seethru, &name("seethru", "exr"))
+                    }
+                }
+            })?;
+            write_text(
+                &dir.join("frames.csv"),
+                &frames_csv(&run.records, &timeline)?,
+            )?;
+            let scale = preview.write(&dir.join("preview.png"))?;
+            over_time_figure(&[(format!("{ms} ms"), &run.records)], timeline.duration)
+                .write(&dir, "misregistration_over_time")?;
+            let mut s = summary(&run, &timeline);
+            s["preview_heat_scale_arcmin"] = json!(scale);
+            write_text(
+                &dir.join("summary.json"),
+                &serde_json::to_string_pretty(&s)?,
+            )?;
+            runs.push((ms, run));
+        }
+        self.write_overview(&runs)?;
+        say(format!(
+            "wrote {} sequence(s) of {} frames (frames.csv, summary.json, plots, preview.png) to {}",
+            runs.len(),
+            runs.first().map_or(0, |r| r.1.records.len()),
+            self.out.display()
+        ));
+        Ok(())
+    }
+
+    /// The top-level summary and plots: misregistration over time for every latency, and
+    /// mean and p95 against latency when there are several.
+    fn write_overview(&self, runs: &[(f64, SequenceRun)]) -> Result<()> {
+        let labelled: Vec<(String, &[_])> = runs
+            .iter()
+            .map(|(ms, r)| (format!("{ms} ms"), r.records.as_slice()))
+            .collect();
+        over_time_figure(&labelled, self.duration).write(&self.out, "misregistration_over_time")?;
+        let mut per_latency = Vec::new();
+        let mut points = Vec::new();
+        for (ms, run) in runs {
+            let timeline = self.options(&HeadMotion::Still, *ms).timeline;
+            let s = summary(run, &timeline);
+            let m = &s["misregistration_arcmin"];
+            let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+            points.push((
+                *ms,
+                f(&m["mean_of_frame_means"]),
+                f(&m["mean_of_frame_p95"]),
+            ));
+            per_latency
+                .push(json!({"latency_camera_ms": ms, "dir": latency_dir(*ms), "summary": s}));
+        }
+        if runs.len() > 1 {
+            latency_figure(&points).write(&self.out, "latency")?;
+        }
+        let overview = json!({
+            "scene": self.scene.display().to_string(),
+            "duration_s": self.duration,
+            "fps": self.fps,
+            "display_hz": self.display_hz.unwrap_or(self.fps),
+            "speed_kmh": self.speed,
+            "yaw_rate_deg_s": self.yaw_rate,
+            "head": self.head_motion()?.name(),
+            "latency_tracking_ms": self.latency_tracking,
+            "predict": self.predict,
+            "reproject": self.reproject,
+            "method": self.method,
+            "d2": format!("{:?}", self.d2),
+            "head_source": self.head_source,
+            "width": self.width,
+            "spp": self.spp,
+            "sequences": per_latency,
+        });
+        // Last: a directory with summary.json holds finished sequences.
+        write_text(
+            &self.out.join("summary.json"),
+            &serde_json::to_string_pretty(&overview)?,
+        )
+        .with_context(|| format!("writing {}", self.out.display()))
+    }
+}
+
+/// The folder of one latency's sequence: `latency_<ms>ms`.
+fn latency_dir(ms: f64) -> String {
+    format!("latency_{ms}ms")
+}

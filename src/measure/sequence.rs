@@ -1,0 +1,267 @@
+//! A sequence measured frame by frame: at every displayed frame the truth is rendered at that
+//! instant from the true eye, and the `seethru` view (what the system shows then, made from
+//! the late capture and head estimate, [`SystemLoop`]) is measured against it with the
+//! metrics of `run` (coverage beside every mean).
+
+use std::time::Instant;
+
+use anyhow::Result;
+use glam::DVec3;
+use obvhs::aabb::Aabb;
+
+use crate::measure::metrics::{MetricMaps, measure};
+use crate::render::footprint::{PixelRect, footprint};
+use crate::render::frame::Frame;
+use crate::render::settings::RenderSettings;
+use crate::scene::world::view_bit;
+use crate::scene::{Obstacle, Scene};
+use crate::system::sequence::system_loop::{SequenceOptions, StageSeconds, SystemLoop};
+use crate::system::sequence::timeline::FrameTimes;
+use crate::util::progress::Progress;
+
+/// The metrics of one frame (from `measure`'s JSON).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct FrameMetrics {
+    pub display_pixels: u64,
+    /// Fraction of the display's pixels that show the scene.
+    pub coverage: f64,
+    /// Misregistration over the covered display pixels, arc-minutes.
+    pub mean_arcmin: f64,
+    pub p95_arcmin: f64,
+    pub max_arcmin: f64,
+    /// Mean misregistration in the border band, arc-minutes.
+    pub border_mean_arcmin: f64,
+    pub psnr_db: f64,
+    pub ssim: f64,
+    pub flip: f64,
+    /// Fraction of display pixels whose truth point the frontal camera cannot see.
+    pub missing_fraction: f64,
+}
+
+impl FrameMetrics {
+    fn from_json(j: &serde_json::Value) -> FrameMetrics {
+        let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+        let d = &j["display"];
+        FrameMetrics {
+            display_pixels: j["display_pixels"].as_u64().unwrap_or(0),
+            coverage: f(&j["coverage"]),
+            mean_arcmin: f(&d["misregistration_arcmin"]["mean"]),
+            p95_arcmin: f(&d["misregistration_arcmin"]["p95"]),
+            max_arcmin: f(&d["misregistration_arcmin"]["max"]),
+            border_mean_arcmin: f(&j["border"]["misregistration_arcmin"]["mean"]),
+            psnr_db: f(&d["psnr_db"]),
+            ssim: f(&d["ssim"]),
+            flip: f(&d["flip_mean"]),
+            missing_fraction: f(&j["missing"]["fraction"]),
+        }
+    }
+}
+
+/// One displayed frame.
+#[derive(Clone, Debug)]
+pub struct FrameRecord {
+    pub frame: usize,
+    pub times: FrameTimes,
+    /// The true eye at display time, obstacle frame, m.
+    pub eye_true: DVec3,
+    /// The head estimate behind the image shown (of time `times.head`), obstacle frame, m.
+    pub eye_estimated: DVec3,
+    /// The eye the compensation used (predicted), obstacle frame, m.
+    pub eye_used: DVec3,
+    /// The vehicle's pivot (the eye at t = 0 carried along), world, m; its yaw, degrees.
+    pub vehicle_position: DVec3,
+    pub vehicle_yaw_deg: f64,
+    pub d2_used: Option<f64>,
+    /// `None` when the sequence runs without truth and metrics.
+    pub metrics: Option<FrameMetrics>,
+}
+
+/// The images of one measured frame, for the caller to write or collect.
+pub struct FrameImages<'a> {
+    pub record: &'a FrameRecord,
+    pub truth: &'a Frame,
+    pub seethru: &'a Frame,
+    pub maps: &'a MetricMaps,
+    /// The driver-view pixels rendered for every frame (the display's neighbourhood over the
+    /// whole sequence), where previews are cut.
+    pub window: PixelRect,
+}
+
+/// What a sequence produced besides its frames.
+pub struct SequenceRun {
+    pub records: Vec<FrameRecord>,
+    /// The system's stages.
+    pub system: StageSeconds,
+    /// Truth, `occluded` and metrics, seconds.
+    pub truth_seconds: f64,
+    pub metrics_seconds: f64,
+    pub total_seconds: f64,
+    pub window: PixelRect,
+    /// Frontal pixels rendered per refresh, on average.
+    pub frontal_pixels_per_refresh: f64,
+}
+
+/// How a sequence is measured.
+#[derive(Clone, Copy, Debug)]
+pub struct Measuring {
+    /// Render the truth and compute the metrics (else only the system's loop runs).
+    pub metrics: bool,
+    /// Render whole driver views (else only the window around the display).
+    pub full_frames: bool,
+    /// Border band, display pixels.
+    pub band: u32,
+    pub progress: bool,
+}
+
+/// The world box of the obstacle's body.
+fn obstacle_box(o: &Obstacle) -> Aabb {
+    let mut b = Aabb::empty();
+    for k in 0..8 {
+        let p = DVec3::new(
+            if k & 1 == 0 { -0.5 } else { 0.5 } * o.width,
+            if k & 2 == 0 { -0.5 } else { 0.5 } * o.height,
+            if k & 4 == 0 { 0.0 } else { -o.thickness },
+        );
+        b.extend(o.world_from_obstacle.transform_point3(p).as_vec3().into());
+    }
+    b
+}
+
+/// The union over the sequence of the driver-view pixels that can see the obstacle, grown by
+/// a fifth of its size on each side.
+fn window(system: &SystemLoop) -> PixelRect {
+    let tl = system.options.timeline;
+    let mut r: Option<PixelRect> = None;
+    for k in 0..tl.frames() {
+        let s = system.rig.scene_at(tl.times(k).display);
+        let f = footprint(&s.driver, &obstacle_box(&s.obstacle));
+        r = Some(r.map_or(f, |r| PixelRect {
+            x0: r.x0.min(f.x0),
+            y0: r.y0.min(f.y0),
+            x1: r.x1.max(f.x1),
+            y1: r.y1.max(f.y1),
+        }));
+    }
+    let camera = system.rig.base.driver;
+    let r = r.unwrap_or(PixelRect::full(&camera));
+    let (gx, gy) = ((r.x1 - r.x0) / 5 + 2, (r.y1 - r.y0) / 5 + 2);
+    PixelRect {
+        x0: r.x0.saturating_sub(gx),
+        y0: r.y0.saturating_sub(gy),
+        x1: (r.x1 + gx).min(camera.width),
+        y1: (r.y1 + gy).min(camera.height),
+    }
+}
+
+/// Runs and measures a sequence; `on_frame` gets every measured frame's images in order.
+pub fn run_sequence(
+    scene: &Scene,
+    options: SequenceOptions,
+    how: Measuring,
+    on_frame: &mut dyn FnMut(FrameImages) -> Result<()>,
+) -> Result<SequenceRun> {
+    let start = Instant::now();
+    let mut system = SystemLoop::new(scene, options)?;
+    let tl = system.options.timeline;
+    let settings = RenderSettings {
+        spp: system.options.run.spp,
+        progress: false,
+    };
+    let window = window(&system);
+    let camera = system.rig.base.driver;
+    let region = if how.full_frames {
+        PixelRect::full(&camera)
+    } else {
+        window
+    };
+    let mut truth = Frame::new(camera.width, camera.height);
+    let mut seethru = truth.clone();
+    let (mut truth_seconds, mut metrics_seconds) = (0.0, 0.0);
+    let mut refreshes = std::collections::BTreeSet::new();
+    let mut records = Vec::with_capacity(tl.frames());
+    let progress = Progress::new("sequence", tl.frames(), how.progress);
+    for k in 0..tl.frames() {
+        let times = tl.times(k);
+        let shown = system.show(k)?.clone();
+        refreshes.insert(shown.times.refresh);
+        let ctx = system.context_at(times.display)?;
+        let rig = system.rig.world_from_rig(times.display);
+        let mut record = FrameRecord {
+            frame: k,
+            times: FrameTimes {
+                display: times.display,
+                ..shown.times
+            },
+            eye_true: system.rig.eye_in_obstacle(times.display),
+            eye_estimated: shown.eye_estimated,
+            eye_used: shown.eye_used,
+            vehicle_position: rig.transform_point3(system.rig.vehicle.pivot),
+            vehicle_yaw_deg: (system.rig.vehicle.yaw_rate * times.display).to_degrees(),
+            d2_used: shown.d2_used,
+            metrics: None,
+        };
+        if !how.metrics {
+            system.render_seethru(&ctx, &mut seethru);
+            records.push(record);
+            progress.advance(1);
+            continue;
+        }
+        let t0 = Instant::now();
+        let driver = ctx.scene.driver;
+        ctx.render_rect(
+            &driver,
+            view_bit::TRUTH,
+            None,
+            settings,
+            region,
+            &mut truth,
+            "truth",
+        );
+        let mut occluded = truth.clone();
+        let around = ctx.difference_region(&driver, view_bit::TRUTH, view_bit::OCCLUDED);
+        ctx.render_rect(
+            &driver,
+            view_bit::OCCLUDED,
+            None,
+            settings,
+            around,
+            &mut occluded,
+            "occluded",
+        );
+        truth_seconds += t0.elapsed().as_secs_f64();
+        seethru.clone_from(&truth);
+        system.render_seethru(&ctx, &mut seethru);
+        let t1 = Instant::now();
+        // Missing pixels are those the frontal camera, where it was at capture, cannot see.
+        let mut measured = ctx.scene.clone();
+        measured.frontal = shown.frontal;
+        let (maps, json) = measure(
+            &ctx,
+            &measured,
+            driver.position(),
+            [&truth, &seethru, &occluded],
+            how.band,
+        );
+        metrics_seconds += t1.elapsed().as_secs_f64();
+        record.metrics = Some(FrameMetrics::from_json(&json));
+        records.push(record);
+        on_frame(FrameImages {
+            record: records.last().expect("just pushed"),
+            truth: &truth,
+            seethru: &seethru,
+            maps: &maps,
+            window,
+        })?;
+        progress.advance(1);
+    }
+    progress.finish();
+    Ok(SequenceRun {
+        records,
+        system: system.seconds,
+        truth_seconds,
+        metrics_seconds,
+        total_seconds: start.elapsed().as_secs_f64(),
+        window,
+        frontal_pixels_per_refresh: system.frontal_pixels as f64 / refreshes.len().max(1) as f64,
+    })
+}

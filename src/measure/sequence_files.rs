@@ -1,0 +1,362 @@
+//! A measured sequence on disk: `frames.csv` (one row per frame), the summary, the plots and
+//! the animated preview truth | seethru | misregistration.
+
+use std::path::Path;
+
+use anyhow::Result;
+use plotters::prelude::SeriesLabelPosition;
+use serde_json::json;
+
+use crate::io::animation::write_apng;
+use crate::io::plot::{Figure, Series};
+use crate::measure::maps::heat_color;
+use crate::measure::sequence::{FrameImages, FrameMetrics, FrameRecord, SequenceRun};
+use crate::system::sequence::timeline::Timeline;
+use crate::util::color::encode_srgb8;
+
+/// The columns of `frames.csv`.
+pub const FRAME_COLUMNS: [&str; 38] = [
+    "frame",
+    "t_s",
+    "refresh_s",
+    "capture_s",
+    "head_sample_s",
+    "latency_camera_ms",
+    "latency_tracking_ms",
+    "hold_ms",
+    "image_age_ms",
+    "head_age_ms",
+    "eye_true_x_m",
+    "eye_true_y_m",
+    "eye_true_z_m",
+    "eye_estimated_x_m",
+    "eye_estimated_y_m",
+    "eye_estimated_z_m",
+    "eye_used_x_m",
+    "eye_used_y_m",
+    "eye_used_z_m",
+    "eye_error_mm",
+    "vehicle_x_m",
+    "vehicle_y_m",
+    "vehicle_z_m",
+    "vehicle_yaw_deg",
+    "d2_m",
+    "display_pixels",
+    "coverage",
+    "misregistration_mean_arcmin",
+    "misregistration_p95_arcmin",
+    "misregistration_max_arcmin",
+    "border_mean_arcmin",
+    "psnr_db",
+    "ssim",
+    "flip",
+    "missing_fraction",
+    "blank_fraction",
+    "eye_x_velocity_m_s",
+    "eye_z_velocity_m_s",
+];
+
+/// `frames.csv`: every number in Rust's shortest round-trip form (the same bytes for any
+/// thread count).
+pub fn frames_csv(records: &[FrameRecord], timeline: &Timeline) -> Result<String> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(FRAME_COLUMNS)?;
+    for (i, r) in records.iter().enumerate() {
+        let t = &r.times;
+        let m = r.metrics.unwrap_or(FrameMetrics {
+            coverage: f64::NAN,
+            mean_arcmin: f64::NAN,
+            p95_arcmin: f64::NAN,
+            max_arcmin: f64::NAN,
+            border_mean_arcmin: f64::NAN,
+            psnr_db: f64::NAN,
+            ssim: f64::NAN,
+            flip: f64::NAN,
+            missing_fraction: f64::NAN,
+            display_pixels: 0,
+        });
+        // The eye's velocity over the previous frame (zero for the first).
+        let velocity = match i.checked_sub(1).map(|j| &records[j]) {
+            Some(p) => (r.eye_true - p.eye_true) / (t.display - p.times.display),
+            None => glam::DVec3::ZERO,
+        };
+        let ms = |s: f64| s * 1e3;
+        let values: Vec<String> = [
+            t.display,
+            t.refresh_time,
+            t.capture,
+            t.head,
+            ms(timeline.latency_camera),
+            ms(timeline.latency_tracking),
+            ms(t.display - t.refresh_time),
+            ms(t.display - t.capture),
+            ms(t.display - t.head),
+            r.eye_true.x,
+            r.eye_true.y,
+            r.eye_true.z,
+            r.eye_estimated.x,
+            r.eye_estimated.y,
+            r.eye_estimated.z,
+            r.eye_used.x,
+            r.eye_used.y,
+            r.eye_used.z,
+            (r.eye_used - r.eye_true).length() * 1e3,
+            r.vehicle_position.x,
+            r.vehicle_position.y,
+            r.vehicle_position.z,
+            r.vehicle_yaw_deg,
+            r.d2_used.unwrap_or(f64::INFINITY),
+            m.display_pixels as f64,
+            m.coverage,
+            m.mean_arcmin,
+            m.p95_arcmin,
+            m.max_arcmin,
+            m.border_mean_arcmin,
+            m.psnr_db,
+            m.ssim,
+            m.flip,
+            m.missing_fraction,
+            1.0 - m.coverage,
+            velocity.x,
+            velocity.z,
+        ]
+        .iter()
+        .map(|v| format!("{v}"))
+        .collect();
+        let mut row = vec![r.frame.to_string()];
+        row.extend(values);
+        w.write_record(&row)?;
+    }
+    Ok(String::from_utf8(w.into_inner()?)?)
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (s, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 { f64::NAN } else { s / n as f64 }
+}
+
+/// The sequence's figures over its frames: means of the per-frame statistics, the extremes,
+/// and the coverage they were taken at.
+pub fn summary(run: &SequenceRun, timeline: &Timeline) -> serde_json::Value {
+    let m: Vec<FrameMetrics> = run.records.iter().filter_map(|r| r.metrics).collect();
+    let frames = run.records.len() as f64;
+    let errors: Vec<f64> = run
+        .records
+        .iter()
+        .map(|r| (r.eye_used - r.eye_true).length() * 1e3)
+        .collect();
+    json!({
+        "frames": run.records.len(),
+        "latency_camera_ms": timeline.latency_camera * 1e3,
+        "latency_tracking_ms": timeline.latency_tracking * 1e3,
+        "misregistration_arcmin": {
+            "mean_of_frame_means": mean(m.iter().map(|x| x.mean_arcmin)),
+            "mean_of_frame_p95": mean(m.iter().map(|x| x.p95_arcmin)),
+            "max_of_frame_p95": m.iter().map(|x| x.p95_arcmin).fold(f64::NAN, f64::max),
+            "max": m.iter().map(|x| x.max_arcmin).fold(f64::NAN, f64::max),
+        },
+        "coverage": {
+            "mean": mean(m.iter().map(|x| x.coverage)),
+            "min": m.iter().map(|x| x.coverage).fold(f64::NAN, f64::min),
+        },
+        "missing_fraction_mean": mean(m.iter().map(|x| x.missing_fraction)),
+        "eye_error_mm": {
+            "mean": mean(errors.iter().copied()),
+            "max": errors.iter().copied().fold(f64::NAN, f64::max),
+        },
+        "seconds": {
+            "system": run.system,
+            "system_total": run.system.total(),
+            "truth_and_occluded": run.truth_seconds,
+            "metrics": run.metrics_seconds,
+            "total": run.total_seconds,
+        },
+        "frames_per_second": {
+            "system_loop": frames / run.system.total(),
+            "with_truth_and_metrics": frames / run.total_seconds,
+        },
+        "frontal_pixels_per_refresh": run.frontal_pixels_per_refresh,
+        "window_px": [run.window.x0, run.window.y0, run.window.x1, run.window.y1],
+        "notes": "per-frame statistics over the display pixels that show the scene (coverage beside them); mean_of_frame_means averages the frames' means; eye_error: the compensation's eye against the true eye at display time",
+    })
+}
+
+/// Misregistration over time, one curve per sequence (label, records).
+pub fn over_time_figure(sequences: &[(String, &[FrameRecord])], duration: f64) -> Figure {
+    let series: Vec<Series> = sequences
+        .iter()
+        .map(|(label, records)| {
+            Series::new(
+                label.clone(),
+                records
+                    .iter()
+                    .filter_map(|r| r.metrics.map(|m| (r.times.display, m.mean_arcmin)))
+                    .collect(),
+            )
+        })
+        .collect();
+    let top = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .filter(|v| v.is_finite())
+        .fold(1.0, f64::max);
+    Figure {
+        title: "Mean misregistration over the display, frame by frame".into(),
+        x_label: "time (s)".into(),
+        y_label: "mean misregistration (arc-minutes)".into(),
+        x_range: (0.0, duration),
+        y_range: (0.0, top * 1.1),
+        series,
+        bounds: Vec::new(),
+        marks: Vec::new(),
+        legend: SeriesLabelPosition::UpperLeft,
+    }
+}
+
+/// Mean and p95 misregistration against the camera latency: (latency ms, mean, p95).
+pub fn latency_figure(points: &[(f64, f64, f64)]) -> Figure {
+    let top = points
+        .iter()
+        .map(|p| p.2)
+        .filter(|v| v.is_finite())
+        .fold(1.0, f64::max);
+    let right = points.iter().map(|p| p.0).fold(1.0, f64::max);
+    Figure {
+        title: "Misregistration against the camera latency".into(),
+        x_label: "capture-to-display latency (ms)".into(),
+        y_label: "misregistration (arc-minutes)".into(),
+        x_range: (0.0, right * 1.05),
+        y_range: (0.0, top * 1.1),
+        series: vec![
+            Series::new(
+                "mean (of frame means)".into(),
+                points.iter().map(|p| (p.0, p.1)).collect(),
+            ),
+            Series::new(
+                "p95 (mean of frame p95)".into(),
+                points.iter().map(|p| (p.0, p.2)).collect(),
+            ),
+        ],
+        bounds: Vec::new(),
+        marks: Vec::new(),
+        legend: SeriesLabelPosition::UpperLeft,
+    }
+}
+
+/// Longest side of a preview panel, pixels.
+const PREVIEW_PANEL_MAX: u32 = 320;
+/// Highest preview frame rate, Hz (frames beyond it are skipped).
+const PREVIEW_MAX_FPS: f64 = 30.0;
+
+/// Collects preview frames (truth | seethru | misregistration, cut to the window around the
+/// display) and writes them as an APNG with one colour scale for the whole sequence.
+pub struct Preview {
+    every: usize,
+    fps: f64,
+    step: u32,
+    size: (u32, u32),
+    panels: Vec<PreviewFrame>,
+}
+
+/// One preview frame's panels, cut to the window: sRGB truth and seethru, and the
+/// misregistration (arc-minutes; NaN on blank display pixels, −∞ outside the display).
+struct PreviewFrame {
+    truth: Vec<[u8; 3]>,
+    shown: Vec<[u8; 3]>,
+    misregistration: Vec<f32>,
+}
+
+impl Preview {
+    pub fn new(fps: f64) -> Preview {
+        let every = (fps / PREVIEW_MAX_FPS).ceil().max(1.0) as usize;
+        Preview {
+            every,
+            fps: fps / every as f64,
+            step: 1,
+            size: (0, 0),
+            panels: Vec::new(),
+        }
+    }
+
+    pub fn add(&mut self, f: &FrameImages) {
+        if !f.record.frame.is_multiple_of(self.every) {
+            return;
+        }
+        let w = f.window;
+        let (ww, wh) = (w.x1 - w.x0, w.y1 - w.y0);
+        self.step = ww.max(wh).div_ceil(PREVIEW_PANEL_MAX).max(1);
+        self.size = (ww.div_ceil(self.step), wh.div_ceil(self.step));
+        let (mut truth, mut shown, mut mis) = (Vec::new(), Vec::new(), Vec::new());
+        for y in (w.y0..w.y1).step_by(self.step as usize) {
+            for x in (w.x0..w.x1).step_by(self.step as usize) {
+                let i = f.truth.index(x, y);
+                truth.push(encode_srgb8(f.truth.color[i]));
+                shown.push(encode_srgb8(f.seethru.color[i]));
+                mis.push(if f.maps.display[i] {
+                    f.maps.misregistration[i]
+                } else {
+                    f32::NEG_INFINITY
+                });
+            }
+        }
+        self.panels.push(PreviewFrame {
+            truth,
+            shown,
+            misregistration: mis,
+        });
+    }
+
+    /// Writes the APNG; the heat scale tops out at the 99th percentile of every frame's
+    /// values. Returns that scale, arc-minutes.
+    pub fn write(&self, path: &Path) -> Result<f32> {
+        let mut all: Vec<f32> = self
+            .panels
+            .iter()
+            .flat_map(|p| p.misregistration.iter().copied().filter(|v| v.is_finite()))
+            .collect();
+        all.sort_by(f32::total_cmp);
+        let top = all
+            .get((all.len() as f32 * 0.99) as usize)
+            .copied()
+            .unwrap_or(1.0)
+            .max(1.0);
+        let (w, h) = self.size;
+        let gap = 4;
+        let width = 3 * w + 2 * gap;
+        let frames: Vec<Vec<u8>> = self
+            .panels
+            .iter()
+            .map(
+                |PreviewFrame {
+                     truth,
+                     shown,
+                     misregistration: mis,
+                 }| {
+                    let mut rgb = vec![255u8; (width * h * 3) as usize];
+                    for y in 0..h {
+                        for x in 0..w {
+                            let i = (y * w + x) as usize;
+                            let heat = match mis[i] {
+                                v if v.is_finite() => heat_color(v / top),
+                                v if v == f32::NEG_INFINITY => {
+                                    let g =
+                                        (truth[i].iter().map(|&c| c as u32).sum::<u32>() / 6) as u8;
+                                    [g, g, g]
+                                }
+                                // A display pixel without a misregistration: blank.
+                                _ => [0, 0, 0],
+                            };
+                            for (panel, c) in [truth[i], shown[i], heat].into_iter().enumerate() {
+                                let o = ((y * width + panel as u32 * (w + gap) + x) * 3) as usize;
+                                rgb[o..o + 3].copy_from_slice(&c);
+                            }
+                        }
+                    }
+                    rgb
+                },
+            )
+            .collect();
+        write_apng(path, width, h, &frames, self.fps)?;
+        Ok(top)
+    }
+}

@@ -1,0 +1,115 @@
+//! A recorded head path for `seethru sequence --head-path`: a CSV of `t,x,y,z` rows — time in
+//! seconds, the eye in the obstacle frame in metres — read with the `csv` crate. Times must
+//! increase; every value must be a finite number; a first line `t,x,y,z` is a header.
+
+use std::path::Path;
+
+use anyhow::{Result, bail};
+use glam::DVec3;
+
+/// Most rows of a head path.
+pub const MAX_ROWS: usize = 1_000_000;
+
+/// The eye's path in the obstacle frame: linear between samples, held outside them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeadPath {
+    /// (time s, eye in the obstacle frame m), times strictly increasing.
+    pub samples: Vec<(f64, DVec3)>,
+}
+
+impl HeadPath {
+    pub fn load(path: &Path) -> Result<HeadPath> {
+        let text = std::fs::read(path)
+            .map_err(|e| anyhow::anyhow!("{}: cannot read the head path: {e}", path.display()))?;
+        Self::parse(&text, &path.display().to_string())
+    }
+
+    /// Parses CSV `text`; errors name `name` and the line.
+    pub fn parse(text: &[u8], name: &str) -> Result<HeadPath> {
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .trim(csv::Trim::All)
+            .from_reader(text);
+        let mut samples: Vec<(f64, DVec3)> = Vec::new();
+        for (i, record) in reader.records().enumerate() {
+            let record = record.map_err(|e| {
+                let line = e.position().map_or(i as u64 + 1, |p| p.line());
+                anyhow::anyhow!("{name}:{line}: not CSV: {e}")
+            })?;
+            let line = record.position().map_or(i as u64 + 1, |p| p.line());
+            if i == 0 && record.get(0) == Some("t") {
+                continue;
+            }
+            if record.len() != 4 {
+                bail!(
+                    "{name}:{line}: expected 4 values t,x,y,z (seconds, metres in the obstacle frame), got {}",
+                    record.len()
+                );
+            }
+            let mut values = [0.0; 4];
+            for (k, column) in ["t", "x", "y", "z"].iter().enumerate() {
+                let field = &record[k];
+                values[k] = match field.parse::<f64>() {
+                    Ok(v) if v.is_finite() && v.abs() <= 1e6 => v,
+                    _ => bail!(
+                        "{name}:{line}: `{column}` must be a finite number in [-1000000, 1000000], got `{field}`"
+                    ),
+                };
+            }
+            let [t, x, y, z] = values;
+            if let Some(&(previous, _)) = samples.last()
+                && t <= previous
+            {
+                bail!("{name}:{line}: times must increase: t = {t} s follows t = {previous} s");
+            }
+            if samples.len() == MAX_ROWS {
+                bail!("{name}:{line}: more than {MAX_ROWS} rows");
+            }
+            samples.push((t, DVec3::new(x, y, z)));
+        }
+        if samples.is_empty() {
+            bail!("{name}: the head path has no rows (expected t,x,y,z lines)");
+        }
+        Ok(HeadPath { samples })
+    }
+
+    /// The eye at time `t`, obstacle frame.
+    pub fn at(&self, t: f64) -> DVec3 {
+        let s = &self.samples;
+        match s.iter().position(|&(ts, _)| ts > t) {
+            Some(0) => s[0].1,
+            None => s[s.len() - 1].1,
+            Some(i) => {
+                let ((t0, a), (t1, b)) = (s[i - 1], s[i]);
+                a.lerp(b, (t - t0) / (t1 - t0))
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_path_reads_interpolates_and_holds() {
+        let p = HeadPath::parse(b"t,x,y,z\n0,0,0,0.7\n1, 0.1, 0, 0.7\n", "p.csv").unwrap();
+        assert_eq!(p.samples.len(), 2);
+        assert!((p.at(0.5).x - 0.05).abs() < 1e-15);
+        assert_eq!((p.at(-1.0).x, p.at(5.0).x), (0.0, 0.1));
+    }
+
+    #[test]
+    fn bad_paths_name_the_line() {
+        let err = |text: &str| {
+            HeadPath::parse(text.as_bytes(), "p.csv")
+                .unwrap_err()
+                .to_string()
+        };
+        assert!(err("0,0,0,1\n0,0,0,1\n").starts_with("p.csv:2: times must increase"));
+        assert!(err("0,0,0,1\n1,NaN,0,1\n").starts_with("p.csv:2: `x` must be a finite"));
+        assert!(err("0,0,0\n").starts_with("p.csv:1: expected 4 values"));
+        assert!(err("").contains("no rows"));
+    }
+}

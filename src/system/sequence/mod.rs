@@ -1,0 +1,16 @@
+//! The see-through system over time (`seethru sequence`): the vehicle drives and turns, the
+//! head moves, and every image the display shows is late by the system's latencies.
+//!
+//! - `timeline`: frame, refresh, capture and head-sample times; the rig at any instant;
+//! - `head_motion`: still, sway, lean or a recorded path;
+//! - `predict`: the head estimate carried to display time;
+//! - `system_loop`: per displayed frame, the system's work — frontal render at its capture
+//!   time, head estimate, prediction, compensation, the display image — and the `seethru` view;
+//!   the static world's hierarchy is built once, what moves gets its own small one per instant.
+//!
+//! The truth and the metrics of every frame are `measure::sequence`'s.
+
+pub mod head_motion;
+pub mod predict;
+pub mod system_loop;
+pub mod timeline;

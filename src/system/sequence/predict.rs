@@ -1,0 +1,139 @@
+//! Head prediction: the head estimate (old by the tracking and camera latencies) carried
+//! forward to the time its frame is shown — the thing a product would add.
+
+use glam::DVec3;
+
+/// How the head estimate is carried to display time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Prediction {
+    /// The latest estimate as it is.
+    None,
+    /// The latest estimate plus the velocity of the last two, times the age.
+    ConstantVelocity,
+    /// A constant-velocity Kalman filter per axis over every estimate, extrapolated.
+    Kalman,
+}
+
+/// Process noise of the Kalman filter: white acceleration of this spectral density,
+/// m²/s³ (a lean of 10 cm in 0.3 s peaks near 5 m/s²).
+pub const KALMAN_ACCELERATION_DENSITY: f64 = 4.0;
+
+/// One axis of the constant-velocity Kalman filter: state (position, velocity) and its
+/// covariance.
+#[derive(Clone, Copy, Debug)]
+struct Axis {
+    x: [f64; 2],
+    p: [[f64; 2]; 2],
+}
+
+impl Axis {
+    fn new(z: f64, r: f64) -> Axis {
+        Axis {
+            x: [z, 0.0],
+            p: [[r, 0.0], [0.0, 1.0]],
+        }
+    }
+
+    fn step(&mut self, dt: f64, z: f64, r: f64) {
+        let q = KALMAN_ACCELERATION_DENSITY;
+        let [p, v] = self.x;
+        let [[a, b], [c, d]] = self.p;
+        // Predict: F = [[1, dt], [0, 1]], Q = q [[dt³/3, dt²/2], [dt²/2, dt]].
+        let x = [p + v * dt, v];
+        let p00 = a + dt * (b + c) + dt * dt * d + q * dt.powi(3) / 3.0;
+        let p01 = b + dt * d + q * dt * dt / 2.0;
+        let p10 = c + dt * d + q * dt * dt / 2.0;
+        let p11 = d + q * dt;
+        // Update with a position measurement of variance r.
+        let s = p00 + r;
+        let (k0, k1) = (p00 / s, p10 / s);
+        let y = z - x[0];
+        self.x = [x[0] + k0 * y, x[1] + k1 * y];
+        self.p = [
+            [(1.0 - k0) * p00, (1.0 - k0) * p01],
+            [p10 - k1 * p00, p11 - k1 * p01],
+        ];
+    }
+}
+
+/// Head estimates in, predictions out. Estimates must come in increasing time.
+pub struct Predictor {
+    kind: Prediction,
+    /// Standard deviation of one estimate, m (the filter's measurement noise).
+    sigma: f64,
+    last: Option<(f64, DVec3)>,
+    previous: Option<(f64, DVec3)>,
+    kalman: Option<[Axis; 3]>,
+}
+
+impl Predictor {
+    pub fn new(kind: Prediction, sigma: f64) -> Predictor {
+        Predictor {
+            kind,
+            sigma: sigma.max(1e-4),
+            last: None,
+            previous: None,
+            kalman: None,
+        }
+    }
+
+    /// A head estimate `eye` (obstacle frame, m) of time `t` (s).
+    pub fn observe(&mut self, t: f64, eye: DVec3) {
+        if let Some((t0, _)) = self.last
+            && t <= t0
+        {
+            return;
+        }
+        let r = self.sigma * self.sigma;
+        let dt = self.last.map_or(0.0, |(t0, _)| t - t0);
+        self.previous = self.last;
+        self.last = Some((t, eye));
+        match &mut self.kalman {
+            None => self.kalman = Some(eye.to_array().map(|z| Axis::new(z, r))),
+            Some(axes) => {
+                for (axis, z) in axes.iter_mut().zip(eye.to_array()) {
+                    axis.step(dt, z, r);
+                }
+            }
+        }
+    }
+
+    /// The eye predicted for time `t`.
+    pub fn predict(&self, t: f64) -> DVec3 {
+        let Some((t1, e1)) = self.last else {
+            return DVec3::NAN;
+        };
+        match (self.kind, self.previous) {
+            (Prediction::None, _) => e1,
+            (Prediction::ConstantVelocity, Some((t0, e0))) => e1 + (e1 - e0) / (t1 - t0) * (t - t1),
+            (Prediction::ConstantVelocity, None) => e1,
+            (Prediction::Kalman, _) => {
+                let axes = self.kalman.expect("observed");
+                DVec3::from_array(axes.map(|a| a.x[0] + a.x[1] * (t - t1)))
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn predictions_of_a_constant_velocity_eye_are_exact() {
+        let eye = |t: f64| DVec3::new(0.3 + 0.2 * t, 0.0, 0.7 - 0.1 * t);
+        for kind in [Prediction::ConstantVelocity, Prediction::Kalman] {
+            let mut p = Predictor::new(kind, 1e-4);
+            for k in 0..200 {
+                p.observe(k as f64 / 60.0, eye(k as f64 / 60.0));
+            }
+            let t = 199.0 / 60.0 + 0.1;
+            assert!((p.predict(t) - eye(t)).length() < 1e-4, "{kind:?}");
+        }
+        let mut none = Predictor::new(Prediction::None, 1e-3);
+        none.observe(0.0, eye(0.0));
+        none.observe(1.0, eye(1.0));
+        assert_eq!(none.predict(2.0), eye(1.0));
+    }
+}

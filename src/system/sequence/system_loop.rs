@@ -1,0 +1,366 @@
+//! The system's work for each displayed frame of a sequence, at the instants it happens:
+//! the frontal camera's capture, the back camera's head estimate, the prediction, the
+//! compensation and the display image; and the `seethru` view at display time.
+//!
+//! The static world and its hierarchy are built once; what moves (the obstacle, what rides
+//! with the vehicle or the head, objects on keyframed paths) is a small world of its own whose
+//! hierarchy is rebuilt for each instant ([`MovingParts::at`]).
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use glam::{DVec2, DVec3};
+
+use crate::geometry::camera::Camera;
+use crate::geometry::lens::Lens;
+use crate::render::accel::Accel;
+use crate::render::footprint::PixelRect;
+use crate::render::frame::Frame;
+use crate::render::integrator::RenderContext;
+use crate::render::moving::MovingParts;
+use crate::render::settings::{RenderSettings, check_spp, resized};
+use crate::render::sky::SkyModel;
+use crate::scene::Scene;
+use crate::scene::world::{World, view_bit};
+use crate::system::compensation::Crop;
+use crate::system::display::{DisplayModel, DisplayPlacement, DisplaySurface, resample_through};
+use crate::system::frontal_map::FrontalMap;
+use crate::system::head::{detect, eye_from_detection, gaussian};
+use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
+use crate::system::pipeline::{crop_for, driver_camera, frontal_map};
+use crate::system::sequence::head_motion::HeadMotion;
+use crate::system::sequence::predict::{Prediction, Predictor};
+use crate::system::sequence::timeline::{FrameTimes, Rig, Timeline};
+use crate::util::number::short;
+
+/// Fewest samples per pixel of the back camera's image.
+pub const BACK_MIN_SPP: u32 = 4;
+
+/// Frontal pixels rendered around the crop: the bicubic filter reads two beyond it.
+const CROP_MARGIN_PX: f64 = 3.0;
+
+/// Everything a sequence is asked for.
+#[derive(Clone, Debug)]
+pub struct SequenceOptions {
+    /// The system's choices (method, d2, head source and its errors, sizes, spp, display).
+    pub run: RunOptions,
+    pub timeline: Timeline,
+    /// Vehicle speed along world −z, m/s.
+    pub speed: f64,
+    /// Vehicle yaw rate, rad/s, positive to the left.
+    pub yaw_rate: f64,
+    pub head: HeadMotion,
+    pub predict: Prediction,
+    /// Re-project the frontal image by the vehicle's known motion from capture to display.
+    pub reproject: bool,
+}
+
+/// What the display shows from one refresh on.
+#[derive(Clone, Debug)]
+pub struct Shown {
+    pub times: FrameTimes,
+    /// The head estimate (of time `times.head`), obstacle frame, m.
+    pub eye_estimated: DVec3,
+    /// The eye the compensation used (predicted to the refresh time), obstacle frame, m.
+    pub eye_used: DVec3,
+    pub crop: Crop,
+    /// The model plane's distance, m (`None`: d2 → ∞ or no model).
+    pub d2_used: Option<f64>,
+    /// The frontal camera at the capture time.
+    pub frontal: Camera,
+    /// The believed frontal lens the display image went through (`None`: a pinhole).
+    pub lens: Option<Lens>,
+}
+
+/// Wall time spent in each stage, seconds, summed over the frames.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct StageSeconds {
+    /// Placing the moving part and building its hierarchy.
+    pub moving: f64,
+    pub frontal: f64,
+    pub head: f64,
+    pub compensation: f64,
+    pub seethru: f64,
+}
+
+impl StageSeconds {
+    pub fn total(&self) -> f64 {
+        self.moving + self.frontal + self.head + self.compensation + self.seethru
+    }
+}
+
+pub struct SystemLoop {
+    pub options: SequenceOptions,
+    pub rig: Rig,
+    world: Arc<World>,
+    accel: Arc<Accel>,
+    sky: Arc<SkyModel>,
+    parts: MovingParts,
+    predictor: Predictor,
+    frontal: Frame,
+    shown: Option<Shown>,
+    /// The display showing the image of the last refresh.
+    surface: Option<DisplaySurface>,
+    pub seconds: StageSeconds,
+    /// Frontal pixels rendered, summed over the refreshes.
+    pub frontal_pixels: u64,
+}
+
+impl SystemLoop {
+    /// Checks the options, sizes the cameras and builds the static world's hierarchy.
+    pub fn new(scene: &Scene, options: SequenceOptions) -> Result<SystemLoop> {
+        let run = &options.run;
+        check_spp(run.spp)?;
+        options.timeline.validate()?;
+        if run.method.models_the_scene() {
+            bail!(
+                "sequence: --method ground, plane-fit and depth are not modelled over time; use --method planar or none"
+            );
+        }
+        if !(run.feature_width > 0.0 && run.feature_width.is_finite()) {
+            bail!("--feature-width must be > 0 m, got {}", run.feature_width);
+        }
+        let mut base = scene.clone();
+        base.frontal = resized(base.frontal, run.frontal_width, None)?;
+        base.back = resized(base.back, run.back_width, None)?;
+        base.driver = driver_camera(&base, run)?;
+        let rig = Rig::new(base, options.speed, options.yaw_rate, options.head.clone());
+        let tl = options.timeline;
+        rig.check_eye((0..tl.frames()).flat_map(|k| {
+            let t = tl.times(k);
+            [t.display, t.head]
+        }))?;
+        let moves = |i: usize| scene.objects[i].motion.moves();
+        let world = World::build_part(scene, &|i| !moves(i), false)?;
+        let accel = Accel::build(&world)?;
+        let parts = MovingParts::new(scene, &moves)?;
+        let sigma = match run.head {
+            HeadSource::Oracle => run.head_jitter_cm / 100.0,
+            // About the tracker's error on das at 640×480 (README, "The see-through pipeline").
+            HeadSource::Estimated => (run.head_jitter_cm / 100.0).max(0.005),
+        };
+        let frontal = Frame::new(rig.base.frontal.width, rig.base.frontal.height);
+        Ok(SystemLoop {
+            predictor: Predictor::new(options.predict, sigma),
+            sky: Arc::new(SkyModel::new(&scene.sky, &scene.sun)),
+            world: Arc::new(world),
+            accel: Arc::new(accel),
+            parts,
+            rig,
+            options,
+            frontal,
+            shown: None,
+            surface: None,
+            seconds: StageSeconds::default(),
+            frontal_pixels: 0,
+        })
+    }
+
+    fn settings(&self) -> RenderSettings {
+        RenderSettings {
+            spp: self.options.run.spp,
+            progress: false,
+        }
+    }
+
+    /// The scene at `t`, ready to render: the static hierarchy shared, the moving part
+    /// placed and its hierarchy rebuilt.
+    pub fn context_at(&mut self, t: f64) -> Result<RenderContext> {
+        let start = Instant::now();
+        let rig = &self.rig;
+        let layer = self.parts.at(&|id| rig.object_motion(t, id))?;
+        self.seconds.moving += start.elapsed().as_secs_f64();
+        Ok(RenderContext {
+            scene: self.rig.scene_at(t),
+            world: self.world.clone(),
+            accel: self.accel.clone(),
+            sky: self.sky.clone(),
+            moving: Some(Arc::new(layer)),
+        })
+    }
+
+    /// The head estimate of time `t` (obstacle frame) for refresh `refresh`.
+    fn estimate_head(&mut self, t: f64, refresh: i64) -> Result<DVec3> {
+        let run = self.options.run.clone();
+        let eye = match run.head {
+            HeadSource::Oracle => self.rig.eye_in_obstacle(t),
+            HeadSource::Estimated => {
+                let ctx = self.context_at(t)?;
+                let start = Instant::now();
+                let back = ctx.scene.back;
+                // A camera's image is anti-aliased: the detector mistakes the aliased edge
+                // of a shadow for a pupil at 1 sample per pixel (das, leaning).
+                let settings = RenderSettings {
+                    spp: self.options.run.spp.max(BACK_MIN_SPP),
+                    progress: false,
+                };
+                let (frame, _) = ctx.render(&back, view_bit::BACK, settings, "back");
+                let detection = detect(&frame)
+                    .with_context(|| format!("head estimate at t = {} s", short(t)))?;
+                // The believed back camera ([calibration]), not the true one.
+                let believed = ctx.scene.calibration.back.apply(&back)?;
+                let world = eye_from_detection(&detection, &believed, run.feature_width);
+                self.seconds.head += start.elapsed().as_secs_f64();
+                ctx.scene.obstacle.in_obstacle_frame(world)
+            }
+        };
+        let index = (refresh.max(0) as u32).wrapping_mul(3);
+        let jitter = DVec3::new(
+            gaussian(run.seed, index),
+            gaussian(run.seed, index.wrapping_add(1)),
+            gaussian(run.seed, index.wrapping_add(2)),
+        ) * run.head_jitter_cm;
+        Ok(eye + (DVec3::from_array(run.head_bias_cm) + jitter) / 100.0)
+    }
+
+    /// What the display shows at displayed frame `frame`: the image of the latest refresh,
+    /// made once per refresh.
+    pub fn show(&mut self, frame: usize) -> Result<&Shown> {
+        let times = self.options.timeline.times(frame);
+        if self
+            .shown
+            .as_ref()
+            .is_some_and(|s| s.times.refresh == times.refresh)
+        {
+            return Ok(self.shown.as_ref().expect("just checked"));
+        }
+        let eye_estimated = self.estimate_head(times.head, times.refresh)?;
+        self.predictor.observe(times.head, eye_estimated);
+        let eye_used = match self.options.predict {
+            Prediction::None => eye_estimated,
+            _ => self.predictor.predict(times.refresh_time),
+        };
+        let capture = self.context_at(times.capture)?;
+        let start = Instant::now();
+        // The compensation's geometry: the display where it is when the image is shown (with
+        // re-projection by the known vehicle motion) or where it was at capture.
+        let mut geometry = capture.scene.clone();
+        if self.options.reproject {
+            geometry.obstacle = self.rig.scene_at(times.refresh_time).obstacle;
+        }
+        let eye_world = geometry
+            .obstacle
+            .world_from_obstacle
+            .transform_point3(eye_used);
+        let run = &self.options.run;
+        let at = || format!("at t = {} s", short(times.refresh_time));
+        let full = run.method == Method::None || run.d2 == WorkingDistance::Auto;
+        let frontal_camera = capture.scene.frontal;
+        let settings = self.settings();
+        let (crop, d2_used) = if full {
+            let f = Instant::now();
+            capture.render_into(
+                &frontal_camera,
+                view_bit::FRONTAL,
+                settings,
+                &mut self.frontal,
+                "frontal",
+            );
+            self.seconds.frontal += f.elapsed().as_secs_f64();
+            self.frontal_pixels +=
+                u64::from(frontal_camera.width) * u64::from(frontal_camera.height);
+            crop_for(&geometry, eye_world, &self.frontal, run).with_context(at)?
+        } else {
+            let crop = crop_for(&geometry, eye_world, &self.frontal, run).with_context(at)?;
+            let rect = crop_rect(&frontal_map(&geometry, crop.0, run)?, &frontal_camera);
+            let f = Instant::now();
+            capture.render_rect(
+                &frontal_camera,
+                view_bit::FRONTAL,
+                None,
+                settings,
+                rect,
+                &mut self.frontal,
+                "frontal",
+            );
+            self.seconds.frontal += f.elapsed().as_secs_f64();
+            self.frontal_pixels += rect.pixels();
+            crop
+        };
+        let map = frontal_map(&geometry, crop, run)?;
+        if run.method == Method::Planar && run.outside == Outside::Error {
+            let (min, max) = map.bounds();
+            let [w, h] = crop.frontal_size.map(f64::from);
+            if min.x < -1e-9 || min.y < -1e-9 || max.x > w + 1e-9 || max.y > h + 1e-9 {
+                bail!(
+                    "{}: the crop leaves the frontal camera's view (corners from ({:.1}, {:.1}) to ({:.1}, {:.1}) px in a {w}×{h} image); use --outside black to show the rest black and count it",
+                    at(),
+                    min.x,
+                    min.y,
+                    max.x,
+                    max.y
+                );
+            }
+        }
+        let display = resample_through(&self.frontal, &map, run.filter);
+        self.seconds.compensation += start.elapsed().as_secs_f64();
+        self.surface = Some(DisplaySurface::Pixels {
+            image: display,
+            placement: DisplayPlacement::new(&capture.scene.obstacle),
+        });
+        self.shown = Some(Shown {
+            times,
+            eye_estimated,
+            eye_used,
+            crop,
+            d2_used,
+            frontal: frontal_camera,
+            lens: map.lens,
+        });
+        Ok(self.shown.as_ref().expect("just set"))
+    }
+
+    /// The `seethru` view at display time into `frame` (the truth of the same instant, or
+    /// any frame of the driver camera's size: only the pixels where the display can be seen
+    /// are rendered), with what [`SystemLoop::show`] last made.
+    pub fn render_seethru(&mut self, ctx: &RenderContext, frame: &mut Frame) {
+        let start = Instant::now();
+        let shown = self.shown.as_ref().expect("show() before render_seethru()");
+        let driver = ctx.scene.driver;
+        // The display where it is now, showing the image of its last refresh.
+        let placement = DisplayPlacement::new(&ctx.scene.obstacle);
+        let mut surface = self.surface.take().unwrap_or(DisplaySurface::Pixels {
+            image: Frame::new(0, 0),
+            placement: placement.clone(),
+        });
+        surface = match (self.options.run.display, surface) {
+            (DisplayModel::Pixels, DisplaySurface::Pixels { image, .. }) => {
+                DisplaySurface::Pixels { image, placement }
+            }
+            _ => DisplaySurface::Ideal {
+                crop: shown.crop,
+                frontal: shown.frontal,
+                placement,
+                lens: shown.lens,
+            },
+        };
+        let region = ctx.difference_region(&driver, view_bit::TRUTH, view_bit::SEETHRU);
+        let settings = self.settings();
+        ctx.render_rect(
+            &driver,
+            view_bit::SEETHRU,
+            Some(&surface),
+            settings,
+            region,
+            frame,
+            "seethru",
+        );
+        self.surface = Some(surface);
+        self.seconds.seethru += start.elapsed().as_secs_f64();
+    }
+}
+
+/// The frontal pixels a crop reads, with a margin for the filters, within the image.
+fn crop_rect(map: &FrontalMap, camera: &Camera) -> PixelRect {
+    let (min, max) = map.bounds();
+    let lo = (min - DVec2::splat(CROP_MARGIN_PX)).floor();
+    let hi = (max + DVec2::splat(CROP_MARGIN_PX)).ceil();
+    let clamp = |v: f64, size: u32| v.clamp(0.0, size as f64) as u32;
+    PixelRect {
+        x0: clamp(lo.x, camera.width),
+        y0: clamp(lo.y, camera.height),
+        x1: clamp(hi.x, camera.width),
+        y1: clamp(hi.y, camera.height),
+    }
+}

@@ -1,0 +1,236 @@
+//! The clock of a sequence and where everything is at each instant: displayed frames, the
+//! display's refreshes (sample and hold), the capture and head-sample times behind each, and
+//! the rig (vehicle, obstacle, cameras, the driver's eye and head) at any time.
+
+use anyhow::{Result, bail};
+use glam::{DAffine3, DVec3};
+
+use crate::scene::Scene;
+use crate::scene::motion::{MovesWith, VehicleMotion};
+use crate::system::sequence::head_motion::HeadMotion;
+use crate::util::number::short;
+
+/// Longest sequence, seconds.
+pub const MAX_DURATION_S: f64 = 3600.0;
+/// Highest frame and display rate, Hz.
+pub const MAX_RATE_HZ: f64 = 1000.0;
+/// Most frames of one sequence.
+pub const MAX_FRAMES: usize = 100_000;
+
+/// Frame times and latencies, seconds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Timeline {
+    /// Length of the sequence, s, in (0, 3600].
+    pub duration: f64,
+    /// Frames measured per second (the times at which truth and display are compared), Hz.
+    pub fps: f64,
+    /// Display refresh rate, Hz: the display holds each image until the next refresh.
+    pub display_hz: f64,
+    /// Frontal capture to display, s (≥ 0, shorter than the sequence).
+    pub latency_camera: f64,
+    /// Back-camera capture to head estimate, s (≥ 0, shorter than the sequence).
+    pub latency_tracking: f64,
+}
+
+/// The times behind one displayed frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameTimes {
+    /// When the frame is looked at, s.
+    pub display: f64,
+    /// The display refresh whose image is shown then: its index and time, s.
+    pub refresh: i64,
+    pub refresh_time: f64,
+    /// When the frontal image shown was captured, s.
+    pub capture: f64,
+    /// When the back image behind its head estimate was captured, s.
+    pub head: f64,
+}
+
+impl Timeline {
+    pub fn validate(&self) -> Result<()> {
+        let rate = |name: &str, v: f64| -> Result<()> {
+            if !(v > 0.0 && v <= MAX_RATE_HZ) {
+                bail!("{name} must be in (0, {MAX_RATE_HZ}] Hz, got {}", short(v));
+            }
+            Ok(())
+        };
+        if !(self.duration > 0.0 && self.duration <= MAX_DURATION_S) {
+            bail!(
+                "--duration must be in (0, {MAX_DURATION_S}] s, got {}",
+                short(self.duration)
+            );
+        }
+        rate("--fps", self.fps)?;
+        rate("--display-hz", self.display_hz)?;
+        for (name, v) in [
+            ("--latency-camera", self.latency_camera),
+            ("--latency-tracking", self.latency_tracking),
+        ] {
+            if !(v >= 0.0 && v < self.duration) {
+                bail!(
+                    "{name} {} ms must be ≥ 0 and shorter than the sequence ({} ms)",
+                    short(v * 1e3),
+                    short(self.duration * 1e3)
+                );
+            }
+        }
+        if self.frames() > MAX_FRAMES {
+            bail!(
+                "--duration × --fps gives {} frames, more than the limit of {MAX_FRAMES}",
+                self.frames()
+            );
+        }
+        Ok(())
+    }
+
+    /// Frames in the sequence: one at t = 0 and every 1/fps before `duration`.
+    pub fn frames(&self) -> usize {
+        ((self.duration * self.fps - 1e-9).ceil().max(1.0)) as usize
+    }
+
+    pub fn times(&self, frame: usize) -> FrameTimes {
+        let display = frame as f64 / self.fps;
+        // A refresh at exactly the frame's time counts (the 1e-9 absorbs the rounding of k/fps).
+        let refresh = (display * self.display_hz + 1e-9).floor() as i64;
+        let refresh_time = refresh as f64 / self.display_hz;
+        let capture = refresh_time - self.latency_camera;
+        FrameTimes {
+            display,
+            refresh,
+            refresh_time,
+            capture,
+            head: capture - self.latency_tracking,
+        }
+    }
+}
+
+/// The rig over time: the vehicle's motion and the head's motion relative to it.
+#[derive(Clone, Debug)]
+pub struct Rig {
+    pub vehicle: VehicleMotion,
+    pub head: HeadMotion,
+    /// The scene's eye, obstacle frame.
+    pub eye0: DVec3,
+    /// The scene at t = 0 (cameras already at the sizes used).
+    pub base: Scene,
+}
+
+impl Rig {
+    /// `speed` m/s along world −z, `yaw_rate` rad/s (left > 0).
+    pub fn new(base: Scene, speed: f64, yaw_rate: f64, head: HeadMotion) -> Rig {
+        let eye0 = base.obstacle.in_obstacle_frame(base.eye());
+        let vehicle = VehicleMotion {
+            speed,
+            yaw_rate,
+            forward: DVec3::NEG_Z,
+            pivot: base.eye(),
+        };
+        Rig {
+            vehicle,
+            head,
+            eye0,
+            base,
+        }
+    }
+
+    pub fn world_from_rig(&self, t: f64) -> DAffine3 {
+        self.vehicle.world_from_rig(t)
+    }
+
+    /// The true eye at `t`, in the obstacle frame (relative to the vehicle).
+    pub fn eye_in_obstacle(&self, t: f64) -> DVec3 {
+        self.head.eye(self.eye0, t)
+    }
+
+    /// The head's displacement at `t` from where the scene puts it, rig frame.
+    fn head_offset(&self, t: f64) -> DVec3 {
+        self.base
+            .obstacle
+            .world_from_obstacle
+            .transform_vector3(self.eye_in_obstacle(t) - self.eye0)
+    }
+
+    /// The scene at `t`: obstacle and cameras carried by the vehicle, the driver's eye at
+    /// the head's position (its viewing direction turns with the vehicle only).
+    pub fn scene_at(&self, t: f64) -> Scene {
+        let rig = self.world_from_rig(t);
+        let mut s = self.base.clone();
+        s.obstacle.world_from_obstacle = rig * s.obstacle.world_from_obstacle;
+        s.frontal.world_from_camera = rig * s.frontal.world_from_camera;
+        s.back.world_from_camera = rig * s.back.world_from_camera;
+        s.driver.world_from_camera =
+            rig * DAffine3::from_translation(self.head_offset(t)) * s.driver.world_from_camera;
+        s
+    }
+
+    /// The rigid world_from_world motion at `t` of object id `id` (objects numbered from 1,
+    /// the obstacle last) from its t = 0 placement; `None` for what stands still.
+    pub fn object_motion(&self, t: f64, id: u32) -> Option<DAffine3> {
+        let objects = &self.base.objects;
+        let Some(object) = objects.get(id as usize - 1) else {
+            // The obstacle.
+            return Some(self.world_from_rig(t));
+        };
+        match object.motion.moves_with {
+            MovesWith::Vehicle => Some(self.world_from_rig(t)),
+            MovesWith::Head => {
+                Some(self.world_from_rig(t) * DAffine3::from_translation(self.head_offset(t)))
+            }
+            MovesWith::World => object
+                .motion
+                .world_from_object_at(t)
+                .map(|at| at * object.world_from_object.inverse()),
+        }
+    }
+
+    /// Checks that the eye stays in front of the display at every `times`.
+    pub fn check_eye(&self, times: impl Iterator<Item = f64>) -> Result<()> {
+        for t in times {
+            let d1 = self.eye_in_obstacle(t).z;
+            if d1 <= 0.0 || !d1.is_finite() {
+                bail!(
+                    "the head path puts the eye behind the display at t = {} s (d1 = {} m; it must stay > 0)",
+                    short(t),
+                    short(d1)
+                );
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frames_refreshes_and_latencies() {
+        let tl = Timeline {
+            duration: 1.0,
+            fps: 60.0,
+            display_hz: 30.0,
+            latency_camera: 0.05,
+            latency_tracking: 0.01,
+        };
+        assert_eq!(tl.frames(), 60);
+        let f = tl.times(3);
+        assert_eq!((f.refresh, f.refresh_time), (1, 1.0 / 30.0));
+        assert!((f.capture - (1.0 / 30.0 - 0.05)).abs() < 1e-15);
+        assert!((f.head - (f.capture - 0.01)).abs() < 1e-15);
+        // Refreshes at every frame when the display runs at the frame rate.
+        let same = Timeline {
+            display_hz: 60.0,
+            ..tl
+        };
+        assert!((0..60).all(|k| same.times(k).refresh == k as i64));
+        assert!(
+            Timeline {
+                latency_camera: 1.0,
+                ..tl
+            }
+            .validate()
+            .is_err()
+        );
+        assert!(Timeline { fps: 0.0, ..tl }.validate().is_err());
+    }
+}

@@ -1,0 +1,541 @@
+//! `seethru sequence`: the dynamic misregistration against its formula, the moving part's
+//! own hierarchy against a full rebuild, determinism across thread counts, bad input.
+
+mod common;
+
+use std::path::Path;
+
+use seethru::analysis::dynamic::{Motion, dynamic_misregistration};
+use seethru::analysis::physical::ARCMIN_PER_RAD;
+use seethru::measure::sequence::{Measuring, run_sequence};
+use seethru::render::integrator::RenderContext;
+use seethru::render::settings::RenderSettings;
+use seethru::scene::world::view_bit;
+use seethru::system::options::{RunOptions, WorkingDistance};
+use seethru::system::sequence::head_motion::HeadMotion;
+use seethru::system::sequence::predict::Prediction;
+use seethru::system::sequence::system_loop::{SequenceOptions, SystemLoop};
+use seethru::system::sequence::timeline::Timeline;
+
+fn options(latency: f64, fps: f64, display_hz: f64, yaw_rate: f64) -> SequenceOptions {
+    SequenceOptions {
+        run: RunOptions {
+            d2: WorkingDistance::Metres(6.0),
+            spp: 1,
+            ..RunOptions::default()
+        },
+        timeline: Timeline {
+            duration: 9.0 / fps,
+            fps,
+            display_hz,
+            latency_camera: latency,
+            latency_tracking: 0.0,
+        },
+        speed: 0.0,
+        yaw_rate,
+        head: HeadMotion::Still,
+        predict: Prediction::None,
+        reproject: false,
+    }
+}
+
+/// A textured wall 6 m ahead, the model plane on it (so the static error is the resampling
+/// quantum), a still head and a constant yaw rate: every frame's measured mean
+/// misregistration is the formula's `ω L`, L being the age of the image shown — the camera
+/// latency plus, with a slower display, the time since its refresh — within 2 % (the issue
+/// asks 5 %; the resampling quantum and the wall's tilt leave about 0.5 %).
+#[test]
+fn the_measured_dynamic_misregistration_follows_the_formula() {
+    let wall = common::WallScene::default();
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let eye = scene.obstacle.in_obstacle_frame(scene.eye());
+    let yaw_rate = 20f64.to_radians();
+    for (latency, display_hz) in [(0.05, 60.0), (0.1, 60.0), (0.033, 30.0)] {
+        let how = Measuring {
+            metrics: true,
+            full_frames: false,
+            band: 5,
+            progress: false,
+        };
+        let run = run_sequence(
+            &scene,
+            options(latency, 60.0, display_hz, yaw_rate),
+            how,
+            &mut |_| Ok(()),
+        )
+        .unwrap();
+        let mut ages = std::collections::BTreeSet::new();
+        for r in &run.records {
+            let m = r.metrics.unwrap();
+            assert_eq!(m.coverage, 1.0);
+            let age = r.times.display - r.times.capture;
+            ages.insert((age * 1e6).round() as i64);
+            let motion = Motion {
+                speed: 0.0,
+                yaw_rate,
+                eye_speed: 0.0,
+                latency: age,
+                tracking_latency: 0.0,
+            };
+            // A pure yaw turns every direction alike: any distance and bearing.
+            let predicted = dynamic_misregistration(6.0 - eye.z, 0.3, eye.z, 6.0, &motion).abs()
+                * ARCMIN_PER_RAD;
+            let error = (m.mean_arcmin - predicted).abs() / predicted;
+            assert!(
+                error < 0.02,
+                "latency {latency} s, {display_hz} Hz, frame {}: measured {:.2}′, formula {predicted:.2}′",
+                r.frame,
+                m.mean_arcmin
+            );
+        }
+        // The held display shows images of two ages.
+        assert_eq!(
+            ages.len(),
+            if display_hz < 60.0 { 2 } else { 1 },
+            "{ages:?}"
+        );
+    }
+}
+
+/// The moving part traced beside the static hierarchy gives the images of a world rebuilt
+/// whole with every object where the sequence puts it.
+#[test]
+fn the_moving_part_renders_as_a_whole_rebuilt_world() {
+    let scene = common::das();
+    let mut o = options(0.0, 10.0, 10.0, 0.1);
+    o.speed = 50.0 / 3.6;
+    o.head = HeadMotion::Lean {
+        distance: 0.1,
+        duration: 0.3,
+        start: 0.0,
+    };
+    let mut system = SystemLoop::new(&scene, o).unwrap();
+    let t = 1.5;
+    let layered = system.context_at(t).unwrap();
+    let mut whole = system.rig.scene_at(t);
+    for (i, object) in whole.objects.iter_mut().enumerate() {
+        if let Some(m) = system.rig.object_motion(t, i as u32 + 1) {
+            object.world_from_object = m * object.world_from_object;
+        }
+    }
+    // The ball rolled 2.25 m, the head leaned, the rig drove 20.8 m and turned 8.6°.
+    assert!((whole.objects[6].world_from_object.translation.x - 1.35).abs() < 1e-9);
+    let whole = RenderContext::new(whole).unwrap();
+    let settings = RenderSettings::default();
+    let s = &layered.scene;
+    for (camera, view) in [
+        (s.frontal.with_resolution(128, 72), view_bit::FRONTAL),
+        (s.driver.with_resolution(128, 72), view_bit::OCCLUDED),
+        (s.back.with_resolution(96, 72), view_bit::BACK),
+    ] {
+        let (a, _) = layered.render(&camera, view, settings, "layered");
+        let (b, _) = whole.render(&camera, view, settings, "whole");
+        let differ = a
+            .object_id
+            .iter()
+            .zip(&b.object_id)
+            .filter(|(x, y)| x != y)
+            .count();
+        assert!(
+            differ * 500 < a.object_id.len(),
+            "view {view}: {differ} ids differ"
+        );
+        let colour: f32 = a
+            .color
+            .iter()
+            .zip(&b.color)
+            .map(|(x, y)| (*x - *y).abs().max_element())
+            .sum::<f32>()
+            / a.color.len() as f32;
+        assert!(
+            colour < 2e-3,
+            "view {view}: mean colour difference {colour}"
+        );
+        // What moves is seen: the obstacle in the driver's view, the head from the back.
+        let expected = if view == view_bit::OCCLUDED {
+            layered.world.obstacle_id
+        } else {
+            9
+        };
+        if view != view_bit::FRONTAL {
+            assert!(a.object_id.contains(&expected), "view {view}");
+        }
+    }
+}
+
+fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    for entry in walk(dir) {
+        let name = entry
+            .strip_prefix(dir)
+            .unwrap()
+            .to_string_lossy()
+            .to_string();
+        if name.ends_with("summary.json") {
+            continue; // holds wall-clock timings
+        }
+        out.push((name, std::fs::read(&entry).unwrap()));
+    }
+    out.sort();
+    out
+}
+
+fn walk(dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            out.extend(walk(&p));
+        } else {
+            out.push(p);
+        }
+    }
+    out
+}
+
+#[test]
+fn frames_and_csv_are_bit_identical_for_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut outputs = Vec::new();
+    for threads in ["1", "3"] {
+        let out = dir.path().join(threads);
+        let (ok, _, err) = common::seethru(&[
+            "sequence",
+            "scenes/das.toml",
+            "--out",
+            out.to_str().unwrap(),
+            "--duration",
+            "0.3",
+            "--fps",
+            "10",
+            "--speed",
+            "50",
+            "--yaw-rate",
+            "10",
+            "--head",
+            "sway",
+            "--latency-camera",
+            "0,100",
+            "--predict",
+            "kalman",
+            "--width",
+            "96",
+            "--frames",
+            "png",
+            "--threads",
+            threads,
+        ]);
+        assert!(ok, "{err}");
+        outputs.push(files(&out));
+    }
+    let names: Vec<&str> = outputs[0].iter().map(|f| f.0.as_str()).collect();
+    assert!(names.contains(&"latency_100ms/frames.csv"), "{names:?}");
+    assert!(
+        names.contains(&"latency_0ms/frames/seethru_00002.png"),
+        "{names:?}"
+    );
+    assert!(names.contains(&"latency.svg") && names.contains(&"latency_0ms/preview.png"));
+    assert_eq!(outputs[0].len(), outputs[1].len());
+    for (a, b) in outputs[0].iter().zip(&outputs[1]) {
+        assert!(a == b, "{} differs between 1 and 3 threads", a.0);
+    }
+    // Three frames per latency, and more misregistration with 100 ms of latency.
+    let csv = String::from_utf8(
+        outputs[0]
+            .iter()
+            .find(|f| f.0 == "latency.csv")
+            .unwrap()
+            .1
+            .clone(),
+    )
+    .unwrap();
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 2);
+    assert!(rows[1][1] > rows[0][1] + 10.0, "{rows:?}");
+}
+
+#[test]
+fn bad_input_is_one_line_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str, text: &str| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p.to_string_lossy().to_string()
+    };
+    let decreasing = path(
+        "decreasing.csv",
+        "t,x,y,z\n0,0.3,0,0.7\n0.5,0.3,0,0.7\n0.4,0.3,0,0.7\n",
+    );
+    let nan = path("nan.csv", "0,0.3,0,0.7\n0.5,nan,0,0.7\n");
+    let behind = path("behind.csv", "0,0.3,0,0.7\n1,0.3,0,-0.3\n");
+    let das = std::fs::read_to_string(common::repo_path("scenes/das.toml")).unwrap();
+    let far = das.replace(
+        "translate = [5.1, 0.35, -5.5]",
+        "translate = [999999.9, 0.35, -5.5]",
+    );
+    let far_line = far.lines().position(|l| l.contains("999999.9")).unwrap() + 1;
+    let far = path(
+        "far.toml",
+        &far.replace("../assets", &common::repo_path("assets").to_string_lossy()),
+    );
+    let unknown = path(
+        "unknown.toml",
+        &das.replace("t = 4.0\n", "t = 4.0\nspeed = 3\n")
+            .replace("../assets", &common::repo_path("assets").to_string_lossy()),
+    );
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--duration", "0"], "--duration"),
+        (vec!["--duration", "-1"], "--duration"),
+        (vec!["--fps", "0"], "--fps"),
+        (vec!["--display-hz", "0"], "--display-hz"),
+        (
+            vec!["--duration", "0.1", "--latency-camera", "0,200"],
+            "--latency-camera 200 ms must be ≥ 0 and shorter than the sequence (100 ms)",
+        ),
+        (
+            vec!["--duration", "0.1", "--latency-tracking", "150"],
+            "--latency-tracking 150 ms",
+        ),
+        (vec!["--latency-camera", "0,nan"], "--latency-camera"),
+        (
+            vec!["--head-path", &decreasing],
+            "decreasing.csv:4: times must increase: t = 0.4 s follows t = 0.5 s",
+        ),
+        (
+            vec!["--head-path", &nan],
+            "nan.csv:2: `x` must be a finite number",
+        ),
+        (
+            vec!["--head-path", &behind],
+            "behind the display at t = 0.8 s",
+        ),
+        (
+            vec!["--method", "depth"],
+            "sequence: --method ground, plane-fit and depth are not modelled over time",
+        ),
+    ];
+    let out = dir.path().join("out");
+    for (extra, expected) in cases {
+        let mut args = vec![
+            "sequence",
+            "scenes/das.toml",
+            "--out",
+            out.to_str().unwrap(),
+            "--width",
+            "32",
+        ];
+        for (flag, default) in [("--duration", "1"), ("--fps", "5")] {
+            if !extra.contains(&flag) {
+                args.extend([flag, default]);
+            }
+        }
+        args.extend(extra);
+        let (ok, _, err) = common::seethru(&args);
+        assert!(!ok, "{args:?}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(
+            err.starts_with("error:") && err.contains(expected),
+            "{args:?}: {err}"
+        );
+        assert!(!out.exists(), "{args:?} wrote {}", out.display());
+    }
+    for (scene, expected) in [
+        (
+            far.as_str(),
+            format!(
+                "far.toml:{far_line}:13: key `object[6].keyframe[1].translate`: the path leaves the world at t = 4 s"
+            ),
+        ),
+        (
+            unknown.as_str(),
+            "key `object[6].keyframe[1].speed`: unknown key".to_string(),
+        ),
+    ] {
+        let (ok, _, err) = common::seethru(&["sequence", scene, "--out", out.to_str().unwrap()]);
+        assert!(!ok);
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains(&expected), "{err}");
+        assert!(!out.exists());
+    }
+}
+
+/// The error budget's das geometry is das's: the eye's distance and bearing from the display
+/// centre, the display's half width, and the depth `--d2 auto` finds behind it.
+#[test]
+fn the_budget_geometry_is_the_das_scene() {
+    let scene = common::das();
+    let g = seethru::analysis::examples::das_geometry();
+    let eye = scene.obstacle.in_obstacle_frame(scene.eye());
+    assert!((eye.z - g.d1).abs() < 1e-9, "{eye}");
+    // The road runs along −z; the display centre is ahead-left of the eye.
+    let to_display = scene.obstacle.world_from_obstacle.translation - scene.eye();
+    let bearing = (-to_display.x).atan2(-to_display.z);
+    assert!((bearing - g.bearing).abs() < 1e-9, "{bearing}");
+    assert!((scene.obstacle.width / 2.0 - g.half_width).abs() < 1e-12);
+    let ctx = RenderContext::new(scene).unwrap();
+    let options = RunOptions {
+        d2: WorkingDistance::Auto,
+        width: Some(64),
+        frontal_width: Some(640),
+        back_width: Some(64),
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let run = seethru::system::pipeline::run(&ctx, &options).unwrap();
+    let d2 = run.report["d2_m"].as_f64().unwrap();
+    assert!((d2 - g.scene_depth).abs() < 0.1, "d2 auto = {d2} m");
+}
+
+/// Re-projecting the late frontal image by the known vehicle motion takes the yaw's error
+/// away: on the wall with the model plane on it only the static error (the resampling
+/// quantum) of a sequence without latency is left.
+#[test]
+fn reprojection_by_the_known_yaw_removes_the_dynamic_error() {
+    let wall = common::WallScene::default();
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let how = Measuring {
+        metrics: true,
+        full_frames: false,
+        band: 5,
+        progress: false,
+    };
+    let mut means = Vec::new();
+    for (latency, reproject) in [(0.1, false), (0.1, true), (0.0, false)] {
+        let mut o = options(latency, 30.0, 30.0, 20f64.to_radians());
+        o.reproject = reproject;
+        let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
+        let m: Vec<f64> = run
+            .records
+            .iter()
+            .map(|r| r.metrics.unwrap().mean_arcmin)
+            .collect();
+        means.push(m.iter().sum::<f64>() / m.len() as f64);
+    }
+    assert!((means[0] - 120.0).abs() < 2.4, "{means:?}");
+    assert!(
+        means[2] < 10.0 && means[1] < 1.5 * means[2] + 0.5,
+        "{means:?}"
+    );
+}
+
+/// The formula's head term: a swaying head and a late head estimate, the wall on the model
+/// plane and no vehicle motion: each frame's mean misregistration is the eye's speed across
+/// the display (at display time) times the latency, through the planar model's
+/// `d2 / (d1 (d1 + d2))`, within 8 % where the sway is fast: the formula is first order in the
+/// latency and paraxial (off the display's axis a lateral eye error turns the view by cos² of
+/// the viewing angle less — up to 18° here, so the measured mean is a few percent lower).
+#[test]
+fn a_late_head_estimate_costs_what_the_formula_says() {
+    let wall = common::WallScene::default();
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let eye = scene.obstacle.in_obstacle_frame(scene.eye());
+    let (amplitude, frequency, latency) = (0.03, 0.5, 0.02);
+    let mut o = options(latency, 10.0, 10.0, 0.0);
+    o.timeline.duration = 2.0;
+    // The ideal display: no resampling quantum, only the planar model's (here zero) error.
+    o.run.display = seethru::system::display::DisplayModel::Ideal;
+    o.head = HeadMotion::Sway {
+        amplitude,
+        frequency,
+    };
+    let how = Measuring {
+        metrics: true,
+        full_frames: false,
+        band: 5,
+        progress: false,
+    };
+    let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
+    let mut checked = 0;
+    for r in &run.records {
+        let phase = std::f64::consts::TAU * frequency * r.times.display;
+        if phase.cos().abs() < 0.8 {
+            continue; // near the turning points the first-order formula is not the point
+        }
+        let motion = Motion {
+            speed: 0.0,
+            yaw_rate: 0.0,
+            eye_speed: amplitude * std::f64::consts::TAU * frequency * phase.cos(),
+            latency,
+            tracking_latency: 0.0,
+        };
+        let predicted = dynamic_misregistration(6.0 - eye.z, 0.0, r.eye_true.z, 6.0, &motion).abs()
+            * ARCMIN_PER_RAD;
+        let measured = r.metrics.unwrap().mean_arcmin;
+        assert!(
+            measured < predicted * 1.02 && measured > predicted * 0.92,
+            "frame {}: measured {measured:.2}′, formula {predicted:.2}′",
+            r.frame
+        );
+        checked += 1;
+    }
+    assert!(checked >= 6, "{checked}");
+}
+
+/// A fisheye frontal camera: the display goes through the believed lens in every frame, as
+/// `run` does, so a still sequence misregisters as the single run of the same instant.
+#[test]
+fn a_lens_goes_through_the_sequence_as_through_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let small = [
+        "--width",
+        "96",
+        "--frontal-width",
+        "192",
+        "--back-width",
+        "32",
+        "--spp",
+        "1",
+    ];
+    let seq = dir.path().join("seq");
+    let run = dir.path().join("run");
+    let (ok, _, err) = common::seethru(
+        &[
+            &[
+                "sequence",
+                "scenes/das_fisheye.toml",
+                "--out",
+                seq.to_str().unwrap(),
+            ][..],
+            &["--duration", "0.05", "--fps", "20", "--head", "still"],
+            &small,
+        ]
+        .concat(),
+    );
+    assert!(ok, "{err}");
+    let (ok, _, err) = common::seethru(
+        &[
+            &[
+                "run",
+                "scenes/das_fisheye.toml",
+                "--out",
+                run.to_str().unwrap(),
+            ][..],
+            &small,
+        ]
+        .concat(),
+    );
+    assert!(ok, "{err}");
+    let metrics: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("metrics.json")).unwrap()).unwrap();
+    let single = metrics["display"]["misregistration_arcmin"]["mean"]
+        .as_f64()
+        .unwrap();
+    let csv = std::fs::read_to_string(seq.join("latency_0ms/frames.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let column = header
+        .iter()
+        .position(|c| *c == "misregistration_mean_arcmin")
+        .unwrap_or_else(|| panic!("{header:?}"));
+    let first: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let sequence: f64 = first[column].parse().unwrap();
+    // A crop that ignored the lens would be off by degrees at the display's edges.
+    assert!(
+        (sequence - single).abs() <= 0.05 * single,
+        "sequence {sequence}′ against run {single}′"
+    );
+}
