@@ -10,7 +10,6 @@ use seethru::system::sequence::head_motion::HeadMotion;
 use seethru::system::sequence::predict::Prediction;
 use seethru::system::sequence::system_loop::SequenceOptions;
 use seethru::system::sequence::timeline::Timeline;
-use seethru::util::memory::cpu_seconds;
 use serde_json::json;
 
 /// Frames of each timed sequence (half a second at 60 fps).
@@ -57,7 +56,7 @@ fn sequence(scene: &Scene, head: HeadSource, metrics: bool) -> Result<SequenceRu
 /// The report lines and the JSON of the sequence benchmark.
 pub fn bench_sequence(scene: &Scene) -> Result<(Vec<String>, serde_json::Value)> {
     let mut lines = vec![
-        "sequence     640×360, 1 spp, 30 frames at 50 km/h, lean, 50 ms latency; wall frames/s over the loop's stages (setup excluded), and by CPU time".to_string(),
+        "sequence     640×360, 1 spp, 30 frames at 50 km/h, lean, 50 ms latency; wall frames/s over the loop's stages (setup excluded)".to_string(),
     ];
     let mut out = serde_json::Map::new();
     for (key, label, head, metrics) in [
@@ -80,18 +79,11 @@ pub fn bench_sequence(scene: &Scene) -> Result<(Vec<String>, serde_json::Value)>
             true,
         ),
     ] {
-        let cpu_before = cpu_seconds();
         let run = sequence(scene, head, metrics)?;
-        let cpu = cpu_seconds().zip(cpu_before).map(|(a, b)| a - b);
         let seconds = run.system.total() + run.truth_seconds + run.metrics_seconds;
         let fps = run.records.len() as f64 / seconds;
-        // Frames per second if the CPU time were spread over the threads with nothing else
-        // running (setup included): what the loop gets on a machine of its own.
-        let threads = rayon::current_num_threads() as f64;
-        let cpu_fps = cpu.map(|c| run.records.len() as f64 / (c / threads));
-        let cpu_text = cpu_fps.map_or("?".into(), |f| format!("{f:.1}"));
         lines.push(format!(
-            "  {label:<28} {fps:6.1} frames/s wall, {cpu_text} frames/s by CPU time over {threads} threads  (frontal {:.1} ms, head {:.1} ms, compensation {:.1} ms, seethru {:.1} ms, moving part {:.1} ms, truth {:.1} ms, metrics {:.1} ms per frame)",
+            "  {label:<28} {fps:6.1} frames/s  (frontal {:.1} ms, head {:.1} ms, compensation {:.1} ms, seethru {:.1} ms, moving part {:.1} ms, truth {:.1} ms, metrics {:.1} ms per frame)",
             run.system.frontal / FRAMES * 1e3,
             run.system.head / FRAMES * 1e3,
             run.system.compensation / FRAMES * 1e3,
@@ -102,7 +94,7 @@ pub fn bench_sequence(scene: &Scene) -> Result<(Vec<String>, serde_json::Value)>
         ));
         out.insert(
             key.into(),
-            json!({"frames_per_s": fps, "frames_per_s_by_cpu_time": cpu_fps, "cpu_s": cpu, "stages_s": run.system, "truth_s": run.truth_seconds, "metrics_s": run.metrics_seconds}),
+            json!({"frames_per_s": fps, "stages_s": run.system, "truth_s": run.truth_seconds, "metrics_s": run.metrics_seconds}),
         );
     }
     Ok((lines, serde_json::Value::Object(out)))
