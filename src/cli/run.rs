@@ -19,9 +19,7 @@ use seethru::system::memory::{both_eyes_estimate, check_memory, run_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use seethru::system::pipeline::{RunResult, run};
 
-use crate::cli::args::{
-    RenderArgs, band, head_bias_cm, integer, pixels, positive, real, with_threads,
-};
+use crate::cli::args::{HeadErrorArgs, RenderArgs, band, pixels, positive, with_threads};
 use crate::cli::run_eyes::EyesFlag;
 use crate::cli::scene_model_args::SceneModelArgs;
 
@@ -49,19 +47,9 @@ pub struct Run {
     /// oracle: the true eye; estimated: face detection on the back camera's image.
     #[arg(long, value_enum, default_value_t = HeadSource::Oracle)]
     head: HeadSource,
-    /// Head-tracking bias, obstacle frame, centimetres: x,y,z, each in [-500, 500]
-    /// (e.g. `1,0,0` or `-1,0,0`).
-    #[arg(long = "head-bias-cm", value_name = "X,Y,Z", allow_hyphen_values = true, default_value = "0,0,0", value_parser = head_bias_cm)]
-    head_bias_cm: [f64; 3],
-    /// Head-tracking jitter, standard deviation per axis, centimetres in [0, 100].
-    #[arg(long = "head-jitter-cm", default_value_t = 0.0, value_parser = real(0.0, 100.0))]
-    head_jitter_cm: f64,
-    /// Seed of the jitter, an integer in [0, 4294967295].
-    #[arg(long, default_value_t = 1, value_parser = integer::<u32>(0, u32::MAX as u64))]
-    seed: u32,
-    /// The detector's known feature width A (interpupillary distance), metres in (0, 1].
-    #[arg(long = "feature-width", default_value_t = 0.064, value_parser = positive(1.0))]
-    feature_width: f64,
+    /// Head-tracking errors and the detector's feature width.
+    #[command(flatten)]
+    head_errors: HeadErrorArgs,
     /// When the crop leaves the frontal view: error, or black (flagged as missing).
     #[arg(long, value_enum, default_value_t = Outside::Error)]
     outside: Outside,
@@ -104,10 +92,10 @@ impl Run {
             method: self.method,
             d2: self.d2,
             head: self.head,
-            head_bias_cm: self.head_bias_cm,
-            head_jitter_cm: self.head_jitter_cm,
-            seed: self.seed,
-            feature_width: self.feature_width,
+            head_bias_cm: self.head_errors.head_bias_cm,
+            head_jitter_cm: self.head_errors.head_jitter_cm,
+            seed: self.head_errors.seed,
+            feature_width: self.head_errors.feature_width,
             width: self.render.width,
             height: self.render.height,
             frontal_width: self.frontal_width,

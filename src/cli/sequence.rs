@@ -22,7 +22,7 @@ use seethru::util::progress::summary as say;
 use serde_json::json;
 
 use crate::cli::args::{
-    band, head_bias_cm, integer, pixels, positive, real, samples, threads, with_threads,
+    HeadErrorArgs, band, pixels, positive, real, samples, threads, with_threads,
 };
 
 /// Longest latency, ms.
@@ -142,18 +142,9 @@ pub struct Sequence {
     /// back camera's image of its time.
     #[arg(long = "head-source", value_enum, default_value_t = HeadSource::Oracle)]
     head_source: HeadSource,
-    /// Head-tracking bias, obstacle frame, centimetres: x,y,z, each in [-500, 500].
-    #[arg(long = "head-bias-cm", value_name = "X,Y,Z", allow_hyphen_values = true, default_value = "0,0,0", value_parser = head_bias_cm)]
-    head_bias_cm: [f64; 3],
-    /// Head-tracking jitter per estimate, standard deviation per axis, centimetres in [0, 100].
-    #[arg(long = "head-jitter-cm", default_value_t = 0.0, value_parser = real(0.0, 100.0))]
-    head_jitter_cm: f64,
-    /// Seed of the jitter, an integer in [0, 4294967295].
-    #[arg(long, default_value_t = 1, value_parser = integer::<u32>(0, u32::MAX as u64))]
-    seed: u32,
-    /// The detector's known feature width A, metres in (0, 1].
-    #[arg(long = "feature-width", default_value_t = 0.064, value_parser = positive(1.0))]
-    feature_width: f64,
+    /// Head-tracking errors and the detector's feature width.
+    #[command(flatten)]
+    head_errors: HeadErrorArgs,
     /// When the crop leaves the frontal view: black (counted, coverage < 1) or error.
     #[arg(long, value_enum, default_value_t = Outside::Black)]
     outside: Outside,
@@ -210,10 +201,10 @@ impl Sequence {
                 method: self.method,
                 d2: self.d2,
                 head: self.head_source,
-                head_bias_cm: self.head_bias_cm,
-                head_jitter_cm: self.head_jitter_cm,
-                seed: self.seed,
-                feature_width: self.feature_width,
+                head_bias_cm: self.head_errors.head_bias_cm,
+                head_jitter_cm: self.head_errors.head_jitter_cm,
+                seed: self.head_errors.seed,
+                feature_width: self.head_errors.feature_width,
                 width: Some(self.width),
                 height: self.height,
                 frontal_width: Some(self.frontal_width.unwrap_or(self.width)),

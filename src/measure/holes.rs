@@ -8,7 +8,7 @@ use std::path::Path;
 use anyhow::Result;
 use serde_json::json;
 
-use crate::io::frame_files::write_png;
+use crate::measure::maps::write_mask_png;
 use crate::measure::metrics::{MetricMaps, psnr, stats};
 use crate::render::frame::Frame;
 use crate::scene::Obstacle;
@@ -96,20 +96,7 @@ pub fn hole_metrics(
 
 /// `holes.png`: holes magenta, the rest of the display dark grey, outside black.
 pub fn write_hole_mask(path: &Path, maps: &MetricMaps, holes: &[bool]) -> Result<()> {
-    let rgb = holes
-        .iter()
-        .zip(&maps.display)
-        .flat_map(|(&h, &d)| {
-            if h {
-                [255, 0, 255]
-            } else if d {
-                [60, 60, 60]
-            } else {
-                [0, 0, 0]
-            }
-        })
-        .collect();
-    write_png(path, maps.width, maps.height, rgb)
+    write_mask_png(path, maps, holes)
 }
 
 /// Adds `holes` to a run's metrics when its method found holes; returns the driver-view mask.

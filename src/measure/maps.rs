@@ -152,8 +152,13 @@ pub fn write_metrics(
     )?;
     let (w, h, rgb) = heatmap_rgb(maps, truth)?;
     write_png(&dir.join("misregistration.png"), w, h, rgb)?;
-    let mask = maps
-        .missing
+    write_mask_png(&dir.join("missing.png"), maps, &maps.missing)
+}
+
+/// A mask of driver-view pixels as a PNG: `marked` pixels magenta, the rest of the display
+/// dark grey, outside the display black.
+pub fn write_mask_png(path: &Path, maps: &MetricMaps, marked: &[bool]) -> Result<()> {
+    let rgb = marked
         .iter()
         .zip(&maps.display)
         .flat_map(|(&m, &d)| {
@@ -166,5 +171,5 @@ pub fn write_metrics(
             }
         })
         .collect();
-    write_png(&dir.join("missing.png"), maps.width, maps.height, mask)
+    write_png(path, maps.width, maps.height, rgb)
 }
