@@ -5,6 +5,7 @@
 
 pub mod grow;
 pub mod limits;
+pub mod mesh_checks;
 pub mod mesh_io;
 pub mod procedural;
 pub mod read;
