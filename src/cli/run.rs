@@ -3,10 +3,11 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use rayon::prelude::*;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_frame;
+use seethru::io::staged::StagedDir;
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
 use seethru::render::integrator::RenderContext;
@@ -115,8 +116,9 @@ fn run_command(
     check_memory(&run_estimate(&scene, options)?, max_memory)?;
     let ctx = RenderContext::new(scene)?;
     let result = run(&ctx, options)?;
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("cannot create output directory {}", out.display()))?;
+    // Written whole or not at all: a failure leaves `out` as it was.
+    let staged = StagedDir::new(out)?;
+    let (out, target) = (staged.path(), out);
     let views = [
         ("truth", &result.truth),
         ("occluded", &result.occluded),
@@ -145,9 +147,10 @@ fn run_command(
         &out.join("run.json"),
         &serde_json::to_string_pretty(&result.report)?,
     )?;
+    staged.commit()?;
     seethru::util::progress::summary(format!(
         "wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",
-        out.display()
+        target.display()
     ));
     Ok(())
 }

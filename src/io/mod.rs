@@ -6,3 +6,4 @@ pub mod export;
 pub mod frame_files;
 pub mod plot;
 pub mod run_dir;
+pub mod staged;
