@@ -95,9 +95,7 @@ fn documented(key: &str) -> Documented {
         "sky.cloud_seed" => closed(0.0, 4294967295.0),
         k if k.ends_with("color") => closed(0.0, 1.0),
         "obstacle.width" | "obstacle.height" | "obstacle.thickness" => left_open(0.0, 100.0),
-        "object.size" | "object.radius" | "object.height" | "object.scale" => {
-            left_open(0.0, 1e5)
-        }
+        "object.size" | "object.radius" | "object.height" | "object.scale" => left_open(0.0, 1e5),
         "object.rotate_deg" => closed(-360.0, 360.0),
         "object.segments" => closed(3.0, 4096.0),
         "material.uv_repeat" => left_open(0.0, 1e6),
@@ -134,7 +132,11 @@ fn every_numeric_key_refuses_nan_infinities_and_huge_values_in_one_line() {
     let doc = ImDocument::parse(text.as_str()).unwrap();
     let mut leaves = Vec::new();
     leaves_of_table("", doc.as_table(), &mut leaves);
-    assert!(leaves.len() > 80, "only {} numeric values found", leaves.len());
+    assert!(
+        leaves.len() > 80,
+        "only {} numeric values found",
+        leaves.len()
+    );
     let shown_path = path.display().to_string();
     let mut failures = Vec::new();
     let (mut refused, mut accepted) = (0, 0);
@@ -167,13 +169,19 @@ fn every_numeric_key_refuses_nan_infinities_and_huge_values_in_one_line() {
                     refused += 1;
                     let shown = e.to_string();
                     // A rule between keys names the key it checks, at that key's line.
-                    let line_shown = if e.key == leaf.key { line } else { e.line.unwrap_or(0) };
+                    let line_shown = if e.key == leaf.key {
+                        line
+                    } else {
+                        e.line.unwrap_or(0)
+                    };
                     let prefix = format!("{shown_path}:{line_shown}:");
                     let key_ok = e.key == leaf.key || (!strict && !e.key.is_empty());
                     if !key_ok || !shown.starts_with(&prefix) || shown.contains('\n') {
                         failures.push(format!("{what}: refused as `{shown}` (key `{}`)", e.key));
                     } else if strict && admits(&doc, value) {
-                        failures.push(format!("{what}: documented as admissible, refused: {shown}"));
+                        failures.push(format!(
+                            "{what}: documented as admissible, refused: {shown}"
+                        ));
                     }
                 }
                 Ok(scene) => {
