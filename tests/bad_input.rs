@@ -824,3 +824,88 @@ fn sigterm_removes_the_commands_temporaries() {
     }
     assert!(interrupted > 0, "no run was interrupted");
 }
+
+#[test]
+fn every_sweep_parameter_refuses_values_outside_its_documented_range() {
+    use seethru::measure::sweep_grid::{PARAMETERS, parse_param};
+    // (name, documented low, low included, high): the ranges of PARAMETERS' descriptions.
+    let documented = |name: &str| match name {
+        "theta_f" => (0.0, false, 89.0),
+        "d2" => (0.0, false, 1e6),
+        "display_width" => (0.0, false, 100.0),
+        "eye_x" | "eye_z" => (-1e6, true, 1e6),
+        "head_bias_x_cm" => (-500.0, true, 500.0),
+        "frontal_width" => (1.0, true, 16384.0),
+        other => panic!("`{other}` is not in this test"),
+    };
+    for (name, description) in PARAMETERS {
+        let (lo, lo_in, hi) = documented(name);
+        for (written, x) in [
+            ("nan", f64::NAN),
+            ("-inf", f64::NEG_INFINITY),
+            ("-1", -1.0),
+            ("0", 0.0),
+            ("1", 1.0),
+            ("1e300", 1e300),
+        ] {
+            let admissible = (x > lo || (lo_in && x == lo)) && x <= hi;
+            match parse_param(&format!("{name}={written}")) {
+                Ok(_) => assert!(admissible, "{name}={written} accepted ({description})"),
+                Err(e) => {
+                    let shown = format!("{e:#}");
+                    assert!(!admissible, "{name}={written} refused: {shown}");
+                    assert!(
+                        !shown.contains('\n') && (shown.contains(name) || shown.contains(written)),
+                        "{shown}"
+                    );
+                }
+            }
+        }
+        // `inf` is d2's name for no planar correction; for every other parameter it is refused.
+        assert_eq!(parse_param(&format!("{name}=inf")).is_ok(), name == "d2");
+    }
+    // The value that panicked in the BVH build (a 1e300 m display), through the command.
+    let dir = scratch("", &[]);
+    refused(
+        dir.path(),
+        &[
+            "sweep",
+            "scene.toml",
+            "--param",
+            "display_width=1e300",
+            "--out",
+            "s.csv",
+        ],
+        1,
+        &["display_width = 1e300", "(0, 100] m"],
+    );
+    refused(
+        dir.path(),
+        &[
+            "sweep",
+            "scene.toml",
+            "--param",
+            "eye_x=1,2,,3",
+            "--out",
+            "s.csv",
+        ],
+        1,
+        &["empty value"],
+    );
+    refused(
+        dir.path(),
+        &[
+            "sweep",
+            "scene.toml",
+            "--param",
+            "eye_x=1",
+            "--param",
+            "eye_x=2",
+            "--out",
+            "s.csv",
+        ],
+        1,
+        &["`eye_x` is given twice"],
+    );
+    assert_eq!(listing(dir.path()), ["scene.toml"]);
+}
