@@ -909,3 +909,25 @@ fn every_sweep_parameter_refuses_values_outside_its_documented_range() {
     );
     assert_eq!(listing(dir.path()), ["scene.toml"]);
 }
+
+#[test]
+fn textures_that_are_not_images_or_too_large_name_the_material_and_the_file() {
+    let wide = {
+        let mut png = Vec::new();
+        image::RgbImage::new(16385, 1)
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        png
+    };
+    for (bytes, words) in [
+        (&b"\x89PNG\r\n\x1a\n truncated"[..], &["material `t`", "tex.png"][..]),
+        (b"not an image at all", &["material `t`", "tex.png"]),
+        (&wide, &["material `t`", "tex.png", "limit"]),
+    ] {
+        let dir = scratch(
+            "\n[[material]]\nname = \"t\"\ntexture = \"tex.png\"\n",
+            &[("tex.png", bytes)],
+        );
+        render_refused(dir.path(), words);
+    }
+}
