@@ -920,7 +920,10 @@ fn textures_that_are_not_images_or_too_large_name_the_material_and_the_file() {
         png
     };
     for (bytes, words) in [
-        (&b"\x89PNG\r\n\x1a\n truncated"[..], &["material `t`", "tex.png"][..]),
+        (
+            &b"\x89PNG\r\n\x1a\n truncated"[..],
+            &["material `t`", "tex.png"][..],
+        ),
         (b"not an image at all", &["material `t`", "tex.png"]),
         (&wide, &["material `t`", "tex.png", "limit"]),
     ] {
@@ -930,4 +933,33 @@ fn textures_that_are_not_images_or_too_large_name_the_material_and_the_file() {
         );
         render_refused(dir.path(), words);
     }
+}
+
+#[test]
+fn scenes_past_the_triangle_limit_are_refused_before_building() {
+    // 1 300 cylinders of 4 096 segments are about 21 million triangles: past the limit of
+    // 20 million, refused while parsing (no mesh, no BVH built).
+    let mut text = common::MINIMAL.to_string();
+    for i in 0..1300 {
+        text.push_str(&format!(
+            "\n[[object]]\nkind = \"cylinder\"\nmaterial = \"grey\"\nsegments = 4096\ntranslate = [{i}.0, 0.0, -30.0]\n"
+        ));
+    }
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = send.send(common::parse(&text).map(|s| s.objects.len()));
+    });
+    let err = receive
+        .recv_timeout(std::time::Duration::from_secs(60))
+        .expect("must not hang")
+        .expect_err("past the triangle limit");
+    let shown = err.to_string();
+    assert!(
+        shown.contains("20000000") && shown.contains("triangles"),
+        "{shown}"
+    );
+    assert!(
+        shown.starts_with("test-scenes/scene.toml:") && !shown.contains('\n'),
+        "{shown}"
+    );
 }
