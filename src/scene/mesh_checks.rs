@@ -4,8 +4,6 @@
 
 use anyhow::{Result, anyhow, bail};
 
-use crate::scene::mesh_io::FileMaterial;
-
 /// Text from a file for a message: at most 40 characters, control characters escaped.
 fn clipped(text: &str) -> String {
     let mut out: String = text.chars().take(40).flat_map(char::escape_debug).collect();
@@ -51,15 +49,15 @@ pub(crate) fn check_mtl_lines(mtl: &[u8]) -> std::result::Result<(), String> {
 
 /// Every `usemtl` of an OBJ names a material of its libraries: tobj would draw an unknown one
 /// in the default grey without a word.
-pub(crate) fn check_usemtl_names(obj: &[u8], materials: &[FileMaterial]) -> Result<()> {
+pub(crate) fn check_usemtl_names(obj: &[u8], materials: &[&str]) -> Result<()> {
     for (i, line) in obj.split(|&b| b == b'\n').enumerate() {
         let line = String::from_utf8_lossy(line);
         if line.split_whitespace().next() != Some("usemtl") {
             continue;
         }
         let name = line.split_once(' ').unwrap_or_default().1.trim();
-        if !materials.iter().any(|m| m.name == name) {
-            let mut known: Vec<&str> = materials.iter().map(|m| m.name.as_str()).take(20).collect();
+        if !materials.contains(&name) {
+            let mut known: Vec<&str> = materials.iter().copied().take(20).collect();
             if known.is_empty() {
                 known.push("none: no `mtllib` defines any");
             }

@@ -160,7 +160,8 @@ pub fn parse_obj(
             .collect(),
         ..Default::default()
     };
-    check_usemtl_names(bytes, &out.materials)?;
+    let names: Vec<&str> = out.materials.iter().map(|m| m.name.as_str()).collect();
+    check_usemtl_names(bytes, &names)?;
     let mut triangles = 0usize;
     for (part, model) in models.iter().enumerate() {
         let mesh = &model.mesh;

@@ -125,8 +125,8 @@ impl World {
         for m in &scene.materials {
             let texture = match &m.texture {
                 Some(path) => {
-                    let texture = Texture::load(path)
-                        .with_context(|| format!("material `{}`", m.name))?;
+                    let texture =
+                        Texture::load(path).with_context(|| format!("material `{}`", m.name))?;
                     world.textures.push(texture);
                     Some(world.textures.len() - 1)
                 }
