@@ -173,15 +173,39 @@ fn objs_without_faces_or_with_bad_indices_are_refused() {
             "v 0 0 0\nv 0 0 0\nv 0 0 0\nf 1 2 3\n",
             &["no faces with an area"],
         ),
+        // tobj names no line: the pre-scan that explains its refusals does.
         (
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
-            &["mesh m.obj", "index out of bounds"],
+            &[
+                "mesh m.obj",
+                "line 4",
+                "`9` is not the index of a vertex (the file has 3)",
+            ],
         ),
         (
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n",
-            &["mesh m.obj", "index out of bounds"],
+            &["mesh m.obj", "line 4", "`0` is not the index of a vertex"],
         ),
-        ("v 0 0\nf 1 2 3\n", &["mesh m.obj", "position parse error"]),
+        (
+            "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n",
+            &["mesh m.obj", "line 3", "`-3` is not the index of a vertex"],
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n",
+            &[
+                "mesh m.obj",
+                "line 5",
+                "`2` is not the index of a texture coordinate",
+            ],
+        ),
+        (
+            "v 0 0 0\nv 0 0\nf 1 2 3\n",
+            &["mesh m.obj", "line 2", "`v` needs 3 numbers, got `0 0`"],
+        ),
+        (
+            "v 0 0 0\nvt x 0\n",
+            &["mesh m.obj", "line 2", "`vt` needs 2 numbers"],
+        ),
     ] {
         let dir = scratch(&mesh_object("m.obj"), &[("m.obj", obj.as_bytes())]);
         render_refused(dir.path(), words);

@@ -127,3 +127,68 @@ pub(crate) fn validated(json: gltf::json::Root) -> Result<gltf::Document> {
         other => anyhow!("invalid glTF: {other}"),
     })
 }
+
+/// The first line of an OBJ that tobj refuses, and why: tobj's errors name no line. Vertex
+/// lines need three numbers (texture coordinates two), face indices must be integers other
+/// than 0 that point at a vertex (negative ones count back from the line). `None` where no
+/// line is at fault by these rules.
+pub(crate) fn obj_error_line(obj: &[u8]) -> Option<String> {
+    let lines: Vec<String> = obj
+        .split(|&b| b == b'\n')
+        .map(|l| String::from_utf8_lossy(l).into_owned())
+        .collect();
+    let first_word = |l: &String| l.split_whitespace().next().map(str::to_string);
+    let total = |kind: &str| {
+        lines
+            .iter()
+            .filter(|l| first_word(l).as_deref() == Some(kind))
+            .count()
+    };
+    let totals = [total("v"), total("vt"), total("vn")];
+    let mut so_far = [0usize; 3];
+    for (i, line) in lines.iter().enumerate() {
+        let mut words = line.split_whitespace();
+        let at = |why: String| Some(format!("line {}: {why}", i + 1));
+        match words.next() {
+            Some(key @ ("v" | "vt" | "vn")) => {
+                let (slot, needed) = match key {
+                    "v" => (0, 3),
+                    "vt" => (1, 2),
+                    _ => (2, 3),
+                };
+                so_far[slot] += 1;
+                let numbers: Vec<&str> = words.take(needed).collect();
+                if numbers.len() < needed || numbers.iter().any(|w| w.parse::<f32>().is_err()) {
+                    return at(format!(
+                        "`{key}` needs {needed} numbers, got `{}`",
+                        clipped(&numbers.join(" "))
+                    ));
+                }
+            }
+            Some(key @ ("f" | "l" | "p")) => {
+                for corner in words {
+                    for (slot, part) in corner.split('/').enumerate().filter(|(_, p)| !p.is_empty())
+                    {
+                        let kind = ["vertex", "texture coordinate", "normal"].get(slot);
+                        let ok = match (kind, part.parse::<isize>()) {
+                            (Some(_), Ok(x)) if x > 0 => x as usize <= totals[slot],
+                            (Some(_), Ok(x)) if x < 0 => x.unsigned_abs() <= so_far[slot],
+                            _ => false,
+                        };
+                        if !ok {
+                            return at(format!(
+                                "`{key}` corner `{}`: `{}` is not the index of a {} (the file has {})",
+                                clipped(corner),
+                                clipped(part),
+                                kind.unwrap_or(&"vertex"),
+                                totals.get(slot).copied().unwrap_or(0)
+                            ));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    None
+}

@@ -18,7 +18,9 @@ use anyhow::{Context, Result, anyhow, bail};
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::scene::limits::{MAX_MESH_BYTES, MAX_TRIANGLES, first_bad_vertex};
-use crate::scene::mesh_checks::{check_glb_header, check_mtl_lines, check_usemtl_names, validated};
+use crate::scene::mesh_checks::{
+    check_glb_header, check_mtl_lines, check_usemtl_names, obj_error_line, validated,
+};
 use crate::scene::shapes::Tri;
 use crate::util::number::short_list;
 
@@ -143,8 +145,12 @@ pub fn parse_obj(
         }
     };
     let (models, materials) =
-        tobj::load_obj_buf(&mut BufReader::new(Cursor::new(bytes)), &options, load_mtl)
-            .map_err(|e| anyhow!("invalid OBJ: {e}"))?;
+        tobj::load_obj_buf(&mut BufReader::new(Cursor::new(bytes)), &options, load_mtl).map_err(
+            |e| match obj_error_line(bytes) {
+                Some(why) => anyhow!("invalid OBJ: {why}"),
+                None => anyhow!("invalid OBJ: {e}"),
+            },
+        )?;
     let materials = match (materials, mtl_error.into_inner()) {
         (_, Some(why)) => bail!(why),
         (Err(e), None) => bail!("material library: {e}"),
