@@ -987,3 +987,39 @@ fn scenes_past_the_triangle_limit_are_refused_before_building() {
         "{shown}"
     );
 }
+
+#[test]
+fn numbers_pasted_with_hundreds_of_digits_are_not_repeated_in_full() {
+    let long = format!("1{}.5", "0".repeat(800));
+    let dir = scratch("", &[]);
+    for (args, code) in [
+        (vec!["measure", "run", "--band", long.as_str()], 2),
+        (
+            vec![
+                "render",
+                "scene.toml",
+                "--out",
+                "o",
+                "--width",
+                long.as_str(),
+            ],
+            2,
+        ),
+        (
+            vec!["run", "scene.toml", "--out", "o", "--d2", long.as_str()],
+            2,
+        ),
+    ] {
+        let err = refused(dir.path(), &args, code, &["100000000000…(803 characters)"]);
+        assert!(err.len() < 300, "{err}");
+    }
+    let param = format!("theta_f={long}");
+    let err = refused(
+        dir.path(),
+        &["sweep", "scene.toml", "--param", &param, "--out", "s.csv"],
+        1,
+        &["theta_f", "(803 characters)"],
+    );
+    assert!(err.len() < 300, "{err}");
+    assert_eq!(listing(dir.path()), ["scene.toml"]);
+}
