@@ -25,6 +25,16 @@ pub struct StagedDir {
 impl StagedDir {
     /// Stages the output directory `target`, which must be a directory or not exist yet.
     pub fn new(target: &Path) -> Result<Self> {
+        // `.` and `..` name no folder of their own: stage beside the folder they are.
+        let resolved;
+        let target = if target.file_name().is_none() {
+            resolved = target
+                .canonicalize()
+                .with_context(|| format!("cannot find the output {}", target.display()))?;
+            resolved.as_path()
+        } else {
+            target
+        };
         if target.exists() && !target.is_dir() {
             bail!(
                 "the output {} exists and is not a directory",
@@ -187,5 +197,12 @@ mod tests {
         );
         assert_eq!(names(&target), ["keep.txt", "sub"]);
         assert_eq!(names(target.parent().unwrap()), ["out"]);
+
+        // `.` is the folder it names.
+        let here = target.join("sub/.");
+        let staged = StagedDir::new(&here).unwrap();
+        std::fs::write(staged.path().join("c.txt"), "c").unwrap();
+        staged.commit().unwrap();
+        assert_eq!(names(&target.join("sub")), ["b.txt", "c.txt"]);
     }
 }
