@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use clap::error::ErrorKind;
+use seethru::util::number::clip_long_numbers;
 
 fn main() -> ExitCode {
     // `seethru analyze | head`: a reader that closes the pipe early ends the command quietly,
@@ -31,7 +32,7 @@ fn main() -> ExitCode {
             e.exit()
         }
         Err(e) => {
-            eprintln!("{}", cli::one_line(&e));
+            eprintln!("{}", clip_long_numbers(&cli::one_line(&e)));
             return ExitCode::from(2);
         }
     };
@@ -45,7 +46,8 @@ fn main() -> ExitCode {
     match cli.command.run() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            // Messages repeat the input: an 800-digit number stays 12 digits.
+            eprintln!("error: {}", clip_long_numbers(&format!("{e:#}")));
             ExitCode::FAILURE
         }
     }

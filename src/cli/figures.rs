@@ -14,7 +14,10 @@ pub struct Figures {
 
 impl Figures {
     pub fn run(self) -> Result<()> {
-        let names = seethru::paper::figures::write_all(&self.out)?;
+        // Written whole or not at all: a failure leaves `--out` as it was.
+        let staged = seethru::io::staged::StagedDir::new(&self.out)?;
+        let names = seethru::paper::figures::write_all(staged.path())?;
+        staged.commit()?;
         seethru::util::progress::summary(format!(
             "wrote {} figures (PNG, SVG and CSV) to {}",
             names.len(),

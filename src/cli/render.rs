@@ -2,8 +2,9 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use seethru::io::frame_files::write_frame;
+use seethru::io::staged::StagedDir;
 use seethru::render::integrator::RenderContext;
 use seethru::render::settings::{RenderSettings, check_spp, resized};
 use seethru::render::views::View;
@@ -51,8 +52,8 @@ fn render_views(scene_path: &Path, views: &[View], out: &Path, options: &RenderA
         .collect::<Result<Vec<_>>>()?;
     check_memory(&render_estimate(&cameras), options.max_memory)?;
     let context = RenderContext::new(scene)?;
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("cannot create output directory {}", out.display()))?;
+    // Written whole or not at all: a failure leaves `out` as it was.
+    let staged = StagedDir::new(out)?;
     let settings = RenderSettings {
         spp: options.spp,
         progress: true,
@@ -60,7 +61,7 @@ fn render_views(scene_path: &Path, views: &[View], out: &Path, options: &RenderA
     let mut rendered = Vec::new();
     for (view, camera) in views.iter().zip(&cameras) {
         let (frame, stats) = context.render(camera, view.bit(), settings, view.name());
-        write_frame(&frame, out, view.name())?;
+        write_frame(&frame, staged.path(), view.name())?;
         rendered.push(format!(
             "{} {}×{} in {:.2} s",
             view.name(),
@@ -69,6 +70,7 @@ fn render_views(scene_path: &Path, views: &[View], out: &Path, options: &RenderA
             stats.seconds
         ));
     }
+    staged.commit()?;
     seethru::util::progress::summary(format!(
         "rendered {} (PNG, ids PNG, EXR each) → {}",
         rendered.join(", "),

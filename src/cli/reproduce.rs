@@ -25,9 +25,12 @@ pub struct Reproduce {
 
 impl Reproduce {
     pub fn run(self) -> Result<()> {
+        // Written whole or not at all: a failure leaves `--out` as it was.
+        let staged = seethru::io::staged::StagedDir::new(&self.out)?;
         with_threads(self.threads, || {
-            seethru::paper::reproduce::reproduce(&self.scene, &self.out, self.quick)
+            seethru::paper::reproduce::reproduce(&self.scene, staged.path(), self.quick)
         })??;
+        staged.commit()?;
         seethru::util::progress::summary(format!(
             "wrote report.md, report.html and report.json to {}",
             self.out.display()

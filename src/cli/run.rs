@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 use rayon::prelude::*;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_frame;
+use seethru::io::staged::StagedDir;
 use seethru::measure::holes::{attach_holes, write_hole_mask};
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
@@ -146,15 +147,25 @@ fn run_command(
     };
     check_memory(&estimate, max_memory)?;
     let ctx = RenderContext::new(scene)?;
-    if both {
-        return crate::cli::run_eyes::run_both(&ctx, out, options, |options, dir| {
+    // Written whole or not at all: a failure leaves `out` as it was.
+    let staged = StagedDir::new(out)?;
+    let summary = if both {
+        crate::cli::run_eyes::run_both(&ctx, staged.path(), out, options, |options, dir| {
             write_run(&ctx, dir, options, band)
-        });
-    }
-    write_run(&ctx, out, options, band).map(|_| ())
+        })?
+    } else {
+        write_run(&ctx, staged.path(), options, band)?;
+        format!(
+            "wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",
+            out.display()
+        )
+    };
+    staged.commit()?;
+    seethru::util::progress::summary(summary);
+    Ok(())
 }
 
-/// One run into `out`: every view, the metrics and run.json.
+/// One run into `out` (inside the staging folder): every view, the metrics and run.json.
 fn write_run(
     ctx: &RenderContext,
     out: &Path,
@@ -204,9 +215,5 @@ fn write_run(
         &out.join("run.json"),
         &serde_json::to_string_pretty(&result.report)?,
     )?;
-    seethru::util::progress::summary(format!(
-        "wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",
-        out.display()
-    ));
     Ok(result)
 }

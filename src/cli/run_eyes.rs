@@ -23,13 +23,15 @@ pub enum EyesFlag {
     Both,
 }
 
-/// Runs each eye through `write_run(options, dir)` and writes the binocular outputs.
+/// Runs each eye through `write_run(options, dir)` into `out` and writes the binocular
+/// outputs there; returns the summary line, naming `shown_out` (where `out` will be moved).
 pub fn run_both(
     ctx: &RenderContext,
     out: &Path,
+    shown_out: &Path,
     options: &RunOptions,
     write_run: impl Fn(&RunOptions, &Path) -> Result<RunResult>,
-) -> Result<()> {
+) -> Result<String> {
     let mut results = Vec::new();
     for (eye, name) in [(Eye::Left, "left"), (Eye::Right, "right")] {
         let options = RunOptions {
@@ -55,7 +57,7 @@ pub fn run_both(
     write_binocular(out, &map, &stats, [&results[0].1, &results[1].1])
         .with_context(|| format!("writing the binocular outputs to {}", out.display()))?;
     let m = &stats["mismatch_arcmin"];
-    seethru::util::progress::summary(format!(
+    Ok(format!(
         "binocular mismatch: mean {:.1}′, p5 {:.1}′, p95 {:.1}′ over {} display pixels ({} missing); closed form {:.1}′ straight ahead, {:.1}′ at the display's angle; wrote binocular.json/.exr/.png and anaglyph.png to {}",
         m["mean"].as_f64().unwrap_or(f64::NAN),
         m["p5"].as_f64().unwrap_or(f64::NAN),
@@ -66,7 +68,6 @@ pub fn run_both(
         stats["closed_form_off_axis_arcmin"]
             .as_f64()
             .unwrap_or(f64::NAN),
-        out.display()
-    ));
-    Ok(())
+        shown_out.display()
+    ))
 }

@@ -9,10 +9,11 @@ use std::sync::Mutex;
 
 use anyhow::{Context, Result};
 
-/// Temporaries being written now, by any thread of this process.
+/// Temporaries being written now, by any thread of this process: files, and the staging
+/// folders of `io::staged`.
 static IN_FLIGHT: Mutex<Option<HashSet<PathBuf>>> = Mutex::new(None);
 
-fn track(tmp: &Path, writing: bool) {
+pub(crate) fn track(tmp: &Path, writing: bool) {
     if let Ok(mut set) = IN_FLIGHT.lock() {
         let set = set.get_or_insert_with(HashSet::new);
         if writing {
@@ -32,18 +33,18 @@ pub fn remove_in_flight() -> usize {
     let paths: Vec<PathBuf> = set.take().unwrap_or_default().into_iter().collect();
     paths
         .iter()
-        .filter(|p| std::fs::remove_file(p).is_ok())
+        .filter(|p| std::fs::remove_file(p).is_ok() || std::fs::remove_dir_all(p).is_ok())
         .count()
 }
 
 /// The temporary name of `path` for process `pid`.
-fn temporary(path: &Path, name: &str, pid: u32) -> PathBuf {
+pub(crate) fn temporary(path: &Path, name: &str, pid: u32) -> PathBuf {
     path.with_file_name(format!(".{name}.tmp-{pid}"))
 }
 
 /// Removes temporaries of `path` left by processes that no longer run (killed before they
 /// could clean up). Only Linux says which processes run; elsewhere nothing is removed.
-fn remove_stale(path: &Path, name: &str) {
+pub(crate) fn remove_stale(path: &Path, name: &str) {
     let (Some(dir), true) = (path.parent(), Path::new("/proc/self").exists()) else {
         return;
     };
@@ -65,7 +66,9 @@ fn remove_stale(path: &Path, name: &str) {
             continue;
         };
         if !Path::new(&format!("/proc/{pid}")).exists() {
-            let _ = std::fs::remove_file(entry.path());
+            // A file of an atomic write, or a staging folder (`io::staged`).
+            let _ = std::fs::remove_file(entry.path())
+                .or_else(|_| std::fs::remove_dir_all(entry.path()));
         }
     }
 }

@@ -7,3 +7,4 @@ pub mod export;
 pub mod frame_files;
 pub mod plot;
 pub mod run_dir;
+pub mod staged;

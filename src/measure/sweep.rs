@@ -86,8 +86,11 @@ pub fn sweep(
     }
     let mut names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
     names.sort_unstable();
-    if names.windows(2).any(|w| w[0] == w[1]) {
-        bail!("a parameter is given twice");
+    if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
+        bail!(
+            "the parameter `{}` is given twice (one --param per parameter, with all its values)",
+            w[0]
+        );
     }
     let base = Scene::load(scene_path)?;
     let base_options = RunOptions {

@@ -5,26 +5,37 @@ use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
 use crate::scene::Scene;
+use crate::scene::limits::{MAX_COORDINATE, MAX_RESOLUTION, out_of_world};
 use crate::system::options::{RunOptions, WorkingDistance};
+use crate::util::number::short;
 
 /// What a sweep can vary.
 pub const PARAMETERS: [(&str, &str); 7] = [
-    ("theta_f", "frontal half angle θ_F, degrees, (0, 89)"),
-    ("d2", "model working distance: inf, auto or metres"),
+    ("theta_f", "frontal half angle θ_F, degrees in (0, 89]"),
+    (
+        "d2",
+        "model working distance: inf, auto or metres in (0, 1e6]",
+    ),
     (
         "display_width",
-        "display width D, metres (display pixels scale with it)",
+        "display width D, metres in (0, 100] (display pixels scale with it)",
     ),
-    ("eye_x", "eye moved across the display (obstacle x), metres"),
+    (
+        "eye_x",
+        "eye moved across the display (obstacle x), metres in [-1e6, 1e6]",
+    ),
     (
         "eye_z",
-        "eye moved along the display normal (d1 change), metres",
+        "eye moved along the display normal (d1 change), metres in [-1e6, 1e6]",
     ),
     (
         "head_bias_x_cm",
-        "head-tracking bias across the display, centimetres",
+        "head-tracking bias across the display, centimetres in [-500, 500]",
     ),
-    ("frontal_width", "frontal camera width, pixels"),
+    (
+        "frontal_width",
+        "frontal camera width, pixels in [1, 16384]",
+    ),
 ];
 
 /// One swept parameter and its values (as written on the command line, and parsed).
@@ -60,11 +71,11 @@ pub fn parse_param(spec: &str) -> Result<Param> {
             .map(|i| format!("{}", start + step * i as f64))
             .collect()
     } else {
-        values
-            .split(',')
-            .map(|v| v.trim().to_string())
-            .filter(|v| !v.is_empty())
-            .collect()
+        let values: Vec<String> = values.split(',').map(|v| v.trim().to_string()).collect();
+        if values.len() > 1 && values.iter().any(String::is_empty) {
+            bail!("`{spec}`: an empty value between commas");
+        }
+        values.into_iter().filter(|v| !v.is_empty()).collect()
     };
     if values.is_empty() {
         bail!("`{spec}`: no values");
@@ -88,28 +99,47 @@ fn number(name: &str, v: &str) -> Result<f64> {
     Ok(x)
 }
 
-fn check_value(name: &str, v: &str) -> Result<()> {
+/// The admissible values of a numeric parameter: (low, low included, high, unit), high
+/// included. The same ranges as the scene keys and flags they stand for.
+fn range_of(name: &str) -> (f64, bool, f64, &'static str) {
     match name {
-        "d2" => v
+        "theta_f" => (0.0, false, 89.0, "degrees"),
+        // The obstacle's width, as in the scene file.
+        "display_width" => (0.0, false, 100.0, "m"),
+        // The eye stays inside the world (checked again after the move).
+        "eye_x" | "eye_z" => (-MAX_COORDINATE, true, MAX_COORDINATE, "m"),
+        // As `run --head-bias-cm`.
+        "head_bias_x_cm" => (-500.0, true, 500.0, "cm"),
+        "frontal_width" => (1.0, true, MAX_RESOLUTION as f64, "pixels"),
+        _ => (f64::NEG_INFINITY, true, f64::INFINITY, ""),
+    }
+}
+
+fn check_value(name: &str, v: &str) -> Result<()> {
+    if name == "d2" {
+        return v
             .parse::<WorkingDistance>()
             .map(|_| ())
-            .map_err(anyhow::Error::msg),
-        "theta_f" => {
-            let x = number(name, v)?;
-            if !(x > 0.0 && x < 89.0) {
-                bail!("theta_f = {v}: must be in (0, 89) degrees");
-            }
-            Ok(())
-        }
-        "display_width" | "frontal_width" => {
-            let x = number(name, v)?;
-            if x <= 0.0 || (name == "frontal_width" && (x.fract() != 0.0 || x > 16384.0)) {
-                bail!("{name} = {v}: must be > 0 (and a pixel count ≤ 16384 for frontal_width)");
-            }
-            Ok(())
-        }
-        _ => number(name, v).map(|_| ()),
+            .map_err(anyhow::Error::msg);
     }
+    let x = number(name, v)?;
+    let (lo, lo_in, hi, unit) = range_of(name);
+    let inside = (x > lo || (lo_in && x == lo)) && x <= hi;
+    if !inside || (name == "frontal_width" && x.fract() != 0.0) {
+        let open = if lo_in { '[' } else { '(' };
+        let what = if name == "frontal_width" {
+            "an integer "
+        } else {
+            ""
+        };
+        bail!(
+            "{name} = {}: must be {what}in {open}{}, {}] {unit}",
+            short(x),
+            short(lo),
+            short(hi)
+        );
+    }
+    Ok(())
 }
 
 /// Applies one configuration to the scene and the options.
@@ -155,6 +185,9 @@ pub fn configure(
     {
         bail!("configuration {config:?} puts the eye behind the display");
     }
+    if let Some(why) = out_of_world(scene.eye()) {
+        bail!("configuration {config:?} moves the eye outside the world: {why}");
+    }
     Ok((scene, options))
 }
 
@@ -195,7 +228,7 @@ mod tests {
             parse_param("theta_f=95")
                 .unwrap_err()
                 .to_string()
-                .contains("(0, 89)")
+                .contains("(0, 89]")
         );
         assert!(parse_param("d2=-1").is_err());
         assert!(parse_param("theta_f=80:20:5").is_err());

@@ -18,6 +18,9 @@ use anyhow::{Context, Result, anyhow, bail};
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::scene::limits::{MAX_MESH_BYTES, MAX_TRIANGLES, first_bad_vertex};
+use crate::scene::mesh_checks::{
+    check_glb_header, check_mtl_lines, check_usemtl_names, obj_error_line, validated,
+};
 use crate::scene::shapes::Tri;
 use crate::util::number::short_list;
 
@@ -133,14 +136,21 @@ pub fn parse_obj(
             Err(tobj::LoadError::OpenFileFailed)
         };
         match read(&resolved) {
-            Ok(mtl) => tobj::load_mtl_buf(&mut BufReader::new(Cursor::new(mtl)))
-                .or_else(|e| fail(e.to_string())),
+            Ok(mtl) => match check_mtl_lines(&mtl) {
+                Err(why) => fail(why),
+                Ok(()) => tobj::load_mtl_buf(&mut BufReader::new(Cursor::new(mtl)))
+                    .or_else(|e| fail(e.to_string())),
+            },
             Err(e) => fail(e.to_string()),
         }
     };
     let (models, materials) =
-        tobj::load_obj_buf(&mut BufReader::new(Cursor::new(bytes)), &options, load_mtl)
-            .map_err(|e| anyhow!("invalid OBJ: {e}"))?;
+        tobj::load_obj_buf(&mut BufReader::new(Cursor::new(bytes)), &options, load_mtl).map_err(
+            |e| match obj_error_line(bytes) {
+                Some(why) => anyhow!("invalid OBJ: {why}"),
+                None => anyhow!("invalid OBJ: {e}"),
+            },
+        )?;
     let materials = match (materials, mtl_error.into_inner()) {
         (_, Some(why)) => bail!(why),
         (Err(e), None) => bail!("material library: {e}"),
@@ -156,6 +166,8 @@ pub fn parse_obj(
             .collect(),
         ..Default::default()
     };
+    let names: Vec<&str> = out.materials.iter().map(|m| m.name.as_str()).collect();
+    check_usemtl_names(bytes, &names)?;
     let mut triangles = 0usize;
     for (part, model) in models.iter().enumerate() {
         let mesh = &model.mesh;
@@ -198,29 +210,6 @@ pub fn parse_obj(
     checked(out)
 }
 
-/// A GLB's 12-byte header must declare a length that holds the header and one chunk header
-/// and fits the file: the gltf crate subtracts before it checks (an overflow, found by
-/// fuzzing, that panics where overflow checks are on).
-fn check_glb_header(bytes: &[u8]) -> Result<()> {
-    if !bytes.starts_with(b"glTF") {
-        return Ok(()); // glTF JSON
-    }
-    let word = |at: usize| {
-        bytes
-            .get(at..at + 4)
-            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
-    };
-    match (word(4), word(8)) {
-        (Some(2), Some(length)) if (12 + 8..=bytes.len()).contains(&length) => Ok(()),
-        (Some(2), Some(length)) => bail!(
-            "invalid GLB: its header declares {length} bytes; a GLB holds at least 20 and this file has {}",
-            bytes.len()
-        ),
-        (Some(version), Some(_)) => bail!("invalid GLB: version {version}, only 2 is read"),
-        _ => bail!("invalid GLB: the file ends inside its 12-byte header"),
-    }
-}
-
 /// Parses a glTF (JSON) or GLB file's bytes; `path` names it and anchors its external
 /// buffers, which `read` reads. Images are not loaded: only `baseColorFactor` is used.
 pub fn parse_gltf(
@@ -229,10 +218,9 @@ pub fn parse_gltf(
     read: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
 ) -> Result<LoadedMesh> {
     check_glb_header(bytes)?;
-    let gltf::Gltf {
-        document: doc,
-        blob,
-    } = gltf::Gltf::from_slice(bytes).map_err(|e| anyhow!("invalid glTF: {e}"))?;
+    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(bytes)
+        .map_err(|e| anyhow!("invalid glTF: {e}"))?;
+    let doc = validated(document.into_json())?;
     let buffers = load_buffers(&doc, blob, path, read)?;
     let mut out = LoadedMesh {
         materials: doc

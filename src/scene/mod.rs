@@ -7,6 +7,7 @@ pub mod grow;
 pub mod head_path;
 pub mod lens_keys;
 pub mod limits;
+pub mod mesh_checks;
 pub mod mesh_io;
 pub mod motion;
 pub mod procedural;

@@ -228,8 +228,23 @@ fn read_objects(
         .collect();
     let mut triangles = 0usize;
     let mut objects = Vec::new();
-    for t in bounded_tables(root, "object", MAX_OBJECTS)? {
+    // Names given explicitly are unique (measurements and exports find objects by them);
+    // the default, the kind, may repeat.
+    let mut named: HashMap<String, Option<usize>> = HashMap::new();
+    for (i, t) in bounded_tables(root, "object", MAX_OBJECTS)?
+        .into_iter()
+        .enumerate()
+    {
         let object = read_object(&t, materials, &by_name, file)?;
+        if let Some(name) = t.opt_str("name")?
+            && let Some(first) = named.insert(name.to_string(), t.error("name", "").line)
+        {
+            let at = first.map_or(String::new(), |l| format!(" at line {l}"));
+            return Err(t.error(
+                "name",
+                format!("object `{name}` is named twice: object[{i}] repeats the name of an earlier object{at}"),
+            ));
+        }
         triangles += triangle_count(&object.shape);
         if triangles > MAX_TRIANGLES {
             return Err(t.table_error(format!(

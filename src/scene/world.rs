@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use glam::{Affine3A, DAffine3, DVec3, Mat3A, Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::ray::Ray;
@@ -146,7 +146,9 @@ impl World {
         for (index, m) in scene.materials.iter().enumerate() {
             let texture = match &m.texture {
                 Some(path) if used[index] => {
-                    world.textures.push(Texture::load(path)?);
+                    let texture =
+                        Texture::load(path).with_context(|| format!("material `{}`", m.name))?;
+                    world.textures.push(texture);
                     Some(world.textures.len() - 1)
                 }
                 _ => None,

@@ -49,7 +49,8 @@ pub fn render_estimate(cameras: &[Camera]) -> MemoryEstimate {
     }
 }
 
-/// `run`: the six views are held together, written two at a time, and measured.
+/// `run`: the six views are held together, written side by side (as many EXRs encoded at
+/// once as there are threads, up to all six), and measured.
 pub fn run_estimate(scene: &Scene, options: &RunOptions) -> Result<MemoryEstimate> {
     let driver = resized(scene.driver, options.width, options.height)?;
     let frontal = resized(scene.frontal, options.frontal_width, None)?;
@@ -57,15 +58,13 @@ pub fn run_estimate(scene: &Scene, options: &RunOptions) -> Result<MemoryEstimat
     let [dw, dh] = scene.obstacle.display_resolution;
     let display = dw as u64 * dh as u64;
     let frames = 3 * pixels(&driver) + pixels(&frontal) + pixels(&back) + display;
-    let largest = pixels(&driver).max(pixels(&frontal));
     // A depth sensor's frame and inverse-depth image, at most at the frontal resolution.
     let sensor = if options.method.models_the_scene() {
         pixels(&frontal) * (FRAME_BYTES_PER_PIXEL + 4)
     } else {
         0
     };
-    let bytes = frames * FRAME_BYTES_PER_PIXEL
-        + 2 * largest * EXR_BYTES_PER_PIXEL
+    let bytes = frames * (FRAME_BYTES_PER_PIXEL + EXR_BYTES_PER_PIXEL)
         + pixels(&driver) * METRICS_BYTES_PER_PIXEL
         + sensor;
     Ok(MemoryEstimate {

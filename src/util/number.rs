@@ -31,9 +31,55 @@ pub fn short_list(xs: &[f64]) -> String {
     format!("[{}]", items.join(", "))
 }
 
+/// `text` with every number written with more than 24 digits (as a user or a script may
+/// paste one: 800 digits of a float) cut to its first 12 characters and its length, so that a
+/// message that repeats the input stays short.
+pub fn clip_long_numbers(text: &str) -> String {
+    let is_number_char = |c: char| c.is_ascii_digit() || matches!(c, '.' | 'e' | 'E' | '+' | '-');
+    let mut out = String::with_capacity(text.len().min(1024));
+    let mut run = String::new();
+    let flush = |run: &mut String, out: &mut String| {
+        if run.chars().filter(char::is_ascii_digit).count() > 24 {
+            out.extend(run.chars().take(12));
+            out.push_str(&format!("…({} characters)", run.chars().count()));
+        } else {
+            out.push_str(run);
+        }
+        run.clear();
+    };
+    for c in text.chars() {
+        if is_number_char(c) {
+            run.push(c);
+        } else {
+            flush(&mut run, &mut out);
+            out.push(c);
+        }
+    }
+    flush(&mut run, &mut out);
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn long_numbers_in_messages_are_clipped_and_others_kept() {
+        let long = format!("1{}.5", "0".repeat(800));
+        let clipped = clip_long_numbers(&format!("invalid value '{long}' for '--band <BAND>'"));
+        assert_eq!(
+            clipped,
+            "invalid value '100000000000…(803 characters)' for '--band <BAND>'"
+        );
+        for kept in [
+            "scenes/x.toml:32:10: must be in [1e-6, 100000], got 0",
+            "run-2026-12-01/out.tmp-123456: 1234567890123456789012345 is 25 digits",
+        ] {
+            let expected =
+                kept.replace("1234567890123456789012345", "123456789012…(25 characters)");
+            assert_eq!(clip_long_numbers(kept), expected);
+        }
+    }
 
     #[test]
     fn numbers_are_short_and_round_trip_to_six_digits() {

@@ -1,0 +1,208 @@
+//! An output directory written whole or not at all. A command writes its files into a staging
+//! folder beside the output (`.<name>.tmp-<pid>`), and only when every file is written are
+//! they moved into place: a command that fails, or is interrupted, leaves the output location
+//! as it found it — no partial set of files, no empty folder it created. A staging folder left
+//! by a killed process is removed by the next command writing the same output.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+
+use crate::io::atomic::{remove_stale, temporary, track};
+
+/// A staging folder for the output directory `target`; dropped without [`commit`], it is
+/// removed with everything in it, and so are the parent folders it created.
+///
+/// [`commit`]: StagedDir::commit
+pub struct StagedDir {
+    target: PathBuf,
+    staging: PathBuf,
+    /// The topmost parent folder of `target` that this created (removed on failure).
+    created_parent: Option<PathBuf>,
+    committed: bool,
+}
+
+impl StagedDir {
+    /// Stages the output directory `target`, which must be a directory or not exist yet.
+    pub fn new(target: &Path) -> Result<Self> {
+        // `.` and `..` name no folder of their own: stage beside the folder they are.
+        let resolved;
+        let target = if target.file_name().is_none() {
+            resolved = target
+                .canonicalize()
+                .with_context(|| format!("cannot find the output {}", target.display()))?;
+            resolved.as_path()
+        } else {
+            target
+        };
+        if target.exists() && !target.is_dir() {
+            bail!(
+                "the output {} exists and is not a directory",
+                target.display()
+            );
+        }
+        let name = target
+            .file_name()
+            .with_context(|| format!("not a directory path: {}", target.display()))?
+            .to_string_lossy()
+            .to_string();
+        let parent = target.parent().filter(|p| !p.as_os_str().is_empty());
+        let created_parent = parent.and_then(|p| {
+            p.ancestors()
+                .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+                .last()
+                .map(Path::to_path_buf)
+        });
+        if let Some(parent) = parent {
+            std::fs::create_dir_all(parent)
+                .with_context(|| format!("cannot create the folder {}", parent.display()))?;
+        }
+        remove_stale(target, &name);
+        let staging = temporary(target, &name, std::process::id());
+        let _ = std::fs::remove_dir_all(&staging);
+        track(&staging, true);
+        let staged = Self {
+            target: target.to_path_buf(),
+            staging,
+            created_parent,
+            committed: false,
+        };
+        std::fs::create_dir(&staged.staging).with_context(|| {
+            format!(
+                "cannot create the staging folder {}",
+                staged.staging.display()
+            )
+        })?;
+        Ok(staged)
+    }
+
+    /// Where the command writes its files (and folders).
+    pub fn path(&self) -> &Path {
+        &self.staging
+    }
+
+    /// Moves every staged file into the output directory (replacing files of the same name)
+    /// and removes the staging folder. Nothing is moved unless every file can be.
+    pub fn commit(mut self) -> Result<()> {
+        if !self.target.exists() {
+            std::fs::rename(&self.staging, &self.target).with_context(|| {
+                format!("cannot move the output into {}", self.target.display())
+            })?;
+        } else {
+            let mut moves = Vec::new();
+            plan_moves(&self.staging, &self.target, &mut moves)?;
+            for (from, to) in moves {
+                if let (Some(dir), Some(name)) = (to.parent(), to.file_name()) {
+                    std::fs::create_dir_all(dir)
+                        .with_context(|| format!("cannot create {}", dir.display()))?;
+                    remove_stale(&to, &name.to_string_lossy());
+                }
+                std::fs::rename(&from, &to)
+                    .with_context(|| format!("cannot move {} into place", to.display()))?;
+            }
+            let _ = std::fs::remove_dir_all(&self.staging);
+        }
+        self.committed = true;
+        track(&self.staging, false);
+        Ok(())
+    }
+}
+
+/// Every file under `from` with its place under `to`; an error, before anything moves, where
+/// a file would replace a folder or a folder a file.
+fn plan_moves(from: &Path, to: &Path, moves: &mut Vec<(PathBuf, PathBuf)>) -> Result<()> {
+    let entries =
+        std::fs::read_dir(from).with_context(|| format!("cannot read {}", from.display()))?;
+    for entry in entries {
+        let entry = entry?;
+        let (source, dest) = (entry.path(), to.join(entry.file_name()));
+        if entry.file_type()?.is_dir() {
+            if dest.exists() && !dest.is_dir() {
+                bail!(
+                    "cannot write {}: a file of that name is in the way",
+                    dest.display()
+                );
+            }
+            plan_moves(&source, &dest, moves)?;
+        } else {
+            if dest.is_dir() {
+                bail!(
+                    "cannot write {}: a folder of that name is in the way",
+                    dest.display()
+                );
+            }
+            moves.push((source, dest));
+        }
+    }
+    Ok(())
+}
+
+impl Drop for StagedDir {
+    fn drop(&mut self) {
+        if self.committed {
+            return;
+        }
+        let _ = std::fs::remove_dir_all(&self.staging);
+        track(&self.staging, false);
+        // The parent folders this created, innermost first, each only if it is empty.
+        if let (Some(top), Some(parent)) = (&self.created_parent, self.target.parent()) {
+            for folder in parent.ancestors() {
+                if std::fs::remove_dir(folder).is_err() || folder == top {
+                    break;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().to_string())
+            .collect();
+        names.sort();
+        names
+    }
+
+    #[test]
+    fn a_dropped_stage_leaves_nothing_and_a_commit_moves_everything() {
+        let scratch = tempfile::tempdir().unwrap();
+        let target = scratch.path().join("new/nested/out");
+        let staged = StagedDir::new(&target).unwrap();
+        std::fs::write(staged.path().join("a.txt"), "a").unwrap();
+        drop(staged);
+        assert_eq!(names(scratch.path()), Vec::<String>::new());
+
+        let staged = StagedDir::new(&target).unwrap();
+        std::fs::create_dir(staged.path().join("sub")).unwrap();
+        std::fs::write(staged.path().join("sub/b.txt"), "b").unwrap();
+        staged.commit().unwrap();
+        assert_eq!(names(&target), ["sub"]);
+
+        // Into an existing folder: files replaced, others kept, nothing moved when one
+        // cannot be.
+        std::fs::write(target.join("keep.txt"), "k").unwrap();
+        let staged = StagedDir::new(&target).unwrap();
+        std::fs::write(staged.path().join("keep.txt"), "new").unwrap();
+        std::fs::write(staged.path().join("sub"), "a file where a folder is").unwrap();
+        assert!(staged.commit().is_err());
+        assert_eq!(
+            std::fs::read_to_string(target.join("keep.txt")).unwrap(),
+            "k"
+        );
+        assert_eq!(names(&target), ["keep.txt", "sub"]);
+        assert_eq!(names(target.parent().unwrap()), ["out"]);
+
+        // `.` is the folder it names.
+        let here = target.join("sub/.");
+        let staged = StagedDir::new(&here).unwrap();
+        std::fs::write(staged.path().join("c.txt"), "c").unwrap();
+        staged.commit().unwrap();
+        assert_eq!(names(&target.join("sub")), ["b.txt", "c.txt"]);
+    }
+}

@@ -1,0 +1,314 @@
+//! Bad scene files and command lines as a careless user or script makes them, one test per
+//! class: each is refused with one line on stderr starting `error:` that names the file (and
+//! line, key or flag), the value and what is admissible; the exit code says usage (2) or input
+//! (1); nothing is left behind. Limits that guard against hangs are checked under a watchdog.
+
+mod common;
+
+use common::refusal::{RENDER, listing, refused, render_refused, run_in, scratch};
+
+#[test]
+fn scenes_past_the_object_limit_are_refused_quickly() {
+    // 200 000 objects: twice the limit. Finding the line of a key was quadratic (40 000
+    // objects took 29 s); the watchdog allows a minute, the parse takes well under one.
+    let mut text = common::MINIMAL.to_string();
+    for i in 0..200_000 {
+        text.push_str(&format!(
+            "\n[[object]]\nkind = \"sphere\"\nmaterial = \"grey\"\nradius = 0.1\ntranslate = [{}.0, 0.1, -20.0]\n",
+            i % 1000
+        ));
+    }
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = send.send(common::parse(&text).map(|s| s.objects.len()));
+    });
+    let result = receive
+        .recv_timeout(std::time::Duration::from_secs(60))
+        .expect("parsing 200 000 objects must not hang");
+    let err = result.expect_err("past the object limit");
+    let shown = err.to_string();
+    assert!(
+        shown.contains("100000") && shown.contains("object"),
+        "{shown}"
+    );
+    assert!(!shown.contains('\n'));
+}
+
+#[test]
+fn usage_and_toml_syntax_errors_are_one_line() {
+    let dir = scratch("", &[]);
+    for (args, words) in [
+        (
+            &["render"][..],
+            &["required arguments", "--out", "<SCENE>"][..],
+        ),
+        (&["render", "scene.toml", "--bogus", "1"], &["'--bogus'"]),
+        (
+            &["render", "scene.toml", "--out", "o", "--view", "rear"],
+            &["'rear'", "possible values"],
+        ),
+        (
+            &["render", "scene.toml", "--out", "o", "--width"],
+            &["--width", "none was supplied"],
+        ),
+        (
+            &["measure", "o", "--band", "4000000000"],
+            &["--band", "[1, 1000]"],
+        ),
+        (&["frobnicate"], &["'frobnicate'"]),
+    ] {
+        refused(dir.path(), args, 2, words);
+    }
+    assert_eq!(listing(dir.path()), ["scene.toml"]);
+    for (toml, words) in [
+        ("\n[obstacle\n", &["scene.toml:", "invalid TOML"][..]),
+        ("\nx = \"never closed\n", &["scene.toml:", "invalid TOML"]),
+        (
+            "\n[[object]]\nkind = = 1\n",
+            &["scene.toml:", "invalid TOML"],
+        ),
+    ] {
+        let dir = scratch(toml, &[]);
+        let text = std::fs::read_to_string(dir.path().join("scene.toml")).unwrap();
+        let last = toml.trim_end().lines().last().unwrap();
+        let line = text
+            .lines()
+            .collect::<Vec<_>>()
+            .iter()
+            .rposition(|l| *l == last)
+            .unwrap()
+            + 1;
+        let err = render_refused(dir.path(), words);
+        assert!(
+            err.contains(&format!("scene.toml:{line}:")),
+            "{err} (line {line})"
+        );
+    }
+}
+
+#[test]
+fn names_given_twice_say_which() {
+    let dir = scratch(
+        "\n[[material]]\nname = \"grey\"\ncolor = [0.1, 0.1, 0.1]\n",
+        &[],
+    );
+    render_refused(
+        dir.path(),
+        &[
+            "material[1].name",
+            "material `grey` is defined twice",
+            "line",
+        ],
+    );
+    let dir = scratch(
+        "\n[[object]]\nname = \"ball\"\nkind = \"sphere\"\nmaterial = \"grey\"\nradius = 0.5\n",
+        &[],
+    );
+    render_refused(
+        dir.path(),
+        &[
+            "object[2].name",
+            "object `ball` is named twice",
+            "object[2]",
+            "line",
+        ],
+    );
+    // Default names (the kind) may repeat.
+    let dir = scratch(
+        "\n[[object]]\nkind = \"sphere\"\nmaterial = \"grey\"\nradius = 0.5\n\n[[object]]\nkind = \"sphere\"\nmaterial = \"grey\"\nradius = 0.5\ntranslate = [2.0, 0.0, -10.0]\n",
+        &[],
+    );
+    assert_eq!(run_in(dir.path(), RENDER).0, 0);
+}
+
+#[test]
+fn numbers_in_messages_are_short_and_ranges_run_low_to_high() {
+    for (from, to) in [
+        ("width = 0.3", "width = 123456789012345678901234567890.5"),
+        (
+            "width = 0.3",
+            "width = 0.30000000000000004440892098500626161694526672363281250000000001",
+        ),
+        ("radius = 1.0", "radius = -1e300"),
+        ("size = [100.0, 100.0]", "size = [100.0, 1e-300]"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("scene.toml"),
+            common::MINIMAL
+                .replacen(from, to, 1)
+                .replace("width = 0.3", "width = 200.0"),
+        )
+        .unwrap();
+        let err = render_refused(dir.path(), &["scene.toml:"]);
+        let longest_number = err
+            .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .map(str::len)
+            .max()
+            .unwrap_or(0);
+        assert!(longest_number <= 12, "a long number in `{err}`");
+        // Every `[lo, hi]` in the message has lo ≤ hi.
+        for range in err.split('[').skip(1) {
+            let Some((inside, _)) = range.split_once(']') else {
+                continue;
+            };
+            let bounds: Vec<f64> = inside
+                .split(',')
+                .filter_map(|b| b.trim().parse().ok())
+                .collect();
+            if let [lo, hi] = bounds[..] {
+                assert!(lo <= hi, "range [{inside}] runs high to low in `{err}`");
+            }
+        }
+    }
+}
+
+#[test]
+fn every_sweep_parameter_refuses_values_outside_its_documented_range() {
+    use seethru::measure::sweep_grid::{PARAMETERS, parse_param};
+    // (name, documented low, low included, high): the ranges of PARAMETERS' descriptions.
+    let documented = |name: &str| match name {
+        "theta_f" => (0.0, false, 89.0),
+        "d2" => (0.0, false, 1e6),
+        "display_width" => (0.0, false, 100.0),
+        "eye_x" | "eye_z" => (-1e6, true, 1e6),
+        "head_bias_x_cm" => (-500.0, true, 500.0),
+        "frontal_width" => (1.0, true, 16384.0),
+        other => panic!("`{other}` is not in this test"),
+    };
+    for (name, description) in PARAMETERS {
+        let (lo, lo_in, hi) = documented(name);
+        for (written, x) in [
+            ("nan", f64::NAN),
+            ("-inf", f64::NEG_INFINITY),
+            ("-1", -1.0),
+            ("0", 0.0),
+            ("1", 1.0),
+            ("1e300", 1e300),
+        ] {
+            let admissible = (x > lo || (lo_in && x == lo)) && x <= hi;
+            match parse_param(&format!("{name}={written}")) {
+                Ok(_) => assert!(admissible, "{name}={written} accepted ({description})"),
+                Err(e) => {
+                    let shown = format!("{e:#}");
+                    assert!(!admissible, "{name}={written} refused: {shown}");
+                    assert!(
+                        !shown.contains('\n') && (shown.contains(name) || shown.contains(written)),
+                        "{shown}"
+                    );
+                }
+            }
+        }
+        // `inf` is d2's name for no planar correction; for every other parameter it is refused.
+        assert_eq!(parse_param(&format!("{name}=inf")).is_ok(), name == "d2");
+    }
+    // The value that panicked in the BVH build (a 1e300 m display), through the command.
+    let dir = scratch("", &[]);
+    refused(
+        dir.path(),
+        &[
+            "sweep",
+            "scene.toml",
+            "--param",
+            "display_width=1e300",
+            "--out",
+            "s.csv",
+        ],
+        1,
+        &["display_width = 1e300", "(0, 100] m"],
+    );
+    refused(
+        dir.path(),
+        &[
+            "sweep",
+            "scene.toml",
+            "--param",
+            "eye_x=1,2,,3",
+            "--out",
+            "s.csv",
+        ],
+        1,
+        &["empty value"],
+    );
+    refused(
+        dir.path(),
+        &[
+            "sweep",
+            "scene.toml",
+            "--param",
+            "eye_x=1",
+            "--param",
+            "eye_x=2",
+            "--out",
+            "s.csv",
+        ],
+        1,
+        &["`eye_x` is given twice"],
+    );
+    assert_eq!(listing(dir.path()), ["scene.toml"]);
+}
+
+#[test]
+fn scenes_past_the_triangle_limit_are_refused_before_building() {
+    // 1 300 cylinders of 4 096 segments are about 21 million triangles: past the limit of
+    // 20 million, refused while parsing (no mesh, no BVH built).
+    let mut text = common::MINIMAL.to_string();
+    for i in 0..1300 {
+        text.push_str(&format!(
+            "\n[[object]]\nkind = \"cylinder\"\nmaterial = \"grey\"\nsegments = 4096\ntranslate = [{i}.0, 0.0, -30.0]\n"
+        ));
+    }
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = send.send(common::parse(&text).map(|s| s.objects.len()));
+    });
+    let err = receive
+        .recv_timeout(std::time::Duration::from_secs(60))
+        .expect("must not hang")
+        .expect_err("past the triangle limit");
+    let shown = err.to_string();
+    assert!(
+        shown.contains("20000000") && shown.contains("triangles"),
+        "{shown}"
+    );
+    assert!(
+        shown.starts_with("test-scenes/scene.toml:") && !shown.contains('\n'),
+        "{shown}"
+    );
+}
+
+#[test]
+fn numbers_pasted_with_hundreds_of_digits_are_not_repeated_in_full() {
+    let long = format!("1{}.5", "0".repeat(800));
+    let dir = scratch("", &[]);
+    for (args, code) in [
+        (vec!["measure", "run", "--band", long.as_str()], 2),
+        (
+            vec![
+                "render",
+                "scene.toml",
+                "--out",
+                "o",
+                "--width",
+                long.as_str(),
+            ],
+            2,
+        ),
+        (
+            vec!["run", "scene.toml", "--out", "o", "--d2", long.as_str()],
+            2,
+        ),
+    ] {
+        let err = refused(dir.path(), &args, code, &["100000000000…(803 characters)"]);
+        assert!(err.len() < 300, "{err}");
+    }
+    let param = format!("theta_f={long}");
+    let err = refused(
+        dir.path(),
+        &["sweep", "scene.toml", "--param", &param, "--out", "s.csv"],
+        1,
+        &["theta_f", "(803 characters)"],
+    );
+    assert!(err.len() < 300, "{err}");
+    assert_eq!(listing(dir.path()), ["scene.toml"]);
+}
