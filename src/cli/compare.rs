@@ -3,9 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_png;
+use seethru::io::staged::StagedDir;
 use seethru::measure::compare::{Candidate, compare, html_page, markdown_table};
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
@@ -78,9 +79,9 @@ impl Compare {
         check_memory(&run_estimate(&scene, base)?, self.render.max_memory)?;
         let ctx = RenderContext::new(scene)?;
         let rows = compare(&ctx, &self.methods, base, self.band)?;
-        let out: &Path = &self.out;
-        std::fs::create_dir_all(out)
-            .with_context(|| format!("cannot create output directory {}", out.display()))?;
+        // Written whole or not at all: a failure leaves `--out` as it was.
+        let staged = StagedDir::new(&self.out)?;
+        let out: &Path = staged.path();
         let mut strips = Vec::new();
         for r in &rows {
             let file = format!("strip_{}.png", r.name);
@@ -112,10 +113,11 @@ impl Compare {
             &out.join("compare.json"),
             &serde_json::to_string_pretty(&json)?,
         )?;
+        staged.commit()?;
         seethru::util::progress::summary(format!(
             "compared {} methods; compare.md, compare.json, compare.html and the strips in {}",
             rows.len(),
-            out.display()
+            self.out.display()
         ));
         if !seethru::util::progress::is_quiet() {
             print!("{table}");

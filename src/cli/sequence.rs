@@ -1,11 +1,12 @@
 //! `seethru sequence`: the see-through system over time — vehicle motion, head motion and
 //! latency — measured frame by frame against the truth at the same instant.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{write_color_png, write_exr};
+use seethru::io::staged::StagedDir;
 use seethru::measure::sequence::{Measuring, SequenceRun, run_sequence};
 use seethru::measure::sequence_files::{
     Preview, frames_csv, latency_figure, over_time_figure, summary,
@@ -251,9 +252,12 @@ impl Sequence {
         for o in &all {
             o.timeline.validate()?;
         }
+        // Written whole or not at all: a failure at any latency leaves `--out` as it was.
+        let staged = StagedDir::new(&self.out)?;
+        let out = staged.path().to_path_buf();
         let mut runs: Vec<(f64, SequenceRun)> = Vec::new();
         for (options, &ms) in all.into_iter().zip(&self.latency_camera.0) {
-            let dir = self.out.join(latency_dir(ms));
+            let dir = out.join(latency_dir(ms));
             let timeline = options.timeline;
             let mut preview = Preview::new(timeline.fps);
             let frames = self.frames;
@@ -296,7 +300,8 @@ impl Sequence {
             )?;
             runs.push((ms, run));
         }
-        self.write_overview(&runs)?;
+        self.write_overview(&runs, &out)?;
+        staged.commit()?;
         say(format!(
             "wrote {} sequence(s) of {} frames (frames.csv, summary.json, plots, preview.png) to {}",
             runs.len(),
@@ -308,12 +313,12 @@ impl Sequence {
 
     /// The top-level summary and plots: misregistration over time for every latency, and
     /// mean and p95 against latency when there are several.
-    fn write_overview(&self, runs: &[(f64, SequenceRun)]) -> Result<()> {
+    fn write_overview(&self, runs: &[(f64, SequenceRun)], out: &Path) -> Result<()> {
         let labelled: Vec<(String, &[_])> = runs
             .iter()
             .map(|(ms, r)| (format!("{ms} ms"), r.records.as_slice()))
             .collect();
-        over_time_figure(&labelled, self.duration).write(&self.out, "misregistration_over_time")?;
+        over_time_figure(&labelled, self.duration).write(out, "misregistration_over_time")?;
         let mut per_latency = Vec::new();
         let mut points = Vec::new();
         for (ms, run) in runs {
@@ -330,7 +335,7 @@ impl Sequence {
                 .push(json!({"latency_camera_ms": ms, "dir": latency_dir(*ms), "summary": s}));
         }
         if runs.len() > 1 {
-            latency_figure(&points).write(&self.out, "latency")?;
+            latency_figure(&points).write(out, "latency")?;
         }
         let overview = json!({
             "scene": self.scene.display().to_string(),
@@ -352,7 +357,7 @@ impl Sequence {
         });
         // Last: a directory with summary.json holds finished sequences.
         write_text(
-            &self.out.join("summary.json"),
+            &out.join("summary.json"),
             &serde_json::to_string_pretty(&overview)?,
         )
         .with_context(|| format!("writing {}", self.out.display()))
