@@ -132,7 +132,7 @@ impl RenderContext {
         label: &str,
     ) -> RenderStats {
         let region = PixelRect::full(camera);
-        self.render_region(camera, view, None, settings, region, frame, label)
+        self.render_rect(camera, view, None, settings, region, frame, label)
     }
 
     /// The `seethru` view: the driver's eye with the obstacle present and its display showing
@@ -146,7 +146,7 @@ impl RenderContext {
     ) -> (Frame, RenderStats) {
         let mut frame = Frame::new(camera.width, camera.height);
         let region = PixelRect::full(camera);
-        let stats = self.render_region(
+        let stats = self.render_rect(
             camera,
             view_bit::SEETHRU,
             Some(display),
@@ -176,7 +176,7 @@ impl RenderContext {
         assert_eq!((base.width, base.height), (camera.width, camera.height));
         let region = self.difference_region(camera, base_view, view);
         let mut frame = base.clone();
-        let stats = self.render_region(camera, view, display, settings, region, &mut frame, label);
+        let stats = self.render_rect(camera, view, display, settings, region, &mut frame, label);
         (frame, stats)
     }
 
@@ -203,21 +203,6 @@ impl RenderContext {
     /// pixel is what [`RenderContext::render`] gives it.
     #[allow(clippy::too_many_arguments)]
     pub fn render_rect(
-        &self,
-        camera: &Camera,
-        view: u8,
-        display: Option<&dyn Screen>,
-        settings: RenderSettings,
-        region: PixelRect,
-        frame: &mut Frame,
-        label: &str,
-    ) -> RenderStats {
-        self.render_region(camera, view, display, settings, region, frame, label)
-    }
-
-    /// Renders the pixels of `region` into `frame`.
-    #[allow(clippy::too_many_arguments)]
-    fn render_region(
         &self,
         camera: &Camera,
         view: u8,
