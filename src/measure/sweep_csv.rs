@@ -103,7 +103,13 @@ pub fn finished_rows(
     for (number, fields) in all {
         let first = fields.first().map_or("", String::as_str);
         let Ok(index) = first.parse::<usize>() else {
-            let start: String = first.chars().take(40).collect();
+            // Escaped: a quoted field can hold line breaks, and an error is one line.
+            let start: String = first
+                .chars()
+                .take(40)
+                .collect::<String>()
+                .escape_debug()
+                .to_string();
             bail!(
                 "{}:{number}: a row starts with `{start}`, not a configuration index; remove the file or choose another --out",
                 csv.display()
