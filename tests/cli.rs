@@ -219,16 +219,25 @@ fn run_writes_six_views_run_json_and_metrics_and_measure_recomputes_them() {
     );
 }
 
+/// One option that takes a value: the command's words, `--flag`, its value name and its help.
+struct ValueOption {
+    words: Vec<&'static str>,
+    flag: String,
+    value: String,
+    help: String,
+}
+
 /// Every option that takes a value, per command, read from the command's own `--help`, so
-/// that a flag added later is walked too: `(command words, flag, value name)`.
-fn options_with_values() -> Vec<(Vec<&'static str>, String, String)> {
-    let commands: [&[&str]; 13] = [
+/// that a flag added later is walked too.
+fn options_with_values() -> Vec<ValueOption> {
+    let commands: [&[&str]; 14] = [
         &["render"],
         &["run"],
         &["ratio", "occlusion"],
         &["ratio", "foreshortening"],
         &["reproduce"],
         &["sweep"],
+        &["sweep-merge"],
         &["measure"],
         &["export"],
         &["figures"],
@@ -252,67 +261,159 @@ fn options_with_values() -> Vec<(Vec<&'static str>, String, String)> {
             let Some((flag, value)) = rest.split_once(" <") else {
                 continue;
             };
-            // Options with a fixed list of values (clap checks the names) are not numbers.
-            let listed = lines[i + 1..]
+            let (value, same_line) = value.split_once('>').unwrap_or((value, ""));
+            // The description: the rest of the line (short help) or the lines up to the next
+            // option (long help).
+            let below: Vec<&str> = lines[i + 1..]
                 .iter()
-                .take_while(|l| !l.trim().starts_with("--"))
-                .any(|l| l.contains("Possible values"));
-            if !listed {
-                found.push((
-                    words.to_vec(),
-                    format!("--{flag}"),
-                    value.split('>').next().unwrap_or_default().to_string(),
-                ));
+                .map(|l| l.trim())
+                .take_while(|l| !l.starts_with("--") && !l.starts_with("-h,"))
+                .collect();
+            // Options with a fixed list of values (clap checks the names) are not numbers.
+            if below.iter().any(|l| l.contains("Possible values")) {
+                continue;
             }
+            found.push(ValueOption {
+                words: words.to_vec(),
+                flag: format!("--{flag}"),
+                value: value.to_string(),
+                help: [same_line.trim(), &below.join(" ")].join(" "),
+            });
         }
     }
     found
 }
 
+/// Options whose values are paths, names or free-form specs, not numbers.
+const NOT_NUMBERS: [&str; 7] = ["OUT", "SCENE", "DIR", "PARAMS", "FILE", "CSV", "K/N"];
+
+/// A range as help texts and errors write it: `[a, b]`, `(a, b]`, `[a, b)` or `(a, b)`, the
+/// first such group in `text` (other parentheses, like `(default: …)`, are skipped).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Range {
+    low: f64,
+    high: f64,
+    low_closed: bool,
+    high_closed: bool,
+}
+
+impl Range {
+    fn first_in(text: &str) -> Option<Range> {
+        let number = |s: &str| -> Option<f64> {
+            let s = s.trim().replace('−', "-");
+            match s.as_str() {
+                "∞" | "inf" => Some(f64::INFINITY),
+                "-∞" | "-inf" => Some(f64::NEG_INFINITY),
+                _ => s.parse().ok(),
+            }
+        };
+        for (open_at, open) in text.char_indices().filter(|(_, c)| *c == '[' || *c == '(') {
+            let inner = &text[open_at + 1..];
+            let Some(close_at) = inner.find([']', ')']) else {
+                continue;
+            };
+            let Some((low, high)) = inner[..close_at].split_once(", ") else {
+                continue;
+            };
+            let (Some(low), Some(high)) = (number(low), number(high)) else {
+                continue;
+            };
+            return Some(Range {
+                low,
+                high,
+                low_closed: open == '[',
+                high_closed: inner[close_at..].starts_with(']'),
+            });
+        }
+        None
+    }
+
+    fn contains(&self, v: f64) -> bool {
+        let above = if self.low_closed {
+            v >= self.low
+        } else {
+            v > self.low
+        };
+        let below = if self.high_closed {
+            v <= self.high
+        } else {
+            v < self.high
+        };
+        v.is_finite() && above && below
+    }
+}
+
 #[test]
-fn every_numeric_flag_refuses_values_outside_its_range_in_one_line() {
-    // Paths, names and free-form specs are not numbers; everything else must refuse a NaN,
-    // an infinity, a huge number and an integer beyond 64 bits, naming the flag and its range.
-    let not_numbers = ["OUT", "SCENE", "DIR", "PARAMS", "FILE", "CSV"];
+fn every_numeric_flag_accepts_exactly_the_range_its_help_documents() {
+    // For every numeric option: its help names a range; the range's ends, its middle, one
+    // past each end, 0, −1, a huge number, NaN and the infinities are accepted exactly when
+    // the documented range holds them (`inf` too where the value name offers it); each
+    // refusal is one line naming the flag and the same range. `--flag=v --help` parses the
+    // value and then prints the help, so no command runs.
     let options = options_with_values();
-    assert!(options.len() > 40, "{options:?}");
+    assert!(options.len() > 40, "{} options", options.len());
     let scratch = tempfile::tempdir().unwrap();
     let mut walked = 0;
-    for (words, flag, value) in options {
-        if not_numbers.contains(&value.as_str()) {
+    let mut wrong = Vec::new();
+    for option in options {
+        if NOT_NUMBERS.contains(&option.value.as_str()) {
             continue;
         }
-        for bad in [
-            "nan",
-            "inf",
-            "-inf",
-            "1e308",
-            "99999999999999999999999",
-            "x",
+        let context = format!("{:?} {}", option.words, option.flag);
+        let Some(range) = Range::first_in(&option.help) else {
+            wrong.push(format!("{context}: no range in its help: {}", option.help));
+            continue;
+        };
+        let mid = ((range.low.max(-1e6) + range.high.min(1e6)) / 2.0).floor();
+        let mut probes: Vec<(String, f64)> = [range.low, range.high, mid]
+            .into_iter()
+            .chain([range.low - 1.0, range.high + 1.0, 0.0, -1.0])
+            .filter(|v| v.is_finite())
+            .map(|v| (format!("{v}"), v))
+            .collect();
+        for (text, v) in [
+            ("1e300", 1e300),
+            ("nan", f64::NAN),
+            ("inf", f64::INFINITY),
+            ("-inf", f64::NEG_INFINITY),
+            ("99999999999999999999999", 1e23),
+            ("x", f64::NAN),
         ] {
-            // Distances that take `inf` (d2 → ∞) say so in their value name.
-            if bad == "inf" && value.contains("inf") {
-                continue;
-            }
-            let mut args: Vec<String> = words.iter().map(|w| w.to_string()).collect();
-            args.push(format!("{flag}={bad}"));
+            probes.push((text.to_string(), v));
+        }
+        let takes_inf = option.value.contains("inf");
+        for (text, v) in probes {
+            // X,Y,Z options document the range of each axis.
+            let given = if option.value == "X,Y,Z" {
+                format!("{text},0,0")
+            } else {
+                text.clone()
+            };
+            let mut args: Vec<String> = option.words.iter().map(|w| w.to_string()).collect();
+            args.push(format!("{}={given}", option.flag));
+            args.push("--help".into());
             let args: Vec<&str> = args.iter().map(String::as_str).collect();
             let (ok, _, err) = seethru_in(scratch.path(), &args);
-            assert!(!ok, "{args:?} was accepted");
+            let documented = range.contains(v) || (takes_inf && v == f64::INFINITY);
             let err = err.trim_end();
-            assert_eq!(err.lines().count(), 1, "{args:?}: one line, got {err}");
-            assert!(
-                err.starts_with("error: invalid value") && err.contains(&flag),
-                "{args:?}: {err}"
-            );
-            // X,Y,Z lists name their own range per axis; other numbers name [a, b] or (a, b].
-            assert!(
-                err.contains("must be") && (err.contains('[') || err.contains('(')),
-                "{args:?}: no admissible range in {err}"
-            );
+            if ok != documented {
+                wrong.push(format!(
+                    "{context}={given}: accepted {ok}, but its help says {range:?}: {err}"
+                ));
+            } else if !ok
+                && (err.lines().count() != 1
+                    || !err.starts_with("error: invalid value")
+                    || !err.contains(&option.flag)
+                    || Range::first_in(err) != Some(range))
+            {
+                wrong.push(format!(
+                    "{context}={given}: not one line naming the flag and {range:?}: {err}"
+                ));
+            }
         }
         walked += 1;
     }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
     assert!(walked > 30, "{walked}");
 }
 

@@ -48,23 +48,23 @@ enum RatioSetup {
 /// Where the object and the eye are (the paper's §4.2 parameters), metres.
 #[derive(clap::Args)]
 struct RatioGeometry {
-    /// Lateral position of the object's corner, in [-1e4, 1e4].
+    /// Lateral position of the object's corner b1, metres in [-1e4, 1e4].
     #[arg(long, allow_hyphen_values = true, value_parser = real(-1e4, 1e4))]
     b1: f64,
-    /// Distance of the scene plane from the display, in (0, 1e4].
+    /// Distance of the scene plane from the display d2, metres in (0, 1e4].
     #[arg(long, value_parser = positive(1e4))]
     d2: f64,
-    /// Distance of the eye from the display, in (0, 1e3].
+    /// Distance of the eye from the display d1, metres in (0, 1e3].
     #[arg(long, value_parser = positive(1e3))]
     d1: f64,
-    /// Eye offset b_h (the eye at lateral −b_h), in [-1e3, 1e3].
+    /// Eye offset b_h (the eye at lateral −b_h), metres in [-1e3, 1e3].
     #[arg(long = "bh", allow_hyphen_values = true, value_parser = real(-1e3, 1e3))]
     b_h: f64,
 }
 
 #[derive(clap::Args)]
 struct RatioCommon {
-    /// The compensation's model plane behind the display, metres in (0, ∞), or `inf`
+    /// The compensation's model plane behind the display, metres in (0, 1e6], or `inf`
     /// (default: the scene plane, the paper's case).
     #[arg(
         long = "model-d2",
