@@ -116,6 +116,29 @@ fn objs_without_faces_or_with_bad_indices_are_refused() {
                 "`2` is not the index of a texture coordinate",
             ],
         ),
+        // tobj reads an index 0 of a texture coordinate or normal as "none" without a word;
+        // the scan runs before tobj, so it is refused.
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/0 3/1\n",
+            &[
+                "mesh m.obj",
+                "line 5",
+                "`0` is not the index of a texture coordinate",
+            ],
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//0\n",
+            &["mesh m.obj", "line 5", "`0` is not the index of a normal"],
+        ),
+        // Far below the first element: tobj's index arithmetic overflowed (found by fuzzing).
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/-9223372036854775807\n",
+            &[
+                "mesh m.obj",
+                "line 5",
+                "is not the index of a texture coordinate (the file has 1)",
+            ],
+        ),
         (
             "v 0 0 0\nv 0 0\nf 1 2 3\n",
             &["mesh m.obj", "line 2", "`v` needs 3 numbers, got `0 0`"],

@@ -1,9 +1,25 @@
 //! Inputs the fuzzers of `fuzz/` found a failure with, replayed through the same reader and
 //! held to the same rule: an error of one line, or rows that are rows of the sweep.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use seethru::measure::sweep_csv::finished_rows;
+use seethru::scene::mesh_io::parse_obj;
+
+/// The inputs kept for one fuzz target, `tests/fuzz/<target>/`.
+fn inputs(target: &str) -> Vec<(PathBuf, Vec<u8>)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fuzz")
+        .join(target);
+    let mut found: Vec<(PathBuf, Vec<u8>)> = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .map(|e| (e.path(), std::fs::read(e.path()).unwrap()))
+        .collect();
+    found.sort();
+    assert!(!found.is_empty(), "no inputs in {}", dir.display());
+    found
+}
 
 const HEADER: &str = "index,theta_f,d2,misregistration_mean_arcmin";
 
@@ -24,22 +40,38 @@ fn configs() -> Vec<Vec<(String, String)>> {
 
 #[test]
 fn sweep_csv_inputs_found_by_fuzzing_give_one_line_errors() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz/sweep_csv");
-    let mut replayed = 0;
-    for entry in std::fs::read_dir(&dir).unwrap().flatten() {
-        let bytes = std::fs::read(entry.path()).unwrap();
-        let Ok(text) = std::str::from_utf8(&bytes) else {
-            continue;
-        };
-        replayed += 1;
+    for (path, bytes) in inputs("sweep_csv") {
+        let text = std::str::from_utf8(&bytes).unwrap();
         match finished_rows(text, Path::new("sweep.csv"), HEADER, &configs()) {
             Ok(rows) => assert!(rows.iter().all(|(i, _)| *i < 4), "{rows:?}"),
             // A quoted field may hold line breaks: the message must not.
             Err(e) => {
                 let shown = format!("{e:#}");
-                assert!(!shown.contains('\n'), "{}: {shown}", entry.path().display());
+                assert!(!shown.contains('\n'), "{}: {shown}", path.display());
             }
         }
     }
-    assert!(replayed > 0, "no inputs in {}", dir.display());
+}
+
+#[test]
+fn obj_inputs_found_by_fuzzing_are_refused_naming_the_line() {
+    // As the fuzz target splits them: the OBJ, a NUL byte, the MTL its `mtllib` reads. Each
+    // kept input is broken at a line, which the error names (tobj's own errors name none, and
+    // its index arithmetic overflowed on these: a panic where overflow checks are on).
+    for (path, bytes) in inputs("obj") {
+        let (obj, mtl) = match bytes.iter().position(|&b| b == 0) {
+            Some(i) => (&bytes[..i], bytes[i + 1..].to_vec()),
+            None => (&bytes[..], Vec::new()),
+        };
+        let read = |_: &Path| Ok(mtl.clone());
+        let shown = match parse_obj(obj, Path::new("mesh.obj"), &read) {
+            Ok(_) => panic!("{}: accepted", path.display()),
+            Err(e) => format!("{e:#}"),
+        };
+        assert!(
+            !shown.contains('\n') && shown.starts_with("invalid OBJ: line "),
+            "{}: {shown}",
+            path.display()
+        );
+    }
 }

@@ -128,25 +128,26 @@ pub(crate) fn validated(json: gltf::json::Root) -> Result<gltf::Document> {
     })
 }
 
-/// The first line of an OBJ that tobj refuses, and why: tobj's errors name no line. Vertex
-/// lines need three numbers (texture coordinates two), face indices must be integers other
-/// than 0 that point at a vertex (negative ones count back from the line). `None` where no
-/// line is at fault by these rules.
+/// The first line of an OBJ that is broken, and why, checked before tobj reads the file:
+/// tobj's errors name no line, it reads a face index 0 as "no index" without a word, and an
+/// index far out of range overflows its arithmetic (a panic where overflow checks are on,
+/// found by fuzzing). Vertex lines need three numbers (texture coordinates two); face, line
+/// and point indices must be integers other than 0 that point at an element of the file
+/// (negative ones count back from the line). `None` where no line is at fault by these rules.
+/// Two passes over the bytes, nothing kept but counts.
 pub(crate) fn obj_error_line(obj: &[u8]) -> Option<String> {
-    let lines: Vec<String> = obj
-        .split(|&b| b == b'\n')
-        .map(|l| String::from_utf8_lossy(l).into_owned())
-        .collect();
-    let first_word = |l: &String| l.split_whitespace().next().map(str::to_string);
-    let total = |kind: &str| {
-        lines
-            .iter()
-            .filter(|l| first_word(l).as_deref() == Some(kind))
-            .count()
-    };
-    let totals = [total("v"), total("vt"), total("vn")];
+    let lines = || obj.split(|&b| b == b'\n').map(String::from_utf8_lossy);
+    let mut totals = [0usize; 3];
+    for line in lines() {
+        match line.split_whitespace().next() {
+            Some("v") => totals[0] += 1,
+            Some("vt") => totals[1] += 1,
+            Some("vn") => totals[2] += 1,
+            _ => {}
+        }
+    }
     let mut so_far = [0usize; 3];
-    for (i, line) in lines.iter().enumerate() {
+    for (i, line) in lines().enumerate() {
         let mut words = line.split_whitespace();
         let at = |why: String| Some(format!("line {}: {why}", i + 1));
         match words.next() {

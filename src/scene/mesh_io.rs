@@ -144,13 +144,12 @@ pub fn parse_obj(
             Err(e) => fail(e.to_string()),
         }
     };
+    if let Some(why) = obj_error_line(bytes) {
+        bail!("invalid OBJ: {why}");
+    }
     let (models, materials) =
-        tobj::load_obj_buf(&mut BufReader::new(Cursor::new(bytes)), &options, load_mtl).map_err(
-            |e| match obj_error_line(bytes) {
-                Some(why) => anyhow!("invalid OBJ: {why}"),
-                None => anyhow!("invalid OBJ: {e}"),
-            },
-        )?;
+        tobj::load_obj_buf(&mut BufReader::new(Cursor::new(bytes)), &options, load_mtl)
+            .map_err(|e| anyhow!("invalid OBJ: {e}"))?;
     let materials = match (materials, mtl_error.into_inner()) {
         (_, Some(why)) => bail!(why),
         (Err(e), None) => bail!("material library: {e}"),
