@@ -312,3 +312,74 @@ fn numbers_pasted_with_hundreds_of_digits_are_not_repeated_in_full() {
     assert!(err.len() < 300, "{err}");
     assert_eq!(listing(dir.path()), ["scene.toml"]);
 }
+
+#[test]
+#[cfg(unix)]
+fn inputs_that_are_devices_or_folders_are_refused_without_being_read() {
+    // /dev/zero reports a size of 0 and never ends: read whole, it took all the memory (a
+    // scene, an `mtllib`, a sweep CSV to resume, a head path). Each input is refused before a
+    // byte is read, under a watchdog, naming the file as written.
+    let obj = "mtllib zero.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let mesh = "\n[[object]]\nkind = \"mesh\"\npath = \"m.obj\"\n";
+    let dir = scratch(mesh, &[("m.obj", obj.as_bytes())]);
+    let zero = std::path::Path::new("/dev/zero");
+    for link in ["zero.toml", "zero.mtl", "zero.csv", "zero_path.csv"] {
+        std::os::unix::fs::symlink(zero, dir.path().join(link)).unwrap();
+    }
+    std::fs::create_dir(dir.path().join("folder.toml")).unwrap();
+    let cases: Vec<(Vec<&str>, Vec<&str>)> = vec![
+        (
+            vec!["render", "zero.toml", "--out", "out"],
+            vec!["zero.toml", "not a regular file"],
+        ),
+        (
+            vec!["render", "folder.toml", "--out", "out"],
+            vec!["folder.toml", "a folder, not a file"],
+        ),
+        (RENDER.to_vec(), vec!["zero.mtl", "not a regular file"]),
+        (
+            vec![
+                "sweep",
+                "scene.toml",
+                "--param",
+                "d2=5",
+                "--out",
+                "zero.csv",
+            ],
+            vec!["zero.csv", "not a regular file"],
+        ),
+        (
+            vec![
+                "sequence",
+                "scene.toml",
+                "--head-path",
+                "zero_path.csv",
+                "--out",
+                "out",
+            ],
+            vec!["zero_path.csv", "not a regular file"],
+        ),
+        (
+            vec!["sweep-merge", "zero.csv", "--out", "merged.csv"],
+            vec!["zero.csv", "not a regular file"],
+        ),
+    ];
+    for (args, words) in cases {
+        let before = listing(dir.path());
+        let (send, receive) = std::sync::mpsc::channel();
+        let (path, owned): (std::path::PathBuf, Vec<String>) = (
+            dir.path().to_path_buf(),
+            args.iter().map(|a| a.to_string()).collect(),
+        );
+        let words: Vec<String> = words.iter().map(|w| w.to_string()).collect();
+        std::thread::spawn(move || {
+            let args: Vec<&str> = owned.iter().map(String::as_str).collect();
+            let words: Vec<&str> = words.iter().map(String::as_str).collect();
+            let _ = send.send(refused(&path, &args, 1, &words));
+        });
+        receive
+            .recv_timeout(std::time::Duration::from_secs(60))
+            .unwrap_or_else(|_| panic!("{args:?} did not end within a minute"));
+        assert_eq!(listing(dir.path()), before, "{args:?} left files behind");
+    }
+}

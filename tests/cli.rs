@@ -67,7 +67,7 @@ fn bad_input_gives_one_line_and_no_output() {
         ),
         (
             vec!["render", "nowhere.toml", "--out", out_arg],
-            "error: nowhere.toml: cannot read scene file".into(),
+            "error: nowhere.toml: cannot read the file: no such file".into(),
         ),
         (
             vec![

@@ -194,7 +194,9 @@ fn missing_assets_name_their_path() {
     let shown = err.to_string();
     assert_eq!(err.key, "object[2].path");
     assert!(
-        shown.contains("asset not found") && shown.contains("nowhere/car.obj"),
+        shown.contains("cannot read `nowhere/car.obj`")
+            && shown.contains("no such file")
+            && shown.contains("nowhere/car.obj"),
         "{shown}"
     );
 

@@ -136,19 +136,25 @@ pub fn write_exr_channels(
 /// Most channels an EXR may have to be read as a frame (seethru writes 17).
 const MAX_EXR_CHANNELS: usize = 64;
 
+/// `path` opened for reading if it is a regular file (a device would be read for ever).
+fn open_input(path: &Path) -> Result<std::fs::File> {
+    if let Some(why) = crate::util::input_file::not_a_file(path) {
+        bail!("cannot read {}: {why}", path.display());
+    }
+    std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))
+}
+
 /// Reads an EXR written by [`write_exr`] back into a frame. Errors name the file and what is
 /// wrong with it: not an EXR, truncated, too large, a channel missing or of the wrong type.
 pub fn read_exr(path: &Path) -> Result<Frame> {
-    let file =
-        std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let file = open_input(path)?;
     read_exr_from(std::io::BufReader::new(file), MAX_PIXELS)
         .with_context(|| format!("cannot read {}", path.display()))
 }
 
 /// Width and height of the first layer of an EXR, from its header alone.
 pub fn exr_size(path: &Path) -> Result<(u32, u32)> {
-    let file =
-        std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let file = open_input(path)?;
     let size = exr::meta::MetaData::read_from_unbuffered(file, false)
         .map_err(anyhow::Error::from)
         .and_then(|meta| {

@@ -6,6 +6,7 @@ use anyhow::{Context, Result, bail};
 
 use crate::io::frame_files::read_exr;
 use crate::render::frame::Frame;
+use crate::util::input_file::read_input_text;
 
 /// What `measure` needs of a run.json.
 #[derive(Clone, Debug, PartialEq)]
@@ -49,10 +50,13 @@ pub fn parse_run_json(text: &str) -> Result<RunRecord> {
     })
 }
 
+/// Largest run.json read (seethru writes a few KiB).
+pub const MAX_RUN_JSON_BYTES: u64 = 16 << 20;
+
 /// Reads `dir/run.json`; errors name that file.
 pub fn read_run_json(dir: &Path) -> Result<RunRecord> {
     let path = dir.join("run.json");
-    let text = std::fs::read_to_string(&path).with_context(|| {
+    let text = read_input_text(&path, MAX_RUN_JSON_BYTES).with_context(|| {
         format!(
             "cannot read {} (not a `seethru run` directory?)",
             path.display()

@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use crate::io::atomic::write_text;
 use crate::io::plot::{Figure, Series};
 use crate::measure::metrics::measure;
-use crate::measure::sweep_csv::{decode, encode, finished_rows};
+use crate::measure::sweep_csv::{MAX_SWEEP_CSV_BYTES, decode, encode, finished_rows};
 use crate::measure::sweep_grid::{Param, combinations, configure};
 use crate::measure::sweep_shard::{Shard, merge};
 use crate::render::integrator::{RenderContext, same_geometry};
@@ -23,6 +23,7 @@ use crate::scene::Scene;
 use crate::scene::world::view_bit;
 use crate::system::options::{HeadSource, Outside, RunOptions};
 use crate::system::pipeline::{driver_camera, run_with_truth};
+use crate::util::input_file::read_input_text;
 use crate::util::progress::Progress;
 
 /// The metric columns of a row. `coverage` (the fraction of display pixels that show the
@@ -117,10 +118,12 @@ pub fn sweep(
         .collect();
     let header_line = encode(&header);
     // Rows already done (same header, same parameter values at the same index).
-    let rows = match std::fs::read_to_string(csv) {
-        Ok(text) => finished_rows(&text, csv, &header_line, &configs)?,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
-        Err(e) => bail!("cannot read {} to resume the sweep: {e}", csv.display()),
+    let rows = if csv.exists() || csv.is_symlink() {
+        let text = read_input_text(csv, MAX_SWEEP_CSV_BYTES)
+            .with_context(|| format!("cannot read {} to resume the sweep", csv.display()))?;
+        finished_rows(&text, csv, &header_line, &configs)?
+    } else {
+        Vec::new()
     };
     let done: HashSet<usize> = rows.iter().map(|(i, _)| *i).collect();
     let todo: Vec<usize> = (0..configs.len())

@@ -6,6 +6,9 @@ use std::path::Path;
 
 use anyhow::{Result, bail};
 
+/// Largest sweep CSV read back (to resume or merge): a million rows fit.
+pub const MAX_SWEEP_CSV_BYTES: u64 = 1 << 30;
+
 /// `fields` as one CSV line without its line end, quoted only where CSV needs it (a field
 /// with a comma, a quote or a line break), so that plain numbers read as they are written.
 pub fn encode(fields: &[String]) -> String {

@@ -7,8 +7,9 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 
 use crate::io::atomic::write_text;
-use crate::measure::sweep_csv::{encode, records};
+use crate::measure::sweep_csv::{MAX_SWEEP_CSV_BYTES, encode, records};
 use crate::measure::sweep_grid::Param;
+use crate::util::input_file::read_input_text;
 
 /// Part `index` (0-based, as `SLURM_ARRAY_TASK_ID` with `--array=0-(N-1)` and a Kubernetes
 /// Indexed Job's `JOB_COMPLETION_INDEX` count) of `count` disjoint parts.
@@ -77,7 +78,7 @@ pub fn merge(parts: &[&Path], out: &Path, metric_columns: usize) -> Result<Merge
     let mut header: Option<(Vec<String>, &Path)> = None;
     let mut rows: BTreeMap<usize, (Vec<String>, &Path, usize)> = BTreeMap::new();
     for &part in parts {
-        let text = std::fs::read_to_string(part)
+        let text = read_input_text(part, MAX_SWEEP_CSV_BYTES)
             .with_context(|| format!("cannot read {}", part.display()))?;
         let mut records = records(&text, part)?.into_iter();
         let first = records.next().map(|(_, r)| r).unwrap_or_default();

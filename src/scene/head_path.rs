@@ -17,9 +17,12 @@ pub struct HeadPath {
     pub samples: Vec<(f64, DVec3)>,
 }
 
+/// Largest head-path CSV read (a million samples of four numbers fit).
+pub const MAX_HEAD_PATH_BYTES: u64 = 64 << 20;
+
 impl HeadPath {
     pub fn load(path: &Path) -> Result<HeadPath> {
-        let text = std::fs::read(path)
+        let text = crate::util::input_file::read_input(path, MAX_HEAD_PATH_BYTES)
             .map_err(|e| anyhow::anyhow!("{}: cannot read the head path: {e}", path.display()))?;
         Self::parse(&text, &path.display().to_string())
     }

@@ -41,13 +41,7 @@ pub struct LoadedMesh {
 
 /// Reads a file that a mesh refers to, within [`MAX_MESH_BYTES`].
 pub fn read_limited(path: &Path) -> std::io::Result<Vec<u8>> {
-    let size = std::fs::metadata(path)?.len();
-    if size > MAX_MESH_BYTES {
-        return Err(std::io::Error::other(format!(
-            "{size} bytes is larger than the limit of {MAX_MESH_BYTES} bytes"
-        )));
-    }
-    std::fs::read(path)
+    crate::util::input_file::read_input(path, MAX_MESH_BYTES)
 }
 
 /// Loads an OBJ (with its MTL files) or a glTF/GLB (with its buffers). Errors name the file.

@@ -163,11 +163,11 @@ fn existing_asset(
     file: &SourceFile,
 ) -> Result<PathBuf, SceneError> {
     let path = file.dir().join(rel);
-    if !path.is_file() {
+    if let Some(why) = crate::util::input_file::not_a_file(&path) {
         return Err(t.error(
             key,
             format!(
-                "asset not found: `{rel}` (resolved against the scene's folder: {})",
+                "cannot read `{rel}` (resolved against the scene's folder: {}): {why}",
                 path.display()
             ),
         ));

@@ -64,16 +64,8 @@ impl SourceFile {
             key: String::new(),
             message,
         };
-        let size = std::fs::metadata(path)
-            .map_err(|e| error(format!("cannot read scene file: {e}")))?
-            .len();
-        if size > MAX_SCENE_BYTES {
-            return Err(error(format!(
-                "scene file of {size} bytes is larger than the limit of {MAX_SCENE_BYTES} bytes"
-            )));
-        }
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| error(format!("cannot read scene file: {e}")))?;
+        let text = crate::util::input_file::read_input_text(path, MAX_SCENE_BYTES)
+            .map_err(|e| error(format!("cannot read the file: {e}")))?;
         Ok(Self::from_text(path, text))
     }
 

@@ -3,6 +3,7 @@
 //! the process's peak memory.
 
 pub mod color;
+pub mod input_file;
 pub mod json;
 pub mod memory;
 pub mod number;
