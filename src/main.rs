@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use clap::error::ErrorKind;
-use seethru::util::number::clip_long_numbers;
+use seethru::util::message::printable;
 
 fn main() -> ExitCode {
     // `seethru analyze | head`: a reader that closes the pipe early ends the command quietly,
@@ -32,7 +32,7 @@ fn main() -> ExitCode {
             e.exit()
         }
         Err(e) => {
-            eprintln!("{}", clip_long_numbers(&cli::one_line(&e)));
+            eprintln!("{}", printable(&cli::one_line(&e)));
             return ExitCode::from(2);
         }
     };
@@ -46,8 +46,9 @@ fn main() -> ExitCode {
     match cli.command.run() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            // Messages repeat the input: an 800-digit number stays 12 digits.
-            eprintln!("error: {}", clip_long_numbers(&format!("{e:#}")));
+            // Messages repeat the input: an 800-digit number stays 12 digits, a line break
+            // in a name is shown as `\n`.
+            eprintln!("error: {}", printable(&format!("{e:#}")));
             ExitCode::FAILURE
         }
     }

@@ -160,10 +160,38 @@ fn out_of_view_crops_error_or_show_black() {
     .err()
     .unwrap()
     .to_string();
+    // No eye position fits: the message says so instead of printing ranges high to low.
     assert!(
         err.contains("leaves the frontal camera's view on the")
             && err.contains("px")
-            && err.contains("must stay within x ∈"),
+            && err.contains("no eye position keeps the whole crop inside the frontal view")
+            && !err.contains("must stay within"),
+        "{err}"
+    );
+    // θ_F = 30° fits the true eye; an eye a metre to the side does not, and the message
+    // gives the admissible region, each range low to high.
+    let err = run(
+        &context(6.0, 30.0),
+        &RunOptions {
+            spp: 1,
+            width: Some(40),
+            head_bias_cm: [100.0, 0.0, 0.0],
+            ..RunOptions::default()
+        },
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    let region = err
+        .split("must stay within")
+        .nth(1)
+        .unwrap_or_else(|| panic!("{err}"));
+    let bounds: Vec<f64> = region
+        .split(['[', ']', ','])
+        .filter_map(|t| t.trim().parse().ok())
+        .collect();
+    assert!(
+        bounds.len() == 4 && bounds[0] < bounds[1] && bounds[2] < bounds[3],
         "{err}"
     );
     let r = run(

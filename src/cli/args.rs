@@ -5,6 +5,7 @@ use anyhow::{Result, bail};
 use seethru::render::settings::MAX_SPP;
 use seethru::scene::source::MAX_RESOLUTION;
 use seethru::system::memory::DEFAULT_MAX_MEMORY_GIB;
+use seethru::util::number::short;
 
 /// Most worker threads a command accepts.
 pub const MAX_THREADS: u64 = 1024;
@@ -14,19 +15,26 @@ pub const MAX_THREADS: u64 = 1024;
 pub fn real(min: f64, max: f64) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync {
     move |text| match text.trim().parse::<f64>() {
         Ok(v) if v.is_finite() && (min..=max).contains(&v) => Ok(v),
-        _ => Err(format!("must be a number in [{min}, {max}]")),
+        _ => Err(format!(
+            "must be a number in [{}, {}]",
+            short(min),
+            short(max)
+        )),
     }
 }
 
-/// A finite real number in `(0, max]`: sizes, distances, widths.
+/// Smallest value of a positive quantity (sizes, distances, rates, angles, durations), as in
+/// scene files: a micrometre, a microsecond. Values like 1e-300 pass `> 0` and then make
+/// the geometry degenerate (a panic inside the BVH build, found by an audit), or print as
+/// 300-digit numbers.
+pub const MIN_POSITIVE: f64 = 1e-6;
+
+/// A finite real number in `[1e-6, max]`: sizes, distances, widths, rates.
 pub fn positive(max: f64) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync {
-    move |text| match text.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 && v <= max => Ok(v),
-        _ => Err(format!("must be a number in (0, {max}]")),
-    }
+    real(MIN_POSITIVE, max)
 }
 
-/// A working distance: `inf` (d2 → ∞) or metres in (0, 1e6].
+/// A working distance: `inf` (d2 → ∞) or metres in [1e-6, 1e6].
 pub fn metres_or_inf(text: &str) -> Result<f64, String> {
     match text.trim() {
         "inf" | "infinity" => Ok(f64::INFINITY),
@@ -103,7 +111,7 @@ pub struct RenderArgs {
     /// Worker threads in [1, 1024] (default: all cores). Images are identical for any value.
     #[arg(long, value_parser = threads)]
     pub threads: Option<usize>,
-    /// Refuse to start when the estimated memory exceeds this, GiB in (0, 4096].
+    /// Refuse to start when the estimated memory exceeds this, GiB in [1e-6, 4096].
     #[arg(long = "max-memory", value_name = "GIB", default_value_t = DEFAULT_MAX_MEMORY_GIB, value_parser = max_memory)]
     pub max_memory: f64,
 }
@@ -123,12 +131,12 @@ pub struct HeadErrorArgs {
     /// Seed of the jitter (and of the depth sensor's noise), an integer in [0, 4294967295].
     #[arg(long, default_value_t = 1, value_parser = integer::<u32>(0, u32::MAX as u64))]
     pub seed: u32,
-    /// The detector's known feature width A (interpupillary distance), metres in (0, 1].
+    /// The detector's known feature width A (interpupillary distance), metres in [1e-6, 1].
     #[arg(long = "feature-width", default_value_t = 0.064, value_parser = positive(1.0))]
     pub feature_width: f64,
 }
 
-/// `--max-memory`, GiB in (0, 4096].
+/// `--max-memory`, GiB in [1e-6, 4096].
 pub fn max_memory(text: &str) -> Result<f64, String> {
     positive(4096.0)(text)
 }

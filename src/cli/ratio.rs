@@ -21,7 +21,7 @@ enum RatioSetup {
     /// A box of depth L standing on the scene plane at d2, its near edge at lateral b1.
     #[command(allow_negative_numbers = true)]
     Occlusion {
-        /// Depth of the box L, metres in (0, 1e4].
+        /// Depth of the box L, metres in [1e-6, 1e4].
         #[arg(long = "L", value_parser = positive(1e4))]
         l: f64,
         #[command(flatten)]
@@ -32,10 +32,10 @@ enum RatioSetup {
     /// A surface of length l from its corner at b1 on the plane at d2, at angle γ to the plane.
     #[command(allow_negative_numbers = true)]
     Foreshortening {
-        /// Length of the surface l, metres in (0, 1e4].
+        /// Length of the surface l, metres in [1e-6, 1e4].
         #[arg(long = "l", value_parser = positive(1e4))]
         l: f64,
-        /// Angle between the surface and the plane, degrees in (0, 90].
+        /// Angle between the surface and the plane, degrees in [1e-6, 90].
         #[arg(long, value_parser = positive(90.0))]
         gamma: f64,
         #[command(flatten)]
@@ -51,10 +51,10 @@ struct RatioGeometry {
     /// Lateral position of the object's corner b1, metres in [-1e4, 1e4].
     #[arg(long, allow_hyphen_values = true, value_parser = real(-1e4, 1e4))]
     b1: f64,
-    /// Distance of the scene plane from the display d2, metres in (0, 1e4].
+    /// Distance of the scene plane from the display d2, metres in [1e-6, 1e4].
     #[arg(long, value_parser = positive(1e4))]
     d2: f64,
-    /// Distance of the eye from the display d1, metres in (0, 1e3].
+    /// Distance of the eye from the display d1, metres in [1e-6, 1e3].
     #[arg(long, value_parser = positive(1e3))]
     d1: f64,
     /// Eye offset b_h (the eye at lateral −b_h), metres in [-1e3, 1e3].
@@ -64,7 +64,7 @@ struct RatioGeometry {
 
 #[derive(clap::Args)]
 struct RatioCommon {
-    /// The compensation's model plane behind the display, metres in (0, 1e6], or `inf`
+    /// The compensation's model plane behind the display, metres in [1e-6, 1e6], or `inf`
     /// (default: the scene plane, the paper's case).
     #[arg(
         long = "model-d2",

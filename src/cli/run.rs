@@ -42,7 +42,7 @@ pub struct Run {
     #[arg(long, value_enum, default_value_t = Method::Planar)]
     method: Method,
     /// Working distance of the planar model: inf, auto (median frontal depth behind the
-    /// display) or metres in (0, 1e6].
+    /// display) or metres in [1e-6, 1e6].
     #[arg(long, default_value = "inf", value_name = "METRES|inf|auto")]
     d2: WorkingDistance,
     /// oracle: the true eye; estimated: face detection on the back camera's image.
@@ -70,7 +70,7 @@ pub struct Run {
     /// The eyes the driver's views are rendered from.
     #[arg(long, value_enum, default_value_t = EyesFlag::Mono)]
     eyes: EyesFlag,
-    /// Interpupillary distance, metres in (0, 0.1].
+    /// Interpupillary distance, metres in [1e-6, 0.1].
     #[arg(long, default_value_t = 0.064, value_parser = positive(MAX_IPD))]
     ipd: f64,
     /// The eye the compensation serves.

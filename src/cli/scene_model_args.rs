@@ -17,7 +17,7 @@ pub struct SceneModelArgs {
     /// tof and stereo only; default: the sensor's).
     #[arg(long = "depth-resolution", value_parser = pixels)]
     pub depth_resolution: Option<u32>,
-    /// Depth sensor range: no return past it (d2 → ∞ there), metres in (0, 1e6] (tof and
+    /// Depth sensor range: no return past it (d2 → ∞ there), metres in [1e-6, 1e6] (tof and
     /// stereo only; default: the sensor's).
     #[arg(long = "depth-range", value_parser = positive(1e6))]
     pub depth_range: Option<f64>,

@@ -79,13 +79,13 @@ pub struct Sequence {
     /// Output directory.
     #[arg(long)]
     out: PathBuf,
-    /// Length of the sequence, seconds in (0, 3600].
+    /// Length of the sequence, seconds in [1e-6, 3600].
     #[arg(long, default_value_t = 4.0, value_parser = positive(3600.0))]
     duration: f64,
-    /// Frames measured per second, Hz in (0, 1000].
+    /// Frames measured per second, Hz in [1e-6, 1000].
     #[arg(long, default_value_t = 60.0, value_parser = positive(1000.0))]
     fps: f64,
-    /// Display refresh rate, Hz in (0, 1000] (sample and hold; default: --fps).
+    /// Display refresh rate, Hz in [1e-6, 1000] (sample and hold; default: --fps).
     #[arg(long = "display-hz", value_parser = positive(1000.0))]
     display_hz: Option<f64>,
     /// Vehicle speed along the road (world −z), km/h in [0, 300].
@@ -105,13 +105,13 @@ pub struct Sequence {
     /// Sway amplitude, centimetres in [0, 50].
     #[arg(long = "sway-cm", default_value_t = 3.0, value_parser = real(0.0, 50.0))]
     sway_cm: f64,
-    /// Sway frequency, Hz in (0, 20].
+    /// Sway frequency, Hz in [1e-6, 20].
     #[arg(long = "sway-hz", default_value_t = 0.5, value_parser = positive(20.0))]
     sway_hz: f64,
     /// Lean distance, centimetres in [0, 50].
     #[arg(long = "lean-cm", default_value_t = 10.0, value_parser = real(0.0, 50.0))]
     lean_cm: f64,
-    /// Lean duration, seconds in (0, 10].
+    /// Lean duration, seconds in [1e-6, 10].
     #[arg(long = "lean-s", default_value_t = 0.3, value_parser = positive(10.0))]
     lean_s: f64,
     /// When the lean starts, seconds in [0, 3600].
@@ -136,7 +136,7 @@ pub struct Sequence {
     /// none: the whole frontal image in the display; planar: the paper's compensation.
     #[arg(long, value_enum, default_value_t = Method::Planar)]
     method: Method,
-    /// Working distance of the planar model: inf, auto or metres in (0, 1e6].
+    /// Working distance of the planar model: inf, auto or metres in [1e-6, 1e6].
     #[arg(long, default_value = "inf", value_name = "METRES|inf|auto")]
     d2: WorkingDistance,
     /// oracle: the true eye (late by the tracking latency); estimated: face detection on the

@@ -43,7 +43,7 @@ pub struct Sweep {
     #[arg(long, value_name = "K/N")]
     shard: Option<Shard>,
     /// Refuse to start when the estimated memory of the configurations computed at once
-    /// exceeds this, GiB in (0, 4096].
+    /// exceeds this, GiB in [1e-6, 4096].
     #[arg(long = "max-memory", value_name = "GIB", default_value_t = DEFAULT_MAX_MEMORY_GIB, value_parser = max_memory)]
     max_memory: f64,
 }

@@ -11,6 +11,7 @@ use crate::analysis::paper::{ForeshorteningParams, OcclusionParams};
 use crate::analysis::perceived::PerceivedGeometry;
 use crate::geometry::camera::Camera;
 use crate::scene::{Material, Object, Obstacle, Scene, Shape, Sky, Sun};
+use crate::util::number::short;
 
 /// The two setups of the paper's §4.2.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -142,7 +143,9 @@ impl Setup {
         let (pc, pu) = self.predicted();
         if pc.abs() < 1e-6 || pu.abs() < 1e-6 || !pc.is_finite() || !pu.is_finite() {
             bail!(
-                "the predicted widths are zero or undefined for these parameters (p_cam = {pc}, p_user = {pu})"
+                "the predicted widths are zero or undefined for these parameters (p_cam = {}, p_user = {}): |p| must be at least 1e-6 m",
+                short(pc),
+                short(pu)
             );
         }
         Ok(())

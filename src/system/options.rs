@@ -1,10 +1,11 @@
 //! The choices of one run of the see-through system: method, working distance, head source,
 //! injected head errors, sizes, and how the display is modelled.
 
-use crate::scene::limits::MAX_COORDINATE;
+use crate::scene::limits::{MAX_COORDINATE, MIN_LENGTH};
 use crate::system::display::{DisplayModel, Filter};
 use crate::system::eyes::Eyes;
 use crate::system::scene_model_options::SceneModelOptions;
+use crate::util::number::short;
 
 /// How the display image is made.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
@@ -28,7 +29,7 @@ pub enum Method {
 pub enum WorkingDistance {
     /// `d2 → ∞`, the paper's proposal.
     Infinity,
-    /// A fixed distance from the display plane, metres, > 0.
+    /// A fixed distance from the display plane, metres in [1e-6, 1e6].
     Metres(f64),
     /// The median frontal depth of the region the display covers (a range sensor's answer).
     Auto,
@@ -41,11 +42,13 @@ impl std::str::FromStr for WorkingDistance {
             "inf" | "infinity" => Ok(WorkingDistance::Infinity),
             "auto" => Ok(WorkingDistance::Auto),
             _ => match s.parse::<f64>() {
-                Ok(v) if v.is_finite() && v > 0.0 && v <= MAX_COORDINATE => {
+                Ok(v) if (MIN_LENGTH..=MAX_COORDINATE).contains(&v) => {
                     Ok(WorkingDistance::Metres(v))
                 }
                 _ => Err(format!(
-                    "`{s}`: must be inf, auto or a distance in metres in (0, {MAX_COORDINATE}]"
+                    "`{s}`: must be inf, auto or a distance in metres in [{}, {}]",
+                    short(MIN_LENGTH),
+                    short(MAX_COORDINATE)
                 )),
             },
         }

@@ -26,6 +26,7 @@ use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDis
 use crate::system::report::report;
 use crate::system::scene_model::{check_scene_model, scene_model_display};
 use crate::util::memory::peak_rss_bytes;
+use crate::util::number::short;
 
 /// Everything a run produces.
 pub struct RunResult {
@@ -281,18 +282,29 @@ pub fn run_with_truth(
         let d1 = scene.obstacle.in_obstacle_frame(eye_used).z;
         let (ax, ay) = admissible_offsets(&scene.frontal, &scene.obstacle, d1, d2_used);
         let axis = scene.obstacle.in_obstacle_frame(scene.frontal.position());
+        let extent = if side == "left" || side == "right" {
+            crop.frontal_size[0]
+        } else {
+            crop.frontal_size[1]
+        };
+        let share = 100.0 * px / extent as f64;
+        let region = if ax < 0.0 || ay < 0.0 {
+            // The range would print high to low: no eye position is admissible.
+            "no eye position keeps the whole crop inside the frontal view there (its field of view is too narrow for the display at this d2)".to_string()
+        } else {
+            format!(
+                "the eye must stay within x ∈ [{}, {}] m, y ∈ [{}, {}] m of the obstacle frame",
+                short(axis.x - ax),
+                short(axis.x + ax),
+                short(axis.y - ay),
+                short(axis.y + ay)
+            )
+        };
         bail!(
-            "the crop leaves the frontal camera's view on the {side} by {px:.1} px ({:.1}% of the image); at d1 = {d1:.3} m the eye must stay within x ∈ [{:.3}, {:.3}] m, y ∈ [{:.3}, {:.3}] m of the obstacle frame (use --outside black to show the rest black)",
-            100.0 * px
-                / if side == "left" || side == "right" {
-                    crop.frontal_size[0]
-                } else {
-                    crop.frontal_size[1]
-                } as f64,
-            axis.x - ax,
-            axis.x + ax,
-            axis.y - ay,
-            axis.y + ay
+            "the crop leaves the frontal camera's view on the {side} by {} px ({}% of the image); at d1 = {} m {region} (use --outside black to show the rest black)",
+            short(px),
+            short(share),
+            short(d1),
         );
     }
 

@@ -6,6 +6,7 @@ pub mod color;
 pub mod input_file;
 pub mod json;
 pub mod memory;
+pub mod message;
 pub mod number;
 pub mod progress;
 pub mod sampling;
