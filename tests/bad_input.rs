@@ -388,7 +388,8 @@ fn inputs_that_are_devices_or_folders_are_refused_without_being_read() {
 fn names_with_line_breaks_or_terminal_escapes_are_shown_inert() {
     // A name is echoed in the error: its line break must not split the message, its escape
     // sequence must not reach the terminal.
-    let object = "\n[[object]]\nkind = \"sphere\"\nmaterial = \"no\\nsuch\\u001b[31m\"\nradius = 1.0\n";
+    let object =
+        "\n[[object]]\nkind = \"sphere\"\nmaterial = \"no\\nsuch\\u001b[31m\"\nradius = 1.0\n";
     let dir = scratch(object, &[]);
     let err = render_refused(dir.path(), &["scene.toml", "no\\nsuch\\u{1b}[31m"]);
     assert!(!err.chars().any(char::is_control), "{err:?}");

@@ -73,6 +73,17 @@ fn bad_lens_keys_give_one_line_naming_file_line_and_key() {
             "camera.frontal.k2",
             "must be finite",
         ),
+        // Nothing folds, but the image would see a sliver of the scene: no lens.
+        (
+            "model = \"brown\"\nk1 = 1e10",
+            "camera.frontal.k1",
+            "must be in [-1000, 1000], got 10000000000",
+        ),
+        (
+            "model = \"fisheye\"\nk3 = -1e300",
+            "camera.frontal.k3",
+            "must be in [-1000, 1000], got -1e300",
+        ),
         (
             "fx = 0.0",
             "camera.frontal.fx",

@@ -5,6 +5,7 @@
 use glam::DVec2;
 
 use crate::geometry::lens::{Distortion, Lens};
+use crate::util::number::short;
 
 /// Largest angle off the axis any pixel may see, radians (89°): seethru's cameras see less
 /// than a hemisphere, so every ray they see has camera z < 0.
@@ -35,7 +36,7 @@ impl std::fmt::Display for LensError {
         match self {
             LensError::NotFinite(key) => write!(f, "{key} must be a finite number"),
             LensError::FocalNotPositive(key, v) => {
-                write!(f, "{key} must be > 0 pixels, got {v}")
+                write!(f, "{key} must be > 0 pixels, got {}", short(*v))
             }
             LensError::Folds {
                 radius,
@@ -43,11 +44,15 @@ impl std::fmt::Display for LensError {
                 needed,
             } => write!(
                 f,
-                "the distortion folds (the lens map is not invertible) at undistorted radius {radius:.4} ({pixels:.1} px from the principal point), inside the image, which reaches {needed:.1} px: the coefficients are not a lens"
+                "the distortion folds (the lens map is not invertible) at undistorted radius {} ({} px from the principal point), inside the image, which reaches {} px: the coefficients are not a lens",
+                short(*radius),
+                short(*pixels),
+                short(*needed)
             ),
             LensError::TooWide { needed } => write!(
                 f,
-                "the image reaches {needed:.1} px from the principal point, where the lens sees 89° or more off its axis; seethru's cameras must see less than a hemisphere"
+                "the image reaches {} px from the principal point, where the lens sees 89° or more off its axis; seethru's cameras must see less than a hemisphere",
+                short(*needed)
             ),
         }
     }

@@ -27,9 +27,14 @@ fn coefficient_keys(model: &str) -> &'static [&'static str] {
     }
 }
 
-/// A number that must be finite (any value): a distortion coefficient.
+/// Largest magnitude of a distortion coefficient. Calibrated lenses stay far inside it (|k| of
+/// a few units, tangential terms below 0.1); k1 = 1e10 is no lens, though nothing folds: the
+/// image then sees a sliver of the scene.
+pub const MAX_COEFFICIENT: f64 = 1e3;
+
+/// A distortion coefficient, default 0, in [−MAX_COEFFICIENT, MAX_COEFFICIENT].
 fn coefficient(t: &TableReader, key: &str) -> Result<f64, SceneError> {
-    Ok(t.opt_f64(key)?.unwrap_or(0.0))
+    t.f64_in(key, 0.0, -MAX_COEFFICIENT, MAX_COEFFICIENT)
 }
 
 /// The key a lens error is about, for its file:line.
@@ -156,7 +161,7 @@ fn read_camera_calibration(
                 ),
             ));
         }
-        coefficients[i] = t.opt_f64(name)?;
+        coefficients[i] = Some(coefficient(t, name)?);
     }
     let calibration = CameraCalibration {
         focal_error: t.f64_in(
