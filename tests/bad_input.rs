@@ -394,3 +394,25 @@ fn names_with_line_breaks_or_terminal_escapes_are_shown_inert() {
     let err = render_refused(dir.path(), &["scene.toml", "no\\nsuch\\u{1b}[31m"]);
     assert!(!err.chars().any(char::is_control), "{err:?}");
 }
+
+#[test]
+fn a_display_that_covers_no_pixel_is_refused_not_measured_as_empty() {
+    // The driver looks away from the display, or it is too small to cover a pixel: every
+    // metric would be undefined; `run` says why instead of writing a run of empty metrics.
+    for (from, to) in [
+        ("look_at = [0.0, 1.2, -10.0]", "look_at = [0.0, 1.2, 10.0]"),
+        ("width = 0.3\nheight = 0.4", "width = 1e-5\nheight = 1e-5"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let scene = common::MINIMAL.replace(from, to);
+        assert_ne!(scene, common::MINIMAL);
+        std::fs::write(dir.path().join("scene.toml"), scene).unwrap();
+        refused(
+            dir.path(),
+            &["run", "scene.toml", "--out", "out", "--spp", "1"],
+            1,
+            &["the display covers no pixel of the driver's 64×36 view"],
+        );
+        assert!(!dir.path().join("out").exists());
+    }
+}

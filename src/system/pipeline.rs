@@ -14,6 +14,7 @@ use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::render::settings::{RenderSettings, check_spp, resized};
 use crate::render::views::View;
+use crate::scene::shapes::box_face;
 use crate::scene::world::view_bit;
 use crate::scene::{Obstacle, Scene};
 use crate::system::compensation::{Crop, ModelPlane, compute_crop};
@@ -341,6 +342,21 @@ pub fn run_with_truth(
         "occluded",
     );
     timings.insert("occluded".into(), json!(stats.seconds));
+    // Where the display covers no pixel every metric is undefined: say so rather than write
+    // a run whose measurements are all empty.
+    let display_face = |(&o, &p): (&u32, &u32)| o == ctx.world.obstacle_id && p == box_face::POS_Z;
+    if !occluded
+        .object_id
+        .iter()
+        .zip(&occluded.part_id)
+        .any(display_face)
+    {
+        bail!(
+            "the display covers no pixel of the driver's {}×{} view: the driver looks away from it, or it is too small or too far to cover a pixel; nothing to measure",
+            driver.width,
+            driver.height
+        );
+    }
     let placement = DisplayPlacement::new(&scene.obstacle);
     let surface = match options.display {
         DisplayModel::Pixels => DisplaySurface::Pixels {
