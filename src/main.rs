@@ -26,7 +26,8 @@ fn main() -> ExitCode {
         }
         default_hook(info);
     }));
-    let cli = match cli::Cli::try_parse() {
+    let cli = match cli::Cli::try_parse_from(cli::with_negative_values_joined(std::env::args_os()))
+    {
         Ok(cli) => cli,
         Err(e) if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) => {
             e.exit()

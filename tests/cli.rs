@@ -389,26 +389,33 @@ fn every_numeric_flag_accepts_exactly_the_range_its_help_documents() {
             } else {
                 text.clone()
             };
-            let mut args: Vec<String> = option.words.iter().map(|w| w.to_string()).collect();
-            args.push(format!("{}={given}", option.flag));
-            args.push("--help".into());
-            let args: Vec<&str> = args.iter().map(String::as_str).collect();
-            let (ok, _, err) = seethru_in(scratch.path(), &args);
-            let documented = range.contains(v) || (takes_inf && v == f64::INFINITY);
-            let err = err.trim_end();
-            if ok != documented {
-                wrong.push(format!(
-                    "{context}={given}: accepted {ok}, but its help says {range:?}: {err}"
-                ));
-            } else if !ok
-                && (err.lines().count() != 1
-                    || !err.starts_with("error: invalid value")
-                    || !err.contains(&option.flag)
-                    || Range::first_in(err) != Some(range))
-            {
-                wrong.push(format!(
-                    "{context}={given}: not one line naming the flag and {range:?}: {err}"
-                ));
+            // `--flag=v` and `--flag v` alike (clap took `-inf` after a space for an option).
+            for joined in [true, false] {
+                let mut args: Vec<String> = option.words.iter().map(|w| w.to_string()).collect();
+                if joined {
+                    args.push(format!("{}={given}", option.flag));
+                } else {
+                    args.extend([option.flag.clone(), given.clone()]);
+                }
+                args.push("--help".into());
+                let args: Vec<&str> = args.iter().map(String::as_str).collect();
+                let (ok, _, err) = seethru_in(scratch.path(), &args);
+                let documented = range.contains(v) || (takes_inf && v == f64::INFINITY);
+                let err = err.trim_end();
+                if ok != documented {
+                    wrong.push(format!(
+                        "{context}={given}: accepted {ok}, but its help says {range:?}: {err}"
+                    ));
+                } else if !ok
+                    && (err.lines().count() != 1
+                        || !err.starts_with("error: invalid value")
+                        || !err.contains(&option.flag)
+                        || Range::first_in(err) != Some(range))
+                {
+                    wrong.push(format!(
+                        "{context}={given}: not one line naming the flag and {range:?}: {err}"
+                    ));
+                }
             }
         }
         walked += 1;

@@ -71,6 +71,40 @@ pub enum Command {
     Sequence(sequence::Sequence),
 }
 
+/// The command line with every negative number that follows an option joined to it
+/// (`--b1 -0.35` → `--b1=-0.35`, `--width -inf` → `--width=-inf`): clap takes `-0.35` or
+/// `-inf` for an option of its own and says "unexpected argument '-i'", naming neither the
+/// flag nor its range. No option's name starts with a digit, `inf` or `nan`, so nothing else
+/// changes.
+pub fn with_negative_values_joined(
+    args: impl IntoIterator<Item = std::ffi::OsString>,
+) -> Vec<std::ffi::OsString> {
+    let negative_number = |text: &str| {
+        let rest = text
+            .strip_prefix('-')
+            .unwrap_or_default()
+            .to_ascii_lowercase();
+        rest.starts_with(|c: char| c.is_ascii_digit() || c == '.')
+            || ["inf", "infinity", "nan"].contains(&rest.as_str())
+    };
+    let mut out: Vec<std::ffi::OsString> = Vec::new();
+    for arg in args {
+        let joined = match (out.last().and_then(|a| a.to_str()), arg.to_str()) {
+            (Some(option), Some(value))
+                if option.starts_with("--") && !option.contains('=') && option.len() > 2 =>
+            {
+                negative_number(value).then(|| format!("{option}={value}"))
+            }
+            _ => None,
+        };
+        match joined {
+            Some(j) => *out.last_mut().expect("an option precedes") = j.into(),
+            None => out.push(arg),
+        }
+    }
+    out
+}
+
 /// A clap error as one line starting `error:`: the message and its tip, without the usage
 /// block and the pointer to `--help`, so that scripts and logs get one line per failure.
 pub fn one_line(error: &clap::Error) -> String {
