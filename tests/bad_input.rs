@@ -416,3 +416,51 @@ fn a_display_that_covers_no_pixel_is_refused_not_measured_as_empty() {
         assert!(!dir.path().join("out").exists());
     }
 }
+
+#[test]
+fn flags_the_command_would_ignore_are_refused() {
+    // Each was accepted and then ignored without a word: a sensor's settings for the ideal
+    // sensor, a sensor or a fill for a method that reads none, a head path beside a head
+    // preset, one latency twice (one folder each).
+    let dir = scratch("", &[]);
+    let run = ["run", "scene.toml", "--out", "out", "--spp", "1"];
+    for (extra, words) in [
+        (
+            &["--depth-noise", "0.1"][..],
+            &["--depth-noise is read by --method plane-fit and depth only"][..],
+        ),
+        (
+            &["--method", "depth", "--depth-range", "5"],
+            &[
+                "--depth-range sets the tof and stereo sensors",
+                "--depth-sensor tof",
+            ],
+        ),
+        (
+            &["--method", "plane-fit", "--fill", "inpaint"],
+            &["--fill fills the holes of --method depth only"],
+        ),
+        (
+            &["--depth-sensor", "stereo"],
+            &["--depth-sensor is read by --method plane-fit and depth only"],
+        ),
+    ] {
+        let args: Vec<&str> = run.iter().chain(extra).copied().collect();
+        refused(dir.path(), &args, 1, words);
+    }
+    let sequence = ["sequence", "scene.toml", "--out", "out"];
+    for (extra, words) in [
+        (
+            &["--head", "sway", "--head-path", "p.csv"][..],
+            &["'--head <HEAD>' cannot be used with '--head-path <CSV>'"][..],
+        ),
+        (
+            &["--latency-camera", "16,33,16.0000001"],
+            &["latencies 16 and 16.0000001 ms", "give each once"],
+        ),
+    ] {
+        let args: Vec<&str> = sequence.iter().chain(extra).copied().collect();
+        refused(dir.path(), &args, 2, words);
+    }
+    assert_eq!(listing(dir.path()), vec!["scene.toml".to_string()]);
+}

@@ -89,6 +89,7 @@ pub struct Run {
 
 impl Run {
     pub fn run(self) -> Result<()> {
+        self.scene_model.check_used_by(self.method)?;
         let options = RunOptions {
             method: self.method,
             d2: self.d2,

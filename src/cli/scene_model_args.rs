@@ -1,7 +1,9 @@
 //! The flags of the scene-model methods (`ground`, `plane-fit`, `depth`): the depth sensor
 //! and the filling of disocclusion holes. Shared by `run` and `compare`.
 
+use anyhow::bail;
 use seethru::system::depth_sensor::{SensorKind, SensorOptions};
+use seethru::system::options::Method;
 use seethru::system::scene_model::{Fill, SceneModelOptions};
 
 use crate::cli::args::{pixels, positive, real};
@@ -36,6 +38,38 @@ pub struct SceneModelArgs {
 }
 
 impl SceneModelArgs {
+    /// Refuses flags that `method` would ignore without a word: a sensor for a method that
+    /// reads none, a sensor's settings for the ideal sensor (which has none), a fill for a
+    /// method that leaves no holes.
+    pub fn check_used_by(&self, method: Method) -> anyhow::Result<()> {
+        let given = [
+            ("--depth-resolution", self.depth_resolution.is_some()),
+            ("--depth-range", self.depth_range.is_some()),
+            ("--depth-noise", self.depth_noise.is_some()),
+            ("--depth-quantum", self.depth_quantum.is_some()),
+        ];
+        let reads_depth = matches!(method, Method::PlaneFit | Method::Depth);
+        if !reads_depth
+            && let Some((flag, _)) =
+                std::iter::once(("--depth-sensor", self.depth_sensor != SensorKind::Ideal))
+                    .chain(given)
+                    .find(|(_, g)| *g)
+        {
+            bail!("{flag} is read by --method plane-fit and depth only, not by this method");
+        }
+        if self.depth_sensor == SensorKind::Ideal
+            && let Some((flag, _)) = given.iter().find(|(_, g)| *g)
+        {
+            bail!(
+                "{flag} sets the tof and stereo sensors; the ideal sensor (the default) has none: add --depth-sensor tof or stereo"
+            );
+        }
+        if method != Method::Depth && self.fill != Fill::None {
+            bail!("--fill fills the holes of --method depth only");
+        }
+        Ok(())
+    }
+
     pub fn options(&self) -> SceneModelOptions {
         SceneModelOptions {
             sensor: SensorOptions {

@@ -48,7 +48,21 @@ fn latency_list(text: &str) -> Result<Latencies, String> {
         .iter()
         .map(|p| real(0.0, MAX_LATENCY_MS)(p).map_err(|_| range.clone()))
         .collect::<Result<Vec<f64>, String>>()
-        .map(Latencies)
+        .and_then(|values| {
+            // Each latency has a folder of its own, named by its short value.
+            let mut seen = std::collections::HashMap::new();
+            for &ms in &values {
+                if let Some(first) = seen.insert(latency_dir(ms), ms) {
+                    return Err(format!(
+                        "latencies {} and {} ms are the same to 6 digits (folder {}): give each once",
+                        first,
+                        ms,
+                        latency_dir(ms)
+                    ));
+                }
+            }
+            Ok(Latencies(values))
+        })
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -100,7 +114,7 @@ pub struct Sequence {
     head: HeadPreset,
     /// A recorded head path instead of --head: CSV of t,x,y,z (seconds; the eye in the
     /// obstacle frame, metres), times increasing.
-    #[arg(long = "head-path", value_name = "CSV")]
+    #[arg(long = "head-path", value_name = "CSV", conflicts_with = "head")]
     head_path: Option<PathBuf>,
     /// Sway amplitude, centimetres in [0, 50].
     #[arg(long = "sway-cm", default_value_t = 3.0, value_parser = real(0.0, 50.0))]
@@ -366,5 +380,5 @@ impl Sequence {
 
 /// The folder of one latency's sequence: `latency_<ms>ms`.
 fn latency_dir(ms: f64) -> String {
-    format!("latency_{ms}ms")
+    format!("latency_{}ms", seethru::util::number::short(ms))
 }
