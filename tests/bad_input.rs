@@ -464,3 +464,28 @@ fn flags_the_command_would_ignore_are_refused() {
     }
     assert_eq!(listing(dir.path()), vec!["scene.toml".to_string()]);
 }
+
+#[test]
+fn a_size_flag_whose_aspect_breaks_the_pixel_limit_is_named() {
+    // Each side is admissible, the image is not: the message names the flag, the size the
+    // camera's aspect gives and the limit in pixels, not a 9-digit count.
+    let dir = scratch("", &[]);
+    let err = refused(
+        dir.path(),
+        &[
+            "run",
+            "scene.toml",
+            "--out",
+            "out",
+            "--frontal-width",
+            "16384",
+        ],
+        1,
+        &[
+            "--frontal-width gives 16384×9216",
+            "at most 16384×8192 in all",
+        ],
+    );
+    assert!(!err.contains("134217728"), "{err}");
+    assert!(!dir.path().join("out").exists());
+}

@@ -158,7 +158,8 @@ fn analyze_reports_the_papers_claims_and_any_parameter_set() {
     assert!((v["evaluation"]["left"]["R"].as_f64().unwrap() - r1).abs() < 1e-12);
     let (ok, _, err) = seethru(&["analyze", "--d1", "0"]);
     assert!(
-        !ok && err.starts_with("error: invalid value '0' for '--d1 <D1>': must be a number in [1e-6,"),
+        !ok && err
+            .starts_with("error: invalid value '0' for '--d1 <D1>': must be a number in [1e-6,"),
         "{err}"
     );
 }

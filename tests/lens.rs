@@ -273,7 +273,13 @@ fn ignoring_k1_costs_the_closed_form_at_the_crop_corners() {
         run(&exact, &options).unwrap(),
         run(&ignoring, &options).unwrap(),
     );
-    let camera = resized(exact.scene.frontal, options.frontal_width, None).unwrap();
+    let camera = resized(
+        exact.scene.frontal,
+        options.frontal_width,
+        None,
+        "--frontal-width",
+    )
+    .unwrap();
     let f = camera.lens.unwrap().fx;
     let obstacle = &exact.scene.obstacle;
     let eye = obstacle.in_obstacle_frame(exact.scene.eye());

@@ -27,8 +27,8 @@ fn quick_reproduction_reports_the_papers_experiments() {
             .zip([(4.0, 30.0), (4.0, 63.5), (15.0, 30.0), (15.0, 63.5)])
     {
         let scene = seethru::paper::reproduce::das_case(&base, distance, 1.0, theta).unwrap();
-        let driver = resized(scene.driver, Some(256), None).unwrap();
-        let frontal = resized(scene.frontal, Some(480), None).unwrap();
+        let driver = resized(scene.driver, Some(256), None, "--width").unwrap();
+        let frontal = resized(scene.frontal, Some(480), None, "--frontal-width").unwrap();
         let (display, covered, ambiguous) =
             common::expected_coverage(&scene, &driver, &frontal, None);
         let expected = covered as f64 / display as f64;

@@ -48,7 +48,7 @@ fn sweeps_write_every_row_and_resume() {
     ]) {
         let mut scene = base.clone();
         scene.frontal.half_angle_x = f64::to_radians(theta);
-        let driver = resized(scene.driver, Some(64), None).unwrap();
+        let driver = resized(scene.driver, Some(64), None, "--width").unwrap();
         let (display, covered, ambiguous) =
             common::expected_coverage(&scene, &driver, &scene.frontal, d2);
         let expected = covered as f64 / display as f64;

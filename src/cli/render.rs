@@ -48,7 +48,14 @@ fn render_views(scene_path: &Path, views: &[View], out: &Path, options: &RenderA
     // Check every camera before the first (possibly long) render.
     let cameras = views
         .iter()
-        .map(|v| resized(v.camera(&scene), options.width, options.height))
+        .map(|v| {
+            resized(
+                v.camera(&scene),
+                options.width,
+                options.height,
+                "--width/--height",
+            )
+        })
         .collect::<Result<Vec<_>>>()?;
     check_memory(&render_estimate(&cameras), options.max_memory)?;
     let context = RenderContext::new(scene)?;

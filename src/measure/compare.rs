@@ -111,7 +111,12 @@ pub fn compare(
         let options = candidate.options(base);
         if options.method.models_the_scene() {
             let mut scene = scene.clone();
-            scene.frontal = resized(scene.frontal, options.frontal_width, None)?;
+            scene.frontal = resized(
+                scene.frontal,
+                options.frontal_width,
+                None,
+                "--frontal-width",
+            )?;
             check_scene_model(&scene, &options)
                 .map_err(|e| anyhow::anyhow!("{}: {e:#}", candidate.name()))?;
         }

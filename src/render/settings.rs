@@ -1,7 +1,7 @@
 //! Render settings and their limits: samples per pixel, and image sizes after the
 //! command line's overrides.
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 
 use crate::geometry::camera::Camera;
 use crate::scene::source::{MAX_PIXELS, MAX_RESOLUTION};
@@ -28,8 +28,13 @@ impl Default for RenderSettings {
 }
 
 /// Output size of a camera after optional `--width`/`--height` overrides. Given one side
-/// only, the other follows the camera's aspect ratio.
-pub fn resized(camera: Camera, width: Option<u32>, height: Option<u32>) -> Result<Camera> {
+/// only, the other follows the camera's aspect ratio. `flags` names the overrides in errors.
+pub fn resized(
+    camera: Camera,
+    width: Option<u32>,
+    height: Option<u32>,
+    flags: &str,
+) -> Result<Camera> {
     let aspect = camera.width as f64 / camera.height as f64;
     let (w, h) = match (width, height) {
         (None, None) => (camera.width, camera.height),
@@ -37,7 +42,16 @@ pub fn resized(camera: Camera, width: Option<u32>, height: Option<u32>) -> Resul
         (Some(w), None) => (w, ((w as f64 / aspect).round() as u32).max(1)),
         (None, Some(h)) => (((h as f64 * aspect).round() as u32).max(1), h),
     };
-    check_resolution(w, h)?;
+    if width.is_some() || height.is_some() {
+        check_resolution(w, h).with_context(|| {
+            format!(
+                "{flags} gives {w}×{h} (a side not given follows the camera's aspect {})",
+                crate::util::number::short(aspect)
+            )
+        })?;
+    } else {
+        check_resolution(w, h)?;
+    }
     Ok(camera.with_resolution(w, h))
 }
 
@@ -49,7 +63,8 @@ pub fn check_resolution(w: u32, h: u32) -> Result<()> {
         || w as u64 * h as u64 > MAX_PIXELS
     {
         bail!(
-            "resolution {w}×{h} is out of range: each side in [1, {MAX_RESOLUTION}], at most {MAX_PIXELS} pixels"
+            "{w}×{h} pixels are out of range: each side in [1, {MAX_RESOLUTION}], at most {MAX_RESOLUTION}×{} in all",
+            MAX_PIXELS / MAX_RESOLUTION as u64
         );
     }
     Ok(())

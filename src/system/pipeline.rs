@@ -224,6 +224,7 @@ pub fn driver_camera(scene: &Scene, options: &RunOptions) -> Result<Camera> {
         options.eyes.view_camera(&scene.driver),
         options.width,
         options.height,
+        "--width/--height",
     )
 }
 
@@ -236,8 +237,13 @@ pub fn run_with_truth(
     truth: Option<&Frame>,
 ) -> Result<RunResult> {
     let mut scene = ctx.scene.clone();
-    scene.frontal = resized(scene.frontal, options.frontal_width, None)?;
-    scene.back = resized(scene.back, options.back_width, None)?;
+    scene.frontal = resized(
+        scene.frontal,
+        options.frontal_width,
+        None,
+        "--frontal-width",
+    )?;
+    scene.back = resized(scene.back, options.back_width, None, "--back-width")?;
     let scene = &scene;
     check_spp(options.spp)?;
     if !(options.feature_width > 0.0 && options.feature_width.is_finite()) {

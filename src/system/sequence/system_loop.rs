@@ -122,8 +122,8 @@ impl SystemLoop {
             bail!("--feature-width must be > 0 m, got {}", run.feature_width);
         }
         let mut base = scene.clone();
-        base.frontal = resized(base.frontal, run.frontal_width, None)?;
-        base.back = resized(base.back, run.back_width, None)?;
+        base.frontal = resized(base.frontal, run.frontal_width, None, "--frontal-width")?;
+        base.back = resized(base.back, run.back_width, None, "--back-width")?;
         base.driver = driver_camera(&base, run)?;
         let rig = Rig::new(base, options.speed, options.yaw_rate, options.head.clone());
         let tl = options.timeline;
