@@ -66,12 +66,12 @@ fn bad_lens_keys_give_one_line_naming_file_line_and_key() {
         (
             "model = \"fisheye\"\nk1 = nan",
             "camera.frontal.k1",
-            "must be finite",
+            "must be in [-1000, 1000], got NaN",
         ),
         (
             "model = \"brown\"\nk2 = inf",
             "camera.frontal.k2",
-            "must be finite",
+            "must be in [-1000, 1000], got inf",
         ),
         // Nothing folds, but the image would see a sliver of the scene: no lens.
         (
@@ -155,7 +155,7 @@ fn bad_calibration_keys_are_refused() {
             "",
             "[calibration.back]\nyaw_error_deg = nan",
             "calibration.back.yaw_error_deg",
-            "must be finite",
+            "must be in [-10, 10], got NaN",
         ),
         (
             "",

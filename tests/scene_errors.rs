@@ -47,7 +47,7 @@ fn errors_name_file_line_and_key() {
             "radius = 1.0",
             "radius = nan",
             "object[1].radius",
-            "must be finite",
+            "must be in [1e-6, 100000], got NaN",
         ),
         (
             "radius = 1.0",
@@ -101,7 +101,7 @@ fn errors_name_file_line_and_key() {
             "resolution = [64, 36]",
             "resolution = [16384, 16384]",
             "camera.driver.resolution",
-            "at most 134217728 pixels",
+            "at most 16384×8192 pixels in all",
         ),
         (
             "position = [0.0, 1.2, 0.0]",

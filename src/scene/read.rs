@@ -13,7 +13,7 @@ use crate::scene::limits::{
 };
 use crate::scene::motion::read_object_motion;
 use crate::scene::source::{SceneError, SourceFile};
-use crate::scene::table_reader::{TableReader, range_message};
+use crate::scene::table_reader::TableReader;
 use crate::scene::{CameraKind, Material, Object, Obstacle, Scene, Shape, Sky, Sun};
 
 const OBJECT_KINDS: [&str; 7] = ["plane", "box", "sphere", "cylinder", "cone", "quad", "mesh"];
@@ -195,23 +195,12 @@ fn read_transform(t: &TableReader) -> Result<DAffine3, SceneError> {
 fn read_placement(t: &TableReader) -> Result<(DVec3, [f64; 3], [f64; 3]), SceneError> {
     let translate = t.point("translate", Some([0.0; 3]))?;
     let [rx, ry, rz] = t.array_in("rotate_deg", [0.0; 3], -MAX_ROTATION_DEG, MAX_ROTATION_DEG)?;
-    let scale = match t.opt_f64("scale") {
-        Ok(Some(s)) => [s; 3],
-        Ok(None) => [1.0; 3],
-        Err(_) => t.required_array("scale")?,
+    // One factor or three, each in [MIN_LENGTH, MAX_LENGTH].
+    let scale = if t.is_number("scale") {
+        [t.f64_in("scale", 1.0, MIN_LENGTH, MAX_LENGTH)?; 3]
+    } else {
+        t.array_in("scale", [1.0; 3], MIN_LENGTH, MAX_LENGTH)?
     };
-    if let Some(&bad) = scale
-        .iter()
-        .find(|s| !(MIN_LENGTH..=MAX_LENGTH).contains(*s))
-    {
-        return Err(t.error(
-            "scale",
-            format!(
-                "every factor {}",
-                range_message(bad, MIN_LENGTH, MAX_LENGTH)
-            ),
-        ));
-    }
     Ok((translate, [rx, ry, rz], scale))
 }
 

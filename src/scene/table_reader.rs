@@ -162,7 +162,8 @@ impl<'a> TableReader<'a> {
         Ok(())
     }
 
-    pub fn opt_f64(&self, key: &str) -> Result<Option<f64>, SceneError> {
+    /// A number as written, NaN and infinities included (`nan`, `inf` are TOML floats).
+    fn raw_f64(&self, key: &str) -> Result<Option<f64>, SceneError> {
         let Some(item) = self.item(key) else {
             return Ok(None);
         };
@@ -175,15 +176,28 @@ impl<'a> TableReader<'a> {
                     format!("expected a number, found {}", item.type_name()),
                 )
             })?;
-        if !value.is_finite() {
-            return Err(self.error(key, format!("must be finite, got {}", short(value))));
-        }
         Ok(Some(value))
     }
 
-    /// A number with a default, checked against an inclusive range.
+    /// A finite number, if given.
+    pub fn opt_f64(&self, key: &str) -> Result<Option<f64>, SceneError> {
+        let value = self.raw_f64(key)?;
+        if let Some(v) = value.filter(|v| !v.is_finite()) {
+            return Err(self.error(key, format!("must be a finite number, got {}", short(v))));
+        }
+        Ok(value)
+    }
+
+    /// Whether the key holds a single number (NaN and infinities included).
+    pub fn is_number(&self, key: &str) -> bool {
+        self.item(key)
+            .is_some_and(|i| i.as_float().is_some() || i.as_integer().is_some())
+    }
+
+    /// A number with a default, checked against an inclusive range (NaN and infinities are
+    /// outside every range, and the message gives it).
     pub fn f64_in(&self, key: &str, default: f64, min: f64, max: f64) -> Result<f64, SceneError> {
-        let value = self.opt_f64(key)?.unwrap_or(default);
+        let value = self.raw_f64(key)?.unwrap_or(default);
         if !(min..=max).contains(&value) {
             return Err(self.error(key, range_message(value, min, max)));
         }
@@ -299,8 +313,8 @@ impl<'a> TableReader<'a> {
         Ok(out)
     }
 
-    /// A fixed-length array of finite numbers.
-    pub fn opt_array<const N: usize>(&self, key: &str) -> Result<Option<[f64; N]>, SceneError> {
+    /// A fixed-length array of numbers as written, NaN and infinities included.
+    fn raw_array<const N: usize>(&self, key: &str) -> Result<Option<[f64; N]>, SceneError> {
         let Some(item) = self.item(key) else {
             return Ok(None);
         };
@@ -315,11 +329,20 @@ impl<'a> TableReader<'a> {
                 .as_float()
                 .or_else(|| value.as_integer().map(|i| i as f64))
                 .ok_or_else(wrong)?;
-            if !slot.is_finite() {
-                return Err(self.error(key, format!("must be finite, got {}", short(*slot))));
-            }
         }
         Ok(Some(out))
+    }
+
+    /// A fixed-length array of finite numbers.
+    pub fn opt_array<const N: usize>(&self, key: &str) -> Result<Option<[f64; N]>, SceneError> {
+        let value = self.raw_array::<N>(key)?;
+        if let Some(values) = value.filter(|v| v.iter().any(|x| !x.is_finite())) {
+            return Err(self.error(
+                key,
+                format!("must be finite numbers, got {}", short_list(&values)),
+            ));
+        }
+        Ok(value)
     }
 
     /// An array whose every element is in [min, max].
@@ -330,7 +353,7 @@ impl<'a> TableReader<'a> {
         min: f64,
         max: f64,
     ) -> Result<[f64; N], SceneError> {
-        let value = self.array_or(key, default)?;
+        let value = self.raw_array(key)?.unwrap_or(default);
         if let Some(&bad) = value.iter().find(|v| !(min..=max).contains(*v)) {
             return Err(self.error(
                 key,
@@ -374,7 +397,7 @@ impl<'a> TableReader<'a> {
 
     /// A colour: three components in [0, 1].
     pub fn color(&self, key: &str, default: [f64; 3]) -> Result<[f64; 3], SceneError> {
-        let value = self.array_or(key, default)?;
+        let value = self.raw_array(key)?.unwrap_or(default);
         if value.iter().any(|&v| !(0.0..=1.0).contains(&v)) {
             return Err(self.error(
                 key,
@@ -405,7 +428,10 @@ impl<'a> TableReader<'a> {
             }
             _ => Err(self.error(
                 key,
-                format!("expected [width, height], integers in [1, {MAX_RESOLUTION}], at most {MAX_PIXELS} pixels"),
+                format!(
+                    "expected [width, height], integers in [1, {MAX_RESOLUTION}], at most {MAX_RESOLUTION}×{} pixels in all",
+                    MAX_PIXELS / MAX_RESOLUTION as u64
+                ),
             )),
         }
     }
