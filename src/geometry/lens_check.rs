@@ -51,7 +51,7 @@ impl std::fmt::Display for LensError {
             ),
             LensError::TooWide { needed } => write!(
                 f,
-                "the image reaches {} px from the principal point, where the lens sees 89° or more off its axis; seethru's cameras must see less than a hemisphere",
+                "the image reaches {} px from the principal point, where the lens sees 89° or more off its axis; seethru's cameras must see less than a hemisphere (raise fx, fy, or bring cx, cy nearer the image centre)",
                 short(*needed)
             ),
         }
