@@ -37,7 +37,9 @@ pub enum WorkingDistance {
 
 impl std::str::FromStr for WorkingDistance {
     type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    fn from_str(text: &str) -> Result<Self, String> {
+        // Spaces around the value are ignored, as by every numeric flag.
+        let s = text.trim();
         match s {
             "inf" | "infinity" => Ok(WorkingDistance::Infinity),
             "auto" => Ok(WorkingDistance::Auto),
