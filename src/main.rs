@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use clap::error::ErrorKind;
+use seethru::util::error_text;
 use seethru::util::number::clip_long_numbers;
 
 fn main() -> ExitCode {
@@ -38,16 +39,19 @@ fn main() -> ExitCode {
     };
     seethru::util::progress::set_quiet(cli.quiet);
     // Ctrl-C or SIGTERM: no half-written file stays behind (finished files are whole).
+    // The handler keeps the registry of temporaries locked until the exit, so that no thread
+    // creates one after the clean-up.
     let _ = ctrlc::set_handler(|| {
-        let removed = seethru::io::atomic::remove_in_flight();
-        eprintln!("error: interrupted; {removed} partly written files removed");
-        std::process::exit(130);
+        seethru::io::atomic::remove_in_flight_then(|removed| {
+            eprintln!("error: interrupted; {removed} partly written files removed");
+            std::process::exit(130)
+        })
     });
     match cli.command.run() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             // Messages repeat the input: an 800-digit number stays 12 digits.
-            eprintln!("error: {}", clip_long_numbers(&format!("{e:#}")));
+            eprintln!("error: {}", clip_long_numbers(&error_text(&e)));
             ExitCode::FAILURE
         }
     }
