@@ -11,8 +11,8 @@ fn main() -> anyhow::Result<()> {
     write_text(&dir.join("car.obj"), &car_obj())?;
     write_text(&dir.join("car.mtl"), &car_mtl())?;
     let street = street_texture();
-    write_atomically(&dir.join("street.png"), |tmp| {
-        Ok(street.save_with_format(tmp, image::ImageFormat::Png)?)
+    write_atomically(&dir.join("street.png"), |file| {
+        Ok(street.write_to(file, image::ImageFormat::Png)?)
     })?;
     println!("wrote car.obj, car.mtl and street.png to {}", dir.display());
     Ok(())

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use clap::error::ErrorKind;
-use seethru::util::message::printable;
+use seethru::util::message::{error_text, printable};
 
 fn main() -> ExitCode {
     // `seethru analyze | head`: a reader that closes the pipe early ends the command quietly,
@@ -39,17 +39,20 @@ fn main() -> ExitCode {
     };
     seethru::util::progress::set_quiet(cli.quiet);
     // Ctrl-C or SIGTERM: no half-written file stays behind (finished files are whole).
+    // The handler keeps the registry of temporaries locked until the exit, so that no thread
+    // creates one after the clean-up.
     let _ = ctrlc::set_handler(|| {
-        let removed = seethru::io::atomic::remove_in_flight();
-        eprintln!("error: interrupted; {removed} partly written files removed");
-        std::process::exit(130);
+        seethru::io::atomic::remove_in_flight_then(|removed| {
+            eprintln!("error: interrupted; {removed} partly written files removed");
+            std::process::exit(130)
+        })
     });
     match cli.command.run() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             // Messages repeat the input: an 800-digit number stays 12 digits, a line break
-            // in a name is shown as `\n`.
-            eprintln!("error: {}", printable(&format!("{e:#}")));
+            // in a name is shown as `\n`; each cause is said once.
+            eprintln!("error: {}", printable(&error_text(&e)));
             ExitCode::FAILURE
         }
     }

@@ -192,7 +192,7 @@ fn missing_mtl_bin_and_texture_are_named_as_written_and_as_resolved() {
     );
     render_refused(
         dir.path(),
-        &["`lib/none.mtl`", "meshes/lib/none.mtl", "No such file"],
+        &["`lib/none.mtl`", "meshes/lib/none.mtl", "no such file"],
     );
 
     let gltf = gltf_json(&Gltf {
@@ -209,7 +209,7 @@ fn missing_mtl_bin_and_texture_are_named_as_written_and_as_resolved() {
             "buffer 0",
             "`bin/none.bin`",
             "meshes/bin/none.bin",
-            "No such file",
+            "no such file",
         ],
     );
 

@@ -239,3 +239,273 @@ fn sigterm_removes_the_commands_temporaries() {
     }
     assert!(interrupted > 0, "no run was interrupted");
 }
+
+/// A scratch folder with the minimal scene plus a mesh `m.obj` and its `m.mtl`.
+fn scene_with_mesh() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = format!(
+        "{}\n[[object]]\nname = \"m\"\nkind = \"mesh\"\npath = \"m.obj\"\ntranslate = [0.0, 0.0, -5.0]\n",
+        common::MINIMAL
+    );
+    std::fs::write(dir.path().join("scene.toml"), scene).unwrap();
+    std::fs::write(
+        dir.path().join("m.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("m.mtl"), "newmtl a\nKd 0.5 0.5 0.5\n").unwrap();
+    dir
+}
+
+/// Every file under `dir` with its bytes.
+fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    listing(dir)
+        .into_iter()
+        .filter(|name| dir.join(name).is_file())
+        .map(|name| {
+            let bytes = std::fs::read(dir.join(&name)).unwrap();
+            (name, bytes)
+        })
+        .collect()
+}
+
+#[test]
+fn a_failed_export_leaves_no_file_of_any_format() {
+    let dir = scene_with_mesh();
+    // The last file each format writes, blocked by a folder of its name, in a folder of its
+    // own and beside the scene.
+    for (out, blocked) in [
+        ("e/x.glb", "e/x.cameras.json"),
+        ("e/x.obj", "e/x.cameras.json"),
+        ("e/x.obj", "e/x.mtl"),
+        ("e/x.xml", "e/x.cameras.json"),
+        ("e/x.xml", "e/x.truth.xml"),
+        ("x.xml", "x.cameras.json"),
+    ] {
+        std::fs::create_dir_all(dir.path().join(blocked)).unwrap();
+        let before = listing(dir.path());
+        refused(
+            dir.path(),
+            &["export", "scene.toml", "--out", out],
+            1,
+            &[blocked, "in the way"],
+        );
+        assert_eq!(listing(dir.path()), before, "{out} with {blocked} blocked");
+        std::fs::remove_dir(dir.path().join(blocked)).unwrap();
+    }
+    // Into a new folder: created, and holding the files only (no staging).
+    let (code, err) = run_in(dir.path(), &["export", "scene.toml", "--out", "new/y.glb"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        listing(&dir.path().join("new")),
+        ["y.cameras.json", "y.glb"]
+    );
+}
+
+#[test]
+fn export_refuses_to_overwrite_its_inputs() {
+    let dir = scene_with_mesh();
+    for out in ["m.obj", "./sub/../m.obj"] {
+        std::fs::create_dir_all(dir.path().join("sub")).unwrap();
+        let before = contents(dir.path());
+        refused(
+            dir.path(),
+            &["export", "scene.toml", "--out", out],
+            1,
+            &["--out", "m.obj", "an input of the scene scene.toml"],
+        );
+        assert_eq!(contents(dir.path()), before, "--out {out}");
+    }
+    // The MTL alone: `--out m.glb` writes no m.mtl, but an OBJ export named like the mesh
+    // would write the scene's m.mtl beside it.
+    std::fs::rename(dir.path().join("m.obj"), dir.path().join("mesh.obj")).unwrap();
+    let scene = std::fs::read_to_string(dir.path().join("scene.toml")).unwrap();
+    std::fs::write(
+        dir.path().join("scene.toml"),
+        scene.replace("\"m.obj\"", "\"mesh.obj\""),
+    )
+    .unwrap();
+    let before = contents(dir.path());
+    refused(
+        dir.path(),
+        &["export", "scene.toml", "--out", "m.obj"],
+        1,
+        &["--out m.obj", "would overwrite m.mtl"],
+    );
+    assert_eq!(contents(dir.path()), before);
+}
+
+#[test]
+fn a_failed_measure_replaces_none_of_its_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = finished_run(dir.path());
+    std::fs::remove_file(run.join("misregistration.png")).unwrap();
+    std::fs::create_dir(run.join("misregistration.png")).unwrap();
+    let before = contents(dir.path());
+    refused(
+        dir.path(),
+        &["measure", "run", "--band", "9"],
+        1,
+        &["run/misregistration.png", "in the way"],
+    );
+    assert_eq!(
+        contents(dir.path()),
+        before,
+        "metrics.json or the EXR replaced"
+    );
+    assert_eq!(
+        listing(dir.path()).len(),
+        before.len() + 2,
+        "no staging left"
+    );
+}
+
+#[test]
+fn measure_refuses_samples_seethru_never_writes() {
+    use seethru::io::frame_files::{read_exr, write_exr};
+    let dir = tempfile::tempdir().unwrap();
+    let run = finished_run(dir.path());
+    let good_truth = std::fs::read(run.join("truth.exr")).unwrap();
+    let frame = read_exr(&run.join("truth.exr")).unwrap();
+    // The sky's P is NaN, with Z inf: accepted.
+    let sky = frame.depth.iter().position(|d| d.is_infinite()).unwrap();
+    assert!(frame.position[sky].x.is_nan(), "seethru's sky P is NaN");
+    type Edit = fn(&mut seethru::render::frame::Frame, usize);
+    let cases: [(&str, &str, Edit, &[&str]); 5] = [
+        (
+            "truth",
+            "P.X",
+            |f, i| f.position[i].x = f32::NAN,
+            &["NaN", "[-1e6, 1e6] m"],
+        ),
+        (
+            "seethru",
+            "P.Y",
+            |f, i| f.position[i].y = 1e38,
+            &["1e38", "[-1e6, 1e6] m"],
+        ),
+        (
+            "truth",
+            "R",
+            |f, i| f.color[i].x = f32::NAN,
+            &["NaN", "finite"],
+        ),
+        (
+            "occluded",
+            "Z",
+            |f, i| f.depth[i] = -1.0,
+            &["-1", "[0, inf] m"],
+        ),
+        (
+            "truth",
+            "N.Z",
+            |f, i| f.normal[i].z = f32::INFINITY,
+            &["inf", "[-1, 1]"],
+        ),
+    ];
+    for (view, channel, edit, words) in cases {
+        let path = run.join(format!("{view}.exr"));
+        let good = std::fs::read(&path).unwrap();
+        let mut bad = read_exr(&path).unwrap();
+        // The last pixel that shows an object (finite Z).
+        let hit = bad.depth.iter().rposition(|d| d.is_finite()).unwrap();
+        let (x, y) = (hit % bad.width as usize, hit / bad.width as usize);
+        let pixel = format!("pixel ({x}, {y})");
+        edit(&mut bad, hit);
+        write_exr(&bad, &path).unwrap();
+        let file = format!("run/{view}.exr");
+        let channel = format!("channel `{channel}`");
+        let mut all = vec![file.as_str(), channel.as_str(), pixel.as_str()];
+        all.extend_from_slice(words);
+        refused(dir.path(), &["measure", "run"], 1, &all);
+        std::fs::write(&path, good).unwrap();
+    }
+    assert_eq!(std::fs::read(run.join("truth.exr")).unwrap(), good_truth);
+    let (code, err) = run_in(dir.path(), &["measure", "run"]);
+    assert_eq!(code, 0, "restored, the run measures again: {err}");
+}
+
+#[test]
+fn measure_reads_the_scene_the_run_rendered_or_says_why_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = finished_run(dir.path());
+    // From inside the run folder: run.json records the scene's absolute path too.
+    let (code, err) = run_in(&run, &["measure", "."]);
+    assert_eq!(code, 0, "{err}");
+    let json = std::fs::read_to_string(run.join("run.json")).unwrap();
+    let value: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(value["scene"], "scene.toml");
+
+    // The scene edited since the run: refused, naming both files.
+    let scene = dir.path().join("scene.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(&scene, text.replace("radius = 1.0", "radius = 2.0")).unwrap();
+    let before = contents(dir.path());
+    refused(
+        dir.path(),
+        &["measure", "run"],
+        1,
+        &["scene.toml has changed since the run", "run/run.json"],
+    );
+    assert_eq!(contents(dir.path()), before);
+    std::fs::write(&scene, &text).unwrap();
+
+    // A run.json naming another scene: refused the same way.
+    std::fs::write(
+        dir.path().join("other.toml"),
+        text.replace("1.0, -10.0", "1.0, -9.0"),
+    )
+    .unwrap();
+    let other = std::fs::canonicalize(dir.path().join("other.toml")).unwrap();
+    let mut edited = value.clone();
+    edited["scene"] = "other.toml".into();
+    edited["scene_absolute"] = other.display().to_string().into();
+    std::fs::write(run.join("run.json"), edited.to_string()).unwrap();
+    refused(
+        dir.path(),
+        &["measure", "run"],
+        1,
+        &["other.toml has changed since the run", "run/run.json"],
+    );
+
+    // A scene that is gone: the error names the path as resolved.
+    std::fs::remove_file(dir.path().join("other.toml")).unwrap();
+    refused(
+        dir.path(),
+        &["measure", "run"],
+        1,
+        &[
+            &other.display().to_string(),
+            "run/run.json",
+            "`scene` = other.toml",
+        ],
+    );
+
+    // A run.json older than the hash: its `scene`, relative to the current folder.
+    let mut old = value.clone();
+    let object = old.as_object_mut().unwrap();
+    object.remove("scene_absolute");
+    object.remove("scene_hash");
+    std::fs::write(run.join("run.json"), old.to_string()).unwrap();
+    let (code, err) = run_in(dir.path(), &["measure", "run"]);
+    assert_eq!(code, 0, "{err}");
+}
+
+#[test]
+fn output_errors_name_the_users_path() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("scene.toml"), common::MINIMAL).unwrap();
+    std::fs::write(dir.path().join("f"), "a file").unwrap();
+    let before = listing(dir.path());
+    let mut args: Vec<&str> = RENDER.to_vec();
+    for (out, words) in [
+        ("f/sub", &["f/sub", "f is a file, not a folder"][..]),
+        ("f/a/b", &["f/a/b", "f is a file, not a folder"]),
+        ("/proc/self/nope", &["the output /proc/self/nope"]),
+    ] {
+        args[3] = out;
+        let err = refused(dir.path(), &args, 1, words);
+        assert!(!err.contains(".tmp-"), "{err}");
+    }
+    assert_eq!(listing(dir.path()), before);
+}

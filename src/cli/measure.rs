@@ -2,8 +2,9 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use seethru::io::run_dir::{read_measured_frames, read_run_json};
+use seethru::io::staged::StagedDir;
 use seethru::measure::holes::{hole_metrics, read_hole_mask};
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
@@ -33,8 +34,32 @@ impl Measure {
 /// `seethru measure`: the metrics of a run directory, from its saved EXRs.
 fn measure_command(dir: &Path, band: u32) -> Result<serde_json::Value> {
     let record = read_run_json(dir)?;
-    let scene = Scene::load(&record.scene)
-        .with_context(|| format!("the scene of {}", dir.join("run.json").display()))?;
+    let run_json = dir.join("run.json");
+    // `run` records the scene as given (relative to the folder it was started in) and
+    // absolute; older run.json files have only the first, read relative to this folder.
+    let scene_path = record
+        .scene_absolute
+        .clone()
+        .unwrap_or(record.scene.clone());
+    let scene = Scene::load(&scene_path).with_context(|| {
+        format!(
+            "the scene {} that {} names (`scene` = {})",
+            shown_absolute(&scene_path),
+            run_json.display(),
+            record.scene.display()
+        )
+    })?;
+    if let Some(recorded) = &record.scene_hash
+        && *recorded != scene.source_hash
+    {
+        bail!(
+            "{} has changed since the run that wrote {} (its content hash is {}, the run recorded {}): measure needs the scene the run rendered; run `seethru run` again",
+            shown_absolute(&scene_path),
+            run_json.display(),
+            scene.source_hash,
+            recorded
+        );
+    }
     let ctx = RenderContext::new(scene)?;
     let [truth, seethru, occluded] = read_measured_frames(dir)?;
     // The eye the run's views were rendered from (`--eyes left|right`), else the scene's.
@@ -49,6 +74,17 @@ fn measure_command(dir: &Path, band: u32) -> Result<serde_json::Value> {
         let fill = run["scene_model"]["holes"]["fill"].clone();
         metrics["holes"] = hole_metrics(&holes, &maps, &truth, &seethru, fill);
     }
-    write_metrics(dir, &maps, &truth, &metrics)?;
+    // Whole or not at all: staged beside the run folder, moved in when all are written.
+    let staged = StagedDir::new(dir)?;
+    write_metrics(staged.path(), &maps, &truth, &metrics)?;
+    staged.commit()?;
     Ok(metrics)
+}
+
+/// `path` made absolute for a message (as found from this folder), else as it is.
+fn shown_absolute(path: &Path) -> String {
+    std::path::absolute(path)
+        .unwrap_or_else(|_| path.to_path_buf())
+        .display()
+        .to_string()
 }

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use rayon::prelude::*;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_frame;
@@ -174,8 +174,8 @@ fn write_run(
     band: u32,
 ) -> Result<RunResult> {
     let result = run(ctx, options)?;
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("cannot create output directory {}", out.display()))?;
+    // `out` and its folders are created by the writes (io::atomic), under the lock the
+    // interrupt handler takes: never after its clean-up.
     let views = [
         ("truth", &result.truth),
         ("occluded", &result.occluded),

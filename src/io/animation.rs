@@ -2,10 +2,9 @@
 //! APNG but does not encode it; `png` is already the encoder under `image`'s PNG support).
 //! Viewers without APNG support show the first frame.
 
-use std::io::BufWriter;
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 
 use crate::io::atomic::write_atomically;
 
@@ -31,9 +30,8 @@ pub fn write_apng(
     // The delay as a fraction num/den of a second, den ≤ 65535.
     let den: u16 = 1000;
     let num = ((1000.0 / fps).round() as u16).max(1);
-    write_atomically(path, |tmp| {
-        let file = std::fs::File::create(tmp).context("create")?;
-        let mut encoder = png::Encoder::new(BufWriter::new(file), width, height);
+    write_atomically(path, |file| {
+        let mut encoder = png::Encoder::new(file, width, height);
         encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_animated(frames.len() as u32, 0)?;

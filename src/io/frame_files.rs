@@ -9,17 +9,19 @@ use glam::Vec3;
 
 use crate::io::atomic::write_atomically;
 use crate::render::frame::Frame;
-use crate::scene::limits::{MAX_PIXELS, MAX_RESOLUTION};
+use crate::scene::limits::{MAX_COORDINATE, MAX_PIXELS, MAX_RESOLUTION};
 use crate::util::color::encode_srgb8;
+use crate::util::number::short;
 use crate::util::sampling::hash_u32;
 
 /// Writes an RGB8 buffer as PNG.
 pub fn write_png(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<()> {
     let img =
         image::RgbImage::from_raw(width, height, rgb).context("image buffer has the wrong size")?;
-    write_atomically(path, |tmp| {
-        Ok(img.save_with_format(tmp, image::ImageFormat::Png)?)
-    })
+    write_atomically(
+        path,
+        |file| Ok(img.write_to(file, image::ImageFormat::Png)?),
+    )
 }
 
 /// The colour AOV as an 8-bit sRGB PNG (clamped to [0, 1]).
@@ -130,7 +132,7 @@ pub fn write_exr_channels(
         AnyChannels::sort(SmallVec::from_vec(channels)),
     );
     let image = Image::from_layer(layer);
-    write_atomically(path, |tmp| Ok(image.write().to_file(tmp)?))
+    write_atomically(path, |file| Ok(image.write().to_buffered(file)?))
 }
 
 /// Most channels an EXR may have to be read as a frame (seethru writes 17).
@@ -138,6 +140,7 @@ const MAX_EXR_CHANNELS: usize = 64;
 
 /// `path` opened for reading if it is a regular file (a device would be read for ever).
 fn open_input(path: &Path) -> Result<std::fs::File> {
+    crate::util::input_file::note_input(path);
     if let Some(why) = crate::util::input_file::not_a_file(path) {
         bail!("cannot read {}: {why}", path.display());
     }
@@ -243,7 +246,7 @@ pub fn read_exr_from<R: std::io::Read + std::io::Seek + Send>(
             .collect())
     };
     let [r, g, b, _] = channel::RGBA;
-    Ok(Frame {
+    let frame = Frame {
         width,
         height,
         color: vec3s([r, g, b])?,
@@ -253,7 +256,58 @@ pub fn read_exr_from<R: std::io::Read + std::io::Seek + Send>(
         normal: vec3s(channel::N)?,
         object_id: u32s(channel::OBJECT_ID)?,
         part_id: u32s(channel::PART_ID)?,
-    })
+    };
+    check_samples(&frame)?;
+    Ok(frame)
+}
+
+/// An error at the first sample seethru never writes, naming the channel, the pixel and what
+/// is admissible: colours are finite; `Z` and `camera_z` are distances in [0, inf] m (inf for
+/// the sky); `P` is a point of the world, each coordinate in [-1e6, 1e6] m, wherever `Z` is
+/// finite (the sky's `P` is NaN); `N` is a unit vector (zero for the sky).
+fn check_samples(frame: &Frame) -> Result<()> {
+    let world = MAX_COORDINATE as f32;
+    let at = |i: usize| (i % frame.width as usize, i / frame.width as usize);
+    let refuse = |name: &str, i: usize, value: f32, admissible: &str| -> Result<()> {
+        let (x, y) = at(i);
+        bail!(
+            "channel `{name}` at pixel ({x}, {y}) is {}: seethru writes {admissible}",
+            short(value as f64)
+        )
+    };
+    let [r, g, b, _] = channel::RGBA;
+    for i in 0..frame.color.len() {
+        let color = frame.color[i];
+        for (name, value) in [r, g, b].into_iter().zip(color.to_array()) {
+            if !value.is_finite() {
+                refuse(name, i, value, "a finite linear colour")?;
+            }
+        }
+        let depth = frame.depth[i];
+        for (name, value) in [(channel::Z, depth), (channel::CAMERA_Z, frame.camera_z[i])] {
+            if value.is_nan() || value < 0.0 {
+                refuse(name, i, value, "a distance in [0, inf] m (inf for the sky)")?;
+            }
+        }
+        if depth.is_finite() {
+            for (name, value) in channel::P.into_iter().zip(frame.position[i].to_array()) {
+                if value.is_nan() || value.abs() > world {
+                    refuse(
+                        name,
+                        i,
+                        value,
+                        "a world coordinate in [-1e6, 1e6] m where `Z` is finite (NaN only for the sky)",
+                    )?;
+                }
+            }
+        }
+        for (name, value) in channel::N.into_iter().zip(frame.normal[i].to_array()) {
+            if value.is_nan() || value.abs() > 1.001 {
+                refuse(name, i, value, "a unit vector, each component in [-1, 1]")?;
+            }
+        }
+    }
+    Ok(())
 }
 
 fn sample_type(samples: &FlatSamples) -> &'static str {

@@ -191,8 +191,8 @@ impl Figure {
     pub fn write(&self, dir: &Path, name: &str) -> Result<()> {
         let rgb = self.render()?;
         let img = image::RgbImage::from_raw(SIZE.0, SIZE.1, rgb).context("plot buffer size")?;
-        write_atomically(&dir.join(format!("{name}.png")), |tmp| {
-            Ok(img.save_with_format(tmp, image::ImageFormat::Png)?)
+        write_atomically(&dir.join(format!("{name}.png")), |file| {
+            Ok(img.write_to(file, image::ImageFormat::Png)?)
         })?;
         write_text(&dir.join(format!("{name}.svg")), &self.render_svg()?)?;
         write_text(&dir.join(format!("{name}.csv")), &self.csv())

@@ -6,13 +6,21 @@ use anyhow::{Context, Result, bail};
 
 use crate::io::frame_files::read_exr;
 use crate::render::frame::Frame;
+use crate::scene::limits::MAX_COORDINATE;
 use crate::util::input_file::read_input_text;
+use crate::util::number::{clip_long_numbers, short_list};
 
 /// What `measure` needs of a run.json.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RunRecord {
-    /// The scene file the run rendered, as the run was given it.
+    /// The scene file the run rendered, as the run was given it (relative to the folder the
+    /// run was started in).
     pub scene: PathBuf,
+    /// The same, absolute (`scene_absolute`; `None` in run.json files older than it).
+    pub scene_absolute: Option<PathBuf>,
+    /// The content hash of the scene file when the run read it (`scene_hash`, as
+    /// `util::input_file::content_hash`; `None` in older run.json files).
+    pub scene_hash: Option<String>,
     /// The eye the driver views were rendered from, world, metres (`eyes.view_world_m`;
     /// `None` in run.json files that predate two eyes: the scene's driver camera).
     pub view_eye: Option<[f64; 3]>,
@@ -35,17 +43,28 @@ pub fn parse_run_json(text: &str) -> Result<RunRecord> {
     };
     let view_eye = match object.get("eyes").and_then(|e| e.get("view_world_m")) {
         None => None,
-        Some(v) => Some(
-            serde_json::from_value::<[f64; 3]>(v.clone())
+        Some(v) => {
+            let range = "`eyes.view_world_m` must be 3 numbers in [-1e6, 1e6] m (the world)";
+            let p = serde_json::from_value::<[f64; 3]>(v.clone())
                 .ok()
-                .filter(|p| p.iter().all(|c| c.is_finite()))
-                .with_context(|| {
-                    format!("`eyes.view_world_m` must be 3 finite numbers, got {v}")
-                })?,
-        ),
+                .with_context(|| format!("{range}, got {}", clip_long_numbers(&v.to_string())))?;
+            if p.iter().any(|c| c.is_nan() || c.abs() > MAX_COORDINATE) {
+                bail!("{range}, got {}", short_list(&p));
+            }
+            Some(p)
+        }
+    };
+    let optional_text = |key: &str| -> Result<Option<String>> {
+        match object.get(key) {
+            None | Some(serde_json::Value::Null) => Ok(None),
+            Some(serde_json::Value::String(s)) if !s.is_empty() => Ok(Some(s.clone())),
+            Some(other) => bail!("`{key}` must be a non-empty string, got {other}"),
+        }
     };
     Ok(RunRecord {
         scene: PathBuf::from(scene),
+        scene_absolute: optional_text("scene_absolute")?.map(PathBuf::from),
+        scene_hash: optional_text("scene_hash")?,
         view_eye,
     })
 }
@@ -105,7 +124,15 @@ mod tests {
         for (text, words) in [
             (
                 r#"{"scene": "s.toml", "eyes": {"view_world_m": [1, 2]}}"#,
-                "must be 3 finite numbers",
+                "must be 3 numbers in [-1e6, 1e6] m",
+            ),
+            (
+                r#"{"scene": "s.toml", "eyes": {"view_world_m": [1e300, 1.2, 0]}}"#,
+                "must be 3 numbers in [-1e6, 1e6] m (the world), got [1e300, 1.2, 0]",
+            ),
+            (
+                r#"{"scene": "s.toml", "scene_hash": 3}"#,
+                "`scene_hash` must be",
             ),
             ("", "invalid JSON"),
             ("[1]", "expected a JSON object"),

@@ -8,22 +8,26 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
-use crate::io::atomic::{remove_stale, temporary, track};
+use crate::io::atomic::{create_folders, in_flight, remove_stale, temporary, track};
 
 /// A staging folder for the output directory `target`; dropped without [`commit`], it is
-/// removed with everything in it, and so are the parent folders it created.
+/// removed with everything in it, and so are the folders it created.
 ///
 /// [`commit`]: StagedDir::commit
 pub struct StagedDir {
     target: PathBuf,
+    /// The target as the caller named it (`` for the current folder), for paths in messages.
+    shown: PathBuf,
     staging: PathBuf,
-    /// The topmost parent folder of `target` that this created (removed on failure).
-    created_parent: Option<PathBuf>,
+    /// The topmost folder that this created (removed on failure, if empty), and the innermost
+    /// one the removal starts from.
+    created: Option<(PathBuf, PathBuf)>,
     committed: bool,
 }
 
 impl StagedDir {
-    /// Stages the output directory `target`, which must be a directory or not exist yet.
+    /// Stages the output directory `target`, which must be a directory or not exist yet. The
+    /// staging folder lies beside it.
     pub fn new(target: &Path) -> Result<Self> {
         // `.` and `..` name no folder of their own: stage beside the folder they are.
         let resolved;
@@ -46,33 +50,67 @@ impl StagedDir {
             .with_context(|| format!("not a directory path: {}", target.display()))?
             .to_string_lossy()
             .to_string();
-        let parent = target.parent().filter(|p| !p.as_os_str().is_empty());
-        let created_parent = parent.and_then(|p| {
-            p.ancestors()
-                .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
-                .last()
-                .map(Path::to_path_buf)
-        });
-        if let Some(parent) = parent {
-            std::fs::create_dir_all(parent)
-                .with_context(|| format!("cannot create the folder {}", parent.display()))?;
+        let parent = target.parent().unwrap_or(Path::new(""));
+        Self::create(target, parent, &name)
+    }
+
+    /// Stages files that go into the folder `folder` (created if missing), for an output
+    /// named `name` there: the staging folder `.<name>.tmp-<pid>` lies inside `folder`, so
+    /// the files move into place by renames on one file system, and a file beside the
+    /// output (a `.mtl`, an assets folder) is staged with it.
+    pub fn inside(folder: &Path, name: &str) -> Result<Self> {
+        let target = if folder.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            folder
+        };
+        if target.exists() && !target.is_dir() {
+            bail!("{} is a file, not a folder", target.display());
         }
-        remove_stale(target, &name);
-        let staging = temporary(target, &name, std::process::id());
-        let _ = std::fs::remove_dir_all(&staging);
-        track(&staging, true);
-        let staged = Self {
+        // `commit` moves the files into the folder itself.
+        let mut staged = Self::create(target, target, name)?;
+        staged.shown = folder.to_path_buf();
+        in_flight().stage_as(&staged.staging, folder);
+        Ok(staged)
+    }
+
+    /// Creates `parent` (where missing) and the staging folder `.<name>.tmp-<pid>` in it,
+    /// under the registry's lock: no staging folder is created once an interrupt began.
+    fn create(target: &Path, parent: &Path, name: &str) -> Result<Self> {
+        let created = parent
+            .ancestors()
+            .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+            .last()
+            .map(|top| (top.to_path_buf(), parent.to_path_buf()));
+        // Declared before the lock: on an error, dropped (and cleaned up) after its release.
+        let mut staged = Self {
             target: target.to_path_buf(),
-            staging,
-            created_parent,
+            shown: target.to_path_buf(),
+            staging: temporary(&parent.join(name), name, std::process::id()),
+            created: None,
             committed: false,
         };
-        std::fs::create_dir(&staged.staging).with_context(|| {
-            format!(
-                "cannot create the staging folder {}",
-                staged.staging.display()
+        let mut state = in_flight();
+        state.check_running()?;
+        remove_stale(&parent.join(name), name);
+        let _ = std::fs::remove_dir_all(&staged.staging);
+        create_folders(&state, parent)
+            .with_context(|| format!("cannot write the output {}", target.display()))?;
+        staged.created = created;
+        std::fs::create_dir(&staged.staging).map_err(|e| {
+            anyhow::anyhow!(
+                "cannot write the output {}: cannot create a folder in {}: {e}",
+                target.display(),
+                if parent.as_os_str().is_empty() {
+                    Path::new(".")
+                } else {
+                    parent
+                }
+                .display()
             )
         })?;
+        state.track(&staged.staging, true);
+        state.stage_as(&staged.staging, target);
         Ok(staged)
     }
 
@@ -81,9 +119,22 @@ impl StagedDir {
         &self.staging
     }
 
+    /// Where the staged file `staged` (a path under [`path`]) goes on [`commit`].
+    ///
+    /// [`path`]: StagedDir::path
+    /// [`commit`]: StagedDir::commit
+    pub fn final_path(&self, staged: &Path) -> PathBuf {
+        staged
+            .strip_prefix(&self.staging)
+            .map_or_else(|_| staged.to_path_buf(), |rest| self.shown.join(rest))
+    }
+
     /// Moves every staged file into the output directory (replacing files of the same name)
-    /// and removes the staging folder. Nothing is moved unless every file can be.
+    /// and removes the staging folder. Nothing is moved unless every file can be. The moves
+    /// hold the registry's lock: an interrupt comes before them (nothing moved) or after.
     pub fn commit(mut self) -> Result<()> {
+        let mut state = in_flight();
+        state.check_running()?;
         if !self.target.exists() {
             std::fs::rename(&self.staging, &self.target).with_context(|| {
                 format!("cannot move the output into {}", self.target.display())
@@ -93,8 +144,7 @@ impl StagedDir {
             plan_moves(&self.staging, &self.target, &mut moves)?;
             for (from, to) in moves {
                 if let (Some(dir), Some(name)) = (to.parent(), to.file_name()) {
-                    std::fs::create_dir_all(dir)
-                        .with_context(|| format!("cannot create {}", dir.display()))?;
+                    create_folders(&state, dir)?;
                     remove_stale(&to, &name.to_string_lossy());
                 }
                 std::fs::rename(&from, &to)
@@ -103,7 +153,7 @@ impl StagedDir {
             let _ = std::fs::remove_dir_all(&self.staging);
         }
         self.committed = true;
-        track(&self.staging, false);
+        state.track(&self.staging, false);
         Ok(())
     }
 }
@@ -144,9 +194,9 @@ impl Drop for StagedDir {
         }
         let _ = std::fs::remove_dir_all(&self.staging);
         track(&self.staging, false);
-        // The parent folders this created, innermost first, each only if it is empty.
-        if let (Some(top), Some(parent)) = (&self.created_parent, self.target.parent()) {
-            for folder in parent.ancestors() {
+        // The folders this created, innermost first, each only if it is empty.
+        if let Some((top, innermost)) = &self.created {
+            for folder in innermost.ancestors() {
                 if std::fs::remove_dir(folder).is_err() || folder == top {
                     break;
                 }

@@ -319,6 +319,7 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
     }
     Ok(Scene {
         path: "generated".into(),
+        source_hash: String::new(),
         sun: Sun {
             direction: DVec3::new(0.3, 0.8, 0.5).normalize(),
             color: [1.0; 3],

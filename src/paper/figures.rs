@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use plotters::prelude::*;
 
 use crate::analysis::paper::{CropParams, ForeshorteningParams, OcclusionParams, Side};
@@ -182,7 +182,6 @@ pub fn physical_figure() -> Figure {
 
 /// Writes the four figures and their CSVs into `dir`.
 pub fn write_all(dir: &Path) -> Result<Vec<String>> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let figures = [
         ("fig3_cutting_ratio", cutting_ratio_figure()),
         ("fig4_occlusion", occlusion_figure()),

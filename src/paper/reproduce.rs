@@ -72,7 +72,6 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
             spp: 4,
         }
     };
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let base = Scene::load(scene_path)?;
     let mut cases = Vec::new();
     let mut equal = Vec::new();
@@ -84,7 +83,6 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
         for theta in [30.0, 63.5] {
             let name = format!("car {car_label} (≈{distance} m), θ_F = {theta}°, D = 1 m");
             let dir = format!("car_{car_label}_theta{}", theta as u32);
-            std::fs::create_dir_all(out.join(&dir))?;
             let scene = das_case(&base, distance, 1.0, theta)?;
             let ctx = RenderContext::new(scene)?;
             let options = RunOptions {
@@ -136,7 +134,6 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
     ];
     let mut ratios: Vec<(String, String, RatioResult)> = Vec::new();
     for (name, dir, setup) in setups {
-        std::fs::create_dir_all(out.join(dir))?;
         let (r, frames) = measure_ratio_with_frames(&setup, sizes.ratio, &Compensation::default())?;
         frame_png(&frames.truth, &out.join(dir).join("truth.png"))?;
         frame_png(&frames.seethru, &out.join(dir).join("seethru.png"))?;

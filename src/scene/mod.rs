@@ -201,6 +201,9 @@ impl Obstacle {
 pub struct Scene {
     /// The scene file this was read from.
     pub path: PathBuf,
+    /// The content hash of that file's text (`util::input_file::content_hash`), recorded by
+    /// `run` so that `measure` can tell the scene changed.
+    pub source_hash: String,
     pub sun: Sun,
     pub sky: Sky,
     pub materials: Vec<Material>,

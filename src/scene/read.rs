@@ -53,6 +53,7 @@ impl Scene {
         root.finish()?;
         Ok(Scene {
             path: file.path.clone(),
+            source_hash: file.content_hash(),
             sun,
             sky,
             materials,

@@ -69,6 +69,11 @@ impl SourceFile {
         Ok(Self::from_text(path, text))
     }
 
+    /// The content hash of the text (`util::input_file::content_hash`).
+    pub fn content_hash(&self) -> String {
+        crate::util::input_file::content_hash(self.text.as_bytes())
+    }
+
     pub fn from_text(path: &Path, text: String) -> Self {
         let line_starts = std::iter::once(0)
             .chain(text.match_indices('\n').map(|(i, _)| i + 1))

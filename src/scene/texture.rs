@@ -19,6 +19,7 @@ pub struct Texture {
 impl Texture {
     /// Loads an sRGB PNG of at most [`MAX_RESOLUTION`] pixels per side.
     pub fn load(path: &Path) -> Result<Texture> {
+        crate::util::input_file::note_input(path);
         let decode = || -> Result<image::DynamicImage> {
             let mut reader = image::ImageReader::open(path)?.with_guessed_format()?;
             let mut limits = image::Limits::default();

@@ -29,6 +29,8 @@ pub fn report(
     let [fw, fh] = crop.frontal_size;
     json!({
         "scene": scene.path.display().to_string(),
+        "scene_absolute": scene.path.canonicalize().ok().map(|p| p.display().to_string()),
+        "scene_hash": (!scene.source_hash.is_empty()).then_some(&scene.source_hash),
         "options": {
             "method": options.method,
             "d2": match options.d2 { WorkingDistance::Infinity => json!("inf"), WorkingDistance::Auto => json!("auto"), WorkingDistance::Metres(m) => json!(m) },

@@ -4,7 +4,53 @@
 //! and again while reading (a file can grow, and `/proc` files report 0).
 
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, PoisonError};
+
+/// Every input file this process has opened, so that a command can refuse to write over one
+/// of its inputs.
+static INPUTS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Records `path` as an input of this process (readers outside [`read_input`] call it).
+pub fn note_input(path: &Path) {
+    let mut inputs = INPUTS.lock().unwrap_or_else(PoisonError::into_inner);
+    if !inputs.iter().any(|p| p == path) {
+        inputs.push(path.to_path_buf());
+    }
+}
+
+/// The input `path` is, if it is one this process has read (the same file, under whatever
+/// name: links and `..` included).
+pub fn input_at(path: &Path) -> Option<PathBuf> {
+    let inputs = INPUTS.lock().unwrap_or_else(PoisonError::into_inner);
+    inputs.iter().find(|input| same_file(input, path)).cloned()
+}
+
+/// Whether `a` and `b` are one existing file.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) else {
+        return false;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        ma.dev() == mb.dev() && ma.ino() == mb.ino()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (ma, mb);
+        matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
+    }
+}
+
+/// A 64-bit FNV-1a hash of `bytes`, as 16 hex digits: a content fingerprint (to tell that a
+/// file changed, not against an adversary).
+pub fn content_hash(bytes: &[u8]) -> String {
+    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    });
+    format!("{hash:016x}")
+}
 
 /// A size in bytes for a message: `64 MiB`, `1 GiB`, `812 bytes`.
 pub fn bytes_text(bytes: u64) -> String {
@@ -38,6 +84,7 @@ pub fn not_a_file(path: &Path) -> Option<String> {
 /// The bytes of the regular file `path`, at most `limit` of them; the error says why in words
 /// (without the path, which the caller names as the user wrote it).
 pub fn read_input(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+    note_input(path);
     if let Some(why) = not_a_file(path) {
         return Err(std::io::Error::other(why));
     }

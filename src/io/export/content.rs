@@ -4,6 +4,7 @@
 //! `mitsuba.rs`) turn it into files.
 
 use std::collections::BTreeMap;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
@@ -404,11 +405,10 @@ pub fn assets_dir(path: &Path) -> PathBuf {
     path.with_file_name(format!("{stem}_assets"))
 }
 
-/// Creates `dir` and writes `bytes` to `dir/name` (atomically); returns the file's path.
+/// Writes `bytes` to `dir/name` (atomically, creating `dir`); returns the file's path.
 pub fn write_asset(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let path = dir.join(name);
-    write_atomically(&path, |tmp| Ok(std::fs::write(tmp, bytes)?))?;
+    write_atomically(&path, |file| Ok(file.write_all(bytes)?))?;
     Ok(path)
 }
 

@@ -3,6 +3,7 @@
 //! materials (linear base colour, the texture embedded as PNG), the three cameras, the display
 //! as a node of its own, and the sun as a KHR_lights_punctual directional light.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
@@ -285,6 +286,6 @@ fn glb(doc: &Value, mut bin: Vec<u8>) -> Vec<u8> {
 pub fn write_glb(content: &ExportScene, path: &Path) -> Result<Vec<PathBuf>> {
     let (doc, bin) = document(content)?;
     let bytes = glb(&doc, bin);
-    write_atomically(path, |tmp| Ok(std::fs::write(tmp, bytes)?))?;
+    write_atomically(path, |file| Ok(file.write_all(&bytes)?))?;
     Ok(vec![path.to_path_buf()])
 }

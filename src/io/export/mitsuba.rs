@@ -14,7 +14,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use glam::{DVec3, Vec3};
 
 use crate::geometry::camera::Camera;
@@ -159,14 +159,13 @@ fn write_exr(
     height: usize,
     texel: impl Fn(usize, usize) -> Vec3 + Sync,
 ) -> Result<()> {
-    use exr::prelude::write_rgb_file;
-    write_atomically(path, |tmp| {
-        write_rgb_file(tmp, width, height, |x, y| {
-            let c = texel(x, y);
-            (c.x, c.y, c.z)
-        })
-        .with_context(|| format!("cannot write {}", path.display()))
-    })
+    use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+    let channels = SpecificChannels::rgb(|Vec2(x, y)| {
+        let c = texel(x, y);
+        (c.x, c.y, c.z)
+    });
+    let image = Image::from_channels((width, height), channels);
+    write_atomically(path, |file| Ok(image.write().to_buffered(file)?))
 }
 
 /// The emitters and the materials: what every scene file of the export shares.
@@ -175,8 +174,6 @@ fn lights_and_materials(
     assets: &Path,
     files: &mut Vec<PathBuf>,
 ) -> Result<String> {
-    std::fs::create_dir_all(assets)
-        .with_context(|| format!("cannot create {}", assets.display()))?;
     let assets_name = xml_escape(&assets.file_name().unwrap_or_default().to_string_lossy());
     let light = &content.lighting;
     let sky_path = assets.join("sky.exr");

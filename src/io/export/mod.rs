@@ -16,6 +16,7 @@ use serde_json::json;
 use crate::geometry::camera::Camera;
 use crate::io::atomic::write_text;
 use crate::io::export::content::{ExportScene, display_json};
+use crate::io::staged::StagedDir;
 use crate::scene::Scene;
 use crate::scene::world::World;
 
@@ -113,23 +114,63 @@ pub fn export(
         ),
     };
     let content = ExportScene::new(scene, world)?;
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    }
+    // Every file is written into a staging folder inside --out's folder and moved into place
+    // when all are written: a failure leaves no file, and no folder the export created.
+    let name = path
+        .file_name()
+        .with_context(|| format!("--out {} names no file", path.display()))?;
+    let staged = StagedDir::inside(
+        path.parent().unwrap_or(Path::new("")),
+        &name.to_string_lossy(),
+    )?;
+    let staged_path = staged.path().join(name);
     let mut files = match format {
-        ExportFormat::Gltf => crate::io::export::gltf::write_glb(&content, path)?,
-        ExportFormat::Obj => crate::io::export::obj::write_obj(&content, path)?,
-        ExportFormat::Mitsuba => crate::io::export::mitsuba::write_mitsuba(&content, path)?,
+        ExportFormat::Gltf => crate::io::export::gltf::write_glb(&content, &staged_path)?,
+        ExportFormat::Obj => crate::io::export::obj::write_obj(&content, &staged_path)?,
+        ExportFormat::Mitsuba => crate::io::export::mitsuba::write_mitsuba(&content, &staged_path)?,
     };
-    let cameras_path = path.with_extension("cameras.json");
+    let cameras_path = staged_path.with_extension("cameras.json");
     write_text(
         &cameras_path,
         &serde_json::to_string_pretty(&cameras_json(scene))?,
     )?;
     files.push(cameras_path);
+    let files: Vec<PathBuf> = files.iter().map(|f| staged.final_path(f)).collect();
+    refuse_inputs(scene, path, &staged)?;
+    staged.commit()?;
     Ok(Exported {
         format,
         triangles: content.triangle_count(),
         files,
     })
+}
+
+/// An error where a file the export staged would replace one of its inputs (the scene file,
+/// a mesh, an MTL, a texture): `export scene.toml --out m.obj` must not overwrite the scene's
+/// m.obj or its m.mtl.
+fn refuse_inputs(scene: &Scene, out: &Path, staged: &StagedDir) -> Result<()> {
+    let mut pending = vec![staged.path().to_path_buf()];
+    while let Some(dir) = pending.pop() {
+        let entries =
+            std::fs::read_dir(&dir).with_context(|| format!("cannot read {}", dir.display()))?;
+        for entry in entries {
+            let entry = entry?;
+            let staged_file = entry.path();
+            if entry.file_type()?.is_dir() {
+                pending.push(staged_file);
+                continue;
+            }
+            let file = staged.final_path(&staged_file);
+            if let Some(input) = crate::util::input_file::input_at(&file) {
+                bail!(
+                    "--out {}: the export would overwrite {}, an input of the scene {} (read as {}); name another --out",
+                    out.display(),
+                    file.display(),
+                    scene.path.display(),
+                    input.display()
+                );
+            }
+        }
+    }
+    Ok(())
 }
