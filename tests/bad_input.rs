@@ -166,34 +166,62 @@ fn numbers_in_messages_are_short_and_ranges_run_low_to_high() {
 #[test]
 fn every_sweep_parameter_refuses_values_outside_its_documented_range() {
     use seethru::measure::sweep_grid::{PARAMETERS, parse_param};
-    // (name, documented low, low included, high): the ranges of PARAMETERS' descriptions.
+    // (name, low, high, unit): the ranges of the scene keys and options each parameter sets
+    // (camera.frontal.half_angle_deg, obstacle.width, lengths of the scene, the world,
+    // --head-bias-cm, image sides), both ends included. Tiny positive values (1e-300, 5e-324)
+    // wrote rows of NaN for θ_F and the display width.
     let documented = |name: &str| match name {
-        "theta_f" => (0.0, false, 89.0),
-        "d2" => (0.0, false, 1e6),
-        "display_width" => (0.0, false, 100.0),
-        "eye_x" | "eye_z" => (-1e6, true, 1e6),
-        "head_bias_x_cm" => (-500.0, true, 500.0),
-        "frontal_width" => (1.0, true, 16384.0),
+        "theta_f" => (0.01, 89.0, "degrees", "[0.01, 89]"),
+        "d2" => (1e-6, 1e6, "m", "[1e-6, 1e6]"),
+        "display_width" => (1e-6, 100.0, "m", "[1e-6, 100]"),
+        "eye_x" | "eye_z" => (-1e6, 1e6, "m", "[-1e6, 1e6]"),
+        "head_bias_x_cm" => (-500.0, 500.0, "cm", "[-500, 500]"),
+        "frontal_width" => (1.0, 16384.0, "pixels", "[1, 16384]"),
         other => panic!("`{other}` is not in this test"),
     };
     for (name, description) in PARAMETERS {
-        let (lo, lo_in, hi) = documented(name);
-        for (written, x) in [
-            ("nan", f64::NAN),
-            ("-inf", f64::NEG_INFINITY),
-            ("-1", -1.0),
-            ("0", 0.0),
-            ("1", 1.0),
-            ("1e300", 1e300),
-        ] {
-            let admissible = (x > lo || (lo_in && x == lo)) && x <= hi;
+        let (lo, hi, unit, range) = documented(name);
+        assert!(
+            description.contains(range),
+            "{name}: {description} vs {range}"
+        );
+        // One past each end: the next integer, or 0.1 % beyond.
+        let past = |x: f64, towards: f64| {
+            if name == "frontal_width" {
+                x + towards
+            } else {
+                x + towards * x.abs() * 1e-3
+            }
+        };
+        let cases = [
+            (format!("{lo}"), lo),
+            (format!("{hi}"), hi),
+            (format!("{}", past(lo, -1.0)), past(lo, -1.0)),
+            (format!("{}", past(hi, 1.0)), past(hi, 1.0)),
+            ("0".into(), 0.0),
+            ("-1".into(), -1.0),
+            ("1e-300".into(), 1e-300),
+            ("5e-324".into(), 5e-324),
+            ("nan".into(), f64::NAN),
+            ("-inf".into(), f64::NEG_INFINITY),
+            ("1e300".into(), 1e300),
+        ];
+        for (written, x) in cases {
+            let admissible = x >= lo && x <= hi && (name != "frontal_width" || x.fract() == 0.0);
             match parse_param(&format!("{name}={written}")) {
                 Ok(_) => assert!(admissible, "{name}={written} accepted ({description})"),
                 Err(e) => {
                     let shown = format!("{e:#}");
                     assert!(!admissible, "{name}={written} refused: {shown}");
+                    let shown_range = format!(
+                        "[{}, {}] {unit}",
+                        seethru::util::number::short(lo),
+                        seethru::util::number::short(hi)
+                    );
                     assert!(
-                        !shown.contains('\n') && (shown.contains(name) || shown.contains(written)),
+                        !shown.contains('\n')
+                            && shown.starts_with(&format!("{name} = "))
+                            && shown.contains(&shown_range),
                         "{shown}"
                     );
                 }
@@ -215,7 +243,7 @@ fn every_sweep_parameter_refuses_values_outside_its_documented_range() {
             "s.csv",
         ],
         1,
-        &["display_width = 1e300", "(0, 100] m"],
+        &["display_width = 1e300", "[1e-6, 100] m"],
     );
     refused(
         dir.path(),
@@ -246,6 +274,202 @@ fn every_sweep_parameter_refuses_values_outside_its_documented_range() {
         &["`eye_x` is given twice"],
     );
     assert_eq!(listing(dir.path()), ["scene.toml"]);
+}
+
+/// Runs seethru in `dir` under a watchdog of 60 s (killed past it); (exit code, stderr).
+fn run_with_watchdog(dir: &std::path::Path, args: &[&str]) -> (i32, String) {
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_seethru"))
+        .arg("--quiet")
+        .args(args)
+        .current_dir(dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > std::time::Duration::from_secs(60) {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            panic!("{args:?} still running after 60 s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let out = child.wait_with_output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+#[test]
+fn sweep_grids_past_the_limit_and_repeated_values_are_refused_before_any_work() {
+    let dir = scratch("", &[]);
+    // 401 × 401 = 160 801 configurations, past the limit of 100 000 (the audit's 6·10⁹ ran out
+    // of memory): refused at once, naming each count and the product.
+    let (code, err) = run_with_watchdog(
+        dir.path(),
+        &[
+            "sweep",
+            "scene.toml",
+            "--width",
+            "8",
+            "--param",
+            "theta_f=40:80:0.1",
+            "--param",
+            "eye_x=0:0.4:0.001",
+            "--out",
+            "s.csv",
+        ],
+    );
+    assert_eq!(code, 1, "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains(
+            "theta_f 401 × eye_x 401 = 160801 configurations, more than the limit of 100000"
+        ),
+        "{err}"
+    );
+    // The same value twice computed the same configuration twice.
+    for (spec, words) in [
+        ("d2=1,1", "d2: the value 1 is given twice"),
+        ("d2=5,5,5", "d2: the value 5 is given twice"),
+        ("d2=inf,infinity", "d2: infinity is the value inf again"),
+        ("theta_f=30,30.0", "theta_f: 30.0 is the value 30 again"),
+    ] {
+        refused(
+            dir.path(),
+            &["sweep", "scene.toml", "--param", spec, "--out", "s.csv"],
+            1,
+            &[words],
+        );
+    }
+    assert_eq!(listing(dir.path()), ["scene.toml"]);
+    // Spaces around values are ignored, as around every number of the command line
+    // (`--width ' 5'`): `d2= 5` is `d2=5`, and resumes its CSV.
+    let (code, err) = run_in(
+        dir.path(),
+        &[
+            "sweep",
+            "scene.toml",
+            "--width",
+            "8",
+            "--param",
+            "d2=5",
+            "--out",
+            "s.csv",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let first = std::fs::read_to_string(dir.path().join("s.csv")).unwrap();
+    for spec in ["d2= 5", "d2=5 ", " d2 = 5.0"] {
+        let (code, err) = run_in(
+            dir.path(),
+            &[
+                "sweep",
+                "scene.toml",
+                "--width",
+                "8",
+                "--param",
+                spec,
+                "--out",
+                "s.csv",
+            ],
+        );
+        assert_eq!(code, 0, "{spec}: {err}");
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("s.csv")).unwrap(),
+            first,
+            "{spec}"
+        );
+    }
+    let (code, err) = run_in(
+        dir.path(),
+        &[
+            "sweep",
+            "scene.toml",
+            "--width",
+            "8",
+            "--param",
+            "theta_f= 40 : 60 : 20",
+            "--out",
+            "t.csv",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+}
+
+#[test]
+fn sweep_outputs_that_are_no_file_and_csvs_of_other_sweeps_are_named() {
+    let dir = scratch("", &[]);
+    std::fs::create_dir(dir.path().join("folder")).unwrap();
+    for (out, words) in [
+        ("folder", vec!["--out folder: it is a folder, not a file"]),
+        (
+            "new/",
+            vec!["--out new/: names a folder, not a file", "new/sweep.csv"],
+        ),
+        (
+            "/dev/null",
+            vec!["--out /dev/null: it is not a regular file"],
+        ),
+    ] {
+        refused(
+            dir.path(),
+            &["sweep", "scene.toml", "--param", "d2=5", "--out", out],
+            1,
+            &words,
+        );
+        refused(
+            dir.path(),
+            &["sweep-merge", "scene.toml", "--out", out],
+            1,
+            &words,
+        );
+    }
+    // clap refuses an empty --out (the library refuses it too: `--out is empty`).
+    refused(
+        dir.path(),
+        &["sweep", "scene.toml", "--param", "d2=5", "--out", ""],
+        2,
+        &["'--out <OUT>'"],
+    );
+    assert_eq!(listing(dir.path()), ["folder", "scene.toml"]);
+    // A CSV of another sweep, or an empty one: both headers are named, up to where they
+    // differ.
+    std::fs::write(
+        dir.path().join("other.csv"),
+        "index,theta_f,misregistration_mean_arcmin\n",
+    )
+    .unwrap();
+    refused(
+        dir.path(),
+        &[
+            "sweep",
+            "scene.toml",
+            "--param",
+            "d2=5",
+            "--out",
+            "other.csv",
+        ],
+        1,
+        &[
+            "other.csv exists with other columns: it has the columns `index,theta_f,…` (3), expected `index,d2,…` (21): column 2 is `theta_f` where `d2` belongs",
+        ],
+    );
+    std::fs::write(dir.path().join("empty.csv"), "").unwrap();
+    refused(
+        dir.path(),
+        &[
+            "sweep",
+            "scene.toml",
+            "--param",
+            "d2=5",
+            "--out",
+            "empty.csv",
+        ],
+        1,
+        &["empty.csv exists but is empty (no header; expected `index,d2,…` (21))"],
+    );
 }
 
 #[test]

@@ -2,6 +2,7 @@
 
 mod common;
 
+use common::refusal::{refused, run_in, scratch};
 use seethru::measure::{
     sweep::{SweepOptions, merge_parts, sweep},
     sweep_grid::parse_param,
@@ -9,6 +10,219 @@ use seethru::measure::{
 };
 use seethru::render::settings::resized;
 use seethru::system::options::HeadSource;
+
+/// A sweep of the minimal scene in `dir`, as the command line runs it; panics on failure.
+fn sweep_in(dir: &std::path::Path, args: &[&str]) -> String {
+    let mut all = vec!["sweep", "scene.toml", "--width", "16"];
+    all.extend_from_slice(args);
+    let (code, err) = run_in(dir, &all);
+    assert_eq!(code, 0, "{all:?}: {err}");
+    err
+}
+
+#[test]
+fn resume_refuses_rows_computed_with_other_settings_or_another_scene() {
+    // The audit's case: a CSV made at one width (or spp, band, head, scene) and resumed with
+    // another printed `computed 0 configurations` and kept the old rows as the new sweep's.
+    let dir = scratch("", &[]);
+    let grid = [
+        "--param",
+        "theta_f=30,40",
+        "--param",
+        "d2=2,5",
+        "--out",
+        "s.csv",
+    ];
+    sweep_in(dir.path(), &grid);
+    let csv = dir.path().join("s.csv");
+    let before = std::fs::read_to_string(&csv).unwrap();
+    for (flag, value, was) in [
+        ("--width", "24", "16"),
+        ("--spp", "2", "1"),
+        ("--band", "9", "5"),
+        ("--head", "estimated", "oracle"),
+    ] {
+        let mut args = vec!["sweep", "scene.toml"];
+        if flag != "--width" {
+            args.extend_from_slice(&["--width", "16"]);
+        }
+        args.extend_from_slice(&[flag, value]);
+        args.extend_from_slice(&grid);
+        let words = format!("s.csv:2: computed with {flag} {was}, this sweep has {flag} {value}");
+        refused(dir.path(), &args, 1, &[&words]);
+        assert_eq!(std::fs::read_to_string(&csv).unwrap(), before, "{flag}");
+    }
+    // Another scene: the same file with the ball moved; the same scene from another folder
+    // (a copy of the file elsewhere) resumes.
+    let scene = std::fs::read_to_string(dir.path().join("scene.toml")).unwrap();
+    std::fs::create_dir(dir.path().join("copy")).unwrap();
+    std::fs::write(dir.path().join("copy/scene.toml"), &scene).unwrap();
+    let mut args = vec!["sweep", "copy/scene.toml", "--width", "16"];
+    args.extend_from_slice(&grid);
+    let (code, err) = run_in(dir.path(), &args);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), before);
+    let moved = scene.replace(
+        "translate = [0.0, 1.0, -10.0]",
+        "translate = [0.5, 1.0, -10.0]",
+    );
+    assert_ne!(moved, scene);
+    std::fs::write(dir.path().join("copy/scene.toml"), moved).unwrap();
+    refused(
+        dir.path(),
+        &args,
+        1,
+        &["s.csv:2: computed with scene_hash ", "another scene"],
+    );
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), before);
+}
+
+#[test]
+fn resume_refuses_impossible_cells_and_keeps_undefined_metrics() {
+    let dir = scratch("", &[]);
+    // A display of 1e-6 m covers no driver pixel: its metrics are undefined, written NaN.
+    let grid = ["--param", "display_width=1e-6,0.3", "--out", "s.csv"];
+    sweep_in(dir.path(), &grid);
+    let csv = dir.path().join("s.csv");
+    let good = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = good.lines().collect();
+    assert!(lines[1].contains(",NaN,"), "{}", lines[1]);
+    let err = sweep_in(dir.path(), &grid);
+    assert!(err.is_empty(), "{err}");
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), good);
+    let header: Vec<&str> = lines[0].split(',').collect();
+    for (column, cell, range) in [
+        ("misregistration_mean_arcmin", "-1", "[0, 10800]"),
+        ("misregistration_mean_arcmin", "inf", "[0, 10800]"),
+        ("psnr_db", "1e300", "[0, 200]"),
+        ("coverage", "-1", "[0, 1]"),
+        ("coverage", "1e300", "[0, 1]"),
+        ("missing_fraction", "x", "[0, 1]"),
+        ("R1", "inf", "a finite number"),
+    ] {
+        let at = header.iter().position(|c| *c == column).unwrap();
+        let mut row: Vec<&str> = lines[2].split(',').collect();
+        row[at] = cell;
+        let text = format!("{}\n{}\n{}\n", lines[0], lines[1], row.join(","));
+        std::fs::write(&csv, &text).unwrap();
+        let mut args = vec!["sweep", "scene.toml", "--width", "16"];
+        args.extend_from_slice(&grid);
+        refused(
+            dir.path(),
+            &args,
+            1,
+            &["s.csv:3: ", column, range, "delete the row"],
+        );
+        assert_eq!(std::fs::read_to_string(&csv).unwrap(), text);
+    }
+}
+
+#[test]
+fn resume_refuses_to_drop_rows_and_keeps_them_in_a_grown_grid() {
+    let dir = scratch("", &[]);
+    sweep_in(
+        dir.path(),
+        &[
+            "--param",
+            "theta_f=30,40",
+            "--param",
+            "d2=2,5",
+            "--out",
+            "s.csv",
+        ],
+    );
+    let csv = dir.path().join("s.csv");
+    let before = std::fs::read_to_string(&csv).unwrap();
+    // Fewer values: the rows of θ_F = 40 would be lost.
+    let args = [
+        "sweep",
+        "scene.toml",
+        "--width",
+        "16",
+        "--param",
+        "theta_f=30",
+        "--param",
+        "d2=2,5",
+        "--out",
+        "s.csv",
+    ];
+    refused(
+        dir.path(),
+        &args,
+        1,
+        &[
+            "s.csv: 2 of its 4 rows are outside this sweep's grid",
+            "theta_f=40, d2=2",
+            "another --out",
+        ],
+    );
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), before);
+    // More values: the four rows move to their places; only θ_F = 35 is computed, and the
+    // CSV is what a fresh run of the grown grid writes.
+    let grown = ["--param", "theta_f=30,35,40", "--param", "d2=2,5"];
+    let err = sweep_in(dir.path(), &[&grown[..], &["--out", "s.csv"]].concat());
+    assert!(err.is_empty(), "{err}");
+    sweep_in(dir.path(), &[&grown[..], &["--out", "fresh.csv"]].concat());
+    let resumed = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!(
+        resumed,
+        std::fs::read_to_string(dir.path().join("fresh.csv")).unwrap()
+    );
+    assert_eq!(resumed.lines().count(), 7);
+    // The kept rows are the old ones, with their new index and grid size.
+    let old_row_40_5 = before.lines().nth(4).unwrap();
+    assert!(old_row_40_5.starts_with("3,40,5,"), "{old_row_40_5}");
+    let new_row = old_row_40_5
+        .replacen("3,", "5,", 1)
+        .replacen(",4,16,", ",6,16,", 1);
+    assert_eq!(resumed.lines().nth(6).unwrap(), new_row);
+}
+
+#[test]
+fn merging_counts_the_grid_the_parts_were_cut_from_and_refuses_mixed_settings() {
+    // theta_f = 40, 60, 80 × d2 = inf, 6 in two parts: part 0 holds every d2 = 6 row, part 1
+    // every d2 = inf row. Merged alone, part 0 was said to hold "3 of the grid's 3".
+    let dir = scratch("", &[]);
+    let grid = ["--param", "theta_f=40:80:20", "--param", "d2=inf,6"];
+    for k in 0..2 {
+        let shard = format!("{k}/2");
+        let out = format!("p{k}.csv");
+        sweep_in(
+            dir.path(),
+            &[&grid[..], &["--shard", &shard, "--out", &out]].concat(),
+        );
+    }
+    let p0 = std::fs::read_to_string(dir.path().join("p0.csv")).unwrap();
+    assert!(
+        p0.lines().skip(1).all(|l| l.split(',').nth(2) == Some("6")),
+        "{p0}"
+    );
+    refused(
+        dir.path(),
+        &["sweep-merge", "p0.csv", "--out", "m.csv"],
+        1,
+        &["the parts hold 3 of the grid's 6 configurations; missing: 0, 2, 4"],
+    );
+    let (code, err) = run_in(
+        dir.path(),
+        &["sweep-merge", "p0.csv", "p1.csv", "--out", "m.csv"],
+    );
+    assert_eq!(code, 0, "{err}");
+    // A part computed at another width is not a part of this sweep.
+    sweep_in(
+        dir.path(),
+        &[&grid[..], &["--shard", "1/2", "--out", "w.csv"]].concat(),
+    );
+    let w = std::fs::read_to_string(dir.path().join("w.csv")).unwrap();
+    std::fs::write(dir.path().join("w.csv"), w.replace(",6,16,1,", ",6,24,1,")).unwrap();
+    refused(
+        dir.path(),
+        &["sweep-merge", "p0.csv", "w.csv", "--out", "m2.csv"],
+        1,
+        &["w.csv:2: computed with --width 24, p0.csv:2 with --width 16: not parts of one sweep"],
+    );
+    assert!(!dir.path().join("m2.csv").exists());
+}
 
 #[test]
 fn sweeps_write_every_row_and_resume() {
@@ -30,8 +244,24 @@ fn sweeps_write_every_row_and_resume() {
     let first = std::fs::read_to_string(&csv).unwrap();
     let lines: Vec<&str> = first.lines().collect();
     assert_eq!(lines.len(), 5);
-    assert!(lines[0].starts_with("index,theta_f,d2,misregistration_mean_arcmin"));
-    assert!(lines[0].ends_with(",R1,R2,coverage"), "{}", lines[0]);
+    assert_eq!(
+        lines[0],
+        "index,theta_f,d2,misregistration_mean_arcmin,misregistration_p95_arcmin,\
+         misregistration_max_arcmin,border_mean_arcmin,border_p95_arcmin,psnr_db,ssim,\
+         missing_fraction,display_outside_frontal_fraction,R1,R2,coverage,configurations,\
+         width,spp,head,band,scene_hash,seethru_version"
+    );
+    // The grid's size and the settings close every row, the same on each.
+    let tail = |l: &str| l.split(',').skip(15).collect::<Vec<_>>().join(",");
+    for line in &lines[1..] {
+        let t = tail(line);
+        assert!(t.starts_with("4,64,1,oracle,3,"), "{line}");
+        assert!(
+            t.ends_with(&format!(",{}", env!("CARGO_PKG_VERSION"))),
+            "{line}"
+        );
+        assert_eq!(t, tail(lines[1]));
+    }
     assert!(lines[1].starts_with("0,30,inf,") && lines[4].starts_with("3,60,6,"));
     // Each row's coverage is what ray casting predicts for its configuration (driver 64 px
     // wide, the frontal camera at the scene's resolution and the row's θ_F): at 30° the das

@@ -4,9 +4,15 @@
 use std::path::Path;
 
 use libfuzzer_sys::fuzz_target;
-use seethru::measure::sweep_csv::finished_rows;
+use seethru::measure::sweep_csv::{METRIC_COLUMNS, SETTING_COLUMNS, finished_rows};
 
-const HEADER: &str = "index,theta_f,d2,misregistration_mean_arcmin";
+/// The settings the kept rows must have been computed with (sweep_csv::SETTING_COLUMNS).
+fn settings() -> Vec<String> {
+    ["32", "1", "oracle", "5", "0123456789abcdef", "0.1.0"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+}
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
@@ -23,12 +29,19 @@ fuzz_target!(|data: &[u8]| {
             })
         })
         .collect();
-    match finished_rows(text, Path::new("sweep.csv"), HEADER, &configs) {
+    match finished_rows(
+        text,
+        Path::new("sweep.csv"),
+        &["theta_f".into(), "d2".into()],
+        &configs,
+        &settings(),
+    ) {
         Ok(rows) => {
             let mut seen = std::collections::HashSet::new();
             for (index, line) in rows {
                 assert!(index < configs.len() && seen.insert(index), "{line}");
-                assert_eq!(line.split(',').count(), 4, "{line}");
+                let columns = 3 + METRIC_COLUMNS.len() + 1 + SETTING_COLUMNS.len();
+                assert_eq!(line.split(',').count(), columns, "{line}");
             }
         }
         Err(e) => assert!(!format!("{e:#}").contains('\n'), "{e:#}"),

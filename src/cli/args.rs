@@ -5,6 +5,7 @@ use anyhow::{Result, bail};
 use seethru::render::settings::MAX_SPP;
 use seethru::scene::source::MAX_RESOLUTION;
 use seethru::system::memory::DEFAULT_MAX_MEMORY_GIB;
+use seethru::system::options::MAX_HEAD_BIAS_CM;
 use seethru::util::number::short;
 
 /// Most worker threads a command accepts.
@@ -77,9 +78,6 @@ pub fn threads(text: &str) -> Result<usize, String> {
 pub fn band(text: &str) -> Result<u32, String> {
     integer(1, 1000)(text)
 }
-
-/// Most centimetres of head bias on each axis.
-pub const MAX_HEAD_BIAS_CM: f64 = 500.0;
 
 /// A head bias `x,y,z` in centimetres, each in `[−MAX_HEAD_BIAS_CM, MAX_HEAD_BIAS_CM]`
 /// (`1,0,0`; a leading minus is fine: `-1,0,0`).

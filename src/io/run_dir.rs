@@ -19,7 +19,7 @@ pub struct RunRecord {
     /// The same, absolute (`scene_absolute`; `None` in run.json files older than it).
     pub scene_absolute: Option<PathBuf>,
     /// The content hash of the scene file when the run read it (`scene_hash`, as
-    /// `util::input_file::content_hash`; `None` in older run.json files).
+    /// `util::hash::content_hash`; `None` in older run.json files).
     pub scene_hash: Option<String>,
     /// The eye the driver views were rendered from, world, metres (`eyes.view_world_m`;
     /// `None` in run.json files that predate two eyes: the scene's driver camera).

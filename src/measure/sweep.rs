@@ -14,35 +14,20 @@ use rayon::prelude::*;
 use crate::io::atomic::write_text;
 use crate::io::plot::{Figure, Series};
 use crate::measure::metrics::measure;
-use crate::measure::sweep_csv::{MAX_SWEEP_CSV_BYTES, decode, encode, finished_rows};
-use crate::measure::sweep_grid::{Param, combinations, configure};
+use crate::measure::sweep_csv::{
+    MAX_SWEEP_CSV_BYTES, METRIC_COLUMNS, decode, encode, finished_rows, header,
+};
+use crate::measure::sweep_grid::{Param, check_grid_size, combinations, configure};
 use crate::measure::sweep_shard::{Shard, merge};
 use crate::render::integrator::{RenderContext, same_geometry};
 use crate::render::settings::RenderSettings;
 use crate::scene::Scene;
+use crate::scene::fingerprint::fingerprint;
 use crate::scene::world::view_bit;
 use crate::system::options::{HeadSource, Outside, RunOptions};
 use crate::system::pipeline::{driver_camera, run_with_truth};
-use crate::util::input_file::read_input_text;
+use crate::util::input_file::{not_a_file, read_input_text};
 use crate::util::progress::Progress;
-
-/// The metric columns of a row. `coverage` (the fraction of display pixels that show the
-/// scene, over which the misregistration means are taken) comes last, so that the columns
-/// before it keep their places.
-const METRIC_COLUMNS: [&str; 12] = [
-    "misregistration_mean_arcmin",
-    "misregistration_p95_arcmin",
-    "misregistration_max_arcmin",
-    "border_mean_arcmin",
-    "border_p95_arcmin",
-    "psnr_db",
-    "ssim",
-    "missing_fraction",
-    "display_outside_frontal_fraction",
-    "R1",
-    "R2",
-    "coverage",
-];
 
 fn metric_row(metrics: &serde_json::Value, report: &serde_json::Value) -> Vec<f64> {
     let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
@@ -82,6 +67,7 @@ pub fn sweep(
     csv: &Path,
     options: &SweepOptions,
 ) -> Result<usize> {
+    check_out(csv)?;
     if params.is_empty() {
         bail!("give at least one --param");
     }
@@ -93,6 +79,7 @@ pub fn sweep(
             w[0]
         );
     }
+    check_grid_size(params)?;
     let base = Scene::load(scene_path)?;
     let base_options = RunOptions {
         width: Some(options.width),
@@ -111,17 +98,26 @@ pub fn sweep(
     for c in &configs {
         configure(&base, &base_options, c)?;
     }
-    let header: Vec<String> = ["index".to_string()]
-        .into_iter()
-        .chain(params.iter().map(|p| p.name.clone()))
-        .chain(METRIC_COLUMNS.iter().map(|s| s.to_string()))
-        .collect();
-    let header_line = encode(&header);
-    // Rows already done (same header, same parameter values at the same index).
-    let rows = if csv.exists() || csv.is_symlink() {
+    let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
+    let header_line = encode(&header(&names));
+    // What every row depends on besides its parameter values (sweep_csv::SETTING_COLUMNS).
+    let row_settings: Vec<String> = vec![
+        options.width.to_string(),
+        options.spp.to_string(),
+        match options.head {
+            HeadSource::Oracle => "oracle",
+            HeadSource::Estimated => "estimated",
+        }
+        .to_string(),
+        options.band.to_string(),
+        fingerprint(&base).with_context(|| format!("scene {}", scene_path.display()))?,
+        env!("CARGO_PKG_VERSION").to_string(),
+    ];
+    // Rows already done: this sweep's header, settings and grid; anything else is refused.
+    let rows = if std::fs::symlink_metadata(csv).is_ok() {
         let text = read_input_text(csv, MAX_SWEEP_CSV_BYTES)
             .with_context(|| format!("cannot read {} to resume the sweep", csv.display()))?;
-        finished_rows(&text, csv, &header_line, &configs)?
+        finished_rows(&text, csv, &names, &configs, &row_settings)?
     } else {
         Vec::new()
     };
@@ -204,6 +200,8 @@ pub fn sweep(
                 let fields: Vec<String> = std::iter::once(index.to_string())
                     .chain(config.iter().map(|(_, v)| v.clone()))
                     .chain(values.iter().map(|v| format!("{v}")))
+                    .chain(std::iter::once(configs.len().to_string()))
+                    .chain(row_settings.iter().cloned())
                     .collect();
                 let line = encode(&fields);
                 let mut rows = rows
@@ -225,10 +223,32 @@ pub fn sweep(
     Ok(todo.len())
 }
 
+/// Refuses an `--out` that cannot be a CSV: empty, a folder (or a name ending in `/`), or
+/// something there that is not a regular file (a device, a pipe, a link to one).
+pub fn check_out(csv: &Path) -> Result<()> {
+    let text = csv.to_string_lossy();
+    if text.is_empty() {
+        bail!("--out is empty: give the CSV's file name (e.g. sweep.csv)");
+    }
+    if csv.file_name().is_none() || text.ends_with('/') {
+        bail!(
+            "--out {text}: names a folder, not a file; give the CSV's file name (e.g. {}/sweep.csv)",
+            text.trim_end_matches('/')
+        );
+    }
+    if std::fs::symlink_metadata(csv).is_ok()
+        && let Some(why) = not_a_file(csv)
+    {
+        bail!("--out {text}: {why}; give a regular file (a new name, or a CSV to resume)");
+    }
+    Ok(())
+}
+
 /// Joins the CSVs of a sharded sweep into `out` (byte for byte what one unsharded run writes)
 /// and draws its plot; returns the number of rows.
 pub fn merge_parts(parts: &[&Path], out: &Path) -> Result<usize> {
-    let merged = merge(parts, out, METRIC_COLUMNS.len())?;
+    check_out(out)?;
+    let merged = merge(parts, out)?;
     plot(out, &merged.params, &merged.body)?;
     Ok(merged.rows)
 }
@@ -318,4 +338,23 @@ fn plot(csv: &Path, params: &[Param], rows: &[(usize, String)]) -> Result<()> {
         csv.parent().unwrap_or(Path::new(".")),
         &format!("{stem}_plot"),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outputs_that_cannot_be_a_csv_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        for (out, words) in [
+            (Path::new(""), "--out is empty"),
+            (dir.path(), "it is a folder, not a file"),
+            (Path::new("."), "names a folder, not a file"),
+        ] {
+            let err = check_out(out).unwrap_err().to_string();
+            assert!(err.contains(words), "{err}");
+        }
+        assert!(check_out(&dir.path().join("new.csv")).is_ok());
+    }
 }

@@ -1,10 +1,19 @@
 //! The sweep's CSV files, read and written with the `csv` crate: one record per
 //! configuration, and reading back an interrupted sweep to see which rows can be kept.
+//!
+//! Columns: `index`, one per swept parameter, the metrics ([`METRIC_COLUMNS`]), then
+//! `configurations` (the size of the grid the row belongs to) and the settings every row was
+//! computed with ([`SETTING_COLUMNS`]: the options that change results, the scene's
+//! fingerprint and seethru's version), the same on every row. Every cell has its admissible
+//! values; a file to resume or merge with a cell outside them is refused, naming the line.
 
 use std::collections::HashMap;
 use std::path::Path;
 
 use anyhow::{Result, bail};
+
+use crate::measure::sweep_grid::MAX_CONFIGURATIONS;
+use crate::util::number::short;
 
 /// Largest sweep CSV read back (to resume or merge): a million rows fit.
 pub const MAX_SWEEP_CSV_BYTES: u64 = 1 << 30;
@@ -76,71 +85,288 @@ pub fn records(text: &str, path: &Path) -> Result<Vec<(usize, Vec<String>)>> {
     Ok(out)
 }
 
-/// The rows of an earlier run of the same sweep (`text`, the file `csv`) that can be kept: the
-/// header must be `header` exactly; a row is kept when its index names a configuration of
-/// `configs` with the same parameter values and it has every column, each metric a number
-/// (`NaN` included). Other rows are dropped, to be computed again. A row that is not even
-/// an index, or an index given twice, is an error naming the line: the file is not what this
-/// sweep wrote. Rows come back as [`encode`] writes them.
+/// Largest angle between two directions, arc-minutes (180°).
+const MAX_ARCMIN: f64 = 10_800.0;
+
+/// The metric columns of a row and their admissible values: NaN (the metric is undefined:
+/// no pixel to take it over) or a number in `[low, high]` (to rounding, 1e-9 relative).
+/// `coverage` (the fraction of display pixels that show the scene, over which the
+/// misregistration means are taken) comes last, so that the columns before it keep their
+/// places. PSNR is of 8-bit colours: at most 135 dB even for the largest image.
+pub const METRIC_COLUMNS: [(&str, f64, f64); 12] = [
+    ("misregistration_mean_arcmin", 0.0, MAX_ARCMIN),
+    ("misregistration_p95_arcmin", 0.0, MAX_ARCMIN),
+    ("misregistration_max_arcmin", 0.0, MAX_ARCMIN),
+    ("border_mean_arcmin", 0.0, MAX_ARCMIN),
+    ("border_p95_arcmin", 0.0, MAX_ARCMIN),
+    ("psnr_db", 0.0, 200.0),
+    ("ssim", -1.0, 1.0),
+    ("missing_fraction", 0.0, 1.0),
+    ("display_outside_frontal_fraction", 0.0, 1.0),
+    ("R1", -f64::MAX, f64::MAX),
+    ("R2", -f64::MAX, f64::MAX),
+    ("coverage", 0.0, 1.0),
+];
+
+/// The column after the metrics: how many configurations the row's grid has (so that
+/// `sweep-merge` knows when a part is missing).
+pub const GRID_COLUMN: &str = "configurations";
+
+/// The columns after it: what a row's results depend on besides its parameter values, with
+/// how a message names each. Resuming or merging refuses rows that differ in any.
+pub const SETTING_COLUMNS: [(&str, &str); 6] = [
+    ("width", "--width"),
+    ("spp", "--spp"),
+    ("head", "--head"),
+    ("band", "--band"),
+    ("scene_hash", "scene_hash"),
+    ("seethru_version", "seethru"),
+];
+
+/// The header of a sweep of `params`.
+pub fn header(params: &[String]) -> Vec<String> {
+    std::iter::once("index")
+        .chain(params.iter().map(String::as_str))
+        .chain(METRIC_COLUMNS.iter().map(|c| c.0))
+        .chain(std::iter::once(GRID_COLUMN))
+        .chain(SETTING_COLUMNS.iter().map(|c| c.0))
+        .map(str::to_string)
+        .collect()
+}
+
+/// The parameter names of a sweep CSV's header, or `None` if it is not one.
+pub fn params_of(header: &[String]) -> Option<Vec<String>> {
+    let tail = METRIC_COLUMNS.len() + 1 + SETTING_COLUMNS.len();
+    if header.len() < 2 + tail || header[0] != "index" {
+        return None;
+    }
+    let params = header[1..header.len() - tail].to_vec();
+    (self::header(&params) == header).then_some(params)
+}
+
+/// A cell for a message: a number short, text escaped (one line) and cut to 40 characters.
+fn cell_text(cell: &str) -> String {
+    match cell.trim().parse::<f64>() {
+        Ok(x) => short(x),
+        Err(_) => {
+            let start: String = cell.chars().take(40).collect();
+            let more = if cell.chars().count() > 40 { "…" } else { "" };
+            format!("`{}{more}`", start.escape_debug())
+        }
+    }
+}
+
+/// `columns` up to and including the `upto`-th, joined, `…` for the rest, and their count.
+pub fn columns_text(columns: &[String], upto: usize) -> String {
+    let shown: Vec<String> = columns
+        .iter()
+        .take(upto + 1)
+        .map(|c| {
+            let c: String = c.chars().take(40).collect();
+            c.escape_debug().to_string()
+        })
+        .collect();
+    let more = if columns.len() > upto + 1 { ",…" } else { "" };
+    format!("`{}{more}` ({})", shown.join(","), columns.len())
+}
+
+/// Says how the header `found` differs from the header `expected`, short: both up to the
+/// first column that differs.
+pub fn header_difference(found: &[String], expected: &[String]) -> String {
+    let at = (0..found.len().max(expected.len()))
+        .find(|&i| found.get(i) != expected.get(i))
+        .unwrap_or(0);
+    let which = match (found.get(at), expected.get(at)) {
+        (Some(f), Some(e)) => format!("column {} is `{f}` where `{e}` belongs", at + 1),
+        (None, Some(e)) => format!("column {} (`{e}`) is missing", at + 1),
+        (Some(f), None) => format!("column {} (`{f}`) is extra", at + 1),
+        (None, None) => String::new(),
+    };
+    format!(
+        "it has the columns {}, expected {}: {which}",
+        columns_text(found, at),
+        columns_text(expected, at)
+    )
+}
+
+/// Checks the cells of one row that do not depend on the sweep (`fields`, on line `number`
+/// of `path`, in a file whose header has `params` parameter columns): as many cells as the
+/// header, an index below the row's `configurations` (a positive integer up to
+/// [`MAX_CONFIGURATIONS`]) and every metric admissible. Returns the index. `hint` ends each
+/// message (what to do about it).
+pub fn check_row(
+    fields: &[String],
+    params: usize,
+    path: &Path,
+    number: usize,
+    hint: &str,
+) -> Result<usize> {
+    let at = format!("{}:{number}", path.display());
+    let first = fields.first().map_or("", String::as_str);
+    let Ok(index) = first.parse::<usize>() else {
+        bail!(
+            "{at}: a row starts with {}, not a configuration index; {hint}",
+            cell_text(first)
+        );
+    };
+    let columns = 1 + params + METRIC_COLUMNS.len() + 1 + SETTING_COLUMNS.len();
+    if fields.len() != columns {
+        bail!(
+            "{at}: the row has {} cells, the header {columns}; {hint}",
+            fields.len()
+        );
+    }
+    for (cell, (name, low, high)) in fields[1 + params..].iter().zip(METRIC_COLUMNS) {
+        let tolerance = 1e-9 * high.abs().max(1.0);
+        let admissible = match cell.parse::<f64>() {
+            Ok(x) => x.is_nan() || (x.is_finite() && x >= low - tolerance && x <= high + tolerance),
+            Err(_) => false,
+        };
+        if !admissible {
+            let range = if high == f64::MAX {
+                "a finite number".to_string()
+            } else {
+                format!("a number in [{}, {}]", short(low), short(high))
+            };
+            bail!(
+                "{at}: {name} = {} is not admissible (NaN, for undefined, or {range}); {hint}",
+                cell_text(cell)
+            );
+        }
+    }
+    let grid_cell = &fields[1 + params + METRIC_COLUMNS.len()];
+    match grid_cell.parse::<usize>() {
+        Ok(n) if (1..=MAX_CONFIGURATIONS).contains(&n) => {
+            if index >= n {
+                bail!(
+                    "{at}: index {index} is outside its grid's [0, {}] ({GRID_COLUMN} = {n}); {hint}",
+                    n - 1
+                );
+            }
+        }
+        _ => bail!(
+            "{at}: {GRID_COLUMN} = {} is not admissible (an integer in [1, {MAX_CONFIGURATIONS}]); {hint}",
+            cell_text(grid_cell)
+        ),
+    }
+    Ok(index)
+}
+
+/// The settings cells of a checked row.
+pub fn settings_of(fields: &[String]) -> &[String] {
+    &fields[fields.len() - SETTING_COLUMNS.len()..]
+}
+
+/// The first setting in which `a` and `b` differ: its name for messages and both values.
+pub fn first_difference<'a>(
+    a: &'a [String],
+    b: &'a [String],
+) -> Option<(&'static str, &'a str, &'a str)> {
+    a.iter()
+        .zip(b)
+        .zip(SETTING_COLUMNS)
+        .find(|((x, y), _)| x != y)
+        .map(|((x, y), (_, shown))| (shown, x.as_str(), y.as_str()))
+}
+
+/// The rows of an earlier run of the same sweep (`text`, the file `csv`) to keep. The header
+/// must be this sweep's (`params`); every row must pass [`check_row`], have been computed
+/// with this sweep's `settings` (the values of [`SETTING_COLUMNS`]), and name by its
+/// parameter values a configuration of `configs`, each once. A row whose values are in the
+/// grid at another place (the grid grew) is kept with its index and `configurations`
+/// rewritten. Anything else is an error naming the file (and line): nothing is dropped
+/// silently, nothing computed otherwise is mixed in. Rows come back as [`encode`] writes
+/// them.
 pub fn finished_rows(
     text: &str,
     csv: &Path,
-    header: &str,
+    params: &[String],
     configs: &[Vec<(String, String)>],
+    settings: &[String],
 ) -> Result<Vec<(usize, String)>> {
-    let other_columns = || {
-        anyhow::anyhow!(
-            "{} exists with other columns; remove it or choose another --out",
-            csv.display()
-        )
-    };
-    let all = records(text, csv).map_err(|_| other_columns())?;
+    let expected = header(params);
+    let all = records(text, csv)?;
     let mut all = all.into_iter();
     match all.next() {
-        Some((_, first)) if encode(&first) == header => {}
-        _ => return Err(other_columns()),
+        Some((_, first)) if first == expected => {}
+        Some((_, first)) => bail!(
+            "{} exists with other columns: {}; remove it or choose another --out",
+            csv.display(),
+            header_difference(&first, &expected)
+        ),
+        None => bail!(
+            "{} exists but is empty (no header; expected {}); remove it or choose another --out",
+            csv.display(),
+            columns_text(&expected, params.len())
+        ),
     }
-    let columns = records(header, csv)?.first().map_or(0, |(_, h)| h.len());
+    let hint = "delete the row to compute it again, or choose another --out";
+    let place: HashMap<&[(String, String)], usize> = configs
+        .iter()
+        .enumerate()
+        .map(|(i, c)| (c.as_slice(), i))
+        .collect();
     let mut rows = Vec::new();
-    let mut line_of_index: HashMap<usize, usize> = HashMap::new();
-    for (number, fields) in all {
-        let first = fields.first().map_or("", String::as_str);
-        let Ok(index) = first.parse::<usize>() else {
-            // Escaped: a quoted field can hold line breaks, and an error is one line.
-            let start: String = first
-                .chars()
-                .take(40)
-                .collect::<String>()
-                .escape_debug()
-                .to_string();
-            bail!(
-                "{}:{number}: a row starts with `{start}`, not a configuration index; remove the file or choose another --out",
-                csv.display()
-            );
-        };
+    let (mut line_of_index, mut line_of_place) = (HashMap::new(), HashMap::new());
+    let (mut outside, mut first_outside, mut count) = (0usize, None, 0usize);
+    for (number, mut fields) in all {
+        let index = check_row(&fields, params.len(), csv, number, hint)?;
+        count += 1;
         if let Some(earlier) = line_of_index.insert(index, number) {
             bail!(
                 "{}:{number}: configuration {index} appears twice (also on line {earlier}); remove the file or choose another --out",
                 csv.display()
             );
         }
-        let Some(config) = configs.get(index) else {
+        if let Some((shown, theirs, ours)) = first_difference(settings_of(&fields), settings) {
+            bail!(
+                "{}:{number}: computed with {shown} {theirs}, this sweep has {shown} {ours}{}: resuming would mix the two; resume with the same settings, or choose another --out",
+                csv.display(),
+                if shown == "scene_hash" {
+                    " (another scene, or the scene file, a mesh or a texture it reads changed)"
+                } else {
+                    ""
+                }
+            );
+        }
+        let values: Vec<(String, String)> = params
+            .iter()
+            .cloned()
+            .zip(fields[1..=params.len()].iter().cloned())
+            .collect();
+        let Some(&at) = place.get(values.as_slice()) else {
+            outside += 1;
+            first_outside.get_or_insert((number, values));
             continue;
         };
-        let same_values = fields.len() == columns
-            && config
-                .iter()
-                .zip(&fields[1..])
-                .all(|((_, value), field)| value == field);
-        let metrics_are_numbers = fields
-            .iter()
-            .skip(1 + config.len())
-            .all(|f| f.parse::<f64>().is_ok());
-        if same_values && metrics_are_numbers {
-            rows.push((index, encode(&fields)));
+        if let Some(earlier) = line_of_place.insert(at, number) {
+            bail!(
+                "{}:{number}: the configuration {} appears twice (also on line {earlier}); remove the file or choose another --out",
+                csv.display(),
+                config_text(&values)
+            );
         }
+        fields[0] = at.to_string();
+        fields[1 + params.len() + METRIC_COLUMNS.len()] = configs.len().to_string();
+        rows.push((at, encode(&fields)));
+    }
+    if let Some((line, values)) = first_outside {
+        bail!(
+            "{}: {outside} of its {count} rows are outside this sweep's grid (the first, line {line}: {}); resuming would drop them: give --param values that include theirs, or choose another --out",
+            csv.display(),
+            config_text(&values)
+        );
     }
     Ok(rows)
+}
+
+/// A configuration for a message: `theta_f=30, d2=inf`.
+pub fn config_text(config: &[(String, String)]) -> String {
+    config
+        .iter()
+        .map(|(n, v)| format!("{n}={}", cell_text(v).trim_matches('`')))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 #[cfg(test)]
@@ -154,36 +380,159 @@ mod tests {
             .collect()
     }
 
+    fn params() -> Vec<String> {
+        vec!["theta_f".to_string()]
+    }
+
+    fn settings() -> Vec<String> {
+        ["32", "1", "oracle", "5", "0123456789abcdef", "0.1.0"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    }
+
+    /// A row as a sweep writes it: index, θ_F, the metrics (`cells` first, then 0.5), the
+    /// grid's size and the settings.
+    fn row(index: usize, theta: &str, cells: &[&str], configurations: usize) -> String {
+        let metrics = (0..METRIC_COLUMNS.len()).map(|i| cells.get(i).copied().unwrap_or("0.5"));
+        let fields: Vec<String> = [index.to_string(), theta.to_string()]
+            .into_iter()
+            .chain(metrics.map(str::to_string))
+            .chain([configurations.to_string()])
+            .chain(settings())
+            .collect();
+        encode(&fields)
+    }
+
+    fn file(rows: &[String]) -> String {
+        let mut text = encode(&header(&params())) + "\n";
+        for r in rows {
+            text += &format!("{r}\n");
+        }
+        text
+    }
+
+    fn resume(text: &str) -> Result<Vec<(usize, String)>> {
+        finished_rows(text, Path::new("s.csv"), &params(), &configs(), &settings())
+    }
+
     #[test]
-    fn keeps_matching_rows_and_drops_the_rest() {
-        let header = "index,theta_f,mean";
-        let text = "index,theta_f,mean\n0,20,1.5\n1,45,2\n7,20,1\n\n";
-        let rows = finished_rows(text, Path::new("s.csv"), header, &configs()).unwrap();
-        assert_eq!(rows, vec![(0, "0,20,1.5".to_string())]);
-        let text = "index,theta_f,mean\n0,20,NaN\n1,40,abc\n";
-        let rows = finished_rows(text, Path::new("s.csv"), header, &configs()).unwrap();
-        assert_eq!(rows.len(), 1, "a metric that is not a number is recomputed");
+    fn rows_of_this_sweep_are_kept_and_moved_to_their_place_in_a_grown_grid() {
+        let text = file(&[row(0, "20", &["1.5"], 2), row(1, "40", &["NaN"], 2)]);
+        let rows = resume(&text).unwrap();
+        assert_eq!(
+            rows,
+            vec![
+                (0, row(0, "20", &["1.5"], 2)),
+                (1, row(1, "40", &["NaN"], 2))
+            ]
+        );
+        // The same row from a grid of 3 where θ_F = 40 was index 2: now index 1 of 2.
+        let rows = resume(&file(&[row(2, "40", &[], 3)])).unwrap();
+        assert_eq!(rows, vec![(1, row(1, "40", &[], 2))]);
+    }
+
+    #[test]
+    fn every_cell_outside_its_column_is_refused_naming_the_line_column_and_range() {
+        for (cells, words) in [
+            (
+                vec!["-1"],
+                "misregistration_mean_arcmin = -1 is not admissible (NaN, for undefined, or a number in [0, 10800])",
+            ),
+            (vec!["inf"], "misregistration_mean_arcmin = inf"),
+            (
+                vec!["0.5"; 5].into_iter().chain(["1e300"]).collect(),
+                "psnr_db = 1e300",
+            ),
+            (
+                vec!["0.5"; 6].into_iter().chain(["1.5"]).collect(),
+                "ssim = 1.5",
+            ),
+            (
+                vec!["0.5"; 7].into_iter().chain(["abc"]).collect(),
+                "missing_fraction = `abc`",
+            ),
+            (
+                vec!["0.5"; 9].into_iter().chain(["inf"]).collect(),
+                "R1 = inf is not admissible (NaN, for undefined, or a finite number)",
+            ),
+            (
+                vec!["0.5"; 11].into_iter().chain(["-1"]).collect(),
+                "coverage = -1",
+            ),
+            (
+                vec!["0.5"; 11].into_iter().chain(["1e300"]).collect(),
+                "coverage = 1e300",
+            ),
+            (
+                vec!["0.5"; 11].into_iter().chain([""]).collect(),
+                "coverage = ``",
+            ),
+        ] {
+            let text = file(&[row(0, "20", &[], 2), row(1, "40", &cells, 2)]);
+            let err = resume(&text).unwrap_err().to_string();
+            assert!(err.starts_with("s.csv:3: ") && err.contains(words), "{err}");
+            assert!(err.contains("delete the row"), "{err}");
+        }
+        // Rounding past a bound is not a bad cell; NaN is the undefined metric a sweep writes.
+        let rows = resume(&file(&[row(0, "20", &["NaN", "10800.000000000002"], 2)])).unwrap();
+        assert_eq!(rows.len(), 1);
+        let err = resume(&file(&[row(0, "20", &[], 0)]))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("configurations = 0 is not admissible"),
+            "{err}"
+        );
+        let short_row = file(&["0,20,1".to_string()]);
+        let err = resume(&short_row).unwrap_err().to_string();
+        assert!(
+            err.contains("s.csv:2: the row has 3 cells, the header 21"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn other_settings_and_rows_outside_the_grid_are_refused() {
+        let mut other = row(1, "40", &[], 2);
+        other = other.replace(",32,1,oracle,", ",64,1,oracle,");
+        let err = resume(&file(&[row(0, "20", &[], 2), other]))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with("s.csv:3: computed with --width 64, this sweep has --width 32"),
+            "{err}"
+        );
+        let other = row(0, "20", &[], 2).replace("0123456789abcdef", "fedcba9876543210");
+        let err = resume(&file(&[other])).unwrap_err().to_string();
+        assert!(
+            err.contains("computed with scene_hash fedcba9876543210, this sweep has scene_hash 0123456789abcdef (another scene"),
+            "{err}"
+        );
+        let text = file(&[
+            row(0, "20", &[], 3),
+            row(1, "30", &[], 3),
+            row(2, "40", &[], 3),
+        ]);
+        let err = resume(&text).unwrap_err().to_string();
+        assert!(
+            err.contains("s.csv: 1 of its 3 rows are outside this sweep's grid (the first, line 3: theta_f=30)"),
+            "{err}"
+        );
     }
 
     #[test]
     fn foreign_files_are_errors_naming_the_line() {
-        let header = "index,theta_f,mean";
         for (text, words) in [
-            ("index,x\n", "other columns"),
-            ("", "other columns"),
-            (
-                "index,theta_f,mean\n0,20,1\nx,20,1\n",
-                "s.csv:3: a row starts with `x`",
-            ),
-            (
-                "index,theta_f,mean\n0,20,1\n0,20,1\n",
-                "s.csv:3: configuration 0 appears twice (also on line 2)",
-            ),
+            ("index,x\n".to_string(), "exists with other columns: it has the columns `index,x` (2), expected `index,theta_f,…` (21): column 2 is `x` where `theta_f` belongs".to_string()),
+            (String::new(), "exists but is empty (no header; expected `index,theta_f,…` (21))".to_string()),
+            (file(&[row(0, "20", &[], 2), "x,20,1".to_string()]), "s.csv:3: a row starts with `x`".to_string()),
+            (file(&[row(0, "20", &[], 2), row(0, "40", &[], 2)]), "s.csv:3: configuration 0 appears twice (also on line 2)".to_string()),
+            (file(&[row(0, "20", &[], 2), row(1, "20", &[], 2)]), "s.csv:3: the configuration theta_f=20 appears twice (also on line 2)".to_string()),
         ] {
-            let err = finished_rows(text, Path::new("s.csv"), header, &configs())
-                .unwrap_err()
-                .to_string();
-            assert!(err.contains(words), "{err}");
+            let err = resume(&text).unwrap_err().to_string();
+            assert!(err.contains(&words), "{err}\nlacks {words}");
+            assert!(!err.contains('\n'));
         }
     }
 

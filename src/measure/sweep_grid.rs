@@ -5,20 +5,26 @@ use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
 use crate::scene::Scene;
-use crate::scene::limits::{MAX_COORDINATE, MAX_RESOLUTION, out_of_world};
-use crate::system::options::{RunOptions, WorkingDistance};
+use crate::scene::limits::{
+    MAX_COORDINATE, MAX_DISPLAY_SIZE, MAX_RESOLUTION, MIN_LENGTH, out_of_world,
+};
+use crate::scene::read::{MAX_HALF_ANGLE_DEG, MIN_HALF_ANGLE_DEG};
+use crate::system::options::{MAX_HEAD_BIAS_CM, RunOptions};
 use crate::util::number::short;
 
-/// What a sweep can vary.
+/// What a sweep can vary, each with the range of the scene key or option it sets.
 pub const PARAMETERS: [(&str, &str); 7] = [
-    ("theta_f", "frontal half angle θ_F, degrees in (0, 89]"),
+    (
+        "theta_f",
+        "frontal half angle θ_F (camera.frontal.half_angle_deg), degrees in [0.01, 89]",
+    ),
     (
         "d2",
-        "model working distance: inf, auto or metres in (0, 1e6]",
+        "model working distance: inf, auto or metres in [1e-6, 1e6]",
     ),
     (
         "display_width",
-        "display width D, metres in (0, 100] (display pixels scale with it)",
+        "display width D (obstacle.width), metres in [1e-6, 100] (display pixels scale with it)",
     ),
     (
         "eye_x",
@@ -38,18 +44,28 @@ pub const PARAMETERS: [(&str, &str); 7] = [
     ),
 ];
 
-/// One swept parameter and its values (as written on the command line, and parsed).
+/// Most configurations in one sweep's grid (the product of the parameters' value counts).
+pub const MAX_CONFIGURATIONS: usize = 100_000;
+
+/// Most values of one parameter.
+pub const MAX_VALUES: usize = 10_000;
+
+/// One swept parameter and its values (normalised: numbers as Rust writes the `f64` they
+/// parse to, `inf` for `infinity`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Param {
     pub name: String,
     pub values: Vec<String>,
 }
 
-/// Parses `name=start:stop:step` or `name=v1,v2,...`.
+/// Parses `name=start:stop:step` or `name=v1,v2,...`. Spaces around the name and the values
+/// are ignored, as around every number of the command line (`cli/args.rs`); a value given
+/// twice (`d2=5,5`, or `5,5.0`) is an error naming it.
 pub fn parse_param(spec: &str) -> Result<Param> {
     let (name, values) = spec
         .split_once('=')
         .with_context(|| format!("`{spec}`: expected name=start:stop:step or name=v1,v2,..."))?;
+    let name = name.trim();
     if !PARAMETERS.iter().any(|(n, _)| *n == name) {
         let known: Vec<&str> = PARAMETERS.iter().map(|(n, _)| *n).collect();
         bail!(
@@ -59,12 +75,15 @@ pub fn parse_param(spec: &str) -> Result<Param> {
     }
     let values: Vec<String> = if let [a, b, c] = values.split(':').collect::<Vec<_>>()[..] {
         let parse = |s: &str| {
-            s.parse::<f64>()
-                .with_context(|| format!("`{spec}`: `{s}` is not a number"))
+            s.trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .with_context(|| format!("`{spec}`: `{}` is not a finite number", s.trim()))
         };
         let (start, stop, step) = (parse(a)?, parse(b)?, parse(c)?);
-        if !(step > 0.0 && stop >= start && (stop - start) / step <= 10_000.0) {
-            bail!("`{spec}`: need step > 0, stop ≥ start and at most 10000 values");
+        if !(step > 0.0 && stop >= start && (stop - start) / step < MAX_VALUES as f64) {
+            bail!("`{spec}`: need step > 0, stop ≥ start and at most {MAX_VALUES} values");
         }
         let n = ((stop - start) / step + 1e-9).floor() as usize + 1;
         (0..n)
@@ -80,13 +99,50 @@ pub fn parse_param(spec: &str) -> Result<Param> {
     if values.is_empty() {
         bail!("`{spec}`: no values");
     }
+    if values.len() > MAX_VALUES {
+        bail!(
+            "`{name}`: {} values, more than the limit of {MAX_VALUES}",
+            values.len()
+        );
+    }
+    let mut seen: Vec<(Value, &str)> = Vec::with_capacity(values.len());
+    let mut normal = Vec::with_capacity(values.len());
     for v in &values {
-        check_value(name, v)?;
+        let value = check_value(name, v)?;
+        if let Some((_, earlier)) = seen.iter().find(|(x, _)| *x == value) {
+            let same = if earlier == v {
+                format!("the value {v} is given twice")
+            } else {
+                format!("{v} is the value {earlier} again")
+            };
+            bail!("{name}: {same} (each configuration once: give each value once)");
+        }
+        seen.push((value, v));
+        normal.push(value.text());
     }
     Ok(Param {
         name: name.to_string(),
-        values,
+        values: normal,
     })
+}
+
+/// A parameter value, parsed.
+#[derive(Clone, Copy, PartialEq)]
+enum Value {
+    Number(f64),
+    Inf,
+    Auto,
+}
+
+impl Value {
+    /// How the CSV and the configuration hold it.
+    fn text(self) -> String {
+        match self {
+            Value::Number(x) => format!("{x}"),
+            Value::Inf => "inf".into(),
+            Value::Auto => "auto".into(),
+        }
+    }
 }
 
 fn number(name: &str, v: &str) -> Result<f64> {
@@ -99,47 +155,73 @@ fn number(name: &str, v: &str) -> Result<f64> {
     Ok(x)
 }
 
-/// The admissible values of a numeric parameter: (low, low included, high, unit), high
-/// included. The same ranges as the scene keys and flags they stand for.
-fn range_of(name: &str) -> (f64, bool, f64, &'static str) {
+/// The admissible values of a numeric parameter: `[low, high]` and the unit. The ranges of
+/// the scene keys and options they set; a model distance is a length like the scene's.
+fn range_of(name: &str) -> (f64, f64, &'static str) {
     match name {
-        "theta_f" => (0.0, false, 89.0, "degrees"),
+        "theta_f" => (MIN_HALF_ANGLE_DEG, MAX_HALF_ANGLE_DEG, "degrees"),
+        "d2" => (MIN_LENGTH, MAX_COORDINATE, "m"),
         // The obstacle's width, as in the scene file.
-        "display_width" => (0.0, false, 100.0, "m"),
+        "display_width" => (MIN_LENGTH, MAX_DISPLAY_SIZE, "m"),
         // The eye stays inside the world (checked again after the move).
-        "eye_x" | "eye_z" => (-MAX_COORDINATE, true, MAX_COORDINATE, "m"),
+        "eye_x" | "eye_z" => (-MAX_COORDINATE, MAX_COORDINATE, "m"),
         // As `run --head-bias-cm`.
-        "head_bias_x_cm" => (-500.0, true, 500.0, "cm"),
-        "frontal_width" => (1.0, true, MAX_RESOLUTION as f64, "pixels"),
-        _ => (f64::NEG_INFINITY, true, f64::INFINITY, ""),
+        "head_bias_x_cm" => (-MAX_HEAD_BIAS_CM, MAX_HEAD_BIAS_CM, "cm"),
+        "frontal_width" => (1.0, MAX_RESOLUTION as f64, "pixels"),
+        _ => (f64::NEG_INFINITY, f64::INFINITY, ""),
     }
 }
 
-fn check_value(name: &str, v: &str) -> Result<()> {
+fn check_value(name: &str, v: &str) -> Result<Value> {
+    let (lo, hi, unit) = range_of(name);
+    let integer = name == "frontal_width";
+    let what = if integer { "an integer" } else { "a number" };
+    let or_names = if name == "d2" { "inf, auto or " } else { "" };
     if name == "d2" {
-        return v
-            .parse::<WorkingDistance>()
-            .map(|_| ())
-            .map_err(anyhow::Error::msg);
+        match v {
+            "inf" | "infinity" => return Ok(Value::Inf),
+            "auto" => return Ok(Value::Auto),
+            _ => {}
+        }
     }
-    let x = number(name, v)?;
-    let (lo, lo_in, hi, unit) = range_of(name);
-    let inside = (x > lo || (lo_in && x == lo)) && x <= hi;
-    if !inside || (name == "frontal_width" && x.fract() != 0.0) {
-        let open = if lo_in { '[' } else { '(' };
-        let what = if name == "frontal_width" {
-            "an integer "
-        } else {
-            ""
-        };
+    let x = v.parse::<f64>().ok();
+    let inside =
+        x.is_some_and(|x| x.is_finite() && x >= lo && x <= hi && (!integer || x.fract() == 0.0));
+    match x {
+        Some(x) if inside => Ok(Value::Number(x)),
+        _ => {
+            // A number too long for f64 reads as ±inf: show it as written (clipped when printed).
+            let shown = x
+                .filter(|x| x.is_finite())
+                .map_or_else(|| format!("`{v}`"), short);
+            bail!(
+                "{name} = {shown}: must be {or_names}{what} in [{}, {}] {unit}",
+                short(lo),
+                short(hi)
+            )
+        }
+    }
+}
+
+/// Refuses a grid of more than [`MAX_CONFIGURATIONS`] before any is made, naming each
+/// parameter's count and their product.
+pub fn check_grid_size(params: &[Param]) -> Result<usize> {
+    let product = params
+        .iter()
+        .map(|p| p.values.len() as f64)
+        .product::<f64>();
+    if product > MAX_CONFIGURATIONS as f64 {
+        let counts: Vec<String> = params
+            .iter()
+            .map(|p| format!("{} {}", p.name, p.values.len()))
+            .collect();
         bail!(
-            "{name} = {}: must be {what}in {open}{}, {}] {unit}",
-            short(x),
-            short(lo),
-            short(hi)
+            "the grid has {} = {} configurations, more than the limit of {MAX_CONFIGURATIONS}: sweep fewer values, or split the grid over several --out files",
+            counts.join(" × "),
+            short(product)
         );
     }
-    Ok(())
+    Ok(product as usize)
 }
 
 /// Applies one configuration to the scene and the options.
@@ -228,7 +310,7 @@ mod tests {
             parse_param("theta_f=95")
                 .unwrap_err()
                 .to_string()
-                .contains("(0, 89]")
+                .contains("[0.01, 89] degrees")
         );
         assert!(parse_param("d2=-1").is_err());
         assert!(parse_param("theta_f=80:20:5").is_err());

@@ -7,8 +7,12 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 
 use crate::io::atomic::write_text;
-use crate::measure::sweep_csv::{MAX_SWEEP_CSV_BYTES, encode, records};
+use crate::measure::sweep_csv::{
+    GRID_COLUMN, MAX_SWEEP_CSV_BYTES, METRIC_COLUMNS, check_row, columns_text, encode,
+    first_difference, header as sweep_header, header_difference, params_of, records,
+};
 use crate::measure::sweep_grid::Param;
+use crate::util::hash::Fnv64;
 use crate::util::input_file::read_input_text;
 
 /// Part `index` (0-based, as `SLURM_ARRAY_TASK_ID` with `--array=0-(N-1)` and a Kubernetes
@@ -44,18 +48,14 @@ impl Shard {
     /// parameter names and values only (FNV-1a of `name=value;…`), not on its position in the
     /// grid or on the machine, so every part agrees on it.
     pub fn owns(&self, config: &[(String, String)]) -> bool {
-        let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+        let mut hash = Fnv64::default();
         for (name, value) in config {
-            for byte in name
-                .bytes()
-                .chain([b'='])
-                .chain(value.bytes())
-                .chain([b';'])
-            {
-                hash ^= u64::from(byte);
-                hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
-            }
+            hash.bytes(name.as_bytes())
+                .bytes(b"=")
+                .bytes(value.as_bytes())
+                .bytes(b";");
         }
+        let hash = hash.finish();
         hash % u64::from(self.count) == u64::from(self.index)
     }
 }
@@ -68,42 +68,62 @@ pub struct Merged {
 }
 
 /// Joins the CSVs of a sharded sweep into `out`: one header (every part must have the same),
-/// the rows in configuration order. A configuration missing from every part, or given twice
-/// with different values, is an error naming it; the grid is the product of the values each
-/// parameter column takes, so a part that never ran is noticed.
-pub fn merge(parts: &[&Path], out: &Path, metric_columns: usize) -> Result<Merged> {
+/// the rows in configuration order. Every row is checked as a resumed one is
+/// ([`check_row`]) and must have the same `configurations` and settings as every other; a
+/// configuration missing from every part, or given twice with different values, is an error
+/// naming it. The grid's size is the `configurations` the rows record, so a part that never
+/// ran is noticed.
+pub fn merge(parts: &[&Path], out: &Path) -> Result<Merged> {
     if parts.is_empty() {
         bail!("give the CSVs of the parts to merge");
     }
-    let mut header: Option<(Vec<String>, &Path)> = None;
+    let hint = "not a row of `seethru sweep` (remove it, or run that part again)";
+    let mut header: Option<(Vec<String>, Vec<String>, &Path)> = None;
+    let mut first_tail: Option<(Vec<String>, &Path, usize)> = None;
     let mut rows: BTreeMap<usize, (Vec<String>, &Path, usize)> = BTreeMap::new();
     for &part in parts {
         let text = read_input_text(part, MAX_SWEEP_CSV_BYTES)
             .with_context(|| format!("cannot read {}", part.display()))?;
         let mut records = records(&text, part)?.into_iter();
         let first = records.next().map(|(_, r)| r).unwrap_or_default();
-        match &header {
-            None => header = Some((first.clone(), part)),
-            Some((h, from)) if *h != first => bail!(
-                "{}: its header differs from {}'s: not parts of one sweep",
+        let Some(names) = params_of(&first) else {
+            bail!(
+                "{}: not a seethru sweep CSV: its header is {}, where a sweep's is `index`, its parameters, then {}",
                 part.display(),
-                from.display()
+                columns_text(&first, 2),
+                columns_text(&sweep_header(&[])[1..], 0)
+            );
+        };
+        match &header {
+            None => header = Some((first.clone(), names.clone(), part)),
+            Some((h, _, from)) if *h != first => bail!(
+                "{}: its header differs from {}'s ({}): not parts of one sweep",
+                part.display(),
+                from.display(),
+                header_difference(&first, h)
             ),
             Some(_) => {}
         }
-        let columns = first.len();
+        let tail_at = 1 + names.len() + METRIC_COLUMNS.len();
         for (number, fields) in records {
-            let index = fields
-                .first()
-                .and_then(|f| f.parse::<usize>().ok())
-                .filter(|_| fields.len() == columns);
-            let Some(index) = index else {
-                bail!(
-                    "{}:{number}: not a sweep row ({} columns expected, starting with an index)",
-                    part.display(),
-                    columns
-                );
-            };
+            let index = check_row(&fields, names.len(), part, number, hint)?;
+            let tail = &fields[tail_at..];
+            match &first_tail {
+                None => first_tail = Some((tail.to_vec(), part, number)),
+                Some((earlier, from, at)) if earlier.as_slice() != tail => {
+                    let (shown, a, b) = if earlier[0] != tail[0] {
+                        (GRID_COLUMN, tail[0].as_str(), earlier[0].as_str())
+                    } else {
+                        first_difference(&tail[1..], &earlier[1..]).unwrap_or_default()
+                    };
+                    bail!(
+                        "{}:{number}: computed with {shown} {a}, {}:{at} with {shown} {b}: not parts of one sweep",
+                        part.display(),
+                        from.display()
+                    );
+                }
+                Some(_) => {}
+            }
             if let Some((earlier, from, at)) = rows.get(&index) {
                 if *earlier != fields {
                     bail!(
@@ -117,16 +137,14 @@ pub fn merge(parts: &[&Path], out: &Path, metric_columns: usize) -> Result<Merge
             rows.insert(index, (fields, part, number));
         }
     }
-    let (header, _) = header.expect("at least one part");
-    if header.first().map(String::as_str) != Some("index") || header.len() < 1 + metric_columns + 1
-    {
+    let (header, param_names, _) = header.expect("at least one part");
+    let Some((tail, _, _)) = first_tail else {
         bail!(
-            "{}: not a seethru sweep CSV (header `{}`)",
-            parts[0].display(),
-            encode(&header)
+            "the parts hold no configurations (header only): nothing to merge — run their shards (or resume them) and merge again"
         );
-    }
-    let param_names = &header[1..header.len() - metric_columns];
+    };
+    // check_row admitted it: an integer in [1, MAX_CONFIGURATIONS].
+    let expected: usize = tail[0].parse().unwrap_or(0);
     // Each parameter's values in grid order: the grid runs the first parameter slowest, so
     // the order of first appearance by index is the order given on the command line.
     let mut params: Vec<Param> = param_names
@@ -143,21 +161,21 @@ pub fn merge(parts: &[&Path], out: &Path, metric_columns: usize) -> Result<Merge
             }
         }
     }
-    let expected: usize = params.iter().map(|p| p.values.len()).product();
     let missing: Vec<String> = (0..expected)
         .filter(|i| !rows.contains_key(i))
         .map(|i| i.to_string())
         .collect();
-    if !missing.is_empty() || rows.keys().any(|&i| i >= expected) {
+    if !missing.is_empty() {
         bail!(
-            "the parts hold {} of the grid's {expected} configurations; missing: {} — run their shards (or resume them) and merge again",
+            "the parts hold {} of the grid's {expected} configurations; missing: {}{} — run their shards (or resume them) and merge again",
             rows.len(),
             missing
                 .iter()
                 .take(20)
                 .cloned()
                 .collect::<Vec<_>>()
-                .join(", ")
+                .join(", "),
+            if missing.len() > 20 { ", …" } else { "" }
         );
     }
     let body: Vec<(usize, String)> = rows

@@ -20,6 +20,8 @@ pub const MAX_COORDINATE: f64 = 1e6;
 pub const MAX_LENGTH: f64 = 1e5;
 /// Smallest size, radius, height or scale factor: below it, f32 geometry degenerates.
 pub const MIN_LENGTH: f64 = 1e-6;
+/// Largest side of the obstacle (its display), metres.
+pub const MAX_DISPLAY_SIZE: f64 = 100.0;
 /// Largest rotation angle in a scene file, degrees (either sign).
 pub const MAX_ROTATION_DEG: f64 = 360.0;
 /// Largest distance of a camera mounted on the obstacle from the display centre, metres.

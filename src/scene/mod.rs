@@ -3,6 +3,7 @@
 //! World frame: right-handed, metres, +y up. See `README.md` § "Scene format" for the
 //! parameter table of every object kind; the defaults below are the ones documented there.
 
+pub mod fingerprint;
 pub mod grow;
 pub mod head_path;
 pub mod lens_keys;
@@ -201,7 +202,7 @@ impl Obstacle {
 pub struct Scene {
     /// The scene file this was read from.
     pub path: PathBuf,
-    /// The content hash of that file's text (`util::input_file::content_hash`), recorded by
+    /// The content hash of that file's text (`util::hash::content_hash`), recorded by
     /// `run` so that `measure` can tell the scene changed.
     pub source_hash: String,
     pub sun: Sun,

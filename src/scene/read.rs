@@ -8,8 +8,8 @@ use glam::{DAffine3, DMat3, DQuat, DVec3, EulerRot};
 
 use crate::geometry::camera::{Camera, world_from_camera_rotation};
 use crate::scene::limits::{
-    MAX_LENGTH, MAX_MATERIALS, MAX_MOUNT_OFFSET, MAX_OBJECTS, MAX_ROTATION_DEG, MAX_TRIANGLES,
-    MAX_UV_REPEAT, MIN_LENGTH, out_of_world,
+    MAX_DISPLAY_SIZE, MAX_LENGTH, MAX_MATERIALS, MAX_MOUNT_OFFSET, MAX_OBJECTS, MAX_ROTATION_DEG,
+    MAX_TRIANGLES, MAX_UV_REPEAT, MIN_LENGTH, out_of_world,
 };
 use crate::scene::motion::read_object_motion;
 use crate::scene::source::{SceneError, SourceFile};
@@ -17,8 +17,6 @@ use crate::scene::table_reader::TableReader;
 use crate::scene::{CameraKind, Material, Object, Obstacle, Scene, Shape, Sky, Sun};
 
 const OBJECT_KINDS: [&str; 7] = ["plane", "box", "sphere", "cylinder", "cone", "quad", "mesh"];
-/// Largest display side, metres.
-const MAX_DISPLAY_SIZE: f64 = 100.0;
 
 impl Scene {
     /// Reads and validates a scene file.

@@ -69,9 +69,9 @@ impl SourceFile {
         Ok(Self::from_text(path, text))
     }
 
-    /// The content hash of the text (`util::input_file::content_hash`).
+    /// The content hash of the text (`util::hash::content_hash`).
     pub fn content_hash(&self) -> String {
-        crate::util::input_file::content_hash(self.text.as_bytes())
+        crate::util::hash::content_hash(self.text.as_bytes())
     }
 
     pub fn from_text(path: &Path, text: String) -> Self {

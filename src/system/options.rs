@@ -57,6 +57,9 @@ impl std::str::FromStr for WorkingDistance {
     }
 }
 
+/// Most centimetres of head bias on each axis (`--head-bias-cm`, a sweep's `head_bias_x_cm`).
+pub const MAX_HEAD_BIAS_CM: f64 = 500.0;
+
 /// Where the head position comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
 #[serde(rename_all = "lowercase")]

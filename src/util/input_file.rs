@@ -43,15 +43,6 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
-/// A 64-bit FNV-1a hash of `bytes`, as 16 hex digits: a content fingerprint (to tell that a
-/// file changed, not against an adversary).
-pub fn content_hash(bytes: &[u8]) -> String {
-    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, &b| {
-        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
-    });
-    format!("{hash:016x}")
-}
-
 /// A size in bytes for a message: `64 MiB`, `1 GiB`, `812 bytes`.
 pub fn bytes_text(bytes: u64) -> String {
     const UNITS: [(&str, u64); 3] = [("GiB", 1 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)];

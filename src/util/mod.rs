@@ -1,8 +1,10 @@
 //! Small pieces every layer uses: sRGB transfer functions, deterministic hashing for
-//! sampling, short numbers for messages, the progress line, JSON for infinite distances and
-//! the process's peak memory; errors as one inert line.
+//! sampling and FNV-1a for fingerprints, short numbers for messages, the progress line,
+//! JSON for infinite distances, the process's peak memory, input files read within limits,
+//! and errors as one inert line.
 
 pub mod color;
+pub mod hash;
 pub mod input_file;
 pub mod json;
 pub mod memory;
