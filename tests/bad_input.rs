@@ -656,7 +656,7 @@ fn flags_the_command_would_ignore_are_refused() {
         (
             &["--method", "depth", "--depth-range", "5"],
             &[
-                "--depth-range sets the tof and stereo sensors",
+                "--depth-range does not apply to --depth-sensor ideal",
                 "--depth-sensor tof",
             ],
         ),

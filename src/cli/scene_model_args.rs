@@ -38,9 +38,9 @@ pub struct SceneModelArgs {
 }
 
 impl SceneModelArgs {
-    /// Refuses flags that `method` would ignore without a word: a sensor for a method that
-    /// reads none, a sensor's settings for the ideal sensor (which has none), a fill for a
-    /// method that leaves no holes.
+    /// Refuses flags that `method` would ignore without a word: a sensor or its settings for
+    /// a method that reads no depth, a fill for a method that leaves no holes. (The settings
+    /// of the ideal sensor, which has none, are refused where the sensor is resolved.)
     pub fn check_used_by(&self, method: Method) -> anyhow::Result<()> {
         let given = [
             ("--depth-resolution", self.depth_resolution.is_some()),
@@ -56,13 +56,6 @@ impl SceneModelArgs {
                     .find(|(_, g)| *g)
         {
             bail!("{flag} is read by --method plane-fit and depth only, not by this method");
-        }
-        if self.depth_sensor == SensorKind::Ideal
-            && let Some((flag, _)) = given.iter().find(|(_, g)| *g)
-        {
-            bail!(
-                "{flag} sets the tof and stereo sensors; the ideal sensor (the default) has none: add --depth-sensor tof or stereo"
-            );
         }
         if method != Method::Depth && self.fill != Fill::None {
             bail!("--fill fills the holes of --method depth only");
