@@ -872,7 +872,7 @@ fn the_ratio_command_prints_a_table_and_refuses_bad_compensations() {
     for (extra, needle) in [
         (
             vec!["--model-d2", "0"],
-            "'--model-d2 <METRES|inf>': must be a number in (0, 1000000] or `inf`",
+            "'--model-d2 <METRES|inf>': must be a number in [1e-6, 1000000] or `inf`",
         ),
         (
             vec!["--model-d2", "-3"],

@@ -13,7 +13,7 @@ use crate::render::settings::{RenderSettings, resized};
 use crate::render::views::View;
 use crate::system::depth_sensor::SensorKind;
 use crate::system::options::{Method, RunOptions, WorkingDistance};
-use crate::system::pipeline::{driver_camera, run_with_truth};
+use crate::system::pipeline::{check_display_seen, driver_camera, run_with_truth};
 use crate::system::scene_model::check_scene_model;
 use crate::util::color::encode_srgb8;
 use crate::util::progress::Progress;
@@ -130,6 +130,7 @@ pub fn compare(
         let mut options = candidate.options(base);
         options.progress = false;
         let result = run_with_truth(ctx, &options, Some(&truth))
+            .and_then(|r| check_display_seen(ctx, &r.occluded).map(|()| r))
             .map_err(|e| anyhow::anyhow!("{}: {e:#}", candidate.name()))?;
         let frames = [&result.truth, &result.seethru, &result.occluded];
         let (maps, mut metrics) = measure(ctx, scene, scene.eye(), frames, band);

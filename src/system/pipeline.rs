@@ -213,9 +213,31 @@ fn admissible_offsets(
     )
 }
 
-/// Runs the system on a loaded scene; renders every view.
+/// Runs the system on a loaded scene; renders every view. A display that covers no pixel of
+/// the driver's view is an error: every metric of the run would be undefined.
 pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
-    run_with_truth(ctx, options, None)
+    let result = run_with_truth(ctx, options, None)?;
+    check_display_seen(ctx, &result.occluded)?;
+    Ok(result)
+}
+
+/// Refuses a run whose display covers no pixel of the driver's view (`occluded`): nothing to
+/// measure. (A sweep keeps such a configuration as a row of undefined metrics.)
+pub fn check_display_seen(ctx: &RenderContext, occluded: &Frame) -> Result<()> {
+    let display_face = |(&o, &p): (&u32, &u32)| o == ctx.world.obstacle_id && p == box_face::POS_Z;
+    if !occluded
+        .object_id
+        .iter()
+        .zip(&occluded.part_id)
+        .any(display_face)
+    {
+        bail!(
+            "the display covers no pixel of the driver's {}×{} view: the driver looks away from it, or it is too small or too far to cover a pixel; nothing to measure",
+            occluded.width,
+            occluded.height
+        );
+    }
+    Ok(())
 }
 
 /// The driver's camera a run renders at: the scene's, resized by the options.
@@ -348,21 +370,6 @@ pub fn run_with_truth(
         "occluded",
     );
     timings.insert("occluded".into(), json!(stats.seconds));
-    // Where the display covers no pixel every metric is undefined: say so rather than write
-    // a run whose measurements are all empty.
-    let display_face = |(&o, &p): (&u32, &u32)| o == ctx.world.obstacle_id && p == box_face::POS_Z;
-    if !occluded
-        .object_id
-        .iter()
-        .zip(&occluded.part_id)
-        .any(display_face)
-    {
-        bail!(
-            "the display covers no pixel of the driver's {}×{} view: the driver looks away from it, or it is too small or too far to cover a pixel; nothing to measure",
-            driver.width,
-            driver.height
-        );
-    }
     let placement = DisplayPlacement::new(&scene.obstacle);
     let surface = match options.display {
         DisplayModel::Pixels => DisplaySurface::Pixels {
