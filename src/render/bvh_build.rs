@@ -1,4 +1,4 @@
-//! The binary hierarchy that [`crate::render::bvh`] collapses into wide nodes, built in time
+//! The binary hierarchy that the wide BVH (`bvh.rs`) collapses into wide nodes, built in time
 //! near-linear in the boxes and to a bounded depth for any arrangement of them.
 //!
 //! obvhs' PLOC builder (with reinsertion) makes the best trees, fast, for ordinary scenes. It
