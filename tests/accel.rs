@@ -7,6 +7,7 @@ mod common;
 use glam::Vec3;
 use seethru::geometry::camera::Camera;
 use seethru::render::accel::{Accel, closest_brute_force, make_ray, occluded_brute_force};
+use seethru::render::bvh_build::Builder;
 use seethru::render::camera_rays::CameraRays;
 use seethru::render::views::View;
 use seethru::scene::world::{World, view_bit};
@@ -133,6 +134,18 @@ fn closest_and_occluded_equal_brute_force() {
 }
 
 #[test]
+fn the_das_scene_is_built_by_ploc() {
+    // The top-down build is the fallback for arrangements PLOC degenerates on; das is not one
+    // (its goldens and `bench` figures are PLOC's).
+    let world = World::build(&common::das()).unwrap();
+    let builders = Accel::build(&world).unwrap().builders();
+    assert!(
+        builders.iter().all(|&(b, _)| b == Builder::Ploc),
+        "{builders:?}"
+    );
+}
+
+#[test]
 fn camera_rays_of_every_view_equal_brute_force() {
     let scene = common::das();
     let world = World::build(&scene).unwrap();
@@ -175,4 +188,126 @@ fn hidden_objects_are_invisible_only_in_their_views() {
         .closest(&ray, view_bit::TRUTH)
         .map(|h| world.object_of(h.prim));
     assert_ne!(seen, Some(head_id));
+}
+
+/// Loads `scene` (the minimal scene plus `extra`, mesh files `files` beside it), builds its
+/// hierarchy and renders a small `truth` on a thread that must finish within `limit`; returns
+/// the context. A build that is quadratic, or that fails, fails here.
+fn build_and_render_within(
+    extra: &str,
+    files: &[(&str, String)],
+    limit: std::time::Duration,
+) -> seethru::render::integrator::RenderContext {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    let text = format!("{}{extra}", common::MINIMAL);
+    let scene = common::parse_in(dir.path(), "scene.toml", &text).unwrap();
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let ctx = seethru::render::integrator::RenderContext::new(scene).inspect(|ctx| {
+            let camera = View::Truth.camera(&ctx.scene).with_resolution(32, 18);
+            let settings = seethru::render::settings::RenderSettings {
+                spp: 1,
+                progress: false,
+            };
+            let _ = ctx.render(&camera, view_bit::TRUTH, settings, "truth");
+        });
+        let _ = send.send(ctx.map_err(|e| format!("{e:#}")));
+    });
+    match receive.recv_timeout(limit) {
+        Ok(ctx) => ctx.unwrap(),
+        Err(_) => panic!("the build and render took longer than {limit:?}"),
+    }
+}
+
+/// Rays from around `centre` (within `spread` metres) in random directions, a third of them
+/// aimed at `centre` itself.
+fn rays_around(centre: Vec3, spread: f32, n: u32) -> Vec<(Vec3, Vec3)> {
+    (0..n)
+        .map(|i| {
+            let u = |k| 2.0 * unit_float(hash_words(&[i, k])) - 1.0;
+            let origin = centre + spread * Vec3::new(u(7), u(8).abs(), u(9));
+            let dir = if i % 3 == 0 {
+                (centre - origin).normalize()
+            } else {
+                random_unit(i + 17)
+            };
+            (origin, dir)
+        })
+        .collect()
+}
+
+const LIMIT: std::time::Duration = std::time::Duration::from_secs(8);
+
+fn mesh(path: &str) -> String {
+    format!(
+        "\n[[object]]\nname = \"m\"\nkind = \"mesh\"\npath = \"{path}\"\nmaterial = \"grey\"\ntranslate = [0.0, 0.0, -5.0]\n"
+    )
+}
+
+#[test]
+fn a_mesh_of_coincident_triangles_builds_fast_and_equals_brute_force() {
+    // 50 000 copies of one triangle (a mesh exported twice, many times over): PLOC merged one
+    // pair per pass (minutes), then the hierarchy was too deep.
+    let mut obj = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    obj.push_str(&"f 1 2 3\n".repeat(50_000));
+    let ctx = build_and_render_within(&mesh("m.obj"), &[("m.obj", obj)], LIMIT);
+    let rays = rays_around(Vec3::new(0.3, 0.3, -5.0), 2.0, 300);
+    let hits = compare(&ctx.world, &ctx.accel, &rays, &ALL_VIEWS);
+    assert!(hits > rays.len() / 4, "{hits} hits of {}", rays.len());
+}
+
+#[test]
+fn a_mesh_of_nested_triangles_builds_fast_and_equals_brute_force() {
+    // 20 000 triangles sharing a corner, each larger than the last: every PLOC pass merged
+    // the two smallest (a chain as deep as the triangles are many).
+    let mut obj = String::new();
+    for i in 1..=20_000 {
+        let s = i as f32 * 1e-4;
+        obj.push_str(&format!("v 0 0 0\nv {s} 0 0\nv 0 {s} 0\n"));
+    }
+    for i in 0..20_000 {
+        obj.push_str(&format!("f {} {} {}\n", 3 * i + 1, 3 * i + 2, 3 * i + 3));
+    }
+    let ctx = build_and_render_within(&mesh("m.obj"), &[("m.obj", obj)], LIMIT);
+    let rays = rays_around(Vec3::new(0.3, 0.3, -5.0), 2.0, 300);
+    let hits = compare(&ctx.world, &ctx.accel, &rays, &ALL_VIEWS);
+    assert!(hits > rays.len() / 4, "{hits} hits of {}", rays.len());
+}
+
+fn boxes(n: usize, place: impl Fn(usize) -> [f32; 3]) -> String {
+    (0..n)
+        .map(|i| {
+            let [x, y, z] = place(i);
+            format!(
+                "\n[[object]]\nkind = \"box\"\nmaterial = \"grey\"\nsize = [0.2, 1.0, 0.2]\ntranslate = [{x:?}, {y:?}, {z:?}]\n"
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn many_identical_objects_build_fast_and_equal_brute_force() {
+    // 3000 boxes at one place (a script that puts every object at the origin): 6 s, then
+    // "the scene's hierarchy is deeper than 128 levels".
+    let ctx = build_and_render_within(&boxes(3000, |_| [0.0, 0.5, -5.0]), &[], LIMIT);
+    let rays = rays_around(Vec3::new(0.0, 0.5, -5.0), 2.0, 200);
+    let hits = compare(&ctx.world, &ctx.accel, &rays, &ALL_VIEWS);
+    assert!(hits > rays.len() / 4, "{hits} hits of {}", rays.len());
+}
+
+#[test]
+fn a_long_row_of_evenly_spaced_objects_builds_fast_and_equals_brute_force() {
+    // 30 000 posts a metre apart (17 s before): the costs of neighbouring pairs tie exactly, and PLOC
+    // merged a pair or two per pass.
+    let ctx = build_and_render_within(
+        &boxes(30_000, |i| [i as f32 - 15_000.0, 0.5, -5.0]),
+        &[],
+        LIMIT,
+    );
+    let rays = rays_around(Vec3::new(0.0, 0.5, -5.0), 3.0, 200);
+    let hits = compare(&ctx.world, &ctx.accel, &rays, &ALL_VIEWS);
+    assert!(hits > rays.len() / 8, "{hits} hits of {}", rays.len());
 }

@@ -426,3 +426,22 @@ fn textures_that_are_not_images_or_too_large_name_the_material_and_the_file() {
         render_refused(dir.path(), words);
     }
 }
+
+#[test]
+fn a_byte_order_mark_on_an_obj_or_mtl_is_skipped_not_taken_for_the_first_line() {
+    use seethru::scene::mesh_io::parse_obj;
+    // tobj read `\u{FEFF}v` as an unknown keyword: the first vertex was lost and the face
+    // drawn from the next three, without a word.
+    let obj = "\u{FEFF}v 9 9 9\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let none = |_: &Path| -> std::io::Result<Vec<u8>> { unreachable!() };
+    let mesh = parse_obj(obj.as_bytes(), Path::new("m.obj"), &none).unwrap();
+    assert_eq!(mesh.tris[0].p[0].to_array(), [9.0, 9.0, 9.0]);
+    // A first line `mtllib` was lost too ("usemtl a names no material"); an MTL's first
+    // `newmtl` likewise.
+    let obj = "\u{FEFF}mtllib m.mtl\nusemtl a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let mtl = |_: &Path| Ok(b"\xEF\xBB\xBFnewmtl a\nKd 0.25 0.5 0.75\n".to_vec());
+    let mesh = parse_obj(obj.as_bytes(), Path::new("m.obj"), &mtl).unwrap();
+    assert_eq!(mesh.materials.len(), 1);
+    assert_eq!(mesh.materials[0].name, "a");
+    assert_eq!(mesh.materials[0].linear_color, [0.25, 0.5, 0.75]);
+}

@@ -36,6 +36,8 @@ struct Group {
     casts_shadow: bool,
     /// World box of the group's primitives.
     bounds: Aabb,
+    /// Boxes the hierarchy was built over.
+    boxes: usize,
     bvh: Bvh,
 }
 
@@ -134,6 +136,7 @@ impl Accel {
                 views,
                 casts_shadow,
                 bounds,
+                boxes: boxes.len(),
                 bvh: Bvh::build(world, &boxes, indices)?,
             });
         }
@@ -197,6 +200,14 @@ impl Accel {
         } else {
             Difference::None
         }
+    }
+
+    /// Which builder made each group's hierarchy, with the boxes it holds, largest first.
+    pub fn builders(&self) -> Vec<(crate::render::bvh_build::Builder, usize)> {
+        self.groups
+            .iter()
+            .filter_map(|g| Some((g.bvh.builder?, g.boxes)))
+            .collect()
     }
 
     /// Bytes held by the hierarchies.

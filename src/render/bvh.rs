@@ -1,6 +1,7 @@
 //! A wide bounding volume hierarchy laid out for SIMD traversal of single rays.
 //!
-//! obvhs builds a binary BVH (PLOC, spatial pre-splits, reinsertion); this module collapses it
+//! obvhs builds a binary BVH (PLOC, spatial pre-splits, reinsertion; a top-down build where
+//! PLOC would degenerate: [`crate::render::bvh_build`]); this module collapses it
 //! into nodes of four children whose boxes are stored structure-of-arrays, so that one ray is
 //! tested against all four with a few SSE instructions (glam's `Vec4`, any x86-64), and into
 //! leaves of primitive packets — four triangles tested together, or single ellipsoids
@@ -14,12 +15,10 @@
 
 use anyhow::{Result, bail};
 use glam::Vec4;
-use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
-use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
-use obvhs::ploc::PlocBuilder;
 
+use crate::render::bvh_build;
 use crate::render::packets::{EllipsoidLeaf, TRI_LANES, Triangles4};
 use crate::render::ray::TraceRay;
 use crate::scene::world::World;
@@ -41,6 +40,7 @@ const MAX_LEAF_PACKETS: usize = COUNT_MASK as usize + 1;
 const EMPTY: u32 = u32::MAX;
 /// Traversal stack entries; a hierarchy that could need more is refused at build time.
 const STACK: usize = 512;
+const _: () = assert!(bvh_build::MAX_DEPTH * WIDTH <= STACK);
 /// Box exits are scaled by this before comparison: 8 ulps of headroom for the rounding of
 /// the slab distances against the exact primitive tests.
 const EXIT_ROUND_UP: f32 = 1.0 + 8.0 * f32::EPSILON;
@@ -156,6 +156,8 @@ fn key_entry(key: u64) -> f32 {
 
 /// A wide BVH over the triangles and ellipsoids of a world.
 pub struct Bvh {
+    /// Which builder made the binary hierarchy (None: no primitives).
+    pub builder: Option<bvh_build::Builder>,
     nodes: Vec<Node>,
     triangles: Vec<Triangles4>,
     ellipsoids: Vec<EllipsoidLeaf>,
@@ -166,6 +168,7 @@ impl Bvh {
     /// `prims` (a primitive may have several boxes: spatial splits).
     pub fn build(world: &World, boxes: &[Aabb], prims: Vec<u32>) -> Result<Self> {
         let mut bvh = Bvh {
+            builder: None,
             nodes: Vec::new(),
             triangles: Vec::new(),
             ellipsoids: Vec::new(),
@@ -173,16 +176,9 @@ impl Bvh {
         if boxes.is_empty() {
             return Ok(bvh);
         }
-        let params = BvhBuildParams::medium_build();
-        let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
-            params.ploc_search_distance,
-            boxes,
-            prims,
-            params.sort_precision,
-            params.search_depth_threshold,
-        );
-        bvh2.uses_spatial_splits = true;
-        ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+        let owners: Vec<u32> = prims.iter().map(|&p| world.object_of(p as usize)).collect();
+        let (bvh2, builder) = bvh_build::build(boxes, prims, &owners);
+        bvh.builder = Some(builder);
         let summaries = summarise(&bvh2, world.triangles.len() as u32);
         let mut builder = Builder {
             bvh2: &bvh2,
@@ -418,9 +414,11 @@ impl Builder<'_> {
     /// until there are `WIDTH`.
     fn fill(&mut self, at: usize, start: &[usize], depth: usize) -> Result<()> {
         // A closest-hit query stacks at most WIDTH − 1 entries per level, an any-hit WIDTH.
+        // The binary hierarchy is at most `bvh_build::MAX_DEPTH` deep, and each wide level
+        // descends at least one binary level: this cannot fail.
         if depth * WIDTH > STACK {
             bail!(
-                "the scene's hierarchy is deeper than {} levels",
+                "internal error: the scene's hierarchy is deeper than {} levels",
                 STACK / WIDTH
             );
         }
@@ -501,7 +499,10 @@ impl Builder<'_> {
             (first, prims.len(), ELLIPSOIDS)
         };
         if count > MAX_LEAF_PACKETS || first + count > FIRST_MASK as usize {
-            bail!("the scene has too many primitives for the BVH's leaf references");
+            bail!(
+                "the scene has more than {} triangle packets or ellipsoids in one hierarchy, the most its leaf references hold: use fewer or coarser meshes",
+                FIRST_MASK
+            );
         }
         Ok(LEAF | kind | ((count as u32 - 1) << COUNT_SHIFT) | first as u32)
     }

@@ -3,6 +3,7 @@
 
 pub mod accel;
 pub mod bvh;
+pub mod bvh_build;
 pub mod camera_rays;
 pub mod footprint;
 pub mod frame;

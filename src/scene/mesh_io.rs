@@ -103,6 +103,11 @@ fn checked(mesh: LoadedMesh) -> Result<LoadedMesh> {
     Ok(mesh)
 }
 
+/// `bytes` without a leading UTF-8 byte order mark.
+fn without_bom(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes)
+}
+
 /// Parses an OBJ file's bytes; `path` names it and anchors its `mtllib` files, which `read`
 /// reads.
 pub fn parse_obj(
@@ -110,6 +115,9 @@ pub fn parse_obj(
     path: &Path,
     read: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
 ) -> Result<LoadedMesh> {
+    // tobj reads a UTF-8 byte order mark as part of the first keyword and drops that line
+    // without a word (a first vertex lost shifts every face onto the wrong vertices).
+    let bytes = without_bom(bytes);
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -129,7 +137,7 @@ pub fn parse_obj(
             ));
             Err(tobj::LoadError::OpenFileFailed)
         };
-        match read(&resolved) {
+        match read(&resolved).map(|mtl| without_bom(&mtl).to_vec()) {
             Ok(mtl) => match check_mtl_lines(&mtl) {
                 Err(why) => fail(why),
                 Ok(()) => tobj::load_mtl_buf(&mut BufReader::new(Cursor::new(mtl)))
