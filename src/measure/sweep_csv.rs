@@ -176,7 +176,12 @@ pub fn header_difference(found: &[String], expected: &[String]) -> String {
     let at = (0..found.len().max(expected.len()))
         .find(|&i| found.get(i) != expected.get(i))
         .unwrap_or(0);
-    let which = match (found.get(at), expected.get(at)) {
+    // Names as written in the file may hold quotes and line breaks: escaped, cut.
+    let name = |c: &String| -> String {
+        let start: String = c.chars().take(40).collect();
+        start.escape_debug().to_string()
+    };
+    let which = match (found.get(at).map(name), expected.get(at).map(name)) {
         (Some(f), Some(e)) => format!("column {} is `{f}` where `{e}` belongs", at + 1),
         (None, Some(e)) => format!("column {} (`{e}`) is missing", at + 1),
         (Some(f), None) => format!("column {} (`{f}`) is extra", at + 1),
