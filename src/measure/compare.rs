@@ -9,7 +9,7 @@ use crate::measure::maps::heat_color;
 use crate::measure::metrics::{MetricMaps, measure};
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
-use crate::render::settings::{RenderSettings, resized};
+use crate::render::settings::RenderSettings;
 use crate::render::views::View;
 use crate::system::depth_sensor::SensorKind;
 use crate::system::options::{Method, RunOptions, WorkingDistance};
@@ -111,12 +111,7 @@ pub fn compare(
         let options = candidate.options(base);
         if options.method.models_the_scene() {
             let mut scene = scene.clone();
-            scene.frontal = resized(
-                scene.frontal,
-                options.frontal_width,
-                None,
-                "--frontal-width",
-            )?;
+            scene.frontal = options.sized_frontal(scene.frontal)?;
             check_scene_model(&scene, &options)
                 .map_err(|e| anyhow::anyhow!("{}: {e:#}", candidate.name()))?;
         }

@@ -6,7 +6,6 @@ use anyhow::{Result, bail};
 
 use crate::geometry::camera::Camera;
 use crate::render::frame::Frame;
-use crate::render::settings::resized;
 use crate::scene::Scene;
 use crate::system::options::RunOptions;
 
@@ -52,19 +51,9 @@ pub fn render_estimate(cameras: &[Camera]) -> MemoryEstimate {
 /// `run`: the six views are held together, written side by side (as many EXRs encoded at
 /// once as there are threads, up to all six), and measured.
 pub fn run_estimate(scene: &Scene, options: &RunOptions) -> Result<MemoryEstimate> {
-    let driver = resized(
-        scene.driver,
-        options.width,
-        options.height,
-        "--width/--height",
-    )?;
-    let frontal = resized(
-        scene.frontal,
-        options.frontal_width,
-        None,
-        "--frontal-width",
-    )?;
-    let back = resized(scene.back, options.back_width, None, "--back-width")?;
+    let driver = options.sized_driver(scene.driver)?;
+    let frontal = options.sized_frontal(scene.frontal)?;
+    let back = options.sized_back(scene.back)?;
     let [dw, dh] = scene.obstacle.display_resolution;
     let display = dw as u64 * dh as u64;
     let frames = 3 * pixels(&driver) + pixels(&frontal) + pixels(&back) + display;
@@ -90,12 +79,7 @@ pub fn run_estimate(scene: &Scene, options: &RunOptions) -> Result<MemoryEstimat
 /// kept for the binocular outputs while the second eye runs.
 pub fn both_eyes_estimate(scene: &Scene, options: &RunOptions) -> Result<MemoryEstimate> {
     let one = run_estimate(scene, options)?;
-    let driver = resized(
-        scene.driver,
-        options.width,
-        options.height,
-        "--width/--height",
-    )?;
+    let driver = options.sized_driver(scene.driver)?;
     let [dw, dh] = scene.obstacle.display_resolution;
     let kept = (pixels(&driver) + dw as u64 * dh as u64) * FRAME_BYTES_PER_PIXEL;
     Ok(MemoryEstimate {

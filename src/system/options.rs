@@ -1,6 +1,8 @@
 //! The choices of one run of the see-through system: method, working distance, head source,
 //! injected head errors, sizes, and how the display is modelled.
 
+use crate::geometry::camera::Camera;
+use crate::render::settings::resized;
 use crate::scene::limits::{MAX_COORDINATE, MIN_LENGTH};
 use crate::system::display::{DisplayModel, Filter};
 use crate::system::eyes::Eyes;
@@ -109,6 +111,23 @@ pub struct RunOptions {
     /// The depth sensor and hole filling of `ground`, `plane-fit` and `depth`.
     pub scene_model: SceneModelOptions,
     pub progress: bool,
+}
+
+impl RunOptions {
+    /// The driver's camera (as given, before the eye is chosen) at `--width`/`--height`.
+    pub fn sized_driver(&self, camera: Camera) -> anyhow::Result<Camera> {
+        resized(camera, self.width, self.height, "--width/--height")
+    }
+
+    /// The frontal camera at `--frontal-width`.
+    pub fn sized_frontal(&self, camera: Camera) -> anyhow::Result<Camera> {
+        resized(camera, self.frontal_width, None, "--frontal-width")
+    }
+
+    /// The back camera at `--back-width`.
+    pub fn sized_back(&self, camera: Camera) -> anyhow::Result<Camera> {
+        resized(camera, self.back_width, None, "--back-width")
+    }
 }
 
 impl Default for RunOptions {

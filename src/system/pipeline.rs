@@ -12,7 +12,7 @@ use crate::geometry::camera::Camera;
 use crate::geometry::homography::homography;
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
-use crate::render::settings::{RenderSettings, check_spp, resized};
+use crate::render::settings::{RenderSettings, check_spp};
 use crate::render::views::View;
 use crate::scene::shapes::box_face;
 use crate::scene::world::view_bit;
@@ -242,12 +242,7 @@ pub fn check_display_seen(ctx: &RenderContext, occluded: &Frame) -> Result<()> {
 
 /// The driver's camera a run renders at: the scene's, resized by the options.
 pub fn driver_camera(scene: &Scene, options: &RunOptions) -> Result<Camera> {
-    resized(
-        options.eyes.view_camera(&scene.driver),
-        options.width,
-        options.height,
-        "--width/--height",
-    )
+    options.sized_driver(options.eyes.view_camera(&scene.driver))
 }
 
 /// [`run`], given the `truth` frame when it is already rendered (a sweep renders it once for
@@ -259,13 +254,8 @@ pub fn run_with_truth(
     truth: Option<&Frame>,
 ) -> Result<RunResult> {
     let mut scene = ctx.scene.clone();
-    scene.frontal = resized(
-        scene.frontal,
-        options.frontal_width,
-        None,
-        "--frontal-width",
-    )?;
-    scene.back = resized(scene.back, options.back_width, None, "--back-width")?;
+    scene.frontal = options.sized_frontal(scene.frontal)?;
+    scene.back = options.sized_back(scene.back)?;
     let scene = &scene;
     check_spp(options.spp)?;
     if !(options.feature_width > 0.0 && options.feature_width.is_finite()) {

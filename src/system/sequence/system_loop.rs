@@ -19,7 +19,7 @@ use crate::render::footprint::PixelRect;
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::render::moving::MovingParts;
-use crate::render::settings::{RenderSettings, check_spp, resized};
+use crate::render::settings::{RenderSettings, check_spp};
 use crate::render::sky::SkyModel;
 use crate::scene::Scene;
 use crate::scene::world::{World, view_bit};
@@ -122,8 +122,8 @@ impl SystemLoop {
             bail!("--feature-width must be > 0 m, got {}", run.feature_width);
         }
         let mut base = scene.clone();
-        base.frontal = resized(base.frontal, run.frontal_width, None, "--frontal-width")?;
-        base.back = resized(base.back, run.back_width, None, "--back-width")?;
+        base.frontal = run.sized_frontal(base.frontal)?;
+        base.back = run.sized_back(base.back)?;
         base.driver = driver_camera(&base, run)?;
         let rig = Rig::new(base, options.speed, options.yaw_rate, options.head.clone());
         let tl = options.timeline;
