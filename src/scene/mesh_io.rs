@@ -11,6 +11,7 @@
 //! refers to (`.mtl`, `.bin`), so that they can be fuzzed without a file system.
 
 use std::cell::RefCell;
+use std::collections::HashMap;
 use std::io::{BufReader, Cursor};
 use std::path::{Path, PathBuf};
 
@@ -19,7 +20,7 @@ use glam::{Mat4, Vec2, Vec3};
 
 use crate::scene::limits::{MAX_MESH_BYTES, MAX_TRIANGLES, first_bad_vertex};
 use crate::scene::mesh_checks::{
-    check_glb_header, check_mtl_lines, check_usemtl_names, obj_error_line, validated,
+    check_glb_header, check_mtl_lines, check_usemtl_names, clipped, obj_error_line, validated,
 };
 use crate::scene::shapes::Tri;
 use crate::util::number::short_list;
@@ -127,8 +128,19 @@ pub fn parse_obj(
     let dir = path.parent().unwrap_or(Path::new(""));
     // tobj's material errors carry no path: remember ours.
     let mtl_error: RefCell<Option<String>> = RefCell::new(None);
+    // Each library is read and parsed once: tobj calls this for every `mtllib` line and
+    // appends the library's materials again each time (a file of many `mtllib` lines of one
+    // library was quadratic, found by fuzzing). The names each library defined, to refuse a
+    // name that two libraries define (tobj would let the later one win without a word).
+    let loaded: RefCell<Vec<PathBuf>> = RefCell::new(Vec::new());
+    let defined_by: RefCell<HashMap<String, String>> = RefCell::new(HashMap::new());
     let load_mtl = |written: &Path| -> tobj::MTLLoadResult {
         let resolved = dir.join(written);
+        let nothing = || Ok((Vec::new(), Default::default()));
+        if mtl_error.borrow().is_some() || loaded.borrow().contains(&resolved) {
+            return nothing();
+        }
+        loaded.borrow_mut().push(resolved.clone());
         let fail = |why: String| {
             mtl_error.borrow_mut().get_or_insert(format!(
                 "material library `{}` (resolved against the OBJ's folder: {}): {why}",
@@ -137,14 +149,30 @@ pub fn parse_obj(
             ));
             Err(tobj::LoadError::OpenFileFailed)
         };
-        match read(&resolved).map(|mtl| without_bom(&mtl).to_vec()) {
-            Ok(mtl) => match check_mtl_lines(&mtl) {
-                Err(why) => fail(why),
-                Ok(()) => tobj::load_mtl_buf(&mut BufReader::new(Cursor::new(mtl)))
-                    .or_else(|e| fail(e.to_string())),
-            },
-            Err(e) => fail(e.to_string()),
+        let mtl = match read(&resolved) {
+            Ok(mtl) => without_bom(&mtl).to_vec(),
+            Err(e) => return fail(e.to_string()),
+        };
+        if let Err(why) = check_mtl_lines(&mtl) {
+            return fail(why);
         }
+        let (materials, names) = match tobj::load_mtl_buf(&mut BufReader::new(Cursor::new(mtl))) {
+            Ok(parsed) => parsed,
+            Err(e) => return fail(e.to_string()),
+        };
+        let mut defined_by = defined_by.borrow_mut();
+        for m in &materials {
+            if let Some(first) = defined_by.get(&m.name) {
+                return fail(format!(
+                    "material `{}` is defined by the library `{first}` too: a name must be defined once",
+                    clipped(&m.name)
+                ));
+            }
+        }
+        for m in &materials {
+            defined_by.insert(m.name.clone(), written.display().to_string());
+        }
+        Ok((materials, names))
     };
     if let Some(why) = obj_error_line(bytes) {
         bail!("invalid OBJ: {why}");
