@@ -626,3 +626,110 @@ fn mtl_lines_tobj_reads_wrongly_or_without_a_line_are_refused_naming_the_mtl_and
         );
     }
 }
+
+#[test]
+fn gltf_files_tobj_or_the_gltf_crate_misread_are_refused_naming_what_is_wrong() {
+    // Each differs from the valid file in one part.
+    let base = gltf_json(&Gltf::default());
+    for (json, words) in [
+        // The last index was dropped without a word.
+        (
+            base.replace(r#""count": 3"#, r#""count": 2"#)
+                .replace(r#""byteLength": 36}]"#, r#""byteLength": 36}]"#),
+            &["POSITION (accessor 0, no indices) has 2 elements, not a multiple of 3"][..],
+        ),
+        (
+            base.replace("[0.5, 0.5, 0.5, 1]", "[0.5, 0.5, 0.5, 7]"),
+            &["material `paint`", "alpha 7", "[0, 1]"],
+        ),
+        (
+            base.replace(
+                r#"[{"mesh": 0}]"#,
+                r#"[{"mesh": 0, "rotation": [0, 0, 0, 0]}]"#,
+            ),
+            &["node 0", "[0, 0, 0, 0]", "length 0", "unit quaternion"],
+        ),
+        (
+            base.replace(r#"[{"mesh": 0}]"#, r#"[{"mesh": 0, "children": [4]}]"#),
+            &[
+                "nodes[0].children[0]",
+                "index 4 is out of bounds",
+                "1 nodes",
+            ],
+        ),
+        // Mesh textures are not read: refused rather than dropped without a word.
+        (
+            base.replace(
+                r#""pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}"#,
+                r#""pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}"#,
+            )
+            .replace(
+                r#""meshes""#,
+                r#""textures": [{"source": 0}], "images": [{"uri": "paint.png"}], "meshes""#,
+            ),
+            &[
+                "material `paint`",
+                "baseColorTexture",
+                "`paint.png`",
+                "mesh textures are not read",
+                "baseColorFactor",
+                "[[material]]",
+            ],
+        ),
+        (String::new(), &["not a GLB/glTF", "empty"]),
+        ("PK\u{3}\u{4}zip".into(), &["not a GLB/glTF", "`PK"]),
+    ] {
+        let dir = scratch(&mesh_object("m.gltf"), &[("m.gltf", json.as_bytes())]);
+        render_refused(dir.path(), &[&["mesh m.gltf"][..], words].concat());
+    }
+    // GLBs: a wrong magic, and chunks that do not fit.
+    let glb = |json_length: u32, json: &[u8]| {
+        let total = 20 + json.len() as u32;
+        [
+            &b"glTF"[..],
+            &2u32.to_le_bytes(),
+            &total.to_le_bytes(),
+            &json_length.to_le_bytes(),
+            b"JSON",
+            json,
+        ]
+        .concat()
+    };
+    let json = b"{\"asset\":{\"version\":\"2.0\"}}".to_vec();
+    let padded = [&json[..], &[b' '; 4][..4 - json.len() % 4]].concat();
+    for (bytes, words) in [
+        (b"gltf\x02\0\0\0".to_vec(), &["not a GLB/glTF", "`gltf"][..]),
+        (
+            glb(1000, &padded),
+            &["JSON chunk declares 1000 bytes", "follow its header"],
+        ),
+        (
+            glb(0, &padded),
+            &["JSON chunk is 0 bytes long", "multiple of 4"],
+        ),
+        (glb(7, &padded), &["JSON chunk is 7 bytes long"]),
+    ] {
+        let dir = scratch(&mesh_object("m.glb"), &[("m.glb", &bytes)]);
+        render_refused(dir.path(), &[&["mesh m.glb"][..], words].concat());
+    }
+    // The crate's "Image size exceeds limit" named no size, and its PNG errors came twice.
+    let wide = {
+        let mut png = Vec::new();
+        image::RgbImage::new(16385, 1)
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        png
+    };
+    for (bytes, words) in [
+        (&wide[..], &["16385×1 px", "16384 px a side"][..]),
+        (b"\x89PNG\r\n\x1a\x00 not one", &["material `t`"]),
+    ] {
+        let dir = scratch(
+            "\n[[material]]\nname = \"t\"\ntexture = \"tex.png\"\n",
+            &[("tex.png", bytes)],
+        );
+        let err = render_refused(dir.path(), words);
+        let tail = err.rsplit(": ").next().unwrap();
+        assert!(!err[..err.len() - tail.len()].contains(tail), "{err}");
+    }
+}

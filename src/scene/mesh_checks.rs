@@ -188,7 +188,9 @@ pub(crate) fn check_glb_header(bytes: &[u8]) -> Result<()> {
             .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
     };
     match (word(4), word(8)) {
-        (Some(2), Some(length)) if (12 + 8..=bytes.len()).contains(&length) => Ok(()),
+        (Some(2), Some(length)) if (12 + 8..=bytes.len()).contains(&length) => {
+            check_glb_chunks(&bytes[..length])
+        }
         (Some(2), Some(length)) => bail!(
             "invalid GLB: its header declares {length} bytes; a GLB holds at least 20 and this file has {}",
             bytes.len()
@@ -196,6 +198,104 @@ pub(crate) fn check_glb_header(bytes: &[u8]) -> Result<()> {
         (Some(version), Some(_)) => bail!("invalid GLB: version {version}, only 2 is read"),
         _ => bail!("invalid GLB: the file ends inside its 12-byte header"),
     }
+}
+
+/// A GLB's chunks (after its 12-byte header) must be a JSON chunk, not empty and a multiple
+/// of 4 bytes long, then at most one BIN chunk, each inside the length the header declares:
+/// the gltf crate says "JSON chunk length exceeds that of slice" or "unknown chunk type".
+fn check_glb_chunks(glb: &[u8]) -> Result<()> {
+    let word = |at: usize| {
+        glb.get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+    };
+    let mut at = 12;
+    for (n, (kind, name)) in [(0x4E4F_534A, "JSON"), (0x004E_4942, "BIN")]
+        .into_iter()
+        .enumerate()
+    {
+        if n == 1 && at == glb.len() {
+            return Ok(()); // no BIN chunk
+        }
+        let (Some(length), Some(found)) = (word(at), word(at + 4)) else {
+            bail!(
+                "invalid GLB: the {name} chunk's 8-byte header at byte {at} does not fit the {} bytes the GLB header declares",
+                glb.len()
+            );
+        };
+        if found != kind {
+            bail!(
+                "invalid GLB: chunk {n} at byte {at} has the type {:?}; expected {name}",
+                String::from_utf8_lossy(&glb[at + 4..at + 8])
+            );
+        }
+        let room = glb.len() - at - 8;
+        if length > room {
+            bail!(
+                "invalid GLB: its {name} chunk declares {length} bytes, but {room} follow its header within the {} bytes the GLB header declares",
+                glb.len()
+            );
+        }
+        if n == 0 && (length == 0 || !length.is_multiple_of(4)) {
+            bail!(
+                "invalid GLB: its JSON chunk is {length} bytes long; it must be a non-zero multiple of 4 (padded with spaces)"
+            );
+        }
+        at += 8 + length;
+    }
+    if at != glb.len() {
+        bail!(
+            "invalid GLB: {} bytes follow its BIN chunk within the {} bytes the GLB header declares",
+            glb.len() - at,
+            glb.len()
+        );
+    }
+    Ok(())
+}
+
+/// Where the glTF JSON `path` (`nodes[0].children[1]`) leads in `root`, if anywhere.
+fn json_at<'a>(root: &'a serde_json::Value, path: &str) -> Option<&'a serde_json::Value> {
+    let mut value = root;
+    for part in path.split('.') {
+        let (name, indices) = part.split_once('[').map_or((part, ""), |(n, i)| (n, i));
+        if !name.is_empty() {
+            value = value.get(name)?;
+        }
+        for index in indices.split('[').filter(|i| !i.is_empty()) {
+            let index = index.trim_end_matches(']');
+            value = match index.parse::<usize>() {
+                Ok(i) => value.get(i)?,
+                Err(_) => value.get(index.trim_matches('"'))?,
+            };
+        }
+    }
+    Some(value)
+}
+
+/// The top-level array an index at `path` points into (`nodes[0].children[1]`: `nodes`).
+fn indexed_array(path: &str) -> Option<&'static str> {
+    let field = path.rsplit('.').next()?;
+    let field = field.split('[').next()?;
+    Some(match field {
+        "children" | "nodes" | "node" | "joints" | "skeleton" => "nodes",
+        "mesh" => "meshes",
+        "material" => "materials",
+        "indices"
+        | "attributes"
+        | "accessor"
+        | "inverseBindMatrices"
+        | "input"
+        | "output"
+        | "targets" => "accessors",
+        "bufferView" => "bufferViews",
+        "buffer" => "buffers",
+        "scene" => "scenes",
+        "camera" => "cameras",
+        "skin" => "skins",
+        "source" => "images",
+        "sampler" => "samplers",
+        "index" => "textures",
+        _ => return None,
+    })
 }
 
 /// The glTF document if it passes the gltf crate's validation, whose errors are listed
@@ -215,12 +315,30 @@ pub(crate) fn validated(json: gltf::json::Root) -> Result<gltf::Document> {
             }
         }
     }
+    // For "Index out of bounds": the index and the count the crate does not give.
+    let value = serde_json::to_value(&json).unwrap_or_default();
     gltf::Document::from_json(json).map_err(|e| match e {
         gltf::Error::Validation(errors) => {
             let mut listed: Vec<String> = errors
                 .iter()
                 .take(3)
-                .map(|(path, error)| format!("{path}: {error}"))
+                .map(|(path, error)| {
+                    let path = path.to_string();
+                    let index = json_at(&value, &path).and_then(serde_json::Value::as_u64);
+                    match (error, index) {
+                        (gltf::json::validation::Error::IndexOutOfBounds, Some(index)) => {
+                            match indexed_array(&path) {
+                                Some(array) => format!(
+                                    "{path}: index {index} is out of bounds: the file has {} {array}, [0, {}]",
+                                    value[array].as_array().map_or(0, Vec::len),
+                                    value[array].as_array().map_or(0, Vec::len) as i64 - 1
+                                ),
+                                None => format!("{path}: index {index} is out of bounds"),
+                            }
+                        }
+                        _ => format!("{path}: {error}"),
+                    }
+                })
                 .collect();
             if errors.len() > 3 {
                 listed.push(format!("and {} more", errors.len() - 3));

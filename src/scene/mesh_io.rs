@@ -23,7 +23,7 @@ use crate::scene::mesh_checks::{
     check_glb_header, check_mtl_lines, check_usemtl_names, clipped, obj_error_line, validated,
 };
 use crate::scene::shapes::Tri;
-use crate::util::number::short_list;
+use crate::util::number::{short, short_list};
 
 /// A material that a mesh file defines.
 #[derive(Clone, Debug, PartialEq)]
@@ -48,7 +48,7 @@ pub fn read_limited(path: &Path) -> std::io::Result<Vec<u8>> {
 /// Loads an OBJ (with its MTL files) or a glTF/GLB (with its buffers). Errors name the file.
 pub fn load_mesh(path: &Path) -> Result<LoadedMesh> {
     let lower = path.to_string_lossy().to_ascii_lowercase();
-    let bytes = read_limited(path).with_context(|| format!("cannot read mesh {}", path.display()));
+    let bytes = read_limited(path).context("cannot read it");
     let mesh = bytes.and_then(|bytes| {
         if lower.ends_with(".obj") {
             parse_obj(&bytes, path, &read_limited)
@@ -246,10 +246,57 @@ pub fn parse_gltf(
     path: &Path,
     read: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
 ) -> Result<LoadedMesh> {
+    let start = bytes.iter().position(|b| !b.is_ascii_whitespace());
+    match start.map(|i| &bytes[i..]) {
+        None => bail!("not a GLB/glTF: the file is empty (or only white space)"),
+        Some(text) if !text.starts_with(b"{") && !bytes.starts_with(b"glTF") => bail!(
+            "not a GLB/glTF: it starts with `{}`; a GLB starts with `glTF`, a glTF file is JSON starting with `{{`",
+            clipped(&String::from_utf8_lossy(&text[..text.len().min(8)]))
+        ),
+        Some(_) => {}
+    }
     check_glb_header(bytes)?;
     let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(bytes)
         .map_err(|e| anyhow!("invalid glTF: {e}"))?;
     let doc = validated(document.into_json())?;
+    for m in doc.materials() {
+        let name = m
+            .name()
+            .map_or_else(|| format!("#{}", m.index().unwrap_or(0)), String::from);
+        let pbr = m.pbr_metallic_roughness();
+        let alpha = pbr.base_color_factor()[3];
+        if !(0.0..=1.0).contains(&alpha) {
+            bail!(
+                "material `{}` has the baseColorFactor alpha {}: it must be in [0, 1]",
+                clipped(&name),
+                short(f64::from(alpha))
+            );
+        }
+        if let Some(t) = pbr.base_color_texture() {
+            let image = match t.texture().source().source() {
+                gltf::image::Source::Uri { uri, .. } => format!("`{}`", clipped(uri)),
+                gltf::image::Source::View { view, .. } => format!("bufferView {}", view.index()),
+            };
+            bail!(
+                "material `{}` has a baseColorTexture (texture {}, image {image}): mesh textures are not read; bake the colour into baseColorFactor, or give the object a scene [[material]] with `texture`",
+                clipped(&name),
+                t.texture().index()
+            );
+        }
+    }
+    for node in doc.nodes() {
+        if let gltf::scene::Transform::Decomposed { rotation, .. } = node.transform() {
+            let length = rotation.iter().map(|q| q * q).sum::<f32>().sqrt();
+            if !(length - 1.0).abs().le(&0.01) {
+                bail!(
+                    "node {} has the rotation {}, a quaternion of length {}: it must be a unit quaternion (length 1 ± 0.01)",
+                    node.index(),
+                    short_list(&rotation.map(f64::from)),
+                    short(f64::from(length))
+                );
+            }
+        }
+    }
     let buffers = load_buffers(&doc, blob, path, read)?;
     let mut out = LoadedMesh {
         materials: doc
@@ -469,7 +516,17 @@ fn read_primitive(
             buffers,
         )?;
     }
-    let count = indices.as_ref().map_or(positions.count(), |i| i.count()) / 3;
+    let corners = indices.as_ref().map_or(positions.count(), |i| i.count());
+    if !corners.is_multiple_of(3) {
+        let what = match &indices {
+            Some(i) => format!("its indices (accessor {})", i.index()),
+            None => format!("its POSITION (accessor {}, no indices)", positions.index()),
+        };
+        bail!(
+            "{what} has {corners} elements, not a multiple of 3: a triangle list takes three a triangle"
+        );
+    }
+    let count = corners / 3;
     if tris.len() + count > MAX_TRIANGLES {
         bail!("more than the limit of {MAX_TRIANGLES} triangles");
     }
