@@ -102,21 +102,19 @@ pub(crate) fn check_mtl_lines(mtl: &[u8]) -> std::result::Result<(), String> {
                     ));
                 }
             }
-            Some(key @ ("Ns" | "Ni" | "d" | "Tr")) => {
-                if rest.len() != 1 || rest[0].parse::<f32>().is_err() {
-                    return at(format!(
-                        "`{key}` needs one number, got `{}`",
-                        clipped(&rest.join(" "))
-                    ));
-                }
+            Some(key @ ("Ns" | "Ni" | "d" | "Tr"))
+                if rest.len() != 1 || rest[0].parse::<f32>().is_err() =>
+            {
+                return at(format!(
+                    "`{key}` needs one number, got `{}`",
+                    clipped(&rest.join(" "))
+                ));
             }
-            Some("illum") => {
-                if rest.len() != 1 || rest[0].parse::<u8>().is_err() {
-                    return at(format!(
-                        "`illum` needs one integer in [0, 255], got `{}`",
-                        clipped(&rest.join(" "))
-                    ));
-                }
+            Some("illum") if rest.len() != 1 || rest[0].parse::<u8>().is_err() => {
+                return at(format!(
+                    "`illum` needs one integer in [0, 255], got `{}`",
+                    clipped(&rest.join(" "))
+                ));
             }
             Some(
                 key @ ("map_Ka" | "map_Kd" | "map_Ks" | "map_Bump" | "map_bump" | "map_Ns"
