@@ -381,7 +381,7 @@ fn gltf_references_that_point_nowhere_are_named() {
         &[
             "invalid glTF",
             "nodes[0].children[0]",
-            "Index out of bounds",
+            "index 4 is out of bounds",
         ],
     );
 }
@@ -432,7 +432,7 @@ fn textures_that_are_not_images_or_too_large_name_the_material_and_the_file() {
             &["material `t`", "tex.png"][..],
         ),
         (b"not an image at all", &["material `t`", "tex.png"]),
-        (&wide, &["material `t`", "tex.png", "limit"]),
+        (&wide, &["material `t`", "tex.png", "16384 px a side"]),
     ] {
         let dir = scratch(
             "\n[[material]]\nname = \"t\"\ntexture = \"tex.png\"\n",
