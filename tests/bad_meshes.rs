@@ -54,11 +54,26 @@ fn mtl_colours_out_of_range_or_short_are_refused() {
     for (kd, words) in [
         (
             "nan 0.5 0.5",
-            &["material `paint`", "[NaN, 0.5, 0.5]", "[0, 1]"][..],
+            &[
+                "m.mtl",
+                "line 2",
+                "material `paint`",
+                "[NaN, 0.5, 0.5]",
+                "[0, 1]",
+            ][..],
         ),
-        ("0.5 inf 0.5", &["material `paint`", "inf", "[0, 1]"]),
-        ("0.5 1e300 0.5", &["material `paint`", "inf", "[0, 1]"]),
-        ("0.5 -1 0.5", &["material `paint`", "-1", "[0, 1]"]),
+        (
+            "0.5 inf 0.5",
+            &["m.mtl", "line 2", "material `paint`", "inf", "[0, 1]"],
+        ),
+        (
+            "0.5 1e300 0.5",
+            &["m.mtl", "line 2", "material `paint`", "inf", "[0, 1]"],
+        ),
+        (
+            "0.5 -1 0.5",
+            &["m.mtl", "line 2", "material `paint`", "-1", "[0, 1]"],
+        ),
         // tobj unwrapped these and panicked.
         (
             "0.5 0.5",
@@ -366,7 +381,7 @@ fn gltf_references_that_point_nowhere_are_named() {
         &[
             "invalid glTF",
             "nodes[0].children[0]",
-            "Index out of bounds",
+            "index 4 is out of bounds",
         ],
     );
 }
@@ -417,7 +432,7 @@ fn textures_that_are_not_images_or_too_large_name_the_material_and_the_file() {
             &["material `t`", "tex.png"][..],
         ),
         (b"not an image at all", &["material `t`", "tex.png"]),
-        (&wide, &["material `t`", "tex.png", "limit"]),
+        (&wide, &["material `t`", "tex.png", "16384 px a side"]),
     ] {
         let dir = scratch(
             "\n[[material]]\nname = \"t\"\ntexture = \"tex.png\"\n",
@@ -444,4 +459,276 @@ fn a_byte_order_mark_on_an_obj_or_mtl_is_skipped_not_taken_for_the_first_line() 
     assert_eq!(mesh.materials.len(), 1);
     assert_eq!(mesh.materials[0].name, "a");
     assert_eq!(mesh.materials[0].linear_color, [0.25, 0.5, 0.75]);
+}
+
+#[test]
+fn a_material_library_named_many_times_is_read_once() {
+    use seethru::scene::mesh_io::parse_obj;
+    // Found by fuzzing: tobj calls the loader for every `mtllib` line and appends the
+    // library's materials again each time (N × the MTL's size: quadratic).
+    let mtl: String = (0..2000)
+        .map(|i| format!("newmtl m{i}\nKd 0.5 0.5 0.5\n"))
+        .collect();
+    let obj = format!("{}usemtl m7\n{TRIANGLE}", "mtllib m.mtl\n".repeat(3000));
+    let reads = std::cell::Cell::new(0);
+    let read = |_: &Path| {
+        reads.set(reads.get() + 1);
+        Ok(mtl.clone().into_bytes())
+    };
+    let mesh = parse_obj(obj.as_bytes(), Path::new("m.obj"), &read).unwrap();
+    assert_eq!(reads.get(), 1);
+    assert_eq!(mesh.materials.len(), 2000);
+    assert_eq!(mesh.tris[0].file_material, Some(7));
+}
+
+#[test]
+fn a_material_two_libraries_define_is_refused_naming_both() {
+    // tobj let the later definition win without a word.
+    let obj = format!("mtllib a.mtl\nmtllib b.mtl\nusemtl paint\n{TRIANGLE}");
+    let dir = scratch(
+        &mesh_object("m.obj"),
+        &[
+            ("m.obj", obj.as_bytes()),
+            ("a.mtl", b"newmtl paint\nKd 0.5 0.5 0.5\n"),
+            ("b.mtl", b"newmtl paint\nKd 0.1 0.1 0.1\n"),
+        ],
+    );
+    render_refused(
+        dir.path(),
+        &["mesh m.obj", "`b.mtl`", "material `paint`", "`a.mtl`"],
+    );
+}
+
+#[test]
+fn obj_lines_tobj_reads_wrongly_or_without_a_line_are_refused_naming_it() {
+    for (obj, words) in [
+        (
+            format!("{TRIANGLE}vn nan 0 1\n"),
+            &["line 5", "`vn` nan 0 1", "NaN is not finite"][..],
+        ),
+        (
+            format!("{TRIANGLE}vt 0 inf\n"),
+            &["line 5", "inf is not finite"],
+        ),
+        // tobj drew the good face and dropped these without a word.
+        (
+            format!("{TRIANGLE}f 1\n"),
+            &["line 5", "`f` has 1 index", "3 corners"],
+        ),
+        (
+            format!("{TRIANGLE}f 1 2\n"),
+            &["line 5", "`f` has 2 indices"],
+        ),
+        // tobj: "invalid polygon".
+        (format!("{TRIANGLE}f\n"), &["line 5", "`f` has 0 indices"]),
+        // tobj: "face vertex color index out of bounds".
+        (
+            "v 0 0 0 nan nan nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".into(),
+            &["line 1", "NaN is not finite", "colour r g b"],
+        ),
+        (
+            "v 0 0 0 1 1 1\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".into(),
+            &[
+                "line 2",
+                "vertex colours",
+                "line 1 has one",
+                "every vertex or none",
+            ],
+        ),
+        ("v 0 0 0 0\n".into(), &["line 1", "w = 0"]),
+        ("v 0 0 0 1 1\n".into(), &["line 1", "`v` has 5 numbers"]),
+        (
+            format!("{TRIANGLE}usemtl\n"),
+            &["line 5", "`usemtl` needs a material name"],
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 18446744073709551616\n".into(),
+            &["line 4", "`184467440737…(20 characters)` is not the index"],
+        ),
+    ] {
+        let dir = scratch(&mesh_object("m.obj"), &[("m.obj", obj.as_bytes())]);
+        let err = render_refused(dir.path(), words);
+        assert!(err.contains("mesh m.obj"), "{err}");
+    }
+    for (obj, words) in [
+        (
+            [TRIANGLE.as_bytes(), b"\0\0\0\0"].concat(),
+            &["line 5", "a NUL byte: not a text OBJ"][..],
+        ),
+        (
+            // tobj: "read error".
+            [TRIANGLE.as_bytes(), b"# caf\xe9\n"].concat(),
+            &["line 5", "byte 6 of the line is not UTF-8"],
+        ),
+        // tobj: "color parse error (too many or too few components)".
+        (
+            TRIANGLE.replace('\n', "\r").into_bytes(),
+            &["line 1", "CR line ends"],
+        ),
+    ] {
+        let dir = scratch(&mesh_object("m.obj"), &[("m.obj", &obj)]);
+        render_refused(dir.path(), words);
+    }
+}
+
+#[test]
+fn mtl_lines_tobj_reads_wrongly_or_without_a_line_are_refused_naming_the_mtl_and_line() {
+    let obj = format!("mtllib m.mtl\nusemtl paint\n{TRIANGLE}");
+    for (mtl, words) in [
+        // tobj read the first three numbers and ignored the rest.
+        (
+            "newmtl paint\nKd 0.5 0.5 0.5 0.5\n",
+            &["line 2", "`Kd` needs three numbers", "0.5 0.5 0.5 0.5"][..],
+        ),
+        (
+            "newmtl paint\nKd -0.1 0.5 0.5\n",
+            &["line 2", "material `paint`", "-0.1", "[0, 1]"],
+        ),
+        (
+            "newmtl paint\nKd 1.5 0.5 0.5\n",
+            &["line 2", "1.5", "[0, 1]"],
+        ),
+        (
+            "newmtl paint\nKd nan 0.5 0.5\n",
+            &["line 2", "NaN", "[0, 1]"],
+        ),
+        // tobj: "material parse error", "invalid object name".
+        ("newmtl paint\nNs\n", &["line 2", "`Ns` needs one number"]),
+        (
+            "newmtl paint\nmap_Kd\n",
+            &["line 2", "`map_Kd` needs a texture"],
+        ),
+        ("newmtl\n", &["line 1", "`newmtl` needs a material name"]),
+        (
+            "newmtl paint\n\0\0",
+            &["line 2", "a NUL byte: not a text MTL"],
+        ),
+        // Mesh textures are not read: refused rather than dropped without a word.
+        (
+            "newmtl paint\nKd 1 1 1\nmap_Kd tex/paint.png\n",
+            &[
+                "line 3",
+                "material `paint`",
+                "`tex/paint.png`",
+                "mesh textures are not read",
+                "Kd",
+                "[[material]]",
+            ],
+        ),
+    ] {
+        let dir = scratch(
+            &mesh_object("m.obj"),
+            &[("m.obj", obj.as_bytes()), ("m.mtl", mtl.as_bytes())],
+        );
+        render_refused(
+            dir.path(),
+            &[&["mesh m.obj", "`m.mtl`"][..], words].concat(),
+        );
+    }
+}
+
+#[test]
+fn gltf_files_tobj_or_the_gltf_crate_misread_are_refused_naming_what_is_wrong() {
+    // Each differs from the valid file in one part.
+    let base = gltf_json(&Gltf::default());
+    for (json, words) in [
+        // The last index was dropped without a word.
+        (
+            base.replace(r#""count": 3"#, r#""count": 2"#),
+            &["POSITION (accessor 0, no indices) has 2 elements, not a multiple of 3"][..],
+        ),
+        (
+            base.replace("[0.5, 0.5, 0.5, 1]", "[0.5, 0.5, 0.5, 7]"),
+            &["material `paint`", "alpha 7", "[0, 1]"],
+        ),
+        (
+            base.replace(
+                r#"[{"mesh": 0}]"#,
+                r#"[{"mesh": 0, "rotation": [0, 0, 0, 0]}]"#,
+            ),
+            &["node 0", "[0, 0, 0, 0]", "length 0", "unit quaternion"],
+        ),
+        (
+            base.replace(r#"[{"mesh": 0}]"#, r#"[{"mesh": 0, "children": [4]}]"#),
+            &[
+                "nodes[0].children[0]",
+                "index 4 is out of bounds",
+                "1 nodes",
+            ],
+        ),
+        // Mesh textures are not read: refused rather than dropped without a word.
+        (
+            base.replace(
+                r#""pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}"#,
+                r#""pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}"#,
+            )
+            .replace(
+                r#""meshes""#,
+                r#""textures": [{"source": 0}], "images": [{"uri": "paint.png"}], "meshes""#,
+            ),
+            &[
+                "material `paint`",
+                "baseColorTexture",
+                "`paint.png`",
+                "mesh textures are not read",
+                "baseColorFactor",
+                "[[material]]",
+            ],
+        ),
+        (String::new(), &["not a GLB/glTF", "empty"]),
+        ("PK\u{3}\u{4}zip".into(), &["not a GLB/glTF", "`PK"]),
+    ] {
+        let dir = scratch(&mesh_object("m.gltf"), &[("m.gltf", json.as_bytes())]);
+        render_refused(dir.path(), &[&["mesh m.gltf"][..], words].concat());
+    }
+    // GLBs: a wrong magic, and chunks that do not fit.
+    let glb = |json_length: u32, json: &[u8]| {
+        let total = 20 + json.len() as u32;
+        [
+            &b"glTF"[..],
+            &2u32.to_le_bytes(),
+            &total.to_le_bytes(),
+            &json_length.to_le_bytes(),
+            b"JSON",
+            json,
+        ]
+        .concat()
+    };
+    let json = b"{\"asset\":{\"version\":\"2.0\"}}".to_vec();
+    let padded = [&json[..], &[b' '; 4][..4 - json.len() % 4]].concat();
+    for (bytes, words) in [
+        (b"gltf\x02\0\0\0".to_vec(), &["not a GLB/glTF", "`gltf"][..]),
+        (
+            glb(1000, &padded),
+            &["JSON chunk declares 1000 bytes", "follow its header"],
+        ),
+        (
+            glb(0, &padded),
+            &["JSON chunk is 0 bytes long", "multiple of 4"],
+        ),
+        (glb(7, &padded), &["JSON chunk is 7 bytes long"]),
+    ] {
+        let dir = scratch(&mesh_object("m.glb"), &[("m.glb", &bytes)]);
+        render_refused(dir.path(), &[&["mesh m.glb"][..], words].concat());
+    }
+    // The crate's "Image size exceeds limit" named no size, and its PNG errors came twice.
+    let wide = {
+        let mut png = Vec::new();
+        image::RgbImage::new(16385, 1)
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        png
+    };
+    for (bytes, words) in [
+        (&wide[..], &["16385×1 px", "16384 px a side"][..]),
+        (b"\x89PNG\r\n\x1a\x00 not one", &["material `t`"]),
+    ] {
+        let dir = scratch(
+            "\n[[material]]\nname = \"t\"\ntexture = \"tex.png\"\n",
+            &[("tex.png", bytes)],
+        );
+        let err = render_refused(dir.path(), words);
+        let tail = err.rsplit(": ").next().unwrap();
+        assert!(!err[..err.len() - tail.len()].contains(tail), "{err}");
+    }
 }

@@ -11,6 +11,7 @@
 //! refers to (`.mtl`, `.bin`), so that they can be fuzzed without a file system.
 
 use std::cell::RefCell;
+use std::collections::HashMap;
 use std::io::{BufReader, Cursor};
 use std::path::{Path, PathBuf};
 
@@ -19,10 +20,10 @@ use glam::{Mat4, Vec2, Vec3};
 
 use crate::scene::limits::{MAX_MESH_BYTES, MAX_TRIANGLES, first_bad_vertex};
 use crate::scene::mesh_checks::{
-    check_glb_header, check_mtl_lines, check_usemtl_names, obj_error_line, validated,
+    check_glb_header, check_mtl_lines, check_usemtl_names, clipped, obj_error_line, validated,
 };
 use crate::scene::shapes::Tri;
-use crate::util::number::short_list;
+use crate::util::number::{short, short_list};
 
 /// A material that a mesh file defines.
 #[derive(Clone, Debug, PartialEq)]
@@ -47,7 +48,7 @@ pub fn read_limited(path: &Path) -> std::io::Result<Vec<u8>> {
 /// Loads an OBJ (with its MTL files) or a glTF/GLB (with its buffers). Errors name the file.
 pub fn load_mesh(path: &Path) -> Result<LoadedMesh> {
     let lower = path.to_string_lossy().to_ascii_lowercase();
-    let bytes = read_limited(path).with_context(|| format!("cannot read mesh {}", path.display()));
+    let bytes = read_limited(path).context("cannot read it");
     let mesh = bytes.and_then(|bytes| {
         if lower.ends_with(".obj") {
             parse_obj(&bytes, path, &read_limited)
@@ -127,8 +128,19 @@ pub fn parse_obj(
     let dir = path.parent().unwrap_or(Path::new(""));
     // tobj's material errors carry no path: remember ours.
     let mtl_error: RefCell<Option<String>> = RefCell::new(None);
+    // Each library is read and parsed once: tobj calls this for every `mtllib` line and
+    // appends the library's materials again each time (a file of many `mtllib` lines of one
+    // library was quadratic, found by fuzzing). The names each library defined, to refuse a
+    // name that two libraries define (tobj would let the later one win without a word).
+    let loaded: RefCell<Vec<PathBuf>> = RefCell::new(Vec::new());
+    let defined_by: RefCell<HashMap<String, String>> = RefCell::new(HashMap::new());
     let load_mtl = |written: &Path| -> tobj::MTLLoadResult {
         let resolved = dir.join(written);
+        let nothing = || Ok((Vec::new(), Default::default()));
+        if mtl_error.borrow().is_some() || loaded.borrow().contains(&resolved) {
+            return nothing();
+        }
+        loaded.borrow_mut().push(resolved.clone());
         let fail = |why: String| {
             mtl_error.borrow_mut().get_or_insert(format!(
                 "material library `{}` (resolved against the OBJ's folder: {}): {why}",
@@ -137,14 +149,30 @@ pub fn parse_obj(
             ));
             Err(tobj::LoadError::OpenFileFailed)
         };
-        match read(&resolved).map(|mtl| without_bom(&mtl).to_vec()) {
-            Ok(mtl) => match check_mtl_lines(&mtl) {
-                Err(why) => fail(why),
-                Ok(()) => tobj::load_mtl_buf(&mut BufReader::new(Cursor::new(mtl)))
-                    .or_else(|e| fail(e.to_string())),
-            },
-            Err(e) => fail(e.to_string()),
+        let mtl = match read(&resolved) {
+            Ok(mtl) => without_bom(&mtl).to_vec(),
+            Err(e) => return fail(e.to_string()),
+        };
+        if let Err(why) = check_mtl_lines(&mtl) {
+            return fail(why);
         }
+        let (materials, names) = match tobj::load_mtl_buf(&mut BufReader::new(Cursor::new(mtl))) {
+            Ok(parsed) => parsed,
+            Err(e) => return fail(e.to_string()),
+        };
+        let mut defined_by = defined_by.borrow_mut();
+        for m in &materials {
+            if let Some(first) = defined_by.get(&m.name) {
+                return fail(format!(
+                    "material `{}` is defined by the library `{first}` too: a name must be defined once",
+                    clipped(&m.name)
+                ));
+            }
+        }
+        for m in &materials {
+            defined_by.insert(m.name.clone(), written.display().to_string());
+        }
+        Ok((materials, names))
     };
     if let Some(why) = obj_error_line(bytes) {
         bail!("invalid OBJ: {why}");
@@ -218,10 +246,57 @@ pub fn parse_gltf(
     path: &Path,
     read: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
 ) -> Result<LoadedMesh> {
+    let start = bytes.iter().position(|b| !b.is_ascii_whitespace());
+    match start.map(|i| &bytes[i..]) {
+        None => bail!("not a GLB/glTF: the file is empty (or only white space)"),
+        Some(text) if !text.starts_with(b"{") && !bytes.starts_with(b"glTF") => bail!(
+            "not a GLB/glTF: it starts with `{}`; a GLB starts with `glTF`, a glTF file is JSON starting with `{{`",
+            clipped(&String::from_utf8_lossy(&text[..text.len().min(8)]))
+        ),
+        Some(_) => {}
+    }
     check_glb_header(bytes)?;
     let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(bytes)
         .map_err(|e| anyhow!("invalid glTF: {e}"))?;
     let doc = validated(document.into_json())?;
+    for m in doc.materials() {
+        let name = m
+            .name()
+            .map_or_else(|| format!("#{}", m.index().unwrap_or(0)), String::from);
+        let pbr = m.pbr_metallic_roughness();
+        let alpha = pbr.base_color_factor()[3];
+        if !(0.0..=1.0).contains(&alpha) {
+            bail!(
+                "material `{}` has the baseColorFactor alpha {}: it must be in [0, 1]",
+                clipped(&name),
+                short(f64::from(alpha))
+            );
+        }
+        if let Some(t) = pbr.base_color_texture() {
+            let image = match t.texture().source().source() {
+                gltf::image::Source::Uri { uri, .. } => format!("`{}`", clipped(uri)),
+                gltf::image::Source::View { view, .. } => format!("bufferView {}", view.index()),
+            };
+            bail!(
+                "material `{}` has a baseColorTexture (texture {}, image {image}): mesh textures are not read; bake the colour into baseColorFactor, or give the object a scene [[material]] with `texture`",
+                clipped(&name),
+                t.texture().index()
+            );
+        }
+    }
+    for node in doc.nodes() {
+        if let gltf::scene::Transform::Decomposed { rotation, .. } = node.transform() {
+            let length = rotation.iter().map(|q| q * q).sum::<f32>().sqrt();
+            if !(length - 1.0).abs().le(&0.01) {
+                bail!(
+                    "node {} has the rotation {}, a quaternion of length {}: it must be a unit quaternion (length 1 ± 0.01)",
+                    node.index(),
+                    short_list(&rotation.map(f64::from)),
+                    short(f64::from(length))
+                );
+            }
+        }
+    }
     let buffers = load_buffers(&doc, blob, path, read)?;
     let mut out = LoadedMesh {
         materials: doc
@@ -441,7 +516,17 @@ fn read_primitive(
             buffers,
         )?;
     }
-    let count = indices.as_ref().map_or(positions.count(), |i| i.count()) / 3;
+    let corners = indices.as_ref().map_or(positions.count(), |i| i.count());
+    if !corners.is_multiple_of(3) {
+        let what = match &indices {
+            Some(i) => format!("its indices (accessor {})", i.index()),
+            None => format!("its POSITION (accessor {}, no indices)", positions.index()),
+        };
+        bail!(
+            "{what} has {corners} elements, not a multiple of 3: a triangle list takes three a triangle"
+        );
+    }
+    let count = corners / 3;
     if tris.len() + count > MAX_TRIANGLES {
         bail!("more than the limit of {MAX_TRIANGLES} triangles");
     }

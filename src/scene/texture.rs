@@ -21,13 +21,29 @@ impl Texture {
     pub fn load(path: &Path) -> Result<Texture> {
         crate::util::input_file::note_input(path);
         let decode = || -> Result<image::DynamicImage> {
-            let mut reader = image::ImageReader::open(path)?.with_guessed_format()?;
+            // The image crate's errors repeat their text as their source ("Invalid PNG
+            // signature.: Invalid PNG signature."): shown once, as text.
+            let text = |e: image::ImageError| anyhow::anyhow!("{e}");
+            let open =
+                || -> Result<_> { Ok(image::ImageReader::open(path)?.with_guessed_format()?) };
+            // The size first: the crate's "Image size exceeds limit" names neither.
+            let (width, height) = open()?.into_dimensions().map_err(text)?;
+            if width > MAX_RESOLUTION
+                || height > MAX_RESOLUTION
+                || u64::from(width) * u64::from(height) > MAX_PIXELS
+            {
+                anyhow::bail!(
+                    "the image is {width}×{height} px; a texture is at most {MAX_RESOLUTION} px a side and {MAX_RESOLUTION}×{} px in all",
+                    MAX_PIXELS / u64::from(MAX_RESOLUTION)
+                );
+            }
+            let mut reader = open()?;
             let mut limits = image::Limits::default();
             limits.max_image_width = Some(MAX_RESOLUTION);
             limits.max_image_height = Some(MAX_RESOLUTION);
             limits.max_alloc = Some(4 * MAX_PIXELS);
             reader.limits(limits);
-            Ok(reader.decode()?)
+            reader.decode().map_err(text)
         };
         let img = decode()
             .with_context(|| format!("cannot load texture {}", path.display()))?
