@@ -346,22 +346,8 @@ fn sweep_grids_past_the_limit_and_repeated_values_are_refused_before_any_work() 
     assert_eq!(listing(dir.path()), ["scene.toml"]);
     // Spaces around values are ignored, as around every number of the command line
     // (`--width ' 5'`): `d2= 5` is `d2=5`, and resumes its CSV.
-    let (code, err) = run_in(
-        dir.path(),
-        &[
-            "sweep",
-            "scene.toml",
-            "--width",
-            "8",
-            "--param",
-            "d2=5",
-            "--out",
-            "s.csv",
-        ],
-    );
-    assert_eq!(code, 0, "{err}");
-    let first = std::fs::read_to_string(dir.path().join("s.csv")).unwrap();
-    for spec in ["d2= 5", "d2=5 ", " d2 = 5.0"] {
+    let mut first: Option<String> = None;
+    for spec in ["d2=5", "d2= 5", "d2=5 ", " d2 = 5.0"] {
         let (code, err) = run_in(
             dir.path(),
             &[
@@ -376,11 +362,8 @@ fn sweep_grids_past_the_limit_and_repeated_values_are_refused_before_any_work() 
             ],
         );
         assert_eq!(code, 0, "{spec}: {err}");
-        assert_eq!(
-            std::fs::read_to_string(dir.path().join("s.csv")).unwrap(),
-            first,
-            "{spec}"
-        );
+        let csv = std::fs::read_to_string(dir.path().join("s.csv")).unwrap();
+        assert_eq!(&csv, first.get_or_insert_with(|| csv.clone()), "{spec}");
     }
     let (code, err) = run_in(
         dir.path(),
