@@ -16,7 +16,6 @@ use crate::analysis::physical::ARCMIN_PER_RAD;
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
-use crate::scene::shapes::box_face;
 use crate::scene::world::view_bit;
 use crate::system::display::MISSING_ID;
 use crate::util::color::encode_srgb8;
@@ -214,7 +213,7 @@ pub fn measure(
         .object_id
         .iter()
         .zip(&occluded.part_id)
-        .map(|(&o, &p)| o == ctx.world.obstacle_id && p == box_face::POS_Z)
+        .map(|(&o, &p)| ctx.world.is_display(o, p))
         .collect();
     let mut misregistration = vec![f32::NAN; w * h];
     let mut missing = vec![false; w * h];

@@ -26,7 +26,6 @@ use crate::render::screen::{Screen, Shown};
 use crate::render::settings::RenderSettings;
 use crate::render::sky::SkyModel;
 use crate::scene::Scene;
-use crate::scene::shapes::box_face;
 use crate::scene::texture::Texture;
 use crate::scene::world::{SurfaceHit, SurfaceMaterial, World, view_bit};
 use crate::util::progress::Progress;
@@ -269,9 +268,7 @@ impl RenderContext {
             let dir = job.rays.direction(x as f32 + dx, y as f32 + dy);
             let hit = self.trace_with(origin, dir, job.view, stack);
             let shown = match (&hit, job.display) {
-                (Some(s), Some(d))
-                    if s.object == self.world.obstacle_id && s.part == box_face::POS_Z =>
-                {
+                (Some(s), Some(d)) if self.world.is_display(s.object, s.part) => {
                     Some(self.display_content(d, s.position, stack, shadows))
                 }
                 _ => None,

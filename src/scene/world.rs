@@ -111,6 +111,11 @@ fn views_of(visible_to: u8) -> u8 {
 }
 
 impl World {
+    /// Whether a hit on `object`'s `part` is on the display (the obstacle's `+z` face).
+    pub fn is_display(&self, object: u32, part: u32) -> bool {
+        object == self.obstacle_id && part == box_face::POS_Z
+    }
+
     /// Builds the world of a scene: tessellates shapes, loads meshes and textures.
     pub fn build(scene: &Scene) -> Result<World> {
         Self::build_part(scene, &|_| true, true)

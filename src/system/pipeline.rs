@@ -14,7 +14,6 @@ use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::render::settings::{RenderSettings, check_spp};
 use crate::render::views::View;
-use crate::scene::shapes::box_face;
 use crate::scene::world::view_bit;
 use crate::scene::{Obstacle, Scene};
 use crate::system::compensation::{Crop, ModelPlane, compute_crop};
@@ -224,7 +223,7 @@ pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
 /// Refuses a run whose display covers no pixel of the driver's view (`occluded`): nothing to
 /// measure. (A sweep keeps such a configuration as a row of undefined metrics.)
 pub fn check_display_seen(ctx: &RenderContext, occluded: &Frame) -> Result<()> {
-    let display_face = |(&o, &p): (&u32, &u32)| o == ctx.world.obstacle_id && p == box_face::POS_Z;
+    let display_face = |(&o, &p): (&u32, &u32)| ctx.world.is_display(o, p);
     if !occluded
         .object_id
         .iter()

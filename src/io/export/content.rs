@@ -15,7 +15,6 @@ use crate::geometry::camera::Camera;
 use crate::io::atomic::write_atomically;
 use crate::render::sky::SkyModel;
 use crate::scene::mesh_io::load_mesh;
-use crate::scene::shapes::box_face;
 use crate::scene::texture::Texture;
 use crate::scene::world::{Ellipsoid, TriAttr, World, view_bit};
 use crate::scene::{Scene, Shape};
@@ -182,7 +181,7 @@ impl<'a> ExportScene<'a> {
         let display = world.objects.len();
         let mut groups: BTreeMap<(usize, u32, u32), Primitive> = BTreeMap::new();
         for (p, attr) in traced_triangles(world) {
-            let owner = if attr.object == world.obstacle_id && attr.part == box_face::POS_Z {
+            let owner = if world.is_display(attr.object, attr.part) {
                 display
             } else {
                 attr.object as usize - 1
