@@ -1,8 +1,9 @@
 //! `seethru reproduce`: the paper's §5 as report.md, report.html and report.json.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{Result, bail};
+use seethru::scene::builtin::{BuiltinDas, DAS_PATH};
 
 use crate::cli::args::{threads, with_threads};
 
@@ -15,9 +16,10 @@ pub struct Reproduce {
     /// Small renders (CI-sized).
     #[arg(long)]
     quick: bool,
-    /// The driver-assistance scene.
-    #[arg(long, default_value = "scenes/das.toml")]
-    scene: PathBuf,
+    /// The driver-assistance scene (default: scenes/das.toml of the current folder, else the
+    /// copy built into seethru).
+    #[arg(long)]
+    scene: Option<PathBuf>,
     /// Worker threads in [1, 1024] (default: all cores).
     #[arg(long, value_parser = threads)]
     threads: Option<usize>,
@@ -26,9 +28,23 @@ pub struct Reproduce {
 impl Reproduce {
     pub fn run(self) -> Result<()> {
         // Written whole or not at all: a failure leaves `--out` as it was.
+        let (scene, label, _builtin) = match &self.scene {
+            Some(path) if !path.exists() => bail!(
+                "--scene {}: no such file (without --scene, reproduce reads scenes/das.toml \
+                 of the current folder, or the copy built into seethru)",
+                path.display()
+            ),
+            Some(path) => (path.clone(), path.display().to_string(), None),
+            None if Path::new(DAS_PATH).exists() => (PathBuf::from(DAS_PATH), DAS_PATH.into(), None),
+            None => {
+                let builtin = BuiltinDas::write()?;
+                let label = format!("{DAS_PATH} (built into seethru {})", env!("CARGO_PKG_VERSION"));
+                (builtin.scene(), label, Some(builtin))
+            }
+        };
         let staged = seethru::io::staged::StagedDir::new(&self.out)?;
         with_threads(self.threads, || {
-            seethru::paper::reproduce::reproduce(&self.scene, staged.path(), self.quick)
+            seethru::paper::reproduce::reproduce_named(&scene, &label, staged.path(), self.quick)
         })??;
         staged.commit()?;
         seethru::util::progress::summary(format!(

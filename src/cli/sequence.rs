@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{write_color_png, write_exr};
 use seethru::io::staged::StagedDir;
-use seethru::measure::sequence::{Measuring, SequenceRun, run_sequence};
+use seethru::measure::sequence::{Measuring, SequenceRun, run_sequence_labelled};
 use seethru::measure::sequence_files::{
     Preview, frames_csv, latency_figure, over_time_figure, summary,
 };
@@ -270,10 +270,12 @@ impl Sequence {
         let staged = StagedDir::new(&self.out)?;
         let out = staged.path().to_path_buf();
         let mut runs: Vec<(f64, SequenceRun)> = Vec::new();
-        for (options, &ms) in all.into_iter().zip(&self.latency_camera.0) {
+        let count = all.len();
+        for (k, (options, &ms)) in all.into_iter().zip(&self.latency_camera.0).enumerate() {
             let dir = out.join(latency_dir(ms));
             let timeline = options.timeline;
-            let mut preview = Preview::new(timeline.fps);
+            let mut preview = Preview::new(timeline.fps).labelled(format!("latency {ms} ms"));
+            let label = format!("latency {}/{count}: {ms} ms", k + 1);
             let frames = self.frames;
             let how = Measuring {
                 metrics: true,
@@ -281,7 +283,7 @@ impl Sequence {
                 band: self.band,
                 progress: true,
             };
-            let run = run_sequence(&scene, options, how, &mut |f| {
+            let run = run_sequence_labelled(&scene, options, how, &label, &mut |f| {
                 preview.add(&f);
                 let name = |view: &str, ext: &str| {
                     dir.join("frames")

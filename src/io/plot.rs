@@ -63,7 +63,91 @@ fn color(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
+/// Fraction of the chart's plotting area, across and up, that a legend of `entries` lines of
+/// at most `chars` characters covers (the legend font at 15 px in the 900×600 figure).
+fn legend_extent(entries: usize, chars: usize) -> (f64, f64) {
+    const PLOT_PX: (f64, f64) = (800.0, 480.0);
+    let across = (chars as f64 * 8.5 + 50.0) / PLOT_PX.0;
+    let up = (entries as f64 * 22.0 + 16.0) / PLOT_PX.1;
+    (across.min(1.0), up.min(1.0))
+}
+
+/// The corners a legend may take, in the order preferred when several are free.
+const CORNERS: [SeriesLabelPosition; 4] = [
+    SeriesLabelPosition::UpperRight,
+    SeriesLabelPosition::UpperLeft,
+    SeriesLabelPosition::LowerRight,
+    SeriesLabelPosition::LowerLeft,
+];
+
 impl Figure {
+    /// Puts the legend in a corner where no curve, bound or mark passes under it; where every
+    /// corner holds data, raises the top of the y range until the upper right corner is
+    /// clear. The curves are followed between their points (a line can cross a corner where
+    /// it has no point).
+    pub fn with_legend_clear_of_data(mut self) -> Self {
+        let entries = self.series.iter().filter(|s| !s.dashed).count() + self.bounds.len();
+        let chars = self
+            .series
+            .iter()
+            .filter(|s| !s.dashed)
+            .map(|s| s.label.chars().count())
+            .chain(self.bounds.iter().map(|b| b.1.chars().count()))
+            .max()
+            .unwrap_or(0);
+        let (across, up) = legend_extent(entries, chars);
+        let (x0, x1) = self.x_range;
+        let mut samples: Vec<(f64, f64)> = Vec::new();
+        for series in &self.series {
+            for pair in series.points.windows(2) {
+                let ((xa, ya), (xb, yb)) = (pair[0], pair[1]);
+                if !(ya.is_finite() && yb.is_finite()) {
+                    continue;
+                }
+                samples.extend((0..=32).map(|k| {
+                    let t = k as f64 / 32.0;
+                    (xa + (xb - xa) * t, ya + (yb - ya) * t)
+                }));
+            }
+            samples.extend(series.points.iter().copied().filter(|p| p.1.is_finite()));
+        }
+        samples.extend(self.marks.iter().map(|m| (m.0, m.1)));
+        for &(y, _) in &self.bounds {
+            samples.extend((0..=32).map(|k| (x0 + (x1 - x0) * k as f64 / 32.0, y)));
+        }
+        let under = |corner: &SeriesLabelPosition, y_range: (f64, f64)| {
+            let (y0, y1) = y_range;
+            let (left, right) = match corner {
+                SeriesLabelPosition::UpperLeft | SeriesLabelPosition::LowerLeft => {
+                    (x0, x0 + across * (x1 - x0))
+                }
+                _ => (x1 - across * (x1 - x0), x1),
+            };
+            let (bottom, top) = match corner {
+                SeriesLabelPosition::LowerLeft | SeriesLabelPosition::LowerRight => {
+                    (y0, y0 + up * (y1 - y0))
+                }
+                _ => (y1 - up * (y1 - y0), y1),
+            };
+            samples
+                .iter()
+                .any(|&(x, y)| (left..=right).contains(&x) && (bottom..=top).contains(&y))
+        };
+        if let Some(free) = CORNERS.iter().find(|c| !under(c, self.y_range)) {
+            self.legend = free.clone();
+            return self;
+        }
+        // Every corner holds data: make room above the highest value.
+        let highest = samples
+            .iter()
+            .map(|p| p.1)
+            .fold(self.y_range.0, f64::max);
+        let span = (highest - self.y_range.0).max(1e-9);
+        self.y_range.1 = self.y_range.0 + span / (1.0 - up).max(0.1) * 1.05;
+        self.legend = SeriesLabelPosition::UpperRight;
+        self
+    }
+
     /// The data as CSV: one row per x of the first series, one column per series.
     pub fn csv(&self) -> String {
         let mut s = String::from("x");
@@ -196,5 +280,61 @@ impl Figure {
         })?;
         write_text(&dir.join(format!("{name}.svg")), &self.render_svg()?)?;
         write_text(&dir.join(format!("{name}.csv")), &self.csv())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn figure(series: Vec<Vec<(f64, f64)>>, y_range: (f64, f64)) -> Figure {
+        Figure {
+            title: String::new(),
+            x_label: String::new(),
+            y_label: String::new(),
+            x_range: (0.0, 10.0),
+            y_range,
+            series: series
+                .into_iter()
+                .enumerate()
+                .map(|(i, p)| Series::new(format!("d2 = {i}"), p))
+                .collect(),
+            bounds: Vec::new(),
+            marks: Vec::new(),
+            legend: SeriesLabelPosition::UpperRight,
+        }
+    }
+
+    fn is(a: &SeriesLabelPosition, b: SeriesLabelPosition) -> bool {
+        std::mem::discriminant(a) == std::mem::discriminant(&b)
+    }
+
+    #[test]
+    fn the_legend_goes_to_a_corner_the_curves_leave_free() {
+        // Rising from the lower left to the upper right: only the other two corners are free.
+        let rising = figure(vec![vec![(0.0, 0.0), (10.0, 10.0)]], (0.0, 10.0));
+        let corner = rising.with_legend_clear_of_data().legend;
+        assert!(is(&corner, SeriesLabelPosition::UpperLeft), "{corner:?}");
+        // Flat near the top (a sweep of means that barely change): a lower corner.
+        let flat = figure(vec![vec![(0.0, 9.6), (5.0, 9.8), (10.0, 9.7)]], (0.0, 10.0));
+        let corner = flat.with_legend_clear_of_data().legend;
+        assert!(is(&corner, SeriesLabelPosition::LowerRight), "{corner:?}");
+        // A line whose two points lie outside the x range crosses both upper corners where
+        // it has no point: a lower corner.
+        let across = figure(vec![vec![(-5.0, 9.5), (15.0, 9.5)]], (0.0, 10.0));
+        let corner = across.with_legend_clear_of_data().legend;
+        assert!(is(&corner, SeriesLabelPosition::LowerRight), "{corner:?}");
+    }
+
+    #[test]
+    fn where_every_corner_holds_data_the_y_range_grows_to_clear_the_top() {
+        let zigzag: Vec<(f64, f64)> = (0..=20)
+            .map(|k| (k as f64 / 2.0, if k % 2 == 0 { 0.0 } else { 10.0 }))
+            .collect();
+        let f = figure(vec![zigzag], (0.0, 10.0)).with_legend_clear_of_data();
+        assert!(is(&f.legend, SeriesLabelPosition::UpperRight));
+        let (_, up) = legend_extent(1, "d2 = 0".len());
+        // The highest value lies below the legend's bottom edge.
+        assert!(10.0 < f.y_range.1 - up * f.y_range.1, "{:?}", f.y_range);
     }
 }

@@ -160,6 +160,17 @@ pub fn run_sequence(
     how: Measuring,
     on_frame: &mut dyn FnMut(FrameImages) -> Result<()>,
 ) -> Result<SequenceRun> {
+    run_sequence_labelled(scene, options, how, "sequence", on_frame)
+}
+
+/// As [`run_sequence`], its progress bar labelled `label` (which of several sequences runs).
+pub fn run_sequence_labelled(
+    scene: &Scene,
+    options: SequenceOptions,
+    how: Measuring,
+    label: &str,
+    on_frame: &mut dyn FnMut(FrameImages) -> Result<()>,
+) -> Result<SequenceRun> {
     let start = Instant::now();
     let mut system = SystemLoop::new(scene, options)?;
     let tl = system.options.timeline;
@@ -179,7 +190,7 @@ pub fn run_sequence(
     let (mut truth_seconds, mut metrics_seconds) = (0.0, 0.0);
     let mut refreshes = std::collections::BTreeSet::new();
     let mut records = Vec::with_capacity(tl.frames());
-    let progress = Progress::new("sequence", tl.frames(), how.progress);
+    let progress = Progress::new(label, tl.frames(), how.progress);
     for k in 0..tl.frames() {
         let times = tl.times(k);
         let shown = system.show(k)?.clone();

@@ -8,6 +8,7 @@ use plotters::prelude::SeriesLabelPosition;
 use serde_json::json;
 
 use crate::io::animation::write_apng;
+use crate::io::caption::{caption_lines, caption_strip, strip_height};
 use crate::io::plot::{Figure, Series};
 use crate::measure::maps::heat_color;
 use crate::measure::sequence::{FrameImages, FrameMetrics, FrameRecord, SequenceRun};
@@ -256,6 +257,9 @@ pub struct Preview {
     step: u32,
     size: (u32, u32),
     panels: Vec<PreviewFrame>,
+    /// What every frame's caption says besides its time and misregistration (the latency);
+    /// `None`: no caption.
+    label: Option<String>,
 }
 
 /// One preview frame's panels, cut to the window: sRGB truth and seethru, and the
@@ -264,6 +268,9 @@ struct PreviewFrame {
     truth: Vec<[u8; 3]>,
     shown: Vec<[u8; 3]>,
     misregistration: Vec<f32>,
+    /// Display time, s, and the frame's mean misregistration, arc-minutes, for the caption.
+    time: f64,
+    mean_arcmin: Option<f64>,
 }
 
 impl Preview {
@@ -275,7 +282,15 @@ impl Preview {
             step: 1,
             size: (0, 0),
             panels: Vec::new(),
+            label: None,
         }
+    }
+
+    /// Captions every frame above its panels: its time, `label` (e.g. the latency) and its
+    /// mean misregistration.
+    pub fn labelled(mut self, label: String) -> Preview {
+        self.label = Some(label);
+        self
     }
 
     pub fn add(&mut self, f: &FrameImages) {
@@ -303,6 +318,8 @@ impl Preview {
             truth,
             shown,
             misregistration: mis,
+            time: f.record.times.display,
+            mean_arcmin: f.record.metrics.as_ref().map(|m| m.mean_arcmin),
         });
     }
 
@@ -323,6 +340,7 @@ impl Preview {
         let (w, h) = self.size;
         let gap = 4;
         let width = 3 * w + 2 * gap;
+        let captions = self.captions(width)?;
         let frames: Vec<Vec<u8>> = self
             .panels
             .iter()
@@ -331,6 +349,7 @@ impl Preview {
                      truth,
                      shown,
                      misregistration: mis,
+                     ..
                  }| {
                     let mut rgb = vec![255u8; (width * h * 3) as usize];
                     for y in 0..h {
@@ -356,7 +375,61 @@ impl Preview {
                 },
             )
             .collect();
+        let (frames, h) = match captions {
+            Some((strips, strip_h)) => (
+                strips
+                    .into_iter()
+                    .zip(frames)
+                    .map(|(mut strip, frame)| {
+                        strip.extend(frame);
+                        strip
+                    })
+                    .collect(),
+                h + strip_h,
+            ),
+            None => (frames, h),
+        };
         write_apng(path, width, h, &frames, self.fps)?;
         Ok(top)
+    }
+
+    /// Each frame's caption strip (all of one height) and that height; `None` unlabelled.
+    fn captions(&self, width: u32) -> Result<Option<(Vec<Vec<u8>>, u32)>> {
+        let Some(label) = &self.label else {
+            return Ok(None);
+        };
+        let parts = |p: &PreviewFrame| {
+            vec![
+                format!("t = {:.3} s", p.time),
+                label.clone(),
+                match p.mean_arcmin {
+                    Some(m) if m.is_finite() => format!("mean misregistration {m:.1}′"),
+                    _ => "mean misregistration undefined".to_string(),
+                },
+            ]
+        };
+        // One layout for the whole animation: the widest caption decides.
+        let lines = self
+            .panels
+            .iter()
+            .map(|p| caption_lines(&parts(p), width).map(|l| l.len()))
+            .collect::<Result<Vec<_>>>()?
+            .into_iter()
+            .max()
+            .unwrap_or(1);
+        let strips = self
+            .panels
+            .iter()
+            .map(|p| {
+                let parts = parts(p);
+                let text = if lines == 1 {
+                    vec![parts.join("   ")]
+                } else {
+                    parts
+                };
+                caption_strip(&text, width)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Some((strips, strip_height(lines))))
     }
 }

@@ -321,7 +321,7 @@ fn plot(csv: &Path, params: &[Param], rows: &[(usize, String)]) -> Result<()> {
                 " (● coverage < 1: part of the display black)"
             }
         ),
-        x_label: params[0].name.clone(),
+        x_label: crate::measure::sweep_grid::axis_label(&params[0].name),
         y_label: "mean misregistration in the display [arcmin]".into(),
         x_range: (x0, if x1 > x0 { x1 } else { x0 + 1.0 }),
         y_range: (0.0, y1),
@@ -329,7 +329,8 @@ fn plot(csv: &Path, params: &[Param], rows: &[(usize, String)]) -> Result<()> {
         bounds: vec![(1.0, "1′".into())],
         marks,
         legend: plotters::prelude::SeriesLabelPosition::UpperRight,
-    };
+    }
+    .with_legend_clear_of_data();
     let stem = csv
         .file_stem()
         .map(|s| s.to_string_lossy().to_string())

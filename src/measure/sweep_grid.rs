@@ -172,6 +172,16 @@ fn range_of(name: &str) -> (f64, f64, &'static str) {
     }
 }
 
+/// A parameter's name with its unit, for a plot's axis: `theta_f (°)`, `d2 (m)`.
+pub fn axis_label(name: &str) -> String {
+    match range_of(name).2 {
+        "" => name.to_string(),
+        "degrees" => format!("{name} (°)"),
+        "pixels" => format!("{name} (px)"),
+        unit => format!("{name} ({unit})"),
+    }
+}
+
 fn check_value(name: &str, v: &str) -> Result<Value> {
     let (lo, hi, unit) = range_of(name);
     let integer = name == "frontal_width";
@@ -289,6 +299,20 @@ pub fn combinations(params: &[Param]) -> Vec<Vec<(String, String)>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn plot_axes_name_the_parameter_and_its_unit() {
+        for (name, label) in [
+            ("theta_f", "theta_f (°)"),
+            ("d2", "d2 (m)"),
+            ("display_width", "display_width (m)"),
+            ("eye_x", "eye_x (m)"),
+            ("head_bias_x_cm", "head_bias_x_cm (cm)"),
+            ("frontal_width", "frontal_width (px)"),
+        ] {
+            assert_eq!(axis_label(name), label);
+        }
+    }
 
     #[test]
     fn ranges_lists_and_errors() {

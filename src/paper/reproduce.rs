@@ -57,6 +57,17 @@ pub fn das_case(base: &Scene, distance: f64, display_width: f64, theta_deg: f64)
 
 /// Runs the reproduction into `out`; returns `report.json`'s content.
 pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_json::Value> {
+    reproduce_named(scene_path, &scene_path.display().to_string(), out, quick)
+}
+
+/// As [`reproduce`], the report naming the scene `scene_name` (the built-in copy's
+/// temporary path would mean nothing to a reader).
+pub fn reproduce_named(
+    scene_path: &Path,
+    scene_name: &str,
+    out: &Path,
+    quick: bool,
+) -> Result<serde_json::Value> {
     let sizes = if quick {
         Sizes {
             driver: 256,
@@ -144,7 +155,7 @@ pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_jso
     let figures = crate::paper::figures::write_all(&out.join("figures"))?;
     let report = json!({
         "quick": quick,
-        "scene": scene_path.display().to_string(),
+        "scene": scene_name,
         "cases": cases.iter().map(|c| json!({"name": c.name, "dir": c.dir, "metrics": c.metrics, "run": c.run})).collect::<Vec<_>>(),
         "equal_coverage": equal,
         "ratios": ratios.iter().map(|(n, d, r)| json!({"name": n, "dir": d, "result": r})).collect::<Vec<_>>(),

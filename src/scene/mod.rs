@@ -3,6 +3,7 @@
 //! World frame: right-handed, metres, +y up. See `README.md` § "Scene format" for the
 //! parameter table of every object kind; the defaults below are the ones documented there.
 
+pub mod builtin;
 pub mod fingerprint;
 pub mod grow;
 pub mod head_path;
