@@ -35,10 +35,15 @@ impl Reproduce {
                 path.display()
             ),
             Some(path) => (path.clone(), path.display().to_string(), None),
-            None if Path::new(DAS_PATH).exists() => (PathBuf::from(DAS_PATH), DAS_PATH.into(), None),
+            None if Path::new(DAS_PATH).exists() => {
+                (PathBuf::from(DAS_PATH), DAS_PATH.into(), None)
+            }
             None => {
                 let builtin = BuiltinDas::write()?;
-                let label = format!("{DAS_PATH} (built into seethru {})", env!("CARGO_PKG_VERSION"));
+                let label = format!(
+                    "{DAS_PATH} (built into seethru {})",
+                    env!("CARGO_PKG_VERSION")
+                );
                 (builtin.scene(), label, Some(builtin))
             }
         };

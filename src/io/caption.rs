@@ -65,6 +65,9 @@ mod tests {
         // Text, not a blank strip nor a filled one.
         assert!(dark > 20 && dark < strip.len() / 3 / 2, "{dark}");
         // Different text draws differently.
-        assert_ne!(strip, caption_strip(&["t = 0.40 s".into(), parts[1].clone()], 120).unwrap());
+        assert_ne!(
+            strip,
+            caption_strip(&["t = 0.40 s".into(), parts[1].clone()], 120).unwrap()
+        );
     }
 }

@@ -138,10 +138,7 @@ impl Figure {
             return self;
         }
         // Every corner holds data: make room above the highest value.
-        let highest = samples
-            .iter()
-            .map(|p| p.1)
-            .fold(self.y_range.0, f64::max);
+        let highest = samples.iter().map(|p| p.1).fold(self.y_range.0, f64::max);
         let span = (highest - self.y_range.0).max(1e-9);
         self.y_range.1 = self.y_range.0 + span / (1.0 - up).max(0.1) * 1.05;
         self.legend = SeriesLabelPosition::UpperRight;

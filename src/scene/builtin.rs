@@ -11,7 +11,10 @@ const FILES: [(&str, &[u8]); 4] = [
     ("scenes/das.toml", include_bytes!("../../scenes/das.toml")),
     ("assets/car.obj", include_bytes!("../../assets/car.obj")),
     ("assets/car.mtl", include_bytes!("../../assets/car.mtl")),
-    ("assets/street.png", include_bytes!("../../assets/street.png")),
+    (
+        "assets/street.png",
+        include_bytes!("../../assets/street.png"),
+    ),
 ];
 
 /// The path the default scene is given by, relative to the current folder.
