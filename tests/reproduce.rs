@@ -95,3 +95,79 @@ fn quick_reproduction_reports_the_papers_experiments() {
     assert_eq!((png, svg), (4 * 3 + 2 * 2, 4), "embedded images");
     assert!(!html.contains("src=\"car_") && !html.contains("src=\"figures/"));
 }
+
+/// `reproduce` outside the repository: without `--scene` it runs the das scene built into the
+/// binary and reports the same numbers as the repository's scenes/das.toml; a `--scene` that is
+/// missing is named as the flag.
+#[test]
+fn reproduce_outside_the_repository_uses_the_built_in_das_scene() {
+    let empty = tempfile::tempdir().unwrap();
+    let seethru = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_seethru"))
+            .args(args)
+            .arg("--quiet")
+            .current_dir(empty.path())
+            .output()
+            .unwrap()
+    };
+    let built_in = seethru(&["reproduce", "--quick", "--out", "built_in"]);
+    assert!(
+        built_in.status.success(),
+        "{}",
+        String::from_utf8_lossy(&built_in.stderr)
+    );
+    let repo_scene = common::repo_path("scenes/das.toml");
+    let from_repo = seethru(&[
+        "reproduce",
+        "--quick",
+        "--out",
+        "from_repo",
+        "--scene",
+        repo_scene.to_str().unwrap(),
+    ]);
+    assert!(from_repo.status.success());
+    let report = |dir: &str| -> serde_json::Value {
+        serde_json::from_str(
+            &std::fs::read_to_string(empty.path().join(dir).join("report.json")).unwrap(),
+        )
+        .unwrap()
+    };
+    let (a, b) = (report("built_in"), report("from_repo"));
+    assert!(
+        a["scene"].as_str().unwrap().contains("built into seethru"),
+        "{}",
+        a["scene"]
+    );
+    let metrics = |r: &serde_json::Value| -> Vec<serde_json::Value> {
+        r["cases"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["metrics"].clone())
+            .collect()
+    };
+    assert_eq!(metrics(&a), metrics(&b));
+    // The built-in copy leaves nothing behind in the temporary folder.
+    let pid_dirs = std::fs::read_dir(std::env::temp_dir())
+        .unwrap()
+        .flatten()
+        .filter(|e| {
+            e.file_name()
+                .to_string_lossy()
+                .starts_with("seethru-builtin-das-")
+        })
+        .count();
+    assert_eq!(
+        pid_dirs, 0,
+        "a built-in scene folder was left in the temporary folder"
+    );
+
+    let missing = seethru(&["reproduce", "--quick", "--out", "x", "--scene", "nope.toml"]);
+    let stderr = String::from_utf8_lossy(&missing.stderr);
+    assert!(!missing.status.success());
+    assert!(
+        stderr.starts_with("error: --scene nope.toml: no such file") && stderr.lines().count() == 1,
+        "{stderr}"
+    );
+    assert!(!empty.path().join("x").exists());
+}
