@@ -125,7 +125,7 @@ fn exr_round_trip_keeps_every_aov_bit_exact() {
 fn simple_exr_readers_find_the_colour_as_plain_rgba() {
     // What OpenCV, imageio and "first RGBA layer" readers do: take R, G, B (and A) of the
     // first part. They must get the linear colour, bit for bit, and the AOV layers must sit
-    // under the names the README documents.
+    // under the names docs/reference/outputs.md documents.
     let ctx = minimal_context();
     let (frame, _) = ctx.render(
         &ctx.scene.driver,

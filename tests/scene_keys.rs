@@ -71,7 +71,7 @@ fn leaves_of_table(prefix: &str, table: &toml_edit::Table, out: &mut Vec<Leaf>) 
 }
 
 /// What the documentation admits for a key (its name without table indices), from the
-/// comments of `scenes/reference.toml` and the README's limits.
+/// comments of `scenes/reference.toml` and docs/reference/limits-and-errors.md.
 enum Documented {
     /// Every value in the range is accepted and every other refused: (low, low included,
     /// high, high included).
@@ -120,7 +120,7 @@ fn documented(key: &str) -> Documented {
         k if k.ends_with("position_error") => closed(-1.0, 1.0),
         "object.keyframe.t" => RangeAndRule(0.0, 3600.0),
         "object.keyframe.rotate_deg" => closed(-360.0, 360.0),
-        other => panic!("`{other}` is not documented in this test: add what the README says"),
+        other => panic!("`{other}` is not documented in this test: add what docs/reference/scene-format.md says"),
     }
 }
 

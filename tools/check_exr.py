@@ -5,7 +5,7 @@
     /tmp/exr/bin/python tools/check_exr.py out/
 
 OpenCV (IMREAD_UNCHANGED) must return the colour as a 4-channel float32 image; the OpenEXR
-binding must list the AOV layers the README documents. Exits 1 when a reader fails.
+binding must list the AOV layers docs/reference/outputs.md documents. Exits 1 when a reader fails.
 """
 import glob
 import os

@@ -1,5 +1,5 @@
 //! Misregistration in motion: what latency costs when the vehicle drives and turns and the
-//! head moves (see README, "Time: sequences and latency").
+//! head moves (see docs/guide/sequences.md).
 //!
 //! The frame shown at time t was captured at t − L (L: capture to display, with the display's
 //! hold), and compensated for the head estimate of its own time, which itself is L_t older

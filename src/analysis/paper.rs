@@ -7,8 +7,8 @@
 //! **Sign convention** (that of eqs. paralax2/RATIO1 and OCLUSION): `b_h > 0` puts the eye at
 //! lateral position `−b_h`, i.e. on the side of the *left* crop `K1`/`R1`. Each function
 //! below is tested against ray–plane intersections of its setup (tests/analysis.rs); where a
-//! printed formula disagrees with the geometry, the code follows the geometry and the README
-//! lists the erratum (the `*_as_printed` functions keep the paper's text for comparison).
+//! printed formula disagrees with the geometry, the code follows the geometry and
+//! docs/reference/equations-errata.md lists the erratum (the `*_as_printed` functions keep the paper's text for comparison).
 
 /// Which crop border: the paper's left (`K1`, `R1`, upper signs) or right (`K2`, `R2`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -2,7 +2,7 @@
 //! between what the display shows and what the truth has there, for a scene on the model
 //! plane. In these units neither `θ_F` nor the frontal resolution appears: the paper's
 //! sensitivities are fractions of the frontal image's width, which spans more scene per unit
-//! as `θ_F` grows, hence their `1/tan θ_F` (see README, "Notes on the paper").
+//! as `θ_F` grows, hence their `1/tan θ_F` (see docs/reference/equations-errata.md, "Notes on the paper").
 
 /// Radians of misregistration per metre of lateral head-position error:
 /// `d2 / (d1 (d1 + d2))` (→ `1/d1` for `d2 → ∞`). Same at every display point.

@@ -246,7 +246,7 @@ pub fn render_report(
     }
     let _ = writeln!(
         md,
-        "## Notes\n\n- The occlusion and foreshortening ratios are measured from the renders' id and position buffers; the model plane is the scene plane (the paper's case), so the prediction is the closed form; the uncertainty is the pixel quantisation (the driver's pixels, and for p_cam the display's and the frontal camera's), and it shrinks with resolution. The paper's Unity measurements missed their predictions by 0.02 and 0.17.\n- With D = 1 m at d1 = 0.75 m, θ_F = 30° cannot cover the display's view: the part outside the frontal camera's view is black and counted as missing; compare it with 63.5° only at equal coverage (above).\n- See the README for the errata of the paper's formulas."
+        "## Notes\n\n- The occlusion and foreshortening ratios are measured from the renders' id and position buffers; the model plane is the scene plane (the paper's case), so the prediction is the closed form; the uncertainty is the pixel quantisation (the driver's pixels, and for p_cam the display's and the frontal camera's), and it shrinks with resolution. The paper's Unity measurements missed their predictions by 0.02 and 0.17.\n- With D = 1 m at d1 = 0.75 m, θ_F = 30° cannot cover the display's view: the part outside the frontal camera's view is black and counted as missing; compare it with 63.5° only at equal coverage (above).\n- See docs/reference/equations-errata.md in the seethru repository for the errata of the paper's formulas."
     );
     if !html {
         return Ok(md);

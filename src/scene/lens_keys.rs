@@ -1,6 +1,6 @@
 //! The lens keys of `[camera.frontal]` and `[camera.back]` (`model`, `fx`, `fy`, `cx`, `cy`,
 //! the distortion coefficients) and the `[calibration]` table: the compensation's own copy
-//! of each camera. Documented in `scenes/reference.toml` and the README's scene tables.
+//! of each camera. Documented in `scenes/reference.toml` and docs/reference/scene-format.md.
 
 use glam::{DAffine3, DVec3};
 

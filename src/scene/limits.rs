@@ -1,4 +1,4 @@
-//! The limits of what seethru accepts, in one place (the README's "Limits" section lists them).
+//! The limits of what seethru accepts, in one place (docs/reference/limits-and-errors.md lists them).
 //!
 //! The renderer traces in f32 and its BVH builder (obvhs) sorts primitives by Morton codes of
 //! their bounding boxes: a coordinate of 1e30 m, a NaN or an infinity makes it index out of

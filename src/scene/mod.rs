@@ -1,6 +1,6 @@
 //! The scene description: what a scene file says, typed, validated and in world units.
 //!
-//! World frame: right-handed, metres, +y up. See `README.md` § "Scene format" for the
+//! World frame: right-handed, metres, +y up. See `docs/reference/scene-format.md` for the
 //! parameter table of every object kind; the defaults below are the ones documented there.
 
 pub mod builtin;

@@ -137,7 +137,7 @@ impl SystemLoop {
         let parts = MovingParts::new(scene, &moves)?;
         let sigma = match run.head {
             HeadSource::Oracle => run.head_jitter_cm / 100.0,
-            // About the tracker's error on das at 640×480 (README, "The see-through pipeline").
+            // About the tracker's error on das at 640×480 (docs/guide/pipeline.md).
             HeadSource::Estimated => (run.head_jitter_cm / 100.0).max(0.005),
         };
         let frontal = Frame::new(rig.base.frontal.width, rig.base.frontal.height);
