@@ -56,8 +56,11 @@ fn shown(page: &Path) -> String {
         .to_string()
 }
 
+/// Commands of a page: (line number, arguments).
+type Commands = Vec<(usize, Vec<String>)>;
+
 /// A page's commands: (line number, arguments), ```sh blocks first, in order.
-fn page_commands(page: &Path) -> Vec<(usize, Vec<String>)> {
+fn page_commands(page: &Path) -> Commands {
     let text = std::fs::read_to_string(page).unwrap();
     let name = shown(page);
     let mut commands = Vec::new();
@@ -159,7 +162,7 @@ fn copy_tree(from: &Path, to: &Path) {
 fn every_command_in_the_docs_runs_as_written() {
     let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let pages = doc_pages();
-    let all: Vec<(PathBuf, Vec<(usize, Vec<String>)>)> = pages
+    let all: Vec<(PathBuf, Commands)> = pages
         .iter()
         .map(|p| (p.clone(), page_commands(p)))
         .collect();

@@ -120,7 +120,9 @@ fn documented(key: &str) -> Documented {
         k if k.ends_with("position_error") => closed(-1.0, 1.0),
         "object.keyframe.t" => RangeAndRule(0.0, 3600.0),
         "object.keyframe.rotate_deg" => closed(-360.0, 360.0),
-        other => panic!("`{other}` is not documented in this test: add what docs/reference/scene-format.md says"),
+        other => panic!(
+            "`{other}` is not documented in this test: add what docs/reference/scene-format.md says"
+        ),
     }
 }
 
