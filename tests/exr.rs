@@ -7,6 +7,7 @@ use exr::prelude::*;
 use seethru::io::frame_files::{
     EXR_COMPRESSION, ExrContent, channel, read_exr, write_exr_channels, write_frame,
 };
+use seethru::io::run_dir::read_measured_frames;
 use seethru::render::frame::Frame;
 use seethru::render::{integrator::RenderContext, settings::RenderSettings};
 use seethru::scene::world::view_bit;
@@ -142,4 +143,27 @@ fn exr_content_writes_what_it_names() {
     let (out, all) = names(ExrContent::All);
     assert_eq!(all, colour);
     assert!(frame.bit_identical(&read_exr(&out.join("truth.exr")).unwrap()));
+}
+
+#[test]
+fn measuring_a_run_without_aovs_names_the_flag() {
+    let frame = rendered();
+    let dir = tempfile::tempdir().unwrap();
+    for content in [ExrContent::Colour, ExrContent::None] {
+        let out = dir.path().join(format!("{content:?}"));
+        for view in ["truth", "seethru", "occluded"] {
+            write_frame(&frame, &out, view, content).unwrap();
+        }
+        let err = read_measured_frames(&out).unwrap_err().to_string();
+        assert!(
+            err.contains("truth.exr") && err.contains("`--exr all`"),
+            "{err}"
+        );
+    }
+    // Every AOV there: it reads.
+    let out = dir.path().join("all");
+    for view in ["truth", "seethru", "occluded"] {
+        write_frame(&frame, &out, view, ExrContent::All).unwrap();
+    }
+    assert!(read_measured_frames(&out).unwrap()[0].bit_identical(&frame));
 }

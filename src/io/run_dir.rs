@@ -92,10 +92,17 @@ pub fn measured_exrs(dir: &Path) -> [PathBuf; 3] {
 /// Reads truth, seethru and occluded from `dir`; they must have the same size.
 pub fn read_measured_frames(dir: &Path) -> Result<[Frame; 3]> {
     let [truth, seethru, occluded] = measured_exrs(dir);
+    // A run written with `--exr colour` or `none` has no AOVs to measure: say which flag.
     let read = |path: &Path| {
-        read_exr(path).context(
-            "the metrics need every AOV: was the run written with `--exr all` (the default)?",
-        )
+        read_exr(path).map_err(|e| {
+            let why = format!("{e:#}");
+            match !path.exists() || why.contains("no channel") {
+                true => anyhow::anyhow!(
+                    "{why}; the metrics need every AOV of truth, seethru and occluded: write the run with `--exr all` (the default)"
+                ),
+                false => e,
+            }
+        })
     };
     let frames = [read(&truth)?, read(&seethru)?, read(&occluded)?];
     let size = |f: &Frame| (f.width, f.height);
