@@ -88,8 +88,13 @@ fn render_views(
     }
     staged.commit()?;
     seethru::util::progress::summary(format!(
-        "rendered {} (PNG, ids PNG, EXR each) → {}",
+        "rendered {} ({} each) → {}",
         rendered.join(", "),
+        match exr {
+            ExrContent::None => "PNG, ids PNG",
+            ExrContent::Colour => "PNG, ids PNG, colour EXR",
+            ExrContent::All => "PNG, ids PNG, EXR",
+        },
         out.display()
     ));
     Ok(())

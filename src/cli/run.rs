@@ -173,8 +173,13 @@ fn run_command(
         })?
     } else {
         write_run(&ctx, staged.path(), options, band, exr)?;
+        let files = match exr {
+            ExrContent::None => "PNG, ids PNG",
+            ExrContent::Colour => "PNG, ids PNG, colour EXR",
+            ExrContent::All => "PNG, ids PNG, EXR",
+        };
         format!(
-            "wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",
+            "wrote the six views ({files}), run.json and the metrics to {}",
             out.display()
         )
     };
