@@ -242,6 +242,8 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
     let methods = crate::cli::bench_methods::method_costs(&ctx, options.repeat, options.json)?;
     let (lines, sequence) = crate::cli::bench_sequence::bench_sequence(&ctx.scene)?;
     lines.into_iter().for_each(say);
+    let (lines, run) = crate::cli::bench_run::bench_run(&options.scene, options.repeat)?;
+    lines.into_iter().for_each(say);
     let peak = peak_rss_bytes();
     say(format!(
         "peak RSS     {}",
@@ -262,6 +264,7 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         "frame": frames,
         "methods": methods,
         "sequence": sequence,
+        "run": run,
         "peak_rss_bytes": peak,
     });
     println!("{report}");

@@ -4,6 +4,7 @@ mod analyze;
 mod args;
 mod bench;
 mod bench_methods;
+mod bench_run;
 mod bench_sequence;
 mod compare;
 mod export;

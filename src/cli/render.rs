@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use seethru::io::frame_files::write_frame;
+use seethru::io::frame_files::{ExrContent, write_frame};
 use seethru::io::staged::StagedDir;
 use seethru::render::integrator::RenderContext;
 use seethru::render::settings::{RenderSettings, check_spp, resized};
@@ -24,6 +24,9 @@ pub struct Render {
     /// Output directory.
     #[arg(long)]
     out: PathBuf,
+    /// What each view's EXR holds: none, colour (R, G, B, A) or all (every AOV).
+    #[arg(long, value_enum, default_value_t = ExrContent::All)]
+    exr: ExrContent,
     #[command(flatten)]
     render: RenderArgs,
 }
@@ -36,13 +39,19 @@ impl Render {
             self.views.clone()
         };
         with_threads(self.render.threads, || {
-            render_views(&self.scene, &views, &self.out, &self.render)
+            render_views(&self.scene, &views, &self.out, &self.render, self.exr)
         })?
     }
 }
 
 /// Renders `views` of the scene into `out` (created if needed).
-fn render_views(scene_path: &Path, views: &[View], out: &Path, options: &RenderArgs) -> Result<()> {
+fn render_views(
+    scene_path: &Path,
+    views: &[View],
+    out: &Path,
+    options: &RenderArgs,
+    exr: ExrContent,
+) -> Result<()> {
     check_spp(options.spp)?;
     let scene = Scene::load(scene_path)?;
     // Check every camera before the first (possibly long) render.
@@ -68,7 +77,7 @@ fn render_views(scene_path: &Path, views: &[View], out: &Path, options: &RenderA
     let mut rendered = Vec::new();
     for (view, camera) in views.iter().zip(&cameras) {
         let (frame, stats) = context.render(camera, view.bit(), settings, view.name());
-        write_frame(&frame, staged.path(), view.name())?;
+        write_frame(&frame, staged.path(), view.name(), exr)?;
         rendered.push(format!(
             "{} {}×{} in {:.2} s",
             view.name(),
@@ -79,8 +88,13 @@ fn render_views(scene_path: &Path, views: &[View], out: &Path, options: &RenderA
     }
     staged.commit()?;
     seethru::util::progress::summary(format!(
-        "rendered {} (PNG, ids PNG, EXR each) → {}",
+        "rendered {} ({} each) → {}",
         rendered.join(", "),
+        match exr {
+            ExrContent::None => "PNG, ids PNG",
+            ExrContent::Colour => "PNG, ids PNG, colour EXR",
+            ExrContent::All => "PNG, ids PNG, EXR",
+        },
         out.display()
     ));
     Ok(())

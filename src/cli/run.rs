@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use rayon::prelude::*;
 use seethru::io::atomic::write_text;
-use seethru::io::frame_files::write_frame;
+use seethru::io::frame_files::{ExrContent, write_frame};
 use seethru::io::staged::StagedDir;
 use seethru::measure::holes::{attach_holes, write_hole_mask};
 use seethru::measure::maps::write_metrics;
@@ -76,6 +76,10 @@ pub struct Run {
     /// The eye the compensation serves.
     #[arg(long = "target-eye", value_enum, default_value_t = Eye::Cyclopean)]
     target_eye: Eye,
+    /// What each view's EXR holds: none, colour (R, G, B, A) or all (every AOV, what
+    /// `seethru measure` reads back).
+    #[arg(long, value_enum, default_value_t = ExrContent::All)]
+    exr: ExrContent,
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
@@ -119,11 +123,24 @@ impl Run {
             progress: true,
         };
         let both = self.eyes == EyesFlag::Both;
-        let (scene, out, band, max_memory) =
-            (&self.scene, &self.out, self.band, self.render.max_memory);
+        let (scene, out, band, max_memory, exr) = (
+            &self.scene,
+            &self.out,
+            self.band,
+            self.render.max_memory,
+            self.exr,
+        );
         let calibration = self.calibration.as_deref();
         with_threads(self.render.threads, || {
-            run_command(scene, calibration, out, &options, band, max_memory, both)
+            run_command(
+                scene,
+                calibration,
+                out,
+                &options,
+                (band, exr),
+                max_memory,
+                both,
+            )
         })?
     }
 }
@@ -134,7 +151,7 @@ fn run_command(
     calibration: Option<&Path>,
     out: &Path,
     options: &RunOptions,
-    band: u32,
+    (band, exr): (u32, ExrContent),
     max_memory: f64,
     both: bool,
 ) -> Result<()> {
@@ -152,12 +169,17 @@ fn run_command(
     let staged = StagedDir::new(out)?;
     let summary = if both {
         crate::cli::run_eyes::run_both(&ctx, staged.path(), out, options, |options, dir| {
-            write_run(&ctx, dir, options, band)
+            write_run(&ctx, dir, options, band, exr)
         })?
     } else {
-        write_run(&ctx, staged.path(), options, band)?;
+        write_run(&ctx, staged.path(), options, band, exr)?;
+        let files = match exr {
+            ExrContent::None => "PNG, ids PNG",
+            ExrContent::Colour => "PNG, ids PNG, colour EXR",
+            ExrContent::All => "PNG, ids PNG, EXR",
+        };
         format!(
-            "wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",
+            "wrote the six views ({files}), run.json and the metrics to {}",
             out.display()
         )
     };
@@ -172,6 +194,7 @@ fn write_run(
     out: &Path,
     options: &RunOptions,
     band: u32,
+    exr: ExrContent,
 ) -> Result<RunResult> {
     let result = run(ctx, options)?;
     // `out` and its folders are created by the writes (io::atomic), under the lock the
@@ -190,7 +213,7 @@ fn write_run(
         || {
             views
                 .par_iter()
-                .try_for_each(|(name, frame)| write_frame(frame, out, name))
+                .try_for_each(|(name, frame)| write_frame(frame, out, name, exr))
         },
         || {
             let frames = [&result.truth, &result.seethru, &result.occluded];

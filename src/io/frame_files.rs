@@ -1,5 +1,6 @@
-//! Frames as files: colour PNG (sRGB), id false-colour PNG, and one EXR with every AOV;
-//! and the EXR read back. Every file is written whole or not at all ([`write_atomically`]).
+//! Frames as files: colour PNG (sRGB), id false-colour PNG, and one EXR with every AOV (or
+//! only the colour, or none: [`ExrContent`]); and the EXR read back. Every file is written
+//! whole or not at all ([`write_atomically`]).
 
 use std::path::Path;
 
@@ -84,15 +85,21 @@ fn vec_channels(names: [&str; 3], values: &[Vec3]) -> [AnyChannel<FlatSamples>; 
     })
 }
 
+/// What the EXR of each view holds (`--exr`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+pub enum ExrContent {
+    /// No EXR (the PNGs only).
+    None,
+    /// The colour only: `R`, `G`, `B`, `A` (linear f32), about a quarter of `all`.
+    Colour,
+    /// Every AOV ([`channel`]): what `seethru measure` reads back.
+    #[default]
+    All,
+}
+
 /// Every AOV in one EXR, under the names of [`channel`].
 pub fn write_exr(frame: &Frame, path: &Path) -> Result<()> {
-    let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
-    let [r, g, b, a] = channel::RGBA;
-    channels.extend(vec_channels([r, g, b], &frame.color));
-    channels.push(AnyChannel::new(
-        a,
-        FlatSamples::F32(vec![1.0; frame.color.len()]),
-    ));
+    let mut channels = colour_channels(frame);
     channels.push(AnyChannel::new(
         channel::Z,
         FlatSamples::F32(frame.depth.clone()),
@@ -114,6 +121,30 @@ pub fn write_exr(frame: &Frame, path: &Path) -> Result<()> {
     write_exr_channels(path, frame.width, frame.height, channels)
 }
 
+/// The colour (`R`, `G`, `B`, linear f32) and an opaque `A`.
+fn colour_channels(frame: &Frame) -> Vec<AnyChannel<FlatSamples>> {
+    let [r, g, b, a] = channel::RGBA;
+    let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
+    channels.extend(vec_channels([r, g, b], &frame.color));
+    channels.push(AnyChannel::new(
+        a,
+        FlatSamples::F32(vec![1.0; frame.color.len()]),
+    ));
+    channels
+}
+
+/// The colour alone in one EXR (`R`, `G`, `B`, `A`): what image viewers show.
+pub fn write_colour_exr(frame: &Frame, path: &Path) -> Result<()> {
+    write_exr_channels(path, frame.width, frame.height, colour_channels(frame))
+}
+
+/// The lossless compression of every EXR seethru writes: PIZ (wavelet + Huffman, exact for
+/// f32 and u32 samples). On das's `run` it gave the smallest folder of RLE, ZIP1, ZIP16 and
+/// PIZ (89 MB against ZIP16's 95 and 230 uncompressed) for the least CPU of the three
+/// compressors that beat RLE (docs/guide/performance.md has the figures). Every OpenEXR
+/// reader (OpenCV, imageio, Blender, Nuke) reads it.
+pub const EXR_COMPRESSION: Compression = Compression::PIZ;
+
 /// Writes named channels of a `width`×`height` image as one single-part EXR (no layer name,
 /// so that readers of the "first RGBA layer" find plain `R`, `G`, `B`).
 pub fn write_exr_channels(
@@ -122,13 +153,14 @@ pub fn write_exr_channels(
     height: u32,
     channels: Vec<AnyChannel<FlatSamples>>,
 ) -> Result<()> {
-    // Uncompressed: ZIP took longer than rendering the views, and run-length encoding of
-    // float AOVs saves only a quarter of the size for 0.9 s of CPU per `run` on das. Every
-    // EXR reader reads uncompressed files.
+    let encoding = Encoding {
+        compression: EXR_COMPRESSION,
+        ..Encoding::UNCOMPRESSED
+    };
     let layer = Layer::new(
         (width as usize, height as usize),
         LayerAttributes::default(),
-        Encoding::UNCOMPRESSED,
+        encoding,
         AnyChannels::sort(SmallVec::from_vec(channels)),
     );
     let image = Image::from_layer(layer);
@@ -318,9 +350,14 @@ fn sample_type(samples: &FlatSamples) -> &'static str {
     }
 }
 
-/// Writes `<name>.png`, `<name>_ids.png` and `<name>.exr` into `dir`.
-pub fn write_frame(frame: &Frame, dir: &Path, name: &str) -> Result<()> {
+/// Writes `<name>.png`, `<name>_ids.png` and `<name>.exr` (holding `exr`) into `dir`.
+pub fn write_frame(frame: &Frame, dir: &Path, name: &str, exr: ExrContent) -> Result<()> {
     write_color_png(frame, &dir.join(format!("{name}.png")))?;
     write_id_png(frame, &dir.join(format!("{name}_ids.png")))?;
-    write_exr(frame, &dir.join(format!("{name}.exr")))
+    let path = dir.join(format!("{name}.exr"));
+    match exr {
+        ExrContent::None => Ok(()),
+        ExrContent::Colour => write_colour_exr(frame, &path),
+        ExrContent::All => write_exr(frame, &path),
+    }
 }

@@ -92,7 +92,19 @@ pub fn measured_exrs(dir: &Path) -> [PathBuf; 3] {
 /// Reads truth, seethru and occluded from `dir`; they must have the same size.
 pub fn read_measured_frames(dir: &Path) -> Result<[Frame; 3]> {
     let [truth, seethru, occluded] = measured_exrs(dir);
-    let frames = [read_exr(&truth)?, read_exr(&seethru)?, read_exr(&occluded)?];
+    // A run written with `--exr colour` or `none` has no AOVs to measure: say which flag.
+    let read = |path: &Path| {
+        read_exr(path).map_err(|e| {
+            let why = format!("{e:#}");
+            match !path.exists() || why.contains("no channel") {
+                true => anyhow::anyhow!(
+                    "{why}; the metrics need every AOV of truth, seethru and occluded: write the run with `--exr all` (the default)"
+                ),
+                false => e,
+            }
+        })
+    };
+    let frames = [read(&truth)?, read(&seethru)?, read(&occluded)?];
     let size = |f: &Frame| (f.width, f.height);
     for (frame, path) in frames.iter().zip([&truth, &seethru, &occluded]).skip(1) {
         if size(frame) != size(&frames[0]) {

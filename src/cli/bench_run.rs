@@ -1,0 +1,97 @@
+//! `seethru bench`'s run figures: wall and CPU seconds of `seethru run` on the bench's scene
+//! with its defaults (1280×720 driver views at 4 spp unless the scene says otherwise), and the
+//! size of the folder it writes with each `--exr` choice.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::{Args, FromArgMatches};
+use serde_json::json;
+
+use crate::cli::run::Run;
+
+/// CPU seconds (user + system) this process has used, from `/proc/self/stat`; `None` where
+/// the system does not say (not Linux). Under load, CPU time is a steadier figure than wall.
+fn process_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which may hold spaces) start at state (field 3);
+    // utime and stime are fields 14 and 15, in clock ticks (100 per second on Linux).
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i)?.parse::<f64>().ok();
+    Some((ticks(11)? + ticks(12)?) / 100.0)
+}
+
+/// Bytes of the files under `dir`.
+fn folder_bytes(dir: &Path) -> Result<u64> {
+    let mut total = 0;
+    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+        let entry = entry?;
+        let meta = entry.metadata()?;
+        total += match meta.is_dir() {
+            true => folder_bytes(&entry.path())?,
+            false => meta.len(),
+        };
+    }
+    Ok(total)
+}
+
+/// One `seethru run SCENE --out OUT --exr EXR --threads N` (the bench's threads) as the command line would run it.
+fn run_once(scene: &Path, out: &Path, exr: &str) -> Result<()> {
+    let threads = rayon::current_num_threads().to_string();
+    let command = Run::augment_args(clap::Command::new("run"));
+    let matches = command.try_get_matches_from([
+        "run".as_ref(),
+        scene.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--exr".as_ref(),
+        exr.as_ref(),
+        "--threads".as_ref(),
+        threads.as_ref(),
+    ])?;
+    Run::from_arg_matches(&matches)?.run()
+}
+
+/// The report lines and the JSON of the run benchmark: `repeat` (at most 3) timed runs with
+/// the default `--exr all`, then one with `--exr colour` and one with `--exr none`.
+pub fn bench_run(scene: &Path, repeat: usize) -> Result<(Vec<String>, serde_json::Value)> {
+    let scratch: PathBuf =
+        std::env::temp_dir().join(format!("seethru-bench-run-{}", std::process::id()));
+    let quiet = seethru::util::progress::is_quiet();
+    seethru::util::progress::set_quiet(true);
+    let result = (|| {
+        let mut lines = vec![
+            "run          seethru run SCENE (its defaults) into a scratch folder; wall s, CPU s (user + system, all threads), folder MB".to_string(),
+        ];
+        let mut out = serde_json::Map::new();
+        for (exr, times) in [("all", repeat.clamp(1, 3)), ("colour", 1), ("none", 1)] {
+            let (mut walls, mut cpus) = (Vec::new(), Vec::new());
+            for _ in 0..times {
+                let _ = std::fs::remove_dir_all(&scratch);
+                let (wall, cpu) = (Instant::now(), process_cpu_seconds());
+                run_once(scene, &scratch, exr)?;
+                walls.push(wall.elapsed().as_secs_f64());
+                cpus.push(cpu.zip(process_cpu_seconds()).map(|(a, b)| b - a));
+            }
+            let bytes = folder_bytes(&scratch)?;
+            let wall = walls.iter().copied().fold(f64::INFINITY, f64::min);
+            let cpu = cpus.iter().flatten().copied().fold(f64::INFINITY, f64::min);
+            let cpu = cpu.is_finite().then_some(cpu);
+            lines.push(format!(
+                "  --exr {exr:<8} wall {wall:6.3} s  CPU {}  folder {:6.1} MB  (best of {times})",
+                cpu.map_or("unknown".into(), |c| format!("{c:6.3} s")),
+                bytes as f64 / 1e6
+            ));
+            out.insert(
+                exr.into(),
+                json!({"wall_s": wall, "cpu_s": cpu, "folder_bytes": bytes, "runs": times}),
+            );
+        }
+        Ok((lines, serde_json::Value::Object(out)))
+    })();
+    seethru::util::progress::set_quiet(quiet);
+    let _ = std::fs::remove_dir_all(&scratch);
+    result
+}

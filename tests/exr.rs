@@ -1,0 +1,169 @@
+//! The EXRs seethru writes: compressed losslessly (every bit of every sample read back), and
+//! `--exr none|colour|all` writing what it says.
+
+mod common;
+
+use exr::prelude::*;
+use seethru::io::frame_files::{
+    EXR_COMPRESSION, ExrContent, channel, read_exr, write_exr_channels, write_frame,
+};
+use seethru::io::run_dir::read_measured_frames;
+use seethru::render::frame::Frame;
+use seethru::render::{integrator::RenderContext, settings::RenderSettings};
+use seethru::scene::world::view_bit;
+use seethru::util::sampling::hash_u32;
+
+fn rendered() -> Frame {
+    let ctx = RenderContext::new(common::parse(common::MINIMAL).unwrap()).unwrap();
+    let camera = ctx.scene.driver.with_resolution(97, 61);
+    let settings = RenderSettings {
+        spp: 2,
+        progress: false,
+    };
+    ctx.render(&camera, view_bit::TRUTH, settings, "test").0
+}
+
+/// Every channel of the first layer of `path`, by name, as the exr crate reads it.
+fn channels(path: &std::path::Path) -> Vec<(String, FlatSamples)> {
+    let image = read_all_flat_layers_from_file(path).unwrap();
+    let layer = &image.layer_data[0];
+    layer
+        .channel_data
+        .list
+        .iter()
+        .map(|c| (c.name.to_string(), c.sample_data.clone()))
+        .collect()
+}
+
+fn bits(samples: &FlatSamples) -> Vec<u32> {
+    match samples {
+        FlatSamples::F32(v) => v.iter().map(|x| x.to_bits()).collect(),
+        FlatSamples::U32(v) => v.clone(),
+        FlatSamples::F16(v) => v.iter().map(|x| x.to_bits() as u32).collect(),
+    }
+}
+
+#[test]
+fn compressed_exrs_keep_every_bit_of_awkward_samples() {
+    // Noise (the worst case of a wavelet coder), NaN payloads, both zeros, infinities,
+    // subnormals and the largest values, as f32 and u32, at an odd size (partial blocks).
+    let (width, height) = (131, 37);
+    let n = width * height;
+    let special = [
+        f32::NAN.to_bits(),
+        0x7fc0_1234,
+        0xffff_ffff,
+        0x8000_0000,
+        0,
+        f32::INFINITY.to_bits(),
+        f32::NEG_INFINITY.to_bits(),
+        1,
+        0x807f_ffff,
+        f32::MAX.to_bits(),
+    ];
+    let word = |i: usize, salt: u32| match i % 7 {
+        0 => special[(i / 7) % special.len()],
+        _ => hash_u32(i as u32 ^ salt.wrapping_mul(0x9e37_79b9)),
+    };
+    let f32s: Vec<f32> = (0..n).map(|i| f32::from_bits(word(i, 1))).collect();
+    let smooth: Vec<f32> = (0..n).map(|i| (i as f32 * 0.01).sin() * 40.0).collect();
+    let u32s: Vec<u32> = (0..n).map(|i| word(i, 2)).collect();
+    let written = vec![
+        ("noise", FlatSamples::F32(f32s)),
+        ("smooth", FlatSamples::F32(smooth)),
+        ("ids", FlatSamples::U32(u32s)),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("awkward.exr");
+    let list = written
+        .iter()
+        .map(|(name, s)| AnyChannel::new(*name, s.clone()))
+        .collect();
+    write_exr_channels(&path, width as u32, height as u32, list).unwrap();
+    let meta = exr::meta::MetaData::read_from_file(&path, false).unwrap();
+    assert_eq!(meta.headers[0].compression, EXR_COMPRESSION);
+    assert_ne!(EXR_COMPRESSION, Compression::Uncompressed);
+    let read = channels(&path);
+    assert_eq!(read.len(), written.len());
+    for (name, samples) in &written {
+        let (_, back) = read.iter().find(|(n, _)| n == name).unwrap();
+        assert_eq!(bits(back), bits(samples), "channel {name}");
+    }
+}
+
+#[test]
+fn a_rendered_frame_compresses_and_reads_back_bit_identical() {
+    let frame = rendered();
+    let dir = tempfile::tempdir().unwrap();
+    write_frame(&frame, dir.path(), "truth", ExrContent::All).unwrap();
+    let path = dir.path().join("truth.exr");
+    assert!(frame.bit_identical(&read_exr(&path).unwrap()));
+    // 17 channels of 4 bytes per pixel uncompressed; the sky and the flat ground compress.
+    let raw = 17 * 4 * frame.color.len() as u64;
+    let size = std::fs::metadata(&path).unwrap().len();
+    assert!(
+        size < raw * 3 / 4,
+        "{size} bytes against {raw} uncompressed"
+    );
+}
+
+#[test]
+fn exr_content_writes_what_it_names() {
+    let frame = rendered();
+    let dir = tempfile::tempdir().unwrap();
+    let names = |content: ExrContent| {
+        let out = dir.path().join(format!("{content:?}"));
+        write_frame(&frame, &out, "truth", content).unwrap();
+        let mut files: Vec<String> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into())
+            .collect();
+        files.sort();
+        (out, files)
+    };
+    let (_, none) = names(ExrContent::None);
+    assert_eq!(none, ["truth.png", "truth_ids.png"]);
+    let (out, colour) = names(ExrContent::Colour);
+    assert_eq!(colour, ["truth.exr", "truth.png", "truth_ids.png"]);
+    let read = channels(&out.join("truth.exr"));
+    let mut read_names: Vec<&str> = read.iter().map(|(n, _)| n.as_str()).collect();
+    read_names.sort();
+    assert_eq!(read_names, ["A", "B", "G", "R"]);
+    let [r, g, b, a] = channel::RGBA;
+    for (i, name) in [r, g, b].into_iter().enumerate() {
+        let (_, samples) = read.iter().find(|(n, _)| n == name).unwrap();
+        let expected: Vec<u32> = frame.color.iter().map(|c| c[i].to_bits()).collect();
+        assert_eq!(bits(samples), expected, "channel {name}");
+    }
+    let (_, alpha) = read.iter().find(|(n, _)| n == a).unwrap();
+    assert!(bits(alpha).iter().all(|&x| x == 1f32.to_bits()));
+    // A colour-only EXR is not a frame: reading it as one names the missing AOV.
+    let err = read_exr(&out.join("truth.exr")).unwrap_err();
+    assert!(format!("{err:#}").contains("no channel `Z`"), "{err:#}");
+    let (out, all) = names(ExrContent::All);
+    assert_eq!(all, colour);
+    assert!(frame.bit_identical(&read_exr(&out.join("truth.exr")).unwrap()));
+}
+
+#[test]
+fn measuring_a_run_without_aovs_names_the_flag() {
+    let frame = rendered();
+    let dir = tempfile::tempdir().unwrap();
+    for content in [ExrContent::Colour, ExrContent::None] {
+        let out = dir.path().join(format!("{content:?}"));
+        for view in ["truth", "seethru", "occluded"] {
+            write_frame(&frame, &out, view, content).unwrap();
+        }
+        let err = read_measured_frames(&out).unwrap_err().to_string();
+        assert!(
+            err.contains("truth.exr") && err.contains("`--exr all`"),
+            "{err}"
+        );
+    }
+    // Every AOV there: it reads.
+    let out = dir.path().join("all");
+    for view in ["truth", "seethru", "occluded"] {
+        write_frame(&frame, &out, view, ExrContent::All).unwrap();
+    }
+    assert!(read_measured_frames(&out).unwrap()[0].bit_identical(&frame));
+}
