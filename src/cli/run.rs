@@ -97,6 +97,7 @@ impl Run {
             head_bias_cm: self.head_errors.head_bias_cm,
             head_jitter_cm: self.head_errors.head_jitter_cm,
             seed: self.head_errors.seed,
+            require_confident_head: self.head_errors.require_confident_head,
             feature_width: self.head_errors.feature_width,
             width: self.render.width,
             height: self.render.height,
@@ -174,6 +175,9 @@ fn write_run(
     band: u32,
 ) -> Result<RunResult> {
     let result = run(ctx, options)?;
+    if let Some(d) = result.detection.filter(|d| !d.confidence.is_confident()) {
+        eprintln!("warning: {}", d.confidence.warning(""));
+    }
     // `out` and its folders are created by the writes (io::atomic), under the lock the
     // interrupt handler takes: never after its clean-up.
     let views = [

@@ -8,6 +8,7 @@ pub mod display;
 pub mod eyes;
 pub mod frontal_map;
 pub mod head;
+pub mod head_confidence;
 pub mod memory;
 pub mod options;
 pub mod pipeline;

@@ -93,6 +93,9 @@ pub struct RunOptions {
     pub head_jitter_cm: f64,
     /// Seed of the jitter.
     pub seed: u32,
+    /// Refuse a head estimate whose confidence is below `head::CONFIDENT_HEAD` (`--head
+    /// estimated` only).
+    pub require_confident_head: bool,
     /// Feature width `A` the detector measures (interpupillary distance), metres.
     pub feature_width: f64,
     /// Driver-view resolution overrides (truth, occluded, seethru).
@@ -139,6 +142,7 @@ impl Default for RunOptions {
             head_bias_cm: [0.0; 3],
             head_jitter_cm: 0.0,
             seed: 1,
+            require_confident_head: false,
             feature_width: 0.064,
             width: None,
             height: None,

@@ -57,6 +57,12 @@ fn eye_for_compensation(
         HeadSource::Oracle => (eyes.position(&scene.driver, eyes.target), None),
         HeadSource::Estimated => {
             let detection = detect(back)?;
+            if options.require_confident_head && !detection.confidence.is_confident() {
+                bail!(
+                    "--require-confident-head: {}",
+                    detection.confidence.warning("")
+                );
+            }
             // The believed back camera ([calibration]), not the true one.
             let believed = scene.calibration.back.apply(&scene.back)?;
             let cyclopean = eye_from_detection(&detection, &believed, options.feature_width);
@@ -269,6 +275,11 @@ pub fn run_with_truth(
         bail!("head bias must be finite and jitter ≥ 0");
     }
     options.eyes.check().map_err(anyhow::Error::msg)?;
+    if options.require_confident_head && options.head != HeadSource::Estimated {
+        bail!(
+            "--require-confident-head needs --head estimated (only the image-based estimate has a confidence)"
+        );
+    }
     if options.method.models_the_scene() {
         // Bad sensor flags, an ideal display and a scene without a road fail before anything
         // is rendered.
