@@ -168,3 +168,102 @@ fn a_sequence_records_the_confidence_of_every_estimate() {
     assert_eq!(values.len(), 2);
     assert!(values.iter().all(|c| (0.9..=1.0).contains(c)), "{values:?}");
 }
+
+#[test]
+fn the_tracker_model_moves_the_eye_by_its_noise_seeded_and_states_its_figures() {
+    let ctx = RenderContext::new(common::das()).unwrap();
+    let model = |seed| {
+        run(
+            &ctx,
+            &RunOptions {
+                head: HeadSource::Model,
+                seed,
+                spp: 1,
+                width: Some(48),
+                ..RunOptions::default()
+            },
+        )
+        .unwrap()
+    };
+    let (a, b, c) = (model(1), model(1), model(2));
+    let error = |r: &seethru::system::pipeline::RunResult| {
+        r.report["eye_used"]["error_m"].as_f64().unwrap()
+    };
+    // Depth σ 5% of 0.75 m = 3.8 cm, lateral 2 mm: one draw is off, and within 5 σ.
+    assert!(error(&a) > 1e-4 && error(&a) < 0.2, "{}", error(&a));
+    assert_eq!(error(&a), error(&b), "seeded");
+    assert_ne!(error(&a), error(&c));
+    assert_eq!(a.report["head_model"]["sigma_depth_fraction"], 0.05);
+    assert!(a.report["head_detection"].is_null());
+}
+
+/// `run` on the left turn at `--display ideal` with `extra` flags: the pedestrian's and the
+/// cyclist's hazard records.
+fn left_turn(dir: &std::path::Path, name: &str, extra: &[&str]) -> Vec<serde_json::Value> {
+    let out = dir.join(name);
+    let mut args = vec![
+        "run",
+        "scenes/left_turn.toml",
+        "--out",
+        out.to_str().unwrap(),
+        "--width",
+        "192",
+        "--spp",
+        "1",
+        "--display",
+        "ideal",
+        "--outside",
+        "black",
+    ];
+    args.extend(extra);
+    let (ok, _, err) = common::seethru(&args);
+    assert!(ok, "{err}");
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    m["hazards"]["objects"].as_array().unwrap().clone()
+}
+
+#[test]
+fn hazard_visibility_is_one_at_the_pedestrians_depth_and_falls_as_the_plane_moves_away() {
+    let scene = Scene::load(&common::repo_path("scenes/left_turn.toml")).unwrap();
+    let hazards: Vec<&str> = scene
+        .objects
+        .iter()
+        .filter(|o| o.hazard)
+        .map(|o| o.name.as_str())
+        .collect();
+    assert_eq!(hazards, ["pedestrian", "cyclist"]);
+    // The pedestrian waits at z = −13.2, the display plane is at z = −0.75: 12.45 m behind it.
+    let depth = 12.45;
+    let dir = tempfile::tempdir().unwrap();
+    let visibility = |d2: &str| {
+        let h = left_turn(dir.path(), d2, &["--d2", d2]);
+        assert!(h[0]["hidden_pixels"].as_u64().unwrap() > 20, "{h:?}");
+        h[0]["visibility"].as_f64().unwrap()
+    };
+    // The eye sits b = 0.35 m beside the frontal camera: a point at depth D through a plane
+    // at d2 is off by about b |1/D − 1/d2| — 0′ at d2 = D (the body's ±0.2 m of depth: < 4′),
+    // 21′ at 16 m (inside the 30′ bound), 48′ at 25 m and 97′ at ∞ (outside).
+    let at_depth = visibility(&depth.to_string());
+    let near = visibility("16");
+    let far = visibility("25");
+    let infinity = visibility("inf");
+    assert!(at_depth > 0.95, "{at_depth}");
+    assert!(near > 0.6, "{near}");
+    assert!(far < near && infinity < 0.1, "{near} {far} {infinity}");
+    assert!(infinity <= far);
+}
+
+#[test]
+fn a_road_user_outside_the_pillars_shadow_is_not_counted_as_hidden() {
+    let dir = tempfile::tempdir().unwrap();
+    let h = left_turn(dir.path(), "static", &[]);
+    let cyclist = &h[1];
+    assert_eq!(cyclist["name"], "cyclist");
+    assert!(
+        cyclist["truth_pixels"].as_u64().unwrap() > 0,
+        "in view: {cyclist}"
+    );
+    assert_eq!(cyclist["hidden_pixels"], 0, "{cyclist}");
+    assert!(cyclist["visibility"].is_null(), "{cyclist}");
+}

@@ -8,6 +8,7 @@ use rayon::prelude::*;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_frame;
 use seethru::io::staged::StagedDir;
+use seethru::measure::hazard::{DEFAULT_BOUND_ARCMIN, hazard_frame, hazards_json};
 use seethru::measure::holes::{attach_holes, write_hole_mask};
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
@@ -18,7 +19,7 @@ use seethru::system::display::{DisplayModel, Filter};
 use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
 use seethru::system::memory::{both_eyes_estimate, check_memory, run_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
-use seethru::system::pipeline::{RunResult, run};
+use seethru::system::pipeline::{RunResult, driver_camera, run};
 
 use crate::cli::args::{HeadErrorArgs, RenderArgs, band, pixels, positive, with_threads};
 use crate::cli::run_eyes::EyesFlag;
@@ -79,6 +80,10 @@ pub struct Run {
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
+    /// Hazard visibility: a hidden hazard pixel counts as shown when the display shows the
+    /// same object within this misregistration, arc-minutes in (0, 10800].
+    #[arg(long = "hazard-bound-arcmin", default_value_t = DEFAULT_BOUND_ARCMIN, value_parser = positive(10800.0))]
+    hazard_bound_arcmin: f64,
     /// The depth sensor and hole filling of ground, plane-fit and depth.
     #[command(flatten)]
     scene_model: SceneModelArgs,
@@ -122,9 +127,18 @@ impl Run {
         let both = self.eyes == EyesFlag::Both;
         let (scene, out, band, max_memory) =
             (&self.scene, &self.out, self.band, self.render.max_memory);
+        let hazard_bound = self.hazard_bound_arcmin;
         let calibration = self.calibration.as_deref();
         with_threads(self.render.threads, || {
-            run_command(scene, calibration, out, &options, band, max_memory, both)
+            run_command(
+                scene,
+                calibration,
+                out,
+                &options,
+                (band, hazard_bound),
+                max_memory,
+                both,
+            )
         })?
     }
 }
@@ -135,7 +149,7 @@ fn run_command(
     calibration: Option<&Path>,
     out: &Path,
     options: &RunOptions,
-    band: u32,
+    (band, hazard_bound): (u32, f64),
     max_memory: f64,
     both: bool,
 ) -> Result<()> {
@@ -153,10 +167,10 @@ fn run_command(
     let staged = StagedDir::new(out)?;
     let summary = if both {
         crate::cli::run_eyes::run_both(&ctx, staged.path(), out, options, |options, dir| {
-            write_run(&ctx, dir, options, band)
+            write_run(&ctx, dir, options, band, hazard_bound)
         })?
     } else {
-        write_run(&ctx, staged.path(), options, band)?;
+        write_run(&ctx, staged.path(), options, band, hazard_bound)?;
         format!(
             "wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",
             out.display()
@@ -173,6 +187,7 @@ fn write_run(
     out: &Path,
     options: &RunOptions,
     band: u32,
+    hazard_bound: f64,
 ) -> Result<RunResult> {
     let result = run(ctx, options)?;
     if let Some(d) = result.detection.filter(|d| !d.confidence.is_confident()) {
@@ -214,6 +229,20 @@ fn write_run(
     if let Some(holes) = &holes {
         write_hole_mask(&out.join("holes.png"), &maps, holes)?;
     }
+    let driver = driver_camera(&ctx.scene, options)?;
+    let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
+        .atan()
+        .to_degrees()
+        * 60.0;
+    let hazards = hazard_frame(
+        &ctx.scene,
+        &result.truth,
+        &result.seethru,
+        &maps,
+        hazard_bound,
+        arcmin_per_px,
+    );
+    metrics["hazards"] = hazards_json(&hazards, hazard_bound);
     write_metrics(out, &maps, &result.truth, &metrics)?;
     // Last: a directory with run.json holds a finished run.
     write_text(

@@ -179,7 +179,7 @@ mod tests {
         let c = HeadConfidence::of(b, p, [8, 48]);
         assert!(c.pupil_sizes == 0.0, "{c:?}");
         // Both pupils at the face's right edge.
-        let c = HeadConfidence::of(b, [DVec2::new(150.0, 377.0), DVec2::new(188.6, 377.0)], a);
+        let c = HeadConfidence::of(b, [DVec2::new(170.0, 377.0), DVec2::new(208.6, 377.0)], a);
         assert!(c.symmetry == 0.0, "{c:?}");
     }
 

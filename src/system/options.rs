@@ -70,6 +70,9 @@ pub enum HeadSource {
     Oracle,
     /// The back camera's image through the face detector and eqs. d1, b_h.
     Estimated,
+    /// A statistical tracker: the true eye with a webcam landmark tracker's bias, noise,
+    /// dropouts and latency (system/tracker_model.rs).
+    Model,
 }
 
 /// What to do when the crop needs more than the frontal camera sees.

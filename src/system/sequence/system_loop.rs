@@ -32,6 +32,7 @@ use crate::system::pipeline::{crop_for, driver_camera, frontal_map};
 use crate::system::sequence::head_motion::HeadMotion;
 use crate::system::sequence::predict::{Prediction, Predictor};
 use crate::system::sequence::timeline::{FrameTimes, Rig, Timeline};
+use crate::system::tracker_model::WEBCAM_LANDMARKS;
 use crate::util::number::short;
 
 /// Fewest samples per pixel of the back camera's image.
@@ -107,6 +108,8 @@ pub struct SystemLoop {
     pub seconds: StageSeconds,
     /// Frontal pixels rendered, summed over the refreshes.
     pub frontal_pixels: u64,
+    /// `--head-source model`: the last estimate, held over a dropped sample.
+    model_last: Option<DVec3>,
 }
 
 impl SystemLoop {
@@ -146,6 +149,7 @@ impl SystemLoop {
             HeadSource::Oracle => run.head_jitter_cm / 100.0,
             // About the tracker's error on das at 640×480 (README, "The see-through pipeline").
             HeadSource::Estimated => (run.head_jitter_cm / 100.0).max(0.005),
+            HeadSource::Model => (run.head_jitter_cm / 100.0).max(WEBCAM_LANDMARKS.sigma_lateral_m),
         };
         let frontal = Frame::new(rig.base.frontal.width, rig.base.frontal.height);
         Ok(SystemLoop {
@@ -161,6 +165,7 @@ impl SystemLoop {
             surface: None,
             seconds: StageSeconds::default(),
             frontal_pixels: 0,
+            model_last: None,
         })
     }
 
@@ -194,6 +199,16 @@ impl SystemLoop {
         let mut confidence = None;
         let eye = match run.head {
             HeadSource::Oracle => self.rig.eye_in_obstacle(t),
+            HeadSource::Model => {
+                // The estimate delivered at `t` is of the eye one latency earlier; a dropped
+                // sample holds the last estimate.
+                let model = WEBCAM_LANDMARKS;
+                let eye = self.rig.eye_in_obstacle(t - model.latency_s);
+                let index = refresh.max(0) as u32;
+                let (estimate, _) = model.sample_or_hold(eye, run.seed, index, self.model_last);
+                self.model_last = Some(estimate);
+                estimate
+            }
             HeadSource::Estimated => {
                 let ctx = self.context_at(t)?;
                 let start = Instant::now();
