@@ -219,8 +219,8 @@ fn left_turn(dir: &std::path::Path, name: &str, extra: &[&str]) -> Vec<serde_jso
     let (ok, _, err) = common::seethru(&args);
     assert!(ok, "{err}");
     let m: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
-    m["hazards"]["objects"].as_array().unwrap().clone()
+        serde_json::from_str(&std::fs::read_to_string(out.join("hazards.json")).unwrap()).unwrap();
+    m["objects"].as_array().unwrap().clone()
 }
 
 #[test]

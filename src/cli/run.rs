@@ -81,7 +81,7 @@ pub struct Run {
     #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
     /// Hazard visibility: a hidden hazard pixel counts as shown when the display shows the
-    /// same object within this misregistration, arc-minutes in (0, 10800].
+    /// same object within this misregistration, arc-minutes in [1e-6, 10800].
     #[arg(long = "hazard-bound-arcmin", default_value_t = DEFAULT_BOUND_ARCMIN, value_parser = positive(10800.0))]
     hazard_bound_arcmin: f64,
     /// The depth sensor and hole filling of ground, plane-fit and depth.
@@ -242,7 +242,11 @@ fn write_run(
         hazard_bound,
         arcmin_per_px,
     );
-    metrics["hazards"] = hazards_json(&hazards, hazard_bound);
+    // Beside metrics.json (which `measure` recomputes from the frames alone).
+    write_text(
+        &out.join("hazards.json"),
+        &serde_json::to_string_pretty(&hazards_json(&hazards, hazard_bound))?,
+    )?;
     write_metrics(out, &maps, &result.truth, &metrics)?;
     // Last: a directory with run.json holds a finished run.
     write_text(
