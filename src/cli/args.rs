@@ -132,6 +132,10 @@ pub struct HeadErrorArgs {
     /// The detector's known feature width A (interpupillary distance), metres in [1e-6, 1].
     #[arg(long = "feature-width", default_value_t = 0.064, value_parser = positive(1.0))]
     pub feature_width: f64,
+    /// Stop with an error when a head estimate's confidence is below 0.5 (else a warning);
+    /// image-based head estimates only.
+    #[arg(long = "require-confident-head")]
+    pub require_confident_head: bool,
 }
 
 /// `--max-memory`, GiB in [1e-6, 4096].

@@ -8,6 +8,7 @@ use rayon::prelude::*;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{ExrContent, write_frame};
 use seethru::io::staged::StagedDir;
+use seethru::measure::hazard::{DEFAULT_BOUND_ARCMIN, hazard_frame, hazards_json};
 use seethru::measure::holes::{attach_holes, write_hole_mask};
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
@@ -18,7 +19,7 @@ use seethru::system::display::{DisplayModel, Filter};
 use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
 use seethru::system::memory::{both_eyes_estimate, check_memory, run_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
-use seethru::system::pipeline::{RunResult, run};
+use seethru::system::pipeline::{RunResult, driver_camera, run};
 
 use crate::cli::args::{HeadErrorArgs, RenderArgs, band, pixels, positive, with_threads};
 use crate::cli::run_eyes::EyesFlag;
@@ -83,6 +84,10 @@ pub struct Run {
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
+    /// Hazard visibility: a hidden hazard pixel counts as shown when the display shows the
+    /// same object within this misregistration, arc-minutes in [1e-6, 10800].
+    #[arg(long = "hazard-bound-arcmin", default_value_t = DEFAULT_BOUND_ARCMIN, value_parser = positive(10800.0))]
+    hazard_bound_arcmin: f64,
     /// The depth sensor and hole filling of ground, plane-fit and depth.
     #[command(flatten)]
     scene_model: SceneModelArgs,
@@ -101,6 +106,7 @@ impl Run {
             head_bias_cm: self.head_errors.head_bias_cm,
             head_jitter_cm: self.head_errors.head_jitter_cm,
             seed: self.head_errors.seed,
+            require_confident_head: self.head_errors.require_confident_head,
             feature_width: self.head_errors.feature_width,
             width: self.render.width,
             height: self.render.height,
@@ -123,26 +129,29 @@ impl Run {
             progress: true,
         };
         let both = self.eyes == EyesFlag::Both;
-        let (scene, out, band, max_memory, exr) = (
-            &self.scene,
-            &self.out,
-            self.band,
-            self.render.max_memory,
-            self.exr,
-        );
+        let (scene, out, max_memory) = (&self.scene, &self.out, self.render.max_memory);
+        let writes = RunWrites {
+            band: self.band,
+            exr: self.exr,
+            hazard_bound_arcmin: self.hazard_bound_arcmin,
+        };
         let calibration = self.calibration.as_deref();
         with_threads(self.render.threads, || {
-            run_command(
-                scene,
-                calibration,
-                out,
-                &options,
-                (band, exr),
-                max_memory,
-                both,
-            )
+            run_command(scene, calibration, out, &options, writes, max_memory, both)
         })?
     }
+}
+
+/// What one run writes beside its views, and how: the flags that shape the files, not the
+/// system.
+#[derive(Clone, Copy)]
+struct RunWrites {
+    /// Border band of the mismatch metrics, display pixels in [1, 1000].
+    band: u32,
+    /// Which EXRs each view gets.
+    exr: ExrContent,
+    /// Hazard visibility's bound, arc-minutes.
+    hazard_bound_arcmin: f64,
 }
 
 /// `seethru run`: renders the six views into `out` with `run.json` and the metrics.
@@ -151,7 +160,7 @@ fn run_command(
     calibration: Option<&Path>,
     out: &Path,
     options: &RunOptions,
-    (band, exr): (u32, ExrContent),
+    writes: RunWrites,
     max_memory: f64,
     both: bool,
 ) -> Result<()> {
@@ -169,11 +178,11 @@ fn run_command(
     let staged = StagedDir::new(out)?;
     let summary = if both {
         crate::cli::run_eyes::run_both(&ctx, staged.path(), out, options, |options, dir| {
-            write_run(&ctx, dir, options, band, exr)
+            write_run(&ctx, dir, options, writes)
         })?
     } else {
-        write_run(&ctx, staged.path(), options, band, exr)?;
-        let files = match exr {
+        write_run(&ctx, staged.path(), options, writes)?;
+        let files = match writes.exr {
             ExrContent::None => "PNG, ids PNG",
             ExrContent::Colour => "PNG, ids PNG, colour EXR",
             ExrContent::All => "PNG, ids PNG, EXR",
@@ -193,10 +202,17 @@ fn write_run(
     ctx: &RenderContext,
     out: &Path,
     options: &RunOptions,
-    band: u32,
-    exr: ExrContent,
+    writes: RunWrites,
 ) -> Result<RunResult> {
+    let RunWrites {
+        band,
+        exr,
+        hazard_bound_arcmin: hazard_bound,
+    } = writes;
     let result = run(ctx, options)?;
+    if let Some(d) = result.detection.filter(|d| !d.confidence.is_confident()) {
+        eprintln!("warning: {}", d.confidence.warning(""));
+    }
     // `out` and its folders are created by the writes (io::atomic), under the lock the
     // interrupt handler takes: never after its clean-up.
     let views = [
@@ -233,6 +249,24 @@ fn write_run(
     if let Some(holes) = &holes {
         write_hole_mask(&out.join("holes.png"), &maps, holes)?;
     }
+    let driver = driver_camera(&ctx.scene, options)?;
+    let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
+        .atan()
+        .to_degrees()
+        * 60.0;
+    let hazards = hazard_frame(
+        &ctx.scene,
+        &result.truth,
+        &result.seethru,
+        &maps,
+        hazard_bound,
+        arcmin_per_px,
+    );
+    // Beside metrics.json (which `measure` recomputes from the frames alone).
+    write_text(
+        &out.join("hazards.json"),
+        &serde_json::to_string_pretty(&hazards_json(&hazards, hazard_bound))?,
+    )?;
     write_metrics(out, &maps, &result.truth, &metrics)?;
     // Last: a directory with run.json holds a finished run.
     write_text(

@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{write_color_png, write_exr};
 use seethru::io::staged::StagedDir;
-use seethru::measure::sequence::{Measuring, SequenceRun, run_sequence_labelled};
+use seethru::measure::sequence::{Measuring, SequenceRun, head_warning, run_sequence_labelled};
 use seethru::measure::sequence_files::{
     Preview, frames_csv, latency_figure, over_time_figure, summary,
 };
@@ -218,6 +218,7 @@ impl Sequence {
                 head: self.head_source,
                 head_bias_cm: self.head_errors.head_bias_cm,
                 head_jitter_cm: self.head_errors.head_jitter_cm,
+                require_confident_head: self.head_errors.require_confident_head,
                 seed: self.head_errors.seed,
                 feature_width: self.head_errors.feature_width,
                 width: Some(self.width),
@@ -301,6 +302,9 @@ impl Sequence {
                     }
                 }
             })?;
+            if let Some(w) = head_warning(&run.records) {
+                eprintln!("warning: {w}");
+            }
             write_text(
                 &dir.join("frames.csv"),
                 &frames_csv(&run.records, &timeline)?,

@@ -177,6 +177,7 @@ fn object(name: &str, shape: Shape, material: usize, world_from_object: DAffine3
         world_from_object,
         visible_to: 0b111,
         casts_shadow: true,
+        hazard: false,
         motion: Default::default(),
     }
 }

@@ -15,8 +15,10 @@ use crate::render::frame::Frame;
 use crate::render::settings::RenderSettings;
 use crate::scene::world::view_bit;
 use crate::scene::{Obstacle, Scene};
+use crate::system::head::CONFIDENT_HEAD;
 use crate::system::sequence::system_loop::{SequenceOptions, StageSeconds, SystemLoop};
 use crate::system::sequence::timeline::FrameTimes;
+use crate::util::number::short;
 use crate::util::progress::Progress;
 
 /// The metrics of one frame (from `measure`'s JSON).
@@ -68,12 +70,32 @@ pub struct FrameRecord {
     pub eye_estimated: DVec3,
     /// The eye the compensation used (predicted), obstacle frame, m.
     pub eye_used: DVec3,
+    /// The image-based head estimate's confidence, [0, 1] (`None`: another head source).
+    pub head_confidence: Option<f64>,
     /// The vehicle's pivot (the eye at t = 0 carried along), world, m; its yaw, degrees.
     pub vehicle_position: DVec3,
     pub vehicle_yaw_deg: f64,
     pub d2_used: Option<f64>,
     /// `None` when the sequence runs without truth and metrics.
     pub metrics: Option<FrameMetrics>,
+}
+
+/// The one-line warning when some frames' image-based head estimates were unreliable
+/// (confidence below [`CONFIDENT_HEAD`]), else `None`.
+pub fn head_warning(records: &[FrameRecord]) -> Option<String> {
+    let scored: Vec<(f64, f64)> = records
+        .iter()
+        .filter_map(|r| r.head_confidence.map(|c| (c, r.times.head)))
+        .collect();
+    let low = scored.iter().filter(|(c, _)| *c < CONFIDENT_HEAD).count();
+    let (worst, at) = scored.iter().copied().min_by(|a, b| a.0.total_cmp(&b.0))?;
+    (low > 0).then(|| {
+        format!(
+            "head estimate unreliable in {low} of {} frames (confidence < {CONFIDENT_HEAD}; lowest {worst:.2}, head sampled at t = {} s): frames.csv's head_confidence column has each (--require-confident-head makes this an error)",
+            scored.len(),
+            short(at)
+        )
+    })
 }
 
 /// The images of one measured frame, for the caller to write or collect.
@@ -206,6 +228,7 @@ pub fn run_sequence_labelled(
             eye_true: system.rig.eye_in_obstacle(times.display),
             eye_estimated: shown.eye_estimated,
             eye_used: shown.eye_used,
+            head_confidence: shown.head_confidence,
             vehicle_position: rig.transform_point3(system.rig.vehicle.pivot),
             vehicle_yaw_deg: (system.rig.vehicle.yaw_rate * times.display).to_degrees(),
             d2_used: shown.d2_used,

@@ -16,7 +16,7 @@ use crate::system::sequence::timeline::Timeline;
 use crate::util::color::encode_srgb8;
 
 /// The columns of `frames.csv`.
-pub const FRAME_COLUMNS: [&str; 38] = [
+pub const FRAME_COLUMNS: [&str; 39] = [
     "frame",
     "t_s",
     "refresh_s",
@@ -55,6 +55,7 @@ pub const FRAME_COLUMNS: [&str; 38] = [
     "blank_fraction",
     "eye_x_velocity_m_s",
     "eye_z_velocity_m_s",
+    "head_confidence",
 ];
 
 /// `frames.csv`: every number in Rust's shortest round-trip form (the same bytes for any
@@ -120,6 +121,7 @@ pub fn frames_csv(records: &[FrameRecord], timeline: &Timeline) -> Result<String
             1.0 - m.coverage,
             velocity.x,
             velocity.z,
+            r.head_confidence.unwrap_or(f64::NAN),
         ]
         .iter()
         .map(|v| format!("{v}"))

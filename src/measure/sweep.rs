@@ -107,6 +107,7 @@ pub fn sweep(
         match options.head {
             HeadSource::Oracle => "oracle",
             HeadSource::Estimated => "estimated",
+            HeadSource::Model => "model",
         }
         .to_string(),
         options.band.to_string(),

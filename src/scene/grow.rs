@@ -75,6 +75,7 @@ pub fn grow(base: &Scene, factor: f64) -> Result<Scene> {
             world_from_object: at,
             visible_to: all_cameras,
             casts_shadow: true,
+            hazard: false,
             motion: Default::default(),
         })
     };

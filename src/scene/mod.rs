@@ -121,6 +121,9 @@ pub struct Object {
     pub visible_to: u8,
     /// Whether the object blocks sunlight.
     pub casts_shadow: bool,
+    /// Whether it is a road user the driver must see (a pedestrian, a cyclist): the hazard
+    /// visibility metric follows it. Default false.
+    pub hazard: bool,
     /// How it moves during a `sequence` (nothing else reads it).
     pub motion: motion::ObjectMotion,
 }

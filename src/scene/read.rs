@@ -388,6 +388,7 @@ fn read_object(
         world_from_object: read_transform(t)?,
         visible_to,
         casts_shadow: t.bool_or("casts_shadow", true)?,
+        hazard: t.bool_or("hazard", false)?,
         motion: {
             let (translate, rotate_deg, scale) = read_placement(t)?;
             let corners = object_bounds(&shape_for_bounds);

@@ -11,6 +11,7 @@ use glam::{DVec2, DVec3};
 use crate::analysis::paper::{head_distance, head_offset};
 use crate::geometry::camera::Camera;
 use crate::render::frame::Frame;
+pub use crate::system::head_confidence::{CONFIDENT_HEAD, HeadConfidence};
 use crate::util::color::encode_srgb8;
 use crate::util::sampling::{hash_words, unit_float};
 
@@ -21,6 +22,10 @@ pub struct FaceDetection {
     pub face_box: [u32; 4],
     /// Centroids of the left and right pupil (left = smaller x).
     pub pupils: [[f64; 2]; 2],
+    /// Pixels in the left and right pupil's dark blob.
+    pub pupil_areas_px: [u32; 2],
+    /// How far the detection can be trusted, from what it measured ([`HeadConfidence`]).
+    pub confidence: HeadConfidence,
 }
 
 impl FaceDetection {
@@ -209,10 +214,17 @@ pub fn detect(frame: &Frame) -> Result<FaceDetection, DetectError> {
         sum / total
     };
     let (a, b) = (centroid(&holes[0]), centroid(&holes[1]));
-    let (left, right) = if a.x <= b.x { (a, b) } else { (b, a) };
+    let areas = [holes[0].len() as u32, holes[1].len() as u32];
+    let (pupils, pupil_areas_px) = if a.x <= b.x {
+        ([a, b], areas)
+    } else {
+        ([b, a], [areas[1], areas[0]])
+    };
     Ok(FaceDetection {
         face_box,
-        pupils: [left.to_array(), right.to_array()],
+        pupils: pupils.map(|p| p.to_array()),
+        pupil_areas_px,
+        confidence: HeadConfidence::of(face_box, pupils, pupil_areas_px),
     })
 }
 

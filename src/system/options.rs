@@ -70,6 +70,9 @@ pub enum HeadSource {
     Oracle,
     /// The back camera's image through the face detector and eqs. d1, b_h.
     Estimated,
+    /// A statistical tracker: the true eye with a webcam landmark tracker's bias, noise,
+    /// dropouts and latency (system/tracker_model.rs).
+    Model,
 }
 
 /// What to do when the crop needs more than the frontal camera sees.
@@ -93,6 +96,9 @@ pub struct RunOptions {
     pub head_jitter_cm: f64,
     /// Seed of the jitter.
     pub seed: u32,
+    /// Refuse a head estimate whose confidence is below `head::CONFIDENT_HEAD` (`--head
+    /// estimated` only).
+    pub require_confident_head: bool,
     /// Feature width `A` the detector measures (interpupillary distance), metres.
     pub feature_width: f64,
     /// Driver-view resolution overrides (truth, occluded, seethru).
@@ -139,6 +145,7 @@ impl Default for RunOptions {
             head_bias_cm: [0.0; 3],
             head_jitter_cm: 0.0,
             seed: 1,
+            require_confident_head: false,
             feature_width: 0.064,
             width: None,
             height: None,

@@ -25,6 +25,7 @@ use crate::system::head::{FaceDetection, detect, eye_from_detection, gaussian};
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use crate::system::report::report;
 use crate::system::scene_model::{check_scene_model, scene_model_display};
+use crate::system::tracker_model::WEBCAM_LANDMARKS;
 use crate::util::memory::peak_rss_bytes;
 use crate::util::number::short;
 
@@ -57,6 +58,12 @@ fn eye_for_compensation(
         HeadSource::Oracle => (eyes.position(&scene.driver, eyes.target), None),
         HeadSource::Estimated => {
             let detection = detect(back)?;
+            if options.require_confident_head && !detection.confidence.is_confident() {
+                bail!(
+                    "--require-confident-head: {}",
+                    detection.confidence.warning("")
+                );
+            }
             // The believed back camera ([calibration]), not the true one.
             let believed = scene.calibration.back.apply(&scene.back)?;
             let cyclopean = eye_from_detection(&detection, &believed, options.feature_width);
@@ -64,6 +71,14 @@ fn eye_for_compensation(
                 eyes.target_from_estimate(cyclopean, &scene.obstacle),
                 Some(detection),
             )
+        }
+        HeadSource::Model => {
+            // A still head: a dropped sample holds the last estimate, which is of the same
+            // eye; latency has nothing to act on.
+            let o = &scene.obstacle;
+            let eye = o.in_obstacle_frame(eyes.position(&scene.driver, eyes.target));
+            let (estimate, _) = WEBCAM_LANDMARKS.sample_or_hold(eye, options.seed, 0, None);
+            (o.world_from_obstacle.transform_point3(estimate), None)
         }
     };
     let jitter = DVec3::new(
@@ -269,6 +284,11 @@ pub fn run_with_truth(
         bail!("head bias must be finite and jitter ≥ 0");
     }
     options.eyes.check().map_err(anyhow::Error::msg)?;
+    if options.require_confident_head && options.head != HeadSource::Estimated {
+        bail!(
+            "--require-confident-head needs --head estimated (only the image-based estimate has a confidence)"
+        );
+    }
     if options.method.models_the_scene() {
         // Bad sensor flags, an ideal display and a scene without a road fail before anything
         // is rendered.

@@ -8,7 +8,8 @@ use crate::analysis::paper::k_px;
 use crate::scene::Scene;
 use crate::system::compensation::Crop;
 use crate::system::head::FaceDetection;
-use crate::system::options::{RunOptions, WorkingDistance};
+use crate::system::options::{HeadSource, RunOptions, WorkingDistance};
+use crate::system::tracker_model::WEBCAM_LANDMARKS;
 
 #[allow(clippy::too_many_arguments)]
 pub fn report(
@@ -38,6 +39,7 @@ pub fn report(
             "head_bias_cm": options.head_bias_cm,
             "head_jitter_cm": options.head_jitter_cm,
             "seed": options.seed,
+            "require_confident_head": options.require_confident_head,
             "feature_width_m": options.feature_width,
             "spp": options.spp,
             "outside": options.outside,
@@ -47,7 +49,8 @@ pub fn report(
         "conventions": "obstacle frame: origin at the display centre, +z towards the driver; paper's b_h = −x (eye on the side of R1 for b_h > 0), b_v = y",
         "eye_true": {"world_m": scene.eye().to_array(), "obstacle_m": true_o.to_array(), "paper": paper(true_o)},
         "eye_used": {"world_m": eye_used.to_array(), "obstacle_m": used_o.to_array(), "paper": paper(used_o), "error_m": (eye_used - scene.eye()).length()},
-        "head_detection": detection.map(|d| json!({"face_box_px": d.face_box, "pupils_px": d.pupils, "feature_px": d.feature_px()})),
+        "head_model": (options.head == HeadSource::Model).then_some(WEBCAM_LANDMARKS),
+        "head_detection": detection.map(|d| json!({"face_box_px": d.face_box, "pupils_px": d.pupils, "feature_px": d.feature_px(), "pupil_areas_px": d.pupil_areas_px, "confidence": d.confidence})),
         "d2_m": d2_used.map_or(json!("inf"), |d| json!(d)),
         "frontal_half_angle_deg": scene.frontal.half_angle_x.to_degrees(),
         "crop": {

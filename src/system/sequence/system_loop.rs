@@ -32,6 +32,7 @@ use crate::system::pipeline::{crop_for, driver_camera, frontal_map};
 use crate::system::sequence::head_motion::HeadMotion;
 use crate::system::sequence::predict::{Prediction, Predictor};
 use crate::system::sequence::timeline::{FrameTimes, Rig, Timeline};
+use crate::system::tracker_model::WEBCAM_LANDMARKS;
 use crate::util::number::short;
 
 /// Fewest samples per pixel of the back camera's image.
@@ -62,6 +63,8 @@ pub struct Shown {
     pub times: FrameTimes,
     /// The head estimate (of time `times.head`), obstacle frame, m.
     pub eye_estimated: DVec3,
+    /// The image-based estimate's confidence, [0, 1] (`None` for other head sources).
+    pub head_confidence: Option<f64>,
     /// The eye the compensation used (predicted to the refresh time), obstacle frame, m.
     pub eye_used: DVec3,
     pub crop: Crop,
@@ -105,6 +108,8 @@ pub struct SystemLoop {
     pub seconds: StageSeconds,
     /// Frontal pixels rendered, summed over the refreshes.
     pub frontal_pixels: u64,
+    /// `--head-source model`: the last estimate, held over a dropped sample.
+    model_last: Option<DVec3>,
 }
 
 impl SystemLoop {
@@ -120,6 +125,11 @@ impl SystemLoop {
         }
         if !(run.feature_width > 0.0 && run.feature_width.is_finite()) {
             bail!("--feature-width must be > 0 m, got {}", run.feature_width);
+        }
+        if run.require_confident_head && run.head != HeadSource::Estimated {
+            bail!(
+                "--require-confident-head needs --head-source estimated (only the image-based estimate has a confidence)"
+            );
         }
         let mut base = scene.clone();
         base.frontal = run.sized_frontal(base.frontal)?;
@@ -139,6 +149,7 @@ impl SystemLoop {
             HeadSource::Oracle => run.head_jitter_cm / 100.0,
             // About the tracker's error on das at 640×480 (docs/guide/pipeline.md).
             HeadSource::Estimated => (run.head_jitter_cm / 100.0).max(0.005),
+            HeadSource::Model => (run.head_jitter_cm / 100.0).max(WEBCAM_LANDMARKS.sigma_lateral_m),
         };
         let frontal = Frame::new(rig.base.frontal.width, rig.base.frontal.height);
         Ok(SystemLoop {
@@ -154,6 +165,7 @@ impl SystemLoop {
             surface: None,
             seconds: StageSeconds::default(),
             frontal_pixels: 0,
+            model_last: None,
         })
     }
 
@@ -180,11 +192,23 @@ impl SystemLoop {
         })
     }
 
-    /// The head estimate of time `t` (obstacle frame) for refresh `refresh`.
-    fn estimate_head(&mut self, t: f64, refresh: i64) -> Result<DVec3> {
+    /// The head estimate of time `t` (obstacle frame) for refresh `refresh`, and the
+    /// image-based estimate's confidence.
+    fn estimate_head(&mut self, t: f64, refresh: i64) -> Result<(DVec3, Option<f64>)> {
         let run = self.options.run.clone();
+        let mut confidence = None;
         let eye = match run.head {
             HeadSource::Oracle => self.rig.eye_in_obstacle(t),
+            HeadSource::Model => {
+                // The estimate delivered at `t` is of the eye one latency earlier; a dropped
+                // sample holds the last estimate.
+                let model = WEBCAM_LANDMARKS;
+                let eye = self.rig.eye_in_obstacle(t - model.latency_s);
+                let index = refresh.max(0) as u32;
+                let (estimate, _) = model.sample_or_hold(eye, run.seed, index, self.model_last);
+                self.model_last = Some(estimate);
+                estimate
+            }
             HeadSource::Estimated => {
                 let ctx = self.context_at(t)?;
                 let start = Instant::now();
@@ -198,6 +222,15 @@ impl SystemLoop {
                 let (frame, _) = ctx.render(&back, view_bit::BACK, settings, "back");
                 let detection = detect(&frame)
                     .with_context(|| format!("head estimate at t = {} s", short(t)))?;
+                if run.require_confident_head && !detection.confidence.is_confident() {
+                    bail!(
+                        "--require-confident-head: {}",
+                        detection
+                            .confidence
+                            .warning(&format!("at t = {} s: ", short(t)))
+                    );
+                }
+                confidence = Some(detection.confidence.value);
                 // The believed back camera ([calibration]), not the true one.
                 let believed = ctx.scene.calibration.back.apply(&back)?;
                 let world = eye_from_detection(&detection, &believed, run.feature_width);
@@ -211,7 +244,10 @@ impl SystemLoop {
             gaussian(run.seed, index.wrapping_add(1)),
             gaussian(run.seed, index.wrapping_add(2)),
         ) * run.head_jitter_cm;
-        Ok(eye + (DVec3::from_array(run.head_bias_cm) + jitter) / 100.0)
+        Ok((
+            eye + (DVec3::from_array(run.head_bias_cm) + jitter) / 100.0,
+            confidence,
+        ))
     }
 
     /// What the display shows at displayed frame `frame`: the image of the latest refresh,
@@ -225,7 +261,7 @@ impl SystemLoop {
         {
             return Ok(self.shown.as_ref().expect("just checked"));
         }
-        let eye_estimated = self.estimate_head(times.head, times.refresh)?;
+        let (eye_estimated, head_confidence) = self.estimate_head(times.head, times.refresh)?;
         self.predictor.observe(times.head, eye_estimated);
         let eye_used = match self.options.predict {
             Prediction::None => eye_estimated,
@@ -302,6 +338,7 @@ impl SystemLoop {
         self.shown = Some(Shown {
             times,
             eye_estimated,
+            head_confidence,
             eye_used,
             crop,
             d2_used,

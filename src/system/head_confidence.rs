@@ -1,0 +1,193 @@
+//! How far a face detection can be trusted, from what the detector measured in the image
+//! alone: the face's size, whether the distance the pupils give agrees with the distance the
+//! face's width gives, whether the pupils sit where eyes sit (the face's upper part, about its
+//! middle) and whether the two pupil blobs are alike.
+//!
+//! Each cue is scored in [0, 1] by a linear ramp from a "bad" limit (score 0) to a "good"
+//! limit (score 1); the confidence is the product of the five scores, so any one cue that
+//! fails sinks it. The limits were set on the shipped head (das at 640×480: every score 1)
+//! against the slanted-pillar failures of issue 27 (docs/guide/hazards.md).
+
+use glam::DVec2;
+
+/// Confidence below which an estimate is called unreliable (a `warning:`, and an error with
+/// `--require-confident-head`).
+pub const CONFIDENT_HEAD: f64 = 0.5;
+
+/// Face width over interpupillary distance of the shipped head model (a 0.15 m wide face,
+/// pupils 0.064 m apart). Real adults: about 14 cm bizygomatic over 6.3 cm, 2.2.
+pub const FACE_OVER_FEATURE: f64 = 0.15 / 0.064;
+
+/// The cue scores and what they were computed from.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct HeadConfidence {
+    /// The product of the five scores below, in [0, 1]; below [`CONFIDENT_HEAD`] the estimate
+    /// is unreliable.
+    pub value: f64,
+    /// Face width in pixels: score 0 at ≤ 12 px, 1 at ≥ 40 px.
+    pub face_size: f64,
+    /// Agreement of the distance from the pupils (eq. d1 with A) with the distance from the
+    /// face width (eq. d1 with [`FACE_OVER_FEATURE`] · A): |ln ratio| 0 at ≥ 0.2, 1 at ≤ 0.06.
+    pub distance_agreement: f64,
+    /// The lower pupil's height in the face box (0 top, 1 bottom): 1 at ≤ 0.45, 0 at ≥ 0.7.
+    pub pupil_height: f64,
+    /// The pupils' midpoint off the face box's centre, in face widths: 1 at ≤ 0.35, 0 at
+    /// ≥ 0.5 (the head seen from the side shifts it: das has 0.26).
+    pub symmetry: f64,
+    /// Smaller over larger pupil blob area: 0 at ≤ 0.2, 1 at ≥ 0.5.
+    pub pupil_sizes: f64,
+    /// Face box width, pixels.
+    pub face_width_px: f64,
+    /// Distance from the pupils over distance from the face width (1: they agree).
+    pub distance_ratio: f64,
+    /// The lower pupil's height in the face box, [0, 1] from the top.
+    pub pupil_height_in_face: f64,
+    /// |pupils' midpoint − face box centre| / face width.
+    pub centre_offset_in_face: f64,
+    /// Smaller over larger pupil blob area, (0, 1].
+    pub pupil_area_ratio: f64,
+}
+
+/// 0 at `bad`, 1 at `good`, linear between, clamped (either order of the limits).
+fn ramp(x: f64, bad: f64, good: f64) -> f64 {
+    ((x - bad) / (good - bad)).clamp(0.0, 1.0)
+}
+
+impl HeadConfidence {
+    /// The cues of a face box `[x0, y0, x1, y1)` and its `pupils` (left, right; pixels).
+    pub fn of(face_box: [u32; 4], pupils: [DVec2; 2], areas: [u32; 2]) -> HeadConfidence {
+        let [x0, y0, x1, y1] = face_box.map(f64::from);
+        let (width, height) = ((x1 - x0).max(1.0), (y1 - y0).max(1.0));
+        let feature_px = (pupils[1] - pupils[0]).length().max(1e-9);
+        // d ∝ width / pixels (eq. d1): the ratio of the two distances.
+        let distance_ratio = width / (FACE_OVER_FEATURE * feature_px);
+        let lower = pupils[0].y.max(pupils[1].y);
+        let pupil_height_in_face = (lower - y0) / height;
+        let mid = (pupils[0] + pupils[1]) / 2.0;
+        let centre_offset_in_face = (mid.x - (x0 + x1) / 2.0).abs() / width;
+        let (small, large) = (areas[0].min(areas[1]), areas[0].max(areas[1]).max(1));
+        let pupil_area_ratio = small as f64 / large as f64;
+        let face_size = ramp(width, 12.0, 40.0);
+        let distance_agreement = ramp(distance_ratio.ln().abs(), 0.2, 0.06);
+        let pupil_height = ramp(pupil_height_in_face, 0.7, 0.45);
+        let symmetry = ramp(centre_offset_in_face, 0.5, 0.35);
+        let pupil_sizes = ramp(pupil_area_ratio, 0.2, 0.5);
+        HeadConfidence {
+            value: face_size * distance_agreement * pupil_height * symmetry * pupil_sizes,
+            face_size,
+            distance_agreement,
+            pupil_height,
+            symmetry,
+            pupil_sizes,
+            face_width_px: width,
+            distance_ratio,
+            pupil_height_in_face,
+            centre_offset_in_face,
+            pupil_area_ratio,
+        }
+    }
+
+    /// Whether the estimate can be relied on (confidence ≥ [`CONFIDENT_HEAD`]).
+    pub fn is_confident(&self) -> bool {
+        self.value >= CONFIDENT_HEAD
+    }
+
+    /// The cues that scored below 1, in words, e.g. "a pupil at 63% of the face's height".
+    pub fn doubts(&self) -> String {
+        let pct = |x: f64| format!("{:.0}%", 100.0 * x);
+        let mut out = Vec::new();
+        if self.face_size < 1.0 {
+            out.push(format!("the face only {:.0} px wide", self.face_width_px));
+        }
+        if self.distance_agreement < 1.0 {
+            out.push(format!(
+                "the distance from the pupils {} of the distance from the face width",
+                pct(self.distance_ratio)
+            ));
+        }
+        if self.pupil_height < 1.0 {
+            out.push(format!(
+                "a pupil at {} of the face's height (eyes sit in its upper half)",
+                pct(self.pupil_height_in_face)
+            ));
+        }
+        if self.symmetry < 1.0 {
+            out.push(format!(
+                "the pupils' midpoint {} of the face's width off its centre",
+                pct(self.centre_offset_in_face)
+            ));
+        }
+        if self.pupil_sizes < 1.0 {
+            out.push(format!(
+                "one pupil blob {} the size of the other",
+                pct(self.pupil_area_ratio)
+            ));
+        }
+        out.join(", ")
+    }
+
+    /// The one-line `warning:` text for an unreliable estimate (without the prefix).
+    pub fn warning(&self, context: &str) -> String {
+        format!(
+            "{context}head estimate unreliable: confidence {:.2} < {CONFIDENT_HEAD} ({}); the eye may be centimetres off (--require-confident-head makes this an error)",
+            self.value,
+            self.doubts()
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn das_like() -> ([u32; 4], [DVec2; 2], [u32; 2]) {
+        // das at 640×480: a 91×86 px face, pupils 38.6 px apart at 29% of its height.
+        (
+            [85, 352, 176, 438],
+            [DVec2::new(87.2, 377.3), DVec2::new(125.8, 377.6)],
+            [40, 44],
+        )
+    }
+
+    #[test]
+    fn a_well_seen_face_is_trusted_and_each_cue_can_sink_it() {
+        let (b, p, a) = das_like();
+        let c = HeadConfidence::of(b, p, a);
+        assert!(c.value > 0.95, "{c:?}");
+        assert!((c.distance_ratio - 91.0 / (FACE_OVER_FEATURE * 38.6)).abs() < 1e-3);
+        // Tiny face (same proportions, a sixth the size).
+        let small = HeadConfidence::of(
+            [0, 0, 15, 14],
+            [DVec2::new(0.4, 4.0), DVec2::new(6.8, 4.0)],
+            a,
+        );
+        assert!(small.face_size < 0.2 && !small.is_confident(), "{small:?}");
+        // Pupils 30% closer than the face's width says: the distances disagree.
+        let close = [p[0], p[0] + (p[1] - p[0]) * 0.7];
+        let c = HeadConfidence::of(b, close, a);
+        assert!(c.distance_agreement == 0.0 && !c.is_confident(), "{c:?}");
+        // A "pupil" near the chin.
+        let low = [p[0], DVec2::new(p[1].x, 352.0 + 0.8 * 86.0)];
+        let c = HeadConfidence::of(b, low, a);
+        assert!(c.pupil_height == 0.0 && !c.is_confident(), "{c:?}");
+        assert!(
+            c.doubts().contains("of the face's height"),
+            "{}",
+            c.doubts()
+        );
+        // One blob a sixth of the other.
+        let c = HeadConfidence::of(b, p, [8, 48]);
+        assert!(c.pupil_sizes == 0.0, "{c:?}");
+        // Both pupils at the face's right edge.
+        let c = HeadConfidence::of(b, [DVec2::new(170.0, 377.0), DVec2::new(208.6, 377.0)], a);
+        assert!(c.symmetry == 0.0, "{c:?}");
+    }
+
+    #[test]
+    fn ramps_are_linear_between_their_limits() {
+        assert_eq!(ramp(26.0, 12.0, 40.0), 0.5);
+        assert!((ramp(0.13, 0.2, 0.06) - 0.5).abs() < 1e-12);
+        assert_eq!(ramp(-1.0, 0.2, 0.06), 1.0);
+        assert_eq!(ramp(100.0, 12.0, 40.0), 1.0);
+    }
+}
