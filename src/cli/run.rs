@@ -8,8 +8,9 @@ use rayon::prelude::*;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_frame;
 use seethru::io::staged::StagedDir;
+use seethru::measure::headline::{read_results, summary_text};
 use seethru::measure::holes::{attach_holes, write_hole_mask};
-use seethru::measure::maps::write_metrics;
+use seethru::measure::maps::write_metrics_scaled;
 use seethru::measure::metrics::measure;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
@@ -79,6 +80,10 @@ pub struct Run {
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
+    /// Top of misregistration.png's scale, arc-minutes in [1e-6, 10000], so that heatmaps of
+    /// runs compare (default: the 99th percentile of the display's values, labelled).
+    #[arg(long = "heatmap-max", value_name = "ARCMIN", value_parser = positive(1e4))]
+    heatmap_max: Option<f64>,
     /// The depth sensor and hole filling of ground, plane-fit and depth.
     #[command(flatten)]
     scene_model: SceneModelArgs,
@@ -119,8 +124,8 @@ impl Run {
             progress: true,
         };
         let both = self.eyes == EyesFlag::Both;
-        let (scene, out, band, max_memory) =
-            (&self.scene, &self.out, self.band, self.render.max_memory);
+        let (scene, out, max_memory) = (&self.scene, &self.out, self.render.max_memory);
+        let band = (self.band, self.heatmap_max.map(|v| v as f32));
         let calibration = self.calibration.as_deref();
         with_threads(self.render.threads, || {
             run_command(scene, calibration, out, &options, band, max_memory, both)
@@ -134,7 +139,7 @@ fn run_command(
     calibration: Option<&Path>,
     out: &Path,
     options: &RunOptions,
-    band: u32,
+    band: (u32, Option<f32>),
     max_memory: f64,
     both: bool,
 ) -> Result<()> {
@@ -156,8 +161,10 @@ fn run_command(
         })?
     } else {
         write_run(&ctx, staged.path(), options, band)?;
+        let (kind, metrics) = read_results(staged.path())?;
         format!(
-            "wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",
+            "{}; wrote the six views (PNG, ids PNG, EXR), run.json and the metrics to {}",
+            summary_text(kind, &metrics),
             out.display()
         )
     };
@@ -166,12 +173,13 @@ fn run_command(
     Ok(())
 }
 
-/// One run into `out` (inside the staging folder): every view, the metrics and run.json.
+/// One run into `out` (inside the staging folder): every view, the metrics and run.json;
+/// `band`: the border band's width and the heatmap's fixed top, if any.
 fn write_run(
     ctx: &RenderContext,
     out: &Path,
     options: &RunOptions,
-    band: u32,
+    (band, heat_max): (u32, Option<f32>),
 ) -> Result<RunResult> {
     let result = run(ctx, options)?;
     // `out` and its folders are created by the writes (io::atomic), under the lock the
@@ -210,7 +218,7 @@ fn write_run(
     if let Some(holes) = &holes {
         write_hole_mask(&out.join("holes.png"), &maps, holes)?;
     }
-    write_metrics(out, &maps, &result.truth, &metrics)?;
+    write_metrics_scaled(out, &maps, &result.truth, &metrics, heat_max)?;
     // Last: a directory with run.json holds a finished run.
     write_text(
         &out.join("run.json"),
