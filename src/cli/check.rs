@@ -258,6 +258,7 @@ impl Check {
                     updates.push((span, text));
                 }
                 bound.value = measured;
+                bound.written = bound.text_with(measured);
             }
             result.rows.push(Row {
                 bound: bound.text(),

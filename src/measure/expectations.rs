@@ -47,6 +47,8 @@ pub struct Bound {
     pub metric: String,
     pub relation: Relation,
     pub value: f64,
+    /// The bound as written (its words joined by single spaces).
+    pub written: String,
     /// Byte span of the bound's string (quotes included) in the file, for `--bless`.
     pub span: Option<Range<usize>>,
     /// 1-based line of the bound in the file.
@@ -79,8 +81,9 @@ impl Bound {
         }
     }
 
+    /// The bound as written in the file.
     pub fn text(&self) -> String {
-        self.text_with(self.value)
+        self.written.clone()
     }
 
     /// Whether the bound compares against the golden image.
@@ -213,6 +216,7 @@ pub fn parse_bound(text: &str, command: CaseCommand) -> Result<Bound, String> {
         metric: metric.to_string(),
         relation,
         value,
+        written: words.join(" "),
         span: None,
         line: None,
     })
