@@ -424,3 +424,71 @@ fn the_example_expectations_pass_on_das() {
     let doc = roxmltree::Document::parse(&xml).unwrap();
     assert_eq!(doc.root_element().attribute("failures"), Some("0"));
 }
+
+#[test]
+fn two_run_folders_diff_their_views_and_their_metrics_with_tolerances() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = common::repo_path("scenes/das.toml");
+    let scene = scene.to_str().unwrap();
+    for (out, extra) in [("a", None), ("b", Some("--head-bias-cm=2,0,0"))] {
+        let mut args = vec!["run", scene, "--out", out, "--width", "96"];
+        args.extend(extra);
+        let (code, _, err) = run(dir.path(), &args);
+        assert_eq!(code, 0, "{err}");
+    }
+    let mean = |run: &str| {
+        let m = json(&std::fs::read_to_string(dir.path().join(run).join("metrics.json")).unwrap());
+        m["display"]["misregistration_arcmin"]["mean"].as_f64().unwrap()
+    };
+    // The same run: every view and metric equal; heatmaps of views of different sizes.
+    let (code, _, err) = run(dir.path(), &["diff", "a", "a", "--out", "same"]);
+    assert_eq!(code, 0, "{err}");
+    for view in ["truth", "seethru", "frontal", "back"] {
+        assert!(dir.path().join(format!("same/flip_{view}.png")).is_file(), "{view}");
+    }
+    // A biased head tracker: the truth is the same, seethru and its metrics are not.
+    let (code, out, err) = run(dir.path(), &["diff", "a", "b", "--json"]);
+    assert_eq!(code, 1, "{err}");
+    let report = json(&out);
+    assert_eq!(report["layers"]["truth"]["differing_pixels"], 0.0);
+    assert!(report["layers"]["seethru"]["differing_pixels"].as_f64().unwrap() > 0.0);
+    let change = report["metrics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["metric"] == "misregistration.mean")
+        .unwrap()
+        .clone();
+    assert_eq!(change["a"].as_f64().unwrap(), mean("a"));
+    assert_eq!(change["b"].as_f64().unwrap(), mean("b"));
+    assert_eq!(change["pass"], false);
+    assert!(err.contains("misregistration.mean moved"), "{err}");
+    // Tolerances wide enough for the change pass (the images are not bounded here).
+    let moved = (mean("a") - mean("b")).abs();
+    let mut args: Vec<String> = ["diff", "a", "b"].map(String::from).to_vec();
+    for name in [
+        "misregistration.mean",
+        "misregistration.p95",
+        "misregistration.max",
+        "coverage",
+        "missing.fraction",
+        "border.misregistration.mean",
+        "border.misregistration.p95",
+        "psnr_db",
+        "ssim",
+        "flip_mean",
+    ] {
+        let tolerance = if name == "misregistration.mean" {
+            moved * 1.001
+        } else {
+            1e6
+        };
+        args.extend(["--tolerance".into(), format!("{name}={tolerance}")]);
+    }
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, _, err) = run(dir.path(), &args);
+    assert_eq!(code, 0, "{err}");
+    let (code, _, err) = run(dir.path(), &["diff", "a", "b", "--tolerance", "coverage.min=1"]);
+    assert_eq!(code, 2);
+    assert_one_error_line(&err, &["--tolerance coverage.min", "misregistration.mean"]);
+}

@@ -108,12 +108,12 @@ impl MetricChange {
 impl Diff {
     pub fn run(self) -> Result<()> {
         let (a_dir, b_dir) = (self.a.is_dir(), self.b.is_dir());
-        let (diffs, size, changes) = match (a_dir, b_dir) {
+        let (diffs, changes) = match (a_dir, b_dir) {
             (true, true) => self.folders()?,
             (false, false) => {
                 let (a, b) = (read_picture(&self.a)?, read_picture(&self.b)?);
                 let ppd = self.ppd(&self.a);
-                (self.layers(&a, &b, &|_| ppd.clone())?, (a.width, a.height), Vec::new())
+                (self.layers(&a, &b, &|_| ppd.clone())?, Vec::new())
             }
             _ => bail!(
                 "{} is a {} but {} is a {}: compare two images or two run folders",
@@ -136,7 +136,7 @@ impl Diff {
             )?;
             for d in &diffs {
                 if let Some(flip) = &d.flip {
-                    let (w, h, rgb) = flip_heatmap(flip, size.0, size.1)?;
+                    let (w, h, rgb) = flip_heatmap(flip, d.width, d.height)?;
                     write_png(&staged.path().join(format!("flip_{}.png", d.name)), w, h, rgb)?;
                 }
             }
@@ -207,7 +207,7 @@ impl Diff {
 
     /// Two run folders: the views both have as PNGs (each a layer named after its view),
     /// and the headline metrics.
-    fn folders(&self) -> Result<(Vec<LayerDiff>, (u32, u32), Vec<MetricChange>)> {
+    fn folders(&self) -> Result<(Vec<LayerDiff>, Vec<MetricChange>)> {
         let views: Vec<&str> = if self.layer.is_empty() {
             VIEWS
                 .iter()
@@ -226,7 +226,6 @@ impl Diff {
             self.layer.iter().map(String::as_str).collect()
         };
         let mut diffs = Vec::new();
-        let mut size = (0, 0);
         for view in views {
             let read = |dir: &Path| -> Result<Picture> {
                 let mut p = read_picture(&dir.join(format!("{view}.png")))?;
@@ -234,7 +233,6 @@ impl Diff {
                 Ok(p)
             };
             let (a, b) = (read(&self.a)?, read(&self.b)?);
-            size = (a.width, a.height);
             let ppd = self.ppd(&self.a.join(format!("{view}.png")));
             diffs.extend(self.layers(&a, &b, &|_| ppd.clone())?);
         }
@@ -270,7 +268,7 @@ impl Diff {
                     .map_or(h.tolerance, |t| t.1),
             })
             .collect();
-        Ok((diffs, size, changes))
+        Ok((diffs, changes))
     }
 
     fn report(

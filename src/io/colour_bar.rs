@@ -32,6 +32,12 @@ pub fn with_colour_bar(
     bar: &ColourBar,
 ) -> Result<(u32, u32, Vec<u8>)> {
     use plotters::prelude::*;
+    if rgb.len() != width as usize * height as usize * 3 {
+        anyhow::bail!(
+            "a heatmap of {width}×{height} pixels was given {} bytes",
+            rgb.len()
+        );
+    }
     let legend_h = 16 * bar.legend.len() as u32;
     let (cw, ch) = (width + BAR_COLUMN, height.max(130 + legend_h));
     let mut buffer = vec![255u8; (cw * ch * 3) as usize];

@@ -222,6 +222,9 @@ pub fn flip_map(a: &[[u8; 3]], b: &[[u8; 3]], width: u32, height: u32, ppd: f32)
 /// The difference of one layer present in both images.
 pub struct LayerDiff {
     pub name: String,
+    /// The size of the layer compared, pixels.
+    pub width: u32,
+    pub height: u32,
     /// Metric name → value (names as in [`KNOWN_METRICS`]).
     pub metrics: Vec<(&'static str, f64)>,
     /// FLIP per pixel (colour layers only), for the heatmap.
@@ -376,6 +379,8 @@ pub fn diff_layer(
     }
     Ok(LayerDiff {
         name: a.name.clone(),
+        width,
+        height,
         metrics,
         flip,
         ppd: flip_ppd,
