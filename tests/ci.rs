@@ -62,7 +62,14 @@ fn identical_images_differ_by_nothing_and_pass() {
     let (code, out, err) = run(
         dir.path(),
         &[
-            "diff", "a.png", "b.png", "--json", "--max", "flip_max=0", "--min", "ssim=1",
+            "diff",
+            "a.png",
+            "b.png",
+            "--json",
+            "--max",
+            "flip_max=0",
+            "--min",
+            "ssim=1",
         ],
     );
     assert_eq!(code, 0, "{err}");
@@ -82,7 +89,11 @@ fn a_one_pixel_change_fails_a_tight_bound_and_passes_a_loose_one() {
     let a = pattern();
     let mut b = a.clone();
     let before = b.get_pixel(10, 7).0;
-    b.put_pixel(10, 7, image::Rgb([before[0], before[1].wrapping_add(100), before[2]]));
+    b.put_pixel(
+        10,
+        7,
+        image::Rgb([before[0], before[1].wrapping_add(100), before[2]]),
+    );
     a.save(dir.path().join("a.png")).unwrap();
     b.save(dir.path().join("b.png")).unwrap();
     let change = (before[1].wrapping_add(100) as f64 - before[1] as f64).abs();
@@ -91,20 +102,33 @@ fn a_one_pixel_change_fails_a_tight_bound_and_passes_a_loose_one() {
         &["diff", "a.png", "b.png", "--json", "--max", "flip_max=0.01"],
     );
     assert_eq!(code, 1, "{err}");
-    assert!(err.starts_with("FAIL: ") && err.contains("flip_max <= 0.01"), "{err}");
+    assert!(
+        err.starts_with("FAIL: ") && err.contains("flip_max <= 0.01"),
+        "{err}"
+    );
     let colour = &json(&out)["layers"]["colour"];
     assert_eq!(colour["differing_pixels"], 1.0);
     assert_eq!(colour["max_abs_error"], change);
     // One channel of one pixel of 32×24×3 values.
     let mean = colour["mean_abs_error"].as_f64().unwrap();
-    assert!((mean - change / (32.0 * 24.0 * 3.0)).abs() < 1e-12, "{mean}");
+    assert!(
+        (mean - change / (32.0 * 24.0 * 3.0)).abs() < 1e-12,
+        "{mean}"
+    );
     let flip_max = colour["flip_max"].as_f64().unwrap();
     assert!(flip_max > 0.01, "{flip_max}");
     // A bound the change meets passes, and the heatmap is written with its colour bar.
     let (code, out, err) = run(
         dir.path(),
         &[
-            "diff", "a.png", "b.png", "--max", "flip_mean=0.5", "--min", "psnr_db=20", "--out",
+            "diff",
+            "a.png",
+            "b.png",
+            "--max",
+            "flip_mean=0.5",
+            "--min",
+            "psnr_db=20",
+            "--out",
             "heat",
         ],
     );
@@ -180,9 +204,15 @@ fn bad_inputs_exit_2_with_one_line_each() {
             &["diff", "a.png", "small.png"],
             &["32×24", "31×24", "different sizes"],
         ),
-        (&["diff", "a.png", "none.png"], &["none.png", "no such file"]),
+        (
+            &["diff", "a.png", "none.png"],
+            &["none.png", "no such file"],
+        ),
         (&["diff", "a.png", "text.png"], &["text.png"]),
-        (&["diff", "a.png", "."], &["a folder", "two images or two run folders"]),
+        (
+            &["diff", "a.png", "."],
+            &["a folder", "two images or two run folders"],
+        ),
         (
             &["diff", "a.png", "a.png", "--max", "flop_mean=1"],
             &["--max", "unknown metric `flop_mean`", "flip_mean"],
@@ -263,7 +293,10 @@ fn a_bound_below_the_measured_mean_fails_one_above_passes_and_junit_says_so() {
     assert!(row("above", &above).ends_with("PASS"), "{out}");
     assert!(row("below", &below).ends_with("FAIL"), "{out}");
     assert!(row("below", "coverage >= 0").ends_with("PASS"), "{out}");
-    assert!(err.contains("1 of 2 cases failed") && err.contains("below"), "{err}");
+    assert!(
+        err.contains("1 of 2 cases failed") && err.contains("below"),
+        "{err}"
+    );
     // The JUnit report: one suite of two cases, one failure naming the bound.
     let xml = std::fs::read_to_string(dir.path().join("report.xml")).unwrap();
     let doc = roxmltree::Document::parse(&xml).unwrap();
@@ -297,11 +330,7 @@ fn a_bound_below_the_measured_mean_fails_one_above_passes_and_junit_says_so() {
         "{xml}"
     );
     // The passing case alone passes.
-    std::fs::write(
-        dir.path().join("pass.toml"),
-        case("above", &[above], None),
-    )
-    .unwrap();
+    std::fs::write(dir.path().join("pass.toml"), case("above", &[above], None)).unwrap();
     let (code, out, err) = run(dir.path(), &["check", "pass.toml", "--out", "c"]);
     assert_eq!(code, 0, "{out}{err}");
 }
@@ -325,18 +354,27 @@ fn bless_is_refused_in_ci_and_writes_only_goldens_and_recorded_values_elsewhere(
     // No golden yet: the case cannot run, and says how to make it.
     let (code, out, err) = run(dir.path(), &["check", "e.toml", "--out", "c"]);
     assert_eq!(code, 2, "{out}{err}");
-    assert!(err.contains("does not exist") && err.contains("--bless"), "{err}");
+    assert!(
+        err.contains("does not exist") && err.contains("--bless"),
+        "{err}"
+    );
     // CI=true: refused before anything runs; nothing written.
     let (code, _, err) = seethru_ci(dir.path(), &["check", "e.toml", "--bless"], Some("true"));
     assert_eq!(code, 2);
     assert_one_error_line(&err, &["--bless is refused", "CI"]);
     assert!(!dir.path().join("golden").exists());
-    assert_eq!(std::fs::read_to_string(dir.path().join("e.toml")).unwrap(), text);
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("e.toml")).unwrap(),
+        text
+    );
     // Elsewhere: the golden and the recorded p95 are written, and listed.
     let (code, out, err) = run(dir.path(), &["check", "e.toml", "--bless", "--out", "c"]);
     assert_eq!(code, 0, "{out}{err}");
     assert!(err.contains("blessed golden/das.png"), "{err}");
-    assert!(err.contains("e.toml:") && err.contains("misregistration.p95 =="), "{err}");
+    assert!(
+        err.contains("e.toml:") && err.contains("misregistration.p95 =="),
+        "{err}"
+    );
     let metrics: serde_json::Value =
         json(&std::fs::read_to_string(dir.path().join("c/golden/metrics.json")).unwrap());
     let p95 = metrics["display"]["misregistration_arcmin"]["p95"]
@@ -362,12 +400,19 @@ fn bless_is_refused_in_ci_and_writes_only_goldens_and_recorded_values_elsewhere(
 fn bad_expectation_files_name_the_file_and_line() {
     let dir = tempfile::tempdir().unwrap();
     let good = case("c", &["coverage >= 0.5".into()], None);
-    let line_of = |text: &str, needle: &str| text.lines().position(|l| l.contains(needle)).unwrap() + 1;
+    let line_of =
+        |text: &str, needle: &str| text.lines().position(|l| l.contains(needle)).unwrap() + 1;
     let cases = [
         (
-            good.replace("coverage >= 0.5", "coverage >= 0.5\",\n  \"misregistration.avg <= 3"),
+            good.replace(
+                "coverage >= 0.5",
+                "coverage >= 0.5\",\n  \"misregistration.avg <= 3",
+            ),
             "misregistration.avg",
-            vec!["unknown metric `misregistration.avg`", "misregistration.mean"],
+            vec![
+                "unknown metric `misregistration.avg`",
+                "misregistration.mean",
+            ],
         ),
         (
             good.replace("options =", "colour = 1\noptions ="),
@@ -438,20 +483,30 @@ fn two_run_folders_diff_their_views_and_their_metrics_with_tolerances() {
     }
     let mean = |run: &str| {
         let m = json(&std::fs::read_to_string(dir.path().join(run).join("metrics.json")).unwrap());
-        m["display"]["misregistration_arcmin"]["mean"].as_f64().unwrap()
+        m["display"]["misregistration_arcmin"]["mean"]
+            .as_f64()
+            .unwrap()
     };
     // The same run: every view and metric equal; heatmaps of views of different sizes.
     let (code, _, err) = run(dir.path(), &["diff", "a", "a", "--out", "same"]);
     assert_eq!(code, 0, "{err}");
     for view in ["truth", "seethru", "frontal", "back"] {
-        assert!(dir.path().join(format!("same/flip_{view}.png")).is_file(), "{view}");
+        assert!(
+            dir.path().join(format!("same/flip_{view}.png")).is_file(),
+            "{view}"
+        );
     }
     // A biased head tracker: the truth is the same, seethru and its metrics are not.
     let (code, out, err) = run(dir.path(), &["diff", "a", "b", "--json"]);
     assert_eq!(code, 1, "{err}");
     let report = json(&out);
     assert_eq!(report["layers"]["truth"]["differing_pixels"], 0.0);
-    assert!(report["layers"]["seethru"]["differing_pixels"].as_f64().unwrap() > 0.0);
+    assert!(
+        report["layers"]["seethru"]["differing_pixels"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
     let change = report["metrics"]
         .as_array()
         .unwrap()
@@ -488,7 +543,10 @@ fn two_run_folders_diff_their_views_and_their_metrics_with_tolerances() {
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let (code, _, err) = run(dir.path(), &args);
     assert_eq!(code, 0, "{err}");
-    let (code, _, err) = run(dir.path(), &["diff", "a", "b", "--tolerance", "coverage.min=1"]);
+    let (code, _, err) = run(
+        dir.path(),
+        &["diff", "a", "b", "--tolerance", "coverage.min=1"],
+    );
     assert_eq!(code, 2);
     assert_one_error_line(&err, &["--tolerance coverage.min", "misregistration.mean"]);
 }

@@ -145,10 +145,7 @@ impl Check {
         if !updates.is_empty() {
             let text = rewritten(&expectations.text, updates);
             write_text(&self.expectations, &text)?;
-            blessed.push(format!(
-                "{} (recorded values)",
-                self.expectations.display()
-            ));
+            blessed.push(format!("{} (recorded values)", self.expectations.display()));
         }
         print!("{}", table(&results));
         if let Some(path) = &self.junit {
@@ -324,7 +321,8 @@ impl Check {
 
 /// Writes the run's image as the golden, when it differs from it (or there is none).
 fn bless_golden(actual: &Path, golden: &Path, blessed: &mut Vec<String>) -> Result<()> {
-    let bytes = std::fs::read(actual).with_context(|| format!("cannot read {}", actual.display()))?;
+    let bytes =
+        std::fs::read(actual).with_context(|| format!("cannot read {}", actual.display()))?;
     if std::fs::read(golden).ok().as_deref() != Some(bytes.as_slice()) {
         write_atomically(golden, |file| Ok(std::io::Write::write_all(file, &bytes)?))?;
         blessed.push(golden.display().to_string());
@@ -334,7 +332,12 @@ fn bless_golden(actual: &Path, golden: &Path, blessed: &mut Vec<String>) -> Resu
 
 /// The PASS/FAIL table: a row per bound of every case.
 fn table(results: &[CaseResult]) -> String {
-    let width = results.iter().map(|r| r.name.len()).max().unwrap_or(4).max(4);
+    let width = results
+        .iter()
+        .map(|r| r.name.len())
+        .max()
+        .unwrap_or(4)
+        .max(4);
     let bound_width = results
         .iter()
         .flat_map(|r| r.rows.iter().map(|b| b.bound.len()))

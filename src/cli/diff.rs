@@ -5,16 +5,16 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
-use serde_json::{Value, json};
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_png;
 use seethru::io::staged::StagedDir;
 use seethru::measure::headline::{RUN_HEADLINES, SEQUENCE_HEADLINES, read_results, value_of};
 use seethru::measure::image_diff::{
-    BoundKind, LayerDiff, Picture, Threshold, Verdict, check_thresholds, diff_layer,
-    flip_heatmap, number, paired_layers, pixels_per_degree, read_picture,
+    BoundKind, LayerDiff, Picture, Threshold, Verdict, check_thresholds, diff_layer, flip_heatmap,
+    number, paired_layers, pixels_per_degree, read_picture,
 };
 use seethru::util::number::short;
+use serde_json::{Value, json};
 
 use crate::cli::args::real;
 use crate::cli::verdict::ChecksFailed;
@@ -137,7 +137,12 @@ impl Diff {
             for d in &diffs {
                 if let Some(flip) = &d.flip {
                     let (w, h, rgb) = flip_heatmap(flip, d.width, d.height)?;
-                    write_png(&staged.path().join(format!("flip_{}.png", d.name)), w, h, rgb)?;
+                    write_png(
+                        &staged.path().join(format!("flip_{}.png", d.name)),
+                        w,
+                        h,
+                        rgb,
+                    )?;
                 }
             }
             staged.commit()?;
@@ -174,9 +179,10 @@ impl Diff {
         seethru::util::progress::summary(format!(
             "{} layer(s) compared, {checked} checks passed{}",
             diffs.len(),
-            self.out
-                .as_ref()
-                .map_or(String::new(), |o| format!("; wrote diff.json and heatmaps to {}", o.display()))
+            self.out.as_ref().map_or(String::new(), |o| format!(
+                "; wrote diff.json and heatmaps to {}",
+                o.display()
+            ))
         ));
         Ok(())
     }

@@ -309,10 +309,7 @@ impl Sequence {
             over_time_figure(&[(format!("{ms} ms"), &run.records)], timeline.duration)
                 .write(&dir, "misregistration_over_time")?;
             let mut s = summary(&run, &timeline);
-            headlines.push(format!(
-                "{ms} ms: {}",
-                summary_text(RunKind::Sequence, &s)
-            ));
+            headlines.push(format!("{ms} ms: {}", summary_text(RunKind::Sequence, &s)));
             s["preview_heat_scale_arcmin"] = json!(scale);
             write_text(
                 &dir.join("summary.json"),

@@ -9,9 +9,14 @@ use std::fmt::Write as _;
 pub enum Outcome {
     Passed,
     /// Bounds not met: a one-line message and the details.
-    Failed { message: String, details: String },
+    Failed {
+        message: String,
+        details: String,
+    },
     /// The case could not run (a bad scene, bad options).
-    Error { message: String },
+    Error {
+        message: String,
+    },
 }
 
 /// One test case of a suite.
@@ -120,5 +125,61 @@ mod tests {
             escape("a<b & \"c\" 'd'>\u{1}"),
             "a&lt;b &amp; &quot;c&quot; &apos;d&apos;&gt;\\u{1}"
         );
+    }
+
+    #[test]
+    fn counts_and_elements_follow_the_outcomes() {
+        let case = |name: &str, outcome| TestCase {
+            name: name.into(),
+            classname: "seethru.check.e".into(),
+            seconds: 0.5,
+            outcome,
+            output: "a <= 1".into(),
+        };
+        let xml = junit_xml(
+            "e.toml",
+            &[
+                case("pass", Outcome::Passed),
+                case(
+                    "fail",
+                    Outcome::Failed {
+                        message: "a <= 1: measured 2".into(),
+                        details: "see x".into(),
+                    },
+                ),
+                case(
+                    "fail too",
+                    Outcome::Failed {
+                        message: "b >= 1: measured 0".into(),
+                        details: String::new(),
+                    },
+                ),
+                case(
+                    "broken",
+                    Outcome::Error {
+                        message: "no scene".into(),
+                    },
+                ),
+            ],
+        );
+        let doc = roxmltree::Document::parse(&xml).unwrap();
+        let suite = doc
+            .descendants()
+            .find(|n| n.has_tag_name("testsuite"))
+            .unwrap();
+        for (attribute, value) in [("tests", "4"), ("failures", "2"), ("errors", "1")] {
+            assert_eq!(suite.attribute(attribute), Some(value), "{xml}");
+        }
+        let count = |tag: &str| doc.descendants().filter(|n| n.has_tag_name(tag)).count();
+        assert_eq!(
+            (count("testcase"), count("failure"), count("error")),
+            (3, 1, 1)
+        );
+        let failure = doc
+            .descendants()
+            .find(|n| n.has_tag_name("failure"))
+            .unwrap();
+        assert_eq!(failure.attribute("message"), Some("a <= 1: measured 2"));
+        assert_eq!(failure.parent().unwrap().attribute("name"), Some("fail"));
     }
 }

@@ -193,8 +193,7 @@ pub fn write_binocular(
         legend: vec![([0, 0, 0], "no value".into())],
         clipped: false,
     };
-    let (w, h, rgb) =
-        crate::io::colour_bar::with_colour_bar(map.width, map.height, &rgb, &bar)?;
+    let (w, h, rgb) = crate::io::colour_bar::with_colour_bar(map.width, map.height, &rgb, &bar)?;
     write_png(&dir.join("binocular.png"), w, h, rgb)?;
     let [l, r] = seethru;
     write_png(

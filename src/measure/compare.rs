@@ -155,7 +155,12 @@ pub fn compare(
             "scene_model": result.report.get("scene_model"),
             "metrics": metrics,
         });
-        drafts.push(strip(&maps, &result.truth, &result.seethru, holes.as_deref()));
+        drafts.push(strip(
+            &maps,
+            &result.truth,
+            &result.seethru,
+            holes.as_deref(),
+        ));
         out.push(Compared {
             name: candidate.name(),
             row,
@@ -192,7 +197,9 @@ fn shared_heat_top(drafts: &[StripDraft]) -> f32 {
     let p99 = |d: &StripDraft| {
         let mut v: Vec<f32> = d.heat.iter().map(|h| h.1).collect();
         v.sort_by(f32::total_cmp);
-        v.get((v.len() as f32 * 0.99) as usize).copied().unwrap_or(0.0)
+        v.get((v.len() as f32 * 0.99) as usize)
+            .copied()
+            .unwrap_or(0.0)
     };
     let top = drafts.iter().map(p99).fold(0.0f32, f32::max);
     ((top / 10.0).ceil() * 10.0).max(10.0)
@@ -224,12 +231,7 @@ fn finish_strip(draft: StripDraft, top: f32) -> Result<(u32, u32, Vec<u8>)> {
 /// Truth, seethru, the misregistration heatmap and the holes, side by side, each cut to the
 /// display's bounding box; the heatmap is coloured later, on the scale shared by every
 /// method ([`finish_strip`]).
-fn strip(
-    maps: &MetricMaps,
-    truth: &Frame,
-    seethru: &Frame,
-    holes: Option<&[bool]>,
-) -> StripDraft {
+fn strip(maps: &MetricMaps, truth: &Frame, seethru: &Frame, holes: Option<&[bool]>) -> StripDraft {
     const GAP: usize = 4;
     let w = maps.width as usize;
     let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);

@@ -38,7 +38,9 @@ pub enum Relation {
     AtMost,
     AtLeast,
     /// `== value +- tolerance`: a recorded value, which `--bless` rewrites.
-    Recorded { tolerance: f64 },
+    Recorded {
+        tolerance: f64,
+    },
 }
 
 /// One bound of a case, as written (`coverage >= 0.99`).
@@ -233,7 +235,10 @@ pub fn read_expectations(
     let root = TableReader::root(&file, &doc);
     let tables = root.array_of_tables("case")?;
     if tables.is_empty() {
-        return Err(root.error("case", "no [[case]]: an expectation file lists at least one"));
+        return Err(root.error(
+            "case",
+            "no [[case]]: an expectation file lists at least one",
+        ));
     }
     let dir = file.dir();
     let mut cases: Vec<Case> = Vec::new();
@@ -258,7 +263,10 @@ pub fn read_expectations(
             .into_iter()
             .map(|(s, _)| s.to_string())
             .collect();
-        if options.iter().any(|o| o == "--out" || o.starts_with("--out=")) {
+        if options
+            .iter()
+            .any(|o| o == "--out" || o.starts_with("--out="))
+        {
             return Err(table.error(
                 "options",
                 "--out is set by seethru check (each case runs into OUT/<name>)",
@@ -348,7 +356,10 @@ mod tests {
         );
         for (text, says) in [
             ("misregistration.mean < 35", "not a comparison"),
-            ("misregistration.avg <= 35", "unknown metric `misregistration.avg`"),
+            (
+                "misregistration.avg <= 35",
+                "unknown metric `misregistration.avg`",
+            ),
             ("coverage >= high", "not a finite number"),
             ("coverage == 0.9", "needs its tolerance"),
             ("coverage <= 1 and more", "goes on after"),

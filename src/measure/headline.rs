@@ -240,9 +240,7 @@ mod tests {
         let values = headlines_of(RunKind::Run, &json);
         assert!(values.contains(&("misregistration.mean", 12.5)));
         assert!(values.contains(&("coverage", 0.9)));
-        let border = values
-            .iter()
-            .find(|v| v.0 == "border.misregistration.mean");
+        let border = values.iter().find(|v| v.0 == "border.misregistration.mean");
         assert!(border.unwrap().1.is_nan());
         assert_eq!(
             summary_text(RunKind::Run, &json),

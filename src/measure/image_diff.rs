@@ -174,7 +174,10 @@ fn read_exr_layers(path: &Path) -> Result<Picture> {
         }
     }
     // The colour channels in R, G, B order (EXR sorts channels by name: B, G, R).
-    for l in layers.iter_mut().filter(|l| l.kind == LayerKind::LinearColour) {
+    for l in layers
+        .iter_mut()
+        .filter(|l| l.kind == LayerKind::LinearColour)
+    {
         let mut pairs: Vec<(String, Vec<f64>)> =
             l.channels.drain(..).zip(l.values.drain(..)).collect();
         pairs.sort_by_key(|(n, _)| ["R", "G", "B"].iter().position(|c| c == n));
@@ -267,14 +270,26 @@ pub fn number(v: f64) -> Value {
 /// Every metric a layer diff may give, with what it is: thresholds may name only these.
 pub const KNOWN_METRICS: [(&str, &str); 10] = [
     ("flip_mean", "mean FLIP, [0, 1] (colour layers)"),
-    ("flip_p95", "95th percentile of FLIP, [0, 1] (colour layers)"),
+    (
+        "flip_p95",
+        "95th percentile of FLIP, [0, 1] (colour layers)",
+    ),
     ("flip_max", "largest FLIP, [0, 1] (colour layers)"),
-    ("psnr_db", "PSNR of the 8-bit sRGB colours, dB (+inf when equal)"),
+    (
+        "psnr_db",
+        "PSNR of the 8-bit sRGB colours, dB (+inf when equal)",
+    ),
     ("ssim", "mean SSIM of the luminance, 7×7 windows, [-1, 1]"),
-    ("max_abs_error", "largest |A − B| of any channel, the layer's units"),
+    (
+        "max_abs_error",
+        "largest |A − B| of any channel, the layer's units",
+    ),
     ("mean_abs_error", "mean |A − B| over channels and pixels"),
     ("differing_pixels", "pixels where any channel differs"),
-    ("differing_fraction", "differing pixels over all pixels, [0, 1]"),
+    (
+        "differing_fraction",
+        "differing pixels over all pixels, [0, 1]",
+    ),
     (
         "nonfinite_mismatch_pixels",
         "pixels finite in one image and not in the other (left out of the errors)",
@@ -655,8 +670,15 @@ mod tests {
         assert_eq!(t.layer.as_deref(), Some("seethru"));
         assert!(t.holds(0.05) && !t.holds(0.0500001));
         let e = Threshold::parse("flop=1", BoundKind::AtMost).unwrap_err();
-        assert!(e.contains("unknown metric `flop`") && e.contains("flip_mean"), "{e}");
+        assert!(
+            e.contains("unknown metric `flop`") && e.contains("flip_mean"),
+            "{e}"
+        );
         assert!(Threshold::parse("psnr_db=nan", BoundKind::AtLeast).is_err());
-        assert!(!Threshold::parse("psnr_db=40", BoundKind::AtLeast).unwrap().holds(f64::NAN));
+        assert!(
+            !Threshold::parse("psnr_db=40", BoundKind::AtLeast)
+                .unwrap()
+                .holds(f64::NAN)
+        );
     }
 }

@@ -7,8 +7,8 @@ use anyhow::Result;
 use exr::prelude::{AnyChannel, FlatSamples};
 
 use crate::io::atomic::write_text;
-use crate::io::frame_files::{write_exr_channels, write_png};
 use crate::io::colour_bar::{ColourBar, with_colour_bar};
+use crate::io::frame_files::{write_exr_channels, write_png};
 use crate::measure::metrics::MetricMaps;
 use crate::render::frame::Frame;
 use crate::util::color::encode_srgb8;

@@ -14,6 +14,9 @@ use crate::scene::limits::{MAX_COORDINATE, MAX_PIXELS, MAX_RESOLUTION};
 use crate::scene::source::{SceneError, SourceFile};
 use crate::util::number::{short, short_list};
 
+/// A string of a TOML array and its byte span in the file.
+pub type SpannedStr<'a> = (&'a str, Option<std::ops::Range<usize>>);
+
 /// Reads the keys of one TOML table, remembering which were read so that
 /// [`TableReader::finish`] can reject the rest as unknown.
 pub struct TableReader<'a> {
@@ -315,10 +318,7 @@ impl<'a> TableReader<'a> {
 
     /// An array of free strings with the byte span of each in the file (for errors at the
     /// element's own line, and for rewriting one element in place); empty if absent.
-    pub fn strings_with_spans(
-        &self,
-        key: &str,
-    ) -> Result<Vec<(&'a str, Option<std::ops::Range<usize>>)>, SceneError> {
+    pub fn strings_with_spans(&self, key: &str) -> Result<Vec<SpannedStr<'a>>, SceneError> {
         let Some(item) = self.item(key) else {
             return Ok(Vec::new());
         };
