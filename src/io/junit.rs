@@ -173,7 +173,7 @@ mod tests {
         let count = |tag: &str| doc.descendants().filter(|n| n.has_tag_name(tag)).count();
         assert_eq!(
             (count("testcase"), count("failure"), count("error")),
-            (3, 1, 1)
+            (4, 2, 1)
         );
         let failure = doc
             .descendants()
