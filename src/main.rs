@@ -47,13 +47,19 @@ fn main() -> ExitCode {
             std::process::exit(130)
         })
     });
+    let error_status = cli.command.error_status();
     match cli.command.run() {
         Ok(()) => ExitCode::SUCCESS,
+        // Thresholds exceeded: the command has said which; exit 1 ("worse"), not an error.
+        Err(e) if e.downcast_ref::<cli::verdict::ChecksFailed>().is_some() => {
+            eprintln!("{}", printable(&e.to_string()));
+            ExitCode::from(1)
+        }
         Err(e) => {
             // Messages repeat the input: an 800-digit number stays 12 digits, a line break
             // in a name is shown as `\n`; each cause is said once.
             eprintln!("error: {}", printable(&error_text(&e)));
-            ExitCode::FAILURE
+            ExitCode::from(error_status)
         }
     }
 }

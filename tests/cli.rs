@@ -231,7 +231,7 @@ struct ValueOption {
 /// Every option that takes a value, per command, read from the command's own `--help`, so
 /// that a flag added later is walked too.
 fn options_with_values() -> Vec<ValueOption> {
-    let commands: [&[&str]; 14] = [
+    let commands: [&[&str]; 16] = [
         &["render"],
         &["run"],
         &["ratio", "occlusion"],
@@ -246,6 +246,8 @@ fn options_with_values() -> Vec<ValueOption> {
         &["bench"],
         &["compare"],
         &["sequence"],
+        &["diff"],
+        &["check"],
     ];
     let mut found = Vec::new();
     for words in commands {
@@ -286,7 +288,18 @@ fn options_with_values() -> Vec<ValueOption> {
 }
 
 /// Options whose values are paths, names or free-form specs, not numbers.
-const NOT_NUMBERS: [&str; 7] = ["OUT", "SCENE", "DIR", "PARAMS", "FILE", "CSV", "K/N"];
+const NOT_NUMBERS: [&str; 10] = [
+    "OUT",
+    "SCENE",
+    "DIR",
+    "PARAMS",
+    "FILE",
+    "CSV",
+    "K/N",
+    "NAME=VALUE",
+    "LAYER",
+    "CASE",
+];
 
 /// A range as help texts and errors write it: `[a, b]`, `(a, b]`, `[a, b)` or `(a, b)`, the
 /// first such group in `text` (other parentheses, like `(default: …)`, are skipped).

@@ -148,9 +148,10 @@ fn compare_writes_one_row_and_one_strip_per_method_as_run_measures_them() {
             html.contains(&format!("<img src=\"strip_{name}.png\"")),
             "{name}"
         );
-        // Four panels of the display's bounding box, three gaps of 4 pixels.
+        // Four panels of the display's bounding box, three gaps of 4 pixels, the colour bar.
         let strip = image::open(out.join(format!("strip_{name}.png"))).unwrap();
-        assert_eq!((strip.width() - 12) % 4, 0);
+        let bar = seethru::io::colour_bar::BAR_COLUMN;
+        assert_eq!((strip.width() - 12 - bar) % 4, 0);
     }
     // The rows are the metrics `run` gives for the same method.
     let run_out = dir.path().join("run");

@@ -6,7 +6,9 @@ mod bench;
 mod bench_methods;
 mod bench_run;
 mod bench_sequence;
+mod check;
 mod compare;
+mod diff;
 mod export;
 mod figures;
 mod measure;
@@ -18,6 +20,7 @@ mod run_eyes;
 mod scene_model_args;
 mod sequence;
 mod sweep;
+pub mod verdict;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -70,6 +73,12 @@ pub enum Command {
     /// The system over time: vehicle and head motion, latencies and prediction, measured frame
     /// by frame against the truth (frames.csv, summary.json, plots, an animated preview).
     Sequence(sequence::Sequence),
+    /// Differences of two images (PNG, EXR layers) or two run folders: FLIP, PSNR, SSIM,
+    /// absolute errors, metrics.json; thresholds give exit 1 when exceeded, 2 on bad input.
+    Diff(diff::Diff),
+    /// Run the cases of an expectations file and check their metrics' bounds: a PASS/FAIL
+    /// table, JUnit XML, diff images of failures; --bless rewrites goldens and recordings.
+    Check(check::Check),
 }
 
 /// The command line with every negative number that follows an option joined to it
@@ -147,6 +156,17 @@ impl Command {
             Command::Bench(c) => c.run(),
             Command::Compare(c) => c.run(),
             Command::Sequence(c) => c.run(),
+            Command::Diff(c) => c.run(),
+            Command::Check(c) => c.run(),
+        }
+    }
+
+    /// The exit status of an error: 2 for `diff` and `check`, whose 1 means "a threshold
+    /// was exceeded" ([`verdict::ChecksFailed`]), 1 for every other command.
+    pub fn error_status(&self) -> u8 {
+        match self {
+            Command::Diff(_) | Command::Check(_) => 2,
+            _ => 1,
         }
     }
 }

@@ -9,8 +9,9 @@ use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{ExrContent, write_frame};
 use seethru::io::staged::StagedDir;
 use seethru::measure::hazard::{DEFAULT_BOUND_ARCMIN, hazard_frame, hazards_json};
+use seethru::measure::headline::{read_results, summary_text};
 use seethru::measure::holes::{attach_holes, write_hole_mask};
-use seethru::measure::maps::write_metrics;
+use seethru::measure::maps::write_metrics_scaled;
 use seethru::measure::metrics::measure;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
@@ -88,6 +89,10 @@ pub struct Run {
     /// same object within this misregistration, arc-minutes in [1e-6, 10800].
     #[arg(long = "hazard-bound-arcmin", default_value_t = DEFAULT_BOUND_ARCMIN, value_parser = positive(10800.0))]
     hazard_bound_arcmin: f64,
+    /// Top of misregistration.png's scale, arc-minutes in [1e-6, 10000], so that heatmaps of
+    /// runs compare (default: the 99th percentile of the display's values, labelled).
+    #[arg(long = "heatmap-max", value_name = "ARCMIN", value_parser = positive(1e4))]
+    heatmap_max: Option<f64>,
     /// The depth sensor and hole filling of ground, plane-fit and depth.
     #[command(flatten)]
     scene_model: SceneModelArgs,
@@ -134,6 +139,7 @@ impl Run {
             band: self.band,
             exr: self.exr,
             hazard_bound_arcmin: self.hazard_bound_arcmin,
+            heatmap_max_arcmin: self.heatmap_max.map(|v| v as f32),
         };
         let calibration = self.calibration.as_deref();
         with_threads(self.render.threads, || {
@@ -152,6 +158,8 @@ struct RunWrites {
     exr: ExrContent,
     /// Hazard visibility's bound, arc-minutes.
     hazard_bound_arcmin: f64,
+    /// Top of misregistration.png's scale, arc-minutes (`None`: the p99, labelled).
+    heatmap_max_arcmin: Option<f32>,
 }
 
 /// `seethru run`: renders the six views into `out` with `run.json` and the metrics.
@@ -187,8 +195,10 @@ fn run_command(
             ExrContent::Colour => "PNG, ids PNG, colour EXR",
             ExrContent::All => "PNG, ids PNG, EXR",
         };
+        let (kind, metrics) = read_results(staged.path())?;
         format!(
-            "wrote the six views ({files}), run.json and the metrics to {}",
+            "{}; wrote the six views ({files}), run.json and the metrics to {}",
+            summary_text(kind, &metrics),
             out.display()
         )
     };
@@ -197,7 +207,8 @@ fn run_command(
     Ok(())
 }
 
-/// One run into `out` (inside the staging folder): every view, the metrics and run.json.
+/// One run into `out` (inside the staging folder): every view, the metrics and run.json;
+/// `band`: the border band's width and the heatmap's fixed top, if any.
 fn write_run(
     ctx: &RenderContext,
     out: &Path,
@@ -208,6 +219,7 @@ fn write_run(
         band,
         exr,
         hazard_bound_arcmin: hazard_bound,
+        heatmap_max_arcmin: heatmap_max,
     } = writes;
     let result = run(ctx, options)?;
     if let Some(d) = result.detection.filter(|d| !d.confidence.is_confident()) {
@@ -267,7 +279,7 @@ fn write_run(
         &out.join("hazards.json"),
         &serde_json::to_string_pretty(&hazards_json(&hazards, hazard_bound))?,
     )?;
-    write_metrics(out, &maps, &result.truth, &metrics)?;
+    write_metrics_scaled(out, &maps, &result.truth, &metrics, heatmap_max)?;
     // Last: a directory with run.json holds a finished run.
     write_text(
         &out.join("run.json"),

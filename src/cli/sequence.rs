@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{write_color_png, write_exr};
 use seethru::io::staged::StagedDir;
+use seethru::measure::headline::{RunKind, summary_text};
 use seethru::measure::sequence::{Measuring, SequenceRun, head_warning, run_sequence_labelled};
 use seethru::measure::sequence_files::{
     Preview, frames_csv, latency_figure, over_time_figure, summary,
@@ -272,6 +273,7 @@ impl Sequence {
         let out = staged.path().to_path_buf();
         let mut runs: Vec<(f64, SequenceRun)> = Vec::new();
         let count = all.len();
+        let mut headlines: Vec<String> = Vec::new();
         for (k, (options, &ms)) in all.into_iter().zip(&self.latency_camera.0).enumerate() {
             let dir = out.join(latency_dir(ms));
             let timeline = options.timeline;
@@ -313,6 +315,7 @@ impl Sequence {
             over_time_figure(&[(format!("{ms} ms"), &run.records)], timeline.duration)
                 .write(&dir, "misregistration_over_time")?;
             let mut s = summary(&run, &timeline);
+            headlines.push(format!("{ms} ms: {}", summary_text(RunKind::Sequence, &s)));
             s["preview_heat_scale_arcmin"] = json!(scale);
             write_text(
                 &dir.join("summary.json"),
@@ -323,7 +326,8 @@ impl Sequence {
         self.write_overview(&runs, &out)?;
         staged.commit()?;
         say(format!(
-            "wrote {} sequence(s) of {} frames (frames.csv, summary.json, plots, preview.png) to {}",
+            "{}; wrote {} sequence(s) of {} frames (frames.csv, summary.json, plots, preview.png) to {}",
+            headlines.join("; "),
             runs.len(),
             runs.first().map_or(0, |r| r.1.records.len()),
             self.out.display()

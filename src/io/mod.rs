@@ -4,8 +4,10 @@
 pub mod animation;
 pub mod atomic;
 pub mod caption;
+pub mod colour_bar;
 pub mod export;
 pub mod frame_files;
+pub mod junit;
 pub mod plot;
 pub mod run_dir;
 pub mod staged;

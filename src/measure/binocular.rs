@@ -172,7 +172,7 @@ pub fn write_binocular(
         (a.min(v), b.max(v))
     });
     let span = (hi - lo).max(1e-6);
-    let rgb = map
+    let rgb: Vec<u8> = map
         .mismatch_arcmin
         .iter()
         .flat_map(|&v| {
@@ -183,7 +183,18 @@ pub fn write_binocular(
             }
         })
         .collect();
-    write_png(&dir.join("binocular.png"), map.width, map.height, rgb)?;
+    let bar = crate::io::colour_bar::ColourBar {
+        colours: heat_color,
+        // A map without a value (no display pixel seen by both eyes) has a scale of 0.
+        bottom: if lo.is_finite() { lo as f64 } else { 0.0 },
+        top: if hi.is_finite() { hi as f64 } else { 0.0 },
+        unit: "′",
+        title: "mismatch, arcmin (min to max)".into(),
+        legend: vec![([0, 0, 0], "no value".into())],
+        clipped: false,
+    };
+    let (w, h, rgb) = crate::io::colour_bar::with_colour_bar(map.width, map.height, &rgb, &bar)?;
+    write_png(&dir.join("binocular.png"), w, h, rgb)?;
     let [l, r] = seethru;
     write_png(
         &dir.join("anaglyph.png"),

@@ -88,7 +88,8 @@ pub struct Compared {
     pub name: &'static str,
     /// The row: metrics and cost (see [`compare`]).
     pub row: serde_json::Value,
-    /// The strip: truth | seethru | misregistration | holes over the display's bounding box,
+    /// The strip: truth | seethru | misregistration | holes over the display's bounding box
+    /// and the heatmap's colour bar (one scale for every method),
     /// RGB8, width × height.
     pub strip: (u32, u32, Vec<u8>),
 }
@@ -121,6 +122,7 @@ pub fn compare(
     let (truth, _) = ctx.render(&driver, View::Truth.bit(), settings, "truth");
     progress.advance(1);
     let mut out = Vec::new();
+    let mut drafts = Vec::new();
     for &candidate in candidates {
         let mut options = candidate.options(base);
         options.progress = false;
@@ -153,27 +155,83 @@ pub fn compare(
             "scene_model": result.report.get("scene_model"),
             "metrics": metrics,
         });
-        let strip = strip(&maps, &result.truth, &result.seethru, holes.as_deref());
+        drafts.push(strip(
+            &maps,
+            &result.truth,
+            &result.seethru,
+            holes.as_deref(),
+        ));
         out.push(Compared {
             name: candidate.name(),
             row,
-            strip,
+            strip: (0, 0, Vec::new()),
         });
         progress.advance(1);
     }
     progress.finish();
+    let top = shared_heat_top(&drafts);
+    for (compared, draft) in out.iter_mut().zip(drafts) {
+        compared.strip = finish_strip(draft, top)?;
+    }
     Ok(out)
 }
 
-/// Truth, seethru, the misregistration heatmap (0 to `HEAT_TOP` arc-minutes, one scale for
-/// every method) and the holes, side by side, each cut to the display's bounding box.
-fn strip(
-    maps: &MetricMaps,
-    truth: &Frame,
-    seethru: &Frame,
-    holes: Option<&[bool]>,
-) -> (u32, u32, Vec<u8>) {
-    const HEAT_TOP: f32 = 60.0;
+/// A strip before its heatmap panel is coloured: the misregistration of each of that
+/// panel's pixels (by byte offset in `rgb`), so that every method's strip can share one
+/// scale that none saturates.
+struct StripDraft {
+    width: u32,
+    height: u32,
+    rgb: Vec<u8>,
+    heat: Vec<(usize, f32)>,
+}
+
+/// Colours of the heatmap panel that are not on its scale.
+const BLANK: [u8; 3] = [0, 0, 0];
+const NO_DIRECTION: [u8; 3] = [40, 40, 40];
+const HOLE: [u8; 3] = [255, 0, 255];
+
+/// The shared scale of the strips' heatmaps: the largest 99th percentile of any method's
+/// misregistration, rounded up to a multiple of 10 arc-minutes (at least 10).
+fn shared_heat_top(drafts: &[StripDraft]) -> f32 {
+    let p99 = |d: &StripDraft| {
+        let mut v: Vec<f32> = d.heat.iter().map(|h| h.1).collect();
+        v.sort_by(f32::total_cmp);
+        v.get((v.len() as f32 * 0.99) as usize)
+            .copied()
+            .unwrap_or(0.0)
+    };
+    let top = drafts.iter().map(p99).fold(0.0f32, f32::max);
+    ((top / 10.0).ceil() * 10.0).max(10.0)
+}
+
+/// The strip with its heatmap coloured on the scale 0 to `top` arc-minutes, beside the
+/// labelled colour bar and the legend of the special colours.
+fn finish_strip(draft: StripDraft, top: f32) -> Result<(u32, u32, Vec<u8>)> {
+    let mut rgb = draft.rgb;
+    for (o, v) in draft.heat {
+        rgb[o..o + 3].copy_from_slice(&heat_color(v / top));
+    }
+    let bar = crate::io::colour_bar::ColourBar {
+        colours: heat_color,
+        bottom: 0.0,
+        top: top as f64,
+        unit: "′",
+        title: "arcmin, one scale for all".into(),
+        legend: vec![
+            (BLANK, "blank".into()),
+            (NO_DIRECTION, "no direction".into()),
+            (HOLE, "hole (4th panel)".into()),
+        ],
+        clipped: true,
+    };
+    crate::io::colour_bar::with_colour_bar(draft.width, draft.height, &rgb, &bar)
+}
+
+/// Truth, seethru, the misregistration heatmap and the holes, side by side, each cut to the
+/// display's bounding box; the heatmap is coloured later, on the scale shared by every
+/// method ([`finish_strip`]).
+fn strip(maps: &MetricMaps, truth: &Frame, seethru: &Frame, holes: Option<&[bool]>) -> StripDraft {
     const GAP: usize = 4;
     let w = maps.width as usize;
     let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
@@ -188,18 +246,20 @@ fn strip(
     let panels = 4;
     let sw = panels * bw + (panels - 1) * GAP;
     let mut rgb = vec![255u8; sw * bh * 3];
+    let mut heat_values = Vec::new();
     for y in 0..bh {
         for x in 0..bw {
             let i = (y0 + y) * w + x0 + x;
             let heat = if maps.blank[i] {
-                [0, 0, 0]
+                BLANK
             } else if maps.misregistration[i].is_finite() {
-                heat_color(maps.misregistration[i] / HEAT_TOP)
+                heat_values.push(((y * sw + 2 * (bw + GAP) + x) * 3, maps.misregistration[i]));
+                BLANK
             } else {
-                [40, 40, 40]
+                NO_DIRECTION
             };
             let hole = match holes {
-                Some(h) if h[i] => [255, 0, 255],
+                Some(h) if h[i] => HOLE,
                 _ if maps.display[i] => [60, 60, 60],
                 _ => [0, 0, 0],
             };
@@ -215,7 +275,12 @@ fn strip(
             }
         }
     }
-    (sw as u32, bh as u32, rgb)
+    StripDraft {
+        width: sw as u32,
+        height: bh as u32,
+        rgb,
+        heat: heat_values,
+    }
 }
 
 /// The table as Markdown: one row per method.

@@ -92,7 +92,7 @@ fn bounding_box(mask: &[bool], w: usize) -> Option<(usize, usize, usize, usize)>
 /// SSIM map on 8-bit luminance with 7×7 windows (Wang et al. 2004 constants) that see only
 /// pixels of `mask`: near the mask's edge a window averages over its pixels inside the mask,
 /// so nothing outside the mask reaches any score. NaN outside the mask.
-fn masked_ssim_map(a: &[f64], b: &[f64], mask: &[bool], w: usize, h: usize) -> Vec<f64> {
+pub fn masked_ssim_map(a: &[f64], b: &[f64], mask: &[bool], w: usize, h: usize) -> Vec<f64> {
     let (c1, c2) = ((0.01f64 * 255.0).powi(2), (0.03f64 * 255.0).powi(2));
     let r = 3i64;
     let mut out = vec![f64::NAN; w * h];

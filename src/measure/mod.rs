@@ -3,8 +3,11 @@
 
 pub mod binocular;
 pub mod compare;
+pub mod expectations;
 pub mod hazard;
+pub mod headline;
 pub mod holes;
+pub mod image_diff;
 pub mod maps;
 pub mod metrics;
 pub mod ratio;

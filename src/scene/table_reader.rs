@@ -14,6 +14,9 @@ use crate::scene::limits::{MAX_COORDINATE, MAX_PIXELS, MAX_RESOLUTION};
 use crate::scene::source::{SceneError, SourceFile};
 use crate::util::number::{short, short_list};
 
+/// A string of a TOML array and its byte span in the file.
+pub type SpannedStr<'a> = (&'a str, Option<std::ops::Range<usize>>);
+
 /// Reads the keys of one TOML table, remembering which were read so that
 /// [`TableReader::finish`] can reject the rest as unknown.
 pub struct TableReader<'a> {
@@ -311,6 +314,45 @@ impl<'a> TableReader<'a> {
             out.push(s);
         }
         Ok(out)
+    }
+
+    /// An array of free strings with the byte span of each in the file (for errors at the
+    /// element's own line, and for rewriting one element in place); empty if absent.
+    pub fn strings_with_spans(&self, key: &str) -> Result<Vec<SpannedStr<'a>>, SceneError> {
+        let Some(item) = self.item(key) else {
+            return Ok(Vec::new());
+        };
+        let array = item.as_array().ok_or_else(|| {
+            self.error(
+                key,
+                format!("expected an array of strings, found {}", item.type_name()),
+            )
+        })?;
+        array
+            .iter()
+            .map(|value| {
+                let s = value.as_str().ok_or_else(|| {
+                    self.error(
+                        key,
+                        format!("expected strings, found {}", value.type_name()),
+                    )
+                })?;
+                Ok((s, value.span()))
+            })
+            .collect()
+    }
+
+    /// An error about `key` located at byte `offset` of the file (an element of its array).
+    pub fn error_at_offset(
+        &self,
+        key: &str,
+        offset: Option<usize>,
+        message: impl Into<String>,
+    ) -> SceneError {
+        match offset {
+            Some(o) => self.error_at(Some(self.file.position_of(o)), self.full_key(key), message),
+            None => self.error(key, message),
+        }
     }
 
     /// A fixed-length array of numbers as written, NaN and infinities included.
