@@ -19,7 +19,7 @@ use seethru::system::display::Filter;
 use seethru::system::options::RunOptions;
 
 use crate::cli::args::{band, threads};
-use crate::cli::capture::{COMMAND_FILE, CaptureArgs, CaptureCommand};
+use crate::cli::capture::{COMMAND_FILE, CaptureCommand};
 
 #[derive(clap::Args)]
 pub struct Score {
