@@ -78,7 +78,12 @@ fn misregistration_map(dir: &Path) -> Vec<f32> {
 
 fn capture(dir: &Path, extra: &[&str]) -> PathBuf {
     let inputs = dir.join("inputs");
-    let mut args = vec!["capture", "scenes/das.toml", "--out", inputs.to_str().unwrap()];
+    let mut args = vec![
+        "capture",
+        "scenes/das.toml",
+        "--out",
+        inputs.to_str().unwrap(),
+    ];
     args.extend(SIZES);
     args.extend(extra);
     run_ok(&args);
@@ -147,7 +152,10 @@ fn the_numpy_planar_crop_scores_as_the_builtin_planar_method() {
             "{x} vs {y} arcmin: more than the quantum {quantum_arcmin}"
         );
     }
-    assert!((mean(&mine) - mean(&theirs)).abs() <= quantum_arcmin * differing as f64 / both.len() as f64 + 1e-9);
+    assert!(
+        (mean(&mine) - mean(&theirs)).abs()
+            <= quantum_arcmin * differing as f64 / both.len() as f64 + 1e-9
+    );
 }
 
 #[test]
@@ -157,7 +165,11 @@ fn a_map_shifted_by_k_display_pixels_adds_the_angle_they_subtend() {
     let (map0, mapk) = (dir.path().join("m0.npy"), dir.path().join("mk.npy"));
     let k = 60;
     python("planar_method.py", &[&inputs, &map0], &[]);
-    python("planar_method.py", &[&inputs, &mapk], &["--shift", &k.to_string()]);
+    python(
+        "planar_method.py",
+        &[&inputs, &mapk],
+        &["--shift", &k.to_string()],
+    );
     let m0 = score(&inputs, &map0, &dir.path().join("s0"));
     let mk = score(&inputs, &mapk, &dir.path().join("sk"));
     // The prediction from the geometry: display pixel i now shows what i − k showed, k pixel
@@ -166,8 +178,13 @@ fn a_map_shifted_by_k_display_pixels_adds_the_angle_they_subtend() {
     let calibration = json(&inputs.join("calibration.json"));
     let d = &calibration["display"];
     let [w, h] = [0, 1].map(|i| d["resolution_px"][i].as_u64().unwrap() as usize);
-    let (dw, dh) = (d["width_m"].as_f64().unwrap(), d["height_m"].as_f64().unwrap());
-    let eye: Vec<f64> = serde_json::from_value(json(&inputs.join("truth/truth.json"))["eye_world_m"].clone()).unwrap();
+    let (dw, dh) = (
+        d["width_m"].as_f64().unwrap(),
+        d["height_m"].as_f64().unwrap(),
+    );
+    let eye: Vec<f64> =
+        serde_json::from_value(json(&inputs.join("truth/truth.json"))["eye_world_m"].clone())
+            .unwrap();
     let m: Vec<Vec<f64>> = serde_json::from_value(d["world_from_display"].clone()).unwrap();
     let world = |x: f64, y: f64| -> [f64; 3] {
         [0, 1, 2].map(|r| m[r][0] * x + m[r][1] * y + m[r][3] - eye[r])
@@ -199,8 +216,73 @@ fn a_map_shifted_by_k_display_pixels_adds_the_angle_they_subtend() {
         "shifted by {k}: {} arcmin, predicted {predicted} ± {slack}",
         mean(&mk)
     );
-    assert!(predicted > 3.0 * slack, "the shift must dominate: {predicted} vs {slack}");
+    assert!(
+        predicted > 3.0 * slack,
+        "the shift must dominate: {predicted} vs {slack}"
+    );
     // The k uncovered columns show nothing: blank, counted, not dropped.
     assert!(mk["blank_pixels"].as_u64().unwrap() > 0);
     assert!(mk["coverage"].as_f64().unwrap() < 1.0);
+}
+
+#[test]
+fn a_depth_forward_warp_lands_between_planar_and_depth_ideal_in_compares_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let inputs = capture(dir.path(), &["--depth"]);
+    let map = dir.path().join("warp.npy");
+    python("depth_warp_method.py", &[&inputs, &map], &[]);
+    let table = dir.path().join("table");
+    let methods = format!("planar-inf,depth-ideal,map:warp={}", map.display());
+    let mut args = vec![
+        "compare",
+        "scenes/das.toml",
+        "--methods",
+        &methods,
+        "--out",
+        table.to_str().unwrap(),
+    ];
+    args.extend(SIZES);
+    run_ok(&args);
+    let rows = json(&table.join("compare.json"))["rows"].clone();
+    let row = |name: &str| {
+        rows.as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["method"] == name)
+            .unwrap_or_else(|| panic!("no row {name} in {rows}"))["misregistration_mean_arcmin"]
+            .as_f64()
+            .unwrap()
+    };
+    let (planar, ideal, warp) = (row("planar-inf"), row("depth-ideal"), row("map:warp"));
+    assert!(
+        ideal < warp && warp < planar,
+        "depth-ideal {ideal} < warp {warp} < planar-inf {planar} arcmin expected"
+    );
+    assert_eq!(
+        rows[2]["method"], "map:warp",
+        "the table keeps --methods' order"
+    );
+}
+
+#[test]
+fn a_map_for_another_capture_is_refused_by_its_fingerprint() {
+    let dir = tempfile::tempdir().unwrap();
+    let inputs = capture(dir.path(), &[]);
+    let map = dir.path().join("m.npy");
+    python("planar_method.py", &[&inputs, &map], &[]);
+    let other = capture(&dir.path().join("other"), &["--head-bias-cm", "1,0,0"]);
+    let (ok, _, err) = seethru(&[
+        "score",
+        other.to_str().unwrap(),
+        "--map",
+        map.to_str().unwrap(),
+        "--out",
+        dir.path().join("s").to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(
+        err.starts_with("error:") && err.contains("made for capture") && err.contains("m.npy"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
 }

@@ -7,6 +7,7 @@ mod bench_methods;
 mod bench_sequence;
 mod capture;
 mod compare;
+mod compare_methods;
 mod export;
 mod figures;
 mod measure;

@@ -85,7 +85,7 @@ impl Candidate {
 
 /// One method's row and its strip.
 pub struct Compared {
-    pub name: &'static str,
+    pub name: String,
     /// The row: metrics and cost (see [`compare`]).
     pub row: serde_json::Value,
     /// The strip: truth | seethru | misregistration | holes over the display's bounding box,
@@ -155,7 +155,7 @@ pub fn compare(
         });
         let strip = strip(&maps, &result.truth, &result.seethru, holes.as_deref());
         out.push(Compared {
-            name: candidate.name(),
+            name: candidate.name().to_string(),
             row,
             strip,
         });
@@ -167,7 +167,7 @@ pub fn compare(
 
 /// Truth, seethru, the misregistration heatmap (0 to `HEAT_TOP` arc-minutes, one scale for
 /// every method) and the holes, side by side, each cut to the display's bounding box.
-fn strip(
+pub(crate) fn strip(
     maps: &MetricMaps,
     truth: &Frame,
     seethru: &Frame,

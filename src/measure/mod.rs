@@ -3,6 +3,7 @@
 
 pub mod binocular;
 pub mod compare;
+pub mod compare_external;
 pub mod holes;
 pub mod maps;
 pub mod metrics;

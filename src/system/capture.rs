@@ -66,8 +66,9 @@ pub struct Capture {
     pub head: HeadEstimate,
     /// `calibration.json`: the calibrated cameras, display and obstacle frame.
     pub calibration: Value,
-    /// 16 hex digits over the images, the head estimate and the calibration: a map made for
-    /// another capture is refused by it.
+    /// 16 hex digits over the frontal and back images, the head estimate and the calibration
+    /// (not the depth image, which follows from the same settings): a map made for another
+    /// capture is refused by it.
     pub fingerprint: String,
     pub truth: CaptureTruth,
 }
@@ -96,22 +97,26 @@ pub fn capture(ctx: &RenderContext, options: &RunOptions, with_depth: bool) -> R
     } else {
         None
     };
-    let mut calibration = calibration_json(scene)?;
-    if let Some(d) = &depth {
-        let mut sensor = camera_json(&d.camera);
-        sensor["model"] = json!(d.model);
-        sensor["note"] = json!("the depth sensor shares the calibrated frontal camera's pose and field of view at its own resolution");
-        calibration["depth_sensor"] = sensor;
-    }
     let head = HeadEstimate {
         source: options.head,
         eye_world_m: eye.to_array(),
         eye_obstacle_m: scene.obstacle.in_obstacle_frame(eye).to_array(),
         detection,
     };
+    let mut calibration = calibration_json(scene)?;
+    // Before the depth sensor is added: a map made from a capture with depth fits the same
+    // capture without (compare's), the sensor being a function of the same settings.
+    let fingerprint = fingerprint(&frontal, &back, &head, &calibration)?;
+    if let Some(d) = &depth {
+        let mut sensor = camera_json(&d.camera);
+        sensor["model"] = json!(d.model);
+        sensor["note"] = json!(
+            "the depth sensor shares the calibrated frontal camera's pose and field of view at its own resolution"
+        );
+        calibration["depth_sensor"] = sensor;
+    }
     let driver = driver_camera(scene, options)?;
     let truth = render(&driver, View::Truth);
-    let fingerprint = fingerprint(&frontal, &back, depth.as_ref(), &head, &calibration)?;
     let true_cameras = json!({
         "frontal": camera_json(&scene.frontal),
         "back": camera_json(&scene.back),
@@ -136,7 +141,6 @@ pub fn capture(ctx: &RenderContext, options: &RunOptions, with_depth: bool) -> R
 fn fingerprint(
     frontal: &Frame,
     back: &Frame,
-    depth: Option<&DepthMap>,
     head: &HeadEstimate,
     calibration: &Value,
 ) -> Result<String> {
@@ -148,11 +152,6 @@ fn fingerprint(
             for v in c.to_array() {
                 h.bytes(&v.to_le_bytes());
             }
-        }
-    }
-    if let Some(d) = depth {
-        for v in &d.inverse_depth {
-            h.bytes(&v.to_le_bytes());
         }
     }
     h.bytes(serde_json::to_string(head)?.as_bytes())
@@ -236,7 +235,10 @@ pub fn check_display_input(
             );
         }
         if i.color.len() != (dw * dh) as usize {
-            bail!("the display image has {} pixels, {dw}×{dh} expected", i.color.len());
+            bail!(
+                "the display image has {} pixels, {dw}×{dh} expected",
+                i.color.len()
+            );
         }
     }
     Ok(())
@@ -256,15 +258,15 @@ pub fn display_from(
     let [dw, dh] = display_size;
     let n = (dw * dh) as usize;
     let mut pixels: Vec<Pixel> = match map {
-        Some(m) => m
-            .xy
-            .par_iter()
-            .map(|&[x, y]| {
-                // OpenCV's pixel centres are at integers; seethru's at +0.5.
-                let p = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
-                sample(frontal, p, options.filter)
-            })
-            .collect(),
+        Some(m) => {
+            m.xy.par_iter()
+                .map(|&[x, y]| {
+                    // OpenCV's pixel centres are at integers; seethru's at +0.5.
+                    let p = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                    sample(frontal, p, options.filter)
+                })
+                .collect()
+        }
         None => vec![
             Pixel {
                 normal: Vec3::ZERO,
