@@ -286,7 +286,9 @@ fn options_with_values() -> Vec<ValueOption> {
 }
 
 /// Options whose values are paths, names or free-form specs, not numbers.
-const NOT_NUMBERS: [&str; 7] = ["OUT", "SCENE", "DIR", "PARAMS", "FILE", "CSV", "K/N"];
+const NOT_NUMBERS: [&str; 8] = [
+    "OUT", "SCENE", "DIR", "PARAMS", "FILE", "CSV", "K/N", "METHOD",
+];
 
 /// A range as help texts and errors write it: `[a, b]`, `(a, b]`, `[a, b)` or `(a, b)`, the
 /// first such group in `text` (other parentheses, like `(default: …)`, are skipped).

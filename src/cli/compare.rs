@@ -25,6 +25,7 @@ pub struct Compare {
     /// method's display map for the capture of these settings, see `seethru score`).
     #[arg(
         long,
+        value_name = "METHOD",
         value_delimiter = ',',
         value_parser = crate::cli::compare_methods::method_spec,
         default_value = "planar-inf,planar-auto,plane-fit,ground,depth-ideal,depth-tof"
