@@ -55,6 +55,7 @@ fn json(path: &Path) -> Value {
 /// The `Y` channel of a misregistration.exr (arcmin per driver pixel, NaN off the display).
 fn misregistration_map(dir: &Path) -> Vec<f32> {
     use exr::prelude::*;
+    let channel = "Y";
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -68,7 +69,7 @@ fn misregistration_map(dir: &Path) -> Vec<f32> {
         .channel_data
         .list
         .iter()
-        .find(|c| c.name.to_string() == "Y")
+        .find(|c| c.name.to_string() == channel)
         .unwrap();
     match &y.sample_data {
         FlatSamples::F32(v) => v.clone(),

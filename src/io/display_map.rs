@@ -23,6 +23,9 @@ pub struct MapFile {
     pub fingerprint: Option<String>,
 }
 
+/// The EXR attribute naming the capture a map was made for.
+const FINGERPRINT_ATTRIBUTE: &str = "capture_fingerprint";
+
 /// Most pixels of a map (the display's resolution is far smaller).
 const MAX_MAP_PIXELS: u64 = 1 << 26;
 
@@ -242,7 +245,7 @@ fn read_exr_map(path: &Path) -> Result<MapFile> {
         .other
         .iter()
         .chain(layer.attributes.other.iter())
-        .find(|(k, _)| k.to_string() == "capture_fingerprint")
+        .find(|(k, _)| *k == FINGERPRINT_ATTRIBUTE)
         .map(|(_, v)| match v {
             exr::meta::attribute::AttributeValue::Text(t) => Ok(t.to_string()),
             _ => bail!("the attribute capture_fingerprint must be a string"),

@@ -18,8 +18,7 @@ pub fn python_with(packages: &[&str]) -> PathBuf {
     }
     let target = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target");
     std::fs::create_dir_all(&target).expect("target/ can be made");
-    let lock = std::fs::File::create(target.join("python-venv.lock")).expect("a lock file");
-    lock.lock().expect("the python-venv lock");
+    let lock = DirLock::take(target.join("python-venv.lock"));
     let venv = target.join("python-venv");
     let python = venv.join("bin").join("python");
     if !python.exists() {
@@ -51,6 +50,44 @@ pub fn python_with(packages: &[&str]) -> PathBuf {
     }
     drop(lock);
     python
+}
+
+/// A lock held by a folder's existence (`create_dir` is atomic; `File::lock` is newer than
+/// the crate's MSRV). A lock older than 15 minutes is a killed test's and is taken over.
+struct DirLock(PathBuf);
+
+impl DirLock {
+    fn take(path: PathBuf) -> Self {
+        let start = std::time::Instant::now();
+        loop {
+            match std::fs::create_dir(&path) {
+                Ok(()) => return DirLock(path),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let stale = std::fs::metadata(&path)
+                        .and_then(|m| m.modified())
+                        .ok()
+                        .and_then(|t| t.elapsed().ok())
+                        .is_some_and(|age| age.as_secs() > 900);
+                    if stale {
+                        let _ = std::fs::remove_dir(&path);
+                    }
+                    assert!(
+                        start.elapsed().as_secs() < 1200,
+                        "waited 20 minutes for {} (another test making the venv?)",
+                        path.display()
+                    );
+                    std::thread::sleep(std::time::Duration::from_millis(200));
+                }
+                Err(e) => panic!("cannot make the lock {}: {e}", path.display()),
+            }
+        }
+    }
+}
+
+impl Drop for DirLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir(&self.0);
+    }
 }
 
 fn check_imports(python: &PathBuf, packages: &[&str]) -> Result<(), String> {
