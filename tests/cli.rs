@@ -288,7 +288,7 @@ fn options_with_values() -> Vec<ValueOption> {
 }
 
 /// Options whose values are paths, names or free-form specs, not numbers.
-const NOT_NUMBERS: [&str; 10] = [
+const NOT_NUMBERS: [&str; 11] = [
     "OUT",
     "SCENE",
     "DIR",
@@ -299,6 +299,7 @@ const NOT_NUMBERS: [&str; 10] = [
     "NAME=VALUE",
     "LAYER",
     "CASE",
+    "METHOD",
 ];
 
 /// A range as help texts and errors write it: `[a, b]`, `(a, b]`, `[a, b)` or `(a, b)`, the

@@ -7,7 +7,7 @@ use anyhow::Result;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_png;
 use seethru::io::staged::StagedDir;
-use seethru::measure::compare::{Candidate, compare, html_page, markdown_table};
+use seethru::measure::compare::{coloured_strips, html_page, markdown_table};
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::system::memory::{check_memory, run_estimate};
@@ -20,14 +20,17 @@ use crate::cli::scene_model_args::SceneModelArgs;
 pub struct Compare {
     /// Scene file (TOML).
     scene: PathBuf,
-    /// Methods, comma-separated, in the table's order.
+    /// Methods, comma-separated, in the table's order: none, planar-inf, planar-auto,
+    /// plane-fit, ground, depth-ideal, depth-tof, depth-stereo, or map:NAME=FILE (your
+    /// method's display map for the capture of these settings, see `seethru score`).
     #[arg(
         long,
-        value_enum,
+        value_name = "METHOD",
         value_delimiter = ',',
+        value_parser = crate::cli::compare_methods::method_spec,
         default_value = "planar-inf,planar-auto,plane-fit,ground,depth-ideal,depth-tof"
     )]
-    methods: Vec<Candidate>,
+    methods: Vec<crate::cli::compare_methods::MethodSpec>,
     /// Output directory: compare.md, compare.json, compare.html and strip_<method>.png.
     #[arg(long, default_value = "compare")]
     out: PathBuf,
@@ -78,16 +81,15 @@ impl Compare {
         let scene = Scene::load(&self.scene)?;
         check_memory(&run_estimate(&scene, base)?, self.render.max_memory)?;
         let ctx = RenderContext::new(scene)?;
-        let rows = compare(&ctx, &self.methods, base, self.band)?;
+        let rows = crate::cli::compare_methods::compare_all(&ctx, &self.methods, base, self.band)?;
         // Written whole or not at all: a failure leaves `--out` as it was.
         let staged = StagedDir::new(&self.out)?;
         let out: &Path = staged.path();
         let mut strips = Vec::new();
-        for r in &rows {
+        for (r, (w, h, rgb)) in rows.iter().zip(coloured_strips(&rows)?) {
             let file = format!("strip_{}.png", r.name);
-            let (w, h, rgb) = r.strip.clone();
             write_png(&out.join(&file), w, h, rgb)?;
-            strips.push((r.name, file));
+            strips.push((r.name.as_str(), file));
         }
         let table = markdown_table(&rows);
         let title = format!("Compensation methods compared on {}", self.scene.display());

@@ -6,8 +6,10 @@ mod bench;
 mod bench_methods;
 mod bench_run;
 mod bench_sequence;
+mod capture;
 mod check;
 mod compare;
+mod compare_methods;
 mod diff;
 mod export;
 mod figures;
@@ -18,6 +20,7 @@ mod reproduce;
 mod run;
 mod run_eyes;
 mod scene_model_args;
+mod score;
 mod sequence;
 mod sweep;
 pub mod verdict;
@@ -79,6 +82,11 @@ pub enum Command {
     /// Run the cases of an expectations file and check their metrics' bounds: a PASS/FAIL
     /// table, JUnit XML, diff images of failures; --bless rewrites goldens and recordings.
     Check(check::Check),
+    /// What a see-through system's algorithm receives (frontal, back and depth images, the
+    /// head estimate, calibration.json), with the truth apart in OUT/truth/: for your method.
+    Capture(capture::CaptureArgs),
+    /// Score your method's display map (or image) for a capture, measured exactly as `run`.
+    Score(score::Score),
 }
 
 /// The command line with every negative number that follows an option joined to it
@@ -145,6 +153,8 @@ impl Command {
         match self {
             Command::Render(c) => c.run(),
             Command::Run(c) => c.run(),
+            Command::Capture(c) => c.run(),
+            Command::Score(c) => c.run(),
             Command::Ratio(c) => c.run(),
             Command::Reproduce(c) => c.run(),
             Command::Sweep(c) => c.run(),

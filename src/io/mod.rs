@@ -5,6 +5,7 @@ pub mod animation;
 pub mod atomic;
 pub mod caption;
 pub mod colour_bar;
+pub mod display_map;
 pub mod export;
 pub mod frame_files;
 pub mod junit;

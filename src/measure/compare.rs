@@ -85,13 +85,12 @@ impl Candidate {
 
 /// One method's row and its strip.
 pub struct Compared {
-    pub name: &'static str,
+    pub name: String,
     /// The row: metrics and cost (see [`compare`]).
     pub row: serde_json::Value,
-    /// The strip: truth | seethru | misregistration | holes over the display's bounding box
-    /// and the heatmap's colour bar (one scale for every method),
-    /// RGB8, width × height.
-    pub strip: (u32, u32, Vec<u8>),
+    /// The strip before its heatmap is coloured: [`coloured_strips`] puts every method's
+    /// strip on one scale.
+    pub strip: StripDraft,
 }
 
 /// Runs every candidate at `base` on one scene (the truth rendered once, the same for all)
@@ -122,7 +121,6 @@ pub fn compare(
     let (truth, _) = ctx.render(&driver, View::Truth.bit(), settings, "truth");
     progress.advance(1);
     let mut out = Vec::new();
-    let mut drafts = Vec::new();
     for &candidate in candidates {
         let mut options = candidate.options(base);
         options.progress = false;
@@ -155,31 +153,30 @@ pub fn compare(
             "scene_model": result.report.get("scene_model"),
             "metrics": metrics,
         });
-        drafts.push(strip(
-            &maps,
-            &result.truth,
-            &result.seethru,
-            holes.as_deref(),
-        ));
         out.push(Compared {
-            name: candidate.name(),
+            name: candidate.name().to_string(),
             row,
-            strip: (0, 0, Vec::new()),
+            strip: strip(&maps, &result.truth, &result.seethru, holes.as_deref()),
         });
         progress.advance(1);
     }
     progress.finish();
-    let top = shared_heat_top(&drafts);
-    for (compared, draft) in out.iter_mut().zip(drafts) {
-        compared.strip = finish_strip(draft, top)?;
-    }
     Ok(out)
+}
+
+/// Every row's strip (truth | seethru | misregistration | holes over the display's bounding
+/// box, and the heatmap's colour bar), RGB8 as (width, height, bytes), all on one scale
+/// that none saturates.
+pub fn coloured_strips(rows: &[Compared]) -> Result<Vec<(u32, u32, Vec<u8>)>> {
+    let drafts: Vec<&StripDraft> = rows.iter().map(|r| &r.strip).collect();
+    let top = shared_heat_top(&drafts);
+    drafts.iter().map(|d| finish_strip(d, top)).collect()
 }
 
 /// A strip before its heatmap panel is coloured: the misregistration of each of that
 /// panel's pixels (by byte offset in `rgb`), so that every method's strip can share one
 /// scale that none saturates.
-struct StripDraft {
+pub struct StripDraft {
     width: u32,
     height: u32,
     rgb: Vec<u8>,
@@ -193,8 +190,8 @@ const HOLE: [u8; 3] = [255, 0, 255];
 
 /// The shared scale of the strips' heatmaps: the largest 99th percentile of any method's
 /// misregistration, rounded up to a multiple of 10 arc-minutes (at least 10).
-fn shared_heat_top(drafts: &[StripDraft]) -> f32 {
-    let p99 = |d: &StripDraft| {
+fn shared_heat_top(drafts: &[&StripDraft]) -> f32 {
+    let p99 = |d: &&StripDraft| {
         let mut v: Vec<f32> = d.heat.iter().map(|h| h.1).collect();
         v.sort_by(f32::total_cmp);
         v.get((v.len() as f32 * 0.99) as usize)
@@ -207,9 +204,9 @@ fn shared_heat_top(drafts: &[StripDraft]) -> f32 {
 
 /// The strip with its heatmap coloured on the scale 0 to `top` arc-minutes, beside the
 /// labelled colour bar and the legend of the special colours.
-fn finish_strip(draft: StripDraft, top: f32) -> Result<(u32, u32, Vec<u8>)> {
-    let mut rgb = draft.rgb;
-    for (o, v) in draft.heat {
+fn finish_strip(draft: &StripDraft, top: f32) -> Result<(u32, u32, Vec<u8>)> {
+    let mut rgb = draft.rgb.clone();
+    for &(o, v) in &draft.heat {
         rgb[o..o + 3].copy_from_slice(&heat_color(v / top));
     }
     let bar = crate::io::colour_bar::ColourBar {
@@ -231,7 +228,12 @@ fn finish_strip(draft: StripDraft, top: f32) -> Result<(u32, u32, Vec<u8>)> {
 /// Truth, seethru, the misregistration heatmap and the holes, side by side, each cut to the
 /// display's bounding box; the heatmap is coloured later, on the scale shared by every
 /// method ([`finish_strip`]).
-fn strip(maps: &MetricMaps, truth: &Frame, seethru: &Frame, holes: Option<&[bool]>) -> StripDraft {
+pub(crate) fn strip(
+    maps: &MetricMaps,
+    truth: &Frame,
+    seethru: &Frame,
+    holes: Option<&[bool]>,
+) -> StripDraft {
     const GAP: usize = 4;
     let w = maps.width as usize;
     let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);

@@ -3,6 +3,7 @@
 
 pub mod binocular;
 pub mod compare;
+pub mod compare_external;
 pub mod expectations;
 pub mod hazard;
 pub mod headline;
