@@ -1,0 +1,35 @@
+"""seethru from Python: scenes, renders and see-through runs as numpy arrays.
+
+The package wraps the same library as the ``seethru`` command line: a scene read by
+:meth:`Scene.load` renders the same pixels as ``seethru render`` and a :func:`run` computes the
+same metrics as ``seethru run`` (bit for bit, for the same scene and options), without files
+in between. Rendering releases the GIL and runs on the library's thread pool (all cores, or
+``RAYON_NUM_THREADS``); Ctrl-C stops a long render between bands of rows.
+
+Errors raise :class:`ValueError` (bad input: a scene key, an option's range) or
+:class:`OSError` (a file that cannot be read) with the command line's one-line message.
+"""
+
+from ._native import Frame, Run, Scene, __version__, read_frame
+from ._native import run as _run
+
+__all__ = ["Frame", "Run", "Scene", "read_frame", "run", "__version__"]
+
+
+def run(scene: Scene, **options) -> Run:
+    """Runs the see-through system on ``scene``, as ``seethru run`` does.
+
+    The keywords are ``seethru run``'s flags with ``_`` for ``-`` and the same defaults and
+    ranges: ``method`` ("none", "planar", "ground", "plane-fit", "depth"), ``d2`` (a float in
+    metres, ``float("inf")``, "inf" or "auto"), ``head`` ("oracle", "estimated"),
+    ``head_bias_cm`` (x, y, z), ``head_jitter_cm``, ``seed``, ``feature_width``, ``outside``
+    ("error", "black"), ``filter``, ``display`` ("pixels", "ideal"), ``frontal_width``,
+    ``back_width``, ``eyes`` ("mono", "left", "right"), ``ipd``, ``target_eye``, ``band``,
+    ``depth_sensor``, ``depth_resolution``, ``depth_range``, ``depth_noise``,
+    ``depth_quantum``, ``fill``, ``width``, ``height``, ``spp`` (default 4) and
+    ``max_memory`` (GiB). An unknown keyword, or one the method would ignore, is refused.
+
+    Returns a :class:`Run`: ``frames`` (the six views), ``metrics`` (metrics.json's content),
+    ``report`` (run.json's content), ``misregistration`` and ``missing`` (driver-view maps).
+    """
+    return _run(scene, **options)

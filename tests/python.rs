@@ -1,0 +1,91 @@
+//! The Python package (python/): builds it into a virtual environment under target/, then
+//! runs its pytest tests, which compare renders and runs from Python with the command line's
+//! EXRs and metrics.json bit for bit, check that the GIL is released, that Ctrl-C stops a
+//! render and that bad input raises with the command line's message.
+//!
+//! Needs `python3` (≥ 3.10, with `venv`) and PyPI or a pip wheel cache: the environment
+//! (numpy, pytest, maturin, OpenEXR) is made once and reused.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+const PACKAGES: [&str; 4] = ["numpy", "pytest", "maturin>=1.16,<2", "OpenEXR>=3.2"];
+const IMPORTS: &str = "import numpy, pytest, maturin, OpenEXR";
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn run(command: &mut Command) -> std::process::Output {
+    let out = command.output().unwrap_or_else(|e| panic!("{command:?}: {e}"));
+    assert!(
+        out.status.success(),
+        "{command:?} failed ({}):\n{}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// target/python-venv with the test packages, made if needed; its python.
+fn venv() -> PathBuf {
+    let dir = repo().join("target/python-venv");
+    let python = dir.join("bin/python");
+    let ready = python.exists()
+        && Command::new(&python)
+            .args(["-c", IMPORTS])
+            .output()
+            .is_ok_and(|o| o.status.success());
+    if !ready {
+        run(Command::new("python3").args(["-m", "venv"]).arg(&dir));
+        run(Command::new(&python)
+            .args(["-m", "pip", "install", "--quiet"])
+            .args(PACKAGES));
+    }
+    python
+}
+
+/// Builds the package and installs it into the environment (`maturin develop --release`).
+fn install(python: &Path) {
+    let venv = python.parent().unwrap().parent().unwrap();
+    run(Command::new(venv.join("bin/maturin"))
+        .args(["develop", "--release", "--quiet", "--manifest-path"])
+        .arg(repo().join("python/Cargo.toml"))
+        .env("VIRTUAL_ENV", venv)
+        // Its own target folder: the outer `cargo test` holds the lock on target/ while its
+        // tests run, and a cargo waiting for it would wait for ever.
+        .env("CARGO_TARGET_DIR", repo().join("target/python-build")));
+}
+
+#[test]
+fn pytest_passes() {
+    let start = Instant::now();
+    let python = venv();
+    let made = start.elapsed();
+    install(&python);
+    let built = start.elapsed();
+    let out = Command::new(&python)
+        .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
+        .arg(repo().join("python/tests"))
+        .env("SEETHRU_BIN", env!("CARGO_BIN_EXE_seethru"))
+        .env("SEETHRU_REPO", repo())
+        .current_dir(repo())
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    eprintln!(
+        "python: environment {:.1} s, build {:.1} s, pytest {:.1} s",
+        made.as_secs_f64(),
+        (built - made).as_secs_f64(),
+        (start.elapsed() - built).as_secs_f64()
+    );
+    // Exit 5 is pytest's "no tests collected": a failure too.
+    assert!(out.status.success(), "pytest failed ({}):\n{text}", out.status);
+    assert!(text.contains(" passed"), "pytest ran no test:\n{text}");
+}
