@@ -18,7 +18,9 @@ fn repo() -> PathBuf {
 }
 
 fn run(command: &mut Command) -> std::process::Output {
-    let out = command.output().unwrap_or_else(|e| panic!("{command:?}: {e}"));
+    let out = command
+        .output()
+        .unwrap_or_else(|e| panic!("{command:?}: {e}"));
     assert!(
         out.status.success(),
         "{command:?} failed ({}):\n{}\n{}",
@@ -50,13 +52,14 @@ fn venv() -> PathBuf {
 /// Builds the package and installs it into the environment (`maturin develop --release`).
 fn install(python: &Path) {
     let venv = python.parent().unwrap().parent().unwrap();
-    run(Command::new(venv.join("bin/maturin"))
-        .args(["develop", "--release", "--quiet", "--manifest-path"])
-        .arg(repo().join("python/Cargo.toml"))
-        .env("VIRTUAL_ENV", venv)
-        // Its own target folder: the outer `cargo test` holds the lock on target/ while its
-        // tests run, and a cargo waiting for it would wait for ever.
-        .env("CARGO_TARGET_DIR", repo().join("target/python-build")));
+    run(
+        Command::new(venv.join("bin/maturin"))
+            .args(["develop", "--release", "--quiet", "--manifest-path"])
+            .arg(repo().join("python/Cargo.toml"))
+            .env("VIRTUAL_ENV", venv), // The same target/ as the outer `cargo test` (which releases its lock before it runs
+                                       // the tests: measured with cargo 1.95), so every dependency built for the package
+                                       // by `pip install ./python` or a previous run is reused.
+    );
 }
 
 #[test]
@@ -86,6 +89,10 @@ fn pytest_passes() {
         (start.elapsed() - built).as_secs_f64()
     );
     // Exit 5 is pytest's "no tests collected": a failure too.
-    assert!(out.status.success(), "pytest failed ({}):\n{text}", out.status);
+    assert!(
+        out.status.success(),
+        "pytest failed ({}):\n{text}",
+        out.status
+    );
     assert!(text.contains(" passed"), "pytest ran no test:\n{text}");
 }

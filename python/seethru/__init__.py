@@ -10,10 +10,10 @@ Errors raise :class:`ValueError` (bad input: a scene key, an option's range) or
 :class:`OSError` (a file that cannot be read) with the command line's one-line message.
 """
 
-from ._native import Frame, Run, Scene, __version__, read_frame
+from ._native import Frame, Run, Scene, __version__, analyze, compare, ratio, read_frame
 from ._native import run as _run
 
-__all__ = ["Frame", "Run", "Scene", "read_frame", "run", "__version__"]
+__all__ = ["Frame", "Run", "Scene", "analyze", "compare", "ratio", "read_frame", "run", "__version__"]
 
 
 def run(scene: Scene, **options) -> Run:

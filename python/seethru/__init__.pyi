@@ -114,3 +114,23 @@ def run(
 
 def read_frame(path: str | PathLike[str]) -> Frame:
     """Reads an EXR written by `seethru render`/`run` as a Frame."""
+
+def compare(
+    scene: Scene,
+    methods: list[str] | None = None,
+    **options: Any,
+) -> dict[str, Any]:
+    """`seethru compare`: {"rows": compare.json's rows, "strips": {method: (h, w, 3) uint8}}.
+
+    methods: none, planar-inf, planar-auto, plane-fit, ground, depth-ideal, depth-tof,
+    depth-stereo (default: compare's six). Options: head, seed, frontal_width, back_width,
+    band, depth_*, fill, width, height, spp, max_memory.
+    """
+
+def ratio(setup: Literal["occlusion", "foreshortening"], **options: Any) -> dict[str, Any]:
+    """`seethru ratio SETUP ... --json`: L (occlusion) or l and gamma (degrees,
+    foreshortening), b1, d2, d1, bh (required), model_d2, head_bias_cm, width (1280)."""
+
+def analyze(**options: float) -> dict[str, Any]:
+    """`seethru analyze --json`'s claims, evaluation and error_budget_das (not lens_and_eyes):
+    d1, d2, bh, width, theta_f, frontal_px, L, b1, l, gamma, tolerance."""

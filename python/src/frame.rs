@@ -52,7 +52,10 @@ pub struct PyFrame {
 #[pymethods]
 impl PyFrame {
     fn __repr__(&self) -> String {
-        format!("<seethru.Frame {} {}×{}>", self.view, self.width, self.height)
+        format!(
+            "<seethru.Frame {} {}×{}>",
+            self.view, self.width, self.height
+        )
     }
 }
 

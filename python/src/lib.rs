@@ -5,6 +5,7 @@
 mod errors;
 mod frame;
 mod interrupt;
+mod measures;
 mod options;
 mod run;
 mod scene;
@@ -18,6 +19,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<run::PyRun>()?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
     m.add_function(wrap_pyfunction!(frame::read_frame, m)?)?;
+    m.add_function(wrap_pyfunction!(measures::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(measures::ratio, m)?)?;
+    m.add_function(wrap_pyfunction!(measures::analyze, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

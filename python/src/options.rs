@@ -94,7 +94,12 @@ pub const RUN_KEYS: [&str; 25] = [
 ];
 
 /// The depth sensor's settings: read by plane-fit and depth only.
-const DEPTH_SETTINGS: [&str; 4] = ["depth_resolution", "depth_range", "depth_noise", "depth_quantum"];
+const DEPTH_SETTINGS: [&str; 4] = [
+    "depth_resolution",
+    "depth_range",
+    "depth_noise",
+    "depth_quantum",
+];
 
 /// What `seethru.run` runs with: the pipeline's options, the border band and the memory limit.
 pub struct RunChoices {
@@ -153,7 +158,12 @@ pub fn run_choices(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<RunChoices> {
                         bad_value("head_bias_cm: three numbers (x, y, z) are needed")
                     })?;
                     for (axis, c) in ["x", "y", "z"].iter().zip(v) {
-                        real_in(&format!("head_bias_cm {axis}"), c, -MAX_HEAD_BIAS_CM, MAX_HEAD_BIAS_CM)?;
+                        real_in(
+                            &format!("head_bias_cm {axis}"),
+                            c,
+                            -MAX_HEAD_BIAS_CM,
+                            MAX_HEAD_BIAS_CM,
+                        )?;
                     }
                     options.head_bias_cm = v;
                 }
@@ -231,4 +241,130 @@ pub fn run_choices(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<RunChoices> {
         band,
         max_memory,
     })
+}
+
+/// Keyword arguments read one by one with their ranges; [`Keywords::finish`] refuses the rest.
+pub struct Keywords<'py> {
+    given: Vec<(String, Bound<'py, PyAny>)>,
+    read: Vec<&'static str>,
+}
+
+impl<'py> Keywords<'py> {
+    pub fn new(kwargs: Option<&Bound<'py, PyDict>>) -> PyResult<Self> {
+        let mut given = Vec::new();
+        if let Some(kwargs) = kwargs {
+            for (k, v) in kwargs.iter() {
+                given.push((k.extract::<String>()?, v));
+            }
+        }
+        Ok(Keywords {
+            given,
+            read: Vec::new(),
+        })
+    }
+
+    /// The value of `key` unless absent or None.
+    fn value(&mut self, key: &'static str) -> Option<Bound<'py, PyAny>> {
+        self.read.push(key);
+        self.given
+            .iter()
+            .find(|(k, v)| k == key && !v.is_none())
+            .map(|(_, v)| v.clone())
+    }
+
+    pub fn real(&mut self, key: &'static str, default: f64, min: f64, max: f64) -> PyResult<f64> {
+        match self.value(key) {
+            None => Ok(default),
+            Some(v) => {
+                let v: f64 = v
+                    .extract()
+                    .map_err(|_| bad_value(format!("{key}: a number is needed")))?;
+                real_in(key, v, min, max)
+            }
+        }
+    }
+
+    /// A number in [min, max] or infinity (a distance `inf`).
+    pub fn real_or_inf(
+        &mut self,
+        key: &'static str,
+        default: f64,
+        min: f64,
+        max: f64,
+    ) -> PyResult<f64> {
+        match self.value(key) {
+            None => Ok(default),
+            Some(v) => match v.extract::<f64>() {
+                Ok(f) if f == f64::INFINITY => Ok(f),
+                Ok(f) => real_in(key, f, min, max),
+                Err(_) => match v.extract::<String>().as_deref() {
+                    Ok("inf") => Ok(f64::INFINITY),
+                    _ => Err(bad_value(format!(
+                        "{key}: a number in [{min}, {max}] or inf is needed"
+                    ))),
+                },
+            },
+        }
+    }
+
+    pub fn required(&mut self, key: &'static str, min: f64, max: f64) -> PyResult<f64> {
+        match self.value(key) {
+            None => Err(bad_value(format!(
+                "{key} is required: a number in [{min}, {max}]"
+            ))),
+            Some(_) => self.real(key, 0.0, min, max),
+        }
+    }
+
+    pub fn int(&mut self, key: &'static str, default: i64, min: i64, max: i64) -> PyResult<i64> {
+        match self.value(key) {
+            None => Ok(default),
+            Some(v) => {
+                let v: i64 = v
+                    .extract()
+                    .map_err(|_| bad_value(format!("{key}: an integer is needed")))?;
+                int_in(key, v, min, max)
+            }
+        }
+    }
+
+    pub fn head_bias_cm(&mut self) -> PyResult<[f64; 3]> {
+        match self.value("head_bias_cm") {
+            None => Ok([0.0; 3]),
+            Some(v) => {
+                let v: [f64; 3] = v
+                    .extract()
+                    .map_err(|_| bad_value("head_bias_cm: three numbers (x, y, z) are needed"))?;
+                for (axis, c) in ["x", "y", "z"].iter().zip(v) {
+                    real_in(
+                        &format!("head_bias_cm {axis}"),
+                        c,
+                        -MAX_HEAD_BIAS_CM,
+                        MAX_HEAD_BIAS_CM,
+                    )?;
+                }
+                Ok(v)
+            }
+        }
+    }
+
+    /// Refuses keywords that were not read.
+    pub fn finish(self) -> PyResult<()> {
+        match self
+            .given
+            .iter()
+            .find(|(k, _)| !self.read.contains(&k.as_str()))
+        {
+            Some((k, _)) => Err(bad_value(format!(
+                "unknown option {k:?}: the options are {}",
+                self.read.join(", ")
+            ))),
+            None => Ok(()),
+        }
+    }
+}
+
+/// A choice among a clap value enum's names (as on the command line).
+pub fn choice_of<T: ValueEnum>(key: &str, value: &str) -> PyResult<T> {
+    choice(key, value)
 }

@@ -49,7 +49,7 @@ impl PyRun {
 
 /// JSON as Python objects, through `json.loads` of the text the command line writes: the
 /// same dict as reading the file.
-fn json_to_py(py: Python<'_>, value: &serde_json::Value) -> PyResult<Py<PyAny>> {
+pub fn json_to_py(py: Python<'_>, value: &serde_json::Value) -> PyResult<Py<PyAny>> {
     let text = serde_json::to_string_pretty(value).map_err(|e| to_py(e.into()))?;
     Ok(py.import("json")?.call_method1("loads", (text,))?.unbind())
 }

@@ -50,10 +50,7 @@ fn parse_view(name: &str) -> PyResult<View> {
         .find(|v| v.name() == name)
         .ok_or_else(|| {
             let names: Vec<_> = View::ALL.iter().map(|v| v.name()).collect();
-            bad_value(format!(
-                "view {name:?} is not one of {}",
-                names.join(", ")
-            ))
+            bad_value(format!("view {name:?} is not one of {}", names.join(", ")))
         })
 }
 
@@ -70,7 +67,9 @@ fn rigid_pose(name: &str, m: [[f64; 4]; 4]) -> PyResult<DAffine3> {
         return Err(bad("a 4×4 matrix of finite numbers is needed"));
     }
     if m[3] != [0.0, 0.0, 0.0, 1.0] {
-        return Err(bad("the last row of a rigid transform must be [0, 0, 0, 1]"));
+        return Err(bad(
+            "the last row of a rigid transform must be [0, 0, 0, 1]",
+        ));
     }
     let pose = DAffine3::from_mat4(DMat4::from_cols_array_2d(&m).transpose());
     let r = pose.matrix3;
