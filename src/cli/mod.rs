@@ -5,6 +5,7 @@ mod args;
 mod bench;
 mod bench_methods;
 mod bench_sequence;
+mod capture;
 mod compare;
 mod export;
 mod figures;
@@ -15,6 +16,7 @@ mod reproduce;
 mod run;
 mod run_eyes;
 mod scene_model_args;
+mod score;
 mod sequence;
 mod sweep;
 
@@ -69,6 +71,11 @@ pub enum Command {
     /// The system over time: vehicle and head motion, latencies and prediction, measured frame
     /// by frame against the truth (frames.csv, summary.json, plots, an animated preview).
     Sequence(sequence::Sequence),
+    /// What a see-through system's algorithm receives (frontal, back and depth images, the
+    /// head estimate, calibration.json), with the truth apart in OUT/truth/: for your method.
+    Capture(capture::CaptureArgs),
+    /// Score your method's display map (or image) for a capture, measured exactly as `run`.
+    Score(score::Score),
 }
 
 /// The command line with every negative number that follows an option joined to it
@@ -135,6 +142,8 @@ impl Command {
         match self {
             Command::Render(c) => c.run(),
             Command::Run(c) => c.run(),
+            Command::Capture(c) => c.run(),
+            Command::Score(c) => c.run(),
             Command::Ratio(c) => c.run(),
             Command::Reproduce(c) => c.run(),
             Command::Sweep(c) => c.run(),

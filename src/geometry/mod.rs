@@ -6,3 +6,4 @@ pub mod camera;
 pub mod homography;
 pub mod lens;
 pub mod lens_check;
+pub mod opencv;

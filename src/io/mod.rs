@@ -3,6 +3,7 @@
 
 pub mod animation;
 pub mod atomic;
+pub mod display_map;
 pub mod export;
 pub mod frame_files;
 pub mod plot;

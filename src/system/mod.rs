@@ -1,6 +1,8 @@
 //! The see-through system of the paper: the back camera's head estimate, the planar
 //! compensation, the display, and the pipeline that runs them on rendered frames.
 
+pub mod calibration_json;
+pub mod capture;
 pub mod compensation;
 pub mod depth_search;
 pub mod depth_sensor;

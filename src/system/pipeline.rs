@@ -47,7 +47,7 @@ pub struct RunResult {
 }
 
 /// The eye the system believes in: true, or estimated from the back image; plus errors.
-fn eye_for_compensation(
+pub fn eye_for_compensation(
     scene: &Scene,
     back: &Frame,
     options: &RunOptions,
@@ -252,6 +252,31 @@ pub fn run_with_truth(
     options: &RunOptions,
     truth: Option<&Frame>,
 ) -> Result<RunResult> {
+    run_given(
+        ctx,
+        options,
+        Given {
+            truth,
+            ..Given::default()
+        },
+    )
+}
+
+/// What a run is handed instead of making it itself: a truth frame already rendered (a
+/// sweep's), the captured back and frontal frames (they must be what the run would render),
+/// and a display image made elsewhere (a method's map or image, `seethru score`): with one,
+/// the method's own display and its crop checks are skipped and the display is physical.
+#[derive(Default)]
+pub struct Given<'a> {
+    pub truth: Option<&'a Frame>,
+    pub back: Option<&'a Frame>,
+    pub frontal: Option<&'a Frame>,
+    pub display: Option<Frame>,
+}
+
+/// [`run_with_truth`] with whatever [`Given`] holds.
+pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Result<RunResult> {
+    let truth = given.truth;
     let mut scene = ctx.scene.clone();
     scene.frontal = options.sized_frontal(scene.frontal)?;
     scene.back = options.sized_back(scene.back)?;
@@ -269,7 +294,7 @@ pub fn run_with_truth(
         bail!("head bias must be finite and jitter ≥ 0");
     }
     options.eyes.check().map_err(anyhow::Error::msg)?;
-    if options.method.models_the_scene() {
+    if options.method.models_the_scene() && given.display.is_none() {
         // Bad sensor flags, an ideal display and a scene without a road fail before anything
         // is rendered.
         check_scene_model(scene, options)?;
@@ -286,14 +311,21 @@ pub fn run_with_truth(
             timings.insert(view.name().into(), json!(stats.seconds));
             frame
         };
-    let back = timed(&mut timings, &scene.back, View::Back);
-    let frontal = timed(&mut timings, &scene.frontal, View::Frontal);
+    let back = match given.back {
+        Some(b) => b.clone(),
+        None => timed(&mut timings, &scene.back, View::Back),
+    };
+    let frontal = match given.frontal {
+        Some(f) => f.clone(),
+        None => timed(&mut timings, &scene.frontal, View::Frontal),
+    };
     let (eye_used, detection) = eye_for_compensation(scene, &back, options)?;
     let (crop, d2_used) = crop_for(scene, eye_used, &frontal, options)?;
     let map = frontal_map(scene, crop, options)?;
 
     let out = overflow(&map);
     if options.method == Method::Planar
+        && given.display.is_none()
         && options.outside == Outside::Error
         && let Some((side, px)) = out.iter().copied().find(|(_, px)| *px > 1e-9)
     {
@@ -327,7 +359,10 @@ pub fn run_with_truth(
     }
 
     let start = Instant::now();
-    let (display, scene_model) = if options.method.models_the_scene() {
+    let given_display = given.display.is_some();
+    let (display, scene_model) = if let Some(d) = given.display {
+        (d, None)
+    } else if options.method.models_the_scene() {
         let m = scene_model_display(ctx, scene, eye_used, &frontal, &crop, options)?;
         (m.display.clone(), Some(m))
     } else {
@@ -361,6 +396,10 @@ pub fn run_with_truth(
     timings.insert("occluded".into(), json!(stats.seconds));
     let placement = DisplayPlacement::new(&scene.obstacle);
     let surface = match options.display {
+        _ if given_display => DisplaySurface::Pixels {
+            image: display.clone(),
+            placement,
+        },
         DisplayModel::Pixels => DisplaySurface::Pixels {
             image: display.clone(),
             placement,
@@ -401,6 +440,7 @@ pub fn run_with_truth(
     report["peak_rss_bytes"] = json!(peak_rss_bytes());
     report["eyes"] = json!({"options": options.eyes, "view_world_m": driver.position().to_array()});
     report["lenses"] = crate::system::frontal_map::lenses_json(scene)?;
+    report["calibration"] = crate::system::calibration_json::calibration_json(scene)?;
     Ok(RunResult {
         truth,
         occluded,

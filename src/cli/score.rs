@@ -1,0 +1,217 @@
+//! `seethru score`: an outside method's display map (and/or display image) for a capture,
+//! shown on the display and measured exactly as `run` measures a built-in method.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use clap::Parser;
+use glam::Vec3;
+use rayon::prelude::*;
+use seethru::io::atomic::write_text;
+use seethru::io::display_map::{read_display_image, read_map};
+use seethru::io::frame_files::write_frame;
+use seethru::io::staged::StagedDir;
+use seethru::measure::maps::write_metrics;
+use seethru::measure::metrics::measure;
+use seethru::render::integrator::RenderContext;
+use seethru::system::capture::{Capture, DisplayImage, DisplayMap, capture, score};
+use seethru::system::display::Filter;
+use seethru::system::options::RunOptions;
+
+use crate::cli::args::{band, threads};
+use crate::cli::capture::{COMMAND_FILE, CaptureCommand};
+
+#[derive(clap::Args)]
+pub struct Score {
+    /// A folder written by `seethru capture` (its truth/ is read here, never by the method).
+    inputs: PathBuf,
+    /// The method's display map: .npy (display height, display width, 2) float32/float64,
+    /// [..., 0] = x, [..., 1] = y in frontal pixels (OpenCV's remap convention, NaN shows
+    /// nothing), or .exr with channels x, y.
+    #[arg(long, value_name = "FILE")]
+    map: Option<PathBuf>,
+    /// The method's display image (.png sRGB or .exr linear RGB, at the display's
+    /// resolution): shown instead of the map's colours; alone, only image metrics.
+    #[arg(long = "display-image", value_name = "FILE")]
+    display_image: Option<PathBuf>,
+    /// Output directory: the views, metrics.json, the heatmaps and run.json, as `run` writes.
+    #[arg(long)]
+    out: PathBuf,
+    /// Colour resampling of the frontal image at the map's points.
+    #[arg(long, value_enum, default_value_t = Filter::Bilinear)]
+    filter: Filter,
+    /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
+    #[arg(long, default_value_t = 5, value_parser = band)]
+    band: u32,
+    /// Worker threads in [1, 1024] (default: all cores). Results are identical for any value.
+    #[arg(long, value_parser = threads)]
+    threads: Option<usize>,
+}
+
+/// A capture folder captured again in memory: its flags, context and capture, the
+/// fingerprint checked against the folder's.
+pub struct Recaptured {
+    pub options: RunOptions,
+    pub ctx: RenderContext,
+    pub capture: Capture,
+}
+
+/// Reads `inputs/capture.json` and `inputs/truth/capture_command.json`, captures again and
+/// checks that the result is the folder's capture.
+pub fn recapture(inputs: &Path) -> Result<Recaptured> {
+    let read_json = |path: PathBuf| -> Result<serde_json::Value> {
+        let text = std::fs::read_to_string(&path).with_context(|| {
+            format!(
+                "cannot read {} (is {} a folder written by seethru capture?)",
+                path.display(),
+                inputs.display()
+            )
+        })?;
+        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))
+    };
+    let manifest = read_json(inputs.join("capture.json"))?;
+    let command = read_json(inputs.join("truth").join(COMMAND_FILE))?;
+    let fingerprint = manifest["fingerprint"]
+        .as_str()
+        .with_context(|| format!("{}: no fingerprint", inputs.join("capture.json").display()))?
+        .to_string();
+    let cwd = PathBuf::from(command["cwd"].as_str().unwrap_or("."));
+    let argv: Vec<std::ffi::OsString> = std::iter::once("seethru capture".into())
+        .chain(
+            command["args"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .filter_map(|a| a.as_str().map(Into::into)),
+        )
+        .collect();
+    let mut args = CaptureCommand::try_parse_from(crate::cli::with_negative_values_joined(argv))
+        .map_err(|e| {
+            anyhow::anyhow!(
+                "{}: the capture's flags do not parse: {}",
+                inputs.join("truth").join(COMMAND_FILE).display(),
+                crate::cli::one_line(&e).trim_start_matches("error: ")
+            )
+        })?
+        .args;
+    args.scene = cwd.join(&args.scene);
+    args.calibration = args.calibration.map(|c| cwd.join(c));
+    let mut options = args.options()?;
+    options.progress = false;
+    let ctx = RenderContext::new(args.scene()?)?;
+    let capture = capture(&ctx, &options, args.depth)?;
+    if capture.fingerprint != fingerprint {
+        bail!(
+            "{}: captured again, the inputs' fingerprint is {} but the folder's is {fingerprint}: the scene, its assets or seethru changed since the capture; capture again",
+            inputs.display(),
+            capture.fingerprint
+        );
+    }
+    Ok(Recaptured {
+        options,
+        ctx,
+        capture,
+    })
+}
+
+/// A map file as the system's map; errors name the file.
+pub fn load_map(path: &Path) -> Result<DisplayMap> {
+    let m = read_map(path)?;
+    Ok(DisplayMap {
+        width: m.width,
+        height: m.height,
+        xy: m.xy,
+        fingerprint: m.fingerprint,
+    })
+}
+
+fn load_image(path: &Path) -> Result<DisplayImage> {
+    let i = read_display_image(path)?;
+    Ok(DisplayImage {
+        width: i.width,
+        height: i.height,
+        color: i.color.into_iter().map(Vec3::from_array).collect(),
+    })
+}
+
+impl Score {
+    pub fn run(self) -> Result<()> {
+        if self.map.is_none() && self.display_image.is_none() {
+            bail!("score needs --map FILE, --display-image FILE or both");
+        }
+        if self.map.is_none() && self.filter != Filter::Bilinear {
+            bail!("--filter resamples the frontal image at the map's points: it needs --map");
+        }
+        crate::cli::args::with_threads(self.threads, || self.write())?
+    }
+
+    fn write(&self) -> Result<()> {
+        // The files first: a bad map fails before anything is rendered.
+        let map = self.map.as_deref().map(load_map).transpose()?;
+        let image = self.display_image.as_deref().map(load_image).transpose()?;
+        let mut r = recapture(&self.inputs)?;
+        r.options.filter = self.filter;
+        let name = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
+        let in_file = |e: anyhow::Error| {
+            let file = name(&self.map)
+                .or(name(&self.display_image))
+                .unwrap_or_default();
+            anyhow::anyhow!("{file}: {e}")
+        };
+        seethru::system::capture::check_display_input(
+            r.ctx.scene.obstacle.display_resolution,
+            &r.capture.fingerprint,
+            map.as_ref(),
+            image.as_ref(),
+        )
+        .map_err(in_file)?;
+        let scored = score(&r.ctx, &r.options, &r.capture, map.as_ref(), image.as_ref())?;
+        let result = &scored.run;
+        let staged = StagedDir::new(&self.out)?;
+        let out = staged.path();
+        let views = [
+            ("truth", &result.truth),
+            ("occluded", &result.occluded),
+            ("display", &result.display),
+            ("seethru", &result.seethru),
+        ];
+        views
+            .par_iter()
+            .try_for_each(|(name, frame)| write_frame(frame, out, name))?;
+        let eye = r.options.eyes.view_camera(&r.ctx.scene.driver).position();
+        let frames = [&result.truth, &result.seethru, &result.occluded];
+        let (maps, mut metrics) = measure(&r.ctx, &r.ctx.scene, eye, frames, self.band);
+        metrics["external_method"] = result.report["external_method"].clone();
+        if !scored.has_map {
+            metrics["misregistration_needs_a_map"] = serde_json::json!(
+                "the display image alone carries no geometry: misregistration is undefined on every display pixel (counted in undefined_pixels); give --map for it"
+            );
+        }
+        write_metrics(out, &maps, &result.truth, &metrics)?;
+        write_text(
+            &out.join("run.json"),
+            &serde_json::to_string_pretty(&result.report)?,
+        )?;
+        staged.commit()?;
+        let d = &metrics["display"];
+        let misregistration = match scored.has_map {
+            true => format!(
+                "misregistration mean {:.3} arcmin (p95 {:.3}) over {} pixels",
+                d["misregistration_arcmin"]["mean"].as_f64().unwrap_or(f64::NAN),
+                d["misregistration_arcmin"]["p95"].as_f64().unwrap_or(f64::NAN),
+                d["misregistration_arcmin"]["count"]
+            ),
+            false => "misregistration needs a map (image only)".to_string(),
+        };
+        seethru::util::progress::summary(format!(
+            "scored {}: {misregistration}, coverage {:.2} %, border mean {:.3} arcmin, PSNR {:.2} dB, SSIM {:.4}; wrote {}",
+            name(&self.map).or(name(&self.display_image)).unwrap_or_default(),
+            100.0 * metrics["coverage"].as_f64().unwrap_or(f64::NAN),
+            metrics["border"]["misregistration_arcmin"]["mean"].as_f64().unwrap_or(f64::NAN),
+            d["psnr_db"].as_f64().unwrap_or(f64::NAN),
+            d["ssim"].as_f64().unwrap_or(f64::NAN),
+            self.out.display()
+        ));
+        Ok(())
+    }
+}
