@@ -78,7 +78,12 @@ fn misregistration_map(dir: &Path) -> Vec<f32> {
 
 fn capture(dir: &Path, extra: &[&str]) -> PathBuf {
     let inputs = dir.join("inputs");
-    let mut args = vec!["capture", "scenes/das.toml", "--out", inputs.to_str().unwrap()];
+    let mut args = vec![
+        "capture",
+        "scenes/das.toml",
+        "--out",
+        inputs.to_str().unwrap(),
+    ];
     args.extend(SIZES);
     args.extend(extra);
     run_ok(&args);
@@ -147,7 +152,10 @@ fn the_numpy_planar_crop_scores_as_the_builtin_planar_method() {
             "{x} vs {y} arcmin: more than the quantum {quantum_arcmin}"
         );
     }
-    assert!((mean(&mine) - mean(&theirs)).abs() <= quantum_arcmin * differing as f64 / both.len() as f64 + 1e-9);
+    assert!(
+        (mean(&mine) - mean(&theirs)).abs()
+            <= quantum_arcmin * differing as f64 / both.len() as f64 + 1e-9
+    );
 }
 
 #[test]
@@ -157,7 +165,11 @@ fn a_map_shifted_by_k_display_pixels_adds_the_angle_they_subtend() {
     let (map0, mapk) = (dir.path().join("m0.npy"), dir.path().join("mk.npy"));
     let k = 60;
     python("planar_method.py", &[&inputs, &map0], &[]);
-    python("planar_method.py", &[&inputs, &mapk], &["--shift", &k.to_string()]);
+    python(
+        "planar_method.py",
+        &[&inputs, &mapk],
+        &["--shift", &k.to_string()],
+    );
     let m0 = score(&inputs, &map0, &dir.path().join("s0"));
     let mk = score(&inputs, &mapk, &dir.path().join("sk"));
     // The prediction from the geometry: display pixel i now shows what i − k showed, k pixel
@@ -166,8 +178,13 @@ fn a_map_shifted_by_k_display_pixels_adds_the_angle_they_subtend() {
     let calibration = json(&inputs.join("calibration.json"));
     let d = &calibration["display"];
     let [w, h] = [0, 1].map(|i| d["resolution_px"][i].as_u64().unwrap() as usize);
-    let (dw, dh) = (d["width_m"].as_f64().unwrap(), d["height_m"].as_f64().unwrap());
-    let eye: Vec<f64> = serde_json::from_value(json(&inputs.join("truth/truth.json"))["eye_world_m"].clone()).unwrap();
+    let (dw, dh) = (
+        d["width_m"].as_f64().unwrap(),
+        d["height_m"].as_f64().unwrap(),
+    );
+    let eye: Vec<f64> =
+        serde_json::from_value(json(&inputs.join("truth/truth.json"))["eye_world_m"].clone())
+            .unwrap();
     let m: Vec<Vec<f64>> = serde_json::from_value(d["world_from_display"].clone()).unwrap();
     let world = |x: f64, y: f64| -> [f64; 3] {
         [0, 1, 2].map(|r| m[r][0] * x + m[r][1] * y + m[r][3] - eye[r])
@@ -199,7 +216,10 @@ fn a_map_shifted_by_k_display_pixels_adds_the_angle_they_subtend() {
         "shifted by {k}: {} arcmin, predicted {predicted} ± {slack}",
         mean(&mk)
     );
-    assert!(predicted > 3.0 * slack, "the shift must dominate: {predicted} vs {slack}");
+    assert!(
+        predicted > 3.0 * slack,
+        "the shift must dominate: {predicted} vs {slack}"
+    );
     // The k uncovered columns show nothing: blank, counted, not dropped.
     assert!(mk["blank_pixels"].as_u64().unwrap() > 0);
     assert!(mk["coverage"].as_f64().unwrap() < 1.0);

@@ -4,14 +4,16 @@
 //! render and that bad input raises with the command line's message.
 //!
 //! Needs `python3` (≥ 3.10, with `venv`) and PyPI or a pip wheel cache: the environment
-//! (numpy, pytest, maturin, OpenEXR) is made once and reused.
+//! (numpy, pytest, maturin, OpenEXR; tests/common/python_env.rs) is made once and reused.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-const PACKAGES: [&str; 4] = ["numpy", "pytest", "maturin>=1.16,<2", "OpenEXR>=3.2"];
-const IMPORTS: &str = "import numpy, pytest, maturin, OpenEXR";
+mod common;
+
+/// What the tests import (pip names that are module names, for common::python_env).
+const PACKAGES: [&str; 4] = ["numpy", "pytest", "maturin", "OpenEXR"];
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -31,24 +33,6 @@ fn run(command: &mut Command) -> std::process::Output {
     out
 }
 
-/// target/python-venv with the test packages, made if needed; its python.
-fn venv() -> PathBuf {
-    let dir = repo().join("target/python-venv");
-    let python = dir.join("bin/python");
-    let ready = python.exists()
-        && Command::new(&python)
-            .args(["-c", IMPORTS])
-            .output()
-            .is_ok_and(|o| o.status.success());
-    if !ready {
-        run(Command::new("python3").args(["-m", "venv"]).arg(&dir));
-        run(Command::new(&python)
-            .args(["-m", "pip", "install", "--quiet"])
-            .args(PACKAGES));
-    }
-    python
-}
-
 /// Builds the package and installs it into the environment (`maturin develop --release`).
 fn install(python: &Path) {
     let venv = python.parent().unwrap().parent().unwrap();
@@ -65,7 +49,7 @@ fn install(python: &Path) {
 #[test]
 fn pytest_passes() {
     let start = Instant::now();
-    let python = venv();
+    let python = common::python_env::python_with(&PACKAGES);
     let made = start.elapsed();
     install(&python);
     let built = start.elapsed();

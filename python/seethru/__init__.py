@@ -10,10 +10,16 @@ Errors raise :class:`ValueError` (bad input: a scene key, an option's range) or
 :class:`OSError` (a file that cannot be read) with the command line's one-line message.
 """
 
-from ._native import Frame, Run, Scene, __version__, analyze, compare, ratio, read_frame
+from ._native import Capture, Frame, Run, Scene, __version__, analyze, capture, compare, ratio, read_frame
 from ._native import run as _run
+from ._native import score as _score
 
-__all__ = ["Frame", "Run", "Scene", "analyze", "compare", "ratio", "read_frame", "run", "__version__"]
+import numpy as _np
+
+__all__ = [
+    "Capture", "Frame", "Run", "Scene", "analyze", "capture", "compare", "ratio", "read_frame", "run",
+    "score", "__version__",
+]
 
 
 def run(scene: Scene, **options) -> Run:
@@ -33,3 +39,16 @@ def run(scene: Scene, **options) -> Run:
     ``report`` (run.json's content), ``misregistration`` and ``missing`` (driver-view maps).
     """
     return _run(scene, **options)
+
+
+def score(capture: Capture, map=None, display_image=None, filter: str = "bilinear", band: int = 5) -> Run:
+    """Measures a method's display as ``seethru score`` does, without files.
+
+    ``map``: (display height, display width, 2), per display pixel the frontal pixel it shows
+    ([..., 0] = x, [..., 1] = y, OpenCV's ``remap`` convention; NaN shows nothing).
+    ``display_image``: (display height, display width, 3) linear RGB shown instead of the
+    map's colours (alone: image metrics only). Any float array (or torch tensor via
+    ``.numpy()``); it is read as float32. Returns a :class:`Run` like :func:`run`.
+    """
+    as_f32 = lambda a: None if a is None else _np.ascontiguousarray(a, dtype=_np.float32)
+    return _score(capture, as_f32(map), as_f32(display_image), filter, band)

@@ -134,3 +134,30 @@ def ratio(setup: Literal["occlusion", "foreshortening"], **options: Any) -> dict
 def analyze(**options: float) -> dict[str, Any]:
     """`seethru analyze --json`'s claims, evaluation and error_budget_das (not lens_and_eyes):
     d1, d2, bh, width, theta_f, frontal_px, L, b1, l, gamma, tolerance."""
+
+class Capture:
+    """What a see-through system's algorithm receives (`seethru capture`), in memory."""
+
+    frontal: Frame
+    back: Frame
+    inverse_depth: npt.NDArray[np.float32] | None
+    """The depth sensor's inverse depth, 1/m (0: no return); with depth=True only."""
+    head: dict[str, Any]
+    """The head tracker's output: source, eye_world_m, eye_obstacle_m, detection."""
+    calibration: dict[str, Any]
+    """calibration.json's content (OpenCV's conventions)."""
+    fingerprint: str
+    display_resolution: tuple[int, int]
+    """(width, height) display pixels: a map is (height, width, 2)."""
+
+def capture(scene: Scene, depth: bool = False, **options: Any) -> Capture:
+    """`seethru capture` in memory, with `seethru run`'s keywords."""
+
+def score(
+    capture: Capture,
+    map: npt.ArrayLike | None = None,
+    display_image: npt.ArrayLike | None = None,
+    filter: str = "bilinear",
+    band: int = 5,
+) -> Run:
+    """`seethru score`: a method's display map (h, w, 2) and/or image (h, w, 3) measured."""

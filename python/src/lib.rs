@@ -2,6 +2,7 @@
 //! and runs of the library, with every buffer handed to numpy without a copy; the pure-Python
 //! part (`python/seethru/__init__.py`) re-exports it with the documentation.
 
+mod capture;
 mod errors;
 mod frame;
 mod interrupt;
@@ -17,6 +18,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PyScene>()?;
     m.add_class::<frame::PyFrame>()?;
     m.add_class::<run::PyRun>()?;
+    m.add_class::<capture::PyCapture>()?;
+    m.add_function(wrap_pyfunction!(capture::capture, m)?)?;
+    m.add_function(wrap_pyfunction!(capture::score, m)?)?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
     m.add_function(wrap_pyfunction!(frame::read_frame, m)?)?;
     m.add_function(wrap_pyfunction!(measures::compare, m)?)?;

@@ -2,15 +2,16 @@
 //! views, the metrics (metrics.json's content), the misregistration map and run.json's
 //! content returned instead of written.
 
-use std::collections::HashMap;
-
 use numpy::ndarray::Array2;
 use numpy::{PyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use seethru::measure::holes::attach_holes;
-use seethru::measure::metrics::measure;
+use seethru::measure::metrics::{MetricMaps, measure};
+use seethru::render::integrator::RenderContext;
 use seethru::system::memory::{check_memory, run_estimate};
+use seethru::system::options::RunOptions;
+use seethru::system::pipeline::RunResult;
 use seethru::system::pipeline::run as run_pipeline;
 
 use crate::errors::to_py;
@@ -71,55 +72,73 @@ pub fn run(
     check_memory(&estimate, choices.max_memory).map_err(to_py)?;
     let (context, result, maps, metrics) = detached(py, move || -> anyhow::Result<_> {
         let ctx = context_for(cached, the_scene)?;
-        let options = &choices.options;
-        let result = run_pipeline(&ctx, options)?;
-        let eye = options.eyes.view_camera(&ctx.scene.driver).position();
-        let frames = [&result.truth, &result.seethru, &result.occluded];
-        let (maps, mut metrics) = measure(&ctx, &ctx.scene, eye, frames, choices.band);
-        attach_holes(
-            &mut metrics,
-            &maps,
-            &result,
-            &ctx.scene.obstacle,
-            options.scene_model.fill,
-        );
+        let result = run_pipeline(&ctx, &choices.options)?;
+        let (maps, metrics) = measured(&ctx, &choices.options, &result, choices.band);
         Ok((ctx, result, maps, metrics))
     })?
     .map_err(to_py)?;
     scene.borrow_mut().context = Some(context);
-    let (w, h) = (maps.width as usize, maps.height as usize);
-    let misregistration = PyArray::from_owned_array(
-        py,
-        Array2::from_shape_vec((h, w), maps.misregistration).expect("a map's size"),
-    )
-    .unbind();
-    let missing = PyArray::from_owned_array(
-        py,
-        Array2::from_shape_vec((h, w), maps.missing).expect("a map's size"),
-    )
-    .unbind();
-    let report = json_to_py(py, &result.report)?;
-    let metrics = json_to_py(py, &metrics)?;
-    let mut frames = HashMap::new();
-    for (name, frame) in [
-        ("truth", result.truth),
-        ("occluded", result.occluded),
-        ("frontal", result.frontal),
-        ("back", result.back),
-        ("display", result.display),
-        ("seethru", result.seethru),
-    ] {
-        frames.insert(name, PyFrame::new(py, name, frame));
+    PyRun::new(py, result, maps, &metrics)
+}
+
+/// The maps and metrics.json of a run, as `seethru run` measures them.
+pub fn measured(
+    ctx: &RenderContext,
+    options: &RunOptions,
+    result: &RunResult,
+    band: u32,
+) -> (MetricMaps, serde_json::Value) {
+    let eye = options.eyes.view_camera(&ctx.scene.driver).position();
+    let frames = [&result.truth, &result.seethru, &result.occluded];
+    let (maps, mut metrics) = measure(ctx, &ctx.scene, eye, frames, band);
+    attach_holes(
+        &mut metrics,
+        &maps,
+        result,
+        &ctx.scene.obstacle,
+        options.scene_model.fill,
+    );
+    (maps, metrics)
+}
+
+impl PyRun {
+    /// A run's frames, maps, metrics and report handed to Python.
+    pub fn new(
+        py: Python<'_>,
+        result: RunResult,
+        maps: MetricMaps,
+        metrics: &serde_json::Value,
+    ) -> PyResult<PyRun> {
+        let (w, h) = (maps.width as usize, maps.height as usize);
+        let misregistration = PyArray::from_owned_array(
+            py,
+            Array2::from_shape_vec((h, w), maps.misregistration).expect("a map's size"),
+        )
+        .unbind();
+        let missing = PyArray::from_owned_array(
+            py,
+            Array2::from_shape_vec((h, w), maps.missing).expect("a map's size"),
+        )
+        .unbind();
+        let report = json_to_py(py, &result.report)?;
+        let metrics = json_to_py(py, metrics)?;
+        let dict = PyDict::new(py);
+        for (name, frame) in [
+            ("truth", result.truth),
+            ("occluded", result.occluded),
+            ("frontal", result.frontal),
+            ("back", result.back),
+            ("display", result.display),
+            ("seethru", result.seethru),
+        ] {
+            dict.set_item(name, PyFrame::new(py, name, frame))?;
+        }
+        Ok(PyRun {
+            frames: dict.unbind(),
+            metrics,
+            report,
+            misregistration,
+            missing,
+        })
     }
-    let dict = PyDict::new(py);
-    for name in ["truth", "occluded", "frontal", "back", "display", "seethru"] {
-        dict.set_item(name, frames.remove(name).expect("each view once"))?;
-    }
-    Ok(PyRun {
-        frames: dict.unbind(),
-        metrics,
-        report,
-        misregistration,
-        missing,
-    })
 }

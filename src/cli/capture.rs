@@ -150,10 +150,10 @@ impl CaptureArgs {
                 captured.frontal.height,
                 captured.back.width,
                 captured.back.height,
-                captured
-                    .depth
-                    .as_ref()
-                    .map_or(String::new(), |d| format!(", depth {}×{}", d.camera.width, d.camera.height)),
+                captured.depth.as_ref().map_or(String::new(), |d| format!(
+                    ", depth {}×{}",
+                    d.camera.width, d.camera.height
+                )),
                 self.out.join("truth").display()
             ));
             Ok(())
@@ -238,7 +238,10 @@ pub fn write_capture(out: &Path, c: &Capture, command: &serde_json::Value) -> Re
             "note": "a method must not read this folder",
         }))?,
     )?;
-    write_text(&truth.join(COMMAND_FILE), &serde_json::to_string_pretty(command)?)?;
+    write_text(
+        &truth.join(COMMAND_FILE),
+        &serde_json::to_string_pretty(command)?,
+    )?;
     // Last: a folder with capture.json holds a finished capture.
     write_text(
         &out.join("capture.json"),

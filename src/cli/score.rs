@@ -197,17 +197,25 @@ impl Score {
         let misregistration = match scored.has_map {
             true => format!(
                 "misregistration mean {:.3} arcmin (p95 {:.3}) over {} pixels",
-                d["misregistration_arcmin"]["mean"].as_f64().unwrap_or(f64::NAN),
-                d["misregistration_arcmin"]["p95"].as_f64().unwrap_or(f64::NAN),
+                d["misregistration_arcmin"]["mean"]
+                    .as_f64()
+                    .unwrap_or(f64::NAN),
+                d["misregistration_arcmin"]["p95"]
+                    .as_f64()
+                    .unwrap_or(f64::NAN),
                 d["misregistration_arcmin"]["count"]
             ),
             false => "misregistration needs a map (image only)".to_string(),
         };
         seethru::util::progress::summary(format!(
             "scored {}: {misregistration}, coverage {:.2} %, border mean {:.3} arcmin, PSNR {:.2} dB, SSIM {:.4}; wrote {}",
-            name(&self.map).or(name(&self.display_image)).unwrap_or_default(),
+            name(&self.map)
+                .or(name(&self.display_image))
+                .unwrap_or_default(),
             100.0 * metrics["coverage"].as_f64().unwrap_or(f64::NAN),
-            metrics["border"]["misregistration_arcmin"]["mean"].as_f64().unwrap_or(f64::NAN),
+            metrics["border"]["misregistration_arcmin"]["mean"]
+                .as_f64()
+                .unwrap_or(f64::NAN),
             d["psnr_db"].as_f64().unwrap_or(f64::NAN),
             d["ssim"].as_f64().unwrap_or(f64::NAN),
             self.out.display()

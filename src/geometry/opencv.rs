@@ -40,7 +40,11 @@ pub fn rows_4x4(t: DAffine3) -> [[f64; 4]; 4] {
 /// A 3×3 row-major matrix.
 pub fn rows_3x3(m: DMat3) -> [[f64; 3]; 3] {
     let t = m.transpose();
-    [t.x_axis.to_array(), t.y_axis.to_array(), t.z_axis.to_array()]
+    [
+        t.x_axis.to_array(),
+        t.y_axis.to_array(),
+        t.z_axis.to_array(),
+    ]
 }
 
 /// OpenCV's Rodrigues vector of a rotation: its axis times its angle, radians.

@@ -64,8 +64,8 @@ fn sidecar_fingerprint(path: &Path) -> Result<Option<String>> {
     }
     let text = String::from_utf8(read_bytes(&sidecar)?)
         .with_context(|| format!("{}: not UTF-8 text", sidecar.display()))?;
-    let value: serde_json::Value = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not JSON", sidecar.display()))?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", sidecar.display()))?;
     match value.get("capture_fingerprint") {
         Some(serde_json::Value::String(s)) => Ok(Some(s.clone())),
         Some(other) => bail!(
@@ -197,7 +197,11 @@ fn read_exr_map(path: &Path) -> Result<MapFile> {
     let header = meta.headers.first().context("the EXR has no layer")?;
     let size = header.layer_size;
     if (size.width() as u64) * (size.height() as u64) > MAX_MAP_PIXELS {
-        bail!("the map is {}×{} pixels: at most {MAX_MAP_PIXELS}", size.width(), size.height());
+        bail!(
+            "the map is {}×{} pixels: at most {MAX_MAP_PIXELS}",
+            size.width(),
+            size.height()
+        );
     }
     let image = read()
         .no_deep_data()
@@ -222,7 +226,9 @@ fn read_exr_map(path: &Path) -> Result<MapFile> {
             .iter()
             .find(|c| c.name.to_string() == name)
             .with_context(|| {
-                format!("no channel `{name}`: a map EXR has channels x and y, this one has {names:?}")
+                format!(
+                    "no channel `{name}`: a map EXR has channels x and y, this one has {names:?}"
+                )
             })?;
         match &c.sample_data {
             FlatSamples::F32(v) => Ok(v.clone()),
@@ -302,7 +308,9 @@ pub fn read_display_image(path: &Path) -> Result<ImageFile> {
                 .to_rgb8();
             let color = image
                 .pixels()
-                .map(|p| p.0.map(|c| crate::util::color::srgb_to_linear(c as f32 / 255.0)))
+                .map(|p| {
+                    p.0.map(|c| crate::util::color::srgb_to_linear(c as f32 / 255.0))
+                })
                 .collect();
             Ok(ImageFile {
                 width: image.width(),
@@ -360,7 +368,8 @@ mod tests {
     #[test]
     fn c_and_fortran_order_and_both_widths_read_alike() {
         let (h, w) = (2usize, 3usize);
-        let value = |j: usize, i: usize, c: usize| (10 * (if c == 0 { i } else { j }) + 1 + c) as f64;
+        let value =
+            |j: usize, i: usize, c: usize| (10 * (if c == 0 { i } else { j }) + 1 + c) as f64;
         let mut c32 = Vec::new();
         let mut f64s = Vec::new();
         for j in 0..h {

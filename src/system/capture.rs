@@ -100,7 +100,9 @@ pub fn capture(ctx: &RenderContext, options: &RunOptions, with_depth: bool) -> R
     if let Some(d) = &depth {
         let mut sensor = camera_json(&d.camera);
         sensor["model"] = json!(d.model);
-        sensor["note"] = json!("the depth sensor shares the calibrated frontal camera's pose and field of view at its own resolution");
+        sensor["note"] = json!(
+            "the depth sensor shares the calibrated frontal camera's pose and field of view at its own resolution"
+        );
         calibration["depth_sensor"] = sensor;
     }
     let head = HeadEstimate {
@@ -236,7 +238,10 @@ pub fn check_display_input(
             );
         }
         if i.color.len() != (dw * dh) as usize {
-            bail!("the display image has {} pixels, {dw}×{dh} expected", i.color.len());
+            bail!(
+                "the display image has {} pixels, {dw}×{dh} expected",
+                i.color.len()
+            );
         }
     }
     Ok(())
@@ -256,15 +261,15 @@ pub fn display_from(
     let [dw, dh] = display_size;
     let n = (dw * dh) as usize;
     let mut pixels: Vec<Pixel> = match map {
-        Some(m) => m
-            .xy
-            .par_iter()
-            .map(|&[x, y]| {
-                // OpenCV's pixel centres are at integers; seethru's at +0.5.
-                let p = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
-                sample(frontal, p, options.filter)
-            })
-            .collect(),
+        Some(m) => {
+            m.xy.par_iter()
+                .map(|&[x, y]| {
+                    // OpenCV's pixel centres are at integers; seethru's at +0.5.
+                    let p = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                    sample(frontal, p, options.filter)
+                })
+                .collect()
+        }
         None => vec![
             Pixel {
                 normal: Vec3::ZERO,
