@@ -38,12 +38,12 @@ def main() -> None:
             except ValueError as e:  # an eye the system cannot serve (e.g. behind the display)
                 print(f"dx={dx:+.3f} m dy={dy:+.3f} m: {e}")
                 continue
-            m = result.misregistration
-            finite = np.isfinite(m)
-            mean[j, i] = float(m[finite].mean()) if finite.any() else np.nan
+            d = result.metrics["display"]["misregistration_arcmin"]
+            mean[j, i] = d["mean"] if d["mean"] is not None else np.nan
             print(
                 f"dx={dx:+.3f} m dy={dy:+.3f} m: mean misregistration {mean[j, i]:.2f} arcmin "
-                f"over {int(finite.sum())} pixels ({int((~finite & ~np.isnan(m)).sum())} excluded)"
+                f"over {d['count']} of {result.metrics['display_pixels']} display pixels "
+                f"({result.metrics['blank_pixels']} blank, {result.metrics['undefined_pixels']} undefined)"
             )
     try:
         import matplotlib
