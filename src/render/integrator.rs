@@ -230,6 +230,10 @@ impl RenderContext {
             .into_par_iter()
             .map_init(Stack::new, |stack, mut band| {
                 let mut shadows = 0;
+                // A cancelled render (render/cancel.rs) leaves its remaining bands as they are.
+                if crate::render::cancel::requested() {
+                    return shadows;
+                }
                 for row in 0..band.len() {
                     let y = band.y + row;
                     if y < region.y0 || y >= region.y1 {

@@ -5,6 +5,7 @@ pub mod accel;
 pub mod bvh;
 pub mod bvh_build;
 pub mod camera_rays;
+pub mod cancel;
 pub mod footprint;
 pub mod frame;
 pub mod integrator;

@@ -1,0 +1,54 @@
+"""seethru from Python: scenes, renders and see-through runs as numpy arrays.
+
+The package wraps the same library as the ``seethru`` command line: a scene read by
+:meth:`Scene.load` renders the same pixels as ``seethru render`` and a :func:`run` computes the
+same metrics as ``seethru run`` (bit for bit, for the same scene and options), without files
+in between. Rendering releases the GIL and runs on the library's thread pool (all cores, or
+``RAYON_NUM_THREADS``); Ctrl-C stops a long render between bands of rows.
+
+Errors raise :class:`ValueError` (bad input: a scene key, an option's range) or
+:class:`OSError` (a file that cannot be read) with the command line's one-line message.
+"""
+
+from ._native import Capture, Frame, Run, Scene, __version__, analyze, capture, compare, ratio, read_frame
+from ._native import run as _run
+from ._native import score as _score
+
+import numpy as _np
+
+__all__ = [
+    "Capture", "Frame", "Run", "Scene", "analyze", "capture", "compare", "ratio", "read_frame", "run",
+    "score", "__version__",
+]
+
+
+def run(scene: Scene, **options) -> Run:
+    """Runs the see-through system on ``scene``, as ``seethru run`` does.
+
+    The keywords are ``seethru run``'s flags with ``_`` for ``-`` and the same defaults and
+    ranges: ``method`` ("none", "planar", "ground", "plane-fit", "depth"), ``d2`` (a float in
+    metres, ``float("inf")``, "inf" or "auto"), ``head`` ("oracle", "estimated"),
+    ``head_bias_cm`` (x, y, z), ``head_jitter_cm``, ``seed``, ``feature_width``, ``outside``
+    ("error", "black"), ``filter``, ``display`` ("pixels", "ideal"), ``frontal_width``,
+    ``back_width``, ``eyes`` ("mono", "left", "right"), ``ipd``, ``target_eye``, ``band``,
+    ``depth_sensor``, ``depth_resolution``, ``depth_range``, ``depth_noise``,
+    ``depth_quantum``, ``fill``, ``width``, ``height``, ``spp`` (default 4) and
+    ``max_memory`` (GiB). An unknown keyword, or one the method would ignore, is refused.
+
+    Returns a :class:`Run`: ``frames`` (the six views), ``metrics`` (metrics.json's content),
+    ``report`` (run.json's content), ``misregistration`` and ``missing`` (driver-view maps).
+    """
+    return _run(scene, **options)
+
+
+def score(capture: Capture, map=None, display_image=None, filter: str = "bilinear", band: int = 5) -> Run:
+    """Measures a method's display as ``seethru score`` does, without files.
+
+    ``map``: (display height, display width, 2), per display pixel the frontal pixel it shows
+    ([..., 0] = x, [..., 1] = y, OpenCV's ``remap`` convention; NaN shows nothing).
+    ``display_image``: (display height, display width, 3) linear RGB shown instead of the
+    map's colours (alone: image metrics only). Any float array (or torch tensor via
+    ``.numpy()``); it is read as float32. Returns a :class:`Run` like :func:`run`.
+    """
+    as_f32 = lambda a: None if a is None else _np.ascontiguousarray(a, dtype=_np.float32)
+    return _score(capture, as_f32(map), as_f32(display_image), filter, band)

@@ -1,0 +1,163 @@
+"""Type stubs of the seethru package (the Rust extension seethru._native)."""
+
+from os import PathLike
+from typing import Any, Literal
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+View = Literal["truth", "occluded", "frontal", "back"]
+Pose = npt.NDArray[np.float64]  # (4, 4) world_from_X, rows [R | t], last row [0, 0, 0, 1]
+
+class Frame:
+    """One rendered view, row 0 at the top; every array owns the Rust buffer (no copy)."""
+
+    view: str
+    width: int
+    height: int
+    colour: npt.NDArray[np.float32]
+    """Linear RGB radiance, (height, width, 3) float32 (EXR R, G, B)."""
+    depth: npt.NDArray[np.float32]
+    """Distance along the pixel-centre ray, metres, +inf for sky; (height, width) float32."""
+    camera_z: npt.NDArray[np.float32]
+    """Depth along the camera's viewing axis, metres, +inf for sky; (height, width) float32."""
+    position: npt.NDArray[np.float32]
+    """World position of the visible point, metres, NaN for sky; (height, width, 3) float32."""
+    normal: npt.NDArray[np.float32]
+    """Unit world normal facing the camera (sky: back along the ray); (height, width, 3)."""
+    object_id: npt.NDArray[np.uint32]
+    """Object index in the scene + 1 (obstacle last), 0 for sky; (height, width) uint32."""
+    part_id: npt.NDArray[np.uint32]
+    """Part of the object (box face, cap, mesh group), 0 for sky; (height, width) uint32."""
+    _buffer_addresses: dict[str, int]
+
+class Scene:
+    """A scene file read and validated as by the command line."""
+
+    @staticmethod
+    def load(path: str | PathLike[str]) -> Scene:
+        """Reads a scene (TOML). ValueError: a bad key or value; OSError: unreadable file."""
+    def copy(self) -> Scene:
+        """An independent copy sharing the built world while the geometry is the same."""
+    @property
+    def path(self) -> str: ...
+    eye: tuple[float, float, float]
+    """The driver's eye, world metres; setting it moves the driver camera (same orientation)."""
+    driver_pose: Pose
+    """world_from_camera of the driver camera (it looks down -z)."""
+    frontal_pose: Pose
+    """world_from_camera of the frontal camera (the compensation keeps [calibration])."""
+    back_pose: Pose
+    """world_from_camera of the back camera (the compensation keeps [calibration])."""
+    obstacle_pose: Pose
+    """world_from_obstacle: display centre at the origin, driver on +z; cameras don't follow."""
+    display_size: tuple[float, float]
+    """Display (width, height), metres, each in [1e-6, 100]."""
+    def resolution(self, view: View) -> tuple[int, int]:
+        """The (width, height) a view renders at without overrides."""
+    def render(
+        self,
+        view: View,
+        width: int | None = None,
+        height: int | None = None,
+        spp: int = 4,
+    ) -> Frame:
+        """Renders a view as `seethru render` does (GIL released; Ctrl-C stops it)."""
+
+class Run:
+    """One run of the see-through system."""
+
+    frames: dict[str, Frame]
+    """truth, occluded, frontal, back, display, seethru."""
+    metrics: dict[str, Any]
+    """metrics.json's content."""
+    report: dict[str, Any]
+    """run.json's content."""
+    misregistration: npt.NDArray[np.float32]
+    """Arcmin per driver-view pixel, NaN outside the display and on blank pixels; (h, w)."""
+    missing: npt.NDArray[np.bool_]
+    """Display pixels whose truth point the frontal camera cannot see; (h, w) bool."""
+
+def run(
+    scene: Scene,
+    *,
+    method: Literal["none", "planar", "ground", "plane-fit", "depth"] = "planar",
+    d2: float | str = "inf",
+    head: Literal["oracle", "estimated"] = "oracle",
+    head_bias_cm: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    head_jitter_cm: float = 0.0,
+    seed: int = 1,
+    feature_width: float = 0.064,
+    outside: Literal["error", "black"] = "error",
+    filter: str = "bilinear",
+    display: Literal["pixels", "ideal"] = "pixels",
+    frontal_width: int | None = None,
+    back_width: int | None = None,
+    eyes: Literal["mono", "left", "right"] = "mono",
+    ipd: float = 0.064,
+    target_eye: Literal["cyclopean", "left", "right"] = "cyclopean",
+    band: int = 5,
+    depth_sensor: Literal["ideal", "tof", "stereo"] = "ideal",
+    depth_resolution: int | None = None,
+    depth_range: float | None = None,
+    depth_noise: float | None = None,
+    depth_quantum: float | None = None,
+    fill: Literal["none", "background", "inpaint"] = "none",
+    width: int | None = None,
+    height: int | None = None,
+    spp: int = 4,
+    max_memory: float = 8.0,
+) -> Run:
+    """Runs the see-through system as `seethru run` does, returning instead of writing."""
+
+def read_frame(path: str | PathLike[str]) -> Frame:
+    """Reads an EXR written by `seethru render`/`run` as a Frame."""
+
+def compare(
+    scene: Scene,
+    methods: list[str] | None = None,
+    **options: Any,
+) -> dict[str, Any]:
+    """`seethru compare`: {"rows": compare.json's rows, "strips": {method: (h, w, 3) uint8}}.
+
+    methods: none, planar-inf, planar-auto, plane-fit, ground, depth-ideal, depth-tof,
+    depth-stereo (default: compare's six). Options: head, seed, frontal_width, back_width,
+    band, depth_*, fill, width, height, spp, max_memory.
+    """
+
+def ratio(setup: Literal["occlusion", "foreshortening"], **options: Any) -> dict[str, Any]:
+    """`seethru ratio SETUP ... --json`: L (occlusion) or l and gamma (degrees,
+    foreshortening), b1, d2, d1, bh (required), model_d2, head_bias_cm, width (1280)."""
+
+def analyze(**options: float) -> dict[str, Any]:
+    """`seethru analyze --json`'s claims, evaluation and error_budget_das (not lens_and_eyes):
+    d1, d2, bh, width, theta_f, frontal_px, L, b1, l, gamma, tolerance."""
+
+class Capture:
+    """What a see-through system's algorithm receives (`seethru capture`), in memory."""
+
+    frontal: Frame
+    back: Frame
+    inverse_depth: npt.NDArray[np.float32] | None
+    """The depth sensor's inverse depth, 1/m (0: no return); with depth=True only."""
+    head: dict[str, Any]
+    """The head tracker's output: source, eye_world_m, eye_obstacle_m, detection."""
+    calibration: dict[str, Any]
+    """calibration.json's content (OpenCV's conventions)."""
+    fingerprint: str
+    display_resolution: tuple[int, int]
+    """(width, height) display pixels: a map is (height, width, 2)."""
+
+def capture(scene: Scene, depth: bool = False, **options: Any) -> Capture:
+    """`seethru capture` in memory, with `seethru run`'s keywords."""
+
+def score(
+    capture: Capture,
+    map: npt.ArrayLike | None = None,
+    display_image: npt.ArrayLike | None = None,
+    filter: str = "bilinear",
+    band: int = 5,
+) -> Run:
+    """`seethru score`: a method's display map (h, w, 2) and/or image (h, w, 3) measured."""

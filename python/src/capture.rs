@@ -1,0 +1,195 @@
+//! `seethru.capture` and `seethru.score`: the "bring your own method" protocol without files.
+//! A capture holds what a real system's algorithm receives (images as arrays, the head
+//! tracker's output and the calibration as dicts); a score shows a method's display map
+//! and/or image on the display and measures it exactly as `seethru score` does.
+
+use std::sync::Arc;
+
+use glam::Vec3;
+use numpy::ndarray::Array2;
+use numpy::{PyArray, PyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use seethru::render::integrator::RenderContext;
+use seethru::system::capture::{
+    Capture, DisplayImage, DisplayMap, capture as capture_views, score as score_display,
+};
+use seethru::system::display::Filter;
+use seethru::system::memory::{check_memory, run_estimate};
+use seethru::system::options::RunOptions;
+
+use crate::errors::{bad_value, to_py};
+use crate::frame::PyFrame;
+use crate::interrupt::detached;
+use crate::options::{choice_of, int_in, run_choices};
+use crate::run::{PyRun, json_to_py, measured};
+use crate::scene::{PyScene, context_for};
+
+/// What a see-through system's algorithm receives; its truth stays inside for `score`.
+#[pyclass(name = "Capture", module = "seethru", frozen)]
+pub struct PyCapture {
+    inner: Arc<Capture>,
+    context: Arc<RenderContext>,
+    options: RunOptions,
+    /// The frontal camera's image (colour is the method's input), a Frame.
+    #[pyo3(get)]
+    frontal: Py<PyFrame>,
+    /// The back camera's image, a Frame.
+    #[pyo3(get)]
+    back: Py<PyFrame>,
+    /// The depth sensor's inverse depth, 1/m (0: no return), (h, w) float32; None unless
+    /// captured with depth=True.
+    #[pyo3(get)]
+    inverse_depth: Option<Py<PyArray2<f32>>>,
+    /// The head tracker's output (head.json's "head").
+    #[pyo3(get)]
+    head: Py<PyAny>,
+    /// calibration.json's content (OpenCV's conventions).
+    #[pyo3(get)]
+    calibration: Py<PyAny>,
+    /// 16 hex digits over the images, head and calibration.
+    #[pyo3(get)]
+    fingerprint: String,
+    /// The display's (width, height) in pixels: a map is (height, width, 2).
+    #[pyo3(get)]
+    display_resolution: (u32, u32),
+}
+
+#[pymethods]
+impl PyCapture {
+    fn __repr__(&self) -> String {
+        format!("<seethru.Capture {}>", self.fingerprint)
+    }
+}
+
+/// Renders what the system receives under `seethru run`'s options (`seethru capture`).
+#[pyfunction]
+#[pyo3(signature = (scene, depth=false, **options))]
+pub fn capture(
+    py: Python<'_>,
+    scene: &Bound<'_, PyScene>,
+    depth: bool,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<PyCapture> {
+    let choices = run_choices(options)?;
+    let (the_scene, cached) = {
+        let s = scene.borrow();
+        (s.scene.clone(), s.context.clone())
+    };
+    let estimate = run_estimate(&the_scene, &choices.options).map_err(to_py)?;
+    check_memory(&estimate, choices.max_memory).map_err(to_py)?;
+    let options = choices.options.clone();
+    let (context, captured) = detached(py, move || -> anyhow::Result<_> {
+        let ctx = context_for(cached, the_scene)?;
+        let captured = capture_views(&ctx, &choices.options, depth)?;
+        Ok((ctx, captured))
+    })?
+    .map_err(to_py)?;
+    scene.borrow_mut().context = Some(context.clone());
+    // Copies: the capture itself is kept whole for `score`.
+    let frontal = Py::new(py, PyFrame::new(py, "frontal", captured.frontal.clone()))?;
+    let back = Py::new(py, PyFrame::new(py, "back", captured.back.clone()))?;
+    let inverse_depth = match &captured.depth {
+        Some(d) => {
+            let (w, h) = (d.camera.width as usize, d.camera.height as usize);
+            let array =
+                Array2::from_shape_vec((h, w), d.inverse_depth.clone()).expect("a depth map");
+            Some(PyArray::from_owned_array(py, array).unbind())
+        }
+        None => None,
+    };
+    let head = serde_json::to_value(&captured.head).map_err(|e| to_py(e.into()))?;
+    let [dw, dh] = context.scene.obstacle.display_resolution;
+    Ok(PyCapture {
+        head: json_to_py(py, &head)?,
+        calibration: json_to_py(py, &captured.calibration)?,
+        fingerprint: captured.fingerprint.clone(),
+        inner: Arc::new(captured),
+        context,
+        options,
+        frontal,
+        back,
+        inverse_depth,
+        display_resolution: (dw, dh),
+    })
+}
+
+/// A (h, w, channels) float32 array's size and values, or why it is not one.
+fn pixels_of(
+    name: &str,
+    array: &PyReadonlyArray3<'_, f32>,
+    channels: usize,
+) -> PyResult<(u32, u32, Vec<f32>)> {
+    let shape = array.shape();
+    if shape[2] != channels {
+        return Err(bad_value(format!(
+            "{name} has shape {shape:?}: (display height, display width, {channels}) is needed"
+        )));
+    }
+    let values = array.as_array().iter().copied().collect();
+    Ok((shape[1] as u32, shape[0] as u32, values))
+}
+
+/// Measures a method's display map (frontal pixel per display pixel, OpenCV's remap
+/// convention, NaN shows nothing) and/or display image (linear RGB) as `seethru score`.
+#[pyfunction]
+#[pyo3(signature = (capture, map=None, display_image=None, filter="bilinear", band=5))]
+pub fn score(
+    py: Python<'_>,
+    capture: &Bound<'_, PyCapture>,
+    map: Option<PyReadonlyArray3<'_, f32>>,
+    display_image: Option<PyReadonlyArray3<'_, f32>>,
+    filter: &str,
+    band: i64,
+) -> PyResult<PyRun> {
+    let filter: Filter = choice_of("filter", filter)?;
+    let band = int_in("band", band, 1, 1000)? as u32;
+    if map.is_none() && display_image.is_none() {
+        return Err(bad_value("score needs map=, display_image= or both"));
+    }
+    if map.is_none() && filter != Filter::Bilinear {
+        return Err(bad_value(
+            "filter resamples the frontal image at the map's points: it needs map=",
+        ));
+    }
+    let map = map
+        .map(|m| {
+            pixels_of("map", &m, 2).map(|(width, height, v)| DisplayMap {
+                width,
+                height,
+                xy: v.chunks_exact(2).map(|p| [p[0], p[1]]).collect(),
+                fingerprint: None,
+            })
+        })
+        .transpose()?;
+    let image = display_image
+        .map(|i| {
+            pixels_of("display_image", &i, 3).map(|(width, height, v)| DisplayImage {
+                width,
+                height,
+                color: v
+                    .chunks_exact(3)
+                    .map(|c| Vec3::new(c[0], c[1], c[2]))
+                    .collect(),
+            })
+        })
+        .transpose()?;
+    let c = capture.get();
+    let (inner, context) = (c.inner.clone(), c.context.clone());
+    let mut options = c.options.clone();
+    options.filter = filter;
+    let (result, maps, metrics) = detached(py, move || -> anyhow::Result<_> {
+        let scored = score_display(&context, &options, &inner, map.as_ref(), image.as_ref())?;
+        let (maps, mut metrics) = measured(&context, &options, &scored.run, band);
+        // As `seethru score` adds them.
+        metrics["external_method"] = scored.run.report["external_method"].clone();
+        if !scored.has_map {
+            metrics["misregistration_needs_a_map"] = serde_json::json!(
+                "the display image alone carries no geometry: misregistration is undefined on every display pixel (counted in undefined_pixels); give --map for it"
+            );
+        }
+        Ok((scored.run, maps, metrics))
+    })?
+    .map_err(to_py)?;
+    PyRun::new(py, result, maps, &metrics)
+}

@@ -1,0 +1,31 @@
+//! `seethru._native`: the Python extension module of the `seethru` package. Scenes, renders
+//! and runs of the library, with every buffer handed to numpy without a copy; the pure-Python
+//! part (`python/seethru/__init__.py`) re-exports it with the documentation.
+
+mod capture;
+mod errors;
+mod frame;
+mod interrupt;
+mod measures;
+mod options;
+mod run;
+mod scene;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<scene::PyScene>()?;
+    m.add_class::<frame::PyFrame>()?;
+    m.add_class::<run::PyRun>()?;
+    m.add_class::<capture::PyCapture>()?;
+    m.add_function(wrap_pyfunction!(capture::capture, m)?)?;
+    m.add_function(wrap_pyfunction!(capture::score, m)?)?;
+    m.add_function(wrap_pyfunction!(run::run, m)?)?;
+    m.add_function(wrap_pyfunction!(frame::read_frame, m)?)?;
+    m.add_function(wrap_pyfunction!(measures::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(measures::ratio, m)?)?;
+    m.add_function(wrap_pyfunction!(measures::analyze, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,144 @@
+//! `seethru.run`: the see-through system end to end, as `seethru run` computes it, with the
+//! views, the metrics (metrics.json's content), the misregistration map and run.json's
+//! content returned instead of written.
+
+use numpy::ndarray::Array2;
+use numpy::{PyArray, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use seethru::measure::holes::attach_holes;
+use seethru::measure::metrics::{MetricMaps, measure};
+use seethru::render::integrator::RenderContext;
+use seethru::system::memory::{check_memory, run_estimate};
+use seethru::system::options::RunOptions;
+use seethru::system::pipeline::RunResult;
+use seethru::system::pipeline::run as run_pipeline;
+
+use crate::errors::to_py;
+use crate::frame::PyFrame;
+use crate::interrupt::detached;
+use crate::options::run_choices;
+use crate::scene::{PyScene, context_for};
+
+/// What one run gives: its six views, its metrics and its report.
+#[pyclass(name = "Run", module = "seethru", frozen)]
+pub struct PyRun {
+    /// truth, occluded, frontal, back, display, seethru → Frame.
+    #[pyo3(get)]
+    frames: Py<PyDict>,
+    /// metrics.json's content.
+    #[pyo3(get)]
+    metrics: Py<PyAny>,
+    /// run.json's content.
+    #[pyo3(get)]
+    report: Py<PyAny>,
+    /// Misregistration per driver-view pixel, arcmin; NaN outside the display and on blank
+    /// pixels; (height, width) float32 (misregistration.exr's Y).
+    #[pyo3(get)]
+    misregistration: Py<PyArray2<f32>>,
+    /// Driver-view pixels of the display that show nothing of the scene; (height, width) bool.
+    #[pyo3(get)]
+    missing: Py<PyArray2<bool>>,
+}
+
+#[pymethods]
+impl PyRun {
+    fn __repr__(&self) -> String {
+        "<seethru.Run: frames, metrics, report, misregistration, missing>".to_string()
+    }
+}
+
+/// JSON as Python objects, through `json.loads` of the text the command line writes: the
+/// same dict as reading the file.
+pub fn json_to_py(py: Python<'_>, value: &serde_json::Value) -> PyResult<Py<PyAny>> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| to_py(e.into()))?;
+    Ok(py.import("json")?.call_method1("loads", (text,))?.unbind())
+}
+
+/// Runs the see-through system on `scene` with `seethru run`'s options as keywords.
+#[pyfunction]
+#[pyo3(signature = (scene, **options))]
+pub fn run(
+    py: Python<'_>,
+    scene: &Bound<'_, PyScene>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<PyRun> {
+    let choices = run_choices(options)?;
+    let (the_scene, cached) = {
+        let s = scene.borrow();
+        (s.scene.clone(), s.context.clone())
+    };
+    let estimate = run_estimate(&the_scene, &choices.options).map_err(to_py)?;
+    check_memory(&estimate, choices.max_memory).map_err(to_py)?;
+    let (context, result, maps, metrics) = detached(py, move || -> anyhow::Result<_> {
+        let ctx = context_for(cached, the_scene)?;
+        let result = run_pipeline(&ctx, &choices.options)?;
+        let (maps, metrics) = measured(&ctx, &choices.options, &result, choices.band);
+        Ok((ctx, result, maps, metrics))
+    })?
+    .map_err(to_py)?;
+    scene.borrow_mut().context = Some(context);
+    PyRun::new(py, result, maps, &metrics)
+}
+
+/// The maps and metrics.json of a run, as `seethru run` measures them.
+pub fn measured(
+    ctx: &RenderContext,
+    options: &RunOptions,
+    result: &RunResult,
+    band: u32,
+) -> (MetricMaps, serde_json::Value) {
+    let eye = options.eyes.view_camera(&ctx.scene.driver).position();
+    let frames = [&result.truth, &result.seethru, &result.occluded];
+    let (maps, mut metrics) = measure(ctx, &ctx.scene, eye, frames, band);
+    attach_holes(
+        &mut metrics,
+        &maps,
+        result,
+        &ctx.scene.obstacle,
+        options.scene_model.fill,
+    );
+    (maps, metrics)
+}
+
+impl PyRun {
+    /// A run's frames, maps, metrics and report handed to Python.
+    pub fn new(
+        py: Python<'_>,
+        result: RunResult,
+        maps: MetricMaps,
+        metrics: &serde_json::Value,
+    ) -> PyResult<PyRun> {
+        let (w, h) = (maps.width as usize, maps.height as usize);
+        let misregistration = PyArray::from_owned_array(
+            py,
+            Array2::from_shape_vec((h, w), maps.misregistration).expect("a map's size"),
+        )
+        .unbind();
+        let missing = PyArray::from_owned_array(
+            py,
+            Array2::from_shape_vec((h, w), maps.missing).expect("a map's size"),
+        )
+        .unbind();
+        let report = json_to_py(py, &result.report)?;
+        let metrics = json_to_py(py, metrics)?;
+        let dict = PyDict::new(py);
+        for (name, frame) in [
+            ("truth", result.truth),
+            ("occluded", result.occluded),
+            ("frontal", result.frontal),
+            ("back", result.back),
+            ("display", result.display),
+            ("seethru", result.seethru),
+        ] {
+            dict.set_item(name, PyFrame::new(py, name, frame))?;
+        }
+        Ok(PyRun {
+            frames: dict.unbind(),
+            metrics,
+            report,
+            misregistration,
+            missing,
+        })
+    }
+}

@@ -1,0 +1,58 @@
+"""seethru.capture and seethru.score: a built-in method's own map scores as run measures it."""
+
+import pathlib
+import sys
+
+import numpy as np
+import pytest
+
+import seethru
+from conftest import REPO, SCENE
+
+sys.path.insert(0, str(REPO / "examples" / "python"))
+from planar_method import planar_map  # noqa: E402  (the numpy planar crop of examples/)
+
+SIZES = dict(width=160, frontal_width=320, back_width=160, spp=1)
+
+
+def test_the_numpy_planar_map_scores_as_run_planar():
+    scene = seethru.Scene.load(SCENE)
+    cap = seethru.capture(scene, **SIZES)
+    w, h = cap.display_resolution
+    assert cap.frontal.colour.shape == (cap.frontal.height, cap.frontal.width, 3)
+    assert cap.calibration["display"]["resolution_px"] == [w, h]
+    m = planar_map(cap.calibration, {"head": cap.head})
+    assert m.shape == (h, w, 2)
+    scored = seethru.score(cap, map=m)
+    builtin = seethru.run(scene, method="planar", **SIZES)
+    # Same truth and driver views; the same pixels counted.
+    for view in ("truth", "occluded"):
+        assert np.array_equal(scored.frames[view].colour, builtin.frames[view].colour)
+    for key in ("display_pixels", "blank_pixels", "undefined_pixels"):
+        assert scored.metrics[key] == builtin.metrics[key], key
+    assert scored.metrics["external_method"]["display_from"] == "map"
+    # Misregistration per pixel: equal but where float32 rounding of the map crosses a
+    # frontal pixel edge (a neighbour shown instead, at most one diagonal pixel away).
+    fx = cap.calibration["frontal"]["K"][0][0]
+    quantum = np.degrees(np.arctan(np.sqrt(2) / fx)) * 60
+    a, b = scored.misregistration, builtin.misregistration
+    both = np.isfinite(a) | np.isfinite(b)
+    assert both.sum() > 100
+    differ = both & (a != b)
+    assert differ.sum() * 20 <= both.sum()
+    assert np.all(np.abs(a[both] - b[both]) <= quantum)
+
+
+def test_a_shifted_map_is_worse_and_a_bad_map_is_refused():
+    scene = seethru.Scene.load(SCENE)
+    cap = seethru.capture(scene, **SIZES)
+    m = planar_map(cap.calibration, {"head": cap.head})
+    good = seethru.score(cap, map=m).metrics["display"]["misregistration_arcmin"]["mean"]
+    shifted = m.copy()
+    shifted[..., 0] += 8.0  # eight frontal pixels to the right
+    worse = seethru.score(cap, map=shifted).metrics["display"]["misregistration_arcmin"]["mean"]
+    assert worse > good + 1.0
+    with pytest.raises(ValueError, match=r"the map is \d+×\d+ display pixels"):
+        seethru.score(cap, map=m[:-1])
+    with pytest.raises(ValueError, match="score needs map=, display_image= or both"):
+        seethru.score(cap)
