@@ -16,3 +16,4 @@ pub mod scene_model;
 pub mod scene_model_options;
 pub mod scene_plane;
 pub mod sequence;
+pub mod surface_map;
