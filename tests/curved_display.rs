@@ -246,3 +246,135 @@ vt 0 1\nvt 1 1\nvt 1 0\nvt 0 0\nf 1/1 4/4 3/3\nf 1/1 3/2 2/4\n",
     );
     one_error(d, &with("display_shape = \"mesh\""), &["display_mesh"]);
 }
+
+#[test]
+fn the_obstruction_angle_of_a_plate_is_2_atan_w_over_2d() {
+    let (w, d, ipd) = (0.1, 0.7, 0.064);
+    let text = common::WallScene {
+        eye: [0.0, 0.0, d],
+        ..common::WallScene::default()
+    }
+    .text()
+    .replace("width = 0.3", &format!("width = {w}"));
+    let ctx = context(&text);
+    let o = seethru::system::obstruction::obstruction(&ctx, DVec3::new(0.0, 0.0, d), ipd);
+    let mono = 2.0 * (w / (2.0 * d)).atan().to_degrees();
+    // Both eyes are blocked only where the plate hides the direction from each.
+    let bino = 2.0 * ((w - ipd) / (2.0 * d)).atan().to_degrees();
+    let step = seethru::system::obstruction::STEP_DEG;
+    assert!(
+        (o.monocular_without_display - mono).abs() <= 2.0 * step,
+        "{o:?} vs {mono}"
+    );
+    assert!(
+        (o.binocular_without_display - bino).abs() <= 2.0 * step,
+        "{o:?} vs {bino}"
+    );
+    // Seen head-on the display is the whole face: nothing of the body is left.
+    assert!(o.monocular_with_display <= 2.0 * step, "{o:?}");
+    assert!(o.binocular_with_display <= 2.0 * step, "{o:?}");
+}
+
+fn scratch_wall(text: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let street = common::repo_path("assets/street.png");
+    let text = text.replace("../assets/street.png", &street.display().to_string());
+    std::fs::write(dir.path().join("scene.toml"), text).unwrap();
+    dir
+}
+
+#[test]
+fn a_display_the_driver_sees_a_sliver_of_is_reported_and_warned_about() {
+    let run_json = |text: &str| {
+        let dir = scratch_wall(text);
+        let (ok, _, stderr) = common::seethru_in(
+            dir.path(),
+            &["run", "scene.toml", "--out", "o", "--d2", "6"],
+        );
+        assert!(ok, "{stderr}");
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join("o/run.json")).unwrap())
+                .unwrap();
+        (json["display_seen"].clone(), stderr)
+    };
+    let eye = "position = [0.0, 0.0, 0.7]";
+    let base = wall("", 6.0).replace("position = [0.08, 0.03, 0.7]", eye);
+    let (seen, stderr) = run_json(&base);
+    assert_eq!(seen["display_pixels"], 150 * 100);
+    assert_eq!(seen["seen_by_driver"], 150 * 100, "{seen}");
+    assert!(
+        !stderr.contains("warning: the driver sees only"),
+        "{stderr}"
+    );
+    // Turned 31° left with a 20° half angle: the view's right edge 11° left of the eye's axis
+    // leaves x ≤ 0.7 tan(−11°) = −0.136 m of the display's [−0.15, 0.15] m: 4.7 %.
+    let turned = base.replace(
+        "look_at = [0.0, 0.0, -6.0]",
+        "look_at = [-3.09, 0.0, -4.44]",
+    );
+    let (seen, stderr) = run_json(&turned);
+    let share = seen["share"].as_f64().unwrap();
+    assert!((share - 0.047).abs() < 0.01, "{seen}");
+    assert!(stderr.contains("warning: the driver sees only"), "{stderr}");
+}
+
+#[test]
+fn the_cabin_runs_compares_and_sequences() {
+    let dir = tempfile::tempdir().unwrap();
+    let cabin = common::repo_path("scenes/cabin.toml");
+    let cabin = cabin.to_str().unwrap();
+    let (ok, _, stderr) = common::seethru_in(
+        dir.path(),
+        &[
+            "run",
+            cabin,
+            "--out",
+            "run",
+            "--width",
+            "240",
+            "--frontal-width",
+            "320",
+        ],
+    );
+    assert!(ok, "{stderr}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("run/run.json")).unwrap())
+            .unwrap();
+    // The pillar blocks degrees of the driver's view; the display gives most of them back.
+    let o = &json["obstruction_deg"];
+    let (without, with) = (
+        o["monocular_without_display"].as_f64().unwrap(),
+        o["monocular_with_display"].as_f64().unwrap(),
+    );
+    assert!(without > 5.0 && with < 0.5 * without, "{o}");
+    let (ok, _, stderr) = common::seethru_in(
+        dir.path(),
+        &[
+            "compare",
+            cabin,
+            "--out",
+            "cmp",
+            "--width",
+            "160",
+            "--methods",
+            "none,planar-inf,ground",
+        ],
+    );
+    assert!(ok, "{stderr}");
+    let (ok, _, stderr) = common::seethru_in(
+        dir.path(),
+        &[
+            "sequence",
+            cabin,
+            "--out",
+            "seq",
+            "--width",
+            "120",
+            "--frontal-width",
+            "200",
+            "--frames",
+            "3",
+        ],
+    );
+    assert!(ok, "{stderr}");
+}

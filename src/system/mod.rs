@@ -9,6 +9,7 @@ pub mod eyes;
 pub mod frontal_map;
 pub mod head;
 pub mod memory;
+pub mod obstruction;
 pub mod options;
 pub mod pipeline;
 pub mod report;

@@ -437,6 +437,9 @@ pub fn run_with_truth(
     report["peak_rss_bytes"] = json!(peak_rss_bytes());
     report["eyes"] = json!({"options": options.eyes, "view_world_m": driver.position().to_array()});
     report["lenses"] = crate::system::frontal_map::lenses_json(scene)?;
+    let seen = crate::system::obstruction::obstruction_json(ctx, &driver, options.eyes.ipd);
+    report["obstruction_deg"] = seen["obstruction_deg"].clone();
+    report["display_seen"] = seen["display_seen"].clone();
     Ok(RunResult {
         truth,
         occluded,
