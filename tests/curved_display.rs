@@ -372,8 +372,10 @@ fn the_cabin_runs_compares_and_sequences() {
             "120",
             "--frontal-width",
             "200",
-            "--frames",
-            "3",
+            "--duration",
+            "0.2",
+            "--fps",
+            "10",
         ],
     );
     assert!(ok, "{stderr}");
