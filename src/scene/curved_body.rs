@@ -9,6 +9,9 @@ use glam::{Vec2, Vec3};
 use crate::scene::display_surface::CurvedSurface;
 use crate::scene::shapes::{Tri, box_face};
 
+/// An edge by its corners' bits, lower first.
+type EdgeKey = ([u32; 3], [u32; 3]);
+
 /// Obstacle-frame triangles of the display (part `POS_Z`) and its body (`NEG_Z` behind,
 /// `POS_X` round the rim).
 pub fn curved_obstacle_tris(surface: &CurvedSurface, thickness: f64) -> Vec<Tri> {
@@ -22,7 +25,7 @@ pub fn curved_obstacle_tris(surface: &CurvedSurface, thickness: f64) -> Vec<Tri>
     let mut out = Vec::with_capacity(4 * surface.tris.len());
     // Edges used by one triangle only are the rim (corners compared bit for bit).
     let key = |p: Vec3| p.to_array().map(f32::to_bits);
-    let mut edges: HashMap<([u32; 3], [u32; 3]), (usize, Vec3, Vec3)> = HashMap::new();
+    let mut edges: HashMap<EdgeKey, (usize, Vec3, Vec3)> = HashMap::new();
     let mut order = Vec::new();
     for t in &surface.tris {
         let p = t.p.map(|p| p.as_vec3());
