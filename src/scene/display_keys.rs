@@ -49,7 +49,16 @@ pub fn read_display_shape(
         }
         _ => {
             let rel = t.required_str("display_mesh")?;
-            let path = crate::scene::read::existing_asset(t, "display_mesh", rel, file)?;
+            let path = file.dir().join(rel);
+            if let Some(why) = crate::util::input_file::not_a_file(&path) {
+                return Err(t.error(
+                    "display_mesh",
+                    format!(
+                        "cannot read `{rel}` (resolved against the scene's folder: {}): {why}",
+                        path.display()
+                    ),
+                ));
+            }
             let mesh = crate::scene::mesh_io::load_mesh(&path)
                 .map_err(|e| t.error("display_mesh", format!("{e:#}")))?;
             if mesh.tris.len() > MAX_DISPLAY_TRIANGLES {

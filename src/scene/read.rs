@@ -155,7 +155,7 @@ fn read_materials(root: &TableReader, file: &SourceFile) -> Result<Vec<Material>
 }
 
 /// Resolves an asset path relative to the scene file and checks that it exists.
-pub(crate) fn existing_asset(
+fn existing_asset(
     t: &TableReader,
     key: &str,
     rel: &str,
