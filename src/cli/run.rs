@@ -285,5 +285,16 @@ fn write_run(
         &out.join("run.json"),
         &serde_json::to_string_pretty(&result.report)?,
     )?;
+    let seen = &result.report["display_seen"];
+    if let Some(share) = seen["share"].as_f64()
+        && share < seethru::system::obstruction::SLIVER_SHARE
+    {
+        eprintln!(
+            "warning: the driver sees only {} of the display's {} pixels ({:.1} %): the display covers a sliver of the driver's view (check the driver's position and look_at, and the obstacle's facing)",
+            seen["seen_by_driver"],
+            seen["display_pixels"],
+            100.0 * share
+        );
+    }
     Ok(result)
 }

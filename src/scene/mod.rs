@@ -4,6 +4,9 @@
 //! parameter table of every object kind; the defaults below are the ones documented there.
 
 pub mod builtin;
+pub mod curved_body;
+pub mod display_keys;
+pub mod display_surface;
 pub mod fingerprint;
 pub mod grow;
 pub mod head_path;
@@ -178,6 +181,10 @@ pub struct Obstacle {
     pub display_off_color: [f64; 3],
     /// Colour of the obstacle body, sRGB in [0, 1].
     pub body_color: [f64; 3],
+    /// The display's surface: flat (the `width` × `height` rectangle at z = 0), or curved
+    /// (triangles with UVs in the obstacle frame; `width` × `height` is then its reference
+    /// rectangle, which the crop's report and the flat formulas use).
+    pub display_shape: display_surface::DisplayShape,
 }
 
 impl Obstacle {

@@ -35,7 +35,7 @@ impl Scene {
         let obstacle_table = root
             .table("obstacle")?
             .ok_or_else(|| root.error("obstacle", "the scene needs an [obstacle] table"))?;
-        let obstacle = read_obstacle(&obstacle_table)?;
+        let obstacle = read_obstacle(&obstacle_table, file)?;
         obstacle_table.finish()?;
         let cameras = root.table("camera")?.ok_or_else(|| {
             root.error(
@@ -397,24 +397,30 @@ fn read_object(
     })
 }
 
-fn read_obstacle(t: &TableReader) -> Result<Obstacle, SceneError> {
+fn read_obstacle(t: &TableReader, file: &SourceFile) -> Result<Obstacle, SceneError> {
     let center = t.point("center", None)?;
     let facing = t.direction("facing", [0.0, 0.0, 1.0])?;
     let up = t.direction("up", [0.0, 1.0, 0.0])?;
     // The display normal is obstacle +z; a camera looking along −facing has the same axes.
     let rotation = world_from_camera_rotation(-facing, up)
         .map_err(|_| t.error("facing", "must not be parallel to `up`"))?;
+    let (width, height) = (
+        length(t, "width", 0.3, MAX_DISPLAY_SIZE)?,
+        length(t, "height", 0.4, MAX_DISPLAY_SIZE)?,
+    );
     let obstacle = Obstacle {
         world_from_obstacle: DAffine3::from_mat3_translation(rotation, center),
-        width: length(t, "width", 0.3, MAX_DISPLAY_SIZE)?,
-        height: length(t, "height", 0.4, MAX_DISPLAY_SIZE)?,
+        width,
+        height,
         thickness: length(t, "thickness", 0.04, MAX_DISPLAY_SIZE)?,
         display_resolution: t.resolution("display_resolution", [300, 400])?,
         display_off_color: t.color("display_off_color", [0.02, 0.02, 0.025])?,
         body_color: t.color("body_color", [0.18, 0.18, 0.2])?,
+        display_shape: crate::scene::display_keys::read_display_shape(t, file, width, height)?,
     };
     let half = DVec3::new(obstacle.width, obstacle.height, 2.0 * obstacle.thickness) / 2.0;
-    for corner in [-half, half] {
+    let curved = crate::scene::display_keys::surface_corners(&obstacle.display_shape);
+    for corner in [-half, half].into_iter().chain(curved) {
         if let Some(why) = out_of_world(obstacle.world_from_obstacle.transform_point3(corner)) {
             return Err(t.error(
                 "center",

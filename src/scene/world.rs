@@ -306,13 +306,20 @@ impl World {
                 uv_repeat: Vec2::ONE,
             });
         }
-        let tris = cuboid([
-            obstacle.width as f32,
-            obstacle.height as f32,
-            obstacle.thickness as f32,
-        ]);
-        let obstacle_from_box =
-            DAffine3::from_translation(DVec3::new(0.0, 0.0, -obstacle.thickness / 2.0));
+        let (tris, obstacle_from_box) = match obstacle.display_shape.curved() {
+            Some(surface) => (
+                crate::scene::curved_body::curved_obstacle_tris(surface, obstacle.thickness),
+                DAffine3::IDENTITY,
+            ),
+            None => (
+                cuboid([
+                    obstacle.width as f32,
+                    obstacle.height as f32,
+                    obstacle.thickness as f32,
+                ]),
+                DAffine3::from_translation(DVec3::new(0.0, 0.0, -obstacle.thickness / 2.0)),
+            ),
+        };
         self.add_tris(
             &tris,
             obstacle.world_from_obstacle * obstacle_from_box,

@@ -127,6 +127,8 @@ pub struct DisplayPlacement {
     width: f64,
     height: f64,
     resolution: [u32; 2],
+    /// A curved display's surface (its UVs give the pixel); `None` for the flat face.
+    curved: Option<std::sync::Arc<crate::scene::display_surface::CurvedSurface>>,
 }
 
 impl DisplayPlacement {
@@ -136,12 +138,21 @@ impl DisplayPlacement {
             width: obstacle.width,
             height: obstacle.height,
             resolution: obstacle.display_resolution,
+            curved: match &obstacle.display_shape {
+                crate::scene::display_surface::DisplayShape::Curved(s) => Some(s.clone()),
+                crate::scene::display_surface::DisplayShape::Flat => None,
+            },
         }
     }
 
     /// Continuous display pixel coordinates (x right, y down) of a world point on the display.
     pub fn pixel_coords(&self, world: Vec3) -> DVec2 {
         let p = self.obstacle_from_world.transform_point3(world.as_dvec3());
+        if let Some(surface) = &self.curved {
+            // NaN (no triangle near the point) clamps to pixel 0 in the lookup.
+            let uv = surface.uv_at_point(p).unwrap_or(DVec2::NAN);
+            return uv * DVec2::new(self.resolution[0] as f64, self.resolution[1] as f64);
+        }
         DVec2::new(
             (p.x / self.width + 0.5) * self.resolution[0] as f64,
             (0.5 - p.y / self.height) * self.resolution[1] as f64,

@@ -227,6 +227,28 @@ fn admissible_offsets(
     )
 }
 
+/// The display image of `--method planar` on a curved display, per pixel; with `--outside
+/// error`, a display pixel whose model point the frontal camera does not see is an error.
+pub fn curved_planar_display(
+    scene: &Scene,
+    eye: DVec3,
+    d2: Option<f64>,
+    frontal: &Frame,
+    options: &RunOptions,
+) -> Result<Frame> {
+    use crate::system::surface_map::{PointModel, curved_display};
+    let plane = d2.map_or(ModelPlane::Infinity, ModelPlane::At);
+    let model = PointModel::new(scene, eye, plane)?;
+    let (display, missing) = curved_display(frontal, &scene.obstacle, &model, options.filter);
+    if missing > 0 && options.outside == Outside::Error {
+        bail!(
+            "{missing} of the curved display's {} pixels show a model point the frontal camera does not see (or lie outside its UVs); use --outside black to show them black and count them",
+            display.object_id.len()
+        );
+    }
+    Ok(display)
+}
+
 /// Runs the system on a loaded scene; renders every view. A display that covers no pixel of
 /// the driver's view is an error: every metric of the run would be undefined.
 pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
@@ -344,8 +366,17 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
     let map = frontal_map(scene, crop, options)?;
 
     let out = overflow(&map);
+    // A curved display is compensated per pixel; its crop is only its reference rectangle's.
+    let curved =
+        options.method == Method::Planar && scene.obstacle.display_shape.curved().is_some();
+    if curved && options.display == DisplayModel::Ideal {
+        bail!(
+            "--display ideal works on a flat display; a curved display (display_shape) models its physical pixels (use --display pixels)"
+        );
+    }
     if options.method == Method::Planar
         && given.display.is_none()
+        && !curved
         && options.outside == Outside::Error
         && let Some((side, px)) = out.iter().copied().find(|(_, px)| *px > 1e-9)
     {
@@ -385,6 +416,11 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
     } else if options.method.models_the_scene() {
         let m = scene_model_display(ctx, scene, eye_used, &frontal, &crop, options)?;
         (m.display.clone(), Some(m))
+    } else if curved {
+        (
+            curved_planar_display(scene, eye_used, d2_used, &frontal, options)?,
+            None,
+        )
     } else {
         (resample_through(&frontal, &map, options.filter), None)
     };
@@ -461,6 +497,9 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
     report["eyes"] = json!({"options": options.eyes, "view_world_m": driver.position().to_array()});
     report["lenses"] = crate::system::frontal_map::lenses_json(scene)?;
     report["calibration"] = crate::system::calibration_json::calibration_json(scene)?;
+    let seen = crate::system::obstruction::obstruction_json(ctx, &driver, options.eyes.ipd);
+    report["obstruction_deg"] = seen["obstruction_deg"].clone();
+    report["display_seen"] = seen["display_seen"].clone();
     Ok(RunResult {
         truth,
         occluded,

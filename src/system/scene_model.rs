@@ -11,7 +11,7 @@ use serde_json::json;
 
 use crate::render::frame::{Frame, Pixel};
 use crate::render::integrator::RenderContext;
-use crate::scene::{Obstacle, Scene};
+use crate::scene::Scene;
 use crate::system::compensation::Crop;
 use crate::system::depth_search::{Found, search};
 use crate::system::depth_sensor::{DepthMap, SensorModel, sense};
@@ -64,16 +64,6 @@ pub struct SceneModelDisplay {
     pub holes: Vec<bool>,
     /// For `run.json`: the sensor, the plane, the holes.
     pub report: serde_json::Value,
-}
-
-/// The world point of continuous display pixel coordinates.
-fn display_point(obstacle: &Obstacle, p: DVec2) -> DVec3 {
-    let [dw, dh] = obstacle.display_resolution.map(f64::from);
-    obstacle.world_from_obstacle.transform_point3(DVec3::new(
-        (p.x / dw - 0.5) * obstacle.width,
-        (0.5 - p.y / dh) * obstacle.height,
-        0.0,
-    ))
 }
 
 fn blank() -> Pixel {
@@ -136,15 +126,11 @@ pub fn scene_model_display(
         _ => bail!("{method:?} is not a scene-model method"),
     };
     let [dw, dh] = scene.obstacle.display_resolution;
-    let looks: Vec<Found> = (0..dw as usize * dh as usize)
-        .into_par_iter()
-        .map(|i| {
-            let p = DVec2::new(
-                (i % dw as usize) as f64 + 0.5,
-                (i / dw as usize) as f64 + 0.5,
-            );
-            found(display_point(&scene.obstacle, p))
-        })
+    // Each display pixel's point on the display's surface, flat or curved.
+    let points = crate::system::surface_map::display_points(&scene.obstacle);
+    let looks: Vec<Found> = points
+        .par_iter()
+        .map(|p| p.map_or(Found::Outside, &found))
         .collect();
     let holes: Vec<bool> = looks.iter().map(|f| matches!(f, Found::Hole(_))).collect();
     let mut pixels: Vec<Pixel> = looks

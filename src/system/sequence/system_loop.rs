@@ -281,7 +281,15 @@ impl SystemLoop {
             .transform_point3(eye_used);
         let run = &self.options.run;
         let at = || format!("at t = {} s", short(times.refresh_time));
-        let full = run.method == Method::None || run.d2 == WorkingDistance::Auto;
+        let curved =
+            run.method == Method::Planar && geometry.obstacle.display_shape.curved().is_some();
+        if curved && run.display == DisplayModel::Ideal {
+            bail!(
+                "--display ideal works on a flat display; a curved display (display_shape) models its physical pixels (use --display pixels)"
+            );
+        }
+        // A curved display's pixels may look beyond its reference rectangle's crop.
+        let full = run.method == Method::None || run.d2 == WorkingDistance::Auto || curved;
         let frontal_camera = capture.scene.frontal;
         let settings = self.settings();
         let (crop, d2_used) = if full {
@@ -315,7 +323,7 @@ impl SystemLoop {
             crop
         };
         let map = frontal_map(&geometry, crop, run)?;
-        if run.method == Method::Planar && run.outside == Outside::Error {
+        if run.method == Method::Planar && run.outside == Outside::Error && !curved {
             let (min, max) = map.bounds();
             let [w, h] = crop.frontal_size.map(f64::from);
             if min.x < -1e-9 || min.y < -1e-9 || max.x > w + 1e-9 || max.y > h + 1e-9 {
@@ -329,7 +337,18 @@ impl SystemLoop {
                 );
             }
         }
-        let display = resample_through(&self.frontal, &map, run.filter);
+        let display = if curved {
+            crate::system::pipeline::curved_planar_display(
+                &geometry,
+                eye_world,
+                d2_used,
+                &self.frontal,
+                run,
+            )
+            .with_context(at)?
+        } else {
+            resample_through(&self.frontal, &map, run.filter)
+        };
         self.seconds.compensation += start.elapsed().as_secs_f64();
         self.surface = Some(DisplaySurface::Pixels {
             image: display,
