@@ -353,3 +353,257 @@ fn every_flag_of_compare_changes_the_output_or_is_refused() {
     );
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
 }
+
+#[test]
+fn the_worlds_limits_follow_what_moves() {
+    // A keyframed mesh: its origin stays inside the world, its triangles leave it at t = 1 s
+    // (a sphere on the same path was refused; the mesh was not).
+    let mesh = "v -3 0 0\nv 3 0 0\nv 0 3 0\nf 1 2 3\n";
+    let keyed = |x: &str| {
+        format!(
+            "\n[[object]]\nname = \"m\"\nkind = \"mesh\"\npath = \"m.obj\"\ntranslate = [0.0, 0.0, -10.0]\n[[object.keyframe]]\nt = 0.0\n[[object.keyframe]]\nt = 1.0\ntranslate = [{x}, 0.0, -10.0]\n"
+        )
+    };
+    let dir = common::refusal::scratch(&keyed("999998.0"), &[("m.obj", mesh.as_bytes())]);
+    let text = std::fs::read_to_string(dir.path().join("scene.toml")).unwrap();
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("translate = [999998.0"))
+        .unwrap()
+        + 1;
+    common::refusal::refused(
+        dir.path(),
+        &["render", "scene.toml", "--out", "out", "--width", "8"],
+        1,
+        &[
+            &format!("scene.toml:{line}:"),
+            "keyframe[1].translate",
+            "takes its mesh m.obj outside the world at t = 1 s",
+            "1000001",
+        ],
+    );
+    assert!(!dir.path().join("out").exists());
+    // Three metres nearer, every vertex is inside: accepted.
+    let dir = common::refusal::scratch(&keyed("999996.0"), &[("m.obj", mesh.as_bytes())]);
+    let (code, err) = run_in(
+        dir.path(),
+        &["render", "scene.toml", "--out", "out", "--width", "8"],
+    );
+    assert_eq!(code, 0, "{err}");
+
+    // A head path: within the CSV's ±1e6 in the obstacle frame, but the obstacle stands at
+    // z = −0.8 m, so z = −999999.5 puts the eye at −1000000.3 in the world.
+    let dir = common::refusal::scratch(
+        "",
+        &[("p.csv", b"t,x,y,z\n0,0,0,0.8\n0.05,0,0,-999999.5\n")],
+    );
+    common::refusal::refused(
+        dir.path(),
+        &[
+            "sequence",
+            "scene.toml",
+            "--out",
+            "out",
+            "--head-path",
+            "p.csv",
+            "--duration",
+            "0.1",
+            "--width",
+            "16",
+        ],
+        1,
+        &["p.csv:3: the eye at t = 0.05 s lies outside the world"],
+    );
+    assert!(!dir.path().join("out").exists());
+}
+
+#[test]
+fn sweep_merge_checks_each_parts_rows_as_a_resume_does() {
+    let dir = common::refusal::scratch("", &[]);
+    let sweep = |out: &str| {
+        let (code, err) = run_in(
+            dir.path(),
+            &[
+                "sweep",
+                "scene.toml",
+                "--width",
+                "8",
+                "--param",
+                "theta_f=20,40",
+                "--out",
+                out,
+            ],
+        );
+        assert_eq!(code, 0, "{err}");
+        std::fs::read_to_string(dir.path().join(out)).unwrap()
+    };
+    let whole = sweep("s.csv");
+    let (code, err) = run_in(dir.path(), &["sweep-merge", "s.csv", "--out", "m.csv"]);
+    assert_eq!(code, 0, "{err}");
+    // One row twice in a part: refused by the merge, as by a resume of the same file.
+    let lines: Vec<&str> = whole.lines().collect();
+    let twice = format!("{}\n{}\n{}\n{}\n", lines[0], lines[1], lines[1], lines[2]);
+    std::fs::write(dir.path().join("twice.csv"), &twice).unwrap();
+    let merged = common::refusal::refused(
+        dir.path(),
+        &["sweep-merge", "twice.csv", "--out", "m2.csv"],
+        1,
+        &["twice.csv:3: configuration 0 appears twice (also on line 2)"],
+    );
+    std::fs::write(dir.path().join("s.csv"), &twice).unwrap();
+    let resumed = common::refusal::refused(
+        dir.path(),
+        &[
+            "sweep",
+            "scene.toml",
+            "--width",
+            "8",
+            "--param",
+            "theta_f=20,40",
+            "--out",
+            "s.csv",
+        ],
+        1,
+        &["s.csv:3: configuration 0 appears twice (also on line 2)"],
+    );
+    assert_eq!(
+        merged.split(": configuration").nth(1),
+        resumed.split(": configuration").nth(1)
+    );
+    assert!(!dir.path().join("m2.csv").exists());
+}
+
+#[test]
+fn sequence_estimates_its_memory_first_and_messages_name_the_form_and_the_file() {
+    let dir = common::refusal::scratch("", &[]);
+    common::refusal::refused(
+        dir.path(),
+        &[
+            "sequence",
+            "scene.toml",
+            "--out",
+            "out",
+            "--width",
+            "64",
+            "--max-memory",
+            "0.0001",
+        ],
+        1,
+        &[
+            "this needs about",
+            "more than --max-memory 0.0001 GiB",
+            "preview frames",
+        ],
+    );
+    assert!(common::refusal::listing(dir.path()) == ["scene.toml"]);
+    // The estimate counts the frames kept: a long sequence needs more than a short one.
+    let needs = |duration: &str| -> String {
+        let (_, err) = run_in(
+            dir.path(),
+            &[
+                "sequence",
+                "scene.toml",
+                "--out",
+                "out",
+                "--duration",
+                duration,
+                "--max-memory",
+                "0.000001",
+            ],
+        );
+        assert!(err.contains("this needs about"), "{err}");
+        err
+    };
+    assert!(needs("1").contains(" 30 preview frames and the records of 1×60 frames"));
+    assert!(needs("1000").contains(" 30000 preview frames and the records of 1×60000 frames"));
+    common::refusal::refused(
+        dir.path(),
+        &[
+            "run",
+            "scene.toml",
+            "--out",
+            "out",
+            "--head-bias-cm",
+            "nan",
+            "0",
+            "0",
+        ],
+        2,
+        &["--head-bias-cm takes x,y,z in one word", "got `nan 0 …`"],
+    );
+    common::refusal::refused(
+        dir.path(),
+        &["export", "scene.toml", "--out", "/proc/x.obj"],
+        1,
+        &["cannot write the output /proc/x.obj"],
+    );
+}
+
+/// The colour images of a run folder, by name.
+fn images(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    files(dir, &[])
+        .into_iter()
+        .filter(|(name, _)| name.ends_with(".png"))
+        .collect()
+}
+
+#[test]
+fn a_kill_at_any_moment_leaves_the_old_set_or_the_new_one() {
+    // Two generations of one output (spp 1 and 2 differ in every view's colours) written in
+    // turn into the same existing --out, each killed (SIGKILL) at a seeded random moment of
+    // its run: afterwards the folder holds exactly one generation's images, never a mix.
+    let dir = common::refusal::scratch("", &[]);
+    let args = |spp: &'static str| {
+        vec![
+            "run",
+            "scene.toml",
+            "--out",
+            "out",
+            "--spp",
+            spp,
+            "--frontal-width",
+            "96",
+            "--width",
+            "96",
+        ]
+    };
+    let mut generations = Vec::new();
+    let start = std::time::Instant::now();
+    for spp in ["1", "2"] {
+        let (code, err) = run_in(dir.path(), &args(spp));
+        assert_eq!(code, 0, "{err}");
+        generations.push(images(&dir.path().join("out")));
+    }
+    assert_ne!(generations[0], generations[1]);
+    let one_run = start.elapsed().as_secs_f64() / 2.0;
+    let mut state: u64 = 0x5eed;
+    let mut kills = 0;
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(40);
+    let mut round = 0usize;
+    while std::time::Instant::now() < deadline && round < 200 {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let at = one_run * 1.2 * ((state >> 11) as f64 / (1u64 << 53) as f64);
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_seethru"))
+            .arg("--quiet")
+            .args(args(["1", "2"][round % 2]))
+            .current_dir(dir.path())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_secs_f64(at));
+        if child.try_wait().unwrap().is_none() {
+            child.kill().unwrap();
+            kills += 1;
+        }
+        let _ = child.wait();
+        let now = images(&dir.path().join("out"));
+        assert!(
+            generations.contains(&now),
+            "round {round}, killed at {at:.3} s: a mixed set of {} images",
+            now.len()
+        );
+        round += 1;
+    }
+    assert!(kills > 0 && round > 10, "{kills} kills in {round} rounds");
+}

@@ -323,6 +323,9 @@ impl Sequence {
         self.refuse_ignored()?;
         let head = self.head_motion()?;
         let scene = Scene::load(&self.scene)?;
+        if let HeadMotion::Path(path) = &head {
+            path.check_in_world(&scene.obstacle.world_from_obstacle)?;
+        }
         // Every latency's timeline is checked before anything is rendered or written.
         let all: Vec<SequenceOptions> = self
             .latency_camera

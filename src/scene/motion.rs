@@ -52,6 +52,9 @@ pub struct ObjectMotion {
     pub keyframes: Vec<Keyframe>,
     /// The object's scale factors (the keyframes replace translation and rotation only).
     pub scale: DVec3,
+    /// Where each keyframe's `translate` is in the scene file (its message empty), for
+    /// errors found once the object's mesh is loaded: its triangles leaving the world.
+    pub places: Vec<crate::scene::source::SceneError>,
 }
 
 impl ObjectMotion {
@@ -122,6 +125,7 @@ pub fn read_object_motion(
         ));
     }
     let mut keyframes: Vec<Keyframe> = Vec::new();
+    let mut places = Vec::new();
     for k in tables {
         let time = k.f64_in("t", f64::NAN, 0.0, MAX_KEY_TIME_S).map_err(|e| {
             if k.has("t") {
@@ -167,6 +171,7 @@ pub fn read_object_motion(
                 format!("the path leaves the world at t = {time} s: {why}"),
             ));
         }
+        places.push(k.error("translate", ""));
         k.finish()?;
         keyframes.push(key);
     }
@@ -174,6 +179,7 @@ pub fn read_object_motion(
         moves_with,
         keyframes,
         scale,
+        places,
     })
 }
 
@@ -252,6 +258,7 @@ mod tests {
             moves_with: MovesWith::World,
             keyframes: vec![key(1.0, 0.0), key(3.0, 4.0)],
             scale: DVec3::ONE,
+            places: Vec::new(),
         };
         let x = |t: f64| m.world_from_object_at(t).unwrap().translation.x;
         assert_eq!(

@@ -10,7 +10,7 @@ use obvhs::aabb::Aabb;
 use obvhs::ray::Ray;
 use obvhs::rt_triangle::RtTriangle;
 
-use crate::scene::limits::check_placed_mesh;
+use crate::scene::limits::{check_keyframed_mesh, check_placed_mesh};
 use crate::scene::mesh_io::{LoadedMesh, load_mesh};
 use crate::scene::shapes::{Tri, box_face, cuboid, frustum, plane_xz, quad_xy};
 use crate::scene::texture::Texture;
@@ -213,6 +213,7 @@ impl World {
                         &object.world_from_object,
                         world.triangles.len(),
                     )?;
+                    check_keyframed_mesh(path, &object.name, &mesh.tris, &object.motion)?;
                     let first = world.materials.len() as u32;
                     world
                         .materials
