@@ -345,11 +345,15 @@ fn every_flag_of_sequence_changes_the_output_or_is_refused() {
 #[test]
 fn every_flag_of_compare_changes_the_output_or_is_refused() {
     // Methods that read no depth: every depth flag is refused, as `run` refuses them.
+    // The table's files record the settings: the strips must show the flag.
     let wrong = each_flag_is_read_or_refused(
         &["compare"],
         &["--spp", "1", "--methods", "planar-inf,ground"],
-        &[],
-        &[("--methods", "the base lists them")],
+        &["compare.md", "compare.html", "compare.json"],
+        &[(
+            "--band",
+            "changes the table's border-band metrics only (tests/measurements.rs checks them)",
+        )],
     );
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
 }

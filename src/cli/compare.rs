@@ -96,6 +96,11 @@ impl Compare {
             read: any(&[PlaneFit, DepthTof, DepthStereo]) || (noisy_kind && any(&[DepthIdeal])),
             when: "when --methods lists plane-fit or a noisy depth sensor",
         });
+        rules.push(ReadWhen {
+            flag: "--back-width",
+            read: self.head == HeadSource::Estimated,
+            when: "with --head estimated (the back camera is rendered for the face detector only)",
+        });
         refuse_ignored(&rules)
     }
 
