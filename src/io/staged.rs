@@ -149,6 +149,12 @@ impl StagedDir {
             // swap (or the folder holds the current directory, which a swap would unlink),
             // the files move one by one.
             if swaps_whole(&self.target) {
+                // Temporaries that killed processes left for these files go, as with moves.
+                for (_, to) in &moves {
+                    if let Some(name) = to.file_name() {
+                        remove_stale(to, &name.to_string_lossy());
+                    }
+                }
                 keep_old_files(&self.target, &self.staging).with_context(|| {
                     format!("cannot keep the files of {}", self.target.display())
                 })?;
