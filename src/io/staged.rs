@@ -158,7 +158,9 @@ impl StagedDir {
                 keep_old_files(&self.target, &self.staging).with_context(|| {
                     format!("cannot keep the files of {}", self.target.display())
                 })?;
-                match exchange(&self.staging, &self.target) {
+                // `out/.` names `out`, but renameat2 refuses a path ending in `.`.
+                let target: PathBuf = self.target.components().collect();
+                match exchange(&self.staging, &target) {
                     Ok(()) => {
                         // The staging path now holds the old set.
                         let _ = std::fs::remove_dir_all(&self.staging);
