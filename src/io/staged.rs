@@ -23,6 +23,9 @@ pub struct StagedDir {
     /// one the removal starts from.
     created: Option<(PathBuf, PathBuf)>,
     committed: bool,
+    /// Whether an existing target is swapped whole (a folder output), not merged file by
+    /// file (files staged into a shared folder, [`StagedDir::inside`]).
+    swaps: bool,
 }
 
 impl StagedDir {
@@ -70,6 +73,7 @@ impl StagedDir {
         // `commit` moves the files into the folder itself.
         let mut staged = Self::create(target, target, name, &folder.join(name))?;
         staged.shown = folder.to_path_buf();
+        staged.swaps = false;
         in_flight().stage_as(&staged.staging, folder);
         Ok(staged)
     }
@@ -90,6 +94,7 @@ impl StagedDir {
             staging: temporary(&parent.join(name), name, std::process::id()),
             created: None,
             committed: false,
+            swaps: true,
         };
         let mut state = in_flight();
         state.check_running()?;
@@ -148,7 +153,7 @@ impl StagedDir {
             // leaves the old set or the new one, never a mix. Where the file system cannot
             // swap (or the folder holds the current directory, which a swap would unlink),
             // the files move one by one.
-            if swaps_whole(&self.target) {
+            if self.swaps && swaps_whole(&self.target) {
                 // Temporaries that killed processes left for these files go, as with moves.
                 for (_, to) in &moves {
                     if let Some(name) = to.file_name() {
