@@ -92,50 +92,6 @@ pub fn check_placed_mesh(
     Ok(())
 }
 
-/// Checks a keyframed mesh at every keyframe: the corners of its bounding box (object frame)
-/// placed by each key stay inside the world, as a keyframed sphere's do. The error names the
-/// scene file and the keyframe's line.
-pub fn check_keyframed_mesh(
-    path: &std::path::Path,
-    object: &str,
-    tris: &[Tri],
-    motion: &crate::scene::motion::ObjectMotion,
-) -> Result<()> {
-    let Some(first) = tris.first() else {
-        return Ok(());
-    };
-    let (mut lo, mut hi) = (first.p[0].as_dvec3(), first.p[0].as_dvec3());
-    for p in tris.iter().flat_map(|t| t.p) {
-        lo = lo.min(p.as_dvec3());
-        hi = hi.max(p.as_dvec3());
-    }
-    let corners: Vec<DVec3> = (0..8)
-        .map(|i| {
-            DVec3::new(
-                if i & 1 == 0 { lo.x } else { hi.x },
-                if i & 2 == 0 { lo.y } else { hi.y },
-                if i & 4 == 0 { lo.z } else { hi.z },
-            )
-        })
-        .collect();
-    for (key, place) in motion.keyframes.iter().zip(&motion.places) {
-        let at = crate::scene::motion::placement(key.translate, key.rotate_deg, motion.scale);
-        if let Some(why) = corners
-            .iter()
-            .find_map(|c| out_of_world(at.transform_point3(*c)))
-        {
-            let mut error = place.clone();
-            error.message = format!(
-                "the path of object `{object}` takes its mesh {} outside the world at t = {} s: {why}",
-                path.display(),
-                key.t
-            );
-            return Err(error.into());
-        }
-    }
-    Ok(())
-}
-
 /// The first vertex of `tris` that is not finite or not within ±[`MAX_COORDINATE`], if any.
 pub fn first_bad_vertex(tris: &[Tri]) -> Option<(usize, Vec3)> {
     tris.iter().enumerate().find_map(|(i, t)| {

@@ -10,8 +10,9 @@ use obvhs::aabb::Aabb;
 use obvhs::ray::Ray;
 use obvhs::rt_triangle::RtTriangle;
 
-use crate::scene::limits::{check_keyframed_mesh, check_placed_mesh};
+use crate::scene::limits::check_placed_mesh;
 use crate::scene::mesh_io::{LoadedMesh, load_mesh};
+use crate::scene::motion::check_keyframed_mesh;
 use crate::scene::shapes::{Tri, box_face, cuboid, frustum, plane_xz, quad_xy};
 use crate::scene::texture::Texture;
 use crate::scene::{CameraKind, Obstacle, Scene, Shape};
