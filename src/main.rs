@@ -5,7 +5,6 @@ mod cli;
 
 use std::process::ExitCode;
 
-use clap::Parser;
 use clap::error::ErrorKind;
 use seethru::util::message::{error_text, printable};
 
@@ -26,8 +25,7 @@ fn main() -> ExitCode {
         }
         default_hook(info);
     }));
-    let cli = match cli::Cli::try_parse_from(cli::with_negative_values_joined(std::env::args_os()))
-    {
+    let cli = match cli::parse(cli::with_negative_values_joined(std::env::args_os())) {
         Ok(cli) => cli,
         Err(e) if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) => {
             e.exit()

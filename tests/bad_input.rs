@@ -634,7 +634,7 @@ fn flags_the_command_would_ignore_are_refused() {
     for (extra, words) in [
         (
             &["--depth-noise", "0.1"][..],
-            &["--depth-noise is read by --method plane-fit and depth only"][..],
+            &["--depth-noise is read only by --method plane-fit and depth"][..],
         ),
         (
             &["--method", "depth", "--depth-range", "5"],
@@ -645,11 +645,11 @@ fn flags_the_command_would_ignore_are_refused() {
         ),
         (
             &["--method", "plane-fit", "--fill", "inpaint"],
-            &["--fill fills the holes of --method depth only"],
+            &["--fill is read only by --method depth"],
         ),
         (
             &["--depth-sensor", "stereo"],
-            &["--depth-sensor is read by --method plane-fit and depth only"],
+            &["--depth-sensor is read only by --method plane-fit and depth"],
         ),
     ] {
         let args: Vec<&str> = run.iter().chain(extra).copied().collect();

@@ -78,7 +78,8 @@ fn bad_method_inputs_give_one_line_each() {
             "error: --method plane-fit: the [calibration.frontal] is not exact".into(),
         ),
         (
-            [vec!["compare", wall, "--out", out, "--methods", "planar-inf,ground"], small.to_vec()].concat(),
+            // compare with the oracle head renders no back view: no --back-width.
+            [vec!["compare", wall, "--out", out, "--methods", "planar-inf,ground"], small[..4].to_vec(), small[6..].to_vec()].concat(),
             format!("error: ground: --method ground: the scene {wall} has no ground plane"),
         ),
     ];
@@ -127,7 +128,9 @@ fn compare_writes_one_row_and_one_strip_per_method_as_run_measures_them() {
                 "--methods",
                 "planar-inf,ground,depth-ideal,depth-tof",
             ],
-            small.to_vec(),
+            // The oracle head: compare renders no back view, so no --back-width.
+            small[..4].to_vec(),
+            small[6..].to_vec(),
         ]
         .concat(),
     );

@@ -138,6 +138,38 @@ pub struct HeadErrorArgs {
     pub require_confident_head: bool,
 }
 
+impl HeadErrorArgs {
+    /// The rules of these flags ([`refuse_ignored`]): none is read where the method uses no
+    /// eye (`eye_used` false: `--method none`); the feature width is the detector's, read
+    /// with `estimated` heads only; the seed is read by the jitter, or where
+    /// `other_seed_reader` (a noisy depth sensor, the plane fit) says so.
+    pub fn rules(&self, eye_used: bool, estimated: bool, other_seed_reader: bool) -> Vec<ReadWhen> {
+        let eye = EYE_METHODS;
+        vec![
+            ReadWhen {
+                flag: "--head-bias-cm",
+                read: eye_used,
+                when: eye,
+            },
+            ReadWhen {
+                flag: "--head-jitter-cm",
+                read: eye_used,
+                when: eye,
+            },
+            ReadWhen {
+                flag: "--feature-width",
+                read: eye_used && estimated,
+                when: "with an estimated head (face detection), not the oracle, and a method that compensates for the eye",
+            },
+            ReadWhen {
+                flag: "--seed",
+                read: (eye_used && self.head_jitter_cm > 0.0) || other_seed_reader,
+                when: "with --head-jitter-cm > 0, a noisy depth sensor or the plane fit",
+            },
+        ]
+    }
+}
+
 /// `--max-memory`, GiB in [1e-6, 4096].
 pub fn max_memory(text: &str) -> Result<f64, String> {
     positive(4096.0)(text)
@@ -154,4 +186,76 @@ pub fn with_threads<T: Send>(threads: Option<usize>, job: impl FnOnce() -> T + S
         .num_threads(threads.unwrap_or(0))
         .build()?;
     Ok(pool.install(job))
+}
+
+/// A value from a fixed list (a clap `ValueEnum`), with spaces around it ignored as they are
+/// around numbers: `--eyes ' both'` is `both`, and in a list (`value_delimiter = ','`) each
+/// item is trimmed, `--methods 'planar-inf, ground'`. Every choice flag uses this parser,
+/// so the rule holds everywhere; the possible values are clap's, for `--help` and errors.
+#[derive(Clone)]
+pub struct Choice<T>(std::marker::PhantomData<T>);
+
+/// The value parser of a choice flag of type `T`: `value_parser = choice::<T>()`.
+pub fn choice<T>() -> Choice<T> {
+    Choice(std::marker::PhantomData)
+}
+
+impl<T: clap::ValueEnum + Clone + Send + Sync + 'static> clap::builder::TypedValueParser
+    for Choice<T>
+{
+    type Value = T;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<T, clap::Error> {
+        let trimmed = value
+            .to_str()
+            .map_or(value, |v| std::ffi::OsStr::new(v.trim()));
+        clap::builder::EnumValueParser::<T>::new().parse_ref(cmd, arg, trimmed)
+    }
+
+    fn possible_values(
+        &self,
+    ) -> Option<Box<dyn Iterator<Item = clap::builder::PossibleValue> + '_>> {
+        Some(Box::new(
+            T::value_variants()
+                .iter()
+                .filter_map(clap::ValueEnum::to_possible_value),
+        ))
+    }
+}
+
+/// Where [`ReadWhen::when`] says a flag is read only by the methods that use the eye.
+pub const EYE_METHODS: &str = "by the methods that compensate for the eye (not --method none)";
+
+/// A flag that a command reads only under some of its settings, for [`refuse_ignored`].
+#[derive(Clone)]
+pub struct ReadWhen {
+    /// The flag as typed, `--ipd`.
+    pub flag: &'static str,
+    /// Whether the command, with the settings given, reads it.
+    pub read: bool,
+    /// The settings that read it, for the message: `with --eyes left, right or both`.
+    pub when: &'static str,
+}
+
+/// Refuses a flag given on the command line that the command would ignore under the other
+/// settings given: the user's intent is not dropped without a word. One rule per flag that
+/// is read only sometimes; the flags given are the parser's ([`crate::cli::given`]), so a
+/// flag set to its default value is refused too.
+pub fn refuse_ignored(rules: &[ReadWhen]) -> Result<()> {
+    if let Some(rule) = rules
+        .iter()
+        .find(|r| !r.read && crate::cli::given::given(r.flag))
+    {
+        bail!(
+            "{} is read only {}; with the other flags given it would be ignored: remove it",
+            rule.flag,
+            rule.when
+        );
+    }
+    Ok(())
 }

@@ -7,13 +7,16 @@ use anyhow::Result;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_png;
 use seethru::io::staged::StagedDir;
-use seethru::measure::compare::{coloured_strips, html_page, markdown_table};
+use seethru::measure::compare::{Candidate, coloured_strips, html_page, markdown_table};
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
+use seethru::system::depth_sensor::SensorKind;
 use seethru::system::memory::{check_memory, run_estimate};
 use seethru::system::options::{HeadSource, Outside, RunOptions};
 
-use crate::cli::args::{RenderArgs, band, integer, pixels, with_threads};
+use crate::cli::args::{
+    ReadWhen, RenderArgs, band, choice, integer, pixels, refuse_ignored, with_threads,
+};
 use crate::cli::scene_model_args::SceneModelArgs;
 
 #[derive(clap::Args)]
@@ -35,7 +38,7 @@ pub struct Compare {
     #[arg(long, default_value = "compare")]
     out: PathBuf,
     /// oracle: the true eye; estimated: face detection on the back camera's image.
-    #[arg(long, value_enum, default_value_t = HeadSource::Oracle)]
+    #[arg(long, value_enum, value_parser = choice::<HeadSource>(), default_value_t = HeadSource::Oracle)]
     head: HeadSource,
     /// Seed of the depth noise and the plane fit, an integer in [0, 4294967295].
     #[arg(long, default_value_t = 1, value_parser = integer::<u32>(0, u32::MAX as u64))]
@@ -59,6 +62,7 @@ pub struct Compare {
 
 impl Compare {
     pub fn run(self) -> Result<()> {
+        self.refuse_ignored()?;
         let base = RunOptions {
             head: self.head,
             seed: self.seed,
@@ -75,6 +79,36 @@ impl Compare {
             ..RunOptions::default()
         };
         with_threads(self.render.threads, || self.write(&base))?
+    }
+
+    /// Refuses the flags no listed method would read ([`refuse_ignored`]).
+    fn refuse_ignored(&self) -> Result<()> {
+        use crate::cli::compare_methods::MethodSpec;
+        let any = |these: &[Candidate]| {
+            self.methods
+                .iter()
+                .any(|m| matches!(m, MethodSpec::Builtin(c) if these.contains(c)))
+        };
+        use Candidate::{DepthIdeal, DepthStereo, DepthTof, PlaneFit};
+        let mut rules = SceneModelArgs::rules(
+            any(&[PlaneFit, DepthIdeal, DepthTof, DepthStereo]),
+            any(&[PlaneFit, DepthIdeal]),
+            any(&[DepthIdeal, DepthTof, DepthStereo]),
+            "when --methods lists plane-fit or a depth method (the sensor's kind: plane-fit or depth-ideal)",
+            "when --methods lists a depth method (their disocclusion holes)",
+        );
+        let noisy_kind = self.scene_model.depth_sensor != SensorKind::Ideal;
+        rules.push(ReadWhen {
+            flag: "--seed",
+            read: any(&[PlaneFit, DepthTof, DepthStereo]) || (noisy_kind && any(&[DepthIdeal])),
+            when: "when --methods lists plane-fit or a noisy depth sensor",
+        });
+        rules.push(ReadWhen {
+            flag: "--back-width",
+            read: self.head == HeadSource::Estimated,
+            when: "with --head estimated (the back camera is rendered for the face detector only)",
+        });
+        refuse_ignored(&rules)
     }
 
     fn write(&self, base: &RunOptions) -> Result<()> {

@@ -1,6 +1,7 @@
 //! `seethru export`: the scene for other renderers — binary glTF, OBJ + MTL, or Mitsuba 3 XML
 //! scenes — and its cameras as JSON.
 
+use crate::cli::args::choice;
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
@@ -17,7 +18,7 @@ pub struct Export {
     #[arg(long)]
     out: PathBuf,
     /// Output format; by default the one --out's extension names.
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, value_parser = choice::<ExportFormat>())]
     format: Option<ExportFormat>,
 }
 

@@ -13,6 +13,7 @@ mod compare_methods;
 mod diff;
 mod export;
 mod figures;
+pub mod given;
 mod measure;
 mod ratio;
 mod render;
@@ -26,7 +27,7 @@ mod sweep;
 pub mod verdict;
 
 use anyhow::Result;
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 #[derive(Parser)]
 #[command(
@@ -121,6 +122,55 @@ pub fn with_negative_values_joined(
         }
     }
     out
+}
+
+/// Parses the command line, recording which flags were given ([`given`]).
+pub fn parse(args: Vec<std::ffi::OsString>) -> Result<Cli, clap::Error> {
+    let command = Cli::command();
+    let matches = match command.clone().try_get_matches_from(&args) {
+        Ok(m) => m,
+        Err(e) if e.kind() == clap::error::ErrorKind::UnknownArgument => {
+            return Err(spaced_triple(&command, &args).map_or(e, |message| {
+                clap::Error::raw(clap::error::ErrorKind::ValueValidation, message)
+            }));
+        }
+        Err(e) => return Err(e),
+    };
+    given::record(&command, &matches);
+    Cli::from_arg_matches(&matches).map_err(|e| e.format(&mut Cli::command()))
+}
+
+/// `--head-bias-cm 1 0 0`: a flag whose value is `X,Y,Z` given three words. clap takes the
+/// first for the value and calls the second an unexpected argument, naming neither the flag
+/// nor its form; this says both.
+fn spaced_triple(command: &clap::Command, args: &[std::ffi::OsString]) -> Option<String> {
+    let mut triples = Vec::new();
+    let mut stack = vec![command];
+    while let Some(c) = stack.pop() {
+        for arg in c.get_arguments() {
+            let xyz = arg
+                .get_value_names()
+                .is_some_and(|names| names.iter().any(|n| n.as_str() == "X,Y,Z"));
+            if xyz && let Some(long) = arg.get_long() {
+                triples.push(format!("--{long}"));
+            }
+        }
+        stack.extend(c.get_subcommands());
+    }
+    let words: Vec<String> = args.iter().map(|a| a.to_string_lossy().into()).collect();
+    words.windows(3).find_map(|w| {
+        let (flag, first) = match w[0].split_once('=') {
+            Some((flag, value)) => (flag, value),
+            None => (w[0].as_str(), w[1].as_str()),
+        };
+        let next = if w[0].contains('=') { &w[1] } else { &w[2] };
+        let looks_spaced = !first.contains(',') && !next.starts_with("--");
+        (triples.iter().any(|t| t == flag) && looks_spaced).then(|| {
+            format!(
+                "{flag} takes x,y,z in one word, the three numbers separated by commas (e.g. `{flag} 1,0,0`), got `{first} {next} …`"
+            )
+        })
+    })
 }
 
 /// A clap error as one line starting `error:`: the message and its tip, without the usage

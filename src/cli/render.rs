@@ -11,7 +11,7 @@ use seethru::render::views::View;
 use seethru::scene::Scene;
 use seethru::system::memory::{check_memory, render_estimate};
 
-use crate::cli::args::{RenderArgs, with_threads};
+use crate::cli::args::{RenderArgs, choice, with_threads};
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -19,7 +19,7 @@ pub struct Render {
     /// Scene file (TOML).
     scene: PathBuf,
     /// View to render; repeat for several. Default: all four.
-    #[arg(long = "view", value_enum)]
+    #[arg(long = "view", value_enum, value_parser = choice::<View>())]
     views: Vec<View>,
     /// Output directory.
     #[arg(long)]

@@ -22,7 +22,10 @@ use seethru::system::memory::{both_eyes_estimate, check_memory, run_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use seethru::system::pipeline::{RunResult, driver_camera, run};
 
-use crate::cli::args::{HeadErrorArgs, RenderArgs, band, pixels, positive, with_threads};
+use crate::cli::args::{
+    EYE_METHODS, HeadErrorArgs, ReadWhen, RenderArgs, band, choice, pixels, positive,
+    refuse_ignored, with_threads,
+};
 use crate::cli::run_eyes::EyesFlag;
 use crate::cli::scene_model_args::SceneModelArgs;
 
@@ -41,27 +44,27 @@ pub struct Run {
     /// none: the whole frontal image in the display; planar: the paper's compensation;
     /// ground: the road plane; plane-fit: a plane fitted to the depth sensor's points; depth:
     /// per-pixel reprojection with the depth sensor's depth.
-    #[arg(long, value_enum, default_value_t = Method::Planar)]
+    #[arg(long, value_enum, value_parser = choice::<Method>(), default_value_t = Method::Planar)]
     method: Method,
     /// Working distance of the planar model: inf, auto (median frontal depth behind the
     /// display) or metres in [1e-6, 1e6].
     #[arg(long, default_value = "inf", value_name = "METRES|inf|auto")]
     d2: WorkingDistance,
     /// oracle: the true eye; estimated: face detection on the back camera's image.
-    #[arg(long, value_enum, default_value_t = HeadSource::Oracle)]
+    #[arg(long, value_enum, value_parser = choice::<HeadSource>(), default_value_t = HeadSource::Oracle)]
     head: HeadSource,
     /// Head-tracking errors and the detector's feature width.
     #[command(flatten)]
     head_errors: HeadErrorArgs,
     /// When the crop leaves the frontal view: error, or black (flagged as missing).
-    #[arg(long, value_enum, default_value_t = Outside::Error)]
+    #[arg(long, value_enum, value_parser = choice::<Outside>(), default_value_t = Outside::Error)]
     outside: Outside,
     /// Colour resampling of the display image.
-    #[arg(long, value_enum, default_value_t = Filter::Bilinear)]
+    #[arg(long, value_enum, value_parser = choice::<Filter>(), default_value_t = Filter::Bilinear)]
     filter: Filter,
     /// pixels: the physical display; ideal: unlimited display and frontal resolution, so
     /// that only the planar model's error remains.
-    #[arg(long, value_enum, default_value_t = DisplayModel::Pixels)]
+    #[arg(long, value_enum, value_parser = choice::<DisplayModel>(), default_value_t = DisplayModel::Pixels)]
     display: DisplayModel,
     /// Frontal camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
     #[arg(long = "frontal-width", value_parser = pixels)]
@@ -70,13 +73,13 @@ pub struct Run {
     #[arg(long = "back-width", value_parser = pixels)]
     back_width: Option<u32>,
     /// The eyes the driver's views are rendered from.
-    #[arg(long, value_enum, default_value_t = EyesFlag::Mono)]
+    #[arg(long, value_enum, value_parser = choice::<EyesFlag>(), default_value_t = EyesFlag::Mono)]
     eyes: EyesFlag,
     /// Interpupillary distance, metres in [1e-6, 0.1].
     #[arg(long, default_value_t = 0.064, value_parser = positive(MAX_IPD))]
     ipd: f64,
     /// The eye the compensation serves.
-    #[arg(long = "target-eye", value_enum, default_value_t = Eye::Cyclopean)]
+    #[arg(long = "target-eye", value_enum, value_parser = choice::<Eye>(), default_value_t = Eye::Cyclopean)]
     target_eye: Eye,
     /// What each view's EXR holds: none, colour (R, G, B, A) or all (every AOV, what
     /// `seethru measure` reads back).
@@ -104,6 +107,38 @@ pub struct Run {
 impl Run {
     pub fn run(self) -> Result<()> {
         self.scene_model.check_used_by(self.method)?;
+        let noisy_sensor = self.method == Method::Depth
+            && self.scene_model.depth_sensor != seethru::system::depth_sensor::SensorKind::Ideal;
+        let eye_used = self.method != Method::None;
+        let mut rules = self.head_errors.rules(
+            eye_used,
+            self.head == HeadSource::Estimated,
+            self.method == Method::PlaneFit || noisy_sensor,
+        );
+        rules.extend([
+            ReadWhen {
+                flag: "--head",
+                read: eye_used,
+                when: EYE_METHODS,
+            },
+            ReadWhen {
+                flag: "--target-eye",
+                read: eye_used,
+                when: EYE_METHODS,
+            },
+            ReadWhen {
+                flag: "--ipd",
+                read: self.eyes != EyesFlag::Mono
+                    || (eye_used && self.target_eye != Eye::Cyclopean),
+                when: "with --eyes left, right or both, or --target-eye left or right",
+            },
+            ReadWhen {
+                flag: "--d2",
+                read: !matches!(self.method, Method::None | Method::Depth),
+                when: "by --method planar, ground and plane-fit",
+            },
+        ]);
+        refuse_ignored(&rules)?;
         let options = RunOptions {
             method: self.method,
             d2: self.d2,

@@ -1,19 +1,18 @@
 //! The flags of the scene-model methods (`ground`, `plane-fit`, `depth`): the depth sensor
 //! and the filling of disocclusion holes. Shared by `run` and `compare`.
 
-use anyhow::bail;
 use seethru::system::depth_sensor::{SensorKind, SensorOptions};
 use seethru::system::options::Method;
 use seethru::system::scene_model::{Fill, SceneModelOptions};
 
-use crate::cli::args::{pixels, positive, real};
+use crate::cli::args::{ReadWhen, choice, pixels, positive, real, refuse_ignored};
 
 #[derive(clap::Args, Clone)]
 pub struct SceneModelArgs {
     /// Depth sensor of plane-fit and depth: ideal (the frontal render's depth), tof (σ ∝ z,
     /// 320 px wide, 15 m range, 1 cm at 1 m, 1 mm steps) or stereo (σ ∝ z², half the frontal
     /// width, 80 m, 2 mm at 1 m, inverse-depth steps of 0.0005 /m).
-    #[arg(long = "depth-sensor", value_enum, default_value_t = SensorKind::Ideal)]
+    #[arg(long = "depth-sensor", value_enum, value_parser = choice::<SensorKind>(), default_value_t = SensorKind::Ideal)]
     pub depth_sensor: SensorKind,
     /// Depth sensor width, pixels in [1, 16384], at most the frontal camera's (aspect kept;
     /// tof and stereo only; default: the sensor's).
@@ -33,7 +32,7 @@ pub struct SceneModelArgs {
     pub depth_quantum: Option<f64>,
     /// Disocclusion holes of --method depth: none (black, counted blank), background (the
     /// nearest farther surface on the epipolar line) or inpaint (diffused from around).
-    #[arg(long, value_enum, default_value_t = Fill::None)]
+    #[arg(long, value_enum, value_parser = choice::<Fill>(), default_value_t = Fill::None)]
     pub fill: Fill,
 }
 
@@ -42,25 +41,46 @@ impl SceneModelArgs {
     /// a method that reads no depth, a fill for a method that leaves no holes. (The settings
     /// of the ideal sensor, which has none, are refused where the sensor is resolved.)
     pub fn check_used_by(&self, method: Method) -> anyhow::Result<()> {
-        let given = [
-            ("--depth-resolution", self.depth_resolution.is_some()),
-            ("--depth-range", self.depth_range.is_some()),
-            ("--depth-noise", self.depth_noise.is_some()),
-            ("--depth-quantum", self.depth_quantum.is_some()),
-        ];
         let reads_depth = matches!(method, Method::PlaneFit | Method::Depth);
-        if !reads_depth
-            && let Some((flag, _)) =
-                std::iter::once(("--depth-sensor", self.depth_sensor != SensorKind::Ideal))
-                    .chain(given)
-                    .find(|(_, g)| *g)
-        {
-            bail!("{flag} is read by --method plane-fit and depth only, not by this method");
-        }
-        if method != Method::Depth && self.fill != Fill::None {
-            bail!("--fill fills the holes of --method depth only");
-        }
-        Ok(())
+        refuse_ignored(&Self::rules(
+            reads_depth,
+            reads_depth,
+            method == Method::Depth,
+            "by --method plane-fit and depth",
+            "by --method depth (its disocclusion holes)",
+        ))
+    }
+
+    /// The rules of these flags: the sensor's settings are read when `reads_depth`, its kind
+    /// when `reads_kind`, the fill when `fills`; `depth_when` and `fill_when` say by what.
+    pub fn rules(
+        reads_depth: bool,
+        reads_kind: bool,
+        fills: bool,
+        depth_when: &'static str,
+        fill_when: &'static str,
+    ) -> Vec<ReadWhen> {
+        let depth = |flag| ReadWhen {
+            flag,
+            read: reads_depth,
+            when: depth_when,
+        };
+        vec![
+            ReadWhen {
+                flag: "--depth-sensor",
+                read: reads_kind,
+                when: depth_when,
+            },
+            depth("--depth-resolution"),
+            depth("--depth-range"),
+            depth("--depth-noise"),
+            depth("--depth-quantum"),
+            ReadWhen {
+                flag: "--fill",
+                read: fills,
+                when: fill_when,
+            },
+        ]
     }
 
     pub fn options(&self) -> SceneModelOptions {

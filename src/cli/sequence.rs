@@ -15,6 +15,7 @@ use seethru::measure::sequence_files::{
 use seethru::scene::Scene;
 use seethru::scene::head_path::HeadPath;
 use seethru::system::display::{DisplayModel, Filter};
+use seethru::system::memory::{DEFAULT_MAX_MEMORY_GIB, check_memory, sequence_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use seethru::system::sequence::head_motion::HeadMotion;
 use seethru::system::sequence::predict::Prediction;
@@ -24,7 +25,8 @@ use seethru::util::progress::summary as say;
 use serde_json::json;
 
 use crate::cli::args::{
-    HeadErrorArgs, band, pixels, positive, real, samples, threads, with_threads,
+    EYE_METHODS, HeadErrorArgs, ReadWhen, band, choice, max_memory, pixels, positive, real,
+    refuse_ignored, samples, threads, with_threads,
 };
 
 /// Longest latency, ms.
@@ -111,7 +113,7 @@ pub struct Sequence {
     yaw_rate: f64,
     /// Head motion relative to the vehicle: still, sway (lateral sinusoid) or lean (towards
     /// the pillar to look around it).
-    #[arg(long, value_enum, default_value_t = HeadPreset::Still)]
+    #[arg(long, value_enum, value_parser = choice::<HeadPreset>(), default_value_t = HeadPreset::Still)]
     head: HeadPreset,
     /// A recorded head path instead of --head: CSV of t,x,y,z (seconds; the eye in the
     /// obstacle frame, metres), times increasing.
@@ -140,35 +142,35 @@ pub struct Sequence {
     #[arg(long = "latency-tracking", default_value_t = 0.0, value_parser = real(0.0, MAX_LATENCY_MS))]
     latency_tracking: f64,
     /// Head prediction to display time.
-    #[arg(long, value_enum, default_value_t = Prediction::None)]
+    #[arg(long, value_enum, value_parser = choice::<Prediction>(), default_value_t = Prediction::None)]
     predict: Prediction,
     /// Re-project the frontal image by the vehicle's known motion from capture to display.
     #[arg(long)]
     reproject: bool,
     /// Write every frame's truth and seethru views (whole driver views) as PNG or EXR.
-    #[arg(long, value_enum, default_value_t = FramesFormat::None)]
+    #[arg(long, value_enum, value_parser = choice::<FramesFormat>(), default_value_t = FramesFormat::None)]
     frames: FramesFormat,
     /// none: the whole frontal image in the display; planar: the paper's compensation.
-    #[arg(long, value_enum, default_value_t = Method::Planar)]
+    #[arg(long, value_enum, value_parser = choice::<Method>(), default_value_t = Method::Planar)]
     method: Method,
     /// Working distance of the planar model: inf, auto or metres in [1e-6, 1e6].
     #[arg(long, default_value = "inf", value_name = "METRES|inf|auto")]
     d2: WorkingDistance,
     /// oracle: the true eye (late by the tracking latency); estimated: face detection on the
     /// back camera's image of its time.
-    #[arg(long = "head-source", value_enum, default_value_t = HeadSource::Oracle)]
+    #[arg(long = "head-source", value_enum, value_parser = choice::<HeadSource>(), default_value_t = HeadSource::Oracle)]
     head_source: HeadSource,
     /// Head-tracking errors and the detector's feature width.
     #[command(flatten)]
     head_errors: HeadErrorArgs,
     /// When the crop leaves the frontal view: black (counted, coverage < 1) or error.
-    #[arg(long, value_enum, default_value_t = Outside::Black)]
+    #[arg(long, value_enum, value_parser = choice::<Outside>(), default_value_t = Outside::Black)]
     outside: Outside,
     /// Colour resampling of the display image.
-    #[arg(long, value_enum, default_value_t = Filter::Bilinear)]
+    #[arg(long, value_enum, value_parser = choice::<Filter>(), default_value_t = Filter::Bilinear)]
     filter: Filter,
     /// pixels: the physical display; ideal: unlimited display and frontal resolution.
-    #[arg(long, value_enum, default_value_t = DisplayModel::Pixels)]
+    #[arg(long, value_enum, value_parser = choice::<DisplayModel>(), default_value_t = DisplayModel::Pixels)]
     display: DisplayModel,
     /// Driver view width, pixels in [1, 16384] (the height follows the camera's aspect).
     #[arg(long, default_value_t = 640, value_parser = pixels)]
@@ -191,6 +193,9 @@ pub struct Sequence {
     /// Worker threads in [1, 1024] (default: all cores). Output is identical for any value.
     #[arg(long, value_parser = threads)]
     threads: Option<usize>,
+    /// Refuse to start when the estimated memory exceeds this, GiB in [1e-6, 4096].
+    #[arg(long = "max-memory", value_name = "GIB", default_value_t = DEFAULT_MAX_MEMORY_GIB, value_parser = max_memory)]
+    max_memory: f64,
 }
 
 impl Sequence {
@@ -255,9 +260,74 @@ impl Sequence {
         with_threads(threads, || self.run_all())?
     }
 
+    /// Refuses the flags these settings would ignore ([`refuse_ignored`]).
+    fn refuse_ignored(&self) -> Result<()> {
+        let preset = |p: HeadPreset| self.head_path.is_none() && self.head == p;
+        let sway = "with --head sway (and no --head-path)";
+        let lean = "with --head lean (and no --head-path)";
+        let eye_used = self.method != Method::None;
+        let estimated = self.head_source == HeadSource::Estimated;
+        let mut rules = self.head_errors.rules(eye_used, estimated, false);
+        let eye = |flag| ReadWhen {
+            flag,
+            read: eye_used,
+            when: EYE_METHODS,
+        };
+        rules.extend([
+            eye("--head-source"),
+            eye("--predict"),
+            eye("--latency-tracking"),
+            ReadWhen {
+                flag: "--reproject",
+                read: self.method == Method::Planar,
+                when: "by --method planar (none shows the whole frontal image as captured)",
+            },
+            ReadWhen {
+                flag: "--back-width",
+                read: eye_used && estimated,
+                when: "with --head-source estimated (the back camera is rendered for the face detector only)",
+            },
+            ReadWhen {
+                flag: "--sway-cm",
+                read: preset(HeadPreset::Sway),
+                when: sway,
+            },
+            ReadWhen {
+                flag: "--sway-hz",
+                read: preset(HeadPreset::Sway),
+                when: sway,
+            },
+            ReadWhen {
+                flag: "--lean-cm",
+                read: preset(HeadPreset::Lean),
+                when: lean,
+            },
+            ReadWhen {
+                flag: "--lean-s",
+                read: preset(HeadPreset::Lean),
+                when: lean,
+            },
+            ReadWhen {
+                flag: "--lean-at",
+                read: preset(HeadPreset::Lean),
+                when: lean,
+            },
+            ReadWhen {
+                flag: "--d2",
+                read: self.method == Method::Planar,
+                when: "by --method planar",
+            },
+        ]);
+        refuse_ignored(&rules)
+    }
+
     fn run_all(&self) -> Result<()> {
+        self.refuse_ignored()?;
         let head = self.head_motion()?;
         let scene = Scene::load(&self.scene)?;
+        if let HeadMotion::Path(path) = &head {
+            path.check_in_world(&scene.obstacle.world_from_obstacle)?;
+        }
         // Every latency's timeline is checked before anything is rendered or written.
         let all: Vec<SequenceOptions> = self
             .latency_camera
@@ -268,6 +338,18 @@ impl Sequence {
         for o in &all {
             o.timeline.validate()?;
         }
+        // Before anything is allocated: a size the machine cannot hold is refused with numbers.
+        let first = &all[0];
+        check_memory(
+            &sequence_estimate(
+                &scene,
+                &first.run,
+                first.timeline.frames() as u64,
+                first.timeline.fps,
+                all.len() as u64,
+            )?,
+            self.max_memory,
+        )?;
         // Written whole or not at all: a failure at any latency leaves `--out` as it was.
         let staged = StagedDir::new(&self.out)?;
         let out = staged.path().to_path_buf();

@@ -10,7 +10,7 @@ use seethru::scene::Scene;
 use seethru::system::memory::{DEFAULT_MAX_MEMORY_GIB, MemoryEstimate, check_memory, run_estimate};
 use seethru::system::options::{HeadSource, RunOptions};
 
-use crate::cli::args::{band, max_memory, pixels, samples, threads, with_threads};
+use crate::cli::args::{band, choice, max_memory, pixels, samples, threads, with_threads};
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -30,7 +30,7 @@ pub struct Sweep {
     #[arg(long, default_value_t = 1, value_parser = samples)]
     spp: u32,
     /// oracle: the true eye; estimated: face detection on the back camera's image.
-    #[arg(long, value_enum, default_value_t = HeadSource::Oracle)]
+    #[arg(long, value_enum, value_parser = choice::<HeadSource>(), default_value_t = HeadSource::Oracle)]
     head: HeadSource,
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]

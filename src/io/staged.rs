@@ -23,6 +23,9 @@ pub struct StagedDir {
     /// one the removal starts from.
     created: Option<(PathBuf, PathBuf)>,
     committed: bool,
+    /// Whether an existing target is swapped whole (a folder output), not merged file by
+    /// file (files staged into a shared folder, [`StagedDir::inside`]).
+    swaps: bool,
 }
 
 impl StagedDir {
@@ -51,7 +54,7 @@ impl StagedDir {
             .to_string_lossy()
             .to_string();
         let parent = target.parent().unwrap_or(Path::new(""));
-        Self::create(target, parent, &name)
+        Self::create(target, parent, &name, target)
     }
 
     /// Stages files that go into the folder `folder` (created if missing), for an output
@@ -68,15 +71,17 @@ impl StagedDir {
             bail!("{} is a file, not a folder", target.display());
         }
         // `commit` moves the files into the folder itself.
-        let mut staged = Self::create(target, target, name)?;
+        let mut staged = Self::create(target, target, name, &folder.join(name))?;
         staged.shown = folder.to_path_buf();
+        staged.swaps = false;
         in_flight().stage_as(&staged.staging, folder);
         Ok(staged)
     }
 
     /// Creates `parent` (where missing) and the staging folder `.<name>.tmp-<pid>` in it,
     /// under the registry's lock: no staging folder is created once an interrupt began.
-    fn create(target: &Path, parent: &Path, name: &str) -> Result<Self> {
+    /// `output` is the path messages name: the folder, or the file staged inside one.
+    fn create(target: &Path, parent: &Path, name: &str, output: &Path) -> Result<Self> {
         let created = parent
             .ancestors()
             .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
@@ -89,18 +94,19 @@ impl StagedDir {
             staging: temporary(&parent.join(name), name, std::process::id()),
             created: None,
             committed: false,
+            swaps: true,
         };
         let mut state = in_flight();
         state.check_running()?;
         remove_stale(&parent.join(name), name);
         let _ = std::fs::remove_dir_all(&staged.staging);
         create_folders(&state, parent)
-            .with_context(|| format!("cannot write the output {}", target.display()))?;
+            .with_context(|| format!("cannot write the output {}", output.display()))?;
         staged.created = created;
         std::fs::create_dir(&staged.staging).map_err(|e| {
             anyhow::anyhow!(
                 "cannot write the output {}: cannot create a folder in {}: {e}",
-                target.display(),
+                output.display(),
                 if parent.as_os_str().is_empty() {
                     Path::new(".")
                 } else {
@@ -142,6 +148,39 @@ impl StagedDir {
         } else {
             let mut moves = Vec::new();
             plan_moves(&self.staging, &self.target, &mut moves)?;
+            // Into an existing folder: the old files the new set does not replace join the
+            // staging folder, and the two folders swap in one step, so a kill at any moment
+            // leaves the old set or the new one, never a mix. Where the file system cannot
+            // swap (or the folder holds the current directory, which a swap would unlink),
+            // the files move one by one.
+            if self.swaps && swaps_whole(&self.target) {
+                // Temporaries that killed processes left for these files go, as with moves.
+                for (_, to) in &moves {
+                    if let Some(name) = to.file_name() {
+                        remove_stale(to, &name.to_string_lossy());
+                    }
+                }
+                keep_old_files(&self.target, &self.staging).with_context(|| {
+                    format!("cannot keep the files of {}", self.target.display())
+                })?;
+                // `out/.` names `out`, but renameat2 refuses a path ending in `.`.
+                let target: PathBuf = self.target.components().collect();
+                match exchange(&self.staging, &target) {
+                    Ok(()) => {
+                        // The staging path now holds the old set.
+                        let _ = std::fs::remove_dir_all(&self.staging);
+                        self.committed = true;
+                        state.track(&self.staging, false);
+                        return Ok(());
+                    }
+                    Err(e) if e.kind() == std::io::ErrorKind::Unsupported => {}
+                    Err(e) => {
+                        return Err(e).with_context(|| {
+                            format!("cannot move the output into {}", self.target.display())
+                        });
+                    }
+                }
+            }
             for (from, to) in moves {
                 if let (Some(dir), Some(name)) = (to.parent(), to.file_name()) {
                     create_folders(&state, dir)?;
@@ -156,6 +195,57 @@ impl StagedDir {
         state.track(&self.staging, false);
         Ok(())
     }
+}
+
+/// Whether the output `target` (an existing folder) is replaced by swapping folders: not
+/// when it holds the current directory.
+fn swaps_whole(target: &Path) -> bool {
+    match (std::env::current_dir(), target.canonicalize()) {
+        (Ok(here), Ok(target)) => !here.starts_with(target),
+        _ => false,
+    }
+}
+
+/// Hard-links (or copies, where links fail) every file of `old` that `new` lacks into `new`,
+/// folders made as needed, so that `new` holds the set the file-by-file moves would leave.
+fn keep_old_files(old: &Path, new: &Path) -> Result<()> {
+    for entry in std::fs::read_dir(old)? {
+        let entry = entry?;
+        let (from, to) = (entry.path(), new.join(entry.file_name()));
+        let kind = entry.file_type()?;
+        if kind.is_dir() {
+            if !to.exists() {
+                std::fs::create_dir(&to)?;
+            }
+            keep_old_files(&from, &to)?;
+        } else if std::fs::symlink_metadata(&to).is_err() && std::fs::hard_link(&from, &to).is_err()
+        {
+            std::fs::copy(&from, &to)?;
+        }
+    }
+    Ok(())
+}
+
+/// Swaps the folders `a` and `b` in one step (Linux `renameat2` with `RENAME_EXCHANGE`);
+/// `Unsupported` where the system or the file system cannot.
+#[cfg(target_os = "linux")]
+fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
+    use rustix::fs::{CWD, RenameFlags, renameat_with};
+    match renameat_with(CWD, a, CWD, b, RenameFlags::EXCHANGE) {
+        Ok(()) => Ok(()),
+        Err(e) if e == rustix::io::Errno::INVAL || e == rustix::io::Errno::NOSYS => Err(
+            std::io::Error::new(std::io::ErrorKind::Unsupported, "no RENAME_EXCHANGE"),
+        ),
+        Err(e) => Err(e.into()),
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn exchange(_: &Path, _: &Path) -> std::io::Result<()> {
+    Err(std::io::Error::new(
+        std::io::ErrorKind::Unsupported,
+        "no atomic folder swap here",
+    ))
 }
 
 /// Every file under `from` with its place under `to`; an error, before anything moves, where

@@ -312,17 +312,12 @@ pub fn finished_rows(
         .map(|(i, c)| (c.as_slice(), i))
         .collect();
     let mut rows = Vec::new();
-    let (mut line_of_index, mut line_of_place) = (HashMap::new(), HashMap::new());
+    let mut seen = SeenRows::default();
     let (mut outside, mut first_outside, mut count) = (0usize, None, 0usize);
     for (number, mut fields) in all {
         let index = check_row(&fields, params.len(), csv, number, hint)?;
         count += 1;
-        if let Some(earlier) = line_of_index.insert(index, number) {
-            bail!(
-                "{}:{number}: configuration {index} appears twice (also on line {earlier}); remove the file or choose another --out",
-                csv.display()
-            );
-        }
+        seen.note(&fields, params, index, csv, number)?;
         if let Some((shown, theirs, ours)) = first_difference(settings_of(&fields), settings) {
             bail!(
                 "{}:{number}: computed with {shown} {theirs}, this sweep has {shown} {ours}{}: resuming would mix the two; resume with the same settings, or choose another --out",
@@ -344,13 +339,6 @@ pub fn finished_rows(
             first_outside.get_or_insert((number, values));
             continue;
         };
-        if let Some(earlier) = line_of_place.insert(at, number) {
-            bail!(
-                "{}:{number}: the configuration {} appears twice (also on line {earlier}); remove the file or choose another --out",
-                csv.display(),
-                config_text(&values)
-            );
-        }
         fields[0] = at.to_string();
         fields[1 + params.len() + METRIC_COLUMNS.len()] = configs.len().to_string();
         rows.push((at, encode(&fields)));
@@ -363,6 +351,50 @@ pub fn finished_rows(
         );
     }
     Ok(rows)
+}
+
+/// The rows of one sweep CSV read so far: a configuration given twice in one file, by its
+/// index or by its parameter values, is an error naming both lines. The one check of a
+/// resumed CSV and of each part `sweep-merge` joins.
+#[derive(Default)]
+pub struct SeenRows {
+    line_of_index: HashMap<usize, usize>,
+    line_of_values: HashMap<Vec<String>, usize>,
+}
+
+impl SeenRows {
+    /// Notes the checked row `fields` (of the parameters `names`, index `index`) on line
+    /// `number` of `csv`.
+    pub fn note(
+        &mut self,
+        fields: &[String],
+        names: &[String],
+        index: usize,
+        csv: &Path,
+        number: usize,
+    ) -> Result<()> {
+        if let Some(earlier) = self.line_of_index.insert(index, number) {
+            bail!(
+                "{}:{number}: configuration {index} appears twice (also on line {earlier}); remove the file or choose another --out",
+                csv.display()
+            );
+        }
+        let values = fields[1..=names.len()].to_vec();
+        if let Some(earlier) = self.line_of_values.insert(values, number) {
+            bail!(
+                "{}:{number}: the configuration {} appears twice (also on line {earlier}); remove the file or choose another --out",
+                csv.display(),
+                config_text(
+                    &names
+                        .iter()
+                        .cloned()
+                        .zip(fields[1..].iter().cloned())
+                        .collect::<Vec<_>>()
+                )
+            );
+        }
+        Ok(())
+    }
 }
 
 /// A configuration for a message: `theta_f=30, d2=inf`.

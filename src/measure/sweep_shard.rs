@@ -8,7 +8,7 @@ use anyhow::{Context, Result, bail};
 
 use crate::io::atomic::write_text;
 use crate::measure::sweep_csv::{
-    GRID_COLUMN, MAX_SWEEP_CSV_BYTES, METRIC_COLUMNS, check_row, columns_text, encode,
+    GRID_COLUMN, MAX_SWEEP_CSV_BYTES, METRIC_COLUMNS, SeenRows, check_row, columns_text, encode,
     first_difference, header as sweep_header, header_difference, params_of, records,
 };
 use crate::measure::sweep_grid::Param;
@@ -105,8 +105,11 @@ pub fn merge(parts: &[&Path], out: &Path) -> Result<Merged> {
             Some(_) => {}
         }
         let tail_at = 1 + names.len() + METRIC_COLUMNS.len();
+        // Within one part, as in a resumed CSV: no configuration twice.
+        let mut seen = SeenRows::default();
         for (number, fields) in records {
             let index = check_row(&fields, names.len(), part, number, hint)?;
+            seen.note(&fields, &names, index, part, number)?;
             let tail = &fields[tail_at..];
             match &first_tail {
                 None => first_tail = Some((tail.to_vec(), part, number)),

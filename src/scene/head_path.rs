@@ -15,6 +15,9 @@ pub const MAX_ROWS: usize = 1_000_000;
 pub struct HeadPath {
     /// (time s, eye in the obstacle frame m), times strictly increasing.
     pub samples: Vec<(f64, DVec3)>,
+    /// The file's name for messages, and each sample's line in it.
+    pub name: String,
+    pub lines: Vec<u64>,
 }
 
 /// Largest head-path CSV read (a million samples of four numbers fit).
@@ -35,6 +38,7 @@ impl HeadPath {
             .trim(csv::Trim::All)
             .from_reader(text);
         let mut samples: Vec<(f64, DVec3)> = Vec::new();
+        let mut lines = Vec::new();
         for (i, record) in reader.records().enumerate() {
             let record = record.map_err(|e| {
                 let line = e.position().map_or(i as u64 + 1, |p| p.line());
@@ -70,11 +74,32 @@ impl HeadPath {
                 bail!("{name}:{line}: more than {MAX_ROWS} rows");
             }
             samples.push((t, DVec3::new(x, y, z)));
+            lines.push(line);
         }
         if samples.is_empty() {
             bail!("{name}: the head path has no rows (expected t,x,y,z lines)");
         }
-        Ok(HeadPath { samples })
+        Ok(HeadPath {
+            samples,
+            name: name.to_string(),
+            lines,
+        })
+    }
+
+    /// Refuses a path that puts the eye outside the world (the camera limit that
+    /// `camera.driver.position` obeys) once placed by `world_from_obstacle`; the error names
+    /// the file and the line.
+    pub fn check_in_world(&self, world_from_obstacle: &glam::DAffine3) -> Result<()> {
+        for (&(t, eye), line) in self.samples.iter().zip(&self.lines) {
+            let world = world_from_obstacle.transform_point3(eye);
+            if let Some(why) = crate::scene::limits::out_of_world(world) {
+                bail!(
+                    "{}:{line}: the eye at t = {t} s lies outside the world once placed by the obstacle: {why}",
+                    self.name
+                );
+            }
+        }
+        Ok(())
     }
 
     /// The eye at time `t`, obstacle frame.

@@ -52,6 +52,9 @@ pub struct ObjectMotion {
     pub keyframes: Vec<Keyframe>,
     /// The object's scale factors (the keyframes replace translation and rotation only).
     pub scale: DVec3,
+    /// Where each keyframe's `translate` is in the scene file (its message empty), for
+    /// errors found once the object's mesh is loaded: its triangles leaving the world.
+    pub places: Vec<crate::scene::source::SceneError>,
 }
 
 impl ObjectMotion {
@@ -122,6 +125,7 @@ pub fn read_object_motion(
         ));
     }
     let mut keyframes: Vec<Keyframe> = Vec::new();
+    let mut places = Vec::new();
     for k in tables {
         let time = k.f64_in("t", f64::NAN, 0.0, MAX_KEY_TIME_S).map_err(|e| {
             if k.has("t") {
@@ -167,6 +171,7 @@ pub fn read_object_motion(
                 format!("the path leaves the world at t = {time} s: {why}"),
             ));
         }
+        places.push(k.error("translate", ""));
         k.finish()?;
         keyframes.push(key);
     }
@@ -174,7 +179,52 @@ pub fn read_object_motion(
         moves_with,
         keyframes,
         scale,
+        places,
     })
+}
+
+/// Checks a keyframed mesh at every keyframe: the corners of its bounding box (object frame)
+/// placed by each key stay inside the world, as a keyframed sphere's do. The error names the
+/// scene file and the keyframe's line.
+pub fn check_keyframed_mesh(
+    path: &std::path::Path,
+    object: &str,
+    tris: &[crate::scene::shapes::Tri],
+    motion: &ObjectMotion,
+) -> anyhow::Result<()> {
+    let Some(first) = tris.first() else {
+        return Ok(());
+    };
+    let (mut lo, mut hi) = (first.p[0].as_dvec3(), first.p[0].as_dvec3());
+    for p in tris.iter().flat_map(|t| t.p) {
+        lo = lo.min(p.as_dvec3());
+        hi = hi.max(p.as_dvec3());
+    }
+    let corners: Vec<DVec3> = (0..8)
+        .map(|i| {
+            DVec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect();
+    for (key, place) in motion.keyframes.iter().zip(&motion.places) {
+        let at = placement(key.translate, key.rotate_deg, motion.scale);
+        if let Some(why) = corners
+            .iter()
+            .find_map(|c| out_of_world(at.transform_point3(*c)))
+        {
+            let mut error = place.clone();
+            error.message = format!(
+                "the path of object `{object}` takes its mesh {} outside the world at t = {} s: {why}",
+                path.display(),
+                key.t
+            );
+            return Err(error.into());
+        }
+    }
+    Ok(())
 }
 
 /// The vehicle's motion: constant speed along its heading, constant yaw rate, on flat ground
@@ -252,6 +302,7 @@ mod tests {
             moves_with: MovesWith::World,
             keyframes: vec![key(1.0, 0.0), key(3.0, 4.0)],
             scale: DVec3::ONE,
+            places: Vec::new(),
         };
         let x = |t: f64| m.world_from_object_at(t).unwrap().translation.x;
         assert_eq!(

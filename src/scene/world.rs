@@ -12,6 +12,7 @@ use obvhs::rt_triangle::RtTriangle;
 
 use crate::scene::limits::check_placed_mesh;
 use crate::scene::mesh_io::{LoadedMesh, load_mesh};
+use crate::scene::motion::check_keyframed_mesh;
 use crate::scene::shapes::{Tri, box_face, cuboid, frustum, plane_xz, quad_xy};
 use crate::scene::texture::Texture;
 use crate::scene::{CameraKind, Obstacle, Scene, Shape};
@@ -213,6 +214,7 @@ impl World {
                         &object.world_from_object,
                         world.triangles.len(),
                     )?;
+                    check_keyframed_mesh(path, &object.name, &mesh.tris, &object.motion)?;
                     let first = world.materials.len() as u32;
                     world
                         .materials

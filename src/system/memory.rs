@@ -91,6 +91,47 @@ pub fn both_eyes_estimate(scene: &Scene, options: &RunOptions) -> Result<MemoryE
     })
 }
 
+/// Bytes kept per frame of a sequence for frames.csv and the summaries (its times, eyes and
+/// metrics; a generous bound).
+const SEQUENCE_RECORD_BYTES: u64 = 512;
+
+/// Bytes per preview pixel a sequence keeps until the end: the truth and seethru panels
+/// (sRGB) and the misregistration (f32).
+const PREVIEW_BYTES_PER_PIXEL: u64 = 3 + 3 + 4;
+
+/// Longest side of a preview panel and the preview's highest frame rate (the preview's own
+/// limits, `measure::sequence_files`), for the estimate's bound.
+const PREVIEW_SIDE: u64 = 320;
+const PREVIEW_FPS: f64 = 30.0;
+
+/// `sequence`: one frame of the system at a time (as `run` holds them), the preview panels of
+/// every previewed frame, and the records of every frame of all `sequences` (one per camera
+/// latency) of `frames` frames at `fps`.
+pub fn sequence_estimate(
+    scene: &Scene,
+    options: &RunOptions,
+    frames: u64,
+    fps: f64,
+    sequences: u64,
+) -> Result<MemoryEstimate> {
+    let one = run_estimate(scene, options)?;
+    let driver = options.sized_driver(scene.driver)?;
+    let panel = (driver.width as u64).min(PREVIEW_SIDE) * (driver.height as u64).min(PREVIEW_SIDE);
+    let every = (fps / PREVIEW_FPS).ceil().max(1.0) as u64;
+    let previewed = frames.div_ceil(every);
+    let preview = previewed.saturating_mul(panel * PREVIEW_BYTES_PER_PIXEL);
+    let records = frames
+        .saturating_mul(sequences)
+        .saturating_mul(SEQUENCE_RECORD_BYTES);
+    Ok(MemoryEstimate {
+        bytes: one.bytes.saturating_add(preview).saturating_add(records),
+        what: format!(
+            "{}, {previewed} preview frames and the records of {sequences}×{frames} frames",
+            one.what
+        ),
+    })
+}
+
 /// Refuses an estimate above `limit_gib`, saying what it counts and how to proceed.
 pub fn check_memory(estimate: &MemoryEstimate, limit_gib: f64) -> Result<()> {
     let gib = estimate.bytes as f64 / (1u64 << 30) as f64;

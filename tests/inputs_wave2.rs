@@ -1,0 +1,613 @@
+//! Wave 2's inputs held to wave 1's standard: spaces around every choice value are ignored,
+//! and every flag of `run`, `sequence` and `compare` either changes the output or is refused
+//! where the other flags make the command ignore it. Both walk the commands' own `--help`,
+//! so a flag added later is checked too.
+
+mod common;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use common::refusal::run_in;
+
+/// An option of a command's `--help`: its flag, value name (None for a switch), possible
+/// values (choices), default and description.
+#[derive(Debug, Clone)]
+struct HelpOption {
+    flag: String,
+    value: Option<String>,
+    choices: Vec<String>,
+    default: Option<String>,
+    help: String,
+}
+
+fn help_options(words: &[&str]) -> Vec<HelpOption> {
+    let mut args = words.to_vec();
+    args.push("--help");
+    let (ok, help, err) = common::seethru(&args);
+    assert!(ok, "{args:?}: {err}");
+    let lines: Vec<&str> = help.lines().map(str::trim).collect();
+    let mut found = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let Some(rest) = line.strip_prefix("--") else {
+            continue;
+        };
+        let (flag, value) = match rest.split_once(" <") {
+            Some((f, v)) => (f, Some(v.trim_end_matches('>').to_string())),
+            None => (rest, None),
+        };
+        let below: Vec<&str> = lines[i + 1..]
+            .iter()
+            .copied()
+            .take_while(|l| !l.starts_with("--") && !l.starts_with("-h,"))
+            .collect();
+        let choices = below
+            .iter()
+            .filter_map(|l| l.strip_prefix("- "))
+            .map(|c| c.split(':').next().unwrap().trim().to_string())
+            .collect();
+        let default = below
+            .iter()
+            .find_map(|l| l.strip_prefix("[default: "))
+            .map(|d| d.trim_end_matches(']').to_string());
+        found.push(HelpOption {
+            flag: format!("--{flag}"),
+            value,
+            choices,
+            default,
+            help: below.join(" "),
+        });
+    }
+    found
+}
+
+const COMMANDS: [&[&str]; 14] = [
+    &["render"],
+    &["run"],
+    &["ratio", "occlusion"],
+    &["ratio", "foreshortening"],
+    &["reproduce"],
+    &["sweep"],
+    &["sweep-merge"],
+    &["measure"],
+    &["export"],
+    &["figures"],
+    &["analyze"],
+    &["bench"],
+    &["compare"],
+    &["sequence"],
+];
+
+#[test]
+fn every_choice_flag_ignores_spaces_around_its_values() {
+    // `--eyes ' both'` is `both`, as `--width ' 5'` is 5; in a list each item is trimmed.
+    // `--flag=v --help` parses the value, then prints the help: nothing runs.
+    let mut walked = 0;
+    let mut wrong = Vec::new();
+    for words in COMMANDS {
+        for option in help_options(words) {
+            if option.choices.is_empty() {
+                continue;
+            }
+            walked += 1;
+            for choice in &option.choices {
+                for given in [
+                    format!(" {choice}"),
+                    format!("{choice} "),
+                    format!(" {choice} "),
+                ] {
+                    let arg = format!("{}={given}", option.flag);
+                    let mut args: Vec<&str> = words.to_vec();
+                    args.extend([arg.as_str(), "--help"]);
+                    let (ok, _, err) = common::seethru(&args);
+                    if !ok {
+                        wrong.push(format!("{words:?} {arg:?}: {err}"));
+                    }
+                }
+            }
+            // A value that is no choice, spaced or not, is still refused, naming the flag.
+            let arg = format!("{}= nothing-of-the-kind ", option.flag);
+            let mut args: Vec<&str> = words.to_vec();
+            args.extend([arg.as_str(), "--help"]);
+            let (ok, _, err) = common::seethru(&args);
+            if ok || !err.starts_with("error: invalid value") || !err.contains(&option.flag) {
+                wrong.push(format!("{words:?} {arg:?} accepted or unclear: {err}"));
+            }
+        }
+    }
+    // A list: `compare --methods 'planar-inf, ground'`.
+    let (ok, _, err) = common::seethru(&["compare", "--methods= planar-inf , ground", "--help"]);
+    if !ok {
+        wrong.push(format!("compare --methods with spaces: {err}"));
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    assert!(walked >= 20, "{walked} choice flags");
+}
+
+/// A value for `option` that differs from its default and is quick to compute with.
+fn probe(option: &HelpOption) -> Option<String> {
+    let quick: BTreeMap<&str, &str> = [
+        ("--width", "24"),
+        ("--height", "12"),
+        ("--frontal-width", "40"),
+        ("--back-width", "40"),
+        ("--spp", "2"),
+        ("--band", "2"),
+        ("--duration", "0.1"),
+        ("--fps", "30"),
+        ("--display-hz", "20"),
+        ("--depth-resolution", "20"),
+        ("--lean-at", "0.02"),
+        ("--lean-s", "0.05"),
+        ("--latency-camera", "30"),
+        ("--head-bias-cm", "2,0,0"),
+        ("--d2", "3"),
+        ("--head-jitter-cm", "2"),
+        ("--speed", "40"),
+    ]
+    .into_iter()
+    .collect();
+    if let Some(v) = quick.get(option.flag.as_str()) {
+        return Some(v.to_string());
+    }
+    if !option.choices.is_empty() {
+        return option
+            .choices
+            .iter()
+            .find(|c| Some(*c) != option.default.as_ref())
+            .cloned();
+    }
+    option.value.as_ref()?;
+    // The middle of the documented range, or its low end when that is the default.
+    let text = option.help.as_str();
+    let open = text.find('[')?;
+    let (low, high) = text[open + 1..].split(']').next()?.split_once(", ")?;
+    let (low, high): (f64, f64) = (low.trim().parse().ok()?, high.trim().parse().ok()?);
+    let mid = (low + high.min(1e3)) / 2.0;
+    let default: Option<f64> = option.default.as_ref().and_then(|d| d.parse().ok());
+    Some(if default == Some(mid) { low } else { mid }.to_string())
+}
+
+/// Every file under `dir` (relative path → bytes), but `skip`'s names, which record the
+/// parameters themselves.
+fn files(dir: &Path, skip: &[&str]) -> BTreeMap<String, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if !skip.contains(&e.file_name().to_str().unwrap()) {
+                out.insert(
+                    p.strip_prefix(dir).unwrap().display().to_string(),
+                    std::fs::read(&p).unwrap(),
+                );
+            }
+        }
+    }
+    out
+}
+
+/// Flags no output file can show: where the output goes, how it is computed (identical
+/// for any thread count, by design), its memory limit, the log, and inputs that need a file.
+const NOT_OUTPUTS: [&str; 8] = [
+    "--out",
+    "--threads",
+    "--max-memory",
+    "--quiet",
+    "--calibration",
+    "--head-path",
+    "--help",
+    "--version",
+];
+
+/// Runs `base` with each flag of `words`' help set to a probe value: each must be refused
+/// as ignored (one line naming it) or change an output file. `unchanged_ok` lists flags the
+/// scene cannot show under `base`, each with the reason.
+fn each_flag_is_read_or_refused(
+    words: &[&str],
+    base: &[&str],
+    skip: &[&str],
+    unchanged_ok: &[(&str, &str)],
+) -> Vec<String> {
+    let dir = common::refusal::scratch("", &[]);
+    let mut args: Vec<&str> = words.to_vec();
+    args.extend(["scene.toml", "--out", "base"]);
+    args.extend(base);
+    let (code, err) = run_in(dir.path(), &args);
+    assert_eq!(code, 0, "{args:?}: {err}");
+    let reference = files(&dir.path().join("base"), skip);
+    let mut wrong = Vec::new();
+    for option in help_options(words) {
+        if NOT_OUTPUTS.contains(&option.flag.as_str())
+            || base.contains(&option.flag.as_str())
+            || unchanged_ok.iter().any(|(f, _)| *f == option.flag)
+        {
+            continue;
+        }
+        let value = probe(&option);
+        let mut args: Vec<&str> = words.to_vec();
+        args.extend(["scene.toml", "--out", "probe"]);
+        args.extend(base);
+        args.push(&option.flag);
+        if option.value.is_some() {
+            let Some(v) = value.as_deref() else {
+                wrong.push(format!("{}: no probe value", option.flag));
+                continue;
+            };
+            args.push(v);
+        }
+        let _ = std::fs::remove_dir_all(dir.path().join("probe"));
+        let (code, err) = run_in(dir.path(), &args);
+        if code != 0 {
+            // Refused as ignored (naming the flag), or for another reason the user is told
+            // (no face in the minimal scene's back camera): not silently dropped.
+            if !(err.starts_with("error: ") && err.lines().count() == 1) {
+                wrong.push(format!("{args:?}: refused without one error line: {err}"));
+            }
+            continue;
+        }
+        if files(&dir.path().join("probe"), skip) == reference {
+            wrong.push(format!(
+                "{args:?}: accepted, and every output is identical without it: ignored"
+            ));
+        }
+    }
+    wrong
+}
+
+#[test]
+fn every_flag_of_run_changes_the_output_or_is_refused() {
+    let mut wrong = Vec::new();
+    // run.json records every parameter: the views and metrics must show the flag.
+    let skip = ["run.json"];
+    for (base, unchanged_ok) in [
+        (
+            &["--spp", "1", "--head-jitter-cm", "0"][..],
+            &[(
+                "--outside",
+                "only a crop past the frontal view differs, and the minimal scene's fits",
+            )][..],
+        ),
+        (
+            &["--spp", "1", "--method", "depth"],
+            &[
+                ("--outside", "as above"),
+                (
+                    "--fill",
+                    "the minimal scene's sphere leaves no disocclusion hole",
+                ),
+                (
+                    "--depth-sensor",
+                    "tested by tests/bad_input.rs (its settings follow it)",
+                ),
+            ],
+        ),
+        (
+            &["--spp", "1", "--method", "none"],
+            &[
+                ("--outside", "as above"),
+                (
+                    "--filter",
+                    "none scales the whole frontal image; its filter is read",
+                ),
+            ],
+        ),
+    ] {
+        wrong.extend(each_flag_is_read_or_refused(
+            &["run"],
+            base,
+            &skip,
+            unchanged_ok,
+        ));
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+#[test]
+fn every_flag_of_sequence_changes_the_output_or_is_refused() {
+    let mut wrong = Vec::new();
+    // The summaries record every parameter: frames.csv, the plots and previews must show it.
+    let skip = ["summary.json"];
+    let quick = [
+        "--duration",
+        "0.1",
+        "--width",
+        "24",
+        "--fps",
+        "30",
+        "--speed",
+        "40",
+        "--yaw-rate",
+        "10",
+    ];
+    // Lean starts within the 0.1 s; the yaw makes --reproject visible (at d2 → ∞ a pure
+    // translation needs none); --method none reads no eye estimate.
+    for extra in [
+        &["--head", "sway"][..],
+        &["--head", "lean", "--lean-at", "0.02"],
+        &["--head", "sway", "--method", "none"],
+    ] {
+        let mut base: Vec<&str> = quick.to_vec();
+        base.extend(["--latency-camera", "30"]);
+        base.extend(extra);
+        wrong.extend(each_flag_is_read_or_refused(
+            &["sequence"],
+            &base,
+            &skip,
+            &[("--outside", "only a crop past the frontal view differs")],
+        ));
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+#[test]
+fn every_flag_of_compare_changes_the_output_or_is_refused() {
+    // Methods that read no depth: every depth flag is refused, as `run` refuses them.
+    // The table's files record the settings: the strips must show the flag.
+    let wrong = each_flag_is_read_or_refused(
+        &["compare"],
+        &["--spp", "1", "--methods", "planar-inf,ground"],
+        &["compare.md", "compare.html", "compare.json"],
+        &[(
+            "--band",
+            "changes the table's border-band metrics only (tests/measurements.rs checks them)",
+        )],
+    );
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+#[test]
+fn the_worlds_limits_follow_what_moves() {
+    // A keyframed mesh: its origin stays inside the world, its triangles leave it at t = 1 s
+    // (a sphere on the same path was refused; the mesh was not).
+    let mesh = "v -3 0 0\nv 3 0 0\nv 0 3 0\nf 1 2 3\n";
+    let keyed = |x: &str| {
+        format!(
+            "\n[[object]]\nname = \"m\"\nkind = \"mesh\"\npath = \"m.obj\"\ntranslate = [0.0, 0.0, -10.0]\n[[object.keyframe]]\nt = 0.0\n[[object.keyframe]]\nt = 1.0\ntranslate = [{x}, 0.0, -10.0]\n"
+        )
+    };
+    let dir = common::refusal::scratch(&keyed("999998.0"), &[("m.obj", mesh.as_bytes())]);
+    let text = std::fs::read_to_string(dir.path().join("scene.toml")).unwrap();
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("translate = [999998.0"))
+        .unwrap()
+        + 1;
+    common::refusal::refused(
+        dir.path(),
+        &["render", "scene.toml", "--out", "out", "--width", "8"],
+        1,
+        &[
+            &format!("scene.toml:{line}:"),
+            "keyframe[1].translate",
+            "takes its mesh m.obj outside the world at t = 1 s",
+            "1000001",
+        ],
+    );
+    assert!(!dir.path().join("out").exists());
+    // Three metres nearer, every vertex is inside: accepted.
+    let dir = common::refusal::scratch(&keyed("999996.0"), &[("m.obj", mesh.as_bytes())]);
+    let (code, err) = run_in(
+        dir.path(),
+        &["render", "scene.toml", "--out", "out", "--width", "8"],
+    );
+    assert_eq!(code, 0, "{err}");
+
+    // A head path: within the CSV's ±1e6 in the obstacle frame, but the obstacle stands at
+    // z = −0.8 m, so z = −999999.5 puts the eye at −1000000.3 in the world.
+    let dir = common::refusal::scratch(
+        "",
+        &[("p.csv", b"t,x,y,z\n0,0,0,0.8\n0.05,0,0,-999999.5\n")],
+    );
+    common::refusal::refused(
+        dir.path(),
+        &[
+            "sequence",
+            "scene.toml",
+            "--out",
+            "out",
+            "--head-path",
+            "p.csv",
+            "--duration",
+            "0.1",
+            "--width",
+            "16",
+        ],
+        1,
+        &["p.csv:3: the eye at t = 0.05 s lies outside the world"],
+    );
+    assert!(!dir.path().join("out").exists());
+}
+
+#[test]
+fn sweep_merge_checks_each_parts_rows_as_a_resume_does() {
+    let dir = common::refusal::scratch("", &[]);
+    let sweep = |out: &str| {
+        let (code, err) = run_in(
+            dir.path(),
+            &[
+                "sweep",
+                "scene.toml",
+                "--width",
+                "8",
+                "--param",
+                "theta_f=20,40",
+                "--out",
+                out,
+            ],
+        );
+        assert_eq!(code, 0, "{err}");
+        std::fs::read_to_string(dir.path().join(out)).unwrap()
+    };
+    let whole = sweep("s.csv");
+    let (code, err) = run_in(dir.path(), &["sweep-merge", "s.csv", "--out", "m.csv"]);
+    assert_eq!(code, 0, "{err}");
+    // One row twice in a part: refused by the merge, as by a resume of the same file.
+    let lines: Vec<&str> = whole.lines().collect();
+    let twice = format!("{}\n{}\n{}\n{}\n", lines[0], lines[1], lines[1], lines[2]);
+    std::fs::write(dir.path().join("twice.csv"), &twice).unwrap();
+    let merged = common::refusal::refused(
+        dir.path(),
+        &["sweep-merge", "twice.csv", "--out", "m2.csv"],
+        1,
+        &["twice.csv:3: configuration 0 appears twice (also on line 2)"],
+    );
+    std::fs::write(dir.path().join("s.csv"), &twice).unwrap();
+    let resumed = common::refusal::refused(
+        dir.path(),
+        &[
+            "sweep",
+            "scene.toml",
+            "--width",
+            "8",
+            "--param",
+            "theta_f=20,40",
+            "--out",
+            "s.csv",
+        ],
+        1,
+        &["s.csv:3: configuration 0 appears twice (also on line 2)"],
+    );
+    assert_eq!(
+        merged.split(": configuration").nth(1),
+        resumed.split(": configuration").nth(1)
+    );
+    assert!(!dir.path().join("m2.csv").exists());
+}
+
+#[test]
+fn sequence_estimates_its_memory_first_and_messages_name_the_form_and_the_file() {
+    let dir = common::refusal::scratch("", &[]);
+    common::refusal::refused(
+        dir.path(),
+        &[
+            "sequence",
+            "scene.toml",
+            "--out",
+            "out",
+            "--width",
+            "64",
+            "--max-memory",
+            "0.0001",
+        ],
+        1,
+        &[
+            "this needs about",
+            "more than --max-memory 0.0001 GiB",
+            "preview frames",
+        ],
+    );
+    assert!(common::refusal::listing(dir.path()) == ["scene.toml"]);
+    // The estimate counts the frames kept: a long sequence needs more than a short one.
+    let needs = |duration: &str| -> String {
+        let (_, err) = run_in(
+            dir.path(),
+            &[
+                "sequence",
+                "scene.toml",
+                "--out",
+                "out",
+                "--duration",
+                duration,
+                "--max-memory",
+                "0.000001",
+            ],
+        );
+        assert!(err.contains("this needs about"), "{err}");
+        err
+    };
+    assert!(needs("1").contains(" 30 preview frames and the records of 1×60 frames"));
+    assert!(needs("1000").contains(" 30000 preview frames and the records of 1×60000 frames"));
+    common::refusal::refused(
+        dir.path(),
+        &[
+            "run",
+            "scene.toml",
+            "--out",
+            "out",
+            "--head-bias-cm",
+            "nan",
+            "0",
+            "0",
+        ],
+        2,
+        &["--head-bias-cm takes x,y,z in one word", "got `nan 0 …`"],
+    );
+    common::refusal::refused(
+        dir.path(),
+        &["export", "scene.toml", "--out", "/proc/x.obj"],
+        1,
+        &["cannot write the output /proc/x.obj"],
+    );
+}
+
+/// The colour images of a run folder, by name.
+fn images(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    files(dir, &[])
+        .into_iter()
+        .filter(|(name, _)| name.ends_with(".png"))
+        .collect()
+}
+
+#[test]
+fn a_kill_at_any_moment_leaves_the_old_set_or_the_new_one() {
+    // Two generations of one output (spp 1 and 2 differ in every view's colours) written in
+    // turn into the same existing --out, each killed (SIGKILL) at a seeded random moment of
+    // its run: afterwards the folder holds exactly one generation's images, never a mix.
+    let dir = common::refusal::scratch("", &[]);
+    let args = |spp: &'static str| {
+        vec![
+            "run",
+            "scene.toml",
+            "--out",
+            "out",
+            "--spp",
+            spp,
+            "--frontal-width",
+            "96",
+            "--width",
+            "96",
+        ]
+    };
+    let mut generations = Vec::new();
+    let start = std::time::Instant::now();
+    for spp in ["1", "2"] {
+        let (code, err) = run_in(dir.path(), &args(spp));
+        assert_eq!(code, 0, "{err}");
+        generations.push(images(&dir.path().join("out")));
+    }
+    assert_ne!(generations[0], generations[1]);
+    let one_run = start.elapsed().as_secs_f64() / 2.0;
+    let mut state: u64 = 0x5eed;
+    let mut kills = 0;
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(40);
+    let mut round = 0usize;
+    while std::time::Instant::now() < deadline && round < 200 {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let at = one_run * 1.2 * ((state >> 11) as f64 / (1u64 << 53) as f64);
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_seethru"))
+            .arg("--quiet")
+            .args(args(["1", "2"][round % 2]))
+            .current_dir(dir.path())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_secs_f64(at));
+        if child.try_wait().unwrap().is_none() {
+            child.kill().unwrap();
+            kills += 1;
+        }
+        let _ = child.wait();
+        let now = images(&dir.path().join("out"));
+        assert!(
+            generations.contains(&now),
+            "round {round}, killed at {at:.3} s: a mixed set of {} images",
+            now.len()
+        );
+        round += 1;
+    }
+    assert!(kills > 0 && round > 10, "{kills} kills in {round} rounds");
+}
