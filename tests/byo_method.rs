@@ -160,6 +160,35 @@ fn the_numpy_planar_crop_scores_as_the_builtin_planar_method() {
 }
 
 #[test]
+fn the_readmes_dozen_line_method_scores_as_the_builtin_planar_method_at_infinity() {
+    let dir = tempfile::tempdir().unwrap();
+    let inputs = capture(dir.path(), &[]);
+    let map = dir.path().join("mine.npy");
+    python("dozen_lines.py", &[&inputs, &map], &[]);
+    let mine = score(&inputs, &map, &dir.path().join("scored"));
+    let builtin = dir.path().join("builtin");
+    let mut args = vec!["run", "scenes/das.toml", "--out", builtin.to_str().unwrap()];
+    args.extend(["--d2", "inf"]);
+    args.extend(SIZES);
+    run_ok(&args);
+    let theirs = json(&builtin.join("metrics.json"));
+    for key in ["display_pixels", "blank_pixels", "undefined_pixels"] {
+        assert_eq!(mine[key], theirs[key], "{key}");
+    }
+    // Every pixel within one diagonal frontal pixel's angle: the mean is too.
+    let fx = json(&inputs.join("calibration.json"))["frontal"]["K"][0][0]
+        .as_f64()
+        .unwrap();
+    let quantum_arcmin = (2f64.sqrt() / fx).atan().to_degrees() * 60.0;
+    assert!(
+        (mean(&mine) - mean(&theirs)).abs() <= quantum_arcmin,
+        "{} vs {} arcmin",
+        mean(&mine),
+        mean(&theirs)
+    );
+}
+
+#[test]
 fn a_map_shifted_by_k_display_pixels_adds_the_angle_they_subtend() {
     let dir = tempfile::tempdir().unwrap();
     let inputs = capture(dir.path(), &[]);

@@ -34,7 +34,7 @@ fn bad_method_inputs_give_one_line_each() {
         ),
         (
             vec!["compare", "scenes/das.toml", "--out", out, "--methods", "planar-inf,planar-9"],
-            "error: invalid value 'planar-9' for '--methods <METHODS>'".into(),
+            "error: invalid value 'planar-9' for '--methods <METHOD>'".into(),
         ),
         (
             vec!["run", "scenes/das.toml", "--out", out, "--method", "depth", "--depth-sensor", "tof", "--depth-resolution", "0"],

@@ -210,17 +210,6 @@ fn every_command_in_the_docs_runs_as_written() {
     }
 }
 
-/// Guide pages that other branches write; a link to one of them may dangle until they are
-/// merged. Exactly these names, nothing else: remove a name once its page exists.
-const PAGES_TO_COME: [&str; 6] = [
-    "docs/guide/capture-score.md",
-    "docs/guide/ci-checks.md",
-    "docs/guide/python.md",
-    "docs/guide/cabin-pillar.md",
-    "docs/guide/hazards.md",
-    "docs/guide/performance.md",
-];
-
 /// Every Markdown file of the repository's documentation: README.md and docs/, recursively.
 fn markdown_files() -> Vec<PathBuf> {
     fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -346,12 +335,10 @@ fn every_relative_link_in_the_docs_resolves() {
             let name = shown(&normal);
             checked += 1;
             if !normal.exists() {
-                if !PAGES_TO_COME.contains(&name.as_str()) {
-                    broken.push(format!(
-                        "{}:{number}: {target}: no file {name}",
-                        shown(&file)
-                    ));
-                }
+                broken.push(format!(
+                    "{}:{number}: {target}: no file {name}",
+                    shown(&file)
+                ));
                 continue;
             }
             if !anchor.is_empty() && normal.extension().is_some_and(|x| x == "md") {

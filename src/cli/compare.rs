@@ -105,8 +105,12 @@ impl Compare {
         });
         rules.push(ReadWhen {
             flag: "--back-width",
-            read: self.head == HeadSource::Estimated,
-            when: "with --head estimated (the back camera is rendered for the face detector only)",
+            read: self.head == HeadSource::Estimated
+                || self
+                    .methods
+                    .iter()
+                    .any(|m| matches!(m, MethodSpec::Map { .. })),
+            when: "with --head estimated or a map: method (the back camera is rendered for the face detector and for the capture a map is checked against)",
         });
         refuse_ignored(&rules)
     }

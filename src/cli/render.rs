@@ -25,7 +25,7 @@ pub struct Render {
     #[arg(long)]
     out: PathBuf,
     /// What each view's EXR holds: none, colour (R, G, B, A) or all (every AOV).
-    #[arg(long, value_enum, default_value_t = ExrContent::All)]
+    #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
     exr: ExrContent,
     #[command(flatten)]
     render: RenderArgs,

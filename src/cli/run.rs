@@ -83,7 +83,7 @@ pub struct Run {
     target_eye: Eye,
     /// What each view's EXR holds: none, colour (R, G, B, A) or all (every AOV, what
     /// `seethru measure` reads back).
-    #[arg(long, value_enum, default_value_t = ExrContent::All)]
+    #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
     exr: ExrContent,
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
