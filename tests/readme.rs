@@ -94,8 +94,13 @@ fn page_commands(page: &Path) -> Commands {
             None => prose.push((number, line)),
         }
     }
-    // Inline code spans that are whole commands (no <placeholders> or [options]); a span may
-    // wrap onto the next line of the paragraph.
+    // Inline code spans that are whole commands (no <placeholders>, PLACEHOLDERS or [options],
+    // and more than the command's name: `seethru capture` names the command); a span may wrap
+    // onto the next line of the paragraph.
+    let placeholder = |a: &String| {
+        a.chars().filter(char::is_ascii_uppercase).count() >= 2
+            && !a.chars().any(|c| c.is_ascii_lowercase())
+    };
     let mut in_span: Option<(usize, String)> = None;
     for (number, line) in prose {
         for (k, piece) in line.split('`').enumerate() {
@@ -104,6 +109,8 @@ fn page_commands(page: &Path) -> Commands {
                     Some((start, span)) => {
                         if let Some(args) = seethru_args(&span)
                             && !span.contains(['<', '['])
+                            && args.len() > 1
+                            && !args.iter().any(placeholder)
                         {
                             inline.push((start, args));
                         }

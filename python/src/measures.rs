@@ -8,7 +8,7 @@ use pyo3::types::PyDict;
 use seethru::analysis::dynamic::error_budget;
 use seethru::analysis::examples::das_geometry;
 use seethru::analysis::paper::{ForeshorteningParams, OcclusionParams};
-use seethru::measure::compare::{Candidate, compare as compare_methods};
+use seethru::measure::compare::{Candidate, coloured_strips, compare as compare_methods};
 use seethru::measure::ratio::measure_ratio;
 use seethru::measure::ratio_setup::{Compensation, Setup};
 use seethru::paper::claims::{AnalyzeParams, evaluate, paper_claims};
@@ -96,8 +96,8 @@ pub fn compare<'py>(
     let out = PyDict::new(py);
     let strips = PyDict::new(py);
     let mut json_rows = Vec::new();
-    for r in rows {
-        let (w, h, rgb) = r.strip;
+    let coloured = coloured_strips(&rows).map_err(to_py)?;
+    for (r, (w, h, rgb)) in rows.into_iter().zip(coloured) {
         let array = Array3::from_shape_vec((h as usize, w as usize, 3), rgb).expect("RGB8");
         strips.set_item(r.name, PyArray::from_owned_array(py, array))?;
         json_rows.push(r.row);
