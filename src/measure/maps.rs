@@ -26,21 +26,22 @@ pub fn heat_top(maps: &MetricMaps, fixed: Option<f32>) -> (f32, String) {
     if let Some(top) = fixed {
         return (top, "arcmin, fixed (--heatmap-max)".into());
     }
-    let mut values: Vec<f32> = maps
-        .misregistration
-        .iter()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    values.sort_by(f32::total_cmp);
-    let top = values
-        .get((values.len() as f32 * 0.99) as usize)
-        .copied()
-        .unwrap_or(1.0)
-        .max(1.0);
+    let top = p99_top(maps.misregistration.iter().copied());
     // Clipped at the 99th percentile of the display's values, so that a few extreme pixels
     // do not wash out the rest; the label says so.
     (top, "arcmin, clipped at p99".into())
+}
+
+/// The 99th percentile of the finite `values`, arc-minutes, at least 1 (1 when there are
+/// none): the top of a heatmap's scale unless `--heatmap-max` fixes it.
+pub fn p99_top(values: impl Iterator<Item = f32>) -> f32 {
+    let mut values: Vec<f32> = values.filter(|v| v.is_finite()).collect();
+    values.sort_by(f32::total_cmp);
+    values
+        .get((values.len() as f32 * 0.99) as usize)
+        .copied()
+        .unwrap_or(1.0)
+        .max(1.0)
 }
 
 /// The misregistration heatmap beside a colour bar in arc-minutes, clipped at the 99th
