@@ -154,3 +154,22 @@ pub fn write_mask_png(path: &Path, maps: &MetricMaps, marked: &[bool]) -> Result
         .collect();
     write_png(path, maps.width, maps.height, rgb)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::p99_top;
+
+    #[test]
+    fn the_p99_top_skips_non_finite_values_and_is_at_least_one() {
+        // 0, 1, …, 199 shuffled, with NaN and ∞ that must not count: the value at index
+        // ⌊200 · 0.99⌋ = 198 of the sorted finite values.
+        let values = (0..200).map(|k| ((k * 67) % 200) as f32).chain([
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ]);
+        assert_eq!(p99_top(values), 198.0);
+        assert_eq!(p99_top([0.1f32, 0.2].into_iter()), 1.0);
+        assert_eq!(p99_top(std::iter::empty()), 1.0);
+    }
+}
