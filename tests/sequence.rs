@@ -541,3 +541,108 @@ fn a_lens_goes_through_the_sequence_as_through_run() {
         "sequence {sequence}′ against run {single}′"
     );
 }
+
+/// The first frame of `dir`'s preview.png (8-bit RGB) and the scale summary.json records.
+fn preview_of(dir: &Path, extra: &[&str]) -> (image::RgbImage, f64, String) {
+    let mut args = vec![
+        "sequence",
+        "scenes/das.toml",
+        "--out",
+        dir.to_str().unwrap(),
+        "--duration",
+        "0.2",
+        "--fps",
+        "20",
+        "--speed",
+        "50",
+        "--latency-camera",
+        "100",
+        "--width",
+        "96",
+    ];
+    args.extend(extra);
+    let (ok, _, err) = common::seethru(&args);
+    assert!(ok, "{err}");
+    let run = dir.join("latency_100ms");
+    let png = std::fs::read(run.join("preview.png")).unwrap();
+    let first = image::load_from_memory(&png).unwrap().to_rgb8();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("summary.json")).unwrap()).unwrap();
+    (
+        first,
+        summary["preview_heat_scale_arcmin"].as_f64().unwrap(),
+        summary["preview_heat_scale"].as_str().unwrap().to_string(),
+    )
+}
+
+/// The pixels of column `x` (top to bottom) and of the heat panel that are not grey: grey is
+/// the caption, the white margins, blank pixels and the dimmed truth outside the display.
+fn coloured(img: &image::RgbImage, xs: std::ops::Range<u32>) -> Vec<[u8; 3]> {
+    let mut out = Vec::new();
+    for y in 0..img.height() {
+        for x in xs.clone() {
+            let p = img.get_pixel(x, y).0;
+            if !(p[0] == p[1] && p[1] == p[2]) {
+                out.push(p);
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_preview_has_a_colour_bar_whose_scale_heatmap_max_fixes() {
+    use seethru::measure::maps::heat_color;
+    let dir = tempfile::tempdir().unwrap();
+    let (auto, auto_top, auto_how) = preview_of(&dir.path().join("auto"), &[]);
+    let (tiny, tiny_top, tiny_how) =
+        preview_of(&dir.path().join("tiny"), &["--heatmap-max", "0.000001"]);
+    // The bar's column (170 px, its bar 25 px in) right of three panels with 4 px gaps.
+    let bar_column = 170;
+    for img in [&auto, &tiny] {
+        assert!(img.width() > bar_column, "{}", img.width());
+        let w = (img.width() - bar_column - 8) / 3;
+        assert_eq!(3 * w + 8 + bar_column, img.width(), "no bar column");
+        let bar = coloured(
+            img,
+            img.width() - bar_column + 25..img.width() - bar_column + 26,
+        );
+        // Top to bottom: the colour map from its top down to its bottom, tall enough to
+        // read. Each colour is read back as the t in [0, 1] whose colour is nearest.
+        assert!(bar.len() >= 70, "bar of {} pixels", bar.len());
+        let t_of = |c: [u8; 3]| {
+            (0..=1000)
+                .map(|k| k as f32 / 1000.0)
+                .min_by_key(|&t| {
+                    let m = heat_color(t);
+                    (0..3)
+                        .map(|i| (c[i] as i32 - m[i] as i32).pow(2))
+                        .sum::<i32>()
+                })
+                .unwrap()
+        };
+        let ts: Vec<f32> = bar.iter().map(|&c| t_of(c)).collect();
+        assert!(ts[0] > 0.97 && *ts.last().unwrap() < 0.05, "{ts:?}");
+        assert!(ts.windows(2).all(|p| p[1] <= p[0] + 0.02), "{ts:?}");
+    }
+    // A scale topping out at a millionth of an arc-minute clips every misregistration to
+    // the top colour; the p99 scale does not.
+    let heat = |img: &image::RgbImage| {
+        let w = (img.width() - bar_column - 8) / 3;
+        coloured(img, 2 * (w + 4)..3 * w + 8)
+    };
+    let (tiny_heat, auto_heat) = (heat(&tiny), heat(&auto));
+    assert!(tiny_heat.len() > 50 && auto_heat.len() > 50);
+    assert!(tiny_heat.iter().all(|&p| p == heat_color(1.0)));
+    assert!(
+        auto_heat.iter().filter(|&&p| p != heat_color(1.0)).count() > auto_heat.len() / 2,
+        "the p99 scale clips most pixels"
+    );
+    // summary.json says which scale and how it was chosen.
+    assert!((tiny_top - 1e-6).abs() < 1e-9, "{tiny_top}");
+    assert_eq!(tiny_how, "fixed (--heatmap-max)");
+    assert!(
+        auto_top >= 1.0 && auto_how == "p99 of all frames",
+        "{auto_top} {auto_how}"
+    );
+}

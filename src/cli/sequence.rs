@@ -193,6 +193,10 @@ pub struct Sequence {
     /// Worker threads in [1, 1024] (default: all cores). Output is identical for any value.
     #[arg(long, value_parser = threads)]
     threads: Option<usize>,
+    /// Top of preview.png's misregistration scale, arc-minutes in [1e-6, 10000], so that
+    /// previews compare (default: the 99th percentile of every frame's values, labelled).
+    #[arg(long = "heatmap-max", value_name = "ARCMIN", value_parser = positive(1e4))]
+    heatmap_max: Option<f64>,
     /// Refuse to start when the estimated memory exceeds this, GiB in [1e-6, 4096].
     #[arg(long = "max-memory", value_name = "GIB", default_value_t = DEFAULT_MAX_MEMORY_GIB, value_parser = max_memory)]
     max_memory: f64,
@@ -359,7 +363,9 @@ impl Sequence {
         for (k, (options, &ms)) in all.into_iter().zip(&self.latency_camera.0).enumerate() {
             let dir = out.join(latency_dir(ms));
             let timeline = options.timeline;
-            let mut preview = Preview::new(timeline.fps).labelled(format!("latency {ms} ms"));
+            let mut preview = Preview::new(timeline.fps)
+                .labelled(format!("latency {ms} ms"))
+                .heat_max(self.heatmap_max.map(|v| v as f32));
             let label = format!("latency {}/{count}: {ms} ms", k + 1);
             let frames = self.frames;
             let how = Measuring {
@@ -393,12 +399,13 @@ impl Sequence {
                 &dir.join("frames.csv"),
                 &frames_csv(&run.records, &timeline)?,
             )?;
-            let scale = preview.write(&dir.join("preview.png"))?;
+            let (scale, chosen) = preview.write(&dir.join("preview.png"))?;
             over_time_figure(&[(format!("{ms} ms"), &run.records)], timeline.duration)
                 .write(&dir, "misregistration_over_time")?;
             let mut s = summary(&run, &timeline);
             headlines.push(format!("{ms} ms: {}", summary_text(RunKind::Sequence, &s)));
             s["preview_heat_scale_arcmin"] = json!(scale);
+            s["preview_heat_scale"] = json!(chosen);
             write_text(
                 &dir.join("summary.json"),
                 &serde_json::to_string_pretty(&s)?,

@@ -26,21 +26,22 @@ pub fn heat_top(maps: &MetricMaps, fixed: Option<f32>) -> (f32, String) {
     if let Some(top) = fixed {
         return (top, "arcmin, fixed (--heatmap-max)".into());
     }
-    let mut values: Vec<f32> = maps
-        .misregistration
-        .iter()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    values.sort_by(f32::total_cmp);
-    let top = values
-        .get((values.len() as f32 * 0.99) as usize)
-        .copied()
-        .unwrap_or(1.0)
-        .max(1.0);
+    let top = p99_top(maps.misregistration.iter().copied());
     // Clipped at the 99th percentile of the display's values, so that a few extreme pixels
     // do not wash out the rest; the label says so.
     (top, "arcmin, clipped at p99".into())
+}
+
+/// The 99th percentile of the finite `values`, arc-minutes, at least 1 (1 when there are
+/// none): the top of a heatmap's scale unless `--heatmap-max` fixes it.
+pub fn p99_top(values: impl Iterator<Item = f32>) -> f32 {
+    let mut values: Vec<f32> = values.filter(|v| v.is_finite()).collect();
+    values.sort_by(f32::total_cmp);
+    values
+        .get((values.len() as f32 * 0.99) as usize)
+        .copied()
+        .unwrap_or(1.0)
+        .max(1.0)
 }
 
 /// The misregistration heatmap beside a colour bar in arc-minutes, clipped at the 99th
@@ -152,4 +153,23 @@ pub fn write_mask_png(path: &Path, maps: &MetricMaps, marked: &[bool]) -> Result
         })
         .collect();
     write_png(path, maps.width, maps.height, rgb)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::p99_top;
+
+    #[test]
+    fn the_p99_top_skips_non_finite_values_and_is_at_least_one() {
+        // 0, 1, …, 199 shuffled, with NaN and ∞ that must not count: the value at index
+        // ⌊200 · 0.99⌋ = 198 of the sorted finite values.
+        let values = (0..200).map(|k| ((k * 67) % 200) as f32).chain([
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ]);
+        assert_eq!(p99_top(values), 198.0);
+        assert_eq!(p99_top([0.1f32, 0.2].into_iter()), 1.0);
+        assert_eq!(p99_top(std::iter::empty()), 1.0);
+    }
 }

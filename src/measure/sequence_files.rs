@@ -9,8 +9,9 @@ use serde_json::json;
 
 use crate::io::animation::write_apng;
 use crate::io::caption::{caption_lines, caption_strip, strip_height};
+use crate::io::colour_bar::{BAR_COLUMN, ColourBar, with_colour_bar};
 use crate::io::plot::{Figure, Series};
-use crate::measure::maps::heat_color;
+use crate::measure::maps::{heat_color, p99_top};
 use crate::measure::sequence::{FrameImages, FrameMetrics, FrameRecord, SequenceRun};
 use crate::system::sequence::timeline::Timeline;
 use crate::util::color::encode_srgb8;
@@ -252,7 +253,8 @@ const PREVIEW_PANEL_MAX: u32 = 320;
 const PREVIEW_MAX_FPS: f64 = 30.0;
 
 /// Collects preview frames (truth | seethru | misregistration, cut to the window around the
-/// display) and writes them as an APNG with one colour scale for the whole sequence.
+/// display) and writes them as an APNG with one colour scale for the whole sequence, drawn as
+/// a colour bar right of the panels.
 pub struct Preview {
     every: usize,
     fps: f64,
@@ -262,7 +264,14 @@ pub struct Preview {
     /// What every frame's caption says besides its time and misregistration (the latency);
     /// `None`: no caption.
     label: Option<String>,
+    /// Top of the misregistration scale, arc-minutes (`--heatmap-max`); `None`: the 99th
+    /// percentile of every frame's values.
+    heat_max: Option<f32>,
 }
+
+/// How the preview's misregistration scale was chosen, for summary.json and the bar's title.
+pub const PREVIEW_SCALE_FIXED: &str = "fixed (--heatmap-max)";
+pub const PREVIEW_SCALE_P99: &str = "p99 of all frames";
 
 /// One preview frame's panels, cut to the window: sRGB truth and seethru, and the
 /// misregistration (arc-minutes; NaN on blank display pixels, −∞ outside the display).
@@ -285,6 +294,30 @@ impl Preview {
             size: (0, 0),
             panels: Vec::new(),
             label: None,
+            heat_max: None,
+        }
+    }
+
+    /// Fixes the top of the misregistration scale at `top` arc-minutes when given.
+    pub fn heat_max(mut self, top: Option<f32>) -> Preview {
+        self.heat_max = top;
+        self
+    }
+
+    /// The top of the misregistration scale, arc-minutes, and how it was chosen: fixed, or
+    /// clipped at the 99th percentile of every frame's values so that a few extreme pixels do
+    /// not wash out the rest.
+    pub fn heat_scale(&self) -> (f32, &'static str) {
+        match self.heat_max {
+            Some(top) => (top, PREVIEW_SCALE_FIXED),
+            None => (
+                p99_top(
+                    self.panels
+                        .iter()
+                        .flat_map(|p| p.misregistration.iter().copied()),
+                ),
+                PREVIEW_SCALE_P99,
+            ),
         }
     }
 
@@ -325,23 +358,31 @@ impl Preview {
         });
     }
 
-    /// Writes the APNG; the heat scale tops out at the 99th percentile of every frame's
-    /// values. Returns that scale, arc-minutes.
-    pub fn write(&self, path: &Path) -> Result<f32> {
-        let mut all: Vec<f32> = self
-            .panels
-            .iter()
-            .flat_map(|p| p.misregistration.iter().copied().filter(|v| v.is_finite()))
-            .collect();
-        all.sort_by(f32::total_cmp);
-        let top = all
-            .get((all.len() as f32 * 0.99) as usize)
-            .copied()
-            .unwrap_or(1.0)
-            .max(1.0);
+    /// Writes the APNG, the scale's colour bar right of the panels. Returns the scale's top,
+    /// arc-minutes, and how it was chosen ([`Preview::heat_scale`]).
+    pub fn write(&self, path: &Path) -> Result<(f32, &'static str)> {
+        let (top, chosen) = self.heat_scale();
         let (w, h) = self.size;
         let gap = 4;
-        let width = 3 * w + 2 * gap;
+        let panels_width = 3 * w + 2 * gap;
+        // One bar for the whole animation, drawn once and pasted beside every frame.
+        let (bar_w, bar_h, bar) = with_colour_bar(
+            0,
+            h,
+            &[],
+            &ColourBar {
+                colours: heat_color,
+                bottom: 0.0,
+                top: top as f64,
+                unit: "′",
+                title: format!("arcmin, {chosen}"),
+                legend: vec![([0, 0, 0], "blank".into())],
+                clipped: true,
+            },
+        )?;
+        debug_assert_eq!(bar_w, BAR_COLUMN);
+        let width = panels_width + bar_w;
+        let rows = h.max(bar_h);
         let captions = self.captions(width)?;
         let frames: Vec<Vec<u8>> = self
             .panels
@@ -353,7 +394,13 @@ impl Preview {
                      misregistration: mis,
                      ..
                  }| {
-                    let mut rgb = vec![255u8; (width * h * 3) as usize];
+                    let mut rgb = vec![255u8; (width * rows * 3) as usize];
+                    for y in 0..bar_h {
+                        let from = (y * bar_w * 3) as usize;
+                        let to = ((y * width + panels_width) * 3) as usize;
+                        rgb[to..to + (bar_w * 3) as usize]
+                            .copy_from_slice(&bar[from..from + (bar_w * 3) as usize]);
+                    }
                     for y in 0..h {
                         for x in 0..w {
                             let i = (y * w + x) as usize;
@@ -387,12 +434,12 @@ impl Preview {
                         strip
                     })
                     .collect(),
-                h + strip_h,
+                rows + strip_h,
             ),
-            None => (frames, h),
+            None => (frames, rows),
         };
         write_apng(path, width, h, &frames, self.fps)?;
-        Ok(top)
+        Ok((top, chosen))
     }
 
     /// Each frame's caption strip (all of one height) and that height; `None` unlabelled.
