@@ -206,15 +206,7 @@ fn read_exr_map(path: &Path) -> Result<MapFile> {
             size.height()
         );
     }
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .non_parallel()
-        .from_file(path)
-        .map_err(|e| anyhow::anyhow!("invalid or truncated EXR: {e}"))?;
+    let image = crate::io::frame_files::read_first_layer(|r| r.from_file(path))?;
     let layer = &image.layer_data;
     let names: Vec<String> = layer
         .channel_data

@@ -200,6 +200,35 @@ pub fn exr_size(path: &Path) -> Result<(u32, u32)> {
     Ok((size.width() as u32, size.height() as u32))
 }
 
+/// Every channel of an EXR's first layer as flat samples: how seethru reads any EXR (a view,
+/// a display map, a diffed image), after its header was checked against the limits.
+pub type FirstLayer = Image<Layer<AnyChannels<FlatSamples>>>;
+
+/// Reads the first layer with `from` (a file or a buffered reader), one thread, no deep data.
+pub fn read_first_layer(
+    from: impl FnOnce(
+        exr::image::read::image::ReadImage<
+            fn(f64),
+            exr::image::read::layers::ReadFirstValidLayer<
+                exr::image::read::any_channels::ReadAnyChannels<
+                    exr::image::read::samples::ReadFlatSamples,
+                >,
+            >,
+        >,
+    ) -> exr::error::Result<FirstLayer>,
+) -> Result<FirstLayer> {
+    from(
+        read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .first_valid_layer()
+            .all_attributes()
+            .non_parallel(),
+    )
+    .map_err(|e| anyhow::anyhow!("invalid or truncated EXR: {e}"))
+}
+
 /// Reads an EXR from a reader into a frame, refusing images of more than `max_pixels` before
 /// decoding them.
 pub fn read_exr_from<R: std::io::Read + std::io::Seek + Send>(
@@ -229,15 +258,7 @@ pub fn read_exr_from<R: std::io::Read + std::io::Seek + Send>(
         );
     }
     reader.seek(std::io::SeekFrom::Start(0))?;
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .non_parallel()
-        .from_buffered(reader)
-        .map_err(|e| anyhow::anyhow!("invalid or truncated EXR: {e}"))?;
+    let image = read_first_layer(|r| r.from_buffered(reader))?;
     let layer = &image.layer_data;
     let (width, height) = (layer.size.width() as u32, layer.size.height() as u32);
     let pixels = width as usize * height as usize;

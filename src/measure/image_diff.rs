@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use exr::prelude::{FlatSamples, ReadChannels, ReadLayers};
+use exr::prelude::FlatSamples;
 use serde_json::{Value, json};
 
 use crate::measure::metrics::{masked_ssim_map, psnr};
@@ -136,15 +136,7 @@ fn read_exr_layers(path: &Path) -> Result<Picture> {
         .map_err(|e| anyhow::anyhow!("not a readable EXR: {e}"))?;
     let header = meta.headers.first().context("the file has no layer")?;
     check_size(header.layer_size.width(), header.layer_size.height())?;
-    let image = exr::prelude::read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .non_parallel()
-        .from_file(path)
-        .map_err(|e| anyhow::anyhow!("invalid or truncated EXR: {e}"))?;
+    let image = crate::io::frame_files::read_first_layer(|r| r.from_file(path))?;
     let layer = &image.layer_data;
     let (width, height) = (layer.size.width() as u32, layer.size.height() as u32);
     let mut layers: Vec<Layer> = Vec::new();
