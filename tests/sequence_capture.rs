@@ -37,7 +37,12 @@ const SEQUENCE: [&str; 14] = [
 const FRAMES: usize = 3;
 
 fn sequence(out: &Path, extra: &[&str]) -> (bool, String) {
-    let mut args = vec!["sequence", "scenes/das.toml", "--out", out.to_str().unwrap()];
+    let mut args = vec![
+        "sequence",
+        "scenes/das.toml",
+        "--out",
+        out.to_str().unwrap(),
+    ];
     args.extend(SEQUENCE);
     args.extend(extra);
     let (ok, out, err) = seethru(&args);
@@ -208,7 +213,10 @@ fn a_shifted_map_raises_only_its_frames_misregistration() {
         theirs[1]
     );
     let blank = column(&scored, "blank_fraction");
-    assert!(blank[1] > 0.0 && blank[0] == 0.0 && blank[2] == 0.0, "{blank:?}");
+    assert!(
+        blank[1] > 0.0 && blank[0] == 0.0 && blank[2] == 0.0,
+        "{blank:?}"
+    );
 }
 
 fn one_error_line(text: &str, names: &[&str]) {
@@ -231,7 +239,12 @@ fn bad_maps_get_one_error_line_naming_the_file_and_the_frame() {
     let maps_arg = maps.to_str().unwrap();
     // Made for another capture: the same sequence without the latency.
     let (ok, text) = {
-        let mut args = vec!["sequence", "scenes/das.toml", "--out", out.to_str().unwrap()];
+        let mut args = vec![
+            "sequence",
+            "scenes/das.toml",
+            "--out",
+            out.to_str().unwrap(),
+        ];
         args.extend(&SEQUENCE[..12]);
         args.extend(["--maps", maps_arg]);
         let (ok, o, e) = seethru(&args);

@@ -9,13 +9,13 @@ use anyhow::Result;
 use glam::DVec3;
 use obvhs::aabb::Aabb;
 
+use crate::geometry::opencv::camera_json;
 use crate::measure::metrics::{MetricMaps, measure};
 use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::Frame;
 use crate::render::settings::RenderSettings;
 use crate::scene::world::view_bit;
 use crate::scene::{Obstacle, Scene};
-use crate::geometry::opencv::camera_json;
 use crate::system::capture::{Capture, CaptureTruth};
 use crate::system::head::CONFIDENT_HEAD;
 use crate::system::sequence::system_loop::{SequenceOptions, StageSeconds, SystemLoop};

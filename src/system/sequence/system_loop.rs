@@ -23,14 +23,14 @@ use crate::render::settings::{RenderSettings, check_spp};
 use crate::render::sky::SkyModel;
 use crate::scene::Scene;
 use crate::scene::world::{World, view_bit};
+use crate::system::calibration_json::calibration_json;
+use crate::system::capture::{HeadEstimate, check_display_input, display_from, fingerprint};
 use crate::system::compensation::Crop;
 use crate::system::display::{DisplayModel, DisplayPlacement, DisplaySurface, resample_through};
 use crate::system::frontal_map::FrontalMap;
 use crate::system::head::{detect, eye_from_detection, gaussian};
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use crate::system::pipeline::{crop_for, driver_camera, frontal_map};
-use crate::system::calibration_json::calibration_json;
-use crate::system::capture::{HeadEstimate, check_display_input, display_from, fingerprint};
 use crate::system::sequence::byo::{Byo, RefreshInputs};
 use crate::system::sequence::head_motion::HeadMotion;
 use crate::system::sequence::predict::{Prediction, Predictor};
@@ -383,13 +383,15 @@ impl SystemLoop {
         let external = byo.maps.as_ref().map(|maps| maps.get(&times.refresh));
         let display = if let Some(named) = external {
             let named = named.with_context(|| {
-                format!("--maps: no map for refresh {} (frame {frame})", times.refresh)
+                format!(
+                    "--maps: no map for refresh {} (frame {frame})",
+                    times.refresh
+                )
             })?;
             let size = geometry.obstacle.display_resolution;
             let given = inputs.as_ref().expect("made for the maps");
-            check_display_input(size, &given.fingerprint, Some(&named.map), None).map_err(
-                |e| anyhow::anyhow!("{} (frame {}): {e}", named.file, named.frame),
-            )?;
+            check_display_input(size, &given.fingerprint, Some(&named.map), None)
+                .map_err(|e| anyhow::anyhow!("{} (frame {}): {e}", named.file, named.frame))?;
             display_from(&self.frontal, size, run, Some(&named.map), None)
         } else if curved {
             crate::system::pipeline::curved_planar_display(
