@@ -336,7 +336,17 @@ fn every_flag_of_sequence_changes_the_output_or_is_refused() {
             &["sequence"],
             &base,
             &skip,
-            &[("--outside", "only a crop past the frontal view differs")],
+            &[
+                ("--outside", "only a crop past the frontal view differs"),
+                (
+                    "--capture",
+                    "writes a folder of its own, outside --out (tests/sequence_capture.rs reads it)",
+                ),
+                (
+                    "--maps",
+                    "needs a folder of maps made from a --capture (tests/sequence_capture.rs scores them)",
+                ),
+            ],
         ));
     }
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));

@@ -36,6 +36,7 @@ fn options(latency: f64, fps: f64, display_hz: f64, yaw_rate: f64) -> SequenceOp
         head: HeadMotion::Still,
         predict: Prediction::None,
         reproject: false,
+        byo: Default::default(),
     }
 }
 

@@ -43,6 +43,7 @@ fn sequence(scene: &Scene, head: HeadSource, metrics: bool) -> Result<SequenceRu
         },
         predict: Prediction::ConstantVelocity,
         reproject: false,
+        byo: Default::default(),
     };
     let how = Measuring {
         metrics,

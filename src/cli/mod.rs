@@ -23,6 +23,7 @@ mod run_eyes;
 mod scene_model_args;
 mod score;
 mod sequence;
+mod sequence_byo;
 mod sweep;
 pub mod verdict;
 

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{write_color_png, write_exr};
 use seethru::io::staged::StagedDir;
@@ -197,6 +197,14 @@ pub struct Sequence {
     /// previews compare (default: the 99th percentile of every frame's values, labelled).
     #[arg(long = "heatmap-max", value_name = "ARCMIN", value_parser = positive(1e4))]
     heatmap_max: Option<f64>,
+    /// Write every refresh's inputs (seethru capture's files, one frame_NNNNN/ folder each)
+    /// and frames.json, the index of their times, to this folder.
+    #[arg(long, value_name = "DIR", conflicts_with = "maps")]
+    capture: Option<PathBuf>,
+    /// Show an outside method's maps instead of the built-in compensation: DIR/frame_NNNNN.npy
+    /// (or .exr), one per folder of --capture, scored as the sequence scores its own.
+    #[arg(long, value_name = "DIR")]
+    maps: Option<PathBuf>,
     /// Refuse to start when the estimated memory exceeds this, GiB in [1e-6, 4096].
     #[arg(long = "max-memory", value_name = "GIB", default_value_t = DEFAULT_MAX_MEMORY_GIB, value_parser = max_memory)]
     max_memory: f64,
@@ -256,6 +264,10 @@ impl Sequence {
             head: head.clone(),
             predict: self.predict,
             reproject: self.reproject,
+            byo: seethru::system::sequence::byo::Byo {
+                capture: self.capture.is_some(),
+                maps: None,
+            },
         }
     }
 
@@ -318,8 +330,18 @@ impl Sequence {
             },
             ReadWhen {
                 flag: "--d2",
-                read: self.method == Method::Planar,
-                when: "by --method planar",
+                read: self.method == Method::Planar && self.maps.is_none(),
+                when: "by --method planar without --maps",
+            },
+            ReadWhen {
+                flag: "--method",
+                read: self.maps.is_none(),
+                when: "without --maps (the maps are the method)",
+            },
+            ReadWhen {
+                flag: "--display",
+                read: self.maps.is_none(),
+                when: "without --maps (a map is shown on the display's pixels)",
             },
         ]);
         refuse_ignored(&rules)
@@ -342,6 +364,21 @@ impl Sequence {
         for o in &all {
             o.timeline.validate()?;
         }
+        if (self.capture.is_some() || self.maps.is_some()) && all.len() > 1 {
+            bail!(
+                "--capture and --maps take one --latency-camera value, got {}",
+                all.len()
+            );
+        }
+        let mut all = all;
+        if let Some(dir) = &self.maps {
+            let t = all[0].timeline;
+            all[0].byo.maps = Some(crate::cli::sequence_byo::load_maps(
+                dir,
+                &t,
+                scene.obstacle.display_resolution,
+            )?);
+        }
         // Before anything is allocated: a size the machine cannot hold is refused with numbers.
         let first = &all[0];
         check_memory(
@@ -357,6 +394,13 @@ impl Sequence {
         // Written whole or not at all: a failure at any latency leaves `--out` as it was.
         let staged = StagedDir::new(&self.out)?;
         let out = staged.path().to_path_buf();
+        let captured = self.capture.as_deref().map(StagedDir::new).transpose()?;
+        let command = json!({
+            "command": "sequence",
+            "args": std::env::args().skip(2).collect::<Vec<_>>(),
+            "note": "the sequence that wrote this folder (seethru score reads a single capture's folder, not this one: score a sequence with sequence --maps)",
+        });
+        let (mut index, mut shown_folder) = (Vec::new(), String::new());
         let mut runs: Vec<(f64, SequenceRun)> = Vec::new();
         let count = all.len();
         let mut headlines: Vec<String> = Vec::new();
@@ -376,6 +420,14 @@ impl Sequence {
             };
             let run = run_sequence_labelled(&scene, options, how, &label, &mut |f| {
                 preview.add(&f);
+                if let Some(c) = &captured {
+                    index.push(crate::cli::sequence_byo::write_frame(
+                        c.path(),
+                        &f,
+                        &command,
+                        &mut shown_folder,
+                    )?);
+                }
                 let name = |view: &str, ext: &str| {
                     dir.join("frames")
                         .join(format!("{view}_{:05}.{ext}", f.record.frame))
@@ -413,6 +465,10 @@ impl Sequence {
             runs.push((ms, run));
         }
         self.write_overview(&runs, &out)?;
+        if let Some(c) = captured {
+            crate::cli::sequence_byo::write_index(c.path(), std::mem::take(&mut index))?;
+            c.commit()?;
+        }
         staged.commit()?;
         say(format!(
             "{}; wrote {} sequence(s) of {} frames (frames.csv, summary.json, plots, preview.png) to {}",
@@ -462,6 +518,7 @@ impl Sequence {
             "predict": self.predict,
             "reproject": self.reproject,
             "method": self.method,
+            "maps": self.maps.as_ref().map(|m| m.display().to_string()),
             "d2": format!("{:?}", self.d2),
             "head_source": self.head_source,
             "width": self.width,

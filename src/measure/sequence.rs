@@ -9,12 +9,14 @@ use anyhow::Result;
 use glam::DVec3;
 use obvhs::aabb::Aabb;
 
+use crate::geometry::opencv::camera_json;
 use crate::measure::metrics::{MetricMaps, measure};
 use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::Frame;
 use crate::render::settings::RenderSettings;
 use crate::scene::world::view_bit;
 use crate::scene::{Obstacle, Scene};
+use crate::system::capture::{Capture, CaptureTruth};
 use crate::system::head::CONFIDENT_HEAD;
 use crate::system::sequence::system_loop::{SequenceOptions, StageSeconds, SystemLoop};
 use crate::system::sequence::timeline::FrameTimes;
@@ -107,6 +109,9 @@ pub struct FrameImages<'a> {
     /// The driver-view pixels rendered for every frame (the display's neighbourhood over the
     /// whole sequence), where previews are cut.
     pub window: PixelRect,
+    /// With `byo.capture`, at the first frame showing a refresh: that refresh's inputs, and
+    /// as its truth this frame's whole truth view and true eye.
+    pub capture: Option<Capture>,
 }
 
 /// What a sequence produced besides its frames.
@@ -202,7 +207,8 @@ pub fn run_sequence_labelled(
     };
     let window = window(&system);
     let camera = system.rig.base.driver;
-    let region = if how.full_frames {
+    // A captured frame's truth is the whole view, as `seethru capture`'s.
+    let region = if how.full_frames || system.options.byo.capture {
         PixelRect::full(&camera)
     } else {
         window
@@ -278,6 +284,24 @@ pub fn run_sequence_labelled(
         );
         metrics_seconds += t1.elapsed().as_secs_f64();
         record.metrics = Some(FrameMetrics::from_json(&json));
+        let capture = system.take_inputs().map(|i| Capture {
+            frontal: i.frontal,
+            back: i.back,
+            depth: None,
+            head: i.head,
+            calibration: i.calibration,
+            fingerprint: i.fingerprint,
+            truth: CaptureTruth {
+                eye_world_m: driver.position(),
+                truth: truth.clone(),
+                cameras: serde_json::json!({
+                    "frontal": camera_json(&shown.frontal),
+                    "back": camera_json(&i.back_true),
+                    "driver_view": camera_json(&driver),
+                    "note": "the true frontal camera at the capture time, back camera at the head-sample time and the driver's view camera at the display time, OpenCV's conventions as in calibration.json",
+                }),
+            },
+        });
         records.push(record);
         on_frame(FrameImages {
             record: records.last().expect("just pushed"),
@@ -285,6 +309,7 @@ pub fn run_sequence_labelled(
             seethru: &seethru,
             maps: &maps,
             window,
+            capture,
         })?;
         progress.advance(1);
     }

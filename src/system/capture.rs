@@ -138,7 +138,8 @@ pub fn capture(ctx: &RenderContext, options: &RunOptions, with_depth: bool) -> R
     })
 }
 
-fn fingerprint(
+/// 16 hex digits over the images, the head estimate and the calibration ([`Capture::fingerprint`]).
+pub fn fingerprint(
     frontal: &Frame,
     back: &Frame,
     head: &HeadEstimate,

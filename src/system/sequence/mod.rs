@@ -10,6 +10,7 @@
 //!
 //! The truth and the metrics of every frame are `measure::sequence`'s.
 
+pub mod byo;
 pub mod head_motion;
 pub mod predict;
 pub mod system_loop;

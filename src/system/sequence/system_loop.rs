@@ -23,12 +23,15 @@ use crate::render::settings::{RenderSettings, check_spp};
 use crate::render::sky::SkyModel;
 use crate::scene::Scene;
 use crate::scene::world::{World, view_bit};
+use crate::system::calibration_json::calibration_json;
+use crate::system::capture::{HeadEstimate, check_display_input, display_from, fingerprint};
 use crate::system::compensation::Crop;
 use crate::system::display::{DisplayModel, DisplayPlacement, DisplaySurface, resample_through};
 use crate::system::frontal_map::FrontalMap;
 use crate::system::head::{detect, eye_from_detection, gaussian};
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use crate::system::pipeline::{crop_for, driver_camera, frontal_map};
+use crate::system::sequence::byo::{Byo, RefreshInputs};
 use crate::system::sequence::head_motion::HeadMotion;
 use crate::system::sequence::predict::{Prediction, Predictor};
 use crate::system::sequence::timeline::{FrameTimes, Rig, Timeline};
@@ -55,6 +58,8 @@ pub struct SequenceOptions {
     pub predict: Prediction,
     /// Re-project the frontal image by the vehicle's known motion from capture to display.
     pub reproject: bool,
+    /// Each refresh's inputs kept, or outside display maps shown (`--capture`, `--maps`).
+    pub byo: Byo,
 }
 
 /// What the display shows from one refresh on.
@@ -110,6 +115,8 @@ pub struct SystemLoop {
     pub frontal_pixels: u64,
     /// `--head-source model`: the last estimate, held over a dropped sample.
     model_last: Option<DVec3>,
+    /// The last refresh's inputs, until taken ([`SystemLoop::take_inputs`]).
+    inputs: Option<RefreshInputs>,
 }
 
 impl SystemLoop {
@@ -166,6 +173,7 @@ impl SystemLoop {
             seconds: StageSeconds::default(),
             frontal_pixels: 0,
             model_last: None,
+            inputs: None,
         })
     }
 
@@ -279,7 +287,7 @@ impl SystemLoop {
             .obstacle
             .world_from_obstacle
             .transform_point3(eye_used);
-        let run = &self.options.run;
+        let run = &self.options.run.clone();
         let at = || format!("at t = {} s", short(times.refresh_time));
         let curved =
             run.method == Method::Planar && geometry.obstacle.display_shape.curved().is_some();
@@ -289,7 +297,16 @@ impl SystemLoop {
             );
         }
         // A curved display's pixels may look beyond its reference rectangle's crop.
-        let full = run.method == Method::None || run.d2 == WorkingDistance::Auto || curved;
+        let byo = self.options.byo.clone();
+        if byo.maps.is_some() && (curved || run.display == DisplayModel::Ideal) {
+            bail!(
+                "--maps shows a map on a flat display's pixels: not with a curved display or --display ideal"
+            );
+        }
+        let full = run.method == Method::None
+            || run.d2 == WorkingDistance::Auto
+            || curved
+            || byo.needs_inputs();
         let frontal_camera = capture.scene.frontal;
         let settings = self.settings();
         let (crop, d2_used) = if full {
@@ -337,7 +354,46 @@ impl SystemLoop {
                 );
             }
         }
-        let display = if curved {
+        let mut inputs = None;
+        if byo.needs_inputs() {
+            let b = self.context_at(times.head)?;
+            let back_true = b.scene.back;
+            let back_settings = RenderSettings {
+                spp: run.spp.max(BACK_MIN_SPP),
+                progress: false,
+            };
+            let (back, _) = b.render(&back_true, view_bit::BACK, back_settings, "back");
+            let head = HeadEstimate {
+                source: run.head,
+                eye_world_m: eye_world.to_array(),
+                eye_obstacle_m: eye_used.to_array(),
+                detection: None,
+            };
+            let calibration = calibration_json(&geometry)?;
+            let fingerprint = fingerprint(&self.frontal, &back, &head, &calibration)?;
+            inputs = Some(RefreshInputs {
+                frontal: self.frontal.clone(),
+                back,
+                head,
+                calibration,
+                fingerprint,
+                back_true,
+            });
+        }
+        let external = byo.maps.as_ref().map(|maps| maps.get(&times.refresh));
+        let display = if let Some(named) = external {
+            let named = named.with_context(|| {
+                format!(
+                    "--maps: no map for refresh {} (frame {frame})",
+                    times.refresh
+                )
+            })?;
+            let size = geometry.obstacle.display_resolution;
+            let given = inputs.as_ref().expect("made for the maps");
+            check_display_input(size, &given.fingerprint, Some(&named.map), None)
+                .map_err(|e| anyhow::anyhow!("{} (frame {}): {e}", named.file, named.frame))?;
+            display_from(&self.frontal, size, run, Some(&named.map), None)
+        } else if curved {
             crate::system::pipeline::curved_planar_display(
                 &geometry,
                 eye_world,
@@ -350,6 +406,7 @@ impl SystemLoop {
             resample_through(&self.frontal, &map, run.filter)
         };
         self.seconds.compensation += start.elapsed().as_secs_f64();
+        self.inputs = inputs;
         self.surface = Some(DisplaySurface::Pixels {
             image: display,
             placement: DisplayPlacement::new(&capture.scene.obstacle),
@@ -365,6 +422,12 @@ impl SystemLoop {
             lens: map.lens,
         });
         Ok(self.shown.as_ref().expect("just set"))
+    }
+
+    /// The inputs of the refresh [`SystemLoop::show`] last made, once (`None` after, or
+    /// without `byo.capture`).
+    pub fn take_inputs(&mut self) -> Option<RefreshInputs> {
+        self.inputs.take()
     }
 
     /// The `seethru` view at display time into `frame` (the truth of the same instant, or
