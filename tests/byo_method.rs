@@ -316,3 +316,74 @@ fn a_map_for_another_capture_is_refused_by_its_fingerprint() {
     );
     assert_eq!(err.lines().count(), 1, "{err}");
 }
+
+#[test]
+fn bad_maps_and_display_images_get_one_line_each_and_outside_points_count_as_blank() {
+    use seethru::io::display_map::write_npy_f32;
+    let dir = tempfile::tempdir().unwrap();
+    let inputs = capture(dir.path(), &[]);
+    let calibration = json(&inputs.join("calibration.json"));
+    let size = &calibration["display"]["resolution_px"];
+    let (w, h) = (
+        size[0].as_u64().unwrap() as usize,
+        size[1].as_u64().unwrap() as usize,
+    );
+    let file = |name: &str| dir.path().join(name);
+    let score_with = |flag: &str, path: &Path| {
+        seethru(&[
+            "score",
+            inputs.to_str().unwrap(),
+            flag,
+            path.to_str().unwrap(),
+            "--out",
+            file("scored").to_str().unwrap(),
+        ])
+    };
+    // Each bad input: its file, and what the one line must say.
+    write_npy_f32(
+        &file("tall.npy"),
+        &[h + 1, w, 2],
+        &vec![1.0; (h + 1) * w * 2],
+    )
+    .unwrap();
+    write_npy_f32(&file("rgb.npy"), &[h, w, 3], &vec![1.0; h * w * 3]).unwrap();
+    write_npy_f32(&file("nan.npy"), &[h, w, 2], &vec![f32::NAN; h * w * 2]).unwrap();
+    seethru::io::frame_files::write_png(&file("small.png"), 2, 2, vec![0; 12]).unwrap();
+    let cases = [
+        ("--map", "tall.npy", format!("({h}, {w}, 2)")),
+        ("--map", "rgb.npy", "3 channels".to_string()),
+        ("--map", "nan.npy", "NaN".to_string()),
+        ("--display-image", "small.png", format!("{w}×{h}")),
+    ];
+    for (flag, name, says) in &cases {
+        let (ok, _, err) = score_with(flag, &file(name));
+        assert!(!ok, "{name} must be refused");
+        assert!(
+            err.starts_with("error:") && err.contains(name) && err.contains(says.as_str()),
+            "{name}: `{err}` should name the file and say {says}"
+        );
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(!file("scored").exists(), "{name}: nothing is written");
+    }
+    // A map whose left half points outside the frontal image: scored, that half blank.
+    let planar = file("planar.npy");
+    python("planar_method.py", &[&inputs, &planar], &[]);
+    let full = score(&inputs, &planar, &file("full"));
+    let mut half = seethru::io::display_map::read_map(&planar).unwrap();
+    for (k, p) in half.xy.iter_mut().enumerate() {
+        if k % w < w / 2 {
+            p[0] = -1e4;
+        }
+    }
+    let flat: Vec<f32> = half.xy.iter().flatten().copied().collect();
+    let halved = file("half.npy");
+    write_npy_f32(&halved, &[h, w, 2], &flat).unwrap();
+    let m = score(&inputs, &halved, &file("half"));
+    let blank = |m: &Value| m["blank_pixels"].as_u64().unwrap();
+    assert!(
+        blank(&m) > blank(&full) && m["coverage"].as_f64() < full["coverage"].as_f64(),
+        "outside points must count as blank: {} vs {}",
+        blank(&m),
+        blank(&full)
+    );
+}
