@@ -109,11 +109,7 @@ impl CaptureArgs {
             back_width: self.back_width,
             spp: self.render.spp,
             eyes: Eyes {
-                view: match self.eyes {
-                    EyesFlag::Left => Eye::Left,
-                    EyesFlag::Right => Eye::Right,
-                    _ => Eye::Cyclopean,
-                },
+                view: self.eyes.view(),
                 target: self.target_eye,
                 ipd: self.ipd,
             },

@@ -157,11 +157,7 @@ impl Run {
             filter: self.filter,
             display: self.display,
             eyes: Eyes {
-                view: match self.eyes {
-                    EyesFlag::Left => Eye::Left,
-                    EyesFlag::Right => Eye::Right,
-                    _ => Eye::Cyclopean,
-                },
+                view: self.eyes.view(),
                 target: self.target_eye,
                 ipd: self.ipd,
             },

@@ -23,6 +23,18 @@ pub enum EyesFlag {
     Both,
 }
 
+impl EyesFlag {
+    /// The eye a single run views from (`both` starts from the cyclopean eye and runs each).
+    pub fn view(self) -> seethru::system::eyes::Eye {
+        use seethru::system::eyes::Eye;
+        match self {
+            EyesFlag::Left => Eye::Left,
+            EyesFlag::Right => Eye::Right,
+            EyesFlag::Mono | EyesFlag::Both => Eye::Cyclopean,
+        }
+    }
+}
+
 /// Runs each eye through `write_run(options, dir)` into `out` and writes the binocular
 /// outputs there; returns the summary line, naming `shown_out` (where `out` will be moved).
 pub fn run_both(
