@@ -7,6 +7,7 @@ pub mod builtin;
 pub mod curved_body;
 pub mod display_keys;
 pub mod display_surface;
+pub mod eyellipse;
 pub mod fingerprint;
 pub mod grow;
 pub mod head_path;
