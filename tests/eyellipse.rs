@@ -123,3 +123,16 @@ fn samples_depend_on_seed_and_index_only() {
     assert_eq!(all[57], e.sample(3, 57));
     assert_ne!(e.samples(4, 100), all);
 }
+
+#[test]
+fn the_cabin_eye_is_the_eyellipse_centre() {
+    // scenes/cabin.toml writes its eye out; it must stay the centre of its seat package's ellipse.
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = seethru::scene::Scene::load(&root.join("scenes/cabin.toml")).unwrap();
+    let centre = Eyellipse::j941_95(&cabin_seat(false)).centre;
+    assert!(
+        (scene.eye() - centre).length() < 1e-9,
+        "{:?} vs {centre:?}",
+        scene.eye()
+    );
+}
