@@ -283,3 +283,107 @@ fn a_road_user_outside_the_pillars_shadow_is_not_counted_as_hidden() {
     assert_eq!(cyclist["hidden_pixels"], 0, "{cyclist}");
     assert!(cyclist["visibility"].is_null(), "{cyclist}");
 }
+
+/// The left turn as a sequence (10 km/h on a 10 m radius, 3 s at 10 frames/s): frames.csv's
+/// header and rows, and summary.json's hazard block.
+fn left_turn_sequence(dir: &std::path::Path) -> (Vec<String>, Vec<Vec<f64>>, serde_json::Value) {
+    let out = dir.join("seq");
+    let args = [
+        "sequence",
+        "scenes/left_turn.toml",
+        "--out",
+        out.to_str().unwrap(),
+        "--speed",
+        "10",
+        "--yaw-rate",
+        "15.9",
+        "--duration",
+        "3",
+        "--fps",
+        "10",
+        "--width",
+        "96",
+    ];
+    let (ok, _, err) = common::seethru(&args);
+    assert!(ok, "{err}");
+    let dir = out.join("latency_0ms");
+    let text = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    (header, rows, s["hazards"].clone())
+}
+
+#[test]
+fn over_the_left_turn_the_hazard_times_agree_with_a_frame_by_frame_check() {
+    let dir = tempfile::tempdir().unwrap();
+    let (header, rows, hazards) = left_turn_sequence(dir.path());
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+    };
+    let (t, off, on, vis, truth, hidden) = (
+        col("t_s"),
+        col("hazard_pedestrian_seen_display_off"),
+        col("hazard_pedestrian_seen_display_on"),
+        col("hazard_pedestrian_visibility"),
+        col("hazard_pedestrian_truth_pixels"),
+        col("hazard_pedestrian_hidden_pixels"),
+    );
+    let period = 0.1;
+    // The guide's definition, applied to the rows: hidden when in view and less than half
+    // of it is seen.
+    let below = 0.5;
+    let first = |c: usize| rows.iter().find(|r| r[c] >= below).map(|r| r[t]);
+    let first_hidden = rows
+        .iter()
+        .find(|r| r[truth] > 0.0 && r[off] < below)
+        .map(|r| r[t]);
+    let longest = |c: usize| {
+        let (mut best, mut run) = (0, 0);
+        for r in &rows {
+            run = if r[truth] > 0.0 && r[c] < below {
+                run + 1
+            } else {
+                0
+            };
+            best = best.max(run);
+        }
+        best as f64 * period
+    };
+    for r in &rows {
+        // What the display adds can only add to what the pillar leaves in view; what it
+        // leaves is no more than the pixels off the display.
+        assert!(r[on] >= r[off], "{r:?}");
+        if r[truth] > 0.0 {
+            assert!(r[off] <= 1.0 - r[hidden] / r[truth] + 1e-12, "{r:?}");
+        }
+    }
+    let p = &hazards["objects"][0];
+    assert_eq!(p["name"], "pedestrian");
+    let close = |a: &serde_json::Value, b: Option<f64>| {
+        let b = b.expect("the pedestrian is hidden and shown during the turn");
+        assert!((a.as_f64().unwrap() - b).abs() < 1e-9, "{a} against {b}");
+    };
+    close(&p["first_hidden_s"], first_hidden);
+    close(&p["first_visible_on_display_s"], first(vis));
+    close(&p["longest_hidden_display_off_s"], Some(longest(off)));
+    close(&p["longest_hidden_display_on_s"], Some(longest(on)));
+    // The scene's geometry puts the pedestrian in the pillar's shadow from about 0.5 s to
+    // 2.6 s; the display shortens the time hidden.
+    let hidden_off = p["longest_hidden_display_off_s"].as_f64().unwrap();
+    assert!((1.5..=2.5).contains(&hidden_off), "{hidden_off}");
+    assert!(p["longest_hidden_display_on_s"].as_f64().unwrap() < hidden_off);
+    assert!((0.3..=0.8).contains(&p["first_hidden_s"].as_f64().unwrap()), "{p}");
+}
