@@ -385,5 +385,65 @@ fn over_the_left_turn_the_hazard_times_agree_with_a_frame_by_frame_check() {
     let hidden_off = p["longest_hidden_display_off_s"].as_f64().unwrap();
     assert!((1.5..=2.5).contains(&hidden_off), "{hidden_off}");
     assert!(p["longest_hidden_display_on_s"].as_f64().unwrap() < hidden_off);
-    assert!((0.3..=0.8).contains(&p["first_hidden_s"].as_f64().unwrap()), "{p}");
+    assert!(
+        (0.3..=0.8).contains(&p["first_hidden_s"].as_f64().unwrap()),
+        "{p}"
+    );
+}
+
+#[test]
+fn compare_rows_carry_each_hazards_visibility_as_run_measures_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cmp");
+    let (ok, _, err) = common::seethru(&[
+        "compare",
+        "scenes/left_turn.toml",
+        "--out",
+        out.to_str().unwrap(),
+        "--width",
+        "160",
+        "--spp",
+        "1",
+    ]);
+    assert!(ok, "{err}");
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("compare.json")).unwrap()).unwrap();
+    let rows = j
+        .as_array()
+        .or(j["rows"].as_array())
+        .or(j["methods"].as_array());
+    let rows = rows.unwrap_or_else(|| panic!("rows in {j}"));
+    let planar_inf = rows.iter().find(|r| r["method"] == "planar-inf").unwrap();
+    // The same method as a `run` (planar, d2 = ∞, 30′): the same hazard figures.
+    let ran = dir.path().join("run");
+    let (ok, _, err) = common::seethru(&[
+        "run",
+        "scenes/left_turn.toml",
+        "--out",
+        ran.to_str().unwrap(),
+        "--width",
+        "160",
+        "--spp",
+        "1",
+        "--d2",
+        "inf",
+        "--outside",
+        "black",
+    ]);
+    assert!(ok, "{err}");
+    let h: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(ran.join("hazards.json")).unwrap()).unwrap();
+    let (a, b) = (&planar_inf["hazards"]["objects"], &h["objects"]);
+    assert_eq!(a[0]["name"], "pedestrian");
+    assert!(a[0]["hidden_pixels"].as_u64().unwrap() > 0, "{a}");
+    assert_eq!(
+        a[0]["hidden_pixels"], b[0]["hidden_pixels"],
+        "{a} against {b}"
+    );
+    assert_eq!(
+        a[0]["shown_pixels"], b[0]["shown_pixels"],
+        "{a} against {b}"
+    );
+    let md = std::fs::read_to_string(out.join("compare.md")).unwrap();
+    assert!(md.contains("| pedestrian visibility |"), "{md}");
 }
