@@ -233,40 +233,90 @@ fn hazard_visibility_is_one_at_the_pedestrians_depth_and_falls_as_the_plane_move
         .map(|o| o.name.as_str())
         .collect();
     assert_eq!(hazards, ["pedestrian", "cyclist"]);
-    // The pedestrian waits at z = −13.2, the display plane is at z = −0.75: 12.45 m behind it.
-    let depth = 12.45;
-    let dir = tempfile::tempdir().unwrap();
-    let visibility = |d2: &str| {
-        let h = left_turn(dir.path(), d2, &["--d2", d2, "--hazard-bound-arcmin", "8"]);
-        assert!(h[0]["hidden_pixels"].as_u64().unwrap() > 20, "{h:?}");
-        h[0]["visibility"].as_f64().unwrap()
+    // The prediction from the scene's geometry: the frontal camera at C sees the pedestrian's
+    // centre P along C→P; the planar model puts that ray's point on the model plane (d2
+    // behind the display plane, parallel to it) at Q, and the display shows it where the eye
+    // E sees Q. The error is the angle at E between P and Q.
+    let pedestrian = scene
+        .objects
+        .iter()
+        .find(|o| o.name == "pedestrian")
+        .unwrap();
+    let p = pedestrian.world_from_object.translation;
+    let (e, c) = (scene.eye(), scene.frontal.position());
+    let n = scene
+        .obstacle
+        .world_from_obstacle
+        .transform_vector3(glam::DVec3::Z)
+        .normalize();
+    let centre = scene.obstacle.world_from_obstacle.translation;
+    let depth = (centre - p).dot(n);
+    let predicted = |d2: f64| {
+        let q = if d2.is_infinite() {
+            // A plane at infinity: the direction C→P seen from E.
+            e + (p - c)
+        } else {
+            let plane = centre - n * d2;
+            let s = (plane - c).dot(n) / (p - c).dot(n);
+            c + (p - c) * s
+        };
+        (p - e).angle_between(q - e).to_degrees() * 60.0
     };
-    // The frontal camera sits 0.83 m from the eye, 4° off the line of sight to the
-    // pedestrian (both about 25–29° left of ahead): a baseline of b = 0.83 sin 4° = 0.06 m
-    // across it. A point at depth D through a plane at d2 is then off by b |1/D − 1/d2|:
-    // 0′ at d2 = D (the body's ±0.2 m of depth: < 1′), 3.7′ at 16 m, 8.3′ at 25 m and 16.5′
-    // at ∞. With an 8′ bound: all shown, nearly all, about half, none.
-    let at_depth = visibility(&depth.to_string());
-    let near = visibility("16");
-    let far = visibility("25");
-    let (infinity, centroid) = {
+    let bound = 8.0;
+    let dir = tempfile::tempdir().unwrap();
+    let measured = |d2: f64| {
+        let text = if d2.is_infinite() {
+            "inf".to_string()
+        } else {
+            d2.to_string()
+        };
         let h = left_turn(
             dir.path(),
-            "inf",
-            &["--d2", "inf", "--hazard-bound-arcmin", "8"],
+            &text,
+            &["--d2", &text, "--hazard-bound-arcmin", &bound.to_string()],
         );
+        assert!(h[0]["hidden_pixels"].as_u64().unwrap() > 20, "{h:?}");
         (
             h[0]["visibility"].as_f64().unwrap(),
             h[0]["centroid_error_arcmin"].as_f64().unwrap(),
         )
     };
-    assert!(at_depth > 0.95, "{at_depth}");
-    assert!(near > 0.9, "{near}");
-    assert!((0.2..0.8).contains(&far), "{far}");
-    assert!(infinity < 0.05, "{infinity}");
+    // From the pedestrian's depth outwards: the predicted error grows, the visibility falls.
+    let planes = [depth, 1.3 * depth, 2.0 * depth, f64::INFINITY];
+    let mut last = (f64::INFINITY, -1.0);
+    for d2 in planes {
+        let (visibility, centroid) = measured(d2);
+        let error = predicted(d2);
+        assert!(error > last.1, "{d2}: predicted {error}′ after {}′", last.1);
+        assert!(
+            visibility <= last.0 + 0.02,
+            "{d2}: {visibility} after {}",
+            last.0
+        );
+        if error < 0.5 * bound {
+            assert!(
+                visibility > 0.9,
+                "{d2} m: {visibility} at a predicted {error}′"
+            );
+        }
+        if error > 1.5 * bound {
+            assert!(
+                visibility < 0.05,
+                "{d2} m: {visibility} at a predicted {error}′"
+            );
+        }
+        // The shown centroid moves by the predicted error (the body's ±0.25 m of depth and
+        // the pixel pitch: within 2′ + 30%).
+        assert!(
+            (centroid - error).abs() < 2.0 + 0.3 * error,
+            "{d2} m: centroid {centroid}′ against a predicted {error}′"
+        );
+        last = (visibility, error);
+    }
+    assert!(predicted(depth) < 0.01, "{}", predicted(depth));
     assert!(
-        (centroid - 16.5).abs() < 0.3 * 16.5,
-        "{centroid}′ against 16.5′"
+        predicted(f64::INFINITY) > 1.5 * bound,
+        "the test needs a plane that hides it"
     );
 }
 
@@ -282,4 +332,168 @@ fn a_road_user_outside_the_pillars_shadow_is_not_counted_as_hidden() {
     );
     assert_eq!(cyclist["hidden_pixels"], 0, "{cyclist}");
     assert!(cyclist["visibility"].is_null(), "{cyclist}");
+}
+
+/// The left turn as a sequence (10 km/h on a 10 m radius, 3 s at 10 frames/s): frames.csv's
+/// header and rows, and summary.json's hazard block.
+fn left_turn_sequence(dir: &std::path::Path) -> (Vec<String>, Vec<Vec<f64>>, serde_json::Value) {
+    let out = dir.join("seq");
+    let args = [
+        "sequence",
+        "scenes/left_turn.toml",
+        "--out",
+        out.to_str().unwrap(),
+        "--speed",
+        "10",
+        "--yaw-rate",
+        "15.9",
+        "--duration",
+        "3",
+        "--fps",
+        "10",
+        "--width",
+        "96",
+    ];
+    let (ok, _, err) = common::seethru(&args);
+    assert!(ok, "{err}");
+    let dir = out.join("latency_0ms");
+    let text = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    (header, rows, s["hazards"].clone())
+}
+
+#[test]
+fn over_the_left_turn_the_hazard_times_agree_with_a_frame_by_frame_check() {
+    let dir = tempfile::tempdir().unwrap();
+    let (header, rows, hazards) = left_turn_sequence(dir.path());
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+    };
+    let (t, off, on, vis, truth, hidden) = (
+        col("t_s"),
+        col("hazard_pedestrian_seen_display_off"),
+        col("hazard_pedestrian_seen_display_on"),
+        col("hazard_pedestrian_visibility"),
+        col("hazard_pedestrian_truth_pixels"),
+        col("hazard_pedestrian_hidden_pixels"),
+    );
+    let period = 0.1;
+    // The guide's definition, applied to the rows: hidden when in view and less than half
+    // of it is seen.
+    let below = 0.5;
+    let first = |c: usize| rows.iter().find(|r| r[c] >= below).map(|r| r[t]);
+    let first_hidden = rows
+        .iter()
+        .find(|r| r[truth] > 0.0 && r[off] < below)
+        .map(|r| r[t]);
+    let longest = |c: usize| {
+        let (mut best, mut run) = (0, 0);
+        for r in &rows {
+            run = if r[truth] > 0.0 && r[c] < below {
+                run + 1
+            } else {
+                0
+            };
+            best = best.max(run);
+        }
+        best as f64 * period
+    };
+    for r in &rows {
+        // What the display adds can only add to what the pillar leaves in view; what it
+        // leaves is no more than the pixels off the display.
+        assert!(r[on] >= r[off], "{r:?}");
+        if r[truth] > 0.0 {
+            assert!(r[off] <= 1.0 - r[hidden] / r[truth] + 1e-12, "{r:?}");
+        }
+    }
+    let p = &hazards["objects"][0];
+    assert_eq!(p["name"], "pedestrian");
+    let close = |a: &serde_json::Value, b: Option<f64>| {
+        let b = b.expect("the pedestrian is hidden and shown during the turn");
+        assert!((a.as_f64().unwrap() - b).abs() < 1e-9, "{a} against {b}");
+    };
+    close(&p["first_hidden_s"], first_hidden);
+    close(&p["first_visible_on_display_s"], first(vis));
+    close(&p["longest_hidden_display_off_s"], Some(longest(off)));
+    close(&p["longest_hidden_display_on_s"], Some(longest(on)));
+    // The scene's geometry puts the pedestrian in the pillar's shadow from about 0.5 s to
+    // 2.6 s; the display shortens the time hidden.
+    let hidden_off = p["longest_hidden_display_off_s"].as_f64().unwrap();
+    assert!((1.5..=2.5).contains(&hidden_off), "{hidden_off}");
+    assert!(p["longest_hidden_display_on_s"].as_f64().unwrap() < hidden_off);
+    assert!(
+        (0.3..=0.8).contains(&p["first_hidden_s"].as_f64().unwrap()),
+        "{p}"
+    );
+}
+
+#[test]
+fn compare_rows_carry_each_hazards_visibility_as_run_measures_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cmp");
+    let (ok, _, err) = common::seethru(&[
+        "compare",
+        "scenes/left_turn.toml",
+        "--out",
+        out.to_str().unwrap(),
+        "--width",
+        "160",
+        "--spp",
+        "1",
+    ]);
+    assert!(ok, "{err}");
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("compare.json")).unwrap()).unwrap();
+    let rows = j
+        .as_array()
+        .or(j["rows"].as_array())
+        .or(j["methods"].as_array());
+    let rows = rows.unwrap_or_else(|| panic!("rows in {j}"));
+    let planar_inf = rows.iter().find(|r| r["method"] == "planar-inf").unwrap();
+    // The same method as a `run` (planar, d2 = ∞, 30′): the same hazard figures.
+    let ran = dir.path().join("run");
+    let (ok, _, err) = common::seethru(&[
+        "run",
+        "scenes/left_turn.toml",
+        "--out",
+        ran.to_str().unwrap(),
+        "--width",
+        "160",
+        "--spp",
+        "1",
+        "--d2",
+        "inf",
+        "--outside",
+        "black",
+    ]);
+    assert!(ok, "{err}");
+    let h: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(ran.join("hazards.json")).unwrap()).unwrap();
+    let (a, b) = (&planar_inf["hazards"]["objects"], &h["objects"]);
+    assert_eq!(a[0]["name"], "pedestrian");
+    assert!(a[0]["hidden_pixels"].as_u64().unwrap() > 0, "{a}");
+    assert_eq!(
+        a[0]["hidden_pixels"], b[0]["hidden_pixels"],
+        "{a} against {b}"
+    );
+    assert_eq!(
+        a[0]["shown_pixels"], b[0]["shown_pixels"],
+        "{a} against {b}"
+    );
+    let md = std::fs::read_to_string(out.join("compare.md")).unwrap();
+    assert!(md.contains("| pedestrian visibility |"), "{md}");
 }

@@ -7,10 +7,11 @@ use anyhow::{Context, Result, bail};
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{write_color_png, write_exr};
 use seethru::io::staged::StagedDir;
+use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
 use seethru::measure::headline::{RunKind, summary_text};
-use seethru::measure::sequence::{Measuring, SequenceRun, head_warning, run_sequence_labelled};
+use seethru::measure::sequence::{Measuring, SequenceRun, head_warning, run_sequence_hazards};
 use seethru::measure::sequence_files::{
-    Preview, frames_csv, latency_figure, over_time_figure, summary,
+    Preview, frames_csv, hazard_figure, latency_figure, over_time_figure, summary,
 };
 use seethru::scene::Scene;
 use seethru::scene::head_path::HeadPath;
@@ -190,6 +191,10 @@ pub struct Sequence {
     /// Border band of the metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
+    /// Hazard visibility: a hidden hazard pixel counts as shown when the display shows the
+    /// same object within this misregistration, arc-minutes in [1e-6, 10800].
+    #[arg(long = "hazard-bound-arcmin", default_value_t = DEFAULT_BOUND_ARCMIN, value_parser = positive(10800.0))]
+    hazard_bound_arcmin: f64,
     /// Worker threads in [1, 1024] (default: all cores). Output is identical for any value.
     #[arg(long, value_parser = threads)]
     threads: Option<usize>,
@@ -418,7 +423,8 @@ impl Sequence {
                 band: self.band,
                 progress: true,
             };
-            let run = run_sequence_labelled(&scene, options, how, &label, &mut |f| {
+            let bound = self.hazard_bound_arcmin;
+            let run = run_sequence_hazards(&scene, options, how, bound, &label, &mut |f| {
                 preview.add(&f);
                 if let Some(c) = &captured {
                     index.push(crate::cli::sequence_byo::write_frame(
@@ -454,6 +460,9 @@ impl Sequence {
             let (scale, chosen) = preview.write(&dir.join("preview.png"))?;
             over_time_figure(&[(format!("{ms} ms"), &run.records)], timeline.duration)
                 .write(&dir, "misregistration_over_time")?;
+            if run.records.first().is_some_and(|r| !r.hazards.is_empty()) {
+                hazard_figure(&run.records, timeline.duration).write(&dir, "hazard_visibility")?;
+            }
             let mut s = summary(&run, &timeline);
             headlines.push(format!("{ms} ms: {}", summary_text(RunKind::Sequence, &s)));
             s["preview_heat_scale_arcmin"] = json!(scale);

@@ -4,6 +4,7 @@
 use anyhow::Result;
 use serde_json::json;
 
+use crate::measure::hazard::{DEFAULT_BOUND_ARCMIN, hazard_frame, hazards_json};
 use crate::measure::holes::attach_holes;
 use crate::measure::maps::heat_color;
 use crate::measure::metrics::{MetricMaps, measure};
@@ -138,7 +139,21 @@ pub fn compare(
         );
         let display = &metrics["display"];
         let misregistration = &display["misregistration_arcmin"];
+        let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
+            .atan()
+            .to_degrees()
+            * 60.0;
+        let hazards = hazard_frame(
+            scene,
+            &result.truth,
+            &result.seethru,
+            &maps,
+            DEFAULT_BOUND_ARCMIN,
+            arcmin_per_px,
+        );
         let row = json!({
+            // Per `hazard = true` object, as `run`'s hazards.json (default bound).
+            "hazards": hazards_json(&hazards, DEFAULT_BOUND_ARCMIN),
             "method": candidate.name(),
             "misregistration_mean_arcmin": misregistration["mean"],
             "misregistration_p95_arcmin": misregistration["p95"],
@@ -287,18 +302,50 @@ pub(crate) fn strip(
 
 /// The table as Markdown: one row per method.
 pub fn markdown_table(rows: &[Compared]) -> String {
+    // One visibility column per hazard object (the same objects in every row).
+    let hazards = |r: &Compared| {
+        r.row["hazards"]["objects"]
+            .as_array()
+            .cloned()
+            .unwrap_or_default()
+    };
+    let names: Vec<String> = rows.first().map_or(Vec::new(), |r| {
+        hazards(r)
+            .iter()
+            .map(|h| h["name"].as_str().unwrap_or("?").to_string())
+            .collect()
+    });
     let mut s = String::from(
-        "| method | mean ′ | p95 ′ | border ′ | coverage | holes | PSNR dB | SSIM | FLIP | ms/frame |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| method | mean ′ | p95 ′ | border ′ | coverage | holes | PSNR dB | SSIM | FLIP | ms/frame |",
     );
+    for n in &names {
+        s += &format!(" {n} visibility | {n} centroid ′ |");
+    }
+    s += "\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|";
+    s += &"---:|---:|".repeat(names.len());
+    s += "\n";
     for r in rows {
         let v = &r.row;
+        let mut extra = String::new();
+        for h in hazards(r) {
+            let g = |key: &str, digits: usize| {
+                h[key]
+                    .as_f64()
+                    .map_or("—".to_string(), |x| format!("{x:.digits$}"))
+            };
+            extra += &format!(
+                " {} | {} |",
+                g("visibility", 3),
+                g("centroid_error_arcmin", 1)
+            );
+        }
         let f = |key: &str, digits: usize| {
             v[key]
                 .as_f64()
                 .map_or("—".to_string(), |x| format!("{x:.digits$}"))
         };
         s += &format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |{extra}\n",
             r.name,
             f("misregistration_mean_arcmin", 1),
             f("misregistration_p95_arcmin", 1),

@@ -115,3 +115,138 @@ pub fn hazards_json(hazards: &[HazardFrame], bound_arcmin: f64) -> serde_json::V
         })).collect::<Vec<_>>(),
     })
 }
+
+/// A hazard counts as hidden from the driver in a frame when the driver sees less than this
+/// fraction of its truth pixels (see [`HazardSeen`]).
+pub const HIDDEN_BELOW: f64 = 0.5;
+
+/// One hazard in one frame of a sequence: [`HazardFrame`] and what the driver sees of it with
+/// the display on and off. Every count is over the truth pixels the frame rendered (the
+/// sequence's window around the pillar, or the whole view with full frames).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct HazardSeen {
+    pub frame: HazardFrame,
+    /// Its truth pixels where the `occluded` view (display off) shows the same object.
+    pub seen_off_pixels: u64,
+    /// Its truth pixels where the `seethru` view shows the same object, within the bound of
+    /// misregistration where the driver sees the display (the display's shown pixels plus
+    /// those the pillar does not cover).
+    pub seen_on_pixels: u64,
+}
+
+impl HazardSeen {
+    /// seen_off / truth, [0, 1]; NaN when it is not in the view.
+    pub fn seen_off(&self) -> f64 {
+        ratio(self.seen_off_pixels, self.frame.truth_pixels)
+    }
+    /// seen_on / truth, [0, 1]; NaN when it is not in the view.
+    pub fn seen_on(&self) -> f64 {
+        ratio(self.seen_on_pixels, self.frame.truth_pixels)
+    }
+    /// Hidden from the driver with the display off: in the view, and less than
+    /// [`HIDDEN_BELOW`] of it seen in the `occluded` view.
+    pub fn hidden_off(&self) -> bool {
+        self.frame.truth_pixels > 0 && self.seen_off() < HIDDEN_BELOW
+    }
+    /// Hidden from the driver with the display on: in the view, and less than
+    /// [`HIDDEN_BELOW`] of it seen in the `seethru` view.
+    pub fn hidden_on(&self) -> bool {
+        self.frame.truth_pixels > 0 && self.seen_on() < HIDDEN_BELOW
+    }
+    /// Visible on the display: the display shows at least [`HIDDEN_BELOW`] of the pixels the
+    /// pillar hides (visibility ≥ 0.5).
+    pub fn visible_on_display(&self) -> bool {
+        self.frame.visibility >= HIDDEN_BELOW
+    }
+}
+
+fn ratio(a: u64, b: u64) -> f64 {
+    if b == 0 {
+        f64::NAN
+    } else {
+        a as f64 / b as f64
+    }
+}
+
+/// [`hazard_frame`] with what the driver sees with the display on (`seethru`) and off
+/// (`occluded`).
+pub fn hazard_seen(
+    scene: &Scene,
+    [truth, seethru, occluded]: [&Frame; 3],
+    maps: &MetricMaps,
+    bound_arcmin: f64,
+    arcmin_per_px: f64,
+) -> Vec<HazardSeen> {
+    hazard_frame(scene, truth, seethru, maps, bound_arcmin, arcmin_per_px)
+        .into_iter()
+        .map(|frame| {
+            let id = frame.id;
+            let (mut off, mut on) = (0u64, 0u64);
+            for i in 0..truth.object_id.len() {
+                if truth.object_id[i] != id {
+                    continue;
+                }
+                off += u64::from(occluded.object_id[i] == id);
+                let within = !maps.display[i] || maps.misregistration[i] as f64 <= bound_arcmin;
+                on += u64::from(seethru.object_id[i] == id && within);
+            }
+            HazardSeen {
+                frame,
+                seen_off_pixels: off,
+                seen_on_pixels: on,
+            }
+        })
+        .collect()
+}
+
+/// One hazard over a sequence: when it was first hidden and first shown, and its longest
+/// hidden stretch with the display on and off.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct HazardTimes {
+    pub name: String,
+    /// Display time of the first frame hidden with the display off, s (`None`: never).
+    pub first_hidden_s: Option<f64>,
+    /// Display time of the first frame visible on the display, s (`None`: never).
+    pub first_visible_on_display_s: Option<f64>,
+    /// Longest run of consecutive hidden frames × the frame period, s.
+    pub longest_hidden_display_on_s: f64,
+    pub longest_hidden_display_off_s: f64,
+    /// Frames hidden with the display on and off, and frames it is not in the view at all
+    /// (not counted as hidden).
+    pub frames_hidden_on: usize,
+    pub frames_hidden_off: usize,
+    pub frames_out_of_view: usize,
+}
+
+/// The times of every hazard over frames at display times `t[k]` (`seen[k]` the frame's
+/// hazards, in the same order each frame), `period` s apart.
+pub fn hazard_times(t: &[f64], seen: &[Vec<HazardSeen>], period: f64) -> Vec<HazardTimes> {
+    let count = seen.first().map_or(0, Vec::len);
+    (0..count)
+        .map(|h| {
+            let of = |k: usize| &seen[k][h];
+            let first =
+                |p: &dyn Fn(&HazardSeen) -> bool| (0..t.len()).find(|&k| p(of(k))).map(|k| t[k]);
+            let longest = |p: &dyn Fn(&HazardSeen) -> bool| {
+                let (mut best, mut run) = (0usize, 0usize);
+                for k in 0..t.len() {
+                    run = if p(of(k)) { run + 1 } else { 0 };
+                    best = best.max(run);
+                }
+                best as f64 * period
+            };
+            let frames =
+                |p: &dyn Fn(&HazardSeen) -> bool| (0..t.len()).filter(|&k| p(of(k))).count();
+            HazardTimes {
+                name: of(0).frame.name.clone(),
+                first_hidden_s: first(&HazardSeen::hidden_off),
+                first_visible_on_display_s: first(&HazardSeen::visible_on_display),
+                longest_hidden_display_on_s: longest(&HazardSeen::hidden_on),
+                longest_hidden_display_off_s: longest(&HazardSeen::hidden_off),
+                frames_hidden_on: frames(&HazardSeen::hidden_on),
+                frames_hidden_off: frames(&HazardSeen::hidden_off),
+                frames_out_of_view: frames(&|s| s.frame.truth_pixels == 0),
+            }
+        })
+        .collect()
+}

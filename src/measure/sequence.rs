@@ -10,6 +10,7 @@ use glam::DVec3;
 use obvhs::aabb::Aabb;
 
 use crate::geometry::opencv::camera_json;
+use crate::measure::hazard::{DEFAULT_BOUND_ARCMIN, HazardSeen, hazard_seen};
 use crate::measure::metrics::{MetricMaps, measure};
 use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::Frame;
@@ -80,6 +81,8 @@ pub struct FrameRecord {
     pub d2_used: Option<f64>,
     /// `None` when the sequence runs without truth and metrics.
     pub metrics: Option<FrameMetrics>,
+    /// Every `hazard = true` object, in scene order (empty without metrics).
+    pub hazards: Vec<HazardSeen>,
 }
 
 /// The one-line warning when some frames' image-based head estimates were unreliable
@@ -198,6 +201,18 @@ pub fn run_sequence_labelled(
     label: &str,
     on_frame: &mut dyn FnMut(FrameImages) -> Result<()>,
 ) -> Result<SequenceRun> {
+    run_sequence_hazards(scene, options, how, DEFAULT_BOUND_ARCMIN, label, on_frame)
+}
+
+/// As [`run_sequence_labelled`], hazard visibility scored within `hazard_bound_arcmin`.
+pub fn run_sequence_hazards(
+    scene: &Scene,
+    options: SequenceOptions,
+    how: Measuring,
+    hazard_bound_arcmin: f64,
+    label: &str,
+    on_frame: &mut dyn FnMut(FrameImages) -> Result<()>,
+) -> Result<SequenceRun> {
     let start = Instant::now();
     let mut system = SystemLoop::new(scene, options)?;
     let tl = system.options.timeline;
@@ -239,6 +254,7 @@ pub fn run_sequence_labelled(
             vehicle_yaw_deg: (system.rig.vehicle.yaw_rate * times.display).to_degrees(),
             d2_used: shown.d2_used,
             metrics: None,
+            hazards: Vec::new(),
         };
         if !how.metrics {
             system.render_seethru(&ctx, &mut seethru);
@@ -281,6 +297,17 @@ pub fn run_sequence_labelled(
             driver.position(),
             [&truth, &seethru, &occluded],
             how.band,
+        );
+        let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
+            .atan()
+            .to_degrees()
+            * 60.0;
+        record.hazards = hazard_seen(
+            scene,
+            [&truth, &seethru, &occluded],
+            &maps,
+            hazard_bound_arcmin,
+            arcmin_per_px,
         );
         metrics_seconds += t1.elapsed().as_secs_f64();
         record.metrics = Some(FrameMetrics::from_json(&json));

@@ -11,6 +11,7 @@ use crate::io::animation::write_apng;
 use crate::io::caption::{caption_lines, caption_strip, strip_height};
 use crate::io::colour_bar::{BAR_COLUMN, ColourBar, with_colour_bar};
 use crate::io::plot::{Figure, Series};
+use crate::measure::hazard::{HIDDEN_BELOW, HazardSeen, hazard_times};
 use crate::measure::maps::{heat_color, p99_top};
 use crate::measure::sequence::{FrameImages, FrameMetrics, FrameRecord, SequenceRun};
 use crate::system::sequence::timeline::Timeline;
@@ -59,11 +60,33 @@ pub const FRAME_COLUMNS: [&str; 39] = [
     "head_confidence",
 ];
 
+/// The columns of `frames.csv` for each hazard object, after [`FRAME_COLUMNS`], each named
+/// `hazard_<object name>_<column>`: its truth pixels, those behind the display, the display's
+/// visibility of them, the centroid error (arc-minutes), and the fraction of it the driver
+/// sees with the display off and on (docs/guide/hazards.md).
+pub const HAZARD_COLUMNS: [&str; 6] = [
+    "truth_pixels",
+    "hidden_pixels",
+    "visibility",
+    "centroid_error_arcmin",
+    "seen_display_off",
+    "seen_display_on",
+];
+
 /// `frames.csv`: every number in Rust's shortest round-trip form (the same bytes for any
 /// thread count).
 pub fn frames_csv(records: &[FrameRecord], timeline: &Timeline) -> Result<String> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(FRAME_COLUMNS)?;
+    // Then, per hazard object (in scene order), HAZARD_COLUMNS prefixed `hazard_<name>_`.
+    let names: Vec<String> = records
+        .first()
+        .map(|r| r.hazards.iter().map(|h| h.frame.name.clone()).collect())
+        .unwrap_or_default();
+    let mut header: Vec<String> = FRAME_COLUMNS.iter().map(|c| c.to_string()).collect();
+    for name in &names {
+        header.extend(HAZARD_COLUMNS.iter().map(|c| format!("hazard_{name}_{c}")));
+    }
+    w.write_record(&header)?;
     for (i, r) in records.iter().enumerate() {
         let t = &r.times;
         let m = r.metrics.unwrap_or(FrameMetrics {
@@ -129,6 +152,20 @@ pub fn frames_csv(records: &[FrameRecord], timeline: &Timeline) -> Result<String
         .collect();
         let mut row = vec![r.frame.to_string()];
         row.extend(values);
+        for h in &r.hazards {
+            row.extend(
+                [
+                    h.frame.truth_pixels as f64,
+                    h.frame.hidden_pixels as f64,
+                    h.frame.visibility,
+                    h.frame.centroid_error_arcmin,
+                    h.seen_off(),
+                    h.seen_on(),
+                ]
+                .iter()
+                .map(|v| format!("{v}")),
+            );
+        }
         w.write_record(&row)?;
     }
     Ok(String::from_utf8(w.into_inner()?)?)
@@ -181,8 +218,56 @@ pub fn summary(run: &SequenceRun, timeline: &Timeline) -> serde_json::Value {
         },
         "frontal_pixels_per_refresh": run.frontal_pixels_per_refresh,
         "window_px": [run.window.x0, run.window.y0, run.window.x1, run.window.y1],
+        "hazards": hazards_summary(run, timeline),
         "notes": "per-frame statistics over the display pixels that show the scene (coverage beside them); mean_of_frame_means averages the frames' means; eye_error: the compensation's eye against the true eye at display time",
     })
+}
+
+/// The `hazards` block of summary.json: per hazard object, the times of [`hazard_times`].
+fn hazards_summary(run: &SequenceRun, timeline: &Timeline) -> serde_json::Value {
+    let t: Vec<f64> = run.records.iter().map(|r| r.times.display).collect();
+    let seen: Vec<Vec<HazardSeen>> = run.records.iter().map(|r| r.hazards.clone()).collect();
+    json!({
+        "hidden_below": HIDDEN_BELOW,
+        "definition": "per frame, a hazard is hidden from the driver when it is in the rendered view and the driver sees less than hidden_below of its truth pixels (display off: the occluded view shows the same object; display on: the seethru view shows it, within the bound where the display is); first_hidden_s: the first frame hidden with the display off; first_visible_on_display_s: the first frame whose visibility (display pixels shown within the bound / its pixels behind the display) is at least hidden_below; longest_hidden_*_s: the longest run of consecutive hidden frames times the frame period; null: never",
+        "frame_period_s": 1.0 / timeline.fps,
+        "objects": hazard_times(&t, &seen, 1.0 / timeline.fps),
+    })
+}
+
+/// Hazard visibility over time: per hazard, the fraction the driver sees with the display
+/// on and off, and the display's visibility of what the pillar hides.
+pub fn hazard_figure(records: &[FrameRecord], duration: f64) -> Figure {
+    let count = records.first().map_or(0, |r| r.hazards.len());
+    let mut series = Vec::new();
+    for h in 0..count {
+        let name = &records[0].hazards[h].frame.name;
+        let curve = |label: &str, f: &dyn Fn(&HazardSeen) -> f64| {
+            Series::new(
+                format!("{name}: {label}"),
+                records
+                    .iter()
+                    // NaN (not in view, nothing hidden) stays: the CSV keeps every row, the
+                    // plot skips what is outside its range.
+                    .map(|r| (r.times.display, f(&r.hazards[h])))
+                    .collect(),
+            )
+        };
+        series.push(curve("seen, display on", &HazardSeen::seen_on));
+        series.push(curve("seen, display off", &HazardSeen::seen_off));
+        series.push(curve("display visibility", &|s| s.frame.visibility));
+    }
+    Figure {
+        title: "Hazard visibility, frame by frame".into(),
+        x_label: "time (s)".into(),
+        y_label: "fraction of its pixels".into(),
+        x_range: (0.0, duration),
+        y_range: (0.0, 1.05),
+        series,
+        bounds: vec![(HIDDEN_BELOW, "hidden below".into())],
+        marks: Vec::new(),
+        legend: SeriesLabelPosition::LowerLeft,
+    }
 }
 
 /// Misregistration over time, one curve per sequence (label, records).
