@@ -132,8 +132,8 @@ def ratio(setup: Literal["occlusion", "foreshortening"], **options: Any) -> dict
     foreshortening), b1, d2, d1, bh (required), model_d2, head_bias_cm, width (1280)."""
 
 def analyze(**options: float) -> dict[str, Any]:
-    """`seethru analyze --json`'s claims, evaluation and error_budget_das (not lens_and_eyes):
-    d1, d2, bh, width, theta_f, frontal_px, L, b1, l, gamma, tolerance."""
+    """`seethru analyze --json` whole (claims, evaluation, lens_and_eyes, error_budget_das):
+    d1, d2, bh, width, height, theta_f, frontal_px, L, b1, l, gamma, tolerance, k1, ipd."""
 
 class Capture:
     """What a see-through system's algorithm receives (`seethru capture`), in memory."""
