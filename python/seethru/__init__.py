@@ -13,12 +13,14 @@ Errors raise :class:`ValueError` (bad input: a scene key, an option's range) or
 from ._native import Capture, Frame, Run, Scene, __version__, analyze, capture, compare, ratio, read_frame
 from ._native import run as _run
 from ._native import score as _score
+from ._native import Sequence, Step
+from ._native import sequence as _sequence
 
 import numpy as _np
 
 __all__ = [
     "Capture", "Frame", "Run", "Scene", "analyze", "capture", "compare", "ratio", "read_frame", "run",
-    "score", "__version__",
+    "score", "sequence", "Sequence", "Step", "__version__",
 ]
 
 
@@ -52,3 +54,25 @@ def score(capture: Capture, map=None, display_image=None, filter: str = "bilinea
     """
     as_f32 = lambda a: None if a is None else _np.ascontiguousarray(a, dtype=_np.float32)
     return _score(capture, as_f32(map), as_f32(display_image), filter, band)
+
+
+def sequence(scene: Scene, predictor=None, **options) -> Sequence:
+    """A sequence (``seethru sequence``) as an iterator of measured frames (:class:`Step`).
+
+    Keywords (``seethru sequence``'s flags, same defaults): ``duration`` (s), ``fps``,
+    ``display_hz``, ``speed`` (km/h), ``yaw_rate`` (deg/s), ``head`` ("still", "sway",
+    "lean"), ``sway_cm``, ``sway_hz``, ``lean_cm``, ``lean_s``, ``lean_at``,
+    ``latency_camera`` and ``latency_tracking`` (ms), ``method`` ("planar", "none"), ``d2``
+    (m or inf), ``outside`` ("black", "error"), ``width``, ``spp`` (default 1), ``band``.
+    Every frame renders whole driver views (as ``--frames exr``), so its metrics equal
+    frames.csv's for the same options.
+
+    ``predictor(info)`` is called once per display refresh, before its image is made, with a
+    dict: ``frame``, ``time``, ``refresh``, ``refresh_time``, ``capture_time``, ``head_time``
+    (s), ``eye_true`` (at ``time``) and ``eye_at_head_time`` (obstacle frame, m). It returns
+    the eye (x, y, z, obstacle frame, m) the compensation uses, or None for the system's own
+    oracle estimate. Each :class:`Step` has the times, ``eye_true``, ``eye_estimated``,
+    ``eye_used``, ``metrics`` (metrics.json's content for that instant), ``truth`` and
+    ``seethru`` (:class:`Frame`) and ``misregistration`` ((h, w) float32, arcmin).
+    """
+    return _sequence(scene, predictor, **options)

@@ -1,7 +1,7 @@
 """Type stubs of the seethru package (the Rust extension seethru._native)."""
 
 from os import PathLike
-from typing import Any, Literal
+from typing import Any, Callable, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -132,8 +132,8 @@ def ratio(setup: Literal["occlusion", "foreshortening"], **options: Any) -> dict
     foreshortening), b1, d2, d1, bh (required), model_d2, head_bias_cm, width (1280)."""
 
 def analyze(**options: float) -> dict[str, Any]:
-    """`seethru analyze --json`'s claims, evaluation and error_budget_das (not lens_and_eyes):
-    d1, d2, bh, width, theta_f, frontal_px, L, b1, l, gamma, tolerance."""
+    """`seethru analyze --json` whole (claims, evaluation, lens_and_eyes, error_budget_das):
+    d1, d2, bh, width, height, theta_f, frontal_px, L, b1, l, gamma, tolerance, k1, ipd."""
 
 class Capture:
     """What a see-through system's algorithm receives (`seethru capture`), in memory."""
@@ -161,3 +161,32 @@ def score(
     band: int = 5,
 ) -> Run:
     """`seethru score`: a method's display map (h, w, 2) and/or image (h, w, 3) measured."""
+
+class Step:
+    """One displayed frame of a :class:`Sequence`."""
+    frame: int
+    time: float  # s, when the frame is looked at
+    refresh: int
+    refresh_time: float  # s
+    capture_time: float  # s
+    head_time: float  # s
+    eye_true: tuple[float, float, float]  # obstacle frame, m, at `time`
+    eye_estimated: tuple[float, float, float]  # the system's head estimate, m
+    eye_used: tuple[float, float, float]  # what the compensation used, m
+    metrics: dict[str, Any]  # metrics.json's content for this instant
+    truth: Frame
+    seethru: Frame
+    misregistration: npt.NDArray[np.float32]  # (height, width), arcmin, NaN off the display
+
+class Sequence:
+    """A sequence being stepped through: iterate it for its :class:`Step`s."""
+    def __iter__(self) -> Sequence: ...
+    def __next__(self) -> Step: ...
+    def __len__(self) -> int: ...
+
+def sequence(
+    scene: Scene,
+    predictor: Callable[[dict[str, Any]], tuple[float, float, float] | None] | None = None,
+    **options: Any,
+) -> Sequence:
+    """A sequence as an iterator of measured frames; `predictor(info)` supplies the eye per refresh."""

@@ -10,6 +10,7 @@ mod measures;
 mod options;
 mod run;
 mod scene;
+mod sequence;
 
 use pyo3::prelude::*;
 
@@ -22,6 +23,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(capture::capture, m)?)?;
     m.add_function(wrap_pyfunction!(capture::score, m)?)?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
+    m.add_class::<sequence::PySequence>()?;
+    m.add_class::<sequence::PyStep>()?;
+    m.add_function(wrap_pyfunction!(sequence::sequence, m)?)?;
     m.add_function(wrap_pyfunction!(frame::read_frame, m)?)?;
     m.add_function(wrap_pyfunction!(measures::compare, m)?)?;
     m.add_function(wrap_pyfunction!(measures::ratio, m)?)?;

@@ -328,6 +328,16 @@ impl<'py> Keywords<'py> {
         }
     }
 
+    /// A string, or `None` when absent.
+    pub fn string(&mut self, key: &'static str) -> PyResult<Option<String>> {
+        self.value(key)
+            .map(|v| {
+                v.extract::<String>()
+                    .map_err(|_| bad_value(format!("{key}: a string is needed")))
+            })
+            .transpose()
+    }
+
     pub fn head_bias_cm(&mut self) -> PyResult<[f64; 3]> {
         match self.value("head_bias_cm") {
             None => Ok([0.0; 3]),

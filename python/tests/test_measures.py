@@ -26,8 +26,12 @@ def test_analyze_matches_the_cli():
     assert cli.returncode == 0, cli.stderr
     expected = json.loads(cli.stdout)
     got = seethru.analyze(d1=0.9, d2=float("inf"), bh=0.2)
-    for key in ("claims", "evaluation", "error_budget_das"):
-        assert got[key] == expected[key], key
+    assert got == expected  # every block, lens_and_eyes included
+    lens = ["--height", "0.3", "--k1", "-0.2", "--ipd", "0.06", "--theta-f", "60", "--frontal-px", "800"]
+    cli = seethru_cli("analyze", "--json", "--d1", "0.7", "--d2", "2.5", "--bh", "-0.1", *lens)
+    assert cli.returncode == 0, cli.stderr
+    got = seethru.analyze(d1=0.7, d2=2.5, bh=-0.1, height=0.3, k1=-0.2, ipd=0.06, theta_f=60, frontal_px=800)
+    assert got == json.loads(cli.stdout)
     # The parameters reach the closed forms: another eye distance, other values.
     assert seethru.analyze(d1=0.5, d2=float("inf"), bh=0.2)["evaluation"] != got["evaluation"]
 

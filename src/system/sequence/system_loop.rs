@@ -117,6 +117,9 @@ pub struct SystemLoop {
     model_last: Option<DVec3>,
     /// The last refresh's inputs, until taken ([`SystemLoop::take_inputs`]).
     inputs: Option<RefreshInputs>,
+    /// An eye supplied from outside (a Python predictor), obstacle frame, m: the next refresh
+    /// [`SystemLoop::show`] makes compensates for it instead of the predicted estimate.
+    pub eye_given: Option<DVec3>,
 }
 
 impl SystemLoop {
@@ -174,6 +177,7 @@ impl SystemLoop {
             frontal_pixels: 0,
             model_last: None,
             inputs: None,
+            eye_given: None,
         })
     }
 
@@ -271,9 +275,10 @@ impl SystemLoop {
         }
         let (eye_estimated, head_confidence) = self.estimate_head(times.head, times.refresh)?;
         self.predictor.observe(times.head, eye_estimated);
-        let eye_used = match self.options.predict {
-            Prediction::None => eye_estimated,
-            _ => self.predictor.predict(times.refresh_time),
+        let eye_used = match (self.eye_given.take(), self.options.predict) {
+            (Some(given), _) => given,
+            (None, Prediction::None) => eye_estimated,
+            (None, _) => self.predictor.predict(times.refresh_time),
         };
         let capture = self.context_at(times.capture)?;
         let start = Instant::now();
