@@ -356,6 +356,11 @@ impl Sequence {
         self.refuse_ignored()?;
         let head = self.head_motion()?;
         let scene = Scene::load(&self.scene)?;
+        refuse_ignored(&[ReadWhen {
+            flag: "--hazard-bound-arcmin",
+            read: scene.objects.iter().any(|o| o.hazard),
+            when: "for a scene with an object marked `hazard = true`",
+        }])?;
         if let HeadMotion::Path(path) = &head {
             path.check_in_world(&scene.obstacle.world_from_obstacle)?;
         }
