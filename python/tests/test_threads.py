@@ -40,6 +40,16 @@ def test_a_python_thread_runs_while_a_render_runs():
 
 
 def test_sigint_interrupts_a_long_render():
+    # Python turns SIGINT into KeyboardInterrupt only if SIGINT was not ignored when it
+    # started; a shell's background job (`cmd &`) starts with it ignored.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        _interrupt_a_long_render()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _interrupt_a_long_render():
     scene = seethru.Scene.load(SCENE)
     scene.render("truth", width=16, spp=1)
     timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
