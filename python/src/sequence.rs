@@ -14,10 +14,10 @@ use numpy::ndarray::Array2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use seethru::measure::metrics::measure;
+use seethru::measure::sequence::render_truth_and_occluded;
 use seethru::render::footprint::PixelRect;
 use seethru::render::frame::Frame;
 use seethru::render::settings::{MAX_SPP, RenderSettings};
-use seethru::scene::world::view_bit;
 use seethru::system::options::{Method, Outside, RunOptions, WorkingDistance};
 use seethru::system::sequence::head_motion::HeadMotion;
 use seethru::system::sequence::predict::Prediction;
@@ -206,26 +206,7 @@ fn step(system: &mut SystemLoop, k: usize, band: u32) -> anyhow::Result<Stepped>
     };
     let driver = ctx.scene.driver;
     let mut truth = Frame::new(driver.width, driver.height);
-    ctx.render_rect(
-        &driver,
-        view_bit::TRUTH,
-        None,
-        settings,
-        PixelRect::full(&driver),
-        &mut truth,
-        "truth",
-    );
-    let mut occluded = truth.clone();
-    let around = ctx.difference_region(&driver, view_bit::TRUTH, view_bit::OCCLUDED);
-    ctx.render_rect(
-        &driver,
-        view_bit::OCCLUDED,
-        None,
-        settings,
-        around,
-        &mut occluded,
-        "occluded",
-    );
+    let occluded = render_truth_and_occluded(&ctx, settings, PixelRect::full(&driver), &mut truth);
     let mut seethru = truth.clone();
     system.render_seethru(&ctx, &mut seethru);
     // Missing pixels are those the frontal camera, where it was at capture, cannot see.

@@ -14,6 +14,7 @@ use crate::measure::hazard::{DEFAULT_BOUND_ARCMIN, HazardSeen, hazard_seen};
 use crate::measure::metrics::{MetricMaps, measure};
 use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::Frame;
+use crate::render::integrator::RenderContext;
 use crate::render::settings::RenderSettings;
 use crate::scene::world::view_bit;
 use crate::scene::{Obstacle, Scene};
@@ -264,26 +265,7 @@ pub fn run_sequence_hazards(
         }
         let t0 = Instant::now();
         let driver = ctx.scene.driver;
-        ctx.render_rect(
-            &driver,
-            view_bit::TRUTH,
-            None,
-            settings,
-            region,
-            &mut truth,
-            "truth",
-        );
-        let mut occluded = truth.clone();
-        let around = ctx.difference_region(&driver, view_bit::TRUTH, view_bit::OCCLUDED);
-        ctx.render_rect(
-            &driver,
-            view_bit::OCCLUDED,
-            None,
-            settings,
-            around,
-            &mut occluded,
-            "occluded",
-        );
+        let occluded = render_truth_and_occluded(&ctx, settings, region, &mut truth);
         truth_seconds += t0.elapsed().as_secs_f64();
         seethru.clone_from(&truth);
         system.render_seethru(&ctx, &mut seethru);
@@ -350,4 +332,37 @@ pub fn run_sequence_hazards(
         window,
         frontal_pixels_per_refresh: system.frontal_pixels as f64 / refreshes.len().max(1) as f64,
     })
+}
+
+/// Renders the driver's truth view into `truth` within `region`, and returns the occluded view:
+/// the truth with the pixels the obstacle and display change rendered again. The measured
+/// sequence and the Python package's stepped sequence both make their frames so.
+pub fn render_truth_and_occluded(
+    ctx: &RenderContext,
+    settings: RenderSettings,
+    region: PixelRect,
+    truth: &mut Frame,
+) -> Frame {
+    let driver = ctx.scene.driver;
+    ctx.render_rect(
+        &driver,
+        view_bit::TRUTH,
+        None,
+        settings,
+        region,
+        truth,
+        "truth",
+    );
+    let mut occluded = truth.clone();
+    let around = ctx.difference_region(&driver, view_bit::TRUTH, view_bit::OCCLUDED);
+    ctx.render_rect(
+        &driver,
+        view_bit::OCCLUDED,
+        None,
+        settings,
+        around,
+        &mut occluded,
+        "occluded",
+    );
+    occluded
 }
