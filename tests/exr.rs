@@ -167,3 +167,154 @@ fn measuring_a_run_without_aovs_names_the_flag() {
     }
     assert!(read_measured_frames(&out).unwrap()[0].bit_identical(&frame));
 }
+
+/// The R, G, B bits of an EXR's channels, for comparing the colour of two files.
+fn rgb_bits(path: &std::path::Path) -> Vec<Vec<u32>> {
+    let read = channels(path);
+    ["R", "G", "B"]
+        .iter()
+        .map(|name| bits(&read.iter().find(|(n, _)| n == name).unwrap().1))
+        .collect()
+}
+
+/// Sorted channel names of an EXR.
+fn channel_names(path: &std::path::Path) -> Vec<String> {
+    let mut names: Vec<String> = channels(path).into_iter().map(|(n, _)| n).collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn capture_and_score_write_the_exrs_their_exr_flag_names() {
+    use common::refusal::{listing, run_in};
+    let dir = common::refusal::scratch("", &[]);
+    let capture = |exr: &str| {
+        let out = format!("cap_{exr}");
+        let args = [
+            "capture",
+            "scene.toml",
+            "--out",
+            &out,
+            "--depth",
+            "--spp",
+            "1",
+            "--exr",
+            exr,
+        ];
+        let (code, err) = run_in(dir.path(), &args);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        let top: Vec<String> = listing(&dir.path().join(&out));
+        let files: Vec<String> = serde_json::from_str::<serde_json::Value>(
+            &std::fs::read_to_string(dir.path().join(&out).join("capture.json")).unwrap(),
+        )
+        .unwrap()["files"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_str().unwrap().to_string())
+            .collect();
+        // capture.json lists exactly the method's image and JSON files that are there.
+        for f in &files {
+            assert!(top.contains(f), "{exr}: {f} listed, not written");
+        }
+        let exrs: Vec<&String> = top.iter().filter(|f| f.ends_with(".exr")).collect();
+        for f in exrs.iter().filter(|f| !f.contains('/')) {
+            assert!(
+                files.contains(f) || *f == "depth.exr",
+                "{exr}: {f} not listed"
+            );
+        }
+        (
+            dir.path().join(&out),
+            exrs.into_iter().cloned().collect::<Vec<_>>(),
+        )
+    };
+    let (all, all_exrs) = capture("all");
+    assert_eq!(
+        all_exrs,
+        ["back.exr", "depth.exr", "frontal.exr", "truth/truth.exr"]
+    );
+    let (colour, colour_exrs) = capture("colour");
+    assert_eq!(colour_exrs, ["back.exr", "frontal.exr", "truth/truth.exr"]);
+    let (_, none_exrs) = capture("none");
+    assert!(none_exrs.is_empty(), "{none_exrs:?}");
+    // The truth: every AOV with `all`, the same colour bits alone with `colour`.
+    let truth = |d: &std::path::Path| d.join("truth/truth.exr");
+    assert_eq!(channel_names(&truth(&all)).len(), 14);
+    assert_eq!(channel_names(&truth(&colour)), ["A", "B", "G", "R"]);
+    assert_eq!(rgb_bits(&truth(&colour)), rgb_bits(&truth(&all)));
+    for view in ["frontal.exr", "back.exr"] {
+        assert_eq!(rgb_bits(&colour.join(view)), rgb_bits(&all.join(view)));
+    }
+
+    // score: the views' EXRs as `run --exr` writes them. A map showing one frontal pixel.
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(all.join("capture.json")).unwrap()).unwrap();
+    let [w, h] = [0, 1].map(|i| manifest["display_resolution_px"][i].as_u64().unwrap() as usize);
+    let xy: Vec<f32> = (0..w * h).flat_map(|_| [10.0f32, 12.0]).collect();
+    seethru::io::display_map::write_npy_f32(&dir.path().join("m.npy"), &[h, w, 2], &xy).unwrap();
+    let score = |exr: &str| {
+        let out = format!("score_{exr}");
+        let args = [
+            "score", "cap_all", "--map", "m.npy", "--out", &out, "--exr", exr,
+        ];
+        let (code, err) = run_in(dir.path(), &args);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        dir.path().join(out)
+    };
+    let (all, colour, none) = (score("all"), score("colour"), score("none"));
+    for view in ["truth", "seethru", "occluded", "display"] {
+        let file = format!("{view}.exr");
+        assert_eq!(channel_names(&all.join(&file)).len(), 14, "{view}");
+        assert_eq!(channel_names(&colour.join(&file)), ["A", "B", "G", "R"]);
+        assert_eq!(rgb_bits(&colour.join(&file)), rgb_bits(&all.join(&file)));
+        assert!(!none.join(&file).exists(), "{view}");
+        assert_eq!(
+            std::fs::read(none.join(format!("{view}.png"))).unwrap(),
+            std::fs::read(all.join(format!("{view}.png"))).unwrap()
+        );
+    }
+}
+
+#[test]
+fn sequence_writes_colour_exr_frames_and_refuses_exr_where_it_writes_none() {
+    use common::refusal::{refused, run_in};
+    let dir = common::refusal::scratch("", &[]);
+    let quick = ["--duration", "0.05", "--width", "24", "--fps", "40"];
+    let frames = |exr: &str| {
+        let out = format!("seq_{exr}");
+        let mut args = vec!["sequence", "scene.toml", "--out", &out, "--frames", "exr"];
+        args.extend(quick);
+        args.extend(["--exr", exr]);
+        let (code, err) = run_in(dir.path(), &args);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        dir.path().join(out).join("latency_0ms/frames")
+    };
+    let (all, colour) = (frames("all"), frames("colour"));
+    let mut names: Vec<String> = std::fs::read_dir(&all)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into())
+        .collect();
+    names.sort();
+    assert_eq!(names.len(), 4, "{names:?}");
+    for name in &names {
+        assert_eq!(channel_names(&all.join(name)).len(), 14, "{name}");
+        assert_eq!(channel_names(&colour.join(name)), ["A", "B", "G", "R"]);
+        assert_eq!(rgb_bits(&colour.join(name)), rgb_bits(&all.join(name)));
+    }
+    // Without --capture or --frames exr nothing is an EXR: the flag is refused, as is
+    // --exr none beside --frames exr.
+    let mut args = vec!["sequence", "scene.toml", "--out", "x", "--exr", "all"];
+    args.extend(quick);
+    refused(
+        dir.path(),
+        &args,
+        1,
+        &["--exr", "--capture or --frames exr"],
+    );
+    let mut args = vec!["sequence", "scene.toml", "--out", "x", "--frames", "exr"];
+    args.extend(quick);
+    args.extend(["--exr", "none"]);
+    refused(dir.path(), &args, 1, &["--exr none", "--frames png"]);
+    assert!(!dir.path().join("x").exists());
+}

@@ -9,7 +9,9 @@ use anyhow::{Result, bail};
 use exr::prelude::{AnyChannel, FlatSamples};
 use seethru::io::atomic::write_text;
 use seethru::io::display_map::write_npy_f32;
-use seethru::io::frame_files::{write_color_png, write_exr, write_exr_channels};
+use seethru::io::frame_files::{
+    ExrContent, write_color_png, write_colour_exr as write_rgba_exr, write_exr, write_exr_channels,
+};
 use seethru::io::staged::StagedDir;
 use seethru::render::frame::Frame;
 use seethru::render::integrator::RenderContext;
@@ -21,7 +23,7 @@ use seethru::system::memory::{check_memory, run_estimate};
 use seethru::system::options::{HeadSource, RunOptions};
 use serde_json::json;
 
-use crate::cli::args::{HeadErrorArgs, RenderArgs, pixels, positive, with_threads};
+use crate::cli::args::{HeadErrorArgs, RenderArgs, choice, pixels, positive, with_threads};
 use crate::cli::run_eyes::EyesFlag;
 use crate::cli::scene_model_args::SceneModelArgs;
 
@@ -77,6 +79,11 @@ pub struct CaptureArgs {
     /// The depth sensor (with --depth).
     #[command(flatten)]
     pub scene_model: SceneModelArgs,
+    /// Which EXRs the capture writes: all (frontal.exr and back.exr in colour, depth.exr with
+    /// --depth, truth/truth.exr with every AOV), colour (the colour EXRs only: truth/truth.exr
+    /// is R, G, B, A, no depth.exr) or none (PNGs, depth.npy and the JSON files only).
+    #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
+    pub exr: ExrContent,
     /// Sizes of the driver's view (the truth), samples, threads.
     #[command(flatten)]
     pub render: RenderArgs,
@@ -136,7 +143,7 @@ impl CaptureArgs {
             let ctx = RenderContext::new(scene)?;
             let captured = capture(&ctx, &options, self.depth)?;
             let staged = StagedDir::new(&self.out)?;
-            write_capture(staged.path(), &captured, &self.command_json()?)?;
+            write_capture(staged.path(), &captured, &self.command_json()?, self.exr)?;
             staged.commit()?;
             seethru::util::progress::summary(format!(
                 "captured {} (fingerprint {}): frontal {}×{}, back {}×{}{}, head.json, calibration.json; the truth in {}",
@@ -187,12 +194,24 @@ fn write_colour_exr(frame: &Frame, path: &Path) -> Result<()> {
     write_exr_channels(path, frame.width, frame.height, channels)
 }
 
-/// The capture's files into `out` (a staging folder): inputs at the top, the truth apart.
-pub fn write_capture(out: &Path, c: &Capture, command: &serde_json::Value) -> Result<()> {
+/// The capture's files into `out` (a staging folder): inputs at the top, the truth apart;
+/// `exr` says which EXRs ([`CaptureArgs::exr`]).
+pub fn write_capture(
+    out: &Path,
+    c: &Capture,
+    command: &serde_json::Value,
+    exr: ExrContent,
+) -> Result<()> {
+    let mut files = Vec::new();
     for (name, frame) in [("frontal", &c.frontal), ("back", &c.back)] {
         write_color_png(frame, &out.join(format!("{name}.png")))?;
-        write_colour_exr(frame, &out.join(format!("{name}.exr")))?;
+        files.push(format!("{name}.png"));
+        if exr != ExrContent::None {
+            write_colour_exr(frame, &out.join(format!("{name}.exr")))?;
+            files.push(format!("{name}.exr"));
+        }
     }
+    files.extend(["head.json".to_string(), "calibration.json".to_string()]);
     if let Some(d) = &c.depth {
         // Axial depth, metres; NaN where the sensor has no return (sky, past its range).
         let depth: Vec<f32> = d
@@ -202,15 +221,18 @@ pub fn write_capture(out: &Path, c: &Capture, command: &serde_json::Value) -> Re
             .collect();
         let [w, h] = [d.camera.width, d.camera.height];
         write_npy_f32(&out.join("depth.npy"), &[h as usize, w as usize], &depth)?;
-        write_exr_channels(
-            &out.join("depth.exr"),
-            w,
-            h,
-            vec![
-                AnyChannel::new("Z", FlatSamples::F32(depth)),
-                AnyChannel::new("inverse_depth", FlatSamples::F32(d.inverse_depth.clone())),
-            ],
-        )?;
+        // depth.exr is no colour: only `--exr all` writes it (depth.npy holds the same).
+        if exr == ExrContent::All {
+            write_exr_channels(
+                &out.join("depth.exr"),
+                w,
+                h,
+                vec![
+                    AnyChannel::new("Z", FlatSamples::F32(depth)),
+                    AnyChannel::new("inverse_depth", FlatSamples::F32(d.inverse_depth.clone())),
+                ],
+            )?;
+        }
     }
     write_text(
         &out.join("head.json"),
@@ -224,7 +246,11 @@ pub fn write_capture(out: &Path, c: &Capture, command: &serde_json::Value) -> Re
         &serde_json::to_string_pretty(&c.calibration)?,
     )?;
     let truth = out.join("truth");
-    write_exr(&c.truth.truth, &truth.join("truth.exr"))?;
+    match exr {
+        ExrContent::None => {}
+        ExrContent::Colour => write_rgba_exr(&c.truth.truth, &truth.join("truth.exr"))?,
+        ExrContent::All => write_exr(&c.truth.truth, &truth.join("truth.exr"))?,
+    }
     write_color_png(&c.truth.truth, &truth.join("truth.png"))?;
     write_text(
         &truth.join("truth.json"),
@@ -247,7 +273,7 @@ pub fn write_capture(out: &Path, c: &Capture, command: &serde_json::Value) -> Re
             "frontal_size_px": [c.frontal.width, c.frontal.height],
             "back_size_px": [c.back.width, c.back.height],
             "depth": c.depth.as_ref().map(|d| json!({"file": "depth.npy", "size_px": [d.camera.width, d.camera.height], "sensor": d.model, "units": "axial depth along the frontal camera's axis, metres, float32, shape (height, width); NaN: no return"})),
-            "files": ["frontal.png", "frontal.exr", "back.png", "back.exr", "head.json", "calibration.json"],
+            "files": files,
             "map_format": "a display map: .npy float32 of shape (display height, display width, 2), [..., 0] = x and [..., 1] = y frontal pixels in OpenCV's remap convention (pixel centres at integers), NaN shows nothing; or EXR with channels x, y. State the capture it was made for in <map>.json: {\"capture_fingerprint\": \"...\"}",
             "truth": "truth/ holds the truth view and the true eye: a method must not read it",
         }))?,

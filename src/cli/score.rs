@@ -18,7 +18,7 @@ use seethru::system::capture::{Capture, DisplayImage, DisplayMap, capture, score
 use seethru::system::display::Filter;
 use seethru::system::options::RunOptions;
 
-use crate::cli::args::{band, threads};
+use crate::cli::args::{band, choice, threads};
 use crate::cli::capture::{COMMAND_FILE, CaptureCommand};
 
 #[derive(clap::Args)]
@@ -46,6 +46,10 @@ pub struct Score {
     /// Worker threads in [1, 1024] (default: all cores). Results are identical for any value.
     #[arg(long, value_parser = threads)]
     threads: Option<usize>,
+    /// What each view's EXR holds, as `run --exr`: all (every AOV, what `measure` reads),
+    /// colour (R, G, B, A only) or none (the PNGs only).
+    #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
+    exr: ExrContent,
 }
 
 /// A capture folder captured again in memory: its flags, context and capture, the
@@ -177,7 +181,7 @@ impl Score {
         ];
         views
             .par_iter()
-            .try_for_each(|(name, frame)| write_frame(frame, out, name, ExrContent::All))?;
+            .try_for_each(|(name, frame)| write_frame(frame, out, name, self.exr))?;
         let eye = r.options.eyes.view_camera(&r.ctx.scene.driver).position();
         let frames = [&result.truth, &result.seethru, &result.occluded];
         let (maps, mut metrics) = measure(&r.ctx, &r.ctx.scene, eye, frames, self.band);

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use seethru::io::atomic::write_text;
-use seethru::io::frame_files::{write_color_png, write_exr};
+use seethru::io::frame_files::{ExrContent, write_color_png, write_colour_exr, write_exr};
 use seethru::io::staged::StagedDir;
 use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
 use seethru::measure::headline::{RunKind, summary_text};
@@ -151,6 +151,10 @@ pub struct Sequence {
     /// Write every frame's truth and seethru views (whole driver views) as PNG or EXR.
     #[arg(long, value_enum, value_parser = choice::<FramesFormat>(), default_value_t = FramesFormat::None)]
     frames: FramesFormat,
+    /// What the EXRs of --frames exr and of --capture's folders hold, as `capture --exr`:
+    /// all (every AOV), colour (R, G, B, A only) or none (--capture: PNGs and JSON only).
+    #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
+    exr: ExrContent,
     /// none: the whole frontal image in the display; planar: the paper's compensation.
     #[arg(long, value_enum, value_parser = choice::<Method>(), default_value_t = Method::Planar)]
     method: Method,
@@ -348,8 +352,19 @@ impl Sequence {
                 read: self.maps.is_none(),
                 when: "without --maps (a map is shown on the display's pixels)",
             },
+            ReadWhen {
+                flag: "--exr",
+                read: self.capture.is_some() || self.frames == FramesFormat::Exr,
+                when: "with --capture or --frames exr (nothing else is written as EXR)",
+            },
         ]);
-        refuse_ignored(&rules)
+        refuse_ignored(&rules)?;
+        if self.frames == FramesFormat::Exr && self.exr == ExrContent::None {
+            bail!(
+                "--frames exr writes each frame as EXR and --exr none writes no EXR: give --frames png, or --exr colour or all"
+            );
+        }
+        Ok(())
     }
 
     fn run_all(&self) -> Result<()> {
@@ -437,6 +452,7 @@ impl Sequence {
                         &f,
                         &command,
                         &mut shown_folder,
+                        self.exr,
                     )?);
                 }
                 let name = |view: &str, ext: &str| {
@@ -448,6 +464,10 @@ impl Sequence {
                     FramesFormat::Png => {
                         write_color_png(f.truth, &name("truth", "png"))?;
                         write_color_png(f.seethru, &name("seethru", "png"))
+                    }
+                    FramesFormat::Exr if self.exr == ExrContent::Colour => {
+                        write_colour_exr(f.truth, &name("truth", "exr"))?;
+                        write_colour_exr(f.seethru, &name("seethru", "exr"))
                     }
                     FramesFormat::Exr => {
                         write_exr(f.truth, &name("truth", "exr"))?;

@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 use anyhow::{Result, bail};
 use seethru::io::atomic::write_text;
+use seethru::io::frame_files::ExrContent;
 use seethru::measure::sequence::FrameImages;
 use seethru::system::capture::check_display_input;
 use seethru::system::sequence::byo::NamedMap;
@@ -95,11 +96,12 @@ pub fn write_frame(
     f: &FrameImages,
     command: &Value,
     last_folder: &mut String,
+    exr: ExrContent,
 ) -> Result<Value> {
     let mut world_from_obstacle = Value::Null;
     if let Some(c) = &f.capture {
         *last_folder = frame_name(f.record.frame);
-        write_capture(&dir.join(last_folder.as_str()), c, command)?;
+        write_capture(&dir.join(last_folder.as_str()), c, command, exr)?;
         world_from_obstacle = c.calibration["obstacle_frame"]["world_from_obstacle"].clone();
     }
     Ok(index_row(f, last_folder, world_from_obstacle))

@@ -167,7 +167,7 @@ pub fn write_exr_channels(
     write_atomically(path, |file| Ok(image.write().to_buffered(file)?))
 }
 
-/// Most channels an EXR may have to be read as a frame (seethru writes 17).
+/// Most channels an EXR may have to be read as a frame (seethru writes 14).
 const MAX_EXR_CHANNELS: usize = 64;
 
 /// `path` opened for reading if it is a regular file (a device would be read for ever).
