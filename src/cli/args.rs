@@ -114,6 +114,15 @@ pub struct RenderArgs {
     pub max_memory: f64,
 }
 
+/// `--max-memory` of a command that renders without [`RenderArgs`] (`ratio`, `bench`,
+/// `reproduce`).
+#[derive(clap::Args, Clone, Copy, Debug)]
+pub struct MemoryLimit {
+    /// Refuse to start when the estimated memory exceeds this, GiB in [1e-6, 4096].
+    #[arg(long = "max-memory", value_name = "GIB", default_value_t = DEFAULT_MAX_MEMORY_GIB, value_parser = max_memory)]
+    pub max_memory: f64,
+}
+
 /// The head-tracking errors a run injects and the detector's feature width: shared by `run`
 /// and `sequence`.
 #[derive(clap::Args)]

@@ -18,7 +18,9 @@ use seethru::scene::grow::grow;
 use seethru::util::memory::peak_rss_bytes;
 use serde_json::json;
 
-use crate::cli::args::{integer, pixels, real, threads, with_threads};
+use seethru::system::memory::{bench_estimate, check_memory};
+
+use crate::cli::args::{MemoryLimit, integer, pixels, real, threads, with_threads};
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -44,6 +46,8 @@ pub struct Bench {
     /// Print only the JSON line.
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    memory: MemoryLimit,
 }
 
 impl Bench {
@@ -52,6 +56,13 @@ impl Bench {
         if !(1..=1000).contains(&self.repeat) {
             anyhow::bail!("--repeat {} is out of range [1, 1000]", self.repeat);
         }
+        let estimate = bench_estimate(
+            &Scene::load(&self.scene)?,
+            self.width,
+            self.height,
+            self.grow,
+        )?;
+        check_memory(&estimate, self.memory.max_memory)?;
         with_threads(self.threads, || bench(&self).map(|_| ()))?
     }
 }

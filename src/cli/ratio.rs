@@ -2,12 +2,13 @@
 
 use anyhow::Result;
 use seethru::analysis::paper::{ForeshorteningParams, OcclusionParams};
-use seethru::measure::ratio::{describe, measure_ratio};
+use seethru::measure::ratio::{describe, measure_ratio, ratio_estimate};
 use seethru::measure::ratio_setup::{Compensation, Setup};
 use seethru::render::settings::check_resolution;
+use seethru::system::memory::check_memory;
 
 use crate::cli::args::{
-    head_bias_cm, metres_or_inf, pixels, positive, real, threads, with_threads,
+    MemoryLimit, head_bias_cm, metres_or_inf, pixels, positive, real, threads, with_threads,
 };
 
 #[derive(clap::Args)]
@@ -92,6 +93,8 @@ struct RatioCommon {
     /// Worker threads in [1, 1024] (default: all cores).
     #[arg(long, value_parser = threads)]
     threads: Option<usize>,
+    #[command(flatten)]
+    memory: MemoryLimit,
 }
 
 impl Ratio {
@@ -130,6 +133,10 @@ impl Ratio {
             model_d2: common.model_d2,
             head_bias_cm: common.head_bias_cm,
         };
+        check_memory(
+            &ratio_estimate(&setup, common.width, &compensation)?,
+            common.memory.max_memory,
+        )?;
         let result = with_threads(common.threads, || {
             measure_ratio(&setup, common.width, &compensation)
         })??;

@@ -5,7 +5,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{Result, bail};
 use seethru::scene::builtin::{BuiltinDas, DAS_PATH};
 
-use crate::cli::args::{threads, with_threads};
+use seethru::paper::reproduce::reproduce_estimate;
+use seethru::system::memory::check_memory;
+
+use crate::cli::args::{MemoryLimit, threads, with_threads};
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -23,6 +26,8 @@ pub struct Reproduce {
     /// Worker threads in [1, 1024] (default: all cores).
     #[arg(long, value_parser = threads)]
     threads: Option<usize>,
+    #[command(flatten)]
+    memory: MemoryLimit,
 }
 
 impl Reproduce {
@@ -47,6 +52,10 @@ impl Reproduce {
                 (builtin.scene(), label, Some(builtin))
             }
         };
+        check_memory(
+            &reproduce_estimate(&scene, self.quick)?,
+            self.memory.max_memory,
+        )?;
         let staged = seethru::io::staged::StagedDir::new(&self.out)?;
         with_threads(self.threads, || {
             seethru::paper::reproduce::reproduce_named(&scene, &label, staged.path(), self.quick)

@@ -20,6 +20,7 @@ use crate::measure::ratio_setup::{Compensation, Setup, build_scene};
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::scene::shapes::box_face;
+use crate::system::memory::{MemoryEstimate, run_estimate};
 use crate::system::options::{RunOptions, WorkingDistance};
 use crate::system::pipeline::{RunResult, run};
 
@@ -125,6 +126,32 @@ pub fn ratio_uncertainty(c: Measured, u: Measured) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The run a ratio measurement makes of its built scene: the compensation's model plane
+/// and head bias, one sample per pixel.
+fn run_options(setup: &Setup, compensation: &Compensation) -> RunOptions {
+    let model_d2 = setup.geometry(compensation).model_d2;
+    RunOptions {
+        d2: if model_d2.is_finite() {
+            WorkingDistance::Metres(model_d2)
+        } else {
+            WorkingDistance::Infinity
+        },
+        head_bias_cm: compensation.head_bias_cm,
+        spp: 1,
+        ..RunOptions::default()
+    }
+}
+
+/// Memory [`measure_ratio`] needs at `width`: the run of the scene it builds.
+pub fn ratio_estimate(
+    setup: &Setup,
+    width: u32,
+    compensation: &Compensation,
+) -> Result<MemoryEstimate> {
+    let scene = build_scene(setup, width, compensation)?;
+    run_estimate(&scene, &run_options(setup, compensation))
+}
+
 /// As [`measure_ratio`], also returning the rendered frames.
 pub fn measure_ratio_with_frames(
     setup: &Setup,
@@ -140,17 +167,7 @@ pub fn measure_ratio_with_frames(
         2.0 * scene.frontal.tan_half_x() / scene.frontal.width as f64,
     );
     let ctx = RenderContext::new(scene)?;
-    let options = RunOptions {
-        d2: if geometry.model_d2.is_finite() {
-            WorkingDistance::Metres(geometry.model_d2)
-        } else {
-            WorkingDistance::Infinity
-        },
-        head_bias_cm: compensation.head_bias_cm,
-        spp: 1,
-        ..RunOptions::default()
-    };
-    let result = run(&ctx, &options)?;
+    let result = run(&ctx, &run_options(setup, compensation))?;
     let obstacle_id = ctx.world.obstacle_id;
     // Each display pixel's line of sight, carried to the scene plane.
     let q: Vec<Option<f64>> = (0..result.occluded.object_id.len())

@@ -13,12 +13,13 @@ use crate::io::frame_files::write_png;
 use crate::measure::maps::heatmap_rgb;
 use crate::measure::metrics::MetricMaps;
 use crate::measure::metrics::measure;
-use crate::measure::ratio::{RatioResult, measure_ratio_with_frames};
+use crate::measure::ratio::{RatioResult, measure_ratio_with_frames, ratio_estimate};
 use crate::measure::ratio_setup::{Compensation, Setup};
 use crate::paper::report::{CaseResult, EqualCoverage, Sizes, render_report};
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
+use crate::system::memory::{MemoryEstimate, largest, metric_maps_bytes, run_estimate};
 use crate::system::options::{Outside, RunOptions};
 use crate::system::pipeline::run;
 use crate::util::color::encode_srgb8;
@@ -55,20 +56,14 @@ pub fn das_case(base: &Scene, distance: f64, display_width: f64, theta_deg: f64)
     Ok(scene)
 }
 
-/// Runs the reproduction into `out`; returns `report.json`'s content.
-pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_json::Value> {
-    reproduce_named(scene_path, &scene_path.display().to_string(), out, quick)
-}
+/// The car's two distances beyond the obstacle (§5.2 Figs. 4 and 5), metres.
+const CARS: [(&str, f64); 2] = [("close", 4.0), ("far", 15.0)];
+/// The frontal camera's two half angles θ_F of each car case, degrees.
+const THETAS_DEG: [f64; 2] = [30.0, 63.5];
 
-/// As [`reproduce`], the report naming the scene `scene_name` (the built-in copy's
-/// temporary path would mean nothing to a reader).
-pub fn reproduce_named(
-    scene_path: &Path,
-    scene_name: &str,
-    out: &Path,
-    quick: bool,
-) -> Result<serde_json::Value> {
-    let sizes = if quick {
+/// The render sizes of a reproduction: CI-sized with `quick`.
+fn sizes(quick: bool) -> Sizes {
+    if quick {
         Sizes {
             driver: 256,
             frontal: 480,
@@ -82,29 +77,96 @@ pub fn reproduce_named(
             ratio: 1920,
             spp: 4,
         }
-    };
+    }
+}
+
+/// The run of each car case.
+fn case_options(sizes: &Sizes) -> RunOptions {
+    RunOptions {
+        width: Some(sizes.driver),
+        frontal_width: Some(sizes.frontal),
+        back_width: Some(64),
+        spp: sizes.spp,
+        outside: Outside::Black,
+        ..RunOptions::default()
+    }
+}
+
+/// §5.2 Figs. 6 and 7: the occlusion and foreshortening cases with the paper's parameters
+/// (name, folder, setup).
+fn ratio_setups() -> [(&'static str, &'static str, Setup); 2] {
+    [
+        (
+            "occlusion (L=5, b1=−0.35, d2=6.3, d1=2.5, b_h=1.75)",
+            "occlusion",
+            Setup::Occlusion(paper_occlusion()),
+        ),
+        (
+            "foreshortening (l=5, b1=−1.5, d2=1.3, d1=2, b_h=0.7, γ=90°)",
+            "foreshortening",
+            Setup::Foreshortening(paper_foreshortening()),
+        ),
+    ]
+}
+
+/// Memory a reproduction of the scene at `scene_path` needs: its largest case, one after
+/// another, with the metric maps of the car's two θ_F cases kept for their comparison.
+pub fn reproduce_estimate(scene_path: &Path, quick: bool) -> Result<MemoryEstimate> {
+    let sizes = sizes(quick);
+    let base = Scene::load(scene_path)?;
+    let options = case_options(&sizes);
+    let mut estimates = Vec::new();
+    for (_, distance) in CARS {
+        for theta in THETAS_DEG {
+            let scene = das_case(&base, distance, 1.0, theta)?;
+            let mut estimate = run_estimate(&scene, &options)?;
+            let driver = options.sized_driver(scene.driver)?;
+            let kept = THETAS_DEG.len() as u64
+                * metric_maps_bytes(driver.width as u64 * driver.height as u64);
+            estimate.bytes += kept;
+            estimate.what = format!(
+                "a car case: {}, and the metric maps it compares",
+                estimate.what
+            );
+            estimates.push(estimate);
+        }
+    }
+    for (name, _, setup) in ratio_setups() {
+        let mut estimate = ratio_estimate(&setup, sizes.ratio, &Compensation::default())?;
+        estimate.what = format!("the {name} case: {}", estimate.what);
+        estimates.push(estimate);
+    }
+    Ok(largest(estimates))
+}
+
+/// Runs the reproduction into `out`; returns `report.json`'s content.
+pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_json::Value> {
+    reproduce_named(scene_path, &scene_path.display().to_string(), out, quick)
+}
+
+/// As [`reproduce`], the report naming the scene `scene_name` (the built-in copy's
+/// temporary path would mean nothing to a reader).
+pub fn reproduce_named(
+    scene_path: &Path,
+    scene_name: &str,
+    out: &Path,
+    quick: bool,
+) -> Result<serde_json::Value> {
+    let sizes = sizes(quick);
     let base = Scene::load(scene_path)?;
     let mut cases = Vec::new();
     let mut equal = Vec::new();
     // Four display cases, then the two ratio setups.
     let progress = Progress::new("reproduce", 6, true);
     // §5.2 Figs. 4 and 5: the car close and far, θ_F = 30° and 63.5°, D = 1 m, d2 → ∞.
-    for (car_label, distance) in [("close", 4.0), ("far", 15.0)] {
+    for (car_label, distance) in CARS {
         let mut compared: Vec<(String, MetricMaps)> = Vec::new();
-        for theta in [30.0, 63.5] {
+        for theta in THETAS_DEG {
             let name = format!("car {car_label} (≈{distance} m), θ_F = {theta}°, D = 1 m");
             let dir = format!("car_{car_label}_theta{}", theta as u32);
             let scene = das_case(&base, distance, 1.0, theta)?;
             let ctx = RenderContext::new(scene)?;
-            let options = RunOptions {
-                width: Some(sizes.driver),
-                frontal_width: Some(sizes.frontal),
-                back_width: Some(64),
-                spp: sizes.spp,
-                outside: Outside::Black,
-                ..RunOptions::default()
-            };
-            let result = run(&ctx, &options)?;
+            let result = run(&ctx, &case_options(&sizes))?;
             let (maps, metrics) = measure(
                 &ctx,
                 &ctx.scene,
@@ -130,21 +192,8 @@ pub fn reproduce_named(
             &compared,
         ));
     }
-    // §5.2 Figs. 6 and 7: the occlusion and foreshortening cases with the paper's parameters.
-    let setups = [
-        (
-            "occlusion (L=5, b1=−0.35, d2=6.3, d1=2.5, b_h=1.75)",
-            "occlusion",
-            Setup::Occlusion(paper_occlusion()),
-        ),
-        (
-            "foreshortening (l=5, b1=−1.5, d2=1.3, d1=2, b_h=0.7, γ=90°)",
-            "foreshortening",
-            Setup::Foreshortening(paper_foreshortening()),
-        ),
-    ];
     let mut ratios: Vec<(String, String, RatioResult)> = Vec::new();
-    for (name, dir, setup) in setups {
+    for (name, dir, setup) in ratio_setups() {
         let (r, frames) = measure_ratio_with_frames(&setup, sizes.ratio, &Compensation::default())?;
         frame_png(&frames.truth, &out.join(dir).join("truth.png"))?;
         frame_png(&frames.seethru, &out.join(dir).join("seethru.png"))?;

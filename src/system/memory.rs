@@ -4,9 +4,14 @@
 
 use anyhow::{Result, bail};
 
+use std::mem::size_of;
+
 use crate::geometry::camera::Camera;
+use crate::render::accel::Hit;
 use crate::render::frame::Frame;
+use crate::render::ray::TraceRay;
 use crate::scene::Scene;
+use crate::scene::world::World;
 use crate::system::options::RunOptions;
 
 /// Bytes of one frame pixel: every AOV of [`Frame`].
@@ -75,6 +80,12 @@ pub fn run_estimate(scene: &Scene, options: &RunOptions) -> Result<MemoryEstimat
     })
 }
 
+/// Bytes of the metric maps of a driver view of `pixels` pixels, for a command that keeps
+/// them beyond a run.
+pub fn metric_maps_bytes(pixels: u64) -> u64 {
+    pixels * METRICS_BYTES_PER_PIXEL
+}
+
 /// `run --eyes both`: one run at a time, plus the first eye's `seethru` and `display` frames
 /// kept for the binocular outputs while the second eye runs.
 pub fn both_eyes_estimate(scene: &Scene, options: &RunOptions) -> Result<MemoryEstimate> {
@@ -130,6 +141,47 @@ pub fn sequence_estimate(
             one.what
         ),
     })
+}
+
+/// Bytes per triangle of a grown scene, an upper bound: its object's copy in the scene, the
+/// world's triangle, its BVH share and the build's working arrays (peak RSS against 1×:
+/// 333 bytes on das grown 50×, 576 grown 1000×, docs/reference/benchmark.md).
+const GROWN_TRIANGLE_BYTES: u64 = 640;
+
+/// `bench`: the trace-only batches at `width`×`height` (primary, shadow and incoherent rays,
+/// their hits and any-hit flags) and one shaded frame, all held while the scene grown
+/// `grow`× is traced; then the `run` it times at the scene's own sizes, with the batches
+/// still held.
+pub fn bench_estimate(scene: &Scene, width: u32, height: u32, grow: f64) -> Result<MemoryEstimate> {
+    let pixels = width as u64 * height as u64;
+    let per_pixel = 3 * size_of::<TraceRay>() as u64
+        + 2 * size_of::<Option<Hit>>() as u64
+        + 1
+        + FRAME_BYTES_PER_PIXEL;
+    let triangles = World::build(scene)?.triangles.len() as u64;
+    let grown = (triangles as f64 * grow).ceil() as u64;
+    let run = run_estimate(scene, &RunOptions::default())?;
+    Ok(MemoryEstimate {
+        bytes: pixels
+            .saturating_mul(per_pixel)
+            .saturating_add(grown.saturating_mul(GROWN_TRIANGLE_BYTES))
+            .saturating_add(run.bytes),
+        what: format!(
+            "{width}×{height} rays and hits, a scene of about {grown} triangles, and a run: {}",
+            run.what
+        ),
+    })
+}
+
+/// The largest of several estimates (commands that run them one after another).
+pub fn largest(estimates: impl IntoIterator<Item = MemoryEstimate>) -> MemoryEstimate {
+    estimates
+        .into_iter()
+        .max_by_key(|e| e.bytes)
+        .unwrap_or(MemoryEstimate {
+            bytes: 0,
+            what: String::new(),
+        })
 }
 
 /// Refuses an estimate above `limit_gib`, saying what it counts and how to proceed.
