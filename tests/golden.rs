@@ -79,13 +79,67 @@ fn the_comparison_catches_a_small_regression() {
 
 #[test]
 fn a_missing_golden_fails_and_is_not_written() {
-    if std::env::var("SEETHRU_BLESS").is_ok_and(|v| v == "1") {
-        return; // Blessing writes goldens by design.
-    }
+    // In a folder without goldens, blessing another name: `truth` is compared, not written.
+    let dir = tempfile::tempdir().unwrap();
     let img = image::RgbImage::new(4, 4);
-    assert!(std::panic::catch_unwind(|| golden::check("no-such-view", &img)).is_err());
-    assert!(!common::repo_path("golden/no-such-view.png").exists());
-    assert!(common::repo_path("target/golden-failures/no-such-view-actual.png").exists());
+    let checked =
+        std::panic::catch_unwind(|| golden::check_in(dir.path(), "truth", &img, &["seethru"]));
+    assert!(checked.is_err());
+    assert!(!dir.path().join("truth.png").exists());
+    assert!(common::repo_path("target/golden-failures/truth-actual.png").exists());
+    // A name no test checks is refused before anything is compared or written.
+    let unknown =
+        std::panic::catch_unwind(|| golden::check_in(dir.path(), "no-such-view", &img, &[]));
+    assert!(unknown.is_err());
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn bless_rewrites_only_the_goldens_it_names() {
+    // The variable's values: names (spaces ignored), `all`, unset; a typo lists the known.
+    assert_eq!(
+        golden::blessed(Some("truth, seethru")),
+        Ok(vec!["truth", "seethru"])
+    );
+    assert_eq!(golden::blessed(Some("all")), Ok(golden::GOLDENS.to_vec()));
+    assert_eq!(golden::blessed(None), Ok(vec![]));
+    for typo in ["1", "truht", "truth,", "truth,seethru,displya"] {
+        let e = golden::blessed(Some(typo)).unwrap_err();
+        let bad = typo.rsplit(',').next().unwrap().trim();
+        assert!(
+            e.contains(&format!("unknown golden `{bad}`")),
+            "{typo}: {e}"
+        );
+        assert!(golden::GOLDENS.iter().all(|g| e.contains(g)), "{typo}: {e}");
+    }
+    // Every golden the tests check is listed, and each listed one is in golden/.
+    for name in golden::GOLDENS {
+        assert!(
+            common::repo_path(&format!("golden/{name}.png")).exists(),
+            "{name}"
+        );
+    }
+    // Blessing `seethru` in a folder holding both: only seethru.png is rewritten.
+    let dir = tempfile::tempdir().unwrap();
+    let old = image::RgbImage::from_pixel(4, 4, image::Rgb([10, 20, 30]));
+    let new = image::RgbImage::from_pixel(4, 4, image::Rgb([200, 100, 0]));
+    for name in ["truth", "seethru"] {
+        old.save(dir.path().join(format!("{name}.png"))).unwrap();
+    }
+    let bless = golden::blessed(Some("seethru")).unwrap();
+    golden::check_in(dir.path(), "seethru", &new, &bless);
+    let truth = std::panic::catch_unwind(|| golden::check_in(dir.path(), "truth", &new, &bless));
+    assert!(
+        truth.is_err(),
+        "truth differs and was not asked to be blessed"
+    );
+    let read = |name: &str| {
+        image::open(dir.path().join(format!("{name}.png")))
+            .unwrap()
+            .to_rgb8()
+    };
+    assert_eq!(read("seethru"), new);
+    assert_eq!(read("truth"), old);
 }
 
 #[test]

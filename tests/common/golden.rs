@@ -1,9 +1,14 @@
 //! Golden-image comparison in the manner of the vello/wgpu tests: the reference PNG lives in
 //! `golden/`, a failure writes `actual`, `expected` and `diff` images under
-//! `target/golden-failures/`, `SEETHRU_BLESS=1` accepts new images, and a missing golden is
-//! a failure, never a silent write.
+//! `target/golden-failures/`, `SEETHRU_BLESS=NAME[,NAME…]` (or `all`) accepts new images of
+//! the goldens named, and a missing golden is a failure, never a silent write.
+//!
+//! Blessing rewrites only what was asked for: a name that is not one of [`GOLDENS`] (a typo)
+//! fails every check with the list of known names, and each image written is named on the
+//! test's real stderr, which the test harness does not capture, so a passing run still shows it.
 
-use std::path::PathBuf;
+use std::io::Write;
+use std::path::{Path, PathBuf};
 
 use image::RgbImage;
 
@@ -23,11 +28,64 @@ fn failure_dir() -> PathBuf {
     repo_path("target/golden-failures")
 }
 
+/// Every golden image a test checks (`golden/NAME.png`): what `SEETHRU_BLESS` may name.
+pub const GOLDENS: [&str; 7] = [
+    "truth",
+    "occluded",
+    "frontal",
+    "back",
+    "display",
+    "seethru",
+    "frontal_fisheye",
+];
+
+/// The goldens a `SEETHRU_BLESS` value asks to rewrite: `all`, or names of [`GOLDENS`]
+/// separated by commas (spaces around a name are ignored). Unset: none. Any other name is
+/// an error that lists the known ones.
+pub fn blessed(value: Option<&str>) -> Result<Vec<&'static str>, String> {
+    let Some(value) = value else {
+        return Ok(Vec::new());
+    };
+    if value.trim() == "all" {
+        return Ok(GOLDENS.to_vec());
+    }
+    value
+        .split(',')
+        .map(|name| {
+            let name = name.trim();
+            GOLDENS.iter().copied().find(|g| *g == name).ok_or_else(|| {
+                format!(
+                    "SEETHRU_BLESS: unknown golden `{name}` (known: {}, or all)",
+                    GOLDENS.join(", ")
+                )
+            })
+        })
+        .collect()
+}
+
+/// The goldens the environment's `SEETHRU_BLESS` asks to rewrite; a bad value fails the test.
+fn blessed_by_env() -> Vec<&'static str> {
+    let value = std::env::var("SEETHRU_BLESS").ok();
+    blessed(value.as_deref()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Compares `actual` with `golden/NAME.png`, or rewrites it when `SEETHRU_BLESS` names it.
 pub fn check(name: &str, actual: &RgbImage) {
-    let path = repo_path(&format!("golden/{name}.png"));
-    if std::env::var("SEETHRU_BLESS").is_ok_and(|v| v == "1") {
+    check_in(&repo_path("golden"), name, actual, &blessed_by_env());
+}
+
+/// [`check`] against the goldens in `dir`, rewriting `NAME.png` only when `bless` holds `name`.
+pub fn check_in(dir: &Path, name: &str, actual: &RgbImage, bless: &[&str]) {
+    assert!(
+        GOLDENS.contains(&name),
+        "golden `{name}` is not in GOLDENS (tests/common/golden.rs: {})",
+        GOLDENS.join(", ")
+    );
+    let path = dir.join(format!("{name}.png"));
+    if bless.contains(&name) {
         actual.save(&path).unwrap();
-        eprintln!("blessed {}", path.display());
+        // Past the harness's capture of eprintln!, so that a passing run lists what it wrote.
+        let _ = writeln!(std::io::stderr(), "blessed {}", path.display());
         return;
     }
     let expected = match image::open(&path) {
@@ -35,7 +93,7 @@ pub fn check(name: &str, actual: &RgbImage) {
         Err(e) => {
             save_failure(name, actual, None);
             panic!(
-                "golden {} missing or unreadable ({e}); inspect target/golden-failures/{name}-actual.png and bless with SEETHRU_BLESS=1",
+                "golden {} missing or unreadable ({e}); inspect target/golden-failures/{name}-actual.png and bless with SEETHRU_BLESS={name}",
                 path.display()
             );
         }
@@ -43,7 +101,7 @@ pub fn check(name: &str, actual: &RgbImage) {
     if let Err(why) = compare(actual, &expected) {
         save_failure(name, actual, Some(&expected));
         panic!(
-            "golden {name}: {why}; see target/golden-failures/{name}-*.png, bless with SEETHRU_BLESS=1"
+            "golden {name}: {why}; see target/golden-failures/{name}-*.png, bless with SEETHRU_BLESS={name}"
         );
     }
 }
