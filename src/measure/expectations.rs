@@ -230,9 +230,17 @@ pub fn read_expectations(
     path: &Path,
     check_options: &dyn Fn(CaseCommand, &[String]) -> Option<String>,
 ) -> Result<Expectations, SceneError> {
-    let file = SourceFile::read(path)?;
+    expectations_from_source(&SourceFile::read(path)?, check_options)
+}
+
+/// [`read_expectations`] of a file already read (the fuzz target's entry).
+pub fn expectations_from_source(
+    file: &SourceFile,
+    check_options: &dyn Fn(CaseCommand, &[String]) -> Option<String>,
+) -> Result<Expectations, SceneError> {
+    let path = file.path.as_path();
     let doc = file.parse()?;
-    let root = TableReader::root(&file, &doc);
+    let root = TableReader::root(file, &doc);
     let tables = root.array_of_tables("case")?;
     if tables.is_empty() {
         return Err(root.error(
@@ -322,7 +330,7 @@ pub fn read_expectations(
     root.finish()?;
     Ok(Expectations {
         path: path.to_path_buf(),
-        text: std::fs::read_to_string(path).unwrap_or_default(),
+        text: file.text().to_string(),
         cases,
     })
 }
