@@ -155,8 +155,7 @@ fn a_stated_fingerprint_that_is_not_one_is_refused_where_it_is_read() {
 fn expectation_files_echoing_a_line_break_are_refused_in_one_line() {
     // A bound or a case name is echoed in its message: a TOML `\n` in it split the message.
     for (path, _) in inputs("expectations") {
-        let shown = match seethru::measure::expectations::read_expectations(&path, &|_, _| None)
-        {
+        let shown = match seethru::measure::expectations::read_expectations(&path, &|_, _| None) {
             Ok(_) => panic!("{}: accepted", path.display()),
             Err(e) => e.to_string(),
         };
