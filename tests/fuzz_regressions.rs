@@ -97,3 +97,74 @@ fn obj_inputs_found_by_fuzzing_are_refused_naming_the_line_and_in_time() {
         );
     }
 }
+
+#[test]
+fn display_map_inputs_found_by_fuzzing_are_refused_in_one_line() {
+    // (2³², 2³², 2) multiplied to 2⁶⁴ pixels: a panic with overflow checks, and without them
+    // the count wrapped to 0, which passed the size check and read as an empty 0×0 map.
+    for (path, bytes) in inputs("display_map") {
+        let shown = match seethru::io::display_map::parse_npy(&bytes) {
+            Ok(m) => panic!("{}: read as a {}×{} map", path.display(), m.width, m.height),
+            Err(e) => format!("{e:#}"),
+        };
+        assert!(
+            !shown.contains('\n') && shown.contains("pixels"),
+            "{}: {shown}",
+            path.display()
+        );
+    }
+}
+
+#[test]
+fn a_stated_fingerprint_that_is_not_one_is_refused_where_it_is_read() {
+    // A sidecar's capture_fingerprint is echoed by the mismatch message of `score`: one with
+    // a line break made that message two lines. It is refused when read, escaped.
+    let dir = tempfile::tempdir().unwrap();
+    let map = dir.path().join("map.npy");
+    seethru::io::display_map::write_npy_f32(&map, &[1, 1, 2], &[0.5, 0.5]).unwrap();
+    let sidecar = dir.path().join("map.npy.json");
+    for (stated, accepted) in [
+        ("0123456789abcdef", true),
+        ("0123456789abcde\n", false),
+        ("0123456789ABCDEF0", false),
+        ("", false),
+    ] {
+        std::fs::write(
+            &sidecar,
+            serde_json::json!({ "capture_fingerprint": stated }).to_string(),
+        )
+        .unwrap();
+        match seethru::io::display_map::read_map(&map) {
+            Ok(m) => {
+                assert!(accepted, "{stated:?} accepted");
+                assert_eq!(m.fingerprint.as_deref(), Some(stated));
+            }
+            Err(e) => {
+                let shown = format!("{e:#}");
+                assert!(!accepted, "{stated:?}: {shown}");
+                assert!(
+                    !shown.contains('\n') && shown.contains("16 hex digits"),
+                    "{shown}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn expectation_files_echoing_a_line_break_are_refused_in_one_line() {
+    // A bound or a case name is echoed in its message: a TOML `\n` in it split the message.
+    for (path, _) in inputs("expectations") {
+        let shown = match seethru::measure::expectations::read_expectations(&path, &|_, _| None) {
+            Ok(_) => panic!("{}: accepted", path.display()),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            shown.starts_with(&format!("{}:", path.display()))
+                && !shown.contains(['\n', '\r', '\u{1b}'])
+                && shown.contains("\\n"),
+            "{}: {shown}",
+            path.display()
+        );
+    }
+}

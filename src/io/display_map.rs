@@ -70,7 +70,9 @@ fn sidecar_fingerprint(path: &Path) -> Result<Option<String>> {
     let value: serde_json::Value =
         serde_json::from_str(&text).with_context(|| format!("{}: not JSON", sidecar.display()))?;
     match value.get("capture_fingerprint") {
-        Some(serde_json::Value::String(s)) => Ok(Some(s.clone())),
+        Some(serde_json::Value::String(s)) => fingerprint_text(s)
+            .map(Some)
+            .with_context(|| sidecar.display().to_string()),
         Some(other) => bail!(
             "{}: capture_fingerprint must be a string of 16 hex digits, got {other}",
             sidecar.display()
@@ -79,6 +81,18 @@ fn sidecar_fingerprint(path: &Path) -> Result<Option<String>> {
             "{}: no key capture_fingerprint (the sidecar states the capture the map was made for)",
             sidecar.display()
         ),
+    }
+}
+
+/// A stated capture fingerprint, refused unless it is one (16 hex digits, as
+/// `capture::fingerprint` writes them): it is echoed in the messages of a mismatch.
+fn fingerprint_text(text: &str) -> Result<String> {
+    if text.len() == 16 && text.bytes().all(|b| b.is_ascii_hexdigit()) {
+        Ok(text.to_string())
+    } else {
+        let shown: String = text.chars().take(40).collect();
+        let more = if shown.len() < text.len() { "…" } else { "" };
+        bail!("capture_fingerprint must be a string of 16 hex digits, got {shown:?}{more}")
     }
 }
 
@@ -135,7 +149,7 @@ pub fn parse_npy(bytes: &[u8]) -> Result<MapFile> {
             "the map has {c} channels (shape {shape_text}): 2 expected, [..., 0] = x and [..., 1] = y"
         );
     }
-    if w == 0 || h == 0 || w * h > MAX_MAP_PIXELS {
+    if w == 0 || h == 0 || w.saturating_mul(h) > MAX_MAP_PIXELS {
         bail!("the map is {w}×{h} pixels: each side ≥ 1, at most {MAX_MAP_PIXELS} pixels");
     }
     let data = &bytes[start + len..];
@@ -195,18 +209,40 @@ fn read_exr_map(path: &Path) -> Result<MapFile> {
     if let Some(why) = crate::util::input_file::not_a_file(path) {
         bail!("cannot read {}: {why}", path.display());
     }
-    let meta = exr::meta::MetaData::read_from_file(path, false)
+    let open = || -> Result<std::io::BufReader<std::fs::File>> {
+        let file =
+            std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+        Ok(std::io::BufReader::new(file))
+    };
+    exr_map_from(open)
+}
+
+/// An EXR map's bytes as a map (the fuzz target's entry; `read_map` reads the file).
+pub fn parse_exr_map(bytes: &[u8]) -> Result<MapFile> {
+    exr_map_from(|| Ok(std::io::Cursor::new(bytes)))
+}
+
+/// The map of the EXR that `open` reads from its start: once for the header (its size is
+/// checked before anything is decoded), once for the channels.
+fn exr_map_from<R: std::io::Read + std::io::Seek>(open: impl Fn() -> Result<R>) -> Result<MapFile> {
+    let meta = exr::meta::MetaData::read_from_buffered(open()?, false)
         .map_err(|e| anyhow::anyhow!("not a readable EXR: {e}"))?;
-    let header = meta.headers.first().context("the EXR has no layer")?;
-    let size = header.layer_size;
-    if (size.width() as u64) * (size.height() as u64) > MAX_MAP_PIXELS {
-        bail!(
-            "the map is {}×{} pixels: at most {MAX_MAP_PIXELS}",
-            size.width(),
-            size.height()
-        );
+    // Every layer's size, as the first one that reads may not be the first in the file.
+    if meta.headers.is_empty() {
+        bail!("the EXR has no layer");
     }
-    let image = crate::io::frame_files::read_first_layer(|r| r.from_file(path))?;
+    for header in meta.headers.iter() {
+        let size = header.layer_size;
+        if (size.width() as u64) * (size.height() as u64) > MAX_MAP_PIXELS {
+            bail!(
+                "the map is {}×{} pixels: at most {MAX_MAP_PIXELS}",
+                size.width(),
+                size.height()
+            );
+        }
+    }
+    let reader = open()?;
+    let image = crate::io::frame_files::read_first_layer(|r| r.from_buffered(reader))?;
     let layer = &image.layer_data;
     let names: Vec<String> = layer
         .channel_data
@@ -239,10 +275,21 @@ fn read_exr_map(path: &Path) -> Result<MapFile> {
         .chain(layer.attributes.other.iter())
         .find(|(k, _)| *k == FINGERPRINT_ATTRIBUTE)
         .map(|(_, v)| match v {
-            exr::meta::attribute::AttributeValue::Text(t) => Ok(t.to_string()),
-            _ => bail!("the attribute capture_fingerprint must be a string"),
+            exr::meta::attribute::AttributeValue::Text(t) => fingerprint_text(&t.to_string()),
+            _ => bail!("the attribute capture_fingerprint must be a string of 16 hex digits"),
         })
         .transpose()?;
+    let size = layer.size;
+    if x.len() != size.area() || y.len() != size.area() {
+        bail!(
+            "the channels x and y hold {} and {} samples, the layer's {}×{} pixels need {}",
+            x.len(),
+            y.len(),
+            size.width(),
+            size.height(),
+            size.area()
+        );
+    }
     Ok(MapFile {
         width: size.width() as u32,
         height: size.height() as u32,

@@ -165,6 +165,12 @@ pub fn known_metrics(command: CaseCommand) -> String {
 /// Reads one bound `METRIC OP VALUE` (OP `<=` or `>=`) or `METRIC == VALUE +- TOLERANCE`;
 /// the message says what is wrong.
 pub fn parse_bound(text: &str, command: CaseCommand) -> Result<Bound, String> {
+    // The messages echo what was written: a line break or an escape in the TOML string must
+    // not split them or reach the terminal.
+    bound_of(text, command).map_err(|m| crate::util::message::printable(&m))
+}
+
+fn bound_of(text: &str, command: CaseCommand) -> Result<Bound, String> {
     let words: Vec<&str> = text.split_whitespace().collect();
     let form = "a bound is `METRIC <= VALUE`, `METRIC >= VALUE` or `METRIC == VALUE +- TOLERANCE`";
     let metric = *words
@@ -230,9 +236,17 @@ pub fn read_expectations(
     path: &Path,
     check_options: &dyn Fn(CaseCommand, &[String]) -> Option<String>,
 ) -> Result<Expectations, SceneError> {
-    let file = SourceFile::read(path)?;
+    expectations_from_source(&SourceFile::read(path)?, check_options)
+}
+
+/// [`read_expectations`] of a file already read (the fuzz target's entry).
+pub fn expectations_from_source(
+    file: &SourceFile,
+    check_options: &dyn Fn(CaseCommand, &[String]) -> Option<String>,
+) -> Result<Expectations, SceneError> {
+    let path = file.path.as_path();
     let doc = file.parse()?;
-    let root = TableReader::root(&file, &doc);
+    let root = TableReader::root(file, &doc);
     let tables = root.array_of_tables("case")?;
     if tables.is_empty() {
         return Err(root.error(
@@ -247,7 +261,10 @@ pub fn read_expectations(
         if name.trim().is_empty() || name.chars().any(|c| c.is_control() || c == '/') {
             return Err(table.error(
                 "name",
-                format!("`{name}` is not a case name (not empty, no `/`, no control characters)"),
+                format!(
+                    "`{}` is not a case name (not empty, no `/`, no control characters)",
+                    crate::util::message::printable(name)
+                ),
             ));
         }
         if cases.iter().any(|c| c.name == name) {
@@ -322,7 +339,7 @@ pub fn read_expectations(
     root.finish()?;
     Ok(Expectations {
         path: path.to_path_buf(),
-        text: std::fs::read_to_string(path).unwrap_or_default(),
+        text: file.text().to_string(),
         cases,
     })
 }

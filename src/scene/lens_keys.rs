@@ -223,8 +223,17 @@ pub fn read_calibration_file(
     back: &Camera,
 ) -> Result<Calibration, SceneError> {
     let file = crate::scene::source::SourceFile::read(path)?;
+    calibration_from_source(&file, frontal, back)
+}
+
+/// [`read_calibration_file`] of a file already read (the fuzz target's entry).
+pub fn calibration_from_source(
+    file: &crate::scene::source::SourceFile,
+    frontal: &Camera,
+    back: &Camera,
+) -> Result<Calibration, SceneError> {
     let doc = file.parse()?;
-    let root = TableReader::root(&file, &doc);
+    let root = TableReader::root(file, &doc);
     let calibration = read_calibration(&root, frontal, back)?;
     root.finish()?;
     Ok(calibration)

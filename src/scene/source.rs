@@ -85,6 +85,11 @@ impl SourceFile {
         }
     }
 
+    /// The file's text, as parsed (the spans of its document index into it).
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
     /// 1-based line of a byte offset.
     pub fn line_of(&self, offset: usize) -> usize {
         self.line_starts.partition_point(|&start| start <= offset)
