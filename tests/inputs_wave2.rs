@@ -864,7 +864,7 @@ fn score_refuses_a_filter_it_would_not_read() {
 #[test]
 fn the_tracker_models_seed_is_read_not_refused() {
     // `--head model` draws the tracker's noise and dropouts from --seed: another seed, another
-    // estimate, in run and compare as in capture (they refused --seed as ignored).
+    // estimate, in run, compare and capture (run and compare refused --seed as ignored).
     let dir = common::refusal::scratch("", &[]);
     for (words, base, shown) in [
         (
@@ -885,6 +885,11 @@ fn the_tracker_models_seed_is_read_not_refused() {
                 "planar-inf",
             ],
             "strip_planar-inf.png",
+        ),
+        (
+            &["capture"],
+            &["--spp", "1", "--width", "16", "--head", "model"],
+            "head.json",
         ),
     ] {
         let mut shown_by = Vec::new();
