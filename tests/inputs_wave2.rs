@@ -61,8 +61,12 @@ fn help_options(words: &[&str]) -> Vec<HelpOption> {
     found
 }
 
-const COMMANDS: [&[&str]; 14] = [
+const COMMANDS: [&[&str]; 18] = [
     &["render"],
+    &["capture"],
+    &["score"],
+    &["diff"],
+    &["check"],
     &["run"],
     &["ratio", "occlusion"],
     &["ratio", "foreshortening"],
@@ -119,6 +123,26 @@ fn every_choice_flag_ignores_spaces_around_its_values() {
     let (ok, _, err) = common::seethru(&["compare", "--methods= planar-inf , ground", "--help"]);
     if !ok {
         wrong.push(format!("compare --methods with spaces: {err}"));
+    }
+    // Every choice flag that takes a list (`a,b` accepted) takes it spaced, `' a , b '`.
+    for words in COMMANDS {
+        for option in help_options(words) {
+            let [a, b, ..] = option.choices.as_slice() else {
+                continue;
+            };
+            let parses = |value: String| {
+                let arg = format!("{}={value}", option.flag);
+                let mut args: Vec<&str> = words.to_vec();
+                args.extend([arg.as_str(), "--help"]);
+                common::seethru(&args)
+            };
+            if parses(format!("{a},{b}")).0 {
+                let (ok, _, err) = parses(format!(" {a} , {b} "));
+                if !ok {
+                    wrong.push(format!("{words:?} {} ' {a} , {b} ': {err}", option.flag));
+                }
+            }
+        }
     }
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
     assert!(walked >= 20, "{walked} choice flags");
@@ -620,4 +644,272 @@ fn a_kill_at_any_moment_leaves_the_old_set_or_the_new_one() {
         round += 1;
     }
     assert!(kills > 0 && round > 10, "{kills} kills in {round} rounds");
+}
+
+/// Runs `words positional --out o base --flag v` and the same with `' v '` for every value
+/// of every choice flag of `words`' help (in `dir`): both give the same exit code, stderr
+/// and files (but `skip`'s, which record the command line as typed). Refusals count too:
+/// a spaced value must be refused with the unspaced one's message.
+fn spaced_choices_give_the_same_output(
+    dir: &Path,
+    words: &[&str],
+    positional: &str,
+    base: &[&str],
+    skip: &[&str],
+) -> (usize, Vec<String>) {
+    let out = dir.join("o");
+    let mut compared = 0;
+    let mut wrong = Vec::new();
+    let outcome = |flag: &str, value: &str| {
+        let _ = std::fs::remove_dir_all(&out);
+        let mut args: Vec<&str> = words.to_vec();
+        args.extend([positional, "--out", "o"]);
+        args.extend(base);
+        args.extend([flag, value]);
+        let (code, err) = run_in(dir, &args);
+        let mut written = if out.is_dir() {
+            files(&out, skip)
+        } else {
+            BTreeMap::new()
+        };
+        // run.json records every parameter as parsed (compared), and the time and memory
+        // the run took (which vary from run to run: left out).
+        for (name, bytes) in written.iter_mut() {
+            if name.ends_with("run.json") {
+                let mut report: serde_json::Value = serde_json::from_slice(bytes).unwrap();
+                for key in ["timings_s", "peak_rss_bytes"] {
+                    report.as_object_mut().unwrap().remove(key);
+                }
+                *bytes = report.to_string().into_bytes();
+            }
+        }
+        (code, err, written)
+    };
+    for option in help_options(words) {
+        if base.contains(&option.flag.as_str()) {
+            continue;
+        }
+        for choice in &option.choices {
+            let plain = outcome(&option.flag, choice);
+            let spaced = outcome(&option.flag, &format!(" {choice} "));
+            compared += 1;
+            if plain != spaced {
+                wrong.push(format!(
+                    "{words:?} {} ' {choice} ' differs from '{choice}': exit {} vs {}, `{}` vs `{}`",
+                    option.flag,
+                    spaced.0,
+                    plain.0,
+                    spaced.1.trim(),
+                    plain.1.trim()
+                ));
+            }
+        }
+    }
+    (compared, wrong)
+}
+
+#[test]
+fn every_spaced_choice_value_gives_the_unspaced_output() {
+    let dir = common::refusal::scratch("", &[]);
+    let mut wrong = Vec::new();
+    let mut compared = 0;
+    for (words, base, skip) in [
+        (
+            &["render"][..],
+            &["--width", "8", "--spp", "1"][..],
+            &[][..],
+        ),
+        (&["run"], &["--width", "16", "--spp", "1"], &[]),
+        (
+            &["capture"],
+            &["--width", "16", "--spp", "1"],
+            &["capture_command.json"],
+        ),
+        (&["export"], &[], &[]),
+    ] {
+        let positional = "scene.toml";
+        let (n, w) = spaced_choices_give_the_same_output(dir.path(), words, positional, base, skip);
+        compared += n;
+        wrong.extend(w);
+    }
+    // score: a capture and a map for it.
+    let inputs = score_inputs(dir.path());
+    let (n, w) = spaced_choices_give_the_same_output(
+        dir.path(),
+        &["score"],
+        &inputs,
+        &["--map", "map.npy"],
+        &[],
+    );
+    compared += n;
+    wrong.extend(w);
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    // render 7 values, run 30, capture 16, export 3, score 2.
+    assert!(compared >= 55, "{compared} values compared");
+}
+
+/// A capture of the minimal scene in `dir`/cap and a display map for it, `dir`/map.npy: the
+/// display's pixels spread over the frontal image (so that the filters differ).
+fn score_inputs(dir: &Path) -> String {
+    let (code, err) = run_in(
+        dir,
+        &[
+            "capture",
+            "scene.toml",
+            "--out",
+            "cap",
+            "--width",
+            "16",
+            "--spp",
+            "1",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("cap/capture.json")).unwrap()).unwrap();
+    let size = |key: &str, i: usize| manifest[key][i].as_u64().unwrap() as usize;
+    let (dw, dh) = (
+        size("display_resolution_px", 0),
+        size("display_resolution_px", 1),
+    );
+    let (fw, fh) = (size("frontal_size_px", 0), size("frontal_size_px", 1));
+    let mut xy = Vec::new();
+    for v in 0..dh {
+        for u in 0..dw {
+            // A non-integer scale: samples between pixels, where the filters differ.
+            xy.push(u as f32 * (fw as f32 - 1.0) / (dw as f32 + 0.37));
+            xy.push(v as f32 * (fh as f32 - 1.0) / (dh as f32 + 0.37));
+        }
+    }
+    seethru::io::display_map::write_npy_f32(&dir.join("map.npy"), &[dh, dw, 2], &xy).unwrap();
+    "cap".to_string()
+}
+
+#[test]
+fn every_flag_of_capture_changes_the_output_or_is_refused() {
+    // truth/capture_command.json records the command line: the other files must show it.
+    let mut wrong = Vec::new();
+    for base in [
+        &["--spp", "1", "--width", "16"][..],
+        // The depth sensor's flags are read with --depth and a sensor that has settings.
+        &[
+            "--spp",
+            "1",
+            "--width",
+            "16",
+            "--depth",
+            "--depth-sensor",
+            "tof",
+        ],
+        // The tracker model draws its noise from --seed.
+        &["--spp", "1", "--width", "16", "--head", "model"],
+        // --ipd places the eyes.
+        &["--spp", "1", "--width", "16", "--eyes", "left"],
+    ] {
+        wrong.extend(each_flag_is_read_or_refused(
+            &["capture"],
+            base,
+            &["capture_command.json"],
+            &[],
+        ));
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+#[test]
+fn score_refuses_a_filter_it_would_not_read() {
+    let dir = common::refusal::scratch("", &[]);
+    let inputs = score_inputs(dir.path());
+    let score = |out: &str, extra: &[&str]| {
+        let mut args = vec!["score", inputs.as_str(), "--out", out];
+        args.extend(extra);
+        let (code, err) = run_in(dir.path(), &args);
+        (code, err, dir.path().join(out))
+    };
+    // With a map, the filter is read: bicubic shows other colours than bilinear.
+    let (code, err, bilinear) = score("bilinear", &["--map", "map.npy"]);
+    assert_eq!(code, 0, "{err}");
+    let (code, err, bicubic) = score("bicubic", &["--map", "map.npy", "--filter", "bicubic"]);
+    assert_eq!(code, 0, "{err}");
+    assert_ne!(
+        std::fs::read(bilinear.join("display.png")).unwrap(),
+        std::fs::read(bicubic.join("display.png")).unwrap()
+    );
+    // A display image replaces the map's colours, and alone has no points to resample at:
+    // --filter, even at its default, is refused with one line, and nothing is written.
+    std::fs::copy(bilinear.join("display.png"), dir.path().join("shown.png")).unwrap();
+    for extra in [
+        &["--display-image", "shown.png", "--filter", "bilinear"][..],
+        &[
+            "--display-image",
+            "shown.png",
+            "--map",
+            "map.npy",
+            "--filter",
+            "bicubic",
+        ],
+    ] {
+        let mut args = vec!["score", inputs.as_str(), "--out", "refused"];
+        args.extend(extra);
+        common::refusal::refused(
+            dir.path(),
+            &args,
+            1,
+            &["--filter is read only with --map and no --display-image"],
+        );
+        assert!(!dir.path().join("refused").exists());
+    }
+}
+
+#[test]
+fn the_tracker_models_seed_is_read_not_refused() {
+    // `--head model` draws the tracker's noise and dropouts from --seed: another seed, another
+    // estimate, in run, compare and capture (run and compare refused --seed as ignored).
+    let dir = common::refusal::scratch("", &[]);
+    for (words, base, shown) in [
+        (
+            &["run"][..],
+            &["--spp", "1", "--width", "16", "--head", "model"][..],
+            "seethru.png",
+        ),
+        (
+            &["compare"],
+            &[
+                "--spp",
+                "1",
+                "--width",
+                "16",
+                "--head",
+                "model",
+                "--methods",
+                "planar-inf",
+            ],
+            "strip_planar-inf.png",
+        ),
+        (
+            &["capture"],
+            &["--spp", "1", "--width", "16", "--head", "model"],
+            "head.json",
+        ),
+    ] {
+        let mut shown_by = Vec::new();
+        for (out, seed) in [("a", "1"), ("b", "7")] {
+            let mut args: Vec<&str> = words.to_vec();
+            args.extend(["scene.toml", "--out", out]);
+            args.extend(base);
+            args.extend(["--seed", seed]);
+            let (code, err) = run_in(dir.path(), &args);
+            assert_eq!(code, 0, "{args:?}: {err}");
+            let all = files(&dir.path().join(out), &[]);
+            let image = all
+                .iter()
+                .find(|(name, _)| name.ends_with(shown))
+                .unwrap_or_else(|| panic!("{words:?}: no {shown} in {:?}", all.keys()));
+            shown_by.push(image.1.clone());
+        }
+        assert_ne!(
+            shown_by[0], shown_by[1],
+            "{words:?}: --seed changes nothing"
+        );
+    }
 }

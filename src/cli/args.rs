@@ -5,7 +5,7 @@ use anyhow::{Result, bail};
 use seethru::render::settings::MAX_SPP;
 use seethru::scene::source::MAX_RESOLUTION;
 use seethru::system::memory::DEFAULT_MAX_MEMORY_GIB;
-use seethru::system::options::MAX_HEAD_BIAS_CM;
+use seethru::system::options::{HeadSource, MAX_HEAD_BIAS_CM};
 use seethru::util::number::short;
 
 /// Most worker threads a command accepts.
@@ -150,10 +150,17 @@ pub struct HeadErrorArgs {
 impl HeadErrorArgs {
     /// The rules of these flags ([`refuse_ignored`]): none is read where the method uses no
     /// eye (`eye_used` false: `--method none`); the feature width is the detector's, read
-    /// with `estimated` heads only; the seed is read by the jitter, or where
+    /// with `head` estimated only (`--require-confident-head` is refused by the pipeline); the seed is read by the
+    /// jitter, the tracker model (`head` model: its noise and dropouts), or where
     /// `other_seed_reader` (a noisy depth sensor, the plane fit) says so.
-    pub fn rules(&self, eye_used: bool, estimated: bool, other_seed_reader: bool) -> Vec<ReadWhen> {
+    pub fn rules(
+        &self,
+        eye_used: bool,
+        head: HeadSource,
+        other_seed_reader: bool,
+    ) -> Vec<ReadWhen> {
         let eye = EYE_METHODS;
+        let estimated = head == HeadSource::Estimated;
         vec![
             ReadWhen {
                 flag: "--head-bias-cm",
@@ -172,8 +179,9 @@ impl HeadErrorArgs {
             },
             ReadWhen {
                 flag: "--seed",
-                read: (eye_used && self.head_jitter_cm > 0.0) || other_seed_reader,
-                when: "with --head-jitter-cm > 0, a noisy depth sensor or the plane fit",
+                read: (eye_used && (self.head_jitter_cm > 0.0 || head == HeadSource::Model))
+                    || other_seed_reader,
+                when: "with --head-jitter-cm > 0, the tracker model's head, a noisy depth sensor or the plane fit",
             },
         ]
     }

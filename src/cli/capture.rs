@@ -18,12 +18,15 @@ use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::scene::lens_keys::read_calibration_file;
 use seethru::system::capture::{Capture, capture};
+use seethru::system::depth_sensor::SensorKind;
 use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
 use seethru::system::memory::{check_memory, run_estimate};
 use seethru::system::options::{HeadSource, RunOptions};
 use serde_json::json;
 
-use crate::cli::args::{HeadErrorArgs, RenderArgs, choice, pixels, positive, with_threads};
+use crate::cli::args::{
+    HeadErrorArgs, ReadWhen, RenderArgs, choice, pixels, positive, refuse_ignored, with_threads,
+};
 use crate::cli::run_eyes::EyesFlag;
 use crate::cli::scene_model_args::SceneModelArgs;
 
@@ -52,7 +55,7 @@ pub struct CaptureArgs {
     #[arg(long, value_name = "FILE")]
     pub calibration: Option<PathBuf>,
     /// oracle: the true eye; estimated: face detection on the back camera's image.
-    #[arg(long, value_enum, default_value_t = HeadSource::Oracle)]
+    #[arg(long, value_enum, value_parser = choice::<HeadSource>(), default_value_t = HeadSource::Oracle)]
     pub head: HeadSource,
     /// Head-tracking errors and the detector's feature width.
     #[command(flatten)]
@@ -64,13 +67,13 @@ pub struct CaptureArgs {
     #[arg(long = "back-width", value_parser = pixels)]
     pub back_width: Option<u32>,
     /// The eye the driver's views are rendered from: mono, left or right (not both).
-    #[arg(long, value_enum, default_value_t = EyesFlag::Mono)]
+    #[arg(long, value_enum, value_parser = choice::<EyesFlag>(), default_value_t = EyesFlag::Mono)]
     pub eyes: EyesFlag,
     /// Interpupillary distance, metres in [1e-6, 0.1].
     #[arg(long, default_value_t = 0.064, value_parser = positive(MAX_IPD))]
     pub ipd: f64,
     /// The eye the head estimate is for.
-    #[arg(long = "target-eye", value_enum, default_value_t = Eye::Cyclopean)]
+    #[arg(long = "target-eye", value_enum, value_parser = choice::<Eye>(), default_value_t = Eye::Cyclopean)]
     pub target_eye: Eye,
     /// Write the depth sensor's image (depth.npy, depth.exr), as --method depth models it
     /// with --depth-sensor and its settings.
@@ -104,12 +107,28 @@ impl CaptureArgs {
                 .check_used_by(seethru::system::options::Method::Planar)
                 .map_err(|e| anyhow::anyhow!("{e} (capture: add --depth)"))?;
         }
+        let noisy_depth = self.depth && self.scene_model.depth_sensor != SensorKind::Ideal;
+        let mut rules = self.head_errors.rules(true, self.head, noisy_depth);
+        rules.extend([
+            ReadWhen {
+                flag: "--require-confident-head",
+                read: self.head == HeadSource::Estimated,
+                when: "with --head estimated (only the face detector's estimate has a confidence)",
+            },
+            ReadWhen {
+                flag: "--ipd",
+                read: self.eyes != EyesFlag::Mono || self.target_eye != Eye::Cyclopean,
+                when: "with --eyes left or right, or --target-eye left or right",
+            },
+        ]);
+        refuse_ignored(&rules)?;
         Ok(RunOptions {
             head: self.head,
             head_bias_cm: self.head_errors.head_bias_cm,
             head_jitter_cm: self.head_errors.head_jitter_cm,
             seed: self.head_errors.seed,
             feature_width: self.head_errors.feature_width,
+            require_confident_head: self.head_errors.require_confident_head,
             width: self.render.width,
             height: self.render.height,
             frontal_width: self.frontal_width,

@@ -100,8 +100,10 @@ impl Compare {
         let noisy_kind = self.scene_model.depth_sensor != SensorKind::Ideal;
         rules.push(ReadWhen {
             flag: "--seed",
-            read: any(&[PlaneFit, DepthTof, DepthStereo]) || (noisy_kind && any(&[DepthIdeal])),
-            when: "when --methods lists plane-fit or a noisy depth sensor",
+            read: any(&[PlaneFit, DepthTof, DepthStereo])
+                || (noisy_kind && any(&[DepthIdeal]))
+                || self.head == HeadSource::Model,
+            when: "with --head model (the tracker model's noise and dropouts) or when --methods lists plane-fit or a noisy depth sensor",
         });
         rules.push(ReadWhen {
             flag: "--back-width",

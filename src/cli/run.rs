@@ -112,7 +112,7 @@ impl Run {
         let eye_used = self.method != Method::None;
         let mut rules = self.head_errors.rules(
             eye_used,
-            self.head == HeadSource::Estimated,
+            self.head,
             self.method == Method::PlaneFit || noisy_sensor,
         );
         rules.extend([

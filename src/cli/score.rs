@@ -38,7 +38,7 @@ pub struct Score {
     #[arg(long)]
     out: PathBuf,
     /// Colour resampling of the frontal image at the map's points.
-    #[arg(long, value_enum, default_value_t = Filter::Bilinear)]
+    #[arg(long, value_enum, value_parser = choice::<Filter>(), default_value_t = Filter::Bilinear)]
     filter: Filter,
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
@@ -143,9 +143,12 @@ impl Score {
         if self.map.is_none() && self.display_image.is_none() {
             bail!("score needs --map FILE, --display-image FILE or both");
         }
-        if self.map.is_none() && self.filter != Filter::Bilinear {
-            bail!("--filter resamples the frontal image at the map's points: it needs --map");
-        }
+        // Given even at its default, --filter without a map would be ignored.
+        crate::cli::args::refuse_ignored(&[crate::cli::args::ReadWhen {
+            flag: "--filter",
+            read: self.map.is_some() && self.display_image.is_none(),
+            when: "with --map and no --display-image (it resamples the frontal image's colours at the map's points; a display image replaces them)",
+        }])?;
         crate::cli::args::with_threads(self.threads, || self.write())?
     }
 

@@ -292,7 +292,7 @@ impl Sequence {
         let lean = "with --head lean (and no --head-path)";
         let eye_used = self.method != Method::None;
         let estimated = self.head_source == HeadSource::Estimated;
-        let mut rules = self.head_errors.rules(eye_used, estimated, false);
+        let mut rules = self.head_errors.rules(eye_used, self.head_source, false);
         let eye = |flag| ReadWhen {
             flag,
             read: eye_used,
