@@ -14,6 +14,7 @@ use std::path::PathBuf;
 use glam::DVec3;
 use numpy::PyArray;
 use numpy::ndarray::Array2;
+use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
@@ -443,7 +444,14 @@ pub fn sequence(
     let head = match (&head_path, head) {
         (Some(path), _) => {
             let path = path.clone();
-            HeadMotion::Path(py.detach(|| HeadPath::load(&path)).map_err(to_py)?)
+            let loaded = py.detach(|| HeadPath::load(&path)).map_err(|e| {
+                // The file could not be read (absent, a folder, no permission): an OSError.
+                match std::fs::File::open(&path).is_err() || !path.is_file() {
+                    true => PyOSError::new_err(to_py(e).value(py).to_string()),
+                    false => to_py(e),
+                }
+            })?;
+            HeadMotion::Path(loaded)
         }
         (None, HeadPreset::Still) => HeadMotion::Still,
         (None, HeadPreset::Sway) => HeadMotion::Sway {
