@@ -37,7 +37,7 @@ use seethru::util::number::short;
 use crate::errors::{bad_value, to_py};
 use crate::frame::PyFrame;
 use crate::interrupt::detached;
-use crate::options::{Keywords, choice_of, real_in, working_distance};
+use crate::options::{Keywords, real_in, working_distance};
 use crate::run::json_to_py;
 use crate::scene::PyScene;
 
