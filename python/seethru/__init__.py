@@ -59,20 +59,37 @@ def score(capture: Capture, map=None, display_image=None, filter: str = "bilinea
 def sequence(scene: Scene, predictor=None, **options) -> Sequence:
     """A sequence (``seethru sequence``) as an iterator of measured frames (:class:`Step`).
 
-    Keywords (``seethru sequence``'s flags, same defaults): ``duration`` (s), ``fps``,
-    ``display_hz``, ``speed`` (km/h), ``yaw_rate`` (deg/s), ``head`` ("still", "sway",
-    "lean"), ``sway_cm``, ``sway_hz``, ``lean_cm``, ``lean_s``, ``lean_at``,
-    ``latency_camera`` and ``latency_tracking`` (ms), ``method`` ("planar", "none"), ``d2``
-    (m or inf), ``outside`` ("black", "error"), ``width``, ``spp`` (default 1), ``band``.
+    The frames are made by the library's stepper, the one ``seethru sequence`` drives. The
+    keywords are that command's flags for the simulated loop, in snake case, with the same
+    defaults, ranges and refusals (a keyword the others make it ignore raises ValueError,
+    e.g. ``sway_cm`` without ``head="sway"``):
+
+    - timing: ``duration`` (s), ``fps``, ``display_hz`` (Hz); ``latency_camera`` (ms, a
+      number or a list: the sequences of every latency one after the other, each
+      :class:`Step` naming its ``latency_camera``), ``latency_tracking`` (ms);
+    - vehicle: ``speed`` (km/h), ``yaw_rate`` (deg/s);
+    - head motion: ``head`` ("still", "sway", "lean") with ``sway_cm``, ``sway_hz``,
+      ``lean_cm``, ``lean_s``, ``lean_at``, or ``head_path`` (a CSV of t,x,y,z);
+    - the system: ``method`` ("planar", "none"), ``d2`` (m, inf or "auto"), ``head_source``
+      ("oracle", "estimated", "model"), ``head_bias_cm`` (x, y, z), ``head_jitter_cm``,
+      ``seed``, ``feature_width`` (m), ``require_confident_head`` (bool), ``predict``
+      ("none", "constant-velocity", "kalman"), ``reproject`` (bool), ``outside`` ("black",
+      "error"), ``filter``, ``display`` ("pixels", "ideal");
+    - sizes and metrics: ``width``, ``height``, ``frontal_width``, ``back_width`` (pixels),
+      ``spp`` (default 1), ``band``, ``hazard_bound_arcmin``, ``max_memory`` (GiB).
+
     Every frame renders whole driver views (as ``--frames exr``), so its metrics equal
     frames.csv's for the same options.
 
     ``predictor(info)`` is called once per display refresh, before its image is made, with a
-    dict: ``frame``, ``time``, ``refresh``, ``refresh_time``, ``capture_time``, ``head_time``
-    (s), ``eye_true`` (at ``time``) and ``eye_at_head_time`` (obstacle frame, m). It returns
-    the eye (x, y, z, obstacle frame, m) the compensation uses, or None for the system's own
-    oracle estimate. Each :class:`Step` has the times, ``eye_true``, ``eye_estimated``,
-    ``eye_used``, ``metrics`` (metrics.json's content for that instant), ``truth`` and
-    ``seethru`` (:class:`Frame`) and ``misregistration`` ((h, w) float32, arcmin).
+    dict: ``latency_camera`` (ms), ``frame``, ``time``, ``refresh``, ``refresh_time``,
+    ``capture_time``, ``head_time`` (s), ``eye_true`` (at ``time``) and
+    ``eye_at_head_time`` (obstacle frame, m). It returns the eye (x, y, z, obstacle frame,
+    m) the compensation uses, or None for the system's own estimate (``head_source``, then
+    ``predict``). Each :class:`Step` has frames.csv's row: the times, ``eye_true``,
+    ``eye_estimated``, ``eye_used``, ``head_confidence``, ``d2_used``,
+    ``vehicle_position``, ``vehicle_yaw_deg``, ``hazards``, with ``metrics``
+    (metrics.json's content for that instant), ``truth`` and ``seethru`` (:class:`Frame`)
+    and ``misregistration`` ((h, w) float32, arcmin).
     """
     return _sequence(scene, predictor, **options)

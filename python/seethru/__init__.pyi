@@ -139,9 +139,11 @@ class Capture:
     """What a see-through system's algorithm receives (`seethru capture`), in memory."""
 
     frontal: Frame
+    """Read-only views of the capture's buffers (no copy): `score` reads the same pixels."""
     back: Frame
+    """Read-only views, as frontal."""
     inverse_depth: npt.NDArray[np.float32] | None
-    """The depth sensor's inverse depth, 1/m (0: no return); with depth=True only."""
+    """The depth sensor's inverse depth, 1/m (0: no return); with depth=True only; read-only."""
     head: dict[str, Any]
     """The head tracker's output: source, eye_world_m, eye_obstacle_m, detection."""
     calibration: dict[str, Any]
@@ -163,8 +165,9 @@ def score(
     """`seethru score`: a method's display map (h, w, 2) and/or image (h, w, 3) measured."""
 
 class Step:
-    """One displayed frame of a :class:`Sequence`."""
-    frame: int
+    """One displayed frame of a :class:`Sequence` (a row of frames.csv, and its views)."""
+    latency_camera: float  # ms, of this frame's sequence
+    frame: int  # from 0 in its latency's sequence
     time: float  # s, when the frame is looked at
     refresh: int
     refresh_time: float  # s
@@ -173,7 +176,12 @@ class Step:
     eye_true: tuple[float, float, float]  # obstacle frame, m, at `time`
     eye_estimated: tuple[float, float, float]  # the system's head estimate, m
     eye_used: tuple[float, float, float]  # what the compensation used, m
+    head_confidence: float | None  # [0, 1], image-based head estimates only
+    d2_used: float | None  # m, the working distance chosen with d2="auto"
+    vehicle_position: tuple[float, float, float]  # the pivot, world, m
+    vehicle_yaw_deg: float
     metrics: dict[str, Any]  # metrics.json's content for this instant
+    hazards: list[dict[str, Any]]  # every hazard object's visibility, scene order
     truth: Frame
     seethru: Frame
     misregistration: npt.NDArray[np.float32]  # (height, width), arcmin, NaN off the display
@@ -182,11 +190,48 @@ class Sequence:
     """A sequence being stepped through: iterate it for its :class:`Step`s."""
     def __iter__(self) -> Sequence: ...
     def __next__(self) -> Step: ...
-    def __len__(self) -> int: ...
+    def __len__(self) -> int:
+        """Frames in all, over every camera latency."""
 
 def sequence(
     scene: Scene,
     predictor: Callable[[dict[str, Any]], tuple[float, float, float] | None] | None = None,
-    **options: Any,
+    *,
+    duration: float = 4.0,
+    fps: float = 60.0,
+    display_hz: float | None = None,
+    speed: float = 0.0,
+    yaw_rate: float = 0.0,
+    head: Literal["still", "sway", "lean"] = "still",
+    head_path: str | PathLike[str] | None = None,
+    sway_cm: float = 3.0,
+    sway_hz: float = 0.5,
+    lean_cm: float = 10.0,
+    lean_s: float = 0.3,
+    lean_at: float = 0.5,
+    latency_camera: float | list[float] = 0.0,
+    latency_tracking: float = 0.0,
+    predict: Literal["none", "constant-velocity", "kalman"] = "none",
+    reproject: bool = False,
+    method: str = "planar",
+    d2: float | str = float("inf"),
+    head_source: Literal["oracle", "estimated", "model"] = "oracle",
+    head_bias_cm: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    head_jitter_cm: float = 0.0,
+    seed: int = 1,
+    feature_width: float = 0.064,
+    require_confident_head: bool = False,
+    outside: Literal["black", "error"] = "black",
+    filter: str = "bilinear",
+    display: Literal["pixels", "ideal"] = "pixels",
+    width: int = 640,
+    height: int | None = None,
+    frontal_width: int | None = None,
+    back_width: int | None = None,
+    spp: int = 1,
+    band: int = 5,
+    hazard_bound_arcmin: float = ...,
+    max_memory: float = ...,
 ) -> Sequence:
-    """A sequence as an iterator of measured frames; `predictor(info)` supplies the eye per refresh."""
+    """`seethru sequence` as an iterator of measured frames, the command's loop options as
+    keywords (refused as it refuses them); `predictor(info)` supplies the eye per refresh."""

@@ -6,8 +6,8 @@
 use std::sync::Arc;
 
 use glam::Vec3;
-use numpy::ndarray::Array2;
-use numpy::{PyArray, PyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use numpy::ndarray::ArrayView2;
+use numpy::{PyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use seethru::render::integrator::RenderContext;
@@ -18,6 +18,7 @@ use seethru::system::display::Filter;
 use seethru::system::memory::{check_memory, run_estimate};
 use seethru::system::options::RunOptions;
 
+use crate::borrowed::{CaptureBuffers, read_only_view};
 use crate::errors::{bad_value, to_py};
 use crate::frame::PyFrame;
 use crate::interrupt::detached;
@@ -31,14 +32,15 @@ pub struct PyCapture {
     inner: Arc<Capture>,
     context: Arc<RenderContext>,
     options: RunOptions,
-    /// The frontal camera's image (colour is the method's input), a Frame.
+    /// The frontal camera's image (colour is the method's input), a Frame of read-only
+    /// views of the capture's buffers (no copy; `score` reads the same buffers).
     #[pyo3(get)]
     frontal: Py<PyFrame>,
-    /// The back camera's image, a Frame.
+    /// The back camera's image, a Frame of read-only views.
     #[pyo3(get)]
     back: Py<PyFrame>,
     /// The depth sensor's inverse depth, 1/m (0: no return), (h, w) float32; None unless
-    /// captured with depth=True.
+    /// captured with depth=True; a read-only view.
     #[pyo3(get)]
     inverse_depth: Option<Py<PyArray2<f32>>>,
     /// The head tracker's output (head.json's "head").
@@ -86,25 +88,31 @@ pub fn capture(
     })?
     .map_err(to_py)?;
     scene.borrow_mut().context = Some(context.clone());
-    // Copies: the capture itself is kept whole for `score`.
-    let frontal = Py::new(py, PyFrame::new(py, "frontal", captured.frontal.clone()))?;
-    let back = Py::new(py, PyFrame::new(py, "back", captured.back.clone()))?;
-    let inverse_depth = match &captured.depth {
-        Some(d) => {
-            let (w, h) = (d.camera.width as usize, d.camera.height as usize);
-            let array =
-                Array2::from_shape_vec((h, w), d.inverse_depth.clone()).expect("a depth map");
-            Some(PyArray::from_owned_array(py, array).unbind())
-        }
-        None => None,
-    };
+    // The capture is kept whole for `score`: numpy views its images, read-only, no copy.
+    let captured = Arc::new(captured);
+    let owner = Bound::new(
+        py,
+        CaptureBuffers {
+            capture: captured.clone(),
+        },
+    )?;
+    let frontal = Py::new(py, PyFrame::view_of(&owner, "frontal", |c| &c.frontal))?;
+    let back = Py::new(py, PyFrame::view_of(&owner, "back", |c| &c.back))?;
+    let inverse_depth = captured.depth.as_ref().map(|d| {
+        let (w, h) = (d.camera.width as usize, d.camera.height as usize);
+        read_only_view(&owner, |c| {
+            let d = c.depth.as_ref().expect("checked above");
+            ArrayView2::from_shape((h, w), &d.inverse_depth[..]).expect("a depth map")
+        })
+        .unbind()
+    });
     let head = serde_json::to_value(&captured.head).map_err(|e| to_py(e.into()))?;
     let [dw, dh] = context.scene.obstacle.display_resolution;
     Ok(PyCapture {
         head: json_to_py(py, &head)?,
         calibration: json_to_py(py, &captured.calibration)?,
         fingerprint: captured.fingerprint.clone(),
-        inner: Arc::new(captured),
+        inner: captured,
         context,
         options,
         frontal,

@@ -1,15 +1,19 @@
 //! `seethru.Frame`: one render's buffers as numpy arrays. Each array takes over the Rust
-//! allocation it was rendered into (`PyArray::from_owned_array`): no pixel is copied, and
+//! allocation it was rendered into (`PyArray::from_owned_array`), or, for a capture's
+//! images, views it read-only ([`crate::borrowed`]): no pixel is copied, and
 //! `Frame._buffer_addresses` records where the allocations were so a test can tell.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
 
 use glam::Vec3;
-use numpy::ndarray::{Array2, Array3};
+use numpy::ndarray::{Array2, Array3, ArrayView2, ArrayView3};
 use numpy::{PyArray, PyArray2, PyArray3};
 use pyo3::prelude::*;
 use seethru::render::frame::Frame;
+use seethru::system::capture::Capture;
+
+use crate::borrowed::{CaptureBuffers, read_only_view};
 
 use crate::errors::to_py;
 
@@ -89,6 +93,60 @@ impl PyFrame {
         };
         let object_id = ids("object_id", frame.object_id);
         let part_id = ids("part_id", frame.part_id);
+        PyFrame {
+            view: view.to_string(),
+            width: frame.width,
+            height: frame.height,
+            colour,
+            depth,
+            camera_z,
+            position,
+            normal,
+            object_id,
+            part_id,
+            buffer_addresses: addresses,
+        }
+    }
+
+    /// Read-only numpy views of the buffers of the frame `pick` chooses in `owner`'s
+    /// capture: no copy ([`read_only_view`]).
+    pub fn view_of(
+        owner: &Bound<'_, CaptureBuffers>,
+        view: &str,
+        pick: fn(&Capture) -> &Frame,
+    ) -> PyFrame {
+        let frame = pick(&owner.get().capture);
+        let (w, h) = (frame.width as usize, frame.height as usize);
+        let mut addresses = HashMap::new();
+        let mut vectors = |name: &str, of: fn(&Frame) -> &[Vec3]| {
+            addresses.insert(name.to_string(), of(frame).as_ptr() as usize);
+            read_only_view(owner, |c| {
+                let flat: &[f32] = bytemuck::cast_slice(of(pick(c)));
+                ArrayView3::from_shape((h, w, 3), flat).expect("a frame's buffer size")
+            })
+            .unbind()
+        };
+        let colour = vectors("colour", |f| &f.color);
+        let position = vectors("position", |f| &f.position);
+        let normal = vectors("normal", |f| &f.normal);
+        let mut scalars = |name: &str, of: fn(&Frame) -> &[f32]| {
+            addresses.insert(name.to_string(), of(frame).as_ptr() as usize);
+            read_only_view(owner, |c| {
+                ArrayView2::from_shape((h, w), of(pick(c))).expect("a frame's buffer size")
+            })
+            .unbind()
+        };
+        let depth = scalars("depth", |f| &f.depth);
+        let camera_z = scalars("camera_z", |f| &f.camera_z);
+        let mut ids = |name: &str, of: fn(&Frame) -> &[u32]| {
+            addresses.insert(name.to_string(), of(frame).as_ptr() as usize);
+            read_only_view(owner, |c| {
+                ArrayView2::from_shape((h, w), of(pick(c))).expect("a frame's buffer size")
+            })
+            .unbind()
+        };
+        let object_id = ids("object_id", |f| &f.object_id);
+        let part_id = ids("part_id", |f| &f.part_id);
         PyFrame {
             view: view.to_string(),
             width: frame.width,

@@ -11,7 +11,7 @@ use seethru::analysis::paper::{ForeshorteningParams, OcclusionParams};
 use seethru::measure::compare::{Candidate, coloured_strips, compare as compare_methods};
 use seethru::measure::ratio::measure_ratio;
 use seethru::measure::ratio_setup::{Compensation, Setup};
-use seethru::paper::claims::{AnalyzeParams, evaluate, paper_claims};
+use seethru::paper::claims::{AnalyzeParams, evaluate, lens_and_eyes, paper_claims};
 use seethru::render::settings::check_resolution;
 use seethru::scene::source::MAX_RESOLUTION;
 use seethru::system::memory::{check_memory, run_estimate};
@@ -175,8 +175,9 @@ fn geometry(k: &mut crate::options::Keywords<'_>) -> PyResult<(f64, f64, f64, f6
     Ok(values)
 }
 
-/// `seethru analyze --json` without its `lens_and_eyes` block: the paper's claims, every
-/// closed form at the parameters, and the error budget of the DAS geometry.
+/// `seethru analyze --json`: the paper's claims, every closed form at the parameters, the
+/// lens and eyes block ([`lens_and_eyes`], shared with the command) and the error budget of
+/// the DAS geometry.
 #[pyfunction]
 #[pyo3(signature = (**options))]
 pub fn analyze(py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResult<Py<PyAny>> {
@@ -206,40 +207,4 @@ pub fn analyze(py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResult<
         "error_budget_das": error_budget(&das_geometry()),
     });
     json_to_py(py, &json)
-}
-
-/// `seethru analyze`'s lens and eyes block (cli/analyze.rs's `lens_and_eyes`, which the binary
-/// keeps private): the frontal pixel error of ignoring k1 at the crop's corners and the flat
-/// display's binocular disparity mismatch. The test compares it with `analyze --json`.
-fn lens_and_eyes(a: &AnalyzeParams, height: f64, k1: f64, ipd: f64) -> serde_json::Value {
-    use seethru::analysis::binocular::{
-        disparity_mismatch, display_corners, model_point_normalised, radial_error_px,
-    };
-    let f_px = a.frontal_px as f64 / (2.0 * a.theta_f_deg.to_radians().tan());
-    let eye = glam::DVec3::new(-a.b_h, 0.0, a.d1);
-    let d2 = a.d2.is_finite().then_some(a.d2);
-    let corners: Vec<serde_json::Value> = display_corners(a.width, height)
-        .iter()
-        .map(|&c| {
-            let r = model_point_normalised(eye, c, d2).length();
-            serde_json::json!({
-                "undistorted_radius": r,
-                "error_px": radial_error_px(f_px, [k1, 0.0, 0.0], [0.0; 3], r),
-            })
-        })
-        .collect();
-    let arcmin = 60.0 * 180.0 / std::f64::consts::PI;
-    serde_json::json!({
-        "ignoring_k1": {
-            "k1": k1,
-            "focal_px": f_px,
-            "formula": "f |k1| r³ at each corner's undistorted normalised radius r",
-            "corners_tl_tr_br_bl": corners,
-        },
-        "disparity_mismatch": {
-            "ipd_m": ipd,
-            "formula": "ipd (1/d1 − 1/(d1 + d2)), straight ahead",
-            "arcmin": disparity_mismatch(ipd, a.d1, a.d2) * arcmin,
-        },
-    })
 }

@@ -64,6 +64,19 @@ fn choice<T: ValueEnum>(key: &str, value: &str) -> PyResult<T> {
         })
 }
 
+/// A working distance: a number of metres in [1e-6, 1e6], inf (a float or "inf") or "auto".
+pub fn working_distance(key: &str, value: &Bound<'_, PyAny>) -> PyResult<WorkingDistance> {
+    match value.extract::<f64>() {
+        Ok(v) if v == f64::INFINITY => Ok(WorkingDistance::Infinity),
+        Ok(v) => real_in(key, v, MIN_POSITIVE, 1e6).map(WorkingDistance::Metres),
+        Err(_) => value
+            .extract::<String>()
+            .map_err(|_| bad_value(format!("{key}: a number, inf or auto is needed")))?
+            .parse()
+            .map_err(|e: String| bad_value(format!("{key}={e}"))),
+    }
+}
+
 /// The keywords `seethru.run` accepts, in `seethru run`'s order.
 pub const RUN_KEYS: [&str; 25] = [
     "method",
@@ -143,15 +156,7 @@ pub fn run_choices(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<RunChoices> {
             let side = || int(1, MAX_RESOLUTION as i64).map(|v| Some(v as u32));
             match key.as_str() {
                 "method" => options.method = choice(&key, &text()?)?,
-                "d2" => {
-                    options.d2 = match value.extract::<f64>() {
-                        Ok(v) if v == f64::INFINITY => WorkingDistance::Infinity,
-                        Ok(_) => WorkingDistance::Metres(real(MIN_POSITIVE, 1e6)?),
-                        Err(_) => text()?
-                            .parse()
-                            .map_err(|e: String| bad_value(format!("d2={e}")))?,
-                    }
-                }
+                "d2" => options.d2 = working_distance(&key, &value)?,
                 "head" => options.head = choice::<HeadSource>(&key, &text()?)?,
                 "head_bias_cm" => {
                     let v: [f64; 3] = value.extract().map_err(|_| {
@@ -325,6 +330,42 @@ impl<'py> Keywords<'py> {
                     .map_err(|_| bad_value(format!("{key}: an integer is needed")))?;
                 int_in(key, v, min, max)
             }
+        }
+    }
+
+    /// Whether `key` was given (and not None).
+    pub fn given(&self, key: &str) -> bool {
+        self.given.iter().any(|(k, v)| k == key && !v.is_none())
+    }
+
+    /// The value of `key`, any type, unless absent or None.
+    pub fn any(&mut self, key: &'static str) -> Option<Bound<'py, PyAny>> {
+        self.value(key)
+    }
+
+    /// A choice among a clap value enum's names, `default` when absent.
+    pub fn choice<T: ValueEnum>(&mut self, key: &'static str, default: T) -> PyResult<T> {
+        match self.string(key)? {
+            None => Ok(default),
+            Some(v) => choice(key, &v),
+        }
+    }
+
+    /// A switch (a command line flag without value): a bool, False when absent.
+    pub fn flag(&mut self, key: &'static str) -> PyResult<bool> {
+        match self.value(key) {
+            None => Ok(false),
+            Some(v) => v
+                .extract::<bool>()
+                .map_err(|_| bad_value(format!("{key}: True or False is needed"))),
+        }
+    }
+
+    /// An optional image side, pixels in [1, 16384].
+    pub fn side(&mut self, key: &'static str) -> PyResult<Option<u32>> {
+        match self.value(key) {
+            None => Ok(None),
+            Some(_) => Ok(Some(self.int(key, 1, 1, MAX_RESOLUTION as i64)? as u32)),
         }
     }
 

@@ -1,52 +1,76 @@
 //! `seethru.sequence`: a sequence (`seethru sequence`) as an iterator of measured frames, so
 //! that a Python predictor can supply, per display refresh, the eye the compensation uses.
 //!
-//! Each step does what `measure::sequence::run_sequence` does for one frame with whole
-//! driver views (`--frames exr`): the system's loop shows the refresh's image, the truth,
-//! `occluded` and `seethru` views are rendered at the frame's instant and measured with
-//! `run`'s metrics. The predictor, when given, is asked once per refresh, before the refresh
-//! is made; its eye replaces the system's (predicted) head estimate
-//! ([`SystemLoop::eye_given`]).
+//! The frames are the library's [`SequenceStepper`]'s, the stepper `seethru sequence` drives,
+//! with whole driver views (`--frames exr`). The keywords are `seethru sequence`'s flags that
+//! concern the simulated loop, in snake case, with the same ranges and the same refusals
+//! ([`sequence_reads`]). The predictor, when given, is asked once per refresh, before the
+//! refresh is made; its eye replaces the system's (predicted) head estimate
+//! ([`seethru::system::sequence::system_loop::SystemLoop::eye_given`]).
+
+use std::collections::VecDeque;
+use std::path::PathBuf;
 
 use glam::DVec3;
 use numpy::PyArray;
 use numpy::ndarray::Array2;
+use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use seethru::measure::metrics::measure;
-use seethru::measure::sequence::render_truth_and_occluded;
-use seethru::render::footprint::PixelRect;
+use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
+use seethru::measure::sequence::{FrameRecord, Measuring, SequenceStepper};
 use seethru::render::frame::Frame;
-use seethru::render::settings::{MAX_SPP, RenderSettings};
-use seethru::system::options::{Method, Outside, RunOptions, WorkingDistance};
-use seethru::system::sequence::head_motion::HeadMotion;
+use seethru::render::settings::MAX_SPP;
+use seethru::scene::Scene;
+use seethru::scene::head_path::HeadPath;
+use seethru::scene::source::MAX_RESOLUTION;
+use seethru::system::display::{DisplayModel, Filter};
+use seethru::system::memory::{DEFAULT_MAX_MEMORY_GIB, check_memory, sequence_estimate};
+use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
+use seethru::system::reads::{ReadWhen, hazard_bound_reads, sequence_reads};
+use seethru::system::sequence::head_motion::{HeadMotion, HeadPreset};
 use seethru::system::sequence::predict::Prediction;
-use seethru::system::sequence::system_loop::{SequenceOptions, SystemLoop};
+use seethru::system::sequence::system_loop::SequenceOptions;
 use seethru::system::sequence::timeline::Timeline;
+use seethru::util::number::short;
 
 use crate::errors::{bad_value, to_py};
 use crate::frame::PyFrame;
 use crate::interrupt::detached;
-use crate::options::{Keywords, choice_of};
+use crate::options::{Keywords, real_in, working_distance};
 use crate::run::json_to_py;
 use crate::scene::PyScene;
 
-/// A sequence being stepped through; iterating yields one [`PyStep`] per displayed frame.
+/// Longest latency, ms; most camera latencies in one sequence (as `seethru sequence`).
+const MAX_LATENCY_MS: f64 = 10_000.0;
+const MAX_LATENCIES: usize = 64;
+
+/// A sequence being stepped through; iterating yields one [`PyStep`] per displayed frame,
+/// the frames of every camera latency one after the other.
 #[pyclass(name = "Sequence", module = "seethru")]
 pub struct PySequence {
-    /// `None` once a step failed (the loop's state is then unknown).
-    system: Option<SystemLoop>,
+    /// The latency being stepped (ms) and its stepper; `None` once a step failed (the
+    /// loop's state is then unknown) or every latency is done.
+    current: Option<(f64, SequenceStepper)>,
+    /// The latencies still to run, ms, with their options.
+    pending: VecDeque<(f64, SequenceOptions)>,
+    scene: Scene,
+    how: Measuring,
+    hazard_bound_arcmin: f64,
     predictor: Option<Py<PyAny>>,
-    next: usize,
-    band: u32,
+    /// Frames in all, over every latency.
+    frames: usize,
     /// The last refresh made (the predictor is asked once per refresh).
     refresh: Option<i64>,
 }
 
-/// One displayed frame: its times, eyes, metrics and images.
+/// One displayed frame: its times, eyes, metrics and images (a row of frames.csv).
 #[pyclass(name = "Step", module = "seethru", frozen)]
 pub struct PyStep {
-    /// Displayed frame index, from 0.
+    /// The frontal capture to display latency of this frame's sequence, ms.
+    #[pyo3(get)]
+    latency_camera: f64,
+    /// Displayed frame index, from 0 (in its latency's sequence).
     #[pyo3(get)]
     frame: usize,
     /// When the frame is looked at, s.
@@ -70,9 +94,24 @@ pub struct PyStep {
     /// The eye the compensation used (the predictor's, or the system's), obstacle frame, m.
     #[pyo3(get)]
     eye_used: (f64, f64, f64),
+    /// The image-based head estimate's confidence in [0, 1]; None for another head source.
+    #[pyo3(get)]
+    head_confidence: Option<f64>,
+    /// The working distance the compensation used, m (d2 auto); None otherwise.
+    #[pyo3(get)]
+    d2_used: Option<f64>,
+    /// The vehicle's pivot, world, m; its yaw, degrees.
+    #[pyo3(get)]
+    vehicle_position: (f64, f64, f64),
+    #[pyo3(get)]
+    vehicle_yaw_deg: f64,
     /// The frame's metrics: `run`'s metrics.json content for this instant.
     #[pyo3(get)]
     metrics: Py<PyAny>,
+    /// Every `hazard = true` object's visibility, in scene order (frames.csv's hazard
+    /// columns), a list of dicts.
+    #[pyo3(get)]
+    hazards: Py<PyAny>,
     /// The truth and `seethru` views at `time` (whole driver views), Frames.
     #[pyo3(get)]
     truth: Py<PyFrame>,
@@ -86,7 +125,10 @@ pub struct PyStep {
 #[pymethods]
 impl PyStep {
     fn __repr__(&self) -> String {
-        format!("<seethru.Step frame {} t = {} s>", self.frame, self.time)
+        format!(
+            "<seethru.Step latency {} ms frame {} t = {} s>",
+            self.latency_camera, self.frame, self.time
+        )
     }
 }
 
@@ -94,32 +136,51 @@ fn triple(v: DVec3) -> (f64, f64, f64) {
     (v.x, v.y, v.z)
 }
 
+/// What one step hands back from the detached render.
+type Stepped = (FrameRecord, Frame, Frame, Vec<f32>, serde_json::Value);
+
 #[pymethods]
 impl PySequence {
     fn __iter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
         slf
     }
 
-    /// Frames displayed in all.
+    /// Frames displayed in all (over every camera latency).
     fn __len__(&self) -> usize {
-        self.system
-            .as_ref()
-            .map_or(0, |s| s.options.timeline.frames())
+        self.frames
     }
 
     fn __next__(&mut self, py: Python<'_>) -> PyResult<Option<PyStep>> {
-        let Some(system) = self.system.as_mut() else {
-            return Ok(None);
-        };
-        let k = self.next;
-        let tl = system.options.timeline;
-        if k >= tl.frames() {
-            return Ok(None);
+        loop {
+            match &self.current {
+                Some((_, stepper)) if stepper.next_frame().is_some() => break,
+                None if self.pending.is_empty() => return Ok(None),
+                _ => {}
+            }
+            // The next latency's sequence.
+            self.current = None;
+            let Some((ms, options)) = self.pending.pop_front() else {
+                return Ok(None);
+            };
+            let (scene, how, bound) = (self.scene.clone(), self.how, self.hazard_bound_arcmin);
+            let stepper = detached(py, move || {
+                SequenceStepper::new(&scene, options, how, bound)
+            })?
+            .map_err(|e| {
+                self.pending.clear();
+                to_py(e)
+            })?;
+            self.current = Some((ms, stepper));
+            self.refresh = None;
         }
-        let times = tl.times(k);
+        let (ms, mut stepper) = self.current.take().expect("checked above");
+        let k = stepper.next_frame().expect("checked above");
+        let system = &mut stepper.system;
+        let times = system.options.timeline.times(k);
         if self.refresh != Some(times.refresh) {
             if let Some(predictor) = &self.predictor {
                 let info = PyDict::new(py);
+                info.set_item("latency_camera", ms)?;
                 info.set_item("frame", k)?;
                 info.set_item("time", times.display)?;
                 info.set_item("refresh", times.refresh)?;
@@ -151,34 +212,43 @@ impl PySequence {
             }
             self.refresh = Some(times.refresh);
         }
-        let band = self.band;
-        let mut taken = self.system.take().expect("checked above");
-        let (taken, result) = detached(py, move || {
-            let result = step(&mut taken, k, band);
-            (taken, result)
+        let (stepper, result) = detached(py, move || {
+            let result = step(&mut stepper);
+            (stepper, result)
         })?;
-        let (shown_estimated, shown_used, truth, seethru, maps, json) = result.map_err(to_py)?;
-        let eye_true = taken.rig.eye_in_obstacle(times.display);
-        self.system = Some(taken);
-        self.next += 1;
-        let (w, h) = (maps.width as usize, maps.height as usize);
+        let (record, truth, seethru, misregistration, json) = match result {
+            Ok(stepped) => stepped,
+            Err(e) => {
+                self.pending.clear();
+                return Err(to_py(e));
+            }
+        };
+        let (w, h) = (truth.width as usize, truth.height as usize);
+        self.current = Some((ms, stepper));
         let misregistration = PyArray::from_owned_array(
             py,
-            Array2::from_shape_vec((h, w), maps.misregistration).expect("a map's size"),
+            Array2::from_shape_vec((h, w), misregistration).expect("a map's size"),
         )
         .into_any()
         .unbind();
+        let hazards = serde_json::to_value(&record.hazards).map_err(|e| to_py(e.into()))?;
         Ok(Some(PyStep {
+            latency_camera: ms,
             frame: k,
             time: times.display,
             refresh: times.refresh,
             refresh_time: times.refresh_time,
             capture_time: times.capture,
             head_time: times.head,
-            eye_true: triple(eye_true),
-            eye_estimated: triple(shown_estimated),
-            eye_used: triple(shown_used),
+            eye_true: triple(record.eye_true),
+            eye_estimated: triple(record.eye_estimated),
+            eye_used: triple(record.eye_used),
+            head_confidence: record.head_confidence,
+            d2_used: record.d2_used,
+            vehicle_position: triple(record.vehicle_position),
+            vehicle_yaw_deg: record.vehicle_yaw_deg,
             metrics: json_to_py(py, &json)?,
+            hazards: json_to_py(py, &hazards)?,
             truth: Py::new(py, PyFrame::new(py, "truth", truth))?,
             seethru: Py::new(py, PyFrame::new(py, "seethru", seethru))?,
             misregistration,
@@ -186,47 +256,85 @@ impl PySequence {
     }
 }
 
-type Stepped = (
-    DVec3,
-    DVec3,
-    Frame,
-    Frame,
-    seethru::measure::metrics::MetricMaps,
-    serde_json::Value,
-);
-
-/// Frame `k` made and measured as `run_sequence` does with whole driver views.
-fn step(system: &mut SystemLoop, k: usize, band: u32) -> anyhow::Result<Stepped> {
-    let times = system.options.timeline.times(k);
-    let shown = system.show(k)?.clone();
-    let ctx = system.context_at(times.display)?;
-    let settings = RenderSettings {
-        spp: system.options.run.spp,
-        progress: false,
-    };
-    let driver = ctx.scene.driver;
-    let mut truth = Frame::new(driver.width, driver.height);
-    let occluded = render_truth_and_occluded(&ctx, settings, PixelRect::full(&driver), &mut truth);
-    let mut seethru = truth.clone();
-    system.render_seethru(&ctx, &mut seethru);
-    // Missing pixels are those the frontal camera, where it was at capture, cannot see.
-    let mut measured = ctx.scene.clone();
-    measured.frontal = shown.frontal;
-    let (maps, json) = measure(
-        &ctx,
-        &measured,
-        driver.position(),
-        [&truth, &seethru, &occluded],
-        band,
-    );
+/// The stepper's next frame, its record, views, misregistration and metrics owned.
+fn step(stepper: &mut SequenceStepper) -> anyhow::Result<Stepped> {
+    let step = stepper.step()?.expect("a frame is left");
+    let images = step.images.expect("measured");
     Ok((
-        shown.eye_estimated,
-        shown.eye_used,
-        truth,
-        seethru,
-        maps,
-        json,
+        step.record.clone(),
+        images.truth.clone(),
+        images.seethru.clone(),
+        images.maps.misregistration.clone(),
+        images.metrics_json.clone(),
     ))
+}
+
+/// The keywords of [`sequence`], in `seethru sequence --help`'s order.
+pub const SEQUENCE_KEYS: [&str; 35] = [
+    "duration",
+    "fps",
+    "display_hz",
+    "speed",
+    "yaw_rate",
+    "head",
+    "head_path",
+    "sway_cm",
+    "sway_hz",
+    "lean_cm",
+    "lean_s",
+    "lean_at",
+    "latency_camera",
+    "latency_tracking",
+    "predict",
+    "reproject",
+    "method",
+    "d2",
+    "head_source",
+    "head_bias_cm",
+    "head_jitter_cm",
+    "seed",
+    "feature_width",
+    "require_confident_head",
+    "outside",
+    "filter",
+    "display",
+    "width",
+    "height",
+    "frontal_width",
+    "back_width",
+    "spp",
+    "band",
+    "hazard_bound_arcmin",
+    "max_memory",
+];
+
+/// `latency_camera`: ms in [0, 10000], one number or a list of up to 64, each once.
+fn latencies(k: &mut Keywords<'_>) -> PyResult<Vec<f64>> {
+    let range = || {
+        bad_value(format!(
+            "latency_camera must be milliseconds in [0, {MAX_LATENCY_MS}], one number or a list of up to {MAX_LATENCIES}"
+        ))
+    };
+    let Some(v) = k.any("latency_camera") else {
+        return Ok(vec![0.0]);
+    };
+    let values: Vec<f64> = match v.extract::<f64>() {
+        Ok(one) => vec![one],
+        Err(_) => v.extract().map_err(|_| range())?,
+    };
+    if values.is_empty() || values.len() > MAX_LATENCIES {
+        return Err(range());
+    }
+    for (i, &ms) in values.iter().enumerate() {
+        real_in("latency_camera", ms, 0.0, MAX_LATENCY_MS)?;
+        // As on the command line, where each latency has a folder named by its short value.
+        if let Some(first) = values[..i].iter().find(|&&m| short(m) == short(ms)) {
+            return Err(bad_value(format!(
+                "latencies {first} and {ms} ms are the same to 6 digits: give each once"
+            )));
+        }
+    }
+    Ok(values)
 }
 
 /// A sequence of `scene` with `seethru sequence`'s options (and defaults) as keywords; the
@@ -251,79 +359,177 @@ pub fn sequence(
     let display_hz = k.real("display_hz", fps, 1e-6, 1000.0)?;
     let speed = k.real("speed", 0.0, 0.0, 300.0)?;
     let yaw_rate = k.real("yaw_rate", 0.0, -180.0, 180.0)?;
+    let head: HeadPreset = k.choice("head", HeadPreset::Still)?;
+    let head_path = k.string("head_path")?.map(PathBuf::from);
+    if head_path.is_some() && k.given("head") {
+        return Err(bad_value(
+            "head_path cannot be used with head (a recorded path is the head's motion)",
+        ));
+    }
     let sway_cm = k.real("sway_cm", 3.0, 0.0, 50.0)?;
     let sway_hz = k.real("sway_hz", 0.5, 1e-6, 20.0)?;
     let lean_cm = k.real("lean_cm", 10.0, 0.0, 50.0)?;
     let lean_s = k.real("lean_s", 0.3, 1e-6, 10.0)?;
     let lean_at = k.real("lean_at", 0.5, 0.0, 3600.0)?;
-    let latency_camera = k.real("latency_camera", 0.0, 0.0, 1e4)?;
-    let latency_tracking = k.real("latency_tracking", 0.0, 0.0, 1e4)?;
-    let d2 = k.real_or_inf("d2", f64::INFINITY, 1e-6, 1e6)?;
-    let width = k.int("width", 640, 1, 16384)? as u32;
+    let latency_camera = latencies(&mut k)?;
+    let latency_tracking = k.real("latency_tracking", 0.0, 0.0, MAX_LATENCY_MS)?;
+    let predict: Prediction = k.choice("predict", Prediction::None)?;
+    let reproject = k.flag("reproject")?;
+    let method: Method = k.choice("method", Method::Planar)?;
+    let d2 = match k.any("d2") {
+        None => WorkingDistance::Infinity,
+        Some(v) => working_distance("d2", &v)?,
+    };
+    let head_source: HeadSource = k.choice("head_source", HeadSource::Oracle)?;
+    let head_bias_cm = k.head_bias_cm()?;
+    let head_jitter_cm = k.real("head_jitter_cm", 0.0, 0.0, 100.0)?;
+    let seed = k.int("seed", 1, 0, u32::MAX as i64)? as u32;
+    let feature_width = k.real("feature_width", 0.064, 1e-6, 1.0)?;
+    let require_confident_head = k.flag("require_confident_head")?;
+    let outside: Outside = k.choice("outside", Outside::Black)?;
+    let filter: Filter = k.choice("filter", Filter::Bilinear)?;
+    let display: DisplayModel = k.choice("display", DisplayModel::Pixels)?;
+    let side = MAX_RESOLUTION as i64;
+    let width = k.int("width", 640, 1, side)? as u32;
+    let height = k.side("height")?;
+    let frontal_width = k.side("frontal_width")?;
+    let back_width = k.side("back_width")?;
     let spp = k.int("spp", 1, 1, MAX_SPP as i64)? as u32;
     let band = k.int("band", 5, 1, 1000)? as u32;
-    let head = text(&mut k, "head", "still")?;
-    let method = text(&mut k, "method", "planar")?;
-    let outside = text(&mut k, "outside", "black")?;
+    let bound = k.real("hazard_bound_arcmin", DEFAULT_BOUND_ARCMIN, 1e-6, 10800.0)?;
+    let max_memory = k.real("max_memory", DEFAULT_MAX_MEMORY_GIB, 1e-6, 4096.0)?;
+    let given: Vec<String> = SEQUENCE_KEYS
+        .iter()
+        // A switch given False is absent, as a flag left off the command line.
+        .filter(|&&key| k.given(key) && (key != "reproject" || reproject))
+        .map(|key| key.to_string())
+        .collect();
     k.finish()?;
-    let head = match head.as_str() {
-        "still" => HeadMotion::Still,
-        "sway" => HeadMotion::Sway {
+    let run = RunOptions {
+        method,
+        d2,
+        head: head_source,
+        head_bias_cm,
+        head_jitter_cm,
+        require_confident_head,
+        seed,
+        feature_width,
+        width: Some(width),
+        height,
+        frontal_width: Some(frontal_width.unwrap_or(width)),
+        back_width,
+        spp,
+        outside,
+        filter,
+        display,
+        progress: false,
+        ..RunOptions::default()
+    };
+    // As `seethru sequence`: a setting the others make it ignore is refused.
+    let refuse = |rules: &[ReadWhen]| -> PyResult<()> {
+        let keyword = |r: &ReadWhen| r.flag.trim_start_matches("--").replace('-', "_");
+        match rules
+            .iter()
+            .find(|r| !r.read && given.contains(&keyword(r)))
+        {
+            Some(r) => Err(bad_value(r.keyword_refusal())),
+            None => Ok(()),
+        }
+    };
+    refuse(&sequence_reads(
+        &run,
+        head_path.is_none().then_some(head),
+        false,
+    ))?;
+    let head = match (&head_path, head) {
+        (Some(path), _) => {
+            let path = path.clone();
+            let loaded = py.detach(|| HeadPath::load(&path)).map_err(|e| {
+                // The file could not be read (absent, a folder, no permission): an OSError.
+                match std::fs::File::open(&path).is_err() || !path.is_file() {
+                    true => PyOSError::new_err(to_py(e).value(py).to_string()),
+                    false => to_py(e),
+                }
+            })?;
+            HeadMotion::Path(loaded)
+        }
+        (None, HeadPreset::Still) => HeadMotion::Still,
+        (None, HeadPreset::Sway) => HeadMotion::Sway {
             amplitude: sway_cm / 100.0,
             frequency: sway_hz,
         },
-        "lean" => HeadMotion::Lean {
+        (None, HeadPreset::Lean) => HeadMotion::Lean {
             distance: lean_cm / 100.0,
             duration: lean_s,
             start: lean_at,
         },
-        other => {
-            return Err(bad_value(format!(
-                "head={other:?} is not one of still, sway, lean"
-            )));
-        }
-    };
-    let run = RunOptions {
-        method: choice_of::<Method>("method", &method)?,
-        d2: match d2 {
-            f64::INFINITY => WorkingDistance::Infinity,
-            m => WorkingDistance::Metres(m),
-        },
-        width: Some(width),
-        frontal_width: Some(width),
-        spp,
-        outside: choice_of::<Outside>("outside", &outside)?,
-        ..RunOptions::default()
-    };
-    let options = SequenceOptions {
-        run,
-        timeline: Timeline {
-            duration,
-            fps,
-            display_hz,
-            latency_camera: latency_camera / 1e3,
-            latency_tracking: latency_tracking / 1e3,
-        },
-        speed: speed / 3.6,
-        yaw_rate: yaw_rate.to_radians(),
-        head,
-        predict: Prediction::None,
-        reproject: false,
-        byo: Default::default(),
     };
     let the_scene = scene.borrow().scene.clone();
-    let system = detached(py, move || SystemLoop::new(&the_scene, options))?.map_err(to_py)?;
-    Ok(PySequence {
-        system: Some(system),
-        predictor,
-        next: 0,
+    refuse(&[hazard_bound_reads(&the_scene)])?;
+    if let HeadMotion::Path(path) = &head {
+        path.check_in_world(&the_scene.obstacle.world_from_obstacle)
+            .map_err(to_py)?;
+    }
+    let all: VecDeque<(f64, SequenceOptions)> = latency_camera
+        .iter()
+        .map(|&ms| {
+            let options = SequenceOptions {
+                run: run.clone(),
+                timeline: Timeline {
+                    duration,
+                    fps,
+                    display_hz,
+                    latency_camera: ms / 1e3,
+                    latency_tracking: latency_tracking / 1e3,
+                },
+                speed: speed / 3.6,
+                yaw_rate: yaw_rate.to_radians(),
+                head: head.clone(),
+                predict,
+                reproject,
+                byo: Default::default(),
+            };
+            (ms, options)
+        })
+        .collect();
+    // Every latency's timeline is checked before anything is rendered.
+    for (_, o) in &all {
+        o.timeline.validate().map_err(to_py)?;
+    }
+    let first = &all[0].1;
+    let estimate = sequence_estimate(
+        &the_scene,
+        &first.run,
+        first.timeline.frames() as u64,
+        first.timeline.fps,
+        all.len() as u64,
+    )
+    .map_err(to_py)?;
+    check_memory(&estimate, max_memory).map_err(to_py)?;
+    let frames = all.iter().map(|(_, o)| o.timeline.frames()).sum();
+    let how = Measuring {
+        metrics: true,
+        full_frames: true,
         band,
+        progress: false,
+    };
+    let mut sequence = PySequence {
+        current: None,
+        pending: all,
+        scene: the_scene,
+        how,
+        hazard_bound_arcmin: bound,
+        predictor,
+        frames,
         refresh: None,
-    })
-}
-
-/// A string keyword with its default.
-fn text(k: &mut Keywords<'_>, key: &'static str, default: &str) -> PyResult<String> {
-    k.string(key)
-        .map(|v| v.unwrap_or_else(|| default.to_string()))
+    };
+    // The first latency's system is made now, so that its errors are raised here.
+    let (ms, options) = sequence.pending.pop_front().expect("one latency at least");
+    let scene = sequence.scene.clone();
+    let stepper = detached(py, move || {
+        SequenceStepper::new(&scene, options, how, bound)
+    })?
+    .map_err(to_py)?;
+    sequence.current = Some((ms, stepper));
+    Ok(sequence)
 }

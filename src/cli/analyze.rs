@@ -3,14 +3,11 @@
 
 use crate::cli::args::{metres_or_inf, pixels, positive, real};
 use anyhow::Result;
-use glam::DVec3;
-use seethru::analysis::binocular::{
-    disparity_mismatch, display_corners, model_point_normalised, radial_error_px,
-};
 use seethru::analysis::dynamic::{budget_text, error_budget};
 use seethru::analysis::examples::das_geometry;
 use seethru::paper::claims::{
-    AnalyzeParams, claims_table, evaluate, head_error_table, head_error_text, paper_claims,
+    AnalyzeParams, claims_table, evaluate, head_error_table, head_error_text, lens_and_eyes,
+    paper_claims,
 };
 
 #[derive(clap::Args)]
@@ -65,39 +62,6 @@ pub struct Analyze {
     ipd: f64,
 }
 
-/// The closed forms of analysis/binocular.rs at the parameters: the frontal pixel error of
-/// ignoring k1 at the crop's corners (frontal camera at the display centre, perpendicular),
-/// and the binocular disparity mismatch of the flat display.
-fn lens_and_eyes(a: &Analyze) -> serde_json::Value {
-    let f_px = a.frontal_px as f64 / (2.0 * a.theta_f.to_radians().tan());
-    let eye = DVec3::new(-a.b_h, 0.0, a.d1);
-    let d2 = a.d2.is_finite().then_some(a.d2);
-    let corners: Vec<serde_json::Value> = display_corners(a.width, a.height)
-        .iter()
-        .map(|&c| {
-            let r = model_point_normalised(eye, c, d2).length();
-            serde_json::json!({
-                "undistorted_radius": r,
-                "error_px": radial_error_px(f_px, [a.k1, 0.0, 0.0], [0.0; 3], r),
-            })
-        })
-        .collect();
-    let arcmin = 60.0 * 180.0 / std::f64::consts::PI;
-    serde_json::json!({
-        "ignoring_k1": {
-            "k1": a.k1,
-            "focal_px": f_px,
-            "formula": "f |k1| r³ at each corner's undistorted normalised radius r",
-            "corners_tl_tr_br_bl": corners,
-        },
-        "disparity_mismatch": {
-            "ipd_m": a.ipd,
-            "formula": "ipd (1/d1 − 1/(d1 + d2)), straight ahead",
-            "arcmin": disparity_mismatch(a.ipd, a.d1, a.d2) * arcmin,
-        },
-    })
-}
-
 impl Analyze {
     pub fn run(self) -> Result<()> {
         let params = AnalyzeParams {
@@ -114,7 +78,7 @@ impl Analyze {
             tolerance: self.tolerance,
         };
         params.validate().map_err(anyhow::Error::msg)?;
-        let lens_eyes = lens_and_eyes(&self);
+        let lens_eyes = lens_and_eyes(&params, self.height, self.k1, self.ipd);
         let claims = paper_claims();
         let values = evaluate(&params);
         let budget = error_budget(&das_geometry());

@@ -159,31 +159,12 @@ impl HeadErrorArgs {
         head: HeadSource,
         other_seed_reader: bool,
     ) -> Vec<ReadWhen> {
-        let eye = EYE_METHODS;
-        let estimated = head == HeadSource::Estimated;
-        vec![
-            ReadWhen {
-                flag: "--head-bias-cm",
-                read: eye_used,
-                when: eye,
-            },
-            ReadWhen {
-                flag: "--head-jitter-cm",
-                read: eye_used,
-                when: eye,
-            },
-            ReadWhen {
-                flag: "--feature-width",
-                read: eye_used && estimated,
-                when: "with an estimated head (face detection), not the oracle, and a method that compensates for the eye",
-            },
-            ReadWhen {
-                flag: "--seed",
-                read: (eye_used && (self.head_jitter_cm > 0.0 || head == HeadSource::Model))
-                    || other_seed_reader,
-                when: "with --head-jitter-cm > 0, the tracker model's head, a noisy depth sensor or the plane fit",
-            },
-        ]
+        seethru::system::reads::head_error_reads(
+            eye_used,
+            head,
+            self.head_jitter_cm > 0.0,
+            other_seed_reader,
+        )
     }
 }
 
@@ -245,19 +226,9 @@ impl<T: clap::ValueEnum + Clone + Send + Sync + 'static> clap::builder::TypedVal
     }
 }
 
-/// Where [`ReadWhen::when`] says a flag is read only by the methods that use the eye.
-pub const EYE_METHODS: &str = "by the methods that compensate for the eye (not --method none)";
-
-/// A flag that a command reads only under some of its settings, for [`refuse_ignored`].
-#[derive(Clone)]
-pub struct ReadWhen {
-    /// The flag as typed, `--ipd`.
-    pub flag: &'static str,
-    /// Whether the command, with the settings given, reads it.
-    pub read: bool,
-    /// The settings that read it, for the message: `with --eyes left, right or both`.
-    pub when: &'static str,
-}
+/// A flag read only under some of the other settings, for [`refuse_ignored`]; the rules are
+/// the library's, shared with the Python package.
+pub use seethru::system::reads::{EYE_METHODS, ReadWhen};
 
 /// Refuses a flag given on the command line that the command would ignore under the other
 /// settings given: the user's intent is not dropped without a word. One rule per flag that
@@ -268,11 +239,7 @@ pub fn refuse_ignored(rules: &[ReadWhen]) -> Result<()> {
         .iter()
         .find(|r| !r.read && crate::cli::given::given(r.flag))
     {
-        bail!(
-            "{} is read only {}; with the other flags given it would be ignored: remove it",
-            rule.flag,
-            rule.when
-        );
+        bail!("{}", rule.refusal(rule.flag, "flags"));
     }
     Ok(())
 }

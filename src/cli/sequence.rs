@@ -18,7 +18,8 @@ use seethru::scene::head_path::HeadPath;
 use seethru::system::display::{DisplayModel, Filter};
 use seethru::system::memory::{DEFAULT_MAX_MEMORY_GIB, check_memory, sequence_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
-use seethru::system::sequence::head_motion::HeadMotion;
+use seethru::system::reads::{hazard_bound_reads, sequence_reads};
+use seethru::system::sequence::head_motion::{HeadMotion, HeadPreset};
 use seethru::system::sequence::predict::Prediction;
 use seethru::system::sequence::system_loop::SequenceOptions;
 use seethru::system::sequence::timeline::Timeline;
@@ -26,8 +27,8 @@ use seethru::util::progress::summary as say;
 use serde_json::json;
 
 use crate::cli::args::{
-    EYE_METHODS, HeadErrorArgs, ReadWhen, band, choice, max_memory, pixels, positive, real,
-    refuse_ignored, samples, threads, with_threads,
+    HeadErrorArgs, ReadWhen, band, choice, max_memory, pixels, positive, real, refuse_ignored, samples,
+    threads, with_threads,
 };
 
 /// Longest latency, ms.
@@ -67,16 +68,6 @@ fn latency_list(text: &str) -> Result<Latencies, String> {
             }
             Ok(Latencies(values))
         })
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-enum HeadPreset {
-    /// The eye stays where the scene puts it.
-    Still,
-    /// Lateral sinusoid across the display (--sway-cm, --sway-hz).
-    Sway,
-    /// Towards the display centre to look around the pillar (--lean-cm, --lean-s, --lean-at).
-    Lean,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -287,77 +278,14 @@ impl Sequence {
 
     /// Refuses the flags these settings would ignore ([`refuse_ignored`]).
     fn refuse_ignored(&self) -> Result<()> {
-        let preset = |p: HeadPreset| self.head_path.is_none() && self.head == p;
-        let sway = "with --head sway (and no --head-path)";
-        let lean = "with --head lean (and no --head-path)";
-        let eye_used = self.method != Method::None;
-        let estimated = self.head_source == HeadSource::Estimated;
-        let mut rules = self.head_errors.rules(eye_used, self.head_source, false);
-        let eye = |flag| ReadWhen {
-            flag,
-            read: eye_used,
-            when: EYE_METHODS,
-        };
-        rules.extend([
-            eye("--head-source"),
-            eye("--predict"),
-            eye("--latency-tracking"),
-            ReadWhen {
-                flag: "--reproject",
-                read: self.method == Method::Planar,
-                when: "by --method planar (none shows the whole frontal image as captured)",
-            },
-            ReadWhen {
-                flag: "--back-width",
-                read: eye_used && estimated,
-                when: "with --head-source estimated (the back camera is rendered for the face detector only)",
-            },
-            ReadWhen {
-                flag: "--sway-cm",
-                read: preset(HeadPreset::Sway),
-                when: sway,
-            },
-            ReadWhen {
-                flag: "--sway-hz",
-                read: preset(HeadPreset::Sway),
-                when: sway,
-            },
-            ReadWhen {
-                flag: "--lean-cm",
-                read: preset(HeadPreset::Lean),
-                when: lean,
-            },
-            ReadWhen {
-                flag: "--lean-s",
-                read: preset(HeadPreset::Lean),
-                when: lean,
-            },
-            ReadWhen {
-                flag: "--lean-at",
-                read: preset(HeadPreset::Lean),
-                when: lean,
-            },
-            ReadWhen {
-                flag: "--d2",
-                read: self.method == Method::Planar && self.maps.is_none(),
-                when: "by --method planar without --maps",
-            },
-            ReadWhen {
-                flag: "--method",
-                read: self.maps.is_none(),
-                when: "without --maps (the maps are the method)",
-            },
-            ReadWhen {
-                flag: "--display",
-                read: self.maps.is_none(),
-                when: "without --maps (a map is shown on the display's pixels)",
-            },
-            ReadWhen {
-                flag: "--exr",
-                read: self.capture.is_some() || self.frames == FramesFormat::Exr,
-                when: "with --capture or --frames exr (nothing else is written as EXR)",
-            },
-        ]);
+        let preset = self.head_path.is_none().then_some(self.head);
+        let run = self.options(&HeadMotion::Still, 0.0).run;
+        let mut rules = sequence_reads(&run, preset, self.maps.is_some());
+        rules.push(ReadWhen {
+            flag: "--exr",
+            read: self.capture.is_some() || self.frames == FramesFormat::Exr,
+            when: "with --capture or --frames exr (nothing else is written as EXR)",
+        });
         refuse_ignored(&rules)?;
         if self.frames == FramesFormat::Exr && self.exr == ExrContent::None {
             bail!(
@@ -371,11 +299,7 @@ impl Sequence {
         self.refuse_ignored()?;
         let head = self.head_motion()?;
         let scene = Scene::load(&self.scene)?;
-        refuse_ignored(&[ReadWhen {
-            flag: "--hazard-bound-arcmin",
-            read: scene.objects.iter().any(|o| o.hazard),
-            when: "for a scene with an object marked `hazard = true`",
-        }])?;
+        refuse_ignored(&[hazard_bound_reads(&scene)])?;
         if let HeadMotion::Path(path) = &head {
             path.check_in_world(&scene.obstacle.world_from_obstacle)?;
         }

@@ -110,6 +110,8 @@ pub struct FrameImages<'a> {
     pub truth: &'a Frame,
     pub seethru: &'a Frame,
     pub maps: &'a MetricMaps,
+    /// The frame's metrics: `run`'s metrics.json content for this instant.
+    pub metrics_json: &'a serde_json::Value,
     /// The driver-view pixels rendered for every frame (the display's neighbourhood over the
     /// whole sequence), where previews are cut.
     pub window: PixelRect,
@@ -214,31 +216,120 @@ pub fn run_sequence_hazards(
     label: &str,
     on_frame: &mut dyn FnMut(FrameImages) -> Result<()>,
 ) -> Result<SequenceRun> {
-    let start = Instant::now();
-    let mut system = SystemLoop::new(scene, options)?;
-    let tl = system.options.timeline;
-    let settings = RenderSettings {
-        spp: system.options.run.spp,
-        progress: false,
-    };
-    let window = window(&system);
-    let camera = system.rig.base.driver;
-    // A captured frame's truth is the whole view, as `seethru capture`'s.
-    let region = if how.full_frames || system.options.byo.capture {
-        PixelRect::full(&camera)
-    } else {
-        window
-    };
-    let mut truth = Frame::new(camera.width, camera.height);
-    let mut seethru = truth.clone();
-    let (mut truth_seconds, mut metrics_seconds) = (0.0, 0.0);
-    let mut refreshes = std::collections::BTreeSet::new();
-    let mut records = Vec::with_capacity(tl.frames());
-    let progress = Progress::new(label, tl.frames(), how.progress);
-    for k in 0..tl.frames() {
-        let times = tl.times(k);
+    let mut stepper = SequenceStepper::new(scene, options, how, hazard_bound_arcmin)?;
+    let progress = Progress::new(label, stepper.frames(), how.progress);
+    while let Some(step) = stepper.step()? {
+        if let Some(images) = step.images {
+            on_frame(images)?;
+        }
+        progress.advance(1);
+    }
+    progress.finish();
+    Ok(stepper.finish())
+}
+
+/// A sequence made and measured one displayed frame at a time ([`SequenceStepper::step`]):
+/// what [`run_sequence`] drives for the command line, and the Python package's iterator,
+/// which may give the system the eye to compensate for before each refresh
+/// ([`SystemLoop::eye_given`] of [`SequenceStepper::system`]).
+pub struct SequenceStepper {
+    /// The system's loop; its timeline and rig tell the next frame's times and eyes.
+    pub system: SystemLoop,
+    /// The scene's hazard objects are scored from it.
+    scene: Scene,
+    how: Measuring,
+    hazard_bound_arcmin: f64,
+    settings: RenderSettings,
+    window: PixelRect,
+    /// The driver-view pixels rendered for the truth: the window, or the whole view.
+    region: PixelRect,
+    truth: Frame,
+    seethru: Frame,
+    maps: Option<MetricMaps>,
+    metrics_json: serde_json::Value,
+    records: Vec<FrameRecord>,
+    refreshes: std::collections::BTreeSet<i64>,
+    truth_seconds: f64,
+    metrics_seconds: f64,
+    start: Instant,
+}
+
+/// One frame from [`SequenceStepper::step`].
+pub struct FrameStep<'a> {
+    pub record: &'a FrameRecord,
+    /// The frame's images and maps (`None` when the sequence runs without truth and metrics).
+    pub images: Option<FrameImages<'a>>,
+}
+
+impl SequenceStepper {
+    /// The system's loop for `options` on `scene`, nothing rendered yet.
+    pub fn new(
+        scene: &Scene,
+        options: SequenceOptions,
+        how: Measuring,
+        hazard_bound_arcmin: f64,
+    ) -> Result<SequenceStepper> {
+        let start = Instant::now();
+        let system = SystemLoop::new(scene, options)?;
+        let settings = RenderSettings {
+            spp: system.options.run.spp,
+            progress: false,
+        };
+        let window = window(&system);
+        let camera = system.rig.base.driver;
+        // A captured frame's truth is the whole view, as `seethru capture`'s.
+        let region = if how.full_frames || system.options.byo.capture {
+            PixelRect::full(&camera)
+        } else {
+            window
+        };
+        let truth = Frame::new(camera.width, camera.height);
+        let frames = system.options.timeline.frames();
+        Ok(SequenceStepper {
+            seethru: truth.clone(),
+            truth,
+            system,
+            scene: scene.clone(),
+            how,
+            hazard_bound_arcmin,
+            settings,
+            window,
+            region,
+            maps: None,
+            metrics_json: serde_json::Value::Null,
+            records: Vec::with_capacity(frames),
+            refreshes: Default::default(),
+            truth_seconds: 0.0,
+            metrics_seconds: 0.0,
+            start,
+        })
+    }
+
+    /// Frames displayed in all.
+    pub fn frames(&self) -> usize {
+        self.system.options.timeline.frames()
+    }
+
+    /// The index of the frame the next [`SequenceStepper::step`] makes, `None` after the last.
+    pub fn next_frame(&self) -> Option<usize> {
+        let k = self.records.len();
+        (k < self.frames()).then_some(k)
+    }
+
+    /// The frames made so far.
+    pub fn records(&self) -> &[FrameRecord] {
+        &self.records
+    }
+
+    /// Makes and measures the next displayed frame; `None` after the last.
+    pub fn step(&mut self) -> Result<Option<FrameStep<'_>>> {
+        let Some(k) = self.next_frame() else {
+            return Ok(None);
+        };
+        let system = &mut self.system;
+        let times = system.options.timeline.times(k);
         let shown = system.show(k)?.clone();
-        refreshes.insert(shown.times.refresh);
+        self.refreshes.insert(shown.times.refresh);
         let ctx = system.context_at(times.display)?;
         let rig = system.rig.world_from_rig(times.display);
         let mut record = FrameRecord {
@@ -257,41 +348,44 @@ pub fn run_sequence_hazards(
             metrics: None,
             hazards: Vec::new(),
         };
-        if !how.metrics {
-            system.render_seethru(&ctx, &mut seethru);
-            records.push(record);
-            progress.advance(1);
-            continue;
+        if !self.how.metrics {
+            system.render_seethru(&ctx, &mut self.seethru);
+            self.records.push(record);
+            return Ok(Some(FrameStep {
+                record: self.records.last().expect("just pushed"),
+                images: None,
+            }));
         }
         let t0 = Instant::now();
         let driver = ctx.scene.driver;
-        let occluded = render_truth_and_occluded(&ctx, settings, region, &mut truth);
-        truth_seconds += t0.elapsed().as_secs_f64();
-        seethru.clone_from(&truth);
-        system.render_seethru(&ctx, &mut seethru);
+        let occluded = render_truth_and_occluded(&ctx, self.settings, self.region, &mut self.truth);
+        self.truth_seconds += t0.elapsed().as_secs_f64();
+        self.seethru.clone_from(&self.truth);
+        system.render_seethru(&ctx, &mut self.seethru);
         let t1 = Instant::now();
         // Missing pixels are those the frontal camera, where it was at capture, cannot see.
         let mut measured = ctx.scene.clone();
         measured.frontal = shown.frontal;
+        let (truth, seethru) = (&self.truth, &self.seethru);
         let (maps, json) = measure(
             &ctx,
             &measured,
             driver.position(),
-            [&truth, &seethru, &occluded],
-            how.band,
+            [truth, seethru, &occluded],
+            self.how.band,
         );
         let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
             .atan()
             .to_degrees()
             * 60.0;
         record.hazards = hazard_seen(
-            scene,
-            [&truth, &seethru, &occluded],
+            &self.scene,
+            [truth, seethru, &occluded],
             &maps,
-            hazard_bound_arcmin,
+            self.hazard_bound_arcmin,
             arcmin_per_px,
         );
-        metrics_seconds += t1.elapsed().as_secs_f64();
+        self.metrics_seconds += t1.elapsed().as_secs_f64();
         record.metrics = Some(FrameMetrics::from_json(&json));
         let capture = system.take_inputs().map(|i| Capture {
             frontal: i.frontal,
@@ -311,27 +405,37 @@ pub fn run_sequence_hazards(
                 }),
             },
         });
-        records.push(record);
-        on_frame(FrameImages {
-            record: records.last().expect("just pushed"),
-            truth: &truth,
-            seethru: &seethru,
-            maps: &maps,
-            window,
-            capture,
-        })?;
-        progress.advance(1);
+        self.records.push(record);
+        self.maps = Some(maps);
+        self.metrics_json = json;
+        let record = self.records.last().expect("just pushed");
+        Ok(Some(FrameStep {
+            record,
+            images: Some(FrameImages {
+                record,
+                truth: &self.truth,
+                seethru: &self.seethru,
+                maps: self.maps.as_ref().expect("just set"),
+                metrics_json: &self.metrics_json,
+                window: self.window,
+                capture,
+            }),
+        }))
     }
-    progress.finish();
-    Ok(SequenceRun {
-        records,
-        system: system.seconds,
-        truth_seconds,
-        metrics_seconds,
-        total_seconds: start.elapsed().as_secs_f64(),
-        window,
-        frontal_pixels_per_refresh: system.frontal_pixels as f64 / refreshes.len().max(1) as f64,
-    })
+
+    /// What the sequence produced besides its frames, once every frame is made.
+    pub fn finish(self) -> SequenceRun {
+        let refreshes = self.refreshes.len().max(1);
+        SequenceRun {
+            records: self.records,
+            system: self.system.seconds,
+            truth_seconds: self.truth_seconds,
+            metrics_seconds: self.metrics_seconds,
+            total_seconds: self.start.elapsed().as_secs_f64(),
+            window: self.window,
+            frontal_pixels_per_refresh: self.system.frontal_pixels as f64 / refreshes as f64,
+        }
+    }
 }
 
 /// Renders the driver's truth view into `truth` within `region`, and returns the occluded view:

@@ -438,3 +438,40 @@ pub fn claims_table(claims: &[Claim]) -> String {
     }
     out
 }
+
+/// The closed forms of analysis/binocular.rs at `p` (`seethru analyze`'s `lens_and_eyes`):
+/// the frontal pixel error of ignoring the lens's k1 at the crop's corners (frontal camera
+/// at the display centre, perpendicular; display `height_m` tall) and the flat display's
+/// binocular disparity mismatch for eyes `ipd_m` apart.
+pub fn lens_and_eyes(p: &AnalyzeParams, height_m: f64, k1: f64, ipd_m: f64) -> serde_json::Value {
+    use crate::analysis::binocular::{
+        disparity_mismatch, display_corners, model_point_normalised, radial_error_px,
+    };
+    let f_px = p.frontal_px as f64 / (2.0 * p.theta_f_deg.to_radians().tan());
+    let eye = glam::DVec3::new(-p.b_h, 0.0, p.d1);
+    let d2 = p.d2.is_finite().then_some(p.d2);
+    let corners: Vec<serde_json::Value> = display_corners(p.width, height_m)
+        .iter()
+        .map(|&c| {
+            let r = model_point_normalised(eye, c, d2).length();
+            json!({
+                "undistorted_radius": r,
+                "error_px": radial_error_px(f_px, [k1, 0.0, 0.0], [0.0; 3], r),
+            })
+        })
+        .collect();
+    let arcmin = 60.0 * 180.0 / std::f64::consts::PI;
+    json!({
+        "ignoring_k1": {
+            "k1": k1,
+            "focal_px": f_px,
+            "formula": "f |k1| r³ at each corner's undistorted normalised radius r",
+            "corners_tl_tr_br_bl": corners,
+        },
+        "disparity_mismatch": {
+            "ipd_m": ipd_m,
+            "formula": "ipd (1/d1 − 1/(d1 + d2)), straight ahead",
+            "arcmin": disparity_mismatch(ipd_m, p.d1, p.d2) * arcmin,
+        },
+    })
+}

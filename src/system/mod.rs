@@ -15,6 +15,7 @@ pub mod memory;
 pub mod obstruction;
 pub mod options;
 pub mod pipeline;
+pub mod reads;
 pub mod report;
 pub mod scene_model;
 pub mod scene_model_options;

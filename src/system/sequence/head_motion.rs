@@ -5,6 +5,17 @@ use glam::DVec3;
 
 use crate::scene::head_path::HeadPath;
 
+/// `--head`: a head motion preset (a recorded path is `--head-path`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum HeadPreset {
+    /// The eye stays where the scene puts it.
+    Still,
+    /// Lateral sinusoid across the display (--sway-cm, --sway-hz).
+    Sway,
+    /// Towards the display centre to look around the pillar (--lean-cm, --lean-s, --lean-at).
+    Lean,
+}
+
 /// The eye's motion in the obstacle frame (at the rig's t = 0 pose), metres and seconds.
 #[derive(Clone, Debug, PartialEq)]
 pub enum HeadMotion {

@@ -1,0 +1,181 @@
+//! Settings read only under others: a run or a sequence refuses a setting it would ignore,
+//! so the user's intent is not dropped without a word. The rules are the library's, so the
+//! command line (`--sway-cm`) and the Python package (`sway_cm`) refuse the same settings
+//! with the same words.
+
+use crate::scene::Scene;
+use crate::system::options::{HeadSource, Method, RunOptions};
+use crate::system::sequence::head_motion::HeadPreset;
+
+/// Where [`ReadWhen::when`] says a setting is read only by the methods that use the eye.
+pub const EYE_METHODS: &str = "by the methods that compensate for the eye (not --method none)";
+
+/// A setting that a command reads only under some of its other settings.
+#[derive(Clone, Debug)]
+pub struct ReadWhen {
+    /// The flag as typed, `--ipd`.
+    pub flag: &'static str,
+    /// Whether the command, with the settings given, reads it.
+    pub read: bool,
+    /// The settings that read it, for the message: `with --eyes left, right or both`.
+    pub when: &'static str,
+}
+
+/// `--sway-cm` → `sway_cm`, and so every flag in a text (Python's keyword names).
+pub fn keyword_names(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find("--") {
+        out.push_str(&rest[..at]);
+        let name = &rest[at + 2..];
+        let end = name
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
+            .unwrap_or(name.len());
+        out.push_str(&name[..end].replace('-', "_"));
+        rest = &name[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
+impl ReadWhen {
+    /// The refusal of this setting when given: `others` names the rest (`flags`, `options`).
+    pub fn refusal(&self, name: &str, others: &str) -> String {
+        format!(
+            "{name} is read only {}; with the other {others} given it would be ignored: remove it",
+            self.when
+        )
+    }
+
+    /// The refusal in Python's words: keyword names for flags, `options` for the rest.
+    pub fn keyword_refusal(&self) -> String {
+        keyword_names(&self.refusal(self.flag, "options"))
+    }
+}
+
+/// The head-tracking errors' rules, shared by `run` and `sequence`: none is read where the
+/// method uses no eye (`eye_used` false: `--method none`); the feature width is the
+/// detector's, read with `head` estimated only; the seed is read by a jitter (`jitter`), the
+/// tracker model (`head` model: its noise and dropouts), or where `other_seed_reader` (a noisy
+/// depth sensor, the plane fit) says so.
+pub fn head_error_reads(
+    eye_used: bool,
+    head: HeadSource,
+    jitter: bool,
+    other_seed_reader: bool,
+) -> Vec<ReadWhen> {
+    let eye = EYE_METHODS;
+    vec![
+        ReadWhen {
+            flag: "--head-bias-cm",
+            read: eye_used,
+            when: eye,
+        },
+        ReadWhen {
+            flag: "--head-jitter-cm",
+            read: eye_used,
+            when: eye,
+        },
+        ReadWhen {
+            flag: "--feature-width",
+            read: eye_used && head == HeadSource::Estimated,
+            when: "with an estimated head (face detection), not the oracle, and a method that compensates for the eye",
+        },
+        ReadWhen {
+            flag: "--seed",
+            read: (eye_used && (jitter || head == HeadSource::Model)) || other_seed_reader,
+            when: "with --head-jitter-cm > 0, the tracker model's head, a noisy depth sensor or the plane fit",
+        },
+    ]
+}
+
+/// A sequence's rules, in the order they are checked: `run` holds its pipeline's options,
+/// `head` the head motion preset (`None`: a recorded head path), `maps` whether an outside
+/// method's maps are shown.
+pub fn sequence_reads(run: &RunOptions, head: Option<HeadPreset>, maps: bool) -> Vec<ReadWhen> {
+    let preset = |p: HeadPreset| head == Some(p);
+    let sway = "with --head sway (and no --head-path)";
+    let lean = "with --head lean (and no --head-path)";
+    let eye_used = run.method != Method::None;
+    let estimated = run.head == HeadSource::Estimated;
+    let mut rules = head_error_reads(eye_used, run.head, run.head_jitter_cm > 0.0, false);
+    let eye = |flag| ReadWhen {
+        flag,
+        read: eye_used,
+        when: EYE_METHODS,
+    };
+    let with = |flag, read, when| ReadWhen { flag, read, when };
+    rules.extend([
+        eye("--head-source"),
+        eye("--predict"),
+        eye("--latency-tracking"),
+        with(
+            "--reproject",
+            run.method == Method::Planar,
+            "by --method planar (none shows the whole frontal image as captured)",
+        ),
+        with(
+            "--back-width",
+            eye_used && estimated,
+            "with --head-source estimated (the back camera is rendered for the face detector only)",
+        ),
+        with("--sway-cm", preset(HeadPreset::Sway), sway),
+        with("--sway-hz", preset(HeadPreset::Sway), sway),
+        with("--lean-cm", preset(HeadPreset::Lean), lean),
+        with("--lean-s", preset(HeadPreset::Lean), lean),
+        with("--lean-at", preset(HeadPreset::Lean), lean),
+        with(
+            "--d2",
+            run.method == Method::Planar && !maps,
+            "by --method planar without --maps",
+        ),
+        with(
+            "--method",
+            !maps,
+            "without --maps (the maps are the method)",
+        ),
+        with(
+            "--display",
+            !maps,
+            "without --maps (a map is shown on the display's pixels)",
+        ),
+    ]);
+    rules
+}
+
+/// `--hazard-bound-arcmin`'s rule: read for a scene with hazard objects only.
+pub fn hazard_bound_reads(scene: &Scene) -> ReadWhen {
+    ReadWhen {
+        flag: "--hazard-bound-arcmin",
+        read: scene.objects.iter().any(|o| o.hazard),
+        when: "for a scene with an object marked `hazard = true`",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flags_become_keyword_names() {
+        assert_eq!(
+            keyword_names("--sway-cm is read only with --head sway (and no --head-path)"),
+            "sway_cm is read only with head sway (and no head_path)"
+        );
+    }
+
+    #[test]
+    fn the_sway_settings_are_read_with_sway_only() {
+        let run = RunOptions::default();
+        let read = |head| {
+            sequence_reads(&run, head, false)
+                .into_iter()
+                .find(|r| r.flag == "--sway-hz")
+                .unwrap()
+                .read
+        };
+        assert!(read(Some(HeadPreset::Sway)));
+        assert!(!read(Some(HeadPreset::Lean)));
+        assert!(!read(None));
+    }
+}
