@@ -277,11 +277,12 @@ fn bad_eyellipse_keys_are_one_error_naming_file_line_key_and_range() {
     // Without [eyellipse] and without a position, the driver's eye is missing.
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let path = root.join("scenes/cabin.toml");
-    let start = text.find("[eyellipse]").unwrap();
-    let end = start + text[start..].find("\n\n").unwrap();
+    let start = text.find("\n[eyellipse]\n").unwrap();
+    let end = start + 1 + text[start + 1..].find("\n\n").unwrap();
     let edited = format!("{}{}", &text[..start], &text[end..]);
-    let err = Scene::from_source(&SourceFile::from_text(&path, edited))
-        .unwrap_err()
-        .to_string();
+    let Err(err) = Scene::from_source(&SourceFile::from_text(&path, edited)) else {
+        panic!("a cabin without [eyellipse] and without an eye position was read");
+    };
+    let err = err.to_string();
     assert!(err.contains("camera.driver.position"), "{err}");
 }
