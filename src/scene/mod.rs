@@ -21,6 +21,7 @@ pub mod procedural;
 pub mod read;
 pub mod shapes;
 pub mod source;
+pub mod surface_grid;
 pub mod table_reader;
 pub mod texture;
 pub mod world;
