@@ -76,11 +76,11 @@ fn check(s: &CurvedSurface, rng: &mut Lcg, rays: usize) -> usize {
         hits += 1;
         // The renderer hands the point over in f32.
         let p = p.as_vec3().as_dvec3();
-        assert_eq!(s.uv_at_point(p), s.uv_at_point_brute(p), "hit {p}");
-        assert!(
-            s.uv_at_point(p).is_some(),
-            "a hit on the surface has a UV: {p}"
-        );
+        // The grid answers every hit itself (no fallback to the scan), with the scan's UV.
+        let brute = s.uv_at_point_brute(p);
+        assert!(brute.is_some(), "a hit on the surface has a UV: {p}");
+        assert_eq!(s.uv_at_point_by_grid(p), brute, "hit {p}");
+        assert_eq!(s.uv_at_point(p), brute, "hit {p}");
         // Off the surface by up to 5 cm along z, and beyond the bounds.
         let off = p + DVec3::new(0.0, 0.0, 0.1 * (rng.next() - 0.5));
         assert_eq!(s.uv_at_point(off), s.uv_at_point_brute(off), "off {off}");

@@ -200,13 +200,17 @@ impl CurvedSurface {
     /// more than the grid's margin from the point, so it cannot beat one found within half
     /// of it; otherwise (a point off the surface) the brute force answers.
     pub fn uv_at_point(&self, p: DVec3) -> Option<DVec2> {
-        if let Some(cell) = self.point_grid.candidates(p) {
-            let best = nearest(cell.iter().map(|&i| &self.tris[i as usize]), p);
-            if best.is_some_and(|(d, _)| d <= self.point_grid.margin / 2.0) {
-                return best.map(|(_, uv)| uv.clamp(DVec2::ZERO, DVec2::ONE));
-            }
-        }
-        self.uv_at_point_brute(p)
+        self.uv_at_point_by_grid(p)
+            .or_else(|| self.uv_at_point_brute(p))
+    }
+
+    /// The grid's answer to [`CurvedSurface::uv_at_point`], where it can vouch for it (the
+    /// nearest triangle of the point's cell within half the grid's margin); `None` otherwise.
+    pub fn uv_at_point_by_grid(&self, p: DVec3) -> Option<DVec2> {
+        let cell = self.point_grid.candidates(p)?;
+        let best = nearest(cell.iter().map(|&i| &self.tris[i as usize]), p);
+        best.filter(|(d, _)| *d <= self.point_grid.margin / 2.0)
+            .map(|(_, uv)| uv.clamp(DVec2::ZERO, DVec2::ONE))
     }
 
     /// [`CurvedSurface::uv_at_point`] by a scan over every triangle: its brute-force twin.
