@@ -67,6 +67,9 @@ impl Share {
     }
 }
 
+/// One combination of the other parameters' values and its drivers' mean and p95.
+type Group = (Vec<(String, String)>, Vec<f64>, Vec<f64>);
+
 /// For each combination of the parameters other than `eye` (one group when there are none):
 /// the shares of drivers whose display mean and p95 misregistration are at most
 /// `bound_arcmin`. `rows` are the sweep CSV's data lines; `seed` and `samples` are stated in
@@ -78,7 +81,8 @@ pub fn driver_shares(
 ) -> Option<Value> {
     let eye = params.iter().position(|p| p.name == "eye")?;
     let mean_column = 1 + params.len();
-    let mut groups: Vec<(Vec<(String, String)>, Vec<f64>, Vec<f64>)> = Vec::new();
+    // (the other parameters' values, each driver's mean, each driver's p95)
+    let mut groups: Vec<Group> = Vec::new();
     for (_, line) in rows {
         let fields = decode(line);
         let config: Vec<(String, String)> = params
