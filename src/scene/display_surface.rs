@@ -117,7 +117,10 @@ impl CurvedSurface {
             .map(DVec3::length)
             .fold(0.0, f64::max);
         let margin = 5.0 * BARYCENTRIC_SLACK * longest + 1e-9;
-        let point_grid = crate::scene::surface_grid::SurfaceGrid::new(&tris, margin);
+        let point_grid = crate::scene::surface_grid::SurfaceGrid::new(
+            &tris.iter().map(|t| t.p).collect::<Vec<_>>(),
+            margin,
+        );
         Ok(CurvedSurface {
             source,
             tris,

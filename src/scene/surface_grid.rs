@@ -6,8 +6,6 @@
 
 use glam::DVec3;
 
-use crate::scene::display_surface::UvTri;
-
 /// Most cells along one axis.
 const MAX_CELLS_PER_AXIS: usize = 128;
 
@@ -29,8 +27,9 @@ impl SurfaceGrid {
     /// `margin` must exceed twice the slack of the lookup's barycentric test (how far outside a
     /// triangle a point may project and still be taken as on it), so that a triangle the grid
     /// leaves out of a point's cell can never be nearer than `margin / 2`.
-    pub fn new(tris: &[UvTri], margin: f64) -> SurfaceGrid {
-        let (lo, hi) = tris.iter().flat_map(|t| t.p).fold(
+    /// `tris` are the triangles' corners, obstacle frame, metres.
+    pub fn new(tris: &[[DVec3; 3]], margin: f64) -> SurfaceGrid {
+        let (lo, hi) = tris.iter().flatten().copied().fold(
             (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
             |(lo, hi), p| (lo.min(p), hi.max(p)),
         );
@@ -51,8 +50,8 @@ impl SurfaceGrid {
             margin,
         };
         for (i, t) in tris.iter().enumerate() {
-            let tlo = t.p[0].min(t.p[1]).min(t.p[2]) - DVec3::splat(margin);
-            let thi = t.p[0].max(t.p[1]).max(t.p[2]) + DVec3::splat(margin);
+            let tlo = t[0].min(t[1]).min(t[2]) - DVec3::splat(margin);
+            let thi = t[0].max(t[1]).max(t[2]) + DVec3::splat(margin);
             let (a, b) = (grid.clamped_cell(tlo), grid.clamped_cell(thi));
             for z in a[2]..=b[2] {
                 for y in a[1]..=b[1] {
