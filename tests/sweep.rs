@@ -238,6 +238,7 @@ fn sweeps_write_every_row_and_resume() {
         head: HeadSource::Oracle,
         band: 3,
         shard: None,
+        bound_arcmin: 1.0,
     };
     let scene = common::repo_path("scenes/das.toml");
     assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 4);
@@ -345,6 +346,7 @@ fn rows_that_share_an_eye_or_a_world_equal_rows_computed_alone() {
         head: HeadSource::Oracle,
         band: 2,
         shard: None,
+        bound_arcmin: 1.0,
     };
     let scene = common::repo_path("scenes/das.toml");
     assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 8);

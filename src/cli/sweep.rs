@@ -3,14 +3,19 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use seethru::measure::sweep::{SweepOptions, merge_parts, sweep};
-use seethru::measure::sweep_grid::parse_param;
+use seethru::measure::sweep::{
+    DEFAULT_BOUND_ARCMIN, SweepOptions, merge_parts_with_bound, samples_drivers, sweep,
+};
+use seethru::measure::sweep_grid::{EYELLIPSE, MAX_VALUES, eyellipse_param, parse_param};
 use seethru::measure::sweep_shard::Shard;
 use seethru::scene::Scene;
 use seethru::system::memory::{DEFAULT_MAX_MEMORY_GIB, MemoryEstimate, check_memory, run_estimate};
 use seethru::system::options::{HeadSource, RunOptions};
 
-use crate::cli::args::{band, choice, max_memory, pixels, samples, threads, with_threads};
+use crate::cli::args::{
+    ReadWhen, band, choice, integer, max_memory, pixels, positive, refuse_ignored, samples,
+    threads, with_threads,
+};
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -46,6 +51,18 @@ pub struct Sweep {
     /// exceeds this, GiB in [1e-6, 4096].
     #[arg(long = "max-memory", value_name = "GIB", default_value_t = DEFAULT_MAX_MEMORY_GIB, value_parser = max_memory)]
     max_memory: f64,
+    /// With --param eye=eyellipse: how many drivers' eyes to draw from the scene's
+    /// [eyellipse], an integer in [1, 10000]; each is a row.
+    #[arg(long = "samples", default_value_t = 100, value_parser = integer::<usize>(1, MAX_VALUES as u64))]
+    eye_samples: usize,
+    /// With --param eye=eyellipse: the seed of those eyes, an integer in [0, 2^64 − 1]; eye i
+    /// of seed s is the same in every sweep, shard and resumed run.
+    #[arg(long, default_value_t = 1, value_parser = integer::<u64>(0, u64::MAX))]
+    seed: u64,
+    /// With --param eye=eyellipse: the misregistration bound of the share of drivers
+    /// (`<out stem>_drivers.json`), arcmin in [1e-6, 10800].
+    #[arg(long = "bound-arcmin", default_value_t = DEFAULT_BOUND_ARCMIN, value_parser = positive(10800.0))]
+    bound_arcmin: f64,
 }
 
 /// `seethru sweep-merge`: the CSVs of a sharded sweep joined into one.
@@ -57,12 +74,16 @@ pub struct SweepMerge {
     /// The merged CSV (its plot goes beside it), byte for byte what one unsharded run writes.
     #[arg(long)]
     out: PathBuf,
+    /// For a sweep of --param eye=eyellipse: the misregistration bound of the share of
+    /// drivers, arcmin in [1e-6, 10800].
+    #[arg(long = "bound-arcmin", default_value_t = DEFAULT_BOUND_ARCMIN, value_parser = positive(10800.0))]
+    bound_arcmin: f64,
 }
 
 impl SweepMerge {
     pub fn run(self) -> Result<()> {
         let parts: Vec<&std::path::Path> = self.parts.iter().map(PathBuf::as_path).collect();
-        let rows = merge_parts(&parts, &self.out)?;
+        let rows = merge_parts_with_bound(&parts, &self.out, self.bound_arcmin)?;
         seethru::util::progress::summary(format!(
             "merged {rows} configurations from {} parts into {}",
             parts.len(),
@@ -77,14 +98,41 @@ impl Sweep {
         let params = self
             .params
             .iter()
-            .map(|p| parse_param(p))
+            .map(|p| {
+                let param = parse_param(p)?;
+                Ok(if param.values == [EYELLIPSE] {
+                    eyellipse_param(self.eye_samples, self.seed)
+                } else {
+                    param
+                })
+            })
             .collect::<Result<Vec<_>>>()?;
+        let drivers = samples_drivers(&params);
+        let when = "with --param eye=eyellipse";
+        refuse_ignored(&[
+            ReadWhen {
+                flag: "--samples",
+                read: drivers,
+                when,
+            },
+            ReadWhen {
+                flag: "--seed",
+                read: drivers,
+                when,
+            },
+            ReadWhen {
+                flag: "--bound-arcmin",
+                read: drivers,
+                when,
+            },
+        ])?;
         let options = SweepOptions {
             width: self.width,
             spp: self.spp,
             head: self.head,
             band: self.band,
             shard: self.shard,
+            bound_arcmin: self.bound_arcmin,
         };
         let computed = with_threads(self.threads, || -> Result<usize> {
             // Every worker thread runs a configuration at a time, each holding its frames.

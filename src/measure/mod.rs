@@ -4,6 +4,7 @@
 pub mod binocular;
 pub mod compare;
 pub mod compare_external;
+pub mod driver_share;
 pub mod expectations;
 pub mod hazard;
 pub mod headline;

@@ -338,5 +338,6 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
         frontal,
         back,
         calibration: Default::default(),
+        eyellipse: None,
     })
 }

@@ -58,7 +58,12 @@ pub struct SweepOptions {
     /// Compute only this part of the grid (the CSV then holds that part's rows and no plot
     /// is drawn; [`merge_parts`] joins the parts).
     pub shard: Option<Shard>,
+    /// The misregistration bound of an `eye=eyellipse` sweep's share of drivers, arcmin.
+    pub bound_arcmin: f64,
 }
+
+/// The default bound of the share of drivers, arcmin: the 1′ of the plots and the paper.
+pub const DEFAULT_BOUND_ARCMIN: f64 = 1.0;
 
 /// Runs the sweep; writes `csv` (and `<csv>.png`); returns the number of rows computed now.
 pub fn sweep(
@@ -220,6 +225,7 @@ pub fn sweep(
     write(&mut rows)?;
     if options.shard.is_none() {
         plot(csv, params, &rows)?;
+        write_driver_shares(csv, params, &rows, options.bound_arcmin)?;
     }
     Ok(todo.len())
 }
@@ -248,10 +254,52 @@ pub fn check_out(csv: &Path) -> Result<()> {
 /// Joins the CSVs of a sharded sweep into `out` (byte for byte what one unsharded run writes)
 /// and draws its plot; returns the number of rows.
 pub fn merge_parts(parts: &[&Path], out: &Path) -> Result<usize> {
+    merge_parts_with_bound(parts, out, DEFAULT_BOUND_ARCMIN)
+}
+
+/// [`merge_parts`], with the share of drivers of an `eye=eyellipse` sweep under
+/// `bound_arcmin`.
+pub fn merge_parts_with_bound(parts: &[&Path], out: &Path, bound_arcmin: f64) -> Result<usize> {
     check_out(out)?;
     let merged = merge(parts, out)?;
     plot(out, &merged.params, &merged.body)?;
+    write_driver_shares(out, &merged.params, &merged.body, bound_arcmin)?;
     Ok(merged.rows)
+}
+
+/// Whether a sweep's parameters sample drivers' eyes (`--param eye=eyellipse`).
+pub fn samples_drivers(params: &[Param]) -> bool {
+    params.iter().any(|p| p.name == "eye")
+}
+
+/// For an `eye=eyellipse` sweep: `<stem>_drivers.json` beside the CSV, with the share of
+/// drivers under the bound, and its lines on stderr.
+fn write_driver_shares(
+    csv: &Path,
+    params: &[Param],
+    rows: &[(usize, String)],
+    bound_arcmin: f64,
+) -> Result<()> {
+    let Some(shares) = crate::measure::driver_share::driver_shares(params, rows, bound_arcmin)
+    else {
+        return Ok(());
+    };
+    let stem = csv
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| "sweep".into());
+    let path = csv
+        .parent()
+        .unwrap_or(Path::new("."))
+        .join(format!("{stem}_drivers.json"));
+    write_text(
+        &path,
+        &format!("{}\n", serde_json::to_string_pretty(&shares)?),
+    )?;
+    for line in crate::measure::driver_share::summary_lines(&shares) {
+        crate::util::progress::summary(line);
+    }
+    Ok(())
 }
 
 /// Mean misregistration against the first parameter, one curve per value of the second;

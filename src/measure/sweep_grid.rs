@@ -13,7 +13,7 @@ use crate::system::options::{MAX_HEAD_BIAS_CM, RunOptions};
 use crate::util::number::short;
 
 /// What a sweep can vary, each with the range of the scene key or option it sets.
-pub const PARAMETERS: [(&str, &str); 7] = [
+pub const PARAMETERS: [(&str, &str); 8] = [
     (
         "theta_f",
         "frontal half angle θ_F (camera.frontal.half_angle_deg), degrees in [0.01, 89]",
@@ -35,6 +35,10 @@ pub const PARAMETERS: [(&str, &str); 7] = [
         "eye moved along the display normal (d1 change), metres in [-1e6, 1e6]",
     ),
     (
+        "eye",
+        "eyellipse: driver eyes drawn from the scene's [eyellipse] (sweep --samples N --seed S)",
+    ),
+    (
         "head_bias_x_cm",
         "head-tracking bias across the display, centimetres in [-500, 500]",
     ),
@@ -49,6 +53,35 @@ pub const MAX_CONFIGURATIONS: usize = 100_000;
 
 /// Most values of one parameter.
 pub const MAX_VALUES: usize = 10_000;
+
+/// The value of `--param eye=eyellipse` before [`eyellipse_param`] draws its samples.
+pub const EYELLIPSE: &str = "eyellipse";
+
+/// The `eye` parameter of `samples` eyes drawn with `seed`: values `eyellipse:<seed>:<i>` for
+/// i in 0..samples, each naming its eye wholly (so shards and resumed sweeps agree on it).
+pub fn eyellipse_param(samples: usize, seed: u64) -> Param {
+    Param {
+        name: "eye".into(),
+        values: (0..samples)
+            .map(|i| format!("{EYELLIPSE}:{seed}:{i}"))
+            .collect(),
+    }
+}
+
+/// The (seed, index) of an `eye` value `eyellipse:<seed>:<i>`.
+fn eyellipse_sample(v: &str) -> Result<(u64, u64)> {
+    let parts: Vec<&str> = v.split(':').collect();
+    match parts[..] {
+        [EYELLIPSE, seed, index] => Ok((
+            seed.parse()
+                .with_context(|| format!("eye = {v}: bad seed"))?,
+            index
+                .parse()
+                .with_context(|| format!("eye = {v}: bad sample index"))?,
+        )),
+        _ => bail!("eye = {v}: expected eyellipse:<seed>:<index>"),
+    }
+}
 
 /// One swept parameter and its values (normalised: numbers as Rust writes the `f64` they
 /// parse to, `inf` for `infinity`).
@@ -66,6 +99,19 @@ pub fn parse_param(spec: &str) -> Result<Param> {
         .split_once('=')
         .with_context(|| format!("`{spec}`: expected name=start:stop:step or name=v1,v2,..."))?;
     let name = name.trim();
+    if name == "eye" {
+        // The samples are made by [`eyellipse_param`] once --samples and --seed are known.
+        if values.trim() != "eyellipse" {
+            bail!(
+                "eye = `{}`: the only value is eyellipse (eyes sampled from the scene's [eyellipse] table; choose how many with --samples and their seed with --seed)",
+                values.trim()
+            );
+        }
+        return Ok(Param {
+            name: name.to_string(),
+            values: vec![EYELLIPSE.to_string()],
+        });
+    }
     if !PARAMETERS.iter().any(|(n, _)| *n == name) {
         let known: Vec<&str> = PARAMETERS.iter().map(|(n, _)| *n).collect();
         bail!(
@@ -261,6 +307,17 @@ pub fn configure(
                     .world_from_obstacle
                     .transform_vector3(axis * number(name, v)?);
                 scene.driver.world_from_camera.translation += shift;
+            }
+            "eye" => {
+                let (seed, index) = eyellipse_sample(v)?;
+                let ellipse = scene.eyellipse.with_context(|| {
+                    format!(
+                        "--param eye=eyellipse: the scene {} has no [eyellipse] table to draw eyes from",
+                        base.path.display()
+                    )
+                })?;
+                // The driver's view keeps its orientation; only the eye moves, as for eye_x.
+                scene.driver.world_from_camera.translation = ellipse.sample(seed, index);
             }
             "head_bias_x_cm" => options.head_bias_cm[0] = number(name, v)?,
             "frontal_width" => options.frontal_width = Some(number(name, v)? as u32),

@@ -43,7 +43,13 @@ pub struct CurvedSurface {
     pub tris: Vec<UvTri>,
     /// Triangle indices per cell of a GRID×GRID grid over UV space (row-major, v down).
     uv_cells: Vec<Vec<u32>>,
+    /// The triangles by position, for [`CurvedSurface::uv_at_point`].
+    point_grid: crate::scene::surface_grid::SurfaceGrid,
 }
+
+/// How far outside a triangle (in barycentric coordinates) a point may project and still be
+/// taken as on it: the seam between two facets must belong to one of them.
+const BARYCENTRIC_SLACK: f64 = 1e-4;
 
 fn uv_area(t: &UvTri) -> f64 {
     let [a, b, c] = t.uv;
@@ -103,10 +109,23 @@ impl CurvedSurface {
                 }
             }
         }
+        // A point outside a triangle by barycentric slack s is at most 2·s·(longest edge)
+        // from it; the grid's margin is more than twice that (see SurfaceGrid::new).
+        let longest = tris
+            .iter()
+            .flat_map(|t| [t.p[1] - t.p[0], t.p[2] - t.p[1], t.p[0] - t.p[2]])
+            .map(DVec3::length)
+            .fold(0.0, f64::max);
+        let margin = 5.0 * BARYCENTRIC_SLACK * longest + 1e-9;
+        let point_grid = crate::scene::surface_grid::SurfaceGrid::new(
+            &tris.iter().map(|t| t.p).collect::<Vec<_>>(),
+            margin,
+        );
         Ok(CurvedSurface {
             source,
             tris,
             uv_cells,
+            point_grid,
         })
     }
 
@@ -179,32 +198,27 @@ impl CurvedSurface {
     }
 
     /// The texture coordinates of a point on the surface (obstacle frame): those of the
-    /// triangle nearest to it.
+    /// triangle nearest to it. The same answer as [`CurvedSurface::uv_at_point_brute`]
+    /// (tested), from the triangles of the point's grid cell: a triangle outside the cell is
+    /// more than the grid's margin from the point, so it cannot beat one found within half
+    /// of it; otherwise (a point off the surface) the brute force answers.
     pub fn uv_at_point(&self, p: DVec3) -> Option<DVec2> {
-        let mut best: Option<(f64, DVec2)> = None;
-        for t in &self.tris {
-            let [a, b, c] = t.p;
-            let (e1, e2) = (b - a, c - a);
-            let n = e1.cross(e2);
-            let nn = n.length_squared();
-            if nn == 0.0 {
-                continue;
-            }
-            let q = p - a;
-            let dist = (q.dot(n)).abs() / nn.sqrt();
-            if best.is_some_and(|(d, _)| d <= dist) {
-                continue;
-            }
-            // Barycentric coordinates of p's projection onto the triangle's plane.
-            let wb = q.cross(e2).dot(n) / nn;
-            let wc = e1.cross(q).dot(n) / nn;
-            let wa = 1.0 - wb - wc;
-            let eps = -1e-4;
-            if wa >= eps && wb >= eps && wc >= eps {
-                best = Some((dist, t.uv[0] * wa + t.uv[1] * wb + t.uv[2] * wc));
-            }
-        }
-        best.map(|(_, uv)| uv.clamp(DVec2::ZERO, DVec2::ONE))
+        self.uv_at_point_by_grid(p)
+            .or_else(|| self.uv_at_point_brute(p))
+    }
+
+    /// The grid's answer to [`CurvedSurface::uv_at_point`], where it can vouch for it (the
+    /// nearest triangle of the point's cell within half the grid's margin); `None` otherwise.
+    pub fn uv_at_point_by_grid(&self, p: DVec3) -> Option<DVec2> {
+        let cell = self.point_grid.candidates(p)?;
+        let best = nearest(cell.iter().map(|&i| &self.tris[i as usize]), p);
+        best.filter(|(d, _)| *d <= self.point_grid.margin / 2.0)
+            .map(|(_, uv)| uv.clamp(DVec2::ZERO, DVec2::ONE))
+    }
+
+    /// [`CurvedSurface::uv_at_point`] by a scan over every triangle: its brute-force twin.
+    pub fn uv_at_point_brute(&self, p: DVec3) -> Option<DVec2> {
+        nearest(self.tris.iter(), p).map(|(_, uv)| uv.clamp(DVec2::ZERO, DVec2::ONE))
     }
 
     /// Obstacle-frame bounding box (min, max) of the surface.
@@ -214,6 +228,35 @@ impl CurvedSurface {
             |(lo, hi), p| (lo.min(p), hi.max(p)),
         )
     }
+}
+
+/// The triangle of `tris` whose plane is nearest to `p` among those `p` projects into (within
+/// the slack), first on ties: its plane distance and the UV of the projection.
+fn nearest<'a>(tris: impl Iterator<Item = &'a UvTri>, p: DVec3) -> Option<(f64, DVec2)> {
+    let mut best: Option<(f64, DVec2)> = None;
+    for t in tris {
+        let [a, b, c] = t.p;
+        let (e1, e2) = (b - a, c - a);
+        let n = e1.cross(e2);
+        let nn = n.length_squared();
+        if nn == 0.0 {
+            continue;
+        }
+        let q = p - a;
+        let dist = (q.dot(n)).abs() / nn.sqrt();
+        if best.is_some_and(|(d, _)| d <= dist) {
+            continue;
+        }
+        // Barycentric coordinates of p's projection onto the triangle's plane.
+        let wb = q.cross(e2).dot(n) / nn;
+        let wc = e1.cross(q).dot(n) / nn;
+        let wa = 1.0 - wb - wc;
+        let eps = -BARYCENTRIC_SLACK;
+        if wa >= eps && wb >= eps && wc >= eps {
+            best = Some((dist, t.uv[0] * wa + t.uv[1] * wb + t.uv[2] * wc));
+        }
+    }
+    best
 }
 
 #[cfg(test)]

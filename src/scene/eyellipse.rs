@@ -14,11 +14,13 @@
 //! 12° tilt are as commonly quoted and are unverified against the standard (the 2002 revision
 //! makes the tilt depend on seat height, which is not modelled).
 //!
-//! Sampling: the standard's ellipse is a tangent-cutoff contour (95 % of eyes lie on one side
-//! of any tangent plane), not a contour holding 95 % of eyes. Samples here read it as the 95 %
-//! contour of a trivariate normal (σ = semi-axis / √χ²₃(0.95) = semi-axis / 2.795), the reading
-//! this project's sweeps state; the tangent-cutoff reading would give σ = semi-axis / 1.645,
-//! 1.7 times wider. Frames: vehicle grid x rearward, y to the driver's right, z up; the world
+//! Sampling: the standard's ellipse is a tangent-cutoff ellipse: 95 % of eyes lie on the near
+//! side of any one of its tangent planes. For a trivariate normal that fixes σ along each axis
+//! at semi-axis / z₀.₉₅ = semi-axis / 1.645 (the 95th percentile of the normal's projection on
+//! any direction is the ellipse's support there), which is what the samples use. (A 95 %
+//! contour, σ = semi-axis / √χ²₃(0.95) = semi-axis / 2.795, is not the standard's meaning and
+//! understates the spread of drivers 1.7 times; only 56 % of the samples lie inside the
+//! ellipse itself, P(χ²₃ ≤ 1.645²).) Frames: vehicle grid x rearward, y to the driver's right, z up; the world
 //! has +y up and the car facing −z, so world_from_vehicle maps (x, y, z) to (y, z, x).
 
 use glam::{DMat3, DVec3};
@@ -28,19 +30,21 @@ use glam::{DMat3, DVec3};
 pub const AXIS_LENGTHS_M: [f64; 3] = [0.2064, 0.0603, 0.0934];
 /// Side-view tilt of the ellipse's x axis, degrees, front end down.
 pub const TILT_DEG: f64 = 12.0;
-/// χ²(3 degrees of freedom) at 0.95: the squared Mahalanobis radius of a 95 % contour.
-pub const CHI2_3_95: f64 = 7.814_727_903_251_178;
+/// The standard normal's 95th percentile: a tangent-cutoff 95th-percentile ellipse's semi-axis
+/// in standard deviations.
+pub const Z_95: f64 = 1.644_853_626_951_472_2;
 
 /// The standard's inputs, in the world frame (metres) where they are points.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SeatPackage {
     /// Seating reference point, world metres: its lateral position is W20, its height H8.
     pub sgrp: DVec3,
-    /// Ball of foot on the accelerator, world metres: its fore-aft position is L1.
-    pub ball_of_foot: DVec3,
-    /// L6: steering-wheel centre's fore-aft distance from the ball of foot, metres in [0, 2].
+    /// World z (fore-aft, the car facing −z) of the ball of foot on the accelerator, metres:
+    /// L1, the ball of foot's X.
+    pub ball_of_foot_z: f64,
+    /// L6: steering-wheel centre's fore-aft distance from the ball of foot, metres in [0, 1.5].
     pub steering_l6: f64,
-    /// H30: the SgRP's height above the heel point, metres in [0, 2].
+    /// H30: the SgRP's height above the heel point, metres in [0.127, 0.405] (Class A).
     pub seat_height_h30: f64,
     /// A clutch pedal (t = 1) moves the centre 12.5 mm forward.
     pub clutch: bool,
@@ -72,10 +76,12 @@ impl Eyellipse {
             - 0.176 * seat.seat_height_h30 * 1000.0
             - 12.5 * t;
         // World z is vehicle rearward, world y up, world x the driver's right.
+        // Summed in millimetres, the standard's unit, so that round seat packages give round
+        // eyes (0.562 m + 0.638 m is not 1.2 in binary, 562 mm + 638 mm is).
         let centre = DVec3::new(
             seat.sgrp.x,
-            seat.sgrp.y + 0.638,
-            seat.ball_of_foot.z + x_mm / 1000.0,
+            (seat.sgrp.y * 1000.0 + 638.0) / 1000.0,
+            (seat.ball_of_foot_z * 1000.0 + x_mm) / 1000.0,
         );
         let beta = TILT_DEG.to_radians();
         // Rearward end up = front end down.
@@ -89,9 +95,16 @@ impl Eyellipse {
         }
     }
 
-    /// Standard deviations along the ellipse's axes when it is the 95 % contour of a normal.
+    /// Standard deviations along the ellipse's axes, metres: the tangent-cutoff reading.
     pub fn sigmas(&self) -> DVec3 {
-        self.semi_axes / CHI2_3_95.sqrt()
+        self.semi_axes / Z_95
+    }
+
+    /// Distance from the centre to the tangent plane whose outward normal is `normal` (a world
+    /// unit vector), metres: the ellipse's support function √(nᵀ R diag(a²) Rᵀ n).
+    pub fn tangent_distance(&self, normal: DVec3) -> f64 {
+        let local = self.world_from_ellipse.transpose() * normal;
+        (local * self.semi_axes).length()
     }
 
     /// Covariance of the sampled eyes, world m²: R·diag(σ²)·Rᵀ.

@@ -8,6 +8,7 @@ pub mod curved_body;
 pub mod display_keys;
 pub mod display_surface;
 pub mod eyellipse;
+pub mod eyellipse_keys;
 pub mod fingerprint;
 pub mod grow;
 pub mod head_path;
@@ -20,6 +21,7 @@ pub mod procedural;
 pub mod read;
 pub mod shapes;
 pub mod source;
+pub mod surface_grid;
 pub mod table_reader;
 pub mod texture;
 pub mod world;
@@ -231,6 +233,9 @@ pub struct Scene {
     /// The compensation's own copies of the frontal and back cameras (`[calibration]`):
     /// head estimation and the crop use them, rendering uses the true ones.
     pub calibration: Calibration,
+    /// The SAE J941 eyellipse of the scene's `[eyellipse]` seat package, if it has one: the
+    /// driver's eye defaults to its centre, and `sweep --param eye=eyellipse` samples it.
+    pub eyellipse: Option<eyellipse::Eyellipse>,
 }
 
 impl Scene {

@@ -43,7 +43,8 @@ impl Scene {
                 "the scene needs [camera.driver], [camera.frontal] and [camera.back]",
             )
         })?;
-        let driver = read_driver(&cameras, &obstacle)?;
+        let eyellipse = crate::scene::eyellipse_keys::read_eyellipse(&root)?;
+        let driver = read_driver(&cameras, &obstacle, eyellipse.as_ref())?;
         let frontal = read_frontal(&cameras, &obstacle)?;
         let back = read_back(&cameras, &obstacle)?;
         cameras.finish()?;
@@ -61,6 +62,7 @@ impl Scene {
             frontal,
             back,
             calibration,
+            eyellipse,
         })
     }
 }
@@ -453,9 +455,14 @@ fn camera_table<'a>(cameras: &TableReader<'a>, name: &str) -> Result<TableReader
         .ok_or_else(|| cameras.error(name, format!("the scene needs a [camera.{name}] table")))
 }
 
-fn read_driver(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, SceneError> {
+fn read_driver(
+    cameras: &TableReader,
+    obstacle: &Obstacle,
+    eyellipse: Option<&crate::scene::eyellipse::Eyellipse>,
+) -> Result<Camera, SceneError> {
     let t = camera_table(cameras, "driver")?;
-    let eye = t.point("position", None)?;
+    // Without a position, the eye is the eyellipse's centre (the cyclopean eye J941 places).
+    let eye = t.point("position", eyellipse.map(|e| e.centre.to_array()))?;
     let target = t.point("look_at", None)?;
     let up = t.direction("up", [0.0, 1.0, 0.0])?;
     let [w, h] = t.resolution("resolution", [1280, 720])?;
