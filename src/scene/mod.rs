@@ -10,6 +10,7 @@ pub mod display_surface;
 pub mod eyellipse;
 pub mod fingerprint;
 pub mod grow;
+pub mod head_model;
 pub mod head_path;
 pub mod lens_keys;
 pub mod limits;
