@@ -2,6 +2,7 @@
 
 mod common;
 
+use seethru::scene::head_model::{head_mtl, head_obj};
 use seethru::scene::mesh_io::load_mesh;
 use seethru::scene::procedural::{car_mtl, car_obj, street_texture};
 
@@ -14,6 +15,11 @@ fn committed_assets_match_their_generators() {
         "assets/car.obj is stale: run `cargo run --example make_assets`"
     );
     assert_eq!(read("car.mtl"), car_mtl(), "assets/car.mtl is stale");
+    assert!(
+        read("head.obj") == head_obj(),
+        "assets/head.obj is stale: run `cargo run --example make_assets`"
+    );
+    assert_eq!(read("head.mtl"), head_mtl(), "assets/head.mtl is stale");
     let png = image::open(common::repo_path("assets/street.png"))
         .unwrap()
         .to_rgb8();

@@ -393,6 +393,88 @@ fn every_flag_of_compare_changes_the_output_or_is_refused() {
 }
 
 #[test]
+fn compare_reads_the_hazard_bound_only_for_a_scene_with_hazards() {
+    // The minimal scene's ball stands behind the pillar; a hazard sphere nearer, at 4 m,
+    // is hidden too. planar-inf misplaces it by a few arc-minutes (its plane is at ∞), so
+    // a bound of 0.5′ shows fewer of its hidden pixels than the default 30′.
+    let hazard = "\n[[object]]\nname = \"walker\"\nkind = \"sphere\"\nmaterial = \"grey\"\nradius = 0.4\ntranslate = [0.0, 1.2, -4.0]\nhazard = true\n";
+    let dir = common::refusal::scratch(hazard, &[]);
+    let compare = |out: &str, extra: &[&str]| -> serde_json::Value {
+        let mut args = vec![
+            "compare",
+            "scene.toml",
+            "--out",
+            out,
+            "--spp",
+            "1",
+            "--width",
+            "64",
+            "--methods",
+            "planar-inf,planar-auto",
+        ];
+        args.extend(extra);
+        let (code, err) = run_in(dir.path(), &args);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        let md = std::fs::read_to_string(dir.path().join(out).join("compare.md")).unwrap();
+        assert!(
+            md.contains("| walker visibility | walker centroid ′ |"),
+            "{md}"
+        );
+        serde_json::from_str(
+            &std::fs::read_to_string(dir.path().join(out).join("compare.json")).unwrap(),
+        )
+        .unwrap()
+    };
+    let (wide, tight) = (
+        compare("wide", &[]),
+        compare("tight", &["--hazard-bound-arcmin", "0.5"]),
+    );
+    let walker = |json: &serde_json::Value, row: usize, key: &str| {
+        json["rows"][row]["hazards"]["objects"][0][key].clone()
+    };
+    assert_eq!(wide["rows"][0]["hazards"]["bound_arcmin"], 30.0);
+    assert_eq!(tight["rows"][0]["hazards"]["bound_arcmin"], 0.5);
+    let hidden = walker(&wide, 0, "hidden_pixels").as_u64().unwrap();
+    assert!(hidden > 20, "{wide}");
+    assert_eq!(
+        walker(&tight, 0, "hidden_pixels"),
+        walker(&wide, 0, "hidden_pixels")
+    );
+    let shown = |json: &serde_json::Value| walker(json, 0, "shown_pixels").as_u64().unwrap();
+    assert!(shown(&wide) > hidden / 2, "{wide}");
+    assert!(
+        shown(&tight) < shown(&wide) / 2,
+        "{} vs {}",
+        shown(&tight),
+        shown(&wide)
+    );
+    // The centroid error does not depend on the bound; each row has its own.
+    assert_eq!(
+        walker(&tight, 0, "centroid_error_arcmin"),
+        walker(&wide, 0, "centroid_error_arcmin")
+    );
+    assert!(walker(&wide, 1, "visibility").as_f64().is_some());
+    // Without a hazard object the flag would be ignored: refused, in one line.
+    let plain = common::refusal::scratch("", &[]);
+    common::refusal::refused(
+        plain.path(),
+        &[
+            "compare",
+            "scene.toml",
+            "--out",
+            "out",
+            "--width",
+            "16",
+            "--hazard-bound-arcmin",
+            "5",
+        ],
+        1,
+        &["--hazard-bound-arcmin is read only for a scene with an object marked `hazard = true`"],
+    );
+    assert!(!plain.path().join("out").exists());
+}
+
+#[test]
 fn the_worlds_limits_follow_what_moves() {
     // A keyframed mesh: its origin stays inside the world, its triangles leave it at t = 1 s
     // (a sphere on the same path was refused; the mesh was not).

@@ -9,6 +9,7 @@ use seethru::analysis::dynamic::error_budget;
 use seethru::analysis::examples::das_geometry;
 use seethru::analysis::paper::{ForeshorteningParams, OcclusionParams};
 use seethru::measure::compare::{Candidate, coloured_strips, compare as compare_methods};
+use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
 use seethru::measure::ratio::measure_ratio;
 use seethru::measure::ratio_setup::{Compensation, Setup};
 use seethru::paper::claims::{AnalyzeParams, evaluate, lens_and_eyes, paper_claims};
@@ -88,7 +89,13 @@ pub fn compare<'py>(
     check_memory(&estimate, choices.max_memory).map_err(to_py)?;
     let (context, rows) = detached(py, move || -> anyhow::Result<_> {
         let ctx = context_for(cached, the_scene)?;
-        let rows = compare_methods(&ctx, &candidates, &choices.options, choices.band)?;
+        let rows = compare_methods(
+            &ctx,
+            &candidates,
+            &choices.options,
+            choices.band,
+            DEFAULT_BOUND_ARCMIN,
+        )?;
         Ok((ctx, rows))
     })?
     .map_err(to_py)?;

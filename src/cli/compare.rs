@@ -8,6 +8,7 @@ use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_png;
 use seethru::io::staged::StagedDir;
 use seethru::measure::compare::{Candidate, coloured_strips, html_page, markdown_table};
+use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::system::depth_sensor::SensorKind;
@@ -15,7 +16,7 @@ use seethru::system::memory::{check_memory, run_estimate};
 use seethru::system::options::{HeadSource, Outside, RunOptions};
 
 use crate::cli::args::{
-    ReadWhen, RenderArgs, band, choice, integer, pixels, refuse_ignored, with_threads,
+    ReadWhen, RenderArgs, band, choice, integer, pixels, positive, refuse_ignored, with_threads,
 };
 use crate::cli::scene_model_args::SceneModelArgs;
 
@@ -52,6 +53,11 @@ pub struct Compare {
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
     band: u32,
+    /// Hazard visibility: a hidden hazard pixel counts as shown when the display shows the
+    /// same object within this misregistration, arc-minutes in [1e-6, 10800] (a scene with
+    /// an object marked `hazard = true` only).
+    #[arg(long = "hazard-bound-arcmin", default_value_t = DEFAULT_BOUND_ARCMIN, value_parser = positive(10800.0))]
+    hazard_bound_arcmin: f64,
     /// The depth sensor (its kind is the method's for depth-tof and depth-stereo) and fill.
     #[command(flatten)]
     scene_model: SceneModelArgs,
@@ -119,9 +125,20 @@ impl Compare {
 
     fn write(&self, base: &RunOptions) -> Result<()> {
         let scene = Scene::load(&self.scene)?;
+        refuse_ignored(&[ReadWhen {
+            flag: "--hazard-bound-arcmin",
+            read: scene.objects.iter().any(|o| o.hazard),
+            when: "for a scene with an object marked `hazard = true`",
+        }])?;
         check_memory(&run_estimate(&scene, base)?, self.render.max_memory)?;
         let ctx = RenderContext::new(scene)?;
-        let rows = crate::cli::compare_methods::compare_all(&ctx, &self.methods, base, self.band)?;
+        let rows = crate::cli::compare_methods::compare_all(
+            &ctx,
+            &self.methods,
+            base,
+            self.band,
+            self.hazard_bound_arcmin,
+        )?;
         // Written whole or not at all: a failure leaves `--out` as it was.
         let staged = StagedDir::new(&self.out)?;
         let out: &Path = staged.path();
@@ -132,9 +149,16 @@ impl Compare {
             strips.push((r.name.as_str(), file));
         }
         let table = markdown_table(&rows);
+        let hazards = match ctx.scene.objects.iter().any(|o| o.hazard) {
+            true => format!(
+                " Per `hazard = true` object: visibility, the fraction of its pixels hidden by the pillar that the display shows as that object within {}′ (— when none is hidden), and the centroid error ′ of what the display shows of it.",
+                self.hazard_bound_arcmin
+            ),
+            false => String::new(),
+        };
         let title = format!("Compensation methods compared on {}", self.scene.display());
         let md = format!(
-            "# {title}\n\nMisregistration in arc-minutes at the true eye over the display (mean, p95, and the border band of {} display pixels); coverage: fraction of display pixels that show the scene; holes: disocclusions of the depth methods (fill: {:?}); ms/frame: the method's own work (sensor, fit or search, resampling).\n\n{table}\n{}",
+            "# {title}\n\nMisregistration in arc-minutes at the true eye over the display (mean, p95, and the border band of {} display pixels); coverage: fraction of display pixels that show the scene; holes: disocclusions of the depth methods (fill: {:?}); ms/frame: the method's own work (sensor, fit or search, resampling).{hazards}\n\n{table}\n{}",
             self.band,
             base.scene_model.fill,
             strips

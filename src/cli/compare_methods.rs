@@ -60,6 +60,7 @@ pub fn compare_all(
     specs: &[MethodSpec],
     base: &RunOptions,
     band: u32,
+    hazard_bound_arcmin: f64,
 ) -> Result<Vec<Compared>> {
     let builtins: Vec<Candidate> = specs
         .iter()
@@ -77,8 +78,8 @@ pub fn compare_all(
             maps.push((name.clone(), crate::cli::score::load_map(file)?));
         }
     }
-    let mut built = compare(ctx, &builtins, base, band)?.into_iter();
-    let mut external = compare_maps(ctx, &maps, base, band)?.into_iter();
+    let mut built = compare(ctx, &builtins, base, band, hazard_bound_arcmin)?.into_iter();
+    let mut external = compare_maps(ctx, &maps, base, band, hazard_bound_arcmin)?.into_iter();
     Ok(specs
         .iter()
         .filter_map(|s| match s {

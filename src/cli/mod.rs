@@ -14,6 +14,7 @@ mod diff;
 mod export;
 mod figures;
 pub mod given;
+mod head_poses;
 mod measure;
 mod ratio;
 mod render;
@@ -75,6 +76,8 @@ pub enum Command {
     Compare(compare::Compare),
     /// Benchmark: BVH build time, rays per second, frame times; ends with one JSON line.
     Bench(bench::Bench),
+    /// The head tracker against the true eye over a grid of head poses: its error table.
+    HeadPoses(head_poses::HeadPoses),
     /// The system over time: vehicle and head motion, latencies and prediction, measured frame
     /// by frame against the truth (frames.csv, summary.json, plots, an animated preview).
     Sequence(sequence::Sequence),
@@ -215,6 +218,7 @@ impl Command {
             Command::Figures(c) => c.run(),
             Command::Analyze(c) => c.run(),
             Command::Bench(c) => c.run(),
+            Command::HeadPoses(c) => c.run(),
             Command::Compare(c) => c.run(),
             Command::Sequence(c) => c.run(),
             Command::Diff(c) => c.run(),

@@ -4,7 +4,8 @@
 use anyhow::Result;
 use serde_json::json;
 
-use crate::measure::hazard::{DEFAULT_BOUND_ARCMIN, hazard_frame, hazards_json};
+use crate::geometry::camera::Camera;
+use crate::measure::hazard::{hazard_frame, hazards_json};
 use crate::measure::holes::attach_holes;
 use crate::measure::maps::heat_color;
 use crate::measure::metrics::{MetricMaps, measure};
@@ -14,7 +15,7 @@ use crate::render::settings::RenderSettings;
 use crate::render::views::View;
 use crate::system::depth_sensor::SensorKind;
 use crate::system::options::{Method, RunOptions, WorkingDistance};
-use crate::system::pipeline::{check_display_seen, driver_camera, run_with_truth};
+use crate::system::pipeline::{RunResult, check_display_seen, driver_camera, run_with_truth};
 use crate::system::scene_model::check_scene_model;
 use crate::util::color::encode_srgb8;
 use crate::util::progress::Progress;
@@ -95,12 +96,14 @@ pub struct Compared {
 }
 
 /// Runs every candidate at `base` on one scene (the truth rendered once, the same for all)
-/// and measures each with a border band of `band` display pixels.
+/// and measures each with a border band of `band` display pixels; a hidden hazard pixel
+/// counts as shown within `hazard_bound_arcmin` ([`hazard_frame`]).
 pub fn compare(
     ctx: &RenderContext,
     candidates: &[Candidate],
     base: &RunOptions,
     band: u32,
+    hazard_bound_arcmin: f64,
 ) -> Result<Vec<Compared>> {
     let scene = &ctx.scene;
     let settings = RenderSettings {
@@ -139,21 +142,9 @@ pub fn compare(
         );
         let display = &metrics["display"];
         let misregistration = &display["misregistration_arcmin"];
-        let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
-            .atan()
-            .to_degrees()
-            * 60.0;
-        let hazards = hazard_frame(
-            scene,
-            &result.truth,
-            &result.seethru,
-            &maps,
-            DEFAULT_BOUND_ARCMIN,
-            arcmin_per_px,
-        );
         let row = json!({
-            // Per `hazard = true` object, as `run`'s hazards.json (default bound).
-            "hazards": hazards_json(&hazards, DEFAULT_BOUND_ARCMIN),
+            // Per `hazard = true` object, as `run`'s hazards.json.
+            "hazards": row_hazards(ctx, &driver, &result, &maps, hazard_bound_arcmin),
             "method": candidate.name(),
             "misregistration_mean_arcmin": misregistration["mean"],
             "misregistration_p95_arcmin": misregistration["p95"],
@@ -177,6 +168,29 @@ pub fn compare(
     }
     progress.finish();
     Ok(out)
+}
+
+/// A row's `hazards`: [`hazards_json`] of the run's driver views at `bound_arcmin`.
+pub fn row_hazards(
+    ctx: &RenderContext,
+    driver: &Camera,
+    result: &RunResult,
+    maps: &MetricMaps,
+    bound_arcmin: f64,
+) -> serde_json::Value {
+    let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
+        .atan()
+        .to_degrees()
+        * 60.0;
+    let hazards = hazard_frame(
+        &ctx.scene,
+        &result.truth,
+        &result.seethru,
+        maps,
+        bound_arcmin,
+        arcmin_per_px,
+    );
+    hazards_json(&hazards, bound_arcmin)
 }
 
 /// Every row's strip (truth | seethru | misregistration | holes over the display's bounding

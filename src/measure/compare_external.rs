@@ -5,19 +5,21 @@
 use anyhow::Result;
 use serde_json::json;
 
-use crate::measure::compare::{Compared, strip};
+use crate::measure::compare::{Compared, row_hazards, strip};
 use crate::measure::metrics::measure;
 use crate::render::integrator::RenderContext;
 use crate::system::capture::{DisplayMap, capture, score};
 use crate::system::options::RunOptions;
+use crate::system::pipeline::driver_camera;
 
 /// One row per `(name, map)`, at the capture of `base`; the border band is `band` display
-/// pixels.
+/// pixels, the hazards' bound `hazard_bound_arcmin`.
 pub fn compare_maps(
     ctx: &RenderContext,
     maps: &[(String, DisplayMap)],
     base: &RunOptions,
     band: u32,
+    hazard_bound_arcmin: f64,
 ) -> Result<Vec<Compared>> {
     if maps.is_empty() {
         return Ok(Vec::new());
@@ -39,7 +41,9 @@ pub fn compare_maps(
         let (maps, metrics) = measure(ctx, scene, eye, frames, band);
         let display = &metrics["display"];
         let misregistration = &display["misregistration_arcmin"];
+        let driver = driver_camera(scene, &options)?;
         let row = json!({
+            "hazards": row_hazards(ctx, &driver, result, &maps, hazard_bound_arcmin),
             "method": format!("map:{name}"),
             "misregistration_mean_arcmin": misregistration["mean"],
             "misregistration_p95_arcmin": misregistration["p95"],

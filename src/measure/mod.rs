@@ -7,6 +7,7 @@ pub mod compare_external;
 pub mod driver_share;
 pub mod expectations;
 pub mod hazard;
+pub mod head_poses;
 pub mod headline;
 pub mod holes;
 pub mod image_diff;

@@ -11,6 +11,7 @@ pub mod eyellipse;
 pub mod eyellipse_keys;
 pub mod fingerprint;
 pub mod grow;
+pub mod head_model;
 pub mod head_path;
 pub mod lens_keys;
 pub mod limits;

@@ -24,6 +24,9 @@ pub struct FaceDetection {
     pub pupils: [[f64; 2]; 2],
     /// Pixels in the left and right pupil's dark blob.
     pub pupil_areas_px: [u32; 2],
+    /// The head's left and right edge on the line through the pupils (pixels): where the skin
+    /// ends beyond each pupil, the outline the yaw is fitted to (`system/head_pose.rs`).
+    pub row_edges: [[f64; 2]; 2],
     /// How far the detection can be trusted, from what it measured ([`HeadConfidence`]).
     pub confidence: HeadConfidence,
 }
@@ -112,6 +115,17 @@ fn components(mask: &[bool], w: usize, h: usize) -> Vec<Vec<usize>> {
 /// Finds the face and the pupils in a colour frame (as a camera would deliver it, 8-bit sRGB).
 /// The face box reported is the skin region's bounding box.
 pub fn detect(frame: &Frame) -> Result<FaceDetection, DetectError> {
+    detect_with(frame, false)
+}
+
+/// [`detect`] for the head mesh (`scene/head_model.rs`) seen turned: its brows, hair and
+/// shadows are dark blobs too, so the pupils are the pair of iris-sized blobs (merged where a
+/// lid's shadow splits one) that is the most level and the largest, not the two largest.
+pub fn detect_turned(frame: &Frame) -> Result<FaceDetection, DetectError> {
+    detect_with(frame, true)
+}
+
+fn detect_with(frame: &Frame, pairing: bool) -> Result<FaceDetection, DetectError> {
     let (w, h) = (frame.width as usize, frame.height as usize);
     let rgb: Vec<[u8; 3]> = frame.color.iter().map(|&c| encode_srgb8(c)).collect();
     let skin: Vec<bool> = rgb.iter().map(|&c| is_skin(c)).collect();
@@ -164,10 +178,58 @@ pub fn detect(frame: &Frame) -> Result<FaceDetection, DetectError> {
                 .collect::<Vec<_>>()
         })
         .collect();
-    holes.sort_by_key(|c| std::cmp::Reverse(c.len()));
-    if holes.len() < 2 {
-        return Err(DetectError::Pupils(holes.len()));
+    if !pairing {
+        holes.sort_by_key(|c| std::cmp::Reverse(c.len()));
+        if holes.len() < 2 {
+            return Err(DetectError::Pupils(holes.len()));
+        }
+        holes.truncate(2);
     }
+    // An iris is at most ~0.08 face widths across: larger dark blobs are hair or shadow.
+    let face_w = (x1 - x0) as f64;
+    let iris_max = ((0.15 * face_w).powi(2) as usize).max(4);
+    holes.retain(|h| !pairing || h.len() <= iris_max);
+    // A blob split by a lid's shadow is one eye: blobs closer than an iris are merged.
+    let centre_of = |h: &[usize]| {
+        h.iter().fold(DVec2::ZERO, |a, &i| {
+            a + DVec2::new((i % w) as f64, (i / w) as f64)
+        }) / h.len() as f64
+    };
+    let mut merged: Vec<Vec<usize>> = Vec::new();
+    holes.sort_by_key(|c| std::cmp::Reverse(c.len()));
+    for hole in holes {
+        let c = centre_of(&hole);
+        match merged
+            .iter_mut()
+            .find(|m| pairing && (centre_of(m) - c).length() < 0.08 * face_w)
+        {
+            Some(m) => m.extend(hole),
+            None => merged.push(hole),
+        }
+    }
+    if merged.len() < 2 {
+        return Err(DetectError::Pupils(merged.len()));
+    }
+    // The pair: apart by at least 0.15 face widths, the larger the smaller blob and the more
+    // level the pair (a head rolled against the camera is allowed, at a lower score).
+    let mut best = (f64::NEG_INFINITY, 0, 1);
+    for a in 0..merged.len() {
+        for b in a + 1..merged.len() {
+            let d = centre_of(&merged[b]) - centre_of(&merged[a]);
+            if pairing && d.length() < 0.15 * face_w {
+                continue;
+            }
+            let tilt = d.y.abs() / d.x.abs().max(1e-9);
+            let score = merged[a].len().min(merged[b].len()) as f64 / (1.0 + 8.0 * tilt);
+            if score > best.0 {
+                best = (score, a, b);
+            }
+        }
+    }
+    if best.0 == f64::NEG_INFINITY {
+        return Err(DetectError::Pupils(1));
+    }
+    let holes = [merged[best.1].clone(), merged[best.2].clone()];
     // Sub-pixel centroids: each pixel of the blob and its one-pixel rim weighs by how far it
     // is from the local skin level (the median of a ring two pixels out) towards the pupil's
     // darkest value, so mixed edge pixels count in proportion and shading does not pull.
@@ -220,12 +282,38 @@ pub fn detect(frame: &Frame) -> Result<FaceDetection, DetectError> {
     } else {
         ([b, a], [areas[1], areas[0]])
     };
+    let row_edges = row_edges(&skin, w, h, pupils, (x1 - x0) as f64);
     Ok(FaceDetection {
         face_box,
         pupils: pupils.map(|p| p.to_array()),
         pupil_areas_px,
+        row_edges: row_edges.map(|p| p.to_array()),
         confidence: HeadConfidence::of(face_box, pupils, pupil_areas_px),
     })
+}
+
+/// Where the skin ends beyond each pupil along the line through both: walking outward in
+/// quarter-pixel steps, the last skin sample before a gap of non-skin wider than the eye
+/// opening could be (a tenth of the face's width, at least 3 px) — the eye's own white and
+/// iris are crossed, the background is not.
+fn row_edges(skin: &[bool], w: usize, h: usize, pupils: [DVec2; 2], face_px: f64) -> [DVec2; 2] {
+    let along = (pupils[1] - pupils[0]).normalize_or(DVec2::X);
+    let gap = (0.1 * face_px).max(3.0);
+    let is_skin = |p: DVec2| {
+        (p.x >= 0.0 && p.y >= 0.0 && (p.x as usize) < w && (p.y as usize) < h)
+            && skin[p.y as usize * w + p.x as usize]
+    };
+    let walk = |from: DVec2, direction: DVec2| {
+        let (mut last, mut s) = (0.0, 0.0);
+        while s < 1.5 * face_px && s - last <= gap {
+            s += 0.25;
+            if is_skin(from + direction * s) {
+                last = s;
+            }
+        }
+        from + direction * (last + 0.125)
+    };
+    [walk(pupils[0], -along), walk(pupils[1], along)]
 }
 
 /// The eye position from a detection: eq. d1 for the distance along the back camera's axis,

@@ -46,6 +46,10 @@ pub struct HeadConfidence {
     pub centre_offset_in_face: f64,
     /// Smaller over larger pupil blob area, (0, 1].
     pub pupil_area_ratio: f64,
+    /// Whether the cues are the yaw fit's ([`HeadConfidence::with_fit`]): then
+    /// `distance_ratio` holds the edge residual over the face width and
+    /// `centre_offset_in_face` the fitted yaw in degrees.
+    pub fitted: bool,
 }
 
 /// 0 at `bad`, 1 at `good`, linear between, clamped (either order of the limits).
@@ -84,7 +88,26 @@ impl HeadConfidence {
             pupil_height_in_face,
             centre_offset_in_face,
             pupil_area_ratio,
+            fitted: false,
         }
+    }
+
+    /// The cues once the head's yaw is fitted (`system/head_pose.rs`), which explains the
+    /// pupils' foreshortening and their place in the face: the distance cue becomes the
+    /// outline's fit (`edge_rms_px`, the edges' RMS residual, over the face's width: 1 at
+    /// ≤ 0.02, 0 at ≥ 0.06), the symmetry cue the yaw's range (1 at |yaw| ≤ 60°, 0 at the
+    /// search's 75° limit) and the size cue the blobs' area ratio over the ratio the fitted
+    /// pose predicts (0 at ≤ 0.35, 1 at ≥ 0.6).
+    pub fn with_fit(&self, edge_rms_px: f64, yaw_deg: f64, expected_area_ratio: f64) -> Self {
+        let mut c = *self;
+        c.distance_ratio = edge_rms_px / self.face_width_px;
+        c.distance_agreement = ramp(c.distance_ratio, 0.06, 0.02);
+        c.centre_offset_in_face = yaw_deg;
+        c.symmetry = ramp(yaw_deg.abs(), 74.0, 60.0);
+        c.pupil_sizes = ramp(self.pupil_area_ratio / expected_area_ratio, 0.35, 0.6);
+        c.fitted = true;
+        c.value = c.face_size * c.distance_agreement * c.pupil_height * c.symmetry * c.pupil_sizes;
+        c
     }
 
     /// Whether the estimate can be relied on (confidence ≥ [`CONFIDENT_HEAD`]).
@@ -99,7 +122,12 @@ impl HeadConfidence {
         if self.face_size < 1.0 {
             out.push(format!("the face only {:.0} px wide", self.face_width_px));
         }
-        if self.distance_agreement < 1.0 {
+        if self.distance_agreement < 1.0 && self.fitted {
+            out.push(format!(
+                "the head's outline off the fitted pose by {} of the face's width",
+                pct(self.distance_ratio)
+            ));
+        } else if self.distance_agreement < 1.0 {
             out.push(format!(
                 "the distance from the pupils {} of the distance from the face width",
                 pct(self.distance_ratio)
@@ -111,7 +139,12 @@ impl HeadConfidence {
                 pct(self.pupil_height_in_face)
             ));
         }
-        if self.symmetry < 1.0 {
+        if self.symmetry < 1.0 && self.fitted {
+            out.push(format!(
+                "a fitted yaw of {:.0}°",
+                self.centre_offset_in_face
+            ));
+        } else if self.symmetry < 1.0 {
             out.push(format!(
                 "the pupils' midpoint {} of the face's width off its centre",
                 pct(self.centre_offset_in_face)

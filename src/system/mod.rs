@@ -11,6 +11,7 @@ pub mod eyes;
 pub mod frontal_map;
 pub mod head;
 pub mod head_confidence;
+pub mod head_pose;
 pub mod memory;
 pub mod obstruction;
 pub mod options;
