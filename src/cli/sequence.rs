@@ -27,8 +27,8 @@ use seethru::util::progress::summary as say;
 use serde_json::json;
 
 use crate::cli::args::{
-    HeadErrorArgs, ReadWhen, band, choice, max_memory, pixels, positive, real, refuse_ignored, samples,
-    threads, with_threads,
+    HeadErrorArgs, ReadWhen, band, choice, max_memory, pixels, positive, real, refuse_ignored,
+    samples, threads, with_threads,
 };
 
 /// Longest latency, ms.

@@ -55,9 +55,9 @@ pub struct Sweep {
     /// [eyellipse], an integer in [1, 10000]; each is a row.
     #[arg(long = "samples", default_value_t = 100, value_parser = integer::<usize>(1, MAX_VALUES as u64))]
     eye_samples: usize,
-    /// With --param eye=eyellipse: the seed of those eyes, an integer in [0, 2^64 − 1]; eye i
+    /// With --param eye=eyellipse: the seed of those eyes, an integer in [0, 4294967295] (as every seed of seethru); eye i
     /// of seed s is the same in every sweep, shard and resumed run.
-    #[arg(long, default_value_t = 1, value_parser = integer::<u64>(0, u64::MAX))]
+    #[arg(long, default_value_t = 1, value_parser = integer::<u64>(0, u32::MAX as u64))]
     seed: u64,
     /// With --param eye=eyellipse: the misregistration bound of the share of drivers
     /// (`<out stem>_drivers.json`), arcmin in [1e-6, 10800].
