@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{ExrContent, write_frame};
 use seethru::io::staged::StagedDir;
-use seethru::measure::hazard::{DEFAULT_BOUND_ARCMIN, hazard_frame, hazards_json};
+use seethru::measure::hazard::{DEFAULT_BOUND_ARCMIN, run_hazards_json};
 use seethru::measure::headline::{read_results, summary_text};
 use seethru::measure::holes::{attach_holes, write_hole_mask};
 use seethru::measure::maps::write_metrics_scaled;
@@ -293,22 +293,11 @@ fn write_run(
         write_hole_mask(&out.join("holes.png"), &maps, holes)?;
     }
     let driver = driver_camera(&ctx.scene, options)?;
-    let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
-        .atan()
-        .to_degrees()
-        * 60.0;
-    let hazards = hazard_frame(
-        &ctx.scene,
-        &result.truth,
-        &result.seethru,
-        &maps,
-        hazard_bound,
-        arcmin_per_px,
-    );
+    let hazards = run_hazards_json(ctx, &driver, &result, &maps, hazard_bound);
     // Beside metrics.json (which `measure` recomputes from the frames alone).
     write_text(
         &out.join("hazards.json"),
-        &serde_json::to_string_pretty(&hazards_json(&hazards, hazard_bound))?,
+        &serde_json::to_string_pretty(&hazards)?,
     )?;
     write_metrics_scaled(out, &maps, &result.truth, &metrics, heatmap_max)?;
     // Last: a directory with run.json holds a finished run.

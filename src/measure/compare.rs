@@ -4,8 +4,7 @@
 use anyhow::Result;
 use serde_json::json;
 
-use crate::geometry::camera::Camera;
-use crate::measure::hazard::{hazard_frame, hazards_json};
+use crate::measure::hazard::run_hazards_json;
 use crate::measure::holes::attach_holes;
 use crate::measure::maps::heat_color;
 use crate::measure::metrics::{MetricMaps, measure};
@@ -15,7 +14,7 @@ use crate::render::settings::RenderSettings;
 use crate::render::views::View;
 use crate::system::depth_sensor::SensorKind;
 use crate::system::options::{Method, RunOptions, WorkingDistance};
-use crate::system::pipeline::{RunResult, check_display_seen, driver_camera, run_with_truth};
+use crate::system::pipeline::{check_display_seen, driver_camera, run_with_truth};
 use crate::system::scene_model::check_scene_model;
 use crate::util::color::encode_srgb8;
 use crate::util::progress::Progress;
@@ -97,7 +96,7 @@ pub struct Compared {
 
 /// Runs every candidate at `base` on one scene (the truth rendered once, the same for all)
 /// and measures each with a border band of `band` display pixels; a hidden hazard pixel
-/// counts as shown within `hazard_bound_arcmin` ([`hazard_frame`]).
+/// counts as shown within `hazard_bound_arcmin` ([`crate::measure::hazard::hazard_frame`]).
 pub fn compare(
     ctx: &RenderContext,
     candidates: &[Candidate],
@@ -144,7 +143,7 @@ pub fn compare(
         let misregistration = &display["misregistration_arcmin"];
         let row = json!({
             // Per `hazard = true` object, as `run`'s hazards.json.
-            "hazards": row_hazards(ctx, &driver, &result, &maps, hazard_bound_arcmin),
+            "hazards": run_hazards_json(ctx, &driver, &result, &maps, hazard_bound_arcmin),
             "method": candidate.name(),
             "misregistration_mean_arcmin": misregistration["mean"],
             "misregistration_p95_arcmin": misregistration["p95"],
@@ -168,29 +167,6 @@ pub fn compare(
     }
     progress.finish();
     Ok(out)
-}
-
-/// A row's `hazards`: [`hazards_json`] of the run's driver views at `bound_arcmin`.
-pub fn row_hazards(
-    ctx: &RenderContext,
-    driver: &Camera,
-    result: &RunResult,
-    maps: &MetricMaps,
-    bound_arcmin: f64,
-) -> serde_json::Value {
-    let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
-        .atan()
-        .to_degrees()
-        * 60.0;
-    let hazards = hazard_frame(
-        &ctx.scene,
-        &result.truth,
-        &result.seethru,
-        maps,
-        bound_arcmin,
-        arcmin_per_px,
-    );
-    hazards_json(&hazards, bound_arcmin)
 }
 
 /// Every row's strip (truth | seethru | misregistration | holes over the display's bounding

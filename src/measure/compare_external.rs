@@ -5,7 +5,8 @@
 use anyhow::Result;
 use serde_json::json;
 
-use crate::measure::compare::{Compared, row_hazards, strip};
+use crate::measure::compare::{Compared, strip};
+use crate::measure::hazard::run_hazards_json;
 use crate::measure::metrics::measure;
 use crate::render::integrator::RenderContext;
 use crate::system::capture::{DisplayMap, capture, score};
@@ -43,7 +44,7 @@ pub fn compare_maps(
         let misregistration = &display["misregistration_arcmin"];
         let driver = driver_camera(scene, &options)?;
         let row = json!({
-            "hazards": row_hazards(ctx, &driver, result, &maps, hazard_bound_arcmin),
+            "hazards": run_hazards_json(ctx, &driver, result, &maps, hazard_bound_arcmin),
             "method": format!("map:{name}"),
             "misregistration_mean_arcmin": misregistration["mean"],
             "misregistration_p95_arcmin": misregistration["p95"],

@@ -6,9 +6,12 @@
 
 use serde_json::json;
 
+use crate::geometry::camera::Camera;
 use crate::measure::metrics::MetricMaps;
 use crate::render::frame::Frame;
+use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
+use crate::system::pipeline::RunResult;
 
 /// Default bound of `--hazard-bound-arcmin`: a pixel counts as showing the hazard when the
 /// shown point is within this angle of the true one, arc-minutes.
@@ -249,4 +252,28 @@ pub fn hazard_times(t: &[f64], seen: &[Vec<HazardSeen>], period: f64) -> Vec<Haz
             }
         })
         .collect()
+}
+
+/// [`hazards_json`] of a run's driver views (`driver`: their camera) at `bound_arcmin`: what
+/// `run` writes as hazards.json and every `compare` row carries.
+pub fn run_hazards_json(
+    ctx: &RenderContext,
+    driver: &Camera,
+    result: &RunResult,
+    maps: &MetricMaps,
+    bound_arcmin: f64,
+) -> serde_json::Value {
+    let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
+        .atan()
+        .to_degrees()
+        * 60.0;
+    let hazards = hazard_frame(
+        &ctx.scene,
+        &result.truth,
+        &result.seethru,
+        maps,
+        bound_arcmin,
+        arcmin_per_px,
+    );
+    hazards_json(&hazards, bound_arcmin)
 }
