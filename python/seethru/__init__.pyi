@@ -12,7 +12,11 @@ View = Literal["truth", "occluded", "frontal", "back"]
 Pose = npt.NDArray[np.float64]  # (4, 4) world_from_X, rows [R | t], last row [0, 0, 0, 1]
 
 class Frame:
-    """One rendered view, row 0 at the top; every array owns the Rust buffer (no copy)."""
+    """One rendered view, row 0 at the top; every array views the renderer's buffer (no copy).
+
+    A render's arrays are writable; their `base` owns the buffers, which are recycled for a
+    later render only when no Frame, array or view of them is left. A capture's are read-only.
+    """
 
     view: str
     width: int
@@ -63,8 +67,17 @@ class Scene:
         width: int | None = None,
         height: int | None = None,
         spp: int = 4,
+        out: Frame | None = None,
     ) -> Frame:
-        """Renders a view as `seethru render` does (GIL released; Ctrl-C stops it)."""
+        """Renders a view as `seethru render` does (GIL released; Ctrl-C stops it).
+
+        Without `out`, into a new Frame (its buffers recycled from frames no longer
+        referenced, see `frame_pool`). With `out`, into that Frame's own arrays, in place, and
+        returns it: views of its arrays see the new render. ValueError if `out` is of another
+        view or size, is a capture's (read-only) frame, has an array whose
+        `flags.writeable` is False, or is being rendered into (or read by a seethru call) in
+        another thread. An interrupted render leaves `out` partly rewritten.
+        """
 
 class Run:
     """One run of the see-through system."""
@@ -114,6 +127,10 @@ def run(
 
 def read_frame(path: str | PathLike[str]) -> Frame:
     """Reads an EXR written by `seethru render`/`run` as a Frame."""
+
+def frame_pool(clear: bool = False) -> dict[str, int]:
+    """The freed frame buffers kept for reuse by `Scene.render`: `frames`, `bytes`, and the
+    bounds `max_frames`, `max_bytes` (oldest freed first). `clear=True` frees them first."""
 
 def compare(
     scene: Scene,

@@ -1,18 +1,26 @@
-//! Read-only numpy arrays over the buffers of a capture, without a copy: the one module of
-//! the package with `unsafe` (rust-numpy's `borrow_from_array`, which cannot check that the
-//! memory outlives the array). A capture is kept whole for `score`, so its images cannot be
-//! handed over to numpy as a render's are ([`crate::frame`]); numpy views them instead, with
-//! the [`CaptureBuffers`] object that owns them as the arrays' base. They are read-only:
-//! `score` reads the same buffers through a shared reference, and the capture's fingerprint
-//! is over them.
+//! numpy arrays over buffers Rust keeps, without a copy: the one module of the package with
+//! `unsafe` (rust-numpy's `borrow_from_array`, which cannot check that the memory outlives the
+//! array). Two owners are the arrays' `base` objects and keep the memory alive:
+//!
+//! - [`CaptureBuffers`]: a capture's images, viewed read-only. A capture is kept whole for
+//!   `score`, which reads the same buffers through a shared reference, and the capture's
+//!   fingerprint is over them.
+//! - [`FrameBuffers`]: a render's frame, viewed writable (numpy arrays a user may change, as
+//!   the arrays of a render always were). The frame is never resized or reallocated while
+//!   the owner lives; it is written only by `Scene.render(..., out=frame)`, which holds
+//!   rust-numpy's exclusive borrow of every array while it renders. When the owner is freed
+//!   (no frame, array or view of it is left), its buffers go to [`crate::frame_pool`].
 #![allow(unsafe_code)]
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, MutexGuard};
 
-use numpy::ndarray::{ArrayView, Dimension};
+use numpy::ndarray::{ArrayView, ArrayViewMut, Dimension};
 use numpy::{Element, PyArray, PyArrayMethods};
 use pyo3::prelude::*;
+use seethru::render::frame::Frame;
 use seethru::system::capture::Capture;
+
+use crate::frame_pool;
 
 /// The owner of a capture's buffers and the base object of the arrays that view them.
 /// Frozen: nothing changes the capture after it is made (no `&mut` to it exists).
@@ -34,4 +42,48 @@ pub fn read_only_view<'py, T: Element, D: Dimension>(
     let array = unsafe { PyArray::borrow_from_array(&view, owner.clone().into_any()) };
     array.readwrite().make_nonwriteable();
     array
+}
+
+/// The owner of a render's frame and the base object of the arrays that view it. On drop,
+/// its buffers are kept for the next render of the same size ([`frame_pool::give`]).
+#[pyclass(name = "_FrameBuffers", module = "seethru", frozen)]
+pub struct FrameBuffers {
+    frame: Mutex<Frame>,
+}
+
+impl FrameBuffers {
+    pub fn new(frame: Frame) -> FrameBuffers {
+        FrameBuffers {
+            frame: Mutex::new(frame),
+        }
+    }
+
+    /// The frame, to render into. Only `Scene.render(out=)` calls it, holding rust-numpy's
+    /// exclusive borrow of every array of the frame (so no other Rust code reads them) for
+    /// as long as it writes; the buffers' sizes must not change.
+    pub fn frame(&self) -> MutexGuard<'_, Frame> {
+        self.frame.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+impl Drop for FrameBuffers {
+    fn drop(&mut self) {
+        let frame = self.frame.get_mut().unwrap_or_else(|e| e.into_inner());
+        frame_pool::give(std::mem::replace(frame, Frame::new(0, 0)));
+    }
+}
+
+/// A writable array over the buffer `pick` chooses in `owner`'s frame.
+pub fn frame_view<'py, T: Element, D: Dimension>(
+    owner: &Bound<'py, FrameBuffers>,
+    pick: impl for<'a> FnOnce(&'a mut Frame) -> ArrayViewMut<'a, T, D>,
+) -> Bound<'py, PyArray<T, D>> {
+    let mut frame = owner.get().frame();
+    let view = pick(&mut frame);
+    // SAFETY: `view` is of a buffer of the `Frame` that `owner` holds and never resizes or
+    // reallocates (`FrameBuffers::frame` is used only to write pixels in place); numpy keeps
+    // `owner` alive as the array's base for as long as the array (or a view of it) lives, and
+    // the buffer is recycled only when `owner` is dropped. The pointer comes from a mutable
+    // view, so numpy's writes through it are writes the frame allows.
+    unsafe { PyArray::borrow_from_array(&view, owner.clone().into_any()) }
 }

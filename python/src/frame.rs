@@ -1,21 +1,22 @@
-//! `seethru.Frame`: one render's buffers as numpy arrays. Each array takes over the Rust
-//! allocation it was rendered into (`PyArray::from_owned_array`), or, for a capture's
-//! images, views it read-only ([`crate::borrowed`]): no pixel is copied, and
-//! `Frame._buffer_addresses` records where the allocations were so a test can tell.
-
+//! `seethru.Frame`: one render's buffers as numpy arrays, without a copy. A render's arrays
+//! are writable views of the frame the renderer wrote, owned by their base object
+//! ([`FrameBuffers`]), which gives the buffers to [`crate::frame_pool`] for the next render
+//! once no frame, array or view of them is left; a capture's images are read-only views of
+//! the capture ([`crate::borrowed`]). `Frame._buffer_addresses` records where the buffers
+//! are so a test can tell.
 use std::collections::HashMap;
 use std::path::PathBuf;
 
 use glam::Vec3;
-use numpy::ndarray::{Array2, Array3, ArrayView2, ArrayView3};
-use numpy::{PyArray, PyArray2, PyArray3};
+use numpy::ndarray::{ArrayView2, ArrayView3, ArrayViewMut2, ArrayViewMut3};
+use numpy::{PyArray, PyArray2, PyArray3, PyArrayMethods, PyReadwriteArray2, PyReadwriteArray3};
 use pyo3::prelude::*;
 use seethru::render::frame::Frame;
 use seethru::system::capture::Capture;
 
-use crate::borrowed::{CaptureBuffers, read_only_view};
+use crate::borrowed::{CaptureBuffers, FrameBuffers, frame_view, read_only_view};
 
-use crate::errors::to_py;
+use crate::errors::{bad_value, to_py};
 
 /// One rendered view: colour and every AOV, row 0 at the top, as in the CLI's EXR.
 #[pyclass(name = "Frame", module = "seethru", frozen)]
@@ -51,6 +52,18 @@ pub struct PyFrame {
     /// Where each buffer's Rust allocation started, by attribute name.
     #[pyo3(get, name = "_buffer_addresses")]
     buffer_addresses: HashMap<String, usize>,
+    /// The owner of a render's buffers (writable, recycled when dropped); None for a
+    /// capture's read-only views.
+    buffers: Option<Py<FrameBuffers>>,
+}
+
+/// rust-numpy's exclusive borrows of every array of a frame: while they are held, no other
+/// Rust code (a render into the same frame, a seethru call reading one of its arrays) can
+/// borrow them.
+pub struct WriteBorrows<'py> {
+    _vectors: [PyReadwriteArray3<'py, f32>; 3],
+    _scalars: [PyReadwriteArray2<'py, f32>; 2],
+    _ids: [PyReadwriteArray2<'py, u32>; 2],
 }
 
 #[pymethods]
@@ -64,39 +77,51 @@ impl PyFrame {
 }
 
 impl PyFrame {
-    /// Hands `frame`'s buffers to numpy.
-    pub fn new(py: Python<'_>, view: &str, frame: Frame) -> PyFrame {
+    /// Hands `frame`'s buffers to numpy: writable arrays over them, whose base object
+    /// ([`FrameBuffers`]) owns the frame and gives its buffers to [`crate::frame_pool`] when
+    /// no frame, array or view of it is left.
+    pub fn new(py: Python<'_>, view: &str, frame: Frame) -> PyResult<PyFrame> {
         let (w, h) = (frame.width as usize, frame.height as usize);
+        let (width, height) = (frame.width, frame.height);
+        let owner = Bound::new(py, FrameBuffers::new(frame))?;
         let mut addresses = HashMap::new();
-        let mut vectors = |name: &str, v: Vec<Vec3>| {
-            // Vec3 is three f32 (glam's scalar Vec3, 4-byte aligned): the same allocation,
-            // read as 3n floats.
-            let flat: Vec<f32> = bytemuck::allocation::cast_vec(v);
-            addresses.insert(name.to_string(), flat.as_ptr() as usize);
-            let array = Array3::from_shape_vec((h, w, 3), flat).expect("a frame's buffer size");
-            PyArray::from_owned_array(py, array).unbind()
+        let mut vectors = |name: &str, of: fn(&mut Frame) -> &mut [Vec3]| {
+            frame_view(&owner, |f| {
+                // Vec3 is three f32 (glam's scalar Vec3, 4-byte aligned): the same buffer,
+                // read as 3n floats.
+                let flat: &mut [f32] = bytemuck::cast_slice_mut(of(f));
+                addresses.insert(name.to_string(), flat.as_ptr() as usize);
+                ArrayViewMut3::from_shape((h, w, 3), flat).expect("a frame's buffer size")
+            })
+            .unbind()
         };
-        let colour = vectors("colour", frame.color);
-        let position = vectors("position", frame.position);
-        let normal = vectors("normal", frame.normal);
-        let mut scalars = |name: &str, v: Vec<f32>| {
-            addresses.insert(name.to_string(), v.as_ptr() as usize);
-            let array = Array2::from_shape_vec((h, w), v).expect("a frame's buffer size");
-            PyArray::from_owned_array(py, array).unbind()
+        let colour = vectors("colour", |f| &mut f.color);
+        let position = vectors("position", |f| &mut f.position);
+        let normal = vectors("normal", |f| &mut f.normal);
+        let mut scalars = |name: &str, of: fn(&mut Frame) -> &mut [f32]| {
+            frame_view(&owner, |f| {
+                let v = of(f);
+                addresses.insert(name.to_string(), v.as_ptr() as usize);
+                ArrayViewMut2::from_shape((h, w), v).expect("a frame's buffer size")
+            })
+            .unbind()
         };
-        let depth = scalars("depth", frame.depth);
-        let camera_z = scalars("camera_z", frame.camera_z);
-        let mut ids = |name: &str, v: Vec<u32>| {
-            addresses.insert(name.to_string(), v.as_ptr() as usize);
-            let array = Array2::from_shape_vec((h, w), v).expect("a frame's buffer size");
-            PyArray::from_owned_array(py, array).unbind()
+        let depth = scalars("depth", |f| &mut f.depth);
+        let camera_z = scalars("camera_z", |f| &mut f.camera_z);
+        let mut ids = |name: &str, of: fn(&mut Frame) -> &mut [u32]| {
+            frame_view(&owner, |f| {
+                let v = of(f);
+                addresses.insert(name.to_string(), v.as_ptr() as usize);
+                ArrayViewMut2::from_shape((h, w), v).expect("a frame's buffer size")
+            })
+            .unbind()
         };
-        let object_id = ids("object_id", frame.object_id);
-        let part_id = ids("part_id", frame.part_id);
-        PyFrame {
+        let object_id = ids("object_id", |f| &mut f.object_id);
+        let part_id = ids("part_id", |f| &mut f.part_id);
+        Ok(PyFrame {
             view: view.to_string(),
-            width: frame.width,
-            height: frame.height,
+            width,
+            height,
             colour,
             depth,
             camera_z,
@@ -105,7 +130,67 @@ impl PyFrame {
             object_id,
             part_id,
             buffer_addresses: addresses,
+            buffers: Some(owner.unbind()),
+        })
+    }
+
+    /// The frame's buffers to render `view` at `width`×`height` into (`Scene.render(out=)`),
+    /// with rust-numpy's exclusive borrow of each of its arrays, held by the caller while it
+    /// writes; or the reason it cannot be written, as a ValueError.
+    pub fn render_target<'py>(
+        &self,
+        py: Python<'py>,
+        view: &str,
+        width: u32,
+        height: u32,
+    ) -> PyResult<(Py<FrameBuffers>, WriteBorrows<'py>)> {
+        let Some(buffers) = &self.buffers else {
+            return Err(bad_value(format!(
+                "out: this {} frame's arrays are read-only views of a capture; pass a frame returned by Scene.render",
+                self.view
+            )));
+        };
+        if self.view != view {
+            return Err(bad_value(format!(
+                "out: the frame is a {:?} view and this render is {view:?}; pass a frame rendered from the same view",
+                self.view
+            )));
         }
+        if (self.width, self.height) != (width, height) {
+            return Err(bad_value(format!(
+                "out: the frame is {}×{} and this render is {width}×{height} (width×height); pass a frame of the same size",
+                self.width, self.height
+            )));
+        }
+        fn borrow<'py, T: numpy::Element, D: numpy::ndarray::Dimension>(
+            name: &str,
+            array: &Bound<'py, PyArray<T, D>>,
+        ) -> PyResult<numpy::PyReadwriteArray<'py, T, D>> {
+            array.try_readwrite().map_err(|e| match e {
+                numpy::BorrowError::NotWriteable => bad_value(format!(
+                    "out: frame.{name} is read-only (its flags.writeable is False); pass a frame whose arrays are all writable"
+                )),
+                _ => bad_value(format!(
+                    "out: frame.{name} is in use by another call (a render into it, or a seethru call reading it in another thread); wait for it to return"
+                )),
+            })
+        }
+        let borrows = WriteBorrows {
+            _vectors: [
+                borrow("colour", self.colour.bind(py))?,
+                borrow("position", self.position.bind(py))?,
+                borrow("normal", self.normal.bind(py))?,
+            ],
+            _scalars: [
+                borrow("depth", self.depth.bind(py))?,
+                borrow("camera_z", self.camera_z.bind(py))?,
+            ],
+            _ids: [
+                borrow("object_id", self.object_id.bind(py))?,
+                borrow("part_id", self.part_id.bind(py))?,
+            ],
+        };
+        Ok((buffers.clone_ref(py), borrows))
     }
 
     /// Read-only numpy views of the buffers of the frame `pick` chooses in `owner`'s
@@ -159,6 +244,7 @@ impl PyFrame {
             object_id,
             part_id,
             buffer_addresses: addresses,
+            buffers: None,
         }
     }
 }
@@ -173,5 +259,5 @@ pub fn read_frame(py: Python<'_>, path: PathBuf) -> PyResult<PyFrame> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    Ok(PyFrame::new(py, &name, frame))
+    PyFrame::new(py, &name, frame)
 }

@@ -1,13 +1,15 @@
 //! `seethru._native`: the Python extension module of the `seethru` package. Scenes, renders
 //! and runs of the library, with every buffer handed to numpy without a copy; the pure-Python
 //! part (`python/seethru/__init__.py`) re-exports it with the documentation.
-// One module, `borrowed`, allows it (numpy views of a capture's buffers), with its reasons.
+// One module, `borrowed`, allows it (numpy views of a capture's and a render's buffers), with
+// its reasons.
 #![deny(unsafe_code)]
 
 mod borrowed;
 mod capture;
 mod errors;
 mod frame;
+mod frame_pool;
 mod interrupt;
 mod measures;
 mod options;
@@ -24,6 +26,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<run::PyRun>()?;
     m.add_class::<capture::PyCapture>()?;
     m.add_class::<borrowed::CaptureBuffers>()?;
+    m.add_class::<borrowed::FrameBuffers>()?;
+    m.add_function(wrap_pyfunction!(frame_pool::frame_pool, m)?)?;
     m.add_function(wrap_pyfunction!(capture::capture, m)?)?;
     m.add_function(wrap_pyfunction!(capture::score, m)?)?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;

@@ -131,7 +131,7 @@ impl PyRun {
             ("display", result.display),
             ("seethru", result.seethru),
         ] {
-            dict.set_item(name, PyFrame::new(py, name, frame))?;
+            dict.set_item(name, PyFrame::new(py, name, frame)?)?;
         }
         Ok(PyRun {
             frames: dict.unbind(),

@@ -9,6 +9,7 @@ use numpy::PyArray2;
 use numpy::ndarray::Array2;
 use pyo3::prelude::*;
 use seethru::geometry::camera::Camera;
+use seethru::render::frame::Frame;
 use seethru::render::integrator::RenderContext;
 use seethru::render::settings::{MAX_SPP, RenderSettings, resized};
 use seethru::render::views::View;
@@ -18,6 +19,7 @@ use seethru::system::memory::{DEFAULT_MAX_MEMORY_GIB, check_memory, render_estim
 
 use crate::errors::{bad_value, to_py};
 use crate::frame::PyFrame;
+use crate::frame_pool;
 use crate::interrupt::detached;
 use crate::options::{int_in, pixels};
 
@@ -229,15 +231,18 @@ impl PyScene {
         Ok((camera.width, camera.height))
     }
 
-    /// Renders one view (truth, occluded, frontal, back) as `seethru render` does.
-    #[pyo3(signature = (view, width=None, height=None, spp=4))]
+    /// Renders one view (truth, occluded, frontal, back) as `seethru render` does, into a
+    /// new frame (its buffers recycled from frames Python has dropped, [`crate::frame_pool`])
+    /// or, with `out`, into that frame's own arrays, which it returns.
+    #[pyo3(signature = (view, width=None, height=None, spp=4, out=None))]
     fn render(
         slf: &Bound<'_, Self>,
         view: &str,
         width: Option<i64>,
         height: Option<i64>,
         spp: i64,
-    ) -> PyResult<PyFrame> {
+        out: Option<Bound<'_, PyFrame>>,
+    ) -> PyResult<Py<PyFrame>> {
         let py = slf.py();
         let view = parse_view(view)?;
         let spp = int_in("spp", spp, 1, MAX_SPP as i64)? as u32;
@@ -248,19 +253,38 @@ impl PyScene {
         };
         let camera =
             resized(view.camera(&scene), width, height, "--width/--height").map_err(to_py)?;
-        check_memory(&render_estimate(&[camera]), DEFAULT_MAX_MEMORY_GIB).map_err(to_py)?;
         let settings = RenderSettings {
             spp,
             progress: false,
         };
-        let (context, frame) = detached(py, move || -> anyhow::Result<_> {
+        let render = move |frame: &mut Frame| -> anyhow::Result<Arc<RenderContext>> {
             let context = context_for(cached, scene)?;
-            let (frame, _) = context.render(&camera, view.bit(), settings, view.name());
-            Ok((context, frame))
-        })?
-        .map_err(to_py)?;
-        slf.borrow_mut().context = Some(context);
-        Ok(PyFrame::new(py, view.name(), frame))
+            context.render_into(&camera, view.bit(), settings, frame, view.name());
+            Ok(context)
+        };
+        match out {
+            Some(out) => {
+                // Held until the render has returned: no other call can borrow the arrays.
+                let (buffers, _borrows) =
+                    out.get()
+                        .render_target(py, view.name(), camera.width, camera.height)?;
+                let buffers = buffers.get();
+                let context = detached(py, move || render(&mut buffers.frame()))?.map_err(to_py)?;
+                slf.borrow_mut().context = Some(context);
+                Ok(out.unbind())
+            }
+            None => {
+                check_memory(&render_estimate(&[camera]), DEFAULT_MAX_MEMORY_GIB).map_err(to_py)?;
+                let (context, frame) = detached(py, move || -> anyhow::Result<_> {
+                    let mut frame = frame_pool::take(camera.width, camera.height);
+                    let context = render(&mut frame)?;
+                    Ok((context, frame))
+                })?
+                .map_err(to_py)?;
+                slf.borrow_mut().context = Some(context);
+                Py::new(py, PyFrame::new(py, view.name(), frame)?)
+            }
+        }
     }
 
     fn __repr__(&self) -> String {

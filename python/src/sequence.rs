@@ -249,8 +249,8 @@ impl PySequence {
             vehicle_yaw_deg: record.vehicle_yaw_deg,
             metrics: json_to_py(py, &json)?,
             hazards: json_to_py(py, &hazards)?,
-            truth: Py::new(py, PyFrame::new(py, "truth", truth))?,
-            seethru: Py::new(py, PyFrame::new(py, "seethru", seethru))?,
+            truth: Py::new(py, PyFrame::new(py, "truth", truth)?)?,
+            seethru: Py::new(py, PyFrame::new(py, "seethru", seethru)?)?,
             misregistration,
         }))
     }
