@@ -13,6 +13,7 @@ use glam::{DVec2, DVec3, Vec3};
 use serde_json::json;
 
 use crate::analysis::physical::ARCMIN_PER_RAD;
+use crate::render::accel::{Hit, make_ray};
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
@@ -196,6 +197,25 @@ fn psnr_over(a: &[[u8; 3]], b: &[[u8; 3]], pixels: &[usize]) -> f64 {
     }
 }
 
+/// Whether the closest surface the frontal camera sees along the ray from `origin` (unit
+/// `dir`) is nearer than `reach` m: exactly `ctx.trace(origin, dir, view_bit::FRONTAL)`'s
+/// hit at `t < reach`, but the traversal stops a little beyond `reach` and nothing is shaded.
+fn nearer_than(ctx: &RenderContext, origin: Vec3, dir: Vec3, reach: f64) -> bool {
+    // Every f32 below `reach` is at most `reach as f32`, below this bound.
+    let tmax = if reach.is_finite() {
+        (reach as f32).max(0.0).next_up().next_up()
+    } else {
+        f32::INFINITY
+    };
+    let ray = make_ray(origin, dir, 0.0, tmax);
+    let near = |hit: Option<Hit>| hit.is_some_and(|h| (h.t as f64) < reach);
+    near(ctx.accel.closest(&ray, view_bit::FRONTAL))
+        || ctx
+            .moving
+            .as_ref()
+            .is_some_and(|m| near(m.accel.closest(&ray, view_bit::FRONTAL)))
+}
+
 /// Why the frontal camera cannot see a display pixel's truth point.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Missing {
@@ -296,18 +316,14 @@ pub fn measure(
             if !inside {
                 out.missing = Some(Missing::OutOfView);
             } else {
-                let hit = ctx.trace(
-                    frontal_origin.as_vec3(),
-                    to.normalize().as_vec3(),
-                    view_bit::FRONTAL,
-                );
                 // A surface short of the point (any surface, towards a sky direction).
                 let reach = if distance.is_finite() {
                     distance - 1e-3 * distance.max(1.0)
                 } else {
                     f64::INFINITY
                 };
-                if hit.is_some_and(|h| (h.t as f64) < reach) {
+                let origin = frontal_origin.as_vec3();
+                if nearer_than(ctx, origin, to.normalize().as_vec3(), reach) {
                     out.missing = Some(Missing::Hidden);
                 }
             }
