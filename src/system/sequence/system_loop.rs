@@ -122,6 +122,11 @@ pub struct SystemLoop {
     pub eye_given: Option<DVec3>,
     /// The back camera's image and where the face was in it.
     back_tracker: BackTracker,
+    /// Whether the back camera renders and searches only around the last face
+    /// ([`BackTracker`]); `false`: the whole image every time (the twin the tests compare).
+    pub track_face: bool,
+    /// Back camera pixels rendered for the head estimates, summed over the refreshes.
+    pub back_pixels: u64,
 }
 
 impl SystemLoop {
@@ -182,6 +187,8 @@ impl SystemLoop {
             inputs: None,
             eye_given: None,
             back_tracker: BackTracker::new(&rig_back),
+            track_face: true,
+            back_pixels: 0,
         })
     }
 
@@ -235,10 +242,13 @@ impl SystemLoop {
                     spp: self.options.run.spp.max(BACK_MIN_SPP),
                     progress: false,
                 };
-                let detection = self
-                    .back_tracker
-                    .detect(&ctx, settings)
-                    .with_context(|| format!("head estimate at t = {} s", short(t)))?;
+                if !self.track_face {
+                    self.back_tracker.region = None;
+                }
+                let (detection, pixels) = self.back_tracker.detect(&ctx, settings);
+                self.back_pixels += pixels;
+                let detection =
+                    detection.with_context(|| format!("head estimate at t = {} s", short(t)))?;
                 if run.require_confident_head && !detection.confidence.is_confident() {
                     bail!(
                         "--require-confident-head: {}",
@@ -518,12 +528,13 @@ impl BackTracker {
         }
     }
 
-    /// The head detection in the back camera's image of `ctx` (its true back camera).
+    /// The head detection in the back camera's image of `ctx` (its true back camera), and the
+    /// pixels rendered for it.
     fn detect(
         &mut self,
         ctx: &RenderContext,
         settings: RenderSettings,
-    ) -> Result<FaceDetection, DetectError> {
+    ) -> (Result<FaceDetection, DetectError>, u64) {
         let back = ctx.scene.back;
         if (self.frame.width, self.frame.height) != (back.width, back.height) {
             self.frame = Frame::new(back.width, back.height);
@@ -532,8 +543,10 @@ impl BackTracker {
         let render = |frame: &mut Frame, region: PixelRect| {
             ctx.render_rect(&back, view_bit::BACK, None, settings, region, frame, "back");
         };
+        let mut pixels = 0;
         let tracked = self.region.and_then(|region| {
             render(&mut self.frame, region);
+            pixels += region.pixels();
             detect_in(&self.frame, region)
                 .ok()
                 .filter(|found| found.whole)
@@ -544,12 +557,15 @@ impl BackTracker {
                 self.region = None;
                 let full = PixelRect::full(&back);
                 render(&mut self.frame, full);
-                detect_in(&self.frame, full)?
+                pixels += full.pixels();
+                match detect_in(&self.frame, full) {
+                    Ok(found) => found,
+                    Err(e) => return (Err(e), pixels),
+                }
             }
         };
-        let (detection, used) = (found.detection, found.used);
-        self.region = Some(grow_region(used, &back));
-        Ok(detection)
+        self.region = Some(grow_region(found.used, &back));
+        (Ok(found.detection), pixels)
     }
 }
 
