@@ -13,6 +13,7 @@ use glam::{DVec2, DVec3, Vec3};
 use serde_json::json;
 
 use crate::analysis::physical::ARCMIN_PER_RAD;
+use crate::render::accel::{Hit, make_ray};
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
@@ -93,10 +94,13 @@ fn bounding_box(mask: &[bool], w: usize) -> Option<(usize, usize, usize, usize)>
 /// pixels of `mask`: near the mask's edge a window averages over its pixels inside the mask,
 /// so nothing outside the mask reaches any score. NaN outside the mask.
 pub fn masked_ssim_map(a: &[f64], b: &[f64], mask: &[bool], w: usize, h: usize) -> Vec<f64> {
+    use rayon::prelude::*;
     let (c1, c2) = ((0.01f64 * 255.0).powi(2), (0.03f64 * 255.0).powi(2));
     let r = 3i64;
     let mut out = vec![f64::NAN; w * h];
-    for i in (0..w * h).filter(|&i| mask[i]) {
+    let inside: Vec<usize> = (0..w * h).filter(|&i| mask[i]).collect();
+    // Each pixel's window on its own, in parallel: the same map for any number of threads.
+    let score = |i: usize| {
         let (x, y) = ((i % w) as i64, (i / w) as i64);
         let (mut sa, mut sb, mut saa, mut sbb, mut sab, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
         for yy in (y - r).max(0)..=(y + r).min(h as i64 - 1) {
@@ -116,8 +120,11 @@ pub fn masked_ssim_map(a: &[f64], b: &[f64], mask: &[bool], w: usize, h: usize) 
         }
         let (ma, mb) = (sa / n, sb / n);
         let (va, vb, cov) = (saa / n - ma * ma, sbb / n - mb * mb, sab / n - ma * mb);
-        out[i] =
-            ((2.0 * ma * mb + c1) * (2.0 * cov + c2)) / ((ma * ma + mb * mb + c1) * (va + vb + c2));
+        ((2.0 * ma * mb + c1) * (2.0 * cov + c2)) / ((ma * ma + mb * mb + c1) * (va + vb + c2))
+    };
+    let scores: Vec<f64> = inside.par_iter().map(|&i| score(i)).collect();
+    for (&i, v) in inside.iter().zip(scores) {
+        out[i] = v;
     }
     out
 }
@@ -165,8 +172,15 @@ fn masked_flip_map(
 
 /// PSNR (dB) of 8-bit sRGB colours over the pixels of `mask`.
 pub fn psnr(a: &[[u8; 3]], b: &[[u8; 3]], mask: &[bool]) -> f64 {
+    let pixels: Vec<usize> = (0..mask.len()).filter(|&i| mask[i]).collect();
+    psnr_over(a, b, &pixels)
+}
+
+/// PSNR (dB) of 8-bit sRGB colours over the pixels `pixels` (indices, summed in this order).
+fn psnr_over(a: &[[u8; 3]], b: &[[u8; 3]], pixels: &[usize]) -> f64 {
     let (mut sum, mut n) = (0.0, 0usize);
-    for ((x, y), _) in a.iter().zip(b).zip(mask).filter(|(_, m)| **m) {
+    for &i in pixels {
+        let (x, y) = (a[i], b[i]);
         for c in 0..3 {
             sum += (x[c] as f64 - y[c] as f64).powi(2);
         }
@@ -181,6 +195,40 @@ pub fn psnr(a: &[[u8; 3]], b: &[[u8; 3]], mask: &[bool]) -> f64 {
     } else {
         10.0 * (255.0 * 255.0 / mse).log10()
     }
+}
+
+/// Whether the closest surface the frontal camera sees along the ray from `origin` (unit
+/// `dir`) is nearer than `reach` m: exactly `ctx.trace(origin, dir, view_bit::FRONTAL)`'s
+/// hit at `t < reach`, but the traversal stops a little beyond `reach` and nothing is shaded.
+fn nearer_than(ctx: &RenderContext, origin: Vec3, dir: Vec3, reach: f64) -> bool {
+    // Every f32 below `reach` is at most `reach as f32`, below this bound.
+    let tmax = if reach.is_finite() {
+        (reach as f32).max(0.0).next_up().next_up()
+    } else {
+        f32::INFINITY
+    };
+    let ray = make_ray(origin, dir, 0.0, tmax);
+    let near = |hit: Option<Hit>| hit.is_some_and(|h| (h.t as f64) < reach);
+    near(ctx.accel.closest(&ray, view_bit::FRONTAL))
+        || ctx
+            .moving
+            .as_ref()
+            .is_some_and(|m| near(m.accel.closest(&ray, view_bit::FRONTAL)))
+}
+
+/// Why the frontal camera cannot see a display pixel's truth point.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Missing {
+    OutOfView,
+    Hidden,
+}
+
+/// One display pixel's measurements.
+struct Measured {
+    misregistration: f32,
+    missing: Option<Missing>,
+    class: PixelClass,
+    sides: [bool; 4],
 }
 
 /// What one display pixel shows, for the statistics.
@@ -215,10 +263,12 @@ pub fn measure(
         .zip(&occluded.part_id)
         .map(|(&o, &p)| ctx.world.is_display(o, p))
         .collect();
+    // Every statistic is over display pixels, taken in index order (row by row): the same
+    // sums as a pass over the whole frame, without visiting the rest of it.
+    let on_display: Vec<usize> = (0..w * h).filter(|&i| display[i]).collect();
     let mut misregistration = vec![f32::NAN; w * h];
     let mut missing = vec![false; w * h];
     let mut class = vec![PixelClass::default(); w * h];
-    let (mut out_of_view, mut hidden) = (0usize, 0usize);
     // Which side bands each pixel is in: left, right, top, bottom.
     let mut sides = vec![[false; 4]; w * h];
     let frontal = &scene.frontal;
@@ -228,11 +278,18 @@ pub fn measure(
         })
     };
     let frontal_origin = frontal.position();
-    for i in (0..w * h).filter(|&i| display[i]) {
+    // Each display pixel on its own (one ray towards the frontal camera each), in parallel.
+    let per_pixel = |i: usize| {
+        let mut out = Measured {
+            misregistration: f32::NAN,
+            missing: None,
+            class: PixelClass::default(),
+            sides: [false; 4],
+        };
         let on_display = obstacle_from_world.transform_point3(occluded.position[i].as_dvec3());
         let u = (on_display.x / obstacle.width + 0.5) * dw as f64;
         let v = (0.5 - on_display.y / obstacle.height) * dh as f64;
-        sides[i] = [
+        out.sides = [
             u < band as f64,
             u >= (dw - band) as f64,
             v < band as f64,
@@ -257,61 +314,76 @@ pub fn measure(
                 )
             };
             if !inside {
-                missing[i] = true;
-                out_of_view += 1;
+                out.missing = Some(Missing::OutOfView);
             } else {
-                let hit = ctx.trace(
-                    frontal_origin.as_vec3(),
-                    to.normalize().as_vec3(),
-                    view_bit::FRONTAL,
-                );
                 // A surface short of the point (any surface, towards a sky direction).
                 let reach = if distance.is_finite() {
                     distance - 1e-3 * distance.max(1.0)
                 } else {
                     f64::INFINITY
                 };
-                if hit.is_some_and(|h| (h.t as f64) < reach) {
-                    missing[i] = true;
-                    hidden += 1;
+                let origin = frontal_origin.as_vec3();
+                if nearer_than(ctx, origin, to.normalize().as_vec3(), reach) {
+                    out.missing = Some(Missing::Hidden);
                 }
             }
         }
         if seethru.object_id[i] == MISSING_ID {
-            class[i].blank = true;
-            continue;
+            out.class.blank = true;
+            return out;
         }
         let shown_dir = shown_direction(seethru.position[i], seethru.normal[i], driver_eye);
         match (shown_dir, true_dir) {
             (Some(a), Some(b)) => {
-                misregistration[i] = (angle_between(a, b) * ARCMIN_PER_RAD) as f32;
-                class[i].truth_sky = !t.is_finite();
-                class[i].shown_sky = !seethru.position[i].is_finite();
+                out.misregistration = (angle_between(a, b) * ARCMIN_PER_RAD) as f32;
+                out.class.truth_sky = !t.is_finite();
+                out.class.shown_sky = !seethru.position[i].is_finite();
             }
-            _ => class[i].undefined = true,
+            _ => out.class.undefined = true,
         }
+        out
+    };
+    let measured: Vec<Measured> = {
+        use rayon::prelude::*;
+        on_display.par_iter().map(|&i| per_pixel(i)).collect()
+    };
+    let (mut out_of_view, mut hidden) = (0usize, 0usize);
+    for (&i, m) in on_display.iter().zip(&measured) {
+        misregistration[i] = m.misregistration;
+        missing[i] = m.missing.is_some();
+        out_of_view += usize::from(m.missing == Some(Missing::OutOfView));
+        hidden += usize::from(m.missing == Some(Missing::Hidden));
+        class[i] = m.class;
+        sides[i] = m.sides;
     }
-    let count = display.iter().filter(|&&m| m).count();
-    let count_where = |keep: &dyn Fn(usize) -> bool| (0..w * h).filter(|&i| keep(i)).count();
+    let count = on_display.len();
+    let count_where =
+        |keep: &dyn Fn(usize) -> bool| on_display.iter().filter(|&&i| keep(i)).count();
     let driver_pixel_arcmin = (2.0 * scene.driver.tan_half_x() / w as f64).atan() * ARCMIN_PER_RAD;
-    let srgb_t: Vec<[u8; 3]> = truth.color.iter().map(|&c| encode_srgb8(c)).collect();
-    let srgb_s: Vec<[u8; 3]> = seethru.color.iter().map(|&c| encode_srgb8(c)).collect();
-    let lum_t: Vec<f64> = srgb_t.iter().map(|&c| luminance(c)).collect();
-    let lum_s: Vec<f64> = srgb_s.iter().map(|&c| luminance(c)).collect();
+    // Colours of the display's pixels only (nothing else is read; black elsewhere).
+    let (mut srgb_t, mut srgb_s) = (vec![[0u8; 3]; w * h], vec![[0u8; 3]; w * h]);
+    let (mut lum_t, mut lum_s) = (vec![0.0; w * h], vec![0.0; w * h]);
+    for &i in &on_display {
+        srgb_t[i] = encode_srgb8(truth.color[i]);
+        srgb_s[i] = encode_srgb8(seethru.color[i]);
+        lum_t[i] = luminance(srgb_t[i]);
+        lum_s[i] = luminance(srgb_s[i]);
+    }
     let ssim = masked_ssim_map(&lum_t, &lum_s, &display, w, h);
     // FLIP with the driver's eye as the observer: pixels per degree of the driver's camera.
     let ppd = w as f32 / (2.0 * scene.driver.half_angle_x.to_degrees() as f32);
     let flip = masked_flip_map(&srgb_t, &srgb_s, &display, w, ppd);
     let region = |keep: &dyn Fn(usize) -> bool| {
-        let mask: Vec<bool> = (0..w * h).map(keep).collect();
-        let pixels = mask.iter().filter(|&&m| m).count();
-        let blank = count_where(&|i| mask[i] && class[i].blank);
-        let mut values: Vec<f64> = (0..w * h)
-            .filter(|&i| mask[i] && misregistration[i].is_finite())
-            .map(|i| misregistration[i] as f64)
+        let pixels_in: Vec<usize> = on_display.iter().copied().filter(|&i| keep(i)).collect();
+        let pixels = pixels_in.len();
+        let blank = pixels_in.iter().filter(|&&i| class[i].blank).count();
+        let mut values: Vec<f64> = pixels_in
+            .iter()
+            .filter(|&&i| misregistration[i].is_finite())
+            .map(|&i| misregistration[i] as f64)
             .collect();
-        let over = |map: &[f64]| mean((0..w * h).filter(|&i| mask[i]).map(|i| map[i]));
-        let colour_error = mean((0..w * h).filter(|&i| mask[i]).map(|i| {
+        let over = |map: &[f64]| mean(pixels_in.iter().map(|&i| map[i]));
+        let colour_error = mean(pixels_in.iter().map(|&i| {
             (0..3)
                 .map(|c| (srgb_t[i][c] as f64 - srgb_s[i][c] as f64).abs())
                 .sum::<f64>()
@@ -323,7 +395,7 @@ pub fn measure(
             "blank_pixels": blank,
             "misregistration_arcmin": stats(&mut values),
             "mean_abs_colour_error_8bit": colour_error,
-            "psnr_db": psnr(&srgb_t, &srgb_s, &mask),
+            "psnr_db": psnr_over(&srgb_t, &srgb_s, &pixels_in),
             "ssim": over(&ssim),
             "flip_mean": over(&flip),
         })
@@ -341,10 +413,11 @@ pub fn measure(
         .collect();
     let blank = count_where(&|i| display[i] && class[i].blank);
     let mean_px = mean(
-        misregistration
+        on_display
             .iter()
+            .map(|&i| misregistration[i])
             .filter(|v| v.is_finite())
-            .map(|&v| v as f64),
+            .map(|v| v as f64),
     ) / driver_pixel_arcmin;
     let sky = |truth_sky: bool, shown_sky: bool| {
         count_where(&|i| {

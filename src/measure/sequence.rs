@@ -128,6 +128,9 @@ pub struct SequenceRun {
     /// Truth, `occluded` and metrics, seconds.
     pub truth_seconds: f64,
     pub metrics_seconds: f64,
+    /// Wall time of making and measuring the frames ([`SequenceStepper::step`]): the
+    /// setup and what the caller does with each frame (writing files) excluded, seconds.
+    pub stepping_seconds: f64,
     pub total_seconds: f64,
     pub window: PixelRect,
     /// Frontal pixels rendered per refresh, on average.
@@ -245,12 +248,20 @@ pub struct SequenceStepper {
     region: PixelRect,
     truth: Frame,
     seethru: Frame,
+    /// The occluded view, kept between frames: only what changes is copied and rendered.
+    occluded: Frame,
+    /// The pixels of `seethru` and `occluded` rendered over the truth at the last frame.
+    seethru_region: PixelRect,
+    occluded_region: PixelRect,
+    /// The capture of the last frame made, until [`SequenceStepper::step`] hands it out.
+    capture: Option<Capture>,
     maps: Option<MetricMaps>,
     metrics_json: serde_json::Value,
     records: Vec<FrameRecord>,
     refreshes: std::collections::BTreeSet<i64>,
     truth_seconds: f64,
     metrics_seconds: f64,
+    stepping_seconds: f64,
     start: Instant,
 }
 
@@ -287,6 +298,10 @@ impl SequenceStepper {
         let frames = system.options.timeline.frames();
         Ok(SequenceStepper {
             seethru: truth.clone(),
+            occluded: truth.clone(),
+            seethru_region: NOTHING,
+            occluded_region: NOTHING,
+            capture: None,
             truth,
             system,
             scene: scene.clone(),
@@ -301,6 +316,7 @@ impl SequenceStepper {
             refreshes: Default::default(),
             truth_seconds: 0.0,
             metrics_seconds: 0.0,
+            stepping_seconds: 0.0,
             start,
         })
     }
@@ -323,8 +339,32 @@ impl SequenceStepper {
 
     /// Makes and measures the next displayed frame; `None` after the last.
     pub fn step(&mut self) -> Result<Option<FrameStep<'_>>> {
+        let start = Instant::now();
+        let made = self.make_step()?;
+        self.stepping_seconds += start.elapsed().as_secs_f64();
+        Ok(if made { Some(self.last_step()) } else { None })
+    }
+
+    /// The frame [`SequenceStepper::make_step`] made last.
+    fn last_step(&mut self) -> FrameStep<'_> {
+        let capture = self.capture.take();
+        let record = self.records.last().expect("a frame was made");
+        let images = self.maps.as_ref().map(|maps| FrameImages {
+            record,
+            truth: &self.truth,
+            seethru: &self.seethru,
+            maps,
+            metrics_json: &self.metrics_json,
+            window: self.window,
+            capture,
+        });
+        FrameStep { record, images }
+    }
+
+    /// Makes and measures the next displayed frame; false after the last.
+    fn make_step(&mut self) -> Result<bool> {
         let Some(k) = self.next_frame() else {
-            return Ok(None);
+            return Ok(false);
         };
         let system = &mut self.system;
         let times = system.options.timeline.times(k);
@@ -351,17 +391,28 @@ impl SequenceStepper {
         if !self.how.metrics {
             system.render_seethru(&ctx, &mut self.seethru);
             self.records.push(record);
-            return Ok(Some(FrameStep {
-                record: self.records.last().expect("just pushed"),
-                images: None,
-            }));
+            return Ok(true);
         }
         let t0 = Instant::now();
         let driver = ctx.scene.driver;
-        let occluded = render_truth_and_occluded(&ctx, self.settings, self.region, &mut self.truth);
+        self.occluded_region = render_truth_and_occluded(
+            &ctx,
+            self.settings,
+            self.region,
+            &mut self.truth,
+            &mut self.occluded,
+            self.occluded_region,
+        );
         self.truth_seconds += t0.elapsed().as_secs_f64();
-        self.seethru.clone_from(&self.truth);
-        system.render_seethru(&ctx, &mut self.seethru);
+        // `seethru` is the truth but where the display and the obstacle can be: the pixels
+        // the truth or the last `seethru` changed are copied, the rest already are the truth.
+        copy_rect(
+            &self.truth,
+            &mut self.seethru,
+            union(self.region, self.seethru_region),
+        );
+        self.seethru_region = system.render_seethru(&ctx, &mut self.seethru);
+        let occluded = &self.occluded;
         let t1 = Instant::now();
         // Missing pixels are those the frontal camera, where it was at capture, cannot see.
         let mut measured = ctx.scene.clone();
@@ -371,7 +422,7 @@ impl SequenceStepper {
             &ctx,
             &measured,
             driver.position(),
-            [truth, seethru, &occluded],
+            [truth, seethru, occluded],
             self.how.band,
         );
         let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
@@ -380,7 +431,7 @@ impl SequenceStepper {
             * 60.0;
         record.hazards = hazard_seen(
             &self.scene,
-            [truth, seethru, &occluded],
+            [truth, seethru, occluded],
             &maps,
             self.hazard_bound_arcmin,
             arcmin_per_px,
@@ -408,19 +459,8 @@ impl SequenceStepper {
         self.records.push(record);
         self.maps = Some(maps);
         self.metrics_json = json;
-        let record = self.records.last().expect("just pushed");
-        Ok(Some(FrameStep {
-            record,
-            images: Some(FrameImages {
-                record,
-                truth: &self.truth,
-                seethru: &self.seethru,
-                maps: self.maps.as_ref().expect("just set"),
-                metrics_json: &self.metrics_json,
-                window: self.window,
-                capture,
-            }),
-        }))
+        self.capture = capture;
+        Ok(true)
     }
 
     /// What the sequence produced besides its frames, once every frame is made.
@@ -431,6 +471,7 @@ impl SequenceStepper {
             system: self.system.seconds,
             truth_seconds: self.truth_seconds,
             metrics_seconds: self.metrics_seconds,
+            stepping_seconds: self.stepping_seconds,
             total_seconds: self.start.elapsed().as_secs_f64(),
             window: self.window,
             frontal_pixels_per_refresh: self.system.frontal_pixels as f64 / refreshes as f64,
@@ -438,15 +479,20 @@ impl SequenceStepper {
     }
 }
 
-/// Renders the driver's truth view into `truth` within `region`, and returns the occluded view:
-/// the truth with the pixels the obstacle and display change rendered again. The measured
-/// sequence and the Python package's stepped sequence both make their frames so.
+/// Renders the driver's truth view into `truth` within `region`, and the occluded view into
+/// `occluded`: the truth with the pixels the obstacle and display change rendered again. The
+/// measured sequence and the Python package's stepped sequence both make their frames so.
+/// `occluded` holds the last frame's occluded view, and `last` is what this function
+/// returned then (its re-rendered pixels): only `region` and `last` are copied from the
+/// truth, since elsewhere neither view changed. Returns the pixels re-rendered this time.
 pub fn render_truth_and_occluded(
     ctx: &RenderContext,
     settings: RenderSettings,
     region: PixelRect,
     truth: &mut Frame,
-) -> Frame {
+    occluded: &mut Frame,
+    last: PixelRect,
+) -> PixelRect {
     let driver = ctx.scene.driver;
     ctx.render_rect(
         &driver,
@@ -457,7 +503,7 @@ pub fn render_truth_and_occluded(
         truth,
         "truth",
     );
-    let mut occluded = truth.clone();
+    copy_rect(truth, occluded, union(region, last));
     let around = ctx.difference_region(&driver, view_bit::TRUTH, view_bit::OCCLUDED);
     ctx.render_rect(
         &driver,
@@ -465,8 +511,59 @@ pub fn render_truth_and_occluded(
         None,
         settings,
         around,
-        &mut occluded,
+        occluded,
         "occluded",
     );
-    occluded
+    around
+}
+
+/// No pixel.
+const NOTHING: PixelRect = PixelRect {
+    x0: 0,
+    y0: 0,
+    x1: 0,
+    y1: 0,
+};
+
+/// The smallest rectangle holding `a` and `b` (an empty one holds nothing).
+fn union(a: PixelRect, b: PixelRect) -> PixelRect {
+    match (a.is_empty(), b.is_empty()) {
+        (true, _) => b,
+        (_, true) => a,
+        _ => PixelRect {
+            x0: a.x0.min(b.x0),
+            y0: a.y0.min(b.y0),
+            x1: a.x1.max(b.x1),
+            y1: a.y1.max(b.y1),
+        },
+    }
+}
+
+/// Every AOV of the pixels of `rect` from `from` into `to` (frames of one size).
+fn copy_rect(from: &Frame, to: &mut Frame, rect: PixelRect) {
+    assert_eq!((from.width, from.height), (to.width, to.height));
+    let (w, rect) = (from.width as usize, clip(rect, from));
+    if rect.is_empty() {
+        return;
+    }
+    for y in rect.y0 as usize..rect.y1 as usize {
+        let r = y * w + rect.x0 as usize..y * w + rect.x1 as usize;
+        to.color[r.clone()].copy_from_slice(&from.color[r.clone()]);
+        to.depth[r.clone()].copy_from_slice(&from.depth[r.clone()]);
+        to.camera_z[r.clone()].copy_from_slice(&from.camera_z[r.clone()]);
+        to.position[r.clone()].copy_from_slice(&from.position[r.clone()]);
+        to.normal[r.clone()].copy_from_slice(&from.normal[r.clone()]);
+        to.object_id[r.clone()].copy_from_slice(&from.object_id[r.clone()]);
+        to.part_id[r.clone()].copy_from_slice(&from.part_id[r]);
+    }
+}
+
+/// `rect` within `frame`.
+fn clip(rect: PixelRect, frame: &Frame) -> PixelRect {
+    PixelRect {
+        x0: rect.x0.min(frame.width),
+        y0: rect.y0.min(frame.height),
+        x1: rect.x1.min(frame.width),
+        y1: rect.y1.min(frame.height),
+    }
 }

@@ -46,18 +46,19 @@ fn resample_with(
 ) -> Frame {
     use rayon::prelude::*;
     let [w, h] = display_size;
-    // Rows in parallel, collected in order: the same image for any number of threads.
-    let pixels: Vec<Pixel> = (0..h)
-        .into_par_iter()
-        .flat_map_iter(|y| {
-            let frontal_point = &frontal_point;
-            (0..w).map(move |x| {
+    // Bands of rows in parallel, each pixel on its own: the same image for any number of
+    // threads, written in place.
+    let mut frame = Frame::new(w, h);
+    frame.bands_mut(8).into_par_iter().for_each(|mut band| {
+        for row in 0..band.len() {
+            let y = band.y + row;
+            for x in 0..w {
                 let p = frontal_point(DVec2::new(x as f64 + 0.5, y as f64 + 0.5));
-                sample(frontal, p, filter)
-            })
-        })
-        .collect();
-    Frame::from_pixels(w, h, &pixels)
+                band.set(x, row, sample(frontal, p, filter));
+            }
+        }
+    });
+    frame
 }
 
 /// One display pixel's content: the frontal frame at frontal point `p` (colour by `filter`,

@@ -10,6 +10,7 @@ use glam::{DVec2, DVec3};
 
 use crate::analysis::paper::{head_distance, head_offset};
 use crate::geometry::camera::Camera;
+use crate::render::footprint::PixelRect;
 use crate::render::frame::Frame;
 pub use crate::system::head_confidence::{CONFIDENT_HEAD, HeadConfidence};
 use crate::util::color::encode_srgb8;
@@ -80,11 +81,12 @@ fn luminance([r, g, b]: [u8; 3]) -> f32 {
     0.2126 * r as f32 + 0.7152 * g as f32 + 0.0722 * b as f32
 }
 
-/// Connected components (4-neighbour) of the pixels where `mask` is true, as pixel lists.
-fn components(mask: &[bool], w: usize, h: usize) -> Vec<Vec<usize>> {
+/// Connected components (4-neighbour) of the pixels of `rect` where `mask` is true, as pixel
+/// lists in the order of their first pixel (row by row). `mask` must be false outside `rect`.
+fn components(mask: &[bool], w: usize, h: usize, rect: Rect) -> Vec<Vec<usize>> {
     let mut label = vec![false; mask.len()];
     let mut out = Vec::new();
-    for start in 0..mask.len() {
+    for start in (rect.y0..rect.y1).flat_map(|y| (rect.x0..rect.x1).map(move |x| y * w + x)) {
         if !mask[start] || label[start] {
             continue;
         }
@@ -112,25 +114,110 @@ fn components(mask: &[bool], w: usize, h: usize) -> Vec<Vec<usize>> {
     out
 }
 
+/// A rectangle of pixels, [x0, x1) × [y0, y1), in the detector's image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Rect {
+    x0: usize,
+    y0: usize,
+    x1: usize,
+    y1: usize,
+}
+
+impl Rect {
+    fn of(r: PixelRect, w: usize, h: usize) -> Rect {
+        Rect {
+            x0: (r.x0 as usize).min(w),
+            y0: (r.y0 as usize).min(h),
+            x1: (r.x1 as usize).min(w),
+            y1: (r.y1 as usize).min(h),
+        }
+    }
+
+    fn pixel_rect(self) -> PixelRect {
+        PixelRect {
+            x0: self.x0 as u32,
+            y0: self.y0 as u32,
+            x1: self.x1 as u32,
+            y1: self.y1 as u32,
+        }
+    }
+
+    fn contains(&self, other: &Rect) -> bool {
+        other.x0 >= self.x0 && other.y0 >= self.y0 && other.x1 <= self.x1 && other.y1 <= self.y1
+    }
+}
+
 /// Finds the face and the pupils in a colour frame (as a camera would deliver it, 8-bit sRGB).
 /// The face box reported is the skin region's bounding box.
 pub fn detect(frame: &Frame) -> Result<FaceDetection, DetectError> {
-    detect_with(frame, false)
+    let full = PixelRect {
+        x0: 0,
+        y0: 0,
+        x1: frame.width,
+        y1: frame.height,
+    };
+    detect_with(frame, false, full).map(|(d, _)| d)
 }
 
 /// [`detect`] for the head mesh (`scene/head_model.rs`) seen turned: its brows, hair and
 /// shadows are dark blobs too, so the pupils are the pair of iris-sized blobs (merged where a
 /// lid's shadow splits one) that is the most level and the largest, not the two largest.
 pub fn detect_turned(frame: &Frame) -> Result<FaceDetection, DetectError> {
-    detect_with(frame, true)
+    let full = PixelRect {
+        x0: 0,
+        y0: 0,
+        x1: frame.width,
+        y1: frame.height,
+    };
+    detect_with(frame, true, full).map(|(d, _)| d)
 }
 
-fn detect_with(frame: &Frame, pairing: bool) -> Result<FaceDetection, DetectError> {
+/// [`detect`] reading only the pixels of `region` (a tracker's region of interest: the
+/// pixels outside it need not even be rendered), with the rectangle of pixels the detection
+/// depended on: the face region and the ring a pixel around it (where its skin ends), the
+/// pupil search box and the rings of the centroids, and the samples of the skin walk beside
+/// the pupils.
+pub fn detect_in(frame: &Frame, region: PixelRect) -> Result<InRegion, DetectError> {
     let (w, h) = (frame.width as usize, frame.height as usize);
-    let rgb: Vec<[u8; 3]> = frame.color.iter().map(|&c| encode_srgb8(c)).collect();
-    let skin: Vec<bool> = rgb.iter().map(|&c| is_skin(c)).collect();
+    let (detection, used) = detect_with(frame, false, region)?;
+    Ok(InRegion {
+        detection,
+        used,
+        whole: Rect::of(region, w, h).contains(&Rect::of(used, w, h)),
+    })
+}
+
+/// What [`detect_in`] found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InRegion {
+    pub detection: FaceDetection,
+    /// The pixels the detection depended on, back-camera pixels, [x0, x1) × [y0, y1).
+    pub used: PixelRect,
+    /// Whether `used` lies inside the region searched. Then the detection is bit for bit what
+    /// [`detect`] finds in the whole frame, unless a skin region larger than the face lies
+    /// wholly outside the region (then [`detect`] would take that one for the face).
+    pub whole: bool,
+}
+
+/// The detection from the pixels of `region` only (the others read as black, not skin), and
+/// the rectangle of pixels it depended on (see [`detect_in`]).
+fn detect_with(
+    frame: &Frame,
+    pairing: bool,
+    region: PixelRect,
+) -> Result<(FaceDetection, PixelRect), DetectError> {
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let region = Rect::of(region, w, h);
+    let mut rgb: Vec<[u8; 3]> = vec![[0; 3]; w * h];
+    let mut skin: Vec<bool> = vec![false; w * h];
+    for y in region.y0..region.y1 {
+        for i in y * w + region.x0..y * w + region.x1 {
+            rgb[i] = encode_srgb8(frame.color[i]);
+            skin[i] = is_skin(rgb[i]);
+        }
+    }
     // The face: the largest skin region.
-    let face = components(&skin, w, h)
+    let face = components(&skin, w, h, region)
         .into_iter()
         .max_by_key(Vec::len)
         .filter(|c| c.len() >= 20)
@@ -165,7 +252,22 @@ fn detect_with(frame: &Frame, pairing: bool) -> Result<FaceDetection, DetectErro
         .map(|k| luminance(rgb[(y0 + k / bw) * w + x0 + k % bw]) < 0.3 * face_lum)
         .collect();
     let max_area = (face.len() / 33).max(4);
-    let mut holes: Vec<Vec<usize>> = components(&dark, bw, bh)
+    let whole = Rect {
+        x0: 0,
+        y0: 0,
+        x1: bw,
+        y1: bh,
+    };
+    // What the detection reads: the pupil search box, and two pixels beyond it for the
+    // rings of the centroids (a blob stays a pixel inside the box, its rim one more, the
+    // ring two more), within the image.
+    let mut used = Rect {
+        x0: x0.saturating_sub(2),
+        y0: y0.saturating_sub(2),
+        x1: (x1 + 2).min(w),
+        y1: (y1 + 2).min(h),
+    };
+    let mut holes: Vec<Vec<usize>> = components(&dark, bw, bh, whole)
         .into_iter()
         .filter(|c| {
             c.len() <= max_area
@@ -282,28 +384,46 @@ fn detect_with(frame: &Frame, pairing: bool) -> Result<FaceDetection, DetectErro
     } else {
         ([b, a], [areas[1], areas[0]])
     };
-    let row_edges = row_edges(&skin, w, h, pupils, (x1 - x0) as f64);
-    Ok(FaceDetection {
+    let row_edges = row_edges(&skin, w, h, pupils, (x1 - x0) as f64, &mut used);
+    let detection = FaceDetection {
         face_box,
         pupils: pupils.map(|p| p.to_array()),
         pupil_areas_px,
         row_edges: row_edges.map(|p| p.to_array()),
         confidence: HeadConfidence::of(face_box, pupils, pupil_areas_px),
-    })
+    };
+    Ok((detection, used.pixel_rect()))
 }
 
 /// Where the skin ends beyond each pupil along the line through both: walking outward in
 /// quarter-pixel steps, the last skin sample before a gap of non-skin wider than the eye
 /// opening could be (a tenth of the face's width, at least 3 px) — the eye's own white and
 /// iris are crossed, the background is not.
-fn row_edges(skin: &[bool], w: usize, h: usize, pupils: [DVec2; 2], face_px: f64) -> [DVec2; 2] {
+/// `used` grows to every pixel the walks read.
+fn row_edges(
+    skin: &[bool],
+    w: usize,
+    h: usize,
+    pupils: [DVec2; 2],
+    face_px: f64,
+    used: &mut Rect,
+) -> [DVec2; 2] {
     let along = (pupils[1] - pupils[0]).normalize_or(DVec2::X);
     let gap = (0.1 * face_px).max(3.0);
-    let is_skin = |p: DVec2| {
-        (p.x >= 0.0 && p.y >= 0.0 && (p.x as usize) < w && (p.y as usize) < h)
-            && skin[p.y as usize * w + p.x as usize]
+    let mut is_skin = |p: DVec2| {
+        let inside = p.x >= 0.0 && p.y >= 0.0 && (p.x as usize) < w && (p.y as usize) < h;
+        if inside {
+            let (x, y) = (p.x as usize, p.y as usize);
+            *used = Rect {
+                x0: used.x0.min(x),
+                y0: used.y0.min(y),
+                x1: used.x1.max(x + 1),
+                y1: used.y1.max(y + 1),
+            };
+        }
+        inside && skin[p.y as usize * w + p.x as usize]
     };
-    let walk = |from: DVec2, direction: DVec2| {
+    let mut walk = |from: DVec2, direction: DVec2| {
         let (mut last, mut s) = (0.0, 0.0);
         while s < 1.5 * face_px && s - last <= gap {
             s += 0.25;

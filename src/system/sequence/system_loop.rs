@@ -28,7 +28,7 @@ use crate::system::capture::{HeadEstimate, check_display_input, display_from, fi
 use crate::system::compensation::Crop;
 use crate::system::display::{DisplayModel, DisplayPlacement, DisplaySurface, resample_through};
 use crate::system::frontal_map::FrontalMap;
-use crate::system::head::{detect, eye_from_detection, gaussian};
+use crate::system::head::{DetectError, FaceDetection, detect_in, eye_from_detection, gaussian};
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use crate::system::pipeline::{crop_for, driver_camera, frontal_map};
 use crate::system::sequence::byo::{Byo, RefreshInputs};
@@ -120,6 +120,13 @@ pub struct SystemLoop {
     /// An eye supplied from outside (a Python predictor), obstacle frame, m: the next refresh
     /// [`SystemLoop::show`] makes compensates for it instead of the predicted estimate.
     pub eye_given: Option<DVec3>,
+    /// The back camera's image and where the face was in it.
+    back_tracker: BackTracker,
+    /// Whether the back camera renders and searches only around the last face
+    /// ([`BackTracker`]); `false`: the whole image every time (the twin the tests compare).
+    pub track_face: bool,
+    /// Back camera pixels rendered for the head estimates, summed over the refreshes.
+    pub back_pixels: u64,
 }
 
 impl SystemLoop {
@@ -162,6 +169,7 @@ impl SystemLoop {
             HeadSource::Model => (run.head_jitter_cm / 100.0).max(WEBCAM_LANDMARKS.sigma_lateral_m),
         };
         let frontal = Frame::new(rig.base.frontal.width, rig.base.frontal.height);
+        let rig_back = rig.base.back;
         Ok(SystemLoop {
             predictor: Predictor::new(options.predict, sigma),
             sky: Arc::new(SkyModel::new(&scene.sky, &scene.sun)),
@@ -178,6 +186,9 @@ impl SystemLoop {
             model_last: None,
             inputs: None,
             eye_given: None,
+            back_tracker: BackTracker::new(&rig_back),
+            track_face: true,
+            back_pixels: 0,
         })
     }
 
@@ -231,9 +242,13 @@ impl SystemLoop {
                     spp: self.options.run.spp.max(BACK_MIN_SPP),
                     progress: false,
                 };
-                let (frame, _) = ctx.render(&back, view_bit::BACK, settings, "back");
-                let detection = detect(&frame)
-                    .with_context(|| format!("head estimate at t = {} s", short(t)))?;
+                if !self.track_face {
+                    self.back_tracker.region = None;
+                }
+                let (detection, pixels) = self.back_tracker.detect(&ctx, settings);
+                self.back_pixels += pixels;
+                let detection =
+                    detection.with_context(|| format!("head estimate at t = {} s", short(t)))?;
                 if run.require_confident_head && !detection.confidence.is_confident() {
                     bail!(
                         "--require-confident-head: {}",
@@ -314,6 +329,8 @@ impl SystemLoop {
             || byo.needs_inputs();
         let frontal_camera = capture.scene.frontal;
         let settings = self.settings();
+        // The frontal render is its own stage, not part of the compensation's time.
+        let frontal_seconds;
         let (crop, d2_used) = if full {
             let f = Instant::now();
             capture.render_into(
@@ -323,7 +340,7 @@ impl SystemLoop {
                 &mut self.frontal,
                 "frontal",
             );
-            self.seconds.frontal += f.elapsed().as_secs_f64();
+            frontal_seconds = f.elapsed().as_secs_f64();
             self.frontal_pixels +=
                 u64::from(frontal_camera.width) * u64::from(frontal_camera.height);
             crop_for(&geometry, eye_world, &self.frontal, run).with_context(at)?
@@ -340,7 +357,7 @@ impl SystemLoop {
                 &mut self.frontal,
                 "frontal",
             );
-            self.seconds.frontal += f.elapsed().as_secs_f64();
+            frontal_seconds = f.elapsed().as_secs_f64();
             self.frontal_pixels += rect.pixels();
             crop
         };
@@ -410,7 +427,8 @@ impl SystemLoop {
         } else {
             resample_through(&self.frontal, &map, run.filter)
         };
-        self.seconds.compensation += start.elapsed().as_secs_f64();
+        self.seconds.frontal += frontal_seconds;
+        self.seconds.compensation += start.elapsed().as_secs_f64() - frontal_seconds;
         self.inputs = inputs;
         self.surface = Some(DisplaySurface::Pixels {
             image: display,
@@ -437,8 +455,8 @@ impl SystemLoop {
 
     /// The `seethru` view at display time into `frame` (the truth of the same instant, or
     /// any frame of the driver camera's size: only the pixels where the display can be seen
-    /// are rendered), with what [`SystemLoop::show`] last made.
-    pub fn render_seethru(&mut self, ctx: &RenderContext, frame: &mut Frame) {
+    /// are rendered), with what [`SystemLoop::show`] last made. Returns the pixels rendered.
+    pub fn render_seethru(&mut self, ctx: &RenderContext, frame: &mut Frame) -> PixelRect {
         let start = Instant::now();
         let shown = self.shown.as_ref().expect("show() before render_seethru()");
         let driver = ctx.scene.driver;
@@ -472,6 +490,7 @@ impl SystemLoop {
         );
         self.surface = Some(surface);
         self.seconds.seethru += start.elapsed().as_secs_f64();
+        region
     }
 }
 
@@ -486,5 +505,77 @@ fn crop_rect(map: &FrontalMap, camera: &Camera) -> PixelRect {
         y0: clamp(lo.y, camera.height),
         x1: clamp(hi.x, camera.width),
         y1: clamp(hi.y, camera.height),
+    }
+}
+
+/// The back camera's image of the head, rendered only where the face can be: the pixels the
+/// last detection depended on ([`detect_in`]), grown by a quarter of their size and 4 px on
+/// each side for the head's motion until the next sample. When the face is not found there
+/// whole, or on the first sample, the whole image is rendered and searched, as
+/// [`crate::system::head::detect`] does. So every estimate is bit for bit the whole image's (but for a skin region larger
+/// than the face wholly outside the region, which the whole image's detector would take for
+/// the face), and each sample depends only on the one before: deterministic.
+struct BackTracker {
+    frame: Frame,
+    region: Option<PixelRect>,
+}
+
+impl BackTracker {
+    fn new(back: &Camera) -> BackTracker {
+        BackTracker {
+            frame: Frame::new(back.width, back.height),
+            region: None,
+        }
+    }
+
+    /// The head detection in the back camera's image of `ctx` (its true back camera), and the
+    /// pixels rendered for it.
+    fn detect(
+        &mut self,
+        ctx: &RenderContext,
+        settings: RenderSettings,
+    ) -> (Result<FaceDetection, DetectError>, u64) {
+        let back = ctx.scene.back;
+        if (self.frame.width, self.frame.height) != (back.width, back.height) {
+            self.frame = Frame::new(back.width, back.height);
+            self.region = None;
+        }
+        let render = |frame: &mut Frame, region: PixelRect| {
+            ctx.render_rect(&back, view_bit::BACK, None, settings, region, frame, "back");
+        };
+        let mut pixels = 0;
+        let tracked = self.region.and_then(|region| {
+            render(&mut self.frame, region);
+            pixels += region.pixels();
+            detect_in(&self.frame, region)
+                .ok()
+                .filter(|found| found.whole)
+        });
+        let found = match tracked {
+            Some(found) => found,
+            None => {
+                self.region = None;
+                let full = PixelRect::full(&back);
+                render(&mut self.frame, full);
+                pixels += full.pixels();
+                match detect_in(&self.frame, full) {
+                    Ok(found) => found,
+                    Err(e) => return (Err(e), pixels),
+                }
+            }
+        };
+        self.region = Some(grow_region(found.used, &back));
+        (Ok(found.detection), pixels)
+    }
+}
+
+/// `r` grown by a quarter of its size and 4 px on each side, within the image of `camera`.
+fn grow_region(r: PixelRect, camera: &Camera) -> PixelRect {
+    let (gx, gy) = ((r.x1 - r.x0) / 4 + 4, (r.y1 - r.y0) / 4 + 4);
+    PixelRect {
+        x0: r.x0.saturating_sub(gx),
+        y0: r.y0.saturating_sub(gy),
+        x1: (r.x1 + gx).min(camera.width),
+        y1: (r.y1 + gy).min(camera.height),
     }
 }

@@ -1,0 +1,152 @@
+//! The sequence's head tracker renders the back camera only around the last face and detects
+//! there (`system/head.rs` `detect_in`, `system/sequence/system_loop.rs` `BackTracker`): its
+//! estimates against the whole image's, bit for bit.
+
+mod common;
+
+use glam::DVec3;
+use seethru::render::footprint::PixelRect;
+use seethru::render::integrator::RenderContext;
+use seethru::render::settings::RenderSettings;
+use seethru::render::views::View;
+use seethru::system::head::{DetectError, detect, detect_in};
+use seethru::system::options::{HeadSource, Outside, RunOptions};
+use seethru::system::sequence::head_motion::HeadMotion;
+use seethru::system::sequence::predict::Prediction;
+use seethru::system::sequence::system_loop::{SequenceOptions, SystemLoop};
+use seethru::system::sequence::timeline::Timeline;
+
+/// The back camera's 320×240 image of das's driver with the head moved by `offset` (m,
+/// world frame).
+fn back_image(offset: DVec3) -> seethru::render::frame::Frame {
+    let mut scene = common::das();
+    let head = ["head", "hair", "left_eye", "right_eye"];
+    for object in scene
+        .objects
+        .iter_mut()
+        .filter(|o| head.contains(&o.name.as_str()))
+    {
+        object.world_from_object.translation += offset;
+    }
+    let ctx = RenderContext::new(scene).unwrap();
+    let back = ctx.scene.back.with_resolution(320, 240);
+    let settings = RenderSettings {
+        spp: 4,
+        progress: false,
+    };
+    ctx.render(&back, View::Back.bit(), settings, "back").0
+}
+
+/// The pixels `detect_in` says it depended on are enough: searching only them gives the
+/// whole image's detection bit for bit, on das's head still and moved. A region one column
+/// short of them is reported as not whole, and one away from the face finds no face.
+#[test]
+fn a_detection_in_the_pixels_it_used_is_the_whole_images() {
+    for offset in [
+        DVec3::ZERO,
+        DVec3::new(-0.08, 0.0, -0.05),
+        DVec3::new(0.05, 0.03, 0.0),
+    ] {
+        let frame = back_image(offset);
+        let whole = detect(&frame).unwrap();
+        let full = PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: frame.width,
+            y1: frame.height,
+        };
+        let first = detect_in(&frame, full).unwrap();
+        assert!(first.whole);
+        assert_eq!(first.detection, whole, "{offset}");
+        let used = first.used;
+        assert!(
+            used.pixels() < full.pixels() / 2,
+            "{offset}: the face's pixels {used:?} should be a small part of the image"
+        );
+        let again = detect_in(&frame, used).unwrap();
+        assert!(again.whole, "{offset}");
+        assert_eq!(again.detection, whole, "{offset}: only the used pixels");
+        assert_eq!(again.used, used);
+        // One column short on the right: the face is still found, but the detection read
+        // that column (where the skin ends), so it is not the whole image's for sure.
+        let cut = PixelRect {
+            x1: used.x1 - 1,
+            ..used
+        };
+        assert!(
+            detect_in(&frame, cut).is_ok_and(|c| !c.whole),
+            "{offset}: a region one column short of the pixels used is not whole"
+        );
+        // Below the face: no skin there.
+        let away = PixelRect {
+            x0: 0,
+            y0: frame.height - 8,
+            x1: 8,
+            y1: frame.height,
+        };
+        assert_eq!(detect_in(&frame, away).err(), Some(DetectError::NoFace));
+    }
+}
+
+/// A leaning, estimated-head sequence (das, 320×240 back camera, 30 refreshes): tracking
+/// the face gives every frame's eye estimate and confidence bit for bit as rendering and
+/// searching the whole back image each time, and renders under half its back pixels.
+#[test]
+fn the_tracked_head_estimates_are_the_whole_images() {
+    let options = SequenceOptions {
+        run: RunOptions {
+            head: HeadSource::Estimated,
+            width: Some(160),
+            height: Some(90),
+            frontal_width: Some(160),
+            back_width: Some(320),
+            spp: 1,
+            outside: Outside::Black,
+            ..RunOptions::default()
+        },
+        timeline: Timeline {
+            duration: 0.5,
+            fps: 60.0,
+            display_hz: 60.0,
+            latency_camera: 0.05,
+            latency_tracking: 0.01,
+        },
+        speed: 50.0 / 3.6,
+        yaw_rate: 0.0,
+        head: HeadMotion::Lean {
+            distance: 0.1,
+            duration: 0.3,
+            start: 0.1,
+        },
+        predict: Prediction::None,
+        reproject: false,
+        byo: Default::default(),
+    };
+    let scene = common::das();
+    let estimates = |track: bool| {
+        let mut system = SystemLoop::new(&scene, options.clone()).unwrap();
+        system.track_face = track;
+        let shown: Vec<_> = (0..system.options.timeline.frames())
+            .map(|k| {
+                let s = system.show(k).unwrap();
+                (s.eye_estimated.to_array(), s.head_confidence)
+            })
+            .collect();
+        (shown, system.back_pixels)
+    };
+    let (tracked, tracked_pixels) = estimates(true);
+    let (whole, whole_pixels) = estimates(false);
+    assert_eq!(tracked.len(), 30);
+    for (k, (t, w)) in tracked.iter().zip(&whole).enumerate() {
+        assert_eq!(t.0.map(f64::to_bits), w.0.map(f64::to_bits), "frame {k}");
+        assert_eq!(t.1.map(f64::to_bits), w.1.map(f64::to_bits), "frame {k}");
+    }
+    // The lean moves the eye 10 cm: the estimates follow it.
+    let moved = DVec3::from_array(tracked[29].0) - DVec3::from_array(tracked[0].0);
+    assert!(moved.length() > 0.05, "{moved}");
+    assert_eq!(whole_pixels, 30 * 320 * 240);
+    assert!(
+        2 * tracked_pixels < whole_pixels,
+        "tracked {tracked_pixels} of {whole_pixels} back pixels"
+    );
+}
