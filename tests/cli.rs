@@ -231,7 +231,7 @@ struct ValueOption {
 /// Every option that takes a value, per command, read from the command's own `--help`, so
 /// that a flag added later is walked too.
 fn options_with_values() -> Vec<ValueOption> {
-    let commands: [&[&str]; 16] = [
+    let commands: [&[&str]; 17] = [
         &["render"],
         &["run"],
         &["ratio", "occlusion"],
@@ -248,6 +248,7 @@ fn options_with_values() -> Vec<ValueOption> {
         &["sequence"],
         &["diff"],
         &["check"],
+        &["head-poses"],
     ];
     let mut found = Vec::new();
     for words in commands {

@@ -61,7 +61,7 @@ fn help_options(words: &[&str]) -> Vec<HelpOption> {
     found
 }
 
-const COMMANDS: [&[&str]; 18] = [
+const COMMANDS: [&[&str]; 19] = [
     &["render"],
     &["capture"],
     &["score"],
@@ -80,6 +80,7 @@ const COMMANDS: [&[&str]; 18] = [
     &["bench"],
     &["compare"],
     &["sequence"],
+    &["head-poses"],
 ];
 
 #[test]
@@ -994,4 +995,87 @@ fn the_tracker_models_seed_is_read_not_refused() {
             "{words:?}: --seed changes nothing"
         );
     }
+}
+
+#[test]
+fn every_flag_of_head_poses_changes_its_table_or_is_refused_with_its_range() {
+    // head-poses prints its table on stdout: each flag walked from its help must change it,
+    // but --threads (bit-identical by design); out-of-range values are one error line naming
+    // the flag and its range; a scene without a head to turn is refused.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("mesh.toml");
+    std::fs::write(&scene, common::das_with_mesh_head_text()).unwrap();
+    let scene = scene.to_str().unwrap();
+    let base = ["--yaw", "0", "--pitch", "0", "--distance-scale", "1"];
+    let table = |extra: &[&str]| {
+        let mut args = vec!["head-poses", scene];
+        args.extend(base);
+        args.extend(extra);
+        let (ok, out, err) = common::seethru(&args);
+        assert!(ok, "{args:?}: {err}");
+        out
+    };
+    let reference = table(&[]);
+    assert!(
+        reference.contains("1 poses") && reference.contains("| yaw fit |"),
+        "{reference}"
+    );
+    let mut walked = Vec::new();
+    for option in help_options(&["head-poses"]) {
+        let probe = match option.flag.as_str() {
+            "--help" | "--version" => continue,
+            "--threads" => {
+                assert_eq!(
+                    table(&["--threads", "1"]),
+                    reference,
+                    "--threads changed the table"
+                );
+                walked.push("--threads".to_string());
+                continue;
+            }
+            "--quiet" => {
+                // Quiets the log on stderr; the table is the output.
+                assert_eq!(table(&["--quiet"]), reference, "--quiet changed the table");
+                walked.push("--quiet".to_string());
+                continue;
+            }
+            "--yaw" => "20",
+            "--pitch" => "8",
+            "--distance-scale" => "1.2",
+            "--back-width" => "480",
+            other => panic!("{other}: a new flag of head-poses: give it a probe here"),
+        };
+        assert_ne!(
+            table(&[&option.flag, probe]),
+            reference,
+            "{} {probe}: accepted, and the table is identical without it: ignored",
+            option.flag
+        );
+        walked.push(option.flag.clone());
+    }
+    assert_eq!(walked.len(), 6, "{walked:?}");
+    for (flag, bad, range) in [
+        ("--yaw", "90", "[-89, 89]"),
+        ("--pitch", "-46", "[-45, 45]"),
+        ("--distance-scale", "0.4", "[0.5, 2]"),
+        ("--back-width", "0", "[1, 16384]"),
+    ] {
+        let (ok, out, err) = common::seethru(&["head-poses", scene, flag, bad]);
+        assert!(!ok && out.is_empty(), "{flag} {bad} accepted");
+        assert!(
+            err.starts_with("error:") && err.lines().count() == 1 && err.contains(flag),
+            "{flag} {bad}: {err}"
+        );
+        assert!(
+            err.contains(range) || err.contains(&range.replace(", ", "..")),
+            "{flag} {bad}: {err}"
+        );
+    }
+    let plain = dir.path().join("plain.toml");
+    std::fs::write(&plain, common::MINIMAL).unwrap();
+    let (ok, _, err) = common::seethru(&["head-poses", plain.to_str().unwrap()]);
+    assert!(
+        !ok && err.starts_with("error:") && err.contains("moves_with"),
+        "{err}"
+    );
 }

@@ -15,8 +15,9 @@ use crate::cli::args::{pixels, real, threads, with_threads};
 pub struct HeadPoses {
     /// Scene file (TOML) with a head (objects with moves_with = "head") and a back camera.
     scene: PathBuf,
-    /// Head yaws about the neck, degrees in [-89, 89], comma-separated (positive: the face
-    /// turns to the driver's left).
+    /// Head yaws about the neck from facing the back camera, degrees in [-89, 89],
+    /// comma-separated (0: the face turned towards the camera; positive: turned further to the
+    /// driver's left).
     #[arg(long, value_delimiter = ',', value_parser = real(-89.0, 89.0), default_value = "-45,-30,-15,0,15,30,45")]
     yaw: Vec<f64>,
     /// Head pitches about the neck, degrees in [-45, 45], comma-separated (positive: up).

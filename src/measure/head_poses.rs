@@ -1,5 +1,6 @@
 //! The head tracker against the true eye over a grid of head poses: the scene's head (the
-//! objects that move with it) turned about its neck by each yaw and pitch and moved along
+//! objects that move with it) turned about its neck by each yaw (from facing the back camera)
+//! and pitch and moved along
 //! the back camera's line of sight to each distance, the back camera's view rendered, and the
 //! eye estimated by the paper's frontal equations (eqs. d1, b_h) and by the yaw fit.
 //! Poses where no face or no two pupils are found are counted, never dropped silently.
@@ -13,14 +14,15 @@ use crate::render::views::View;
 use crate::scene::Scene;
 use crate::scene::head_model::{eye_turned_about_neck, head_rotation};
 use crate::scene::motion::MovesWith;
-use crate::system::head::{detect_turned, eye_from_detection};
+use crate::system::head::eye_from_detection;
 use crate::system::head_pose::locate;
+use crate::system::head_side::detect_turned;
 
 /// One pose of the grid and what the tracker made of it.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct PoseResult {
-    /// Head yaw (positive: the face turns to the driver's left) and pitch (positive: up),
-    /// degrees, about the neck.
+    /// Head yaw from facing the back camera (positive: the face turns further to the driver's
+    /// left) and pitch (positive: up), degrees, about the neck.
     pub yaw_deg: f64,
     pub pitch_deg: f64,
     /// Distance from the back camera to the true eye, metres.
@@ -32,7 +34,7 @@ pub struct PoseResult {
     pub confidence: Option<f64>,
     /// The confidence from the frontal cues alone (what the frontal equations had).
     pub frontal_confidence: Option<f64>,
-    /// The fitted yaw relative to the back camera, degrees.
+    /// The fitted yaw from facing the back camera, degrees.
     pub fitted_yaw_deg: Option<f64>,
 }
 
@@ -63,11 +65,14 @@ pub fn pose_grid(
         anyhow::bail!("the scene has no object with moves_with = \"head\" to turn");
     }
     let camera = back.position();
+    // Yaw 0 faces the back camera: the world yaw whose −z axis points from the eye at it.
+    let to_camera = camera - eye0;
+    let facing_deg = (-to_camera.x).atan2(-to_camera.z).to_degrees();
     let mut out = Vec::new();
     for &scale in distance_scales {
         for &pitch in pitches {
             for &yaw in yaws {
-                let rotation = head_rotation(yaw, pitch);
+                let rotation = head_rotation(facing_deg + yaw, pitch);
                 let start = camera + (eye0 - camera) * scale;
                 let eye = eye_turned_about_neck(start, rotation);
                 let head_from_start = DAffine3::from_translation(eye)

@@ -322,6 +322,54 @@ pub fn eye_row_section(samples: usize) -> Vec<DVec3> {
         .collect()
 }
 
+/// The skin's wireframe for silhouette fits, head frame: the skull's skin grid at
+/// `columns` × `rows` (the same surface as the mesh, coarser; hair quads left out) and the
+/// neck's tube, as vertices and the edges of their quads (sides and one diagonal). The image
+/// of a line crosses the projected wireframe exactly where it crosses the projected surface,
+/// so the extreme crossings are the skin's outline on that line.
+pub fn skin_wireframe(columns: usize, rows: usize) -> (Vec<DVec3>, Vec<[usize; 2]>) {
+    let mut vertices = Vec::new();
+    let mut undeformed = Vec::new();
+    for j in 0..=rows {
+        for i in 0..columns {
+            let d = grid_direction(i, j, columns, rows);
+            undeformed.push(SKULL_CENTRE + d / ((d / SKULL_AXES).length()));
+            vertices.push(skin_point(d));
+        }
+    }
+    let at = |i: usize, j: usize| j * columns + i % columns;
+    let mut edges = Vec::new();
+    for j in 0..rows {
+        for i in 0..columns {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            let centre = (undeformed[a] + undeformed[b] + undeformed[c] + undeformed[d]) / 4.0;
+            if skin_material(centre) != HAIR {
+                edges.extend([[a, b], [a, d], [a, c]]);
+            }
+        }
+    }
+    // The neck (skin-coloured too): the tube of `add_neck`.
+    let around = 24usize;
+    let base = vertices.len();
+    let levels = [(-0.05, 0.05), (-0.1, 0.052), (-0.16, 0.058)];
+    for (y, r) in levels {
+        for k in 0..around {
+            let a = std::f64::consts::TAU * k as f64 / around as f64;
+            vertices.push(DVec3::new(r * a.sin(), y, NECK.z + 0.01 - r * a.cos()));
+        }
+    }
+    for level in 0..levels.len() - 1 {
+        for k in 0..around {
+            let (a, b) = (
+                base + level * around + k,
+                base + level * around + (k + 1) % around,
+            );
+            edges.extend([[a, b], [a, a + around], [a, b + around]]);
+        }
+    }
+    (vertices, edges)
+}
+
 /// The head's rotation for a yaw (about +y, positive turns the face towards −x, the
 /// driver's left) after a pitch (about +x, positive tips the face up), degrees: the
 /// `rotate_deg = [pitch, yaw, 0]` of a scene.

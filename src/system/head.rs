@@ -26,11 +26,20 @@ pub struct FaceDetection {
     /// Pixels in the left and right pupil's dark blob.
     pub pupil_areas_px: [u32; 2],
     /// The head's left and right edge on the line through the pupils (pixels): where the skin
-    /// ends beyond each pupil, the outline the yaw is fitted to (`system/head_pose.rs`).
+    /// ends beyond each pupil; from the side-angle detector, the nearest outline candidates.
     pub row_edges: [[f64; 2]; 2],
+    /// The side-angle detector's candidates for the head's outline on the pupils' line
+    /// (`detect_turned` in `system/head_side.rs`): up to [`OUTLINE_CANDIDATES`] colour steps
+    /// beyond each pupil (left, right), pixels, nearest first, NaN-padded; all NaN from
+    /// [`detect`]. The pose fit (`system/head_pose.rs`) picks which one is the outline.
+    #[serde(skip)]
+    pub outline_candidates: [[[f64; 2]; OUTLINE_CANDIDATES]; 2],
     /// How far the detection can be trusted, from what it measured ([`HeadConfidence`]).
     pub confidence: HeadConfidence,
 }
+
+/// Outline candidates kept per side ([`FaceDetection::outline_candidates`]).
+pub const OUTLINE_CANDIDATES: usize = 12;
 
 impl FaceDetection {
     /// The feature width `A_px`: distance between the pupils, pixels.
@@ -68,7 +77,7 @@ impl std::fmt::Display for DetectError {
 impl std::error::Error for DetectError {}
 
 /// Skin by normalised chromaticity: reddish, with more green than blue, not too dark.
-fn is_skin([r, g, b]: [u8; 3]) -> bool {
+pub(crate) fn is_skin([r, g, b]: [u8; 3]) -> bool {
     let sum = r as f32 + g as f32 + b as f32;
     if sum < 90.0 || !(r > g && g > b) {
         return false;
@@ -77,13 +86,13 @@ fn is_skin([r, g, b]: [u8; 3]) -> bool {
     (0.36..0.50).contains(&rc) && (0.28..0.37).contains(&gc) && bc > 0.20
 }
 
-fn luminance([r, g, b]: [u8; 3]) -> f32 {
+pub(crate) fn luminance([r, g, b]: [u8; 3]) -> f32 {
     0.2126 * r as f32 + 0.7152 * g as f32 + 0.0722 * b as f32
 }
 
 /// Connected components (4-neighbour) of the pixels of `rect` where `mask` is true, as pixel
 /// lists in the order of their first pixel (row by row). `mask` must be false outside `rect`.
-fn components(mask: &[bool], w: usize, h: usize, rect: Rect) -> Vec<Vec<usize>> {
+pub(crate) fn components(mask: &[bool], w: usize, h: usize, rect: Rect) -> Vec<Vec<usize>> {
     let mut label = vec![false; mask.len()];
     let mut out = Vec::new();
     for start in (rect.y0..rect.y1).flat_map(|y| (rect.x0..rect.x1).map(move |x| y * w + x)) {
@@ -116,7 +125,7 @@ fn components(mask: &[bool], w: usize, h: usize, rect: Rect) -> Vec<Vec<usize>> 
 
 /// A rectangle of pixels, [x0, x1) × [y0, y1), in the detector's image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Rect {
+pub(crate) struct Rect {
     x0: usize,
     y0: usize,
     x1: usize,
@@ -124,6 +133,16 @@ struct Rect {
 }
 
 impl Rect {
+    /// Every pixel of a w × h image.
+    pub(crate) fn whole(w: usize, h: usize) -> Rect {
+        Rect {
+            x0: 0,
+            y0: 0,
+            x1: w,
+            y1: h,
+        }
+    }
+
     fn of(r: PixelRect, w: usize, h: usize) -> Rect {
         Rect {
             x0: (r.x0 as usize).min(w),
@@ -156,20 +175,7 @@ pub fn detect(frame: &Frame) -> Result<FaceDetection, DetectError> {
         x1: frame.width,
         y1: frame.height,
     };
-    detect_with(frame, false, full).map(|(d, _)| d)
-}
-
-/// [`detect`] for the head mesh (`scene/head_model.rs`) seen turned: its brows, hair and
-/// shadows are dark blobs too, so the pupils are the pair of iris-sized blobs (merged where a
-/// lid's shadow splits one) that is the most level and the largest, not the two largest.
-pub fn detect_turned(frame: &Frame) -> Result<FaceDetection, DetectError> {
-    let full = PixelRect {
-        x0: 0,
-        y0: 0,
-        x1: frame.width,
-        y1: frame.height,
-    };
-    detect_with(frame, true, full).map(|(d, _)| d)
+    detect_with(frame, full).map(|(d, _)| d)
 }
 
 /// [`detect`] reading only the pixels of `region` (a tracker's region of interest: the
@@ -179,7 +185,7 @@ pub fn detect_turned(frame: &Frame) -> Result<FaceDetection, DetectError> {
 /// the pupils.
 pub fn detect_in(frame: &Frame, region: PixelRect) -> Result<InRegion, DetectError> {
     let (w, h) = (frame.width as usize, frame.height as usize);
-    let (detection, used) = detect_with(frame, false, region)?;
+    let (detection, used) = detect_with(frame, region)?;
     Ok(InRegion {
         detection,
         used,
@@ -203,7 +209,6 @@ pub struct InRegion {
 /// the rectangle of pixels it depended on (see [`detect_in`]).
 fn detect_with(
     frame: &Frame,
-    pairing: bool,
     region: PixelRect,
 ) -> Result<(FaceDetection, PixelRect), DetectError> {
     let (w, h) = (frame.width as usize, frame.height as usize);
@@ -252,12 +257,7 @@ fn detect_with(
         .map(|k| luminance(rgb[(y0 + k / bw) * w + x0 + k % bw]) < 0.3 * face_lum)
         .collect();
     let max_area = (face.len() / 33).max(4);
-    let whole = Rect {
-        x0: 0,
-        y0: 0,
-        x1: bw,
-        y1: bh,
-    };
+    let whole = Rect::whole(bw, bh);
     // What the detection reads: the pupil search box, and two pixels beyond it for the
     // rings of the centroids (a blob stays a pixel inside the box, its rim one more, the
     // ring two more), within the image.
@@ -280,104 +280,15 @@ fn detect_with(
                 .collect::<Vec<_>>()
         })
         .collect();
-    if !pairing {
-        holes.sort_by_key(|c| std::cmp::Reverse(c.len()));
-        if holes.len() < 2 {
-            return Err(DetectError::Pupils(holes.len()));
-        }
-        holes.truncate(2);
-    }
-    // An iris is at most ~0.08 face widths across: larger dark blobs are hair or shadow.
-    let face_w = (x1 - x0) as f64;
-    let iris_max = ((0.15 * face_w).powi(2) as usize).max(4);
-    holes.retain(|h| !pairing || h.len() <= iris_max);
-    // A blob split by a lid's shadow is one eye: blobs closer than an iris are merged.
-    let centre_of = |h: &[usize]| {
-        h.iter().fold(DVec2::ZERO, |a, &i| {
-            a + DVec2::new((i % w) as f64, (i / w) as f64)
-        }) / h.len() as f64
-    };
-    let mut merged: Vec<Vec<usize>> = Vec::new();
     holes.sort_by_key(|c| std::cmp::Reverse(c.len()));
-    for hole in holes {
-        let c = centre_of(&hole);
-        match merged
-            .iter_mut()
-            .find(|m| pairing && (centre_of(m) - c).length() < 0.08 * face_w)
-        {
-            Some(m) => m.extend(hole),
-            None => merged.push(hole),
-        }
+    if holes.len() < 2 {
+        return Err(DetectError::Pupils(holes.len()));
     }
-    if merged.len() < 2 {
-        return Err(DetectError::Pupils(merged.len()));
-    }
-    // The pair: apart by at least 0.15 face widths, the larger the smaller blob and the more
-    // level the pair (a head rolled against the camera is allowed, at a lower score).
-    let mut best = (f64::NEG_INFINITY, 0, 1);
-    for a in 0..merged.len() {
-        for b in a + 1..merged.len() {
-            let d = centre_of(&merged[b]) - centre_of(&merged[a]);
-            if pairing && d.length() < 0.15 * face_w {
-                continue;
-            }
-            let tilt = d.y.abs() / d.x.abs().max(1e-9);
-            let score = merged[a].len().min(merged[b].len()) as f64 / (1.0 + 8.0 * tilt);
-            if score > best.0 {
-                best = (score, a, b);
-            }
-        }
-    }
-    if best.0 == f64::NEG_INFINITY {
-        return Err(DetectError::Pupils(1));
-    }
-    let holes = [merged[best.1].clone(), merged[best.2].clone()];
-    // Sub-pixel centroids: each pixel of the blob and its one-pixel rim weighs by how far it
-    // is from the local skin level (the median of a ring two pixels out) towards the pupil's
-    // darkest value, so mixed edge pixels count in proportion and shading does not pull.
-    let grow = |set: &[usize]| {
-        let mut out: Vec<usize> = set.to_vec();
-        for &i in set {
-            let (x, y) = (i % w, i / w);
-            for (nx, ny) in [
-                (x.wrapping_sub(1), y),
-                (x + 1, y),
-                (x, y.wrapping_sub(1)),
-                (x, y + 1),
-            ] {
-                if nx < w && ny < h {
-                    out.push(ny * w + nx);
-                }
-            }
-        }
-        out.sort_unstable();
-        out.dedup();
-        out
-    };
-    let centroid = |hole: &[usize]| {
-        let rim = grow(hole);
-        let outer = grow(&grow(&rim));
-        let mut ring: Vec<f32> = outer
-            .iter()
-            .filter(|i| rim.binary_search(i).is_err())
-            .map(|&i| luminance(rgb[i]))
-            .collect();
-        ring.sort_by(f32::total_cmp);
-        let skin = ring.get(ring.len() / 2).copied().unwrap_or(face_lum);
-        let darkest = hole
-            .iter()
-            .map(|&i| luminance(rgb[i]))
-            .fold(f32::INFINITY, f32::min);
-        let (mut sum, mut total) = (DVec2::ZERO, 0.0);
-        for i in rim {
-            let weight =
-                ((skin - luminance(rgb[i])) / (skin - darkest).max(1.0)).clamp(0.0, 1.0) as f64;
-            sum += weight * DVec2::new((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
-            total += weight;
-        }
-        sum / total
-    };
-    let (a, b) = (centroid(&holes[0]), centroid(&holes[1]));
+    holes.truncate(2);
+    let (a, b) = (
+        pupil_centroid(&rgb, w, h, &holes[0], face_lum),
+        pupil_centroid(&rgb, w, h, &holes[1], face_lum),
+    );
     let areas = [holes[0].len() as u32, holes[1].len() as u32];
     let (pupils, pupil_areas_px) = if a.x <= b.x {
         ([a, b], areas)
@@ -390,9 +301,64 @@ fn detect_with(
         pupils: pupils.map(|p| p.to_array()),
         pupil_areas_px,
         row_edges: row_edges.map(|p| p.to_array()),
+        outline_candidates: [[[f64::NAN; 2]; OUTLINE_CANDIDATES]; 2],
         confidence: HeadConfidence::of(face_box, pupils, pupil_areas_px),
     };
     Ok((detection, used.pixel_rect()))
+}
+
+/// A pixel set and its 4-neighbours.
+fn grow(set: &[usize], w: usize, h: usize) -> Vec<usize> {
+    let mut out: Vec<usize> = set.to_vec();
+    for &i in set {
+        let (x, y) = (i % w, i / w);
+        for (nx, ny) in [
+            (x.wrapping_sub(1), y),
+            (x + 1, y),
+            (x, y.wrapping_sub(1)),
+            (x, y + 1),
+        ] {
+            if nx < w && ny < h {
+                out.push(ny * w + nx);
+            }
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// A pupil blob's sub-pixel centroid: each pixel of the blob and its one-pixel rim weighs by
+/// how far it is from the local skin level (the median of a ring two pixels out) towards the
+/// pupil's darkest value, so mixed edge pixels count in proportion and shading does not pull.
+pub(crate) fn pupil_centroid(
+    rgb: &[[u8; 3]],
+    w: usize,
+    h: usize,
+    hole: &[usize],
+    face_lum: f32,
+) -> DVec2 {
+    let rim = grow(hole, w, h);
+    let outer = grow(&grow(&rim, w, h), w, h);
+    let mut ring: Vec<f32> = outer
+        .iter()
+        .filter(|i| rim.binary_search(i).is_err())
+        .map(|&i| luminance(rgb[i]))
+        .collect();
+    ring.sort_by(f32::total_cmp);
+    let skin = ring.get(ring.len() / 2).copied().unwrap_or(face_lum);
+    let darkest = hole
+        .iter()
+        .map(|&i| luminance(rgb[i]))
+        .fold(f32::INFINITY, f32::min);
+    let (mut sum, mut total) = (DVec2::ZERO, 0.0);
+    for i in rim {
+        let weight =
+            ((skin - luminance(rgb[i])) / (skin - darkest).max(1.0)).clamp(0.0, 1.0) as f64;
+        sum += weight * DVec2::new((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+        total += weight;
+    }
+    sum / total
 }
 
 /// Where the skin ends beyond each pupil along the line through both: walking outward in

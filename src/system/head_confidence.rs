@@ -47,8 +47,9 @@ pub struct HeadConfidence {
     /// Smaller over larger pupil blob area, (0, 1].
     pub pupil_area_ratio: f64,
     /// Whether the cues are the yaw fit's ([`HeadConfidence::with_fit`]): then
-    /// `distance_ratio` holds the edge residual over the face width and
-    /// `centre_offset_in_face` the fitted yaw in degrees.
+    /// `distance_ratio` holds the outline residual over the face width,
+    /// `centre_offset_in_face` the fitted yaw in degrees and `pupil_height_in_face` the fit's
+    /// margin.
     pub fitted: bool,
 }
 
@@ -94,17 +95,22 @@ impl HeadConfidence {
 
     /// The cues once the head's yaw is fitted (`system/head_pose.rs`), which explains the
     /// pupils' foreshortening and their place in the face: the distance cue becomes the
-    /// outline's fit (`edge_rms_px`, the edges' RMS residual, over the face's width: 1 at
-    /// ≤ 0.02, 0 at ≥ 0.06), the symmetry cue the yaw's range (1 at |yaw| ≤ 60°, 0 at the
-    /// search's 75° limit) and the size cue the blobs' area ratio over the ratio the fitted
-    /// pose predicts (0 at ≤ 0.35, 1 at ≥ 0.6).
-    pub fn with_fit(&self, edge_rms_px: f64, yaw_deg: f64, expected_area_ratio: f64) -> Self {
+    /// outline's fit (`edge_rms_px`, the outline's RMS residual, over the face's width: 1 at
+    /// ≤ 0.015, 0 at ≥ 0.04); the symmetry cue the fitted yaw (1 at |yaw| ≤ 40°, 0 at ≥ 55°:
+    /// beyond, the far eye slips behind the nose) times the fit's `margin` (1 at ≥ 0.03, 0 at
+    /// 0: another yaw fits as well); the pupil-height and pupil-size cues are set to 1 (the
+    /// mesh's skin region includes its neck, and a turned iris is foreshortened by design).
+    /// In this form `distance_ratio` holds the residual over the face width,
+    /// `centre_offset_in_face` the fitted yaw in degrees and `pupil_height_in_face` the margin.
+    pub fn with_fit(&self, edge_rms_px: f64, yaw_deg: f64, margin: f64) -> Self {
         let mut c = *self;
         c.distance_ratio = edge_rms_px / self.face_width_px;
-        c.distance_agreement = ramp(c.distance_ratio, 0.06, 0.02);
+        c.distance_agreement = ramp(c.distance_ratio, 0.04, 0.015);
         c.centre_offset_in_face = yaw_deg;
-        c.symmetry = ramp(yaw_deg.abs(), 74.0, 60.0);
-        c.pupil_sizes = ramp(self.pupil_area_ratio / expected_area_ratio, 0.35, 0.6);
+        c.pupil_height_in_face = margin;
+        c.symmetry = ramp(yaw_deg.abs(), 55.0, 40.0) * ramp(margin, 0.0, 0.03);
+        c.pupil_height = 1.0;
+        c.pupil_sizes = 1.0;
         c.fitted = true;
         c.value = c.face_size * c.distance_agreement * c.pupil_height * c.symmetry * c.pupil_sizes;
         c
@@ -133,18 +139,24 @@ impl HeadConfidence {
                 pct(self.distance_ratio)
             ));
         }
+        if self.symmetry < 1.0 && self.fitted && self.pupil_height_in_face < 0.03 {
+            out.push(format!(
+                "another yaw fits the outline nearly as well (margin {:.3} of the face's width)",
+                self.pupil_height_in_face
+            ));
+        }
         if self.pupil_height < 1.0 {
             out.push(format!(
                 "a pupil at {} of the face's height (eyes sit in its upper half)",
                 pct(self.pupil_height_in_face)
             ));
         }
-        if self.symmetry < 1.0 && self.fitted {
+        if self.symmetry < 1.0 && self.fitted && self.centre_offset_in_face.abs() > 40.0 {
             out.push(format!(
                 "a fitted yaw of {:.0}°",
                 self.centre_offset_in_face
             ));
-        } else if self.symmetry < 1.0 {
+        } else if self.symmetry < 1.0 && !self.fitted {
             out.push(format!(
                 "the pupils' midpoint {} of the face's width off its centre",
                 pct(self.centre_offset_in_face)

@@ -12,6 +12,7 @@ pub mod frontal_map;
 pub mod head;
 pub mod head_confidence;
 pub mod head_pose;
+pub mod head_side;
 pub mod memory;
 pub mod obstruction;
 pub mod options;

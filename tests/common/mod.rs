@@ -37,6 +37,33 @@ pub fn das() -> Scene {
     Scene::load(&repo_path("scenes/das.toml")).expect("das.toml loads")
 }
 
+/// das with its ellipsoid face (head, hair, two pupils) replaced by the head mesh
+/// (`assets/head.obj`, eye point at the driver's eye): what `scenes/das_mesh_head.toml` holds.
+pub fn das_with_mesh_head() -> String {
+    let das = std::fs::read_to_string(repo_path("scenes/das.toml")).unwrap();
+    let start = das
+        .find("# The driver's head, for the back camera")
+        .unwrap();
+    let end = das.find("# Trees on both sides").unwrap();
+    let first = das.find('\n').unwrap();
+    let mesh = "# The driver's head: the head mesh (scene/head_model.rs) instead of das's ellipsoid face,\n\
+                # its origin at the eye point. Otherwise this file is scenes/das.toml: tests/head_poses.rs\n\
+                # checks that it stays so.\n\
+                [[object]]\nname = \"head\"\nkind = \"mesh\"\npath = \"../assets/head.obj\"\n\
+                translate = [1.4, 1.2, 0.0]\nhidden_from = [\"driver\"]\nmoves_with = \"head\"          \
+                # rides with the driver's head in `sequence`\n\n";
+    format!(
+        "# das (scenes/das.toml) with the head mesh as the driver's face: the side-angle head tracker's scene.{}{mesh}{}",
+        &das[first..start],
+        &das[end..]
+    )
+}
+
+/// [`das_with_mesh_head`] with absolute asset paths, so the text can be written anywhere.
+pub fn das_with_mesh_head_text() -> String {
+    das_with_mesh_head().replace("../assets", repo_path("assets").to_str().unwrap())
+}
+
 /// A small valid scene: a ground plane, a sphere and the obstacle with its cameras.
 pub const MINIMAL: &str = r#"
 [obstacle]
