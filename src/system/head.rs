@@ -16,8 +16,9 @@ pub use crate::system::head_confidence::{CONFIDENT_HEAD, HeadConfidence};
 use crate::util::color::encode_srgb8;
 use crate::util::sampling::{hash_words, unit_float};
 
-/// What the detector found, in back-camera pixel coordinates (continuous).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+/// What the detector found, in back-camera pixel coordinates (continuous). Two detections are
+/// equal when every field is, the NaN padding of `outline_candidates` included (bit for bit).
+#[derive(Clone, Copy, Debug, serde::Serialize)]
 pub struct FaceDetection {
     /// Bounding box of the face region: [x0, y0, x1, y1), pixels.
     pub face_box: [u32; 4],
@@ -40,6 +41,21 @@ pub struct FaceDetection {
 
 /// Outline candidates kept per side ([`FaceDetection::outline_candidates`]).
 pub const OUTLINE_CANDIDATES: usize = 12;
+
+impl PartialEq for FaceDetection {
+    fn eq(&self, other: &Self) -> bool {
+        let bits = |d: &FaceDetection| {
+            d.outline_candidates
+                .map(|side| side.map(|p| p.map(f64::to_bits)))
+        };
+        self.face_box == other.face_box
+            && self.pupils == other.pupils
+            && self.pupil_areas_px == other.pupil_areas_px
+            && self.row_edges == other.row_edges
+            && bits(self) == bits(other)
+            && self.confidence == other.confidence
+    }
+}
 
 impl FaceDetection {
     /// The feature width `A_px`: distance between the pupils, pixels.
