@@ -12,7 +12,8 @@ use seethru::scene::shapes::box_face;
 use seethru::system::compensation::ModelPlane;
 use seethru::system::options::{RunOptions, WorkingDistance};
 use seethru::system::pipeline::{crop_for, frontal_map, run};
-use seethru::system::surface_map::{PointModel, display_points};
+use seethru::system::point_model::PointModel;
+use seethru::system::surface_map::display_points;
 
 fn wall(keys: &str, d2: f64) -> String {
     common::WallScene {
@@ -379,4 +380,191 @@ fn the_cabin_runs_compares_and_sequences() {
         ],
     );
     assert!(ok, "{stderr}");
+}
+
+/// The point of a `segments`-facet cylinder display (radius `r`, `width` × `height`, obstacle
+/// frame) at UV (u, v), written out from the shape's definition: u is linear along each flat
+/// facet between the arc's columns at angles (u − ½)·width/r.
+fn cylinder_point(u: f64, v: f64, [width, height, r]: [f64; 3], segments: usize) -> DVec3 {
+    let half = width / (2.0 * r);
+    let column = |k: usize| {
+        let a = (k as f64 / segments as f64 - 0.5) * 2.0 * half;
+        DVec3::new(r * a.sin(), 0.0, r * a.cos() - r)
+    };
+    let k = ((u * segments as f64) as usize).min(segments - 1);
+    let t = u * segments as f64 - k as f64;
+    column(k).lerp(column(k + 1), t) + DVec3::Y * (0.5 - v) * height
+}
+
+fn ideal(d2: WorkingDistance) -> RunOptions {
+    RunOptions {
+        display: seethru::system::display::DisplayModel::Ideal,
+        ..options(d2)
+    }
+}
+
+/// The ideal display on a curved display shows, at every point of its surface, what the
+/// planar model says the eye sees through that point: the eye's ray through the point meets
+/// the model plane, and the frontal camera's ray through that model point meets the wall.
+/// Checked by ray casting for the model plane on the wall (then the truth itself), in front of
+/// it and at infinity, at every display pixel of the driver's view.
+#[test]
+fn the_ideal_display_on_a_curved_display_shows_the_ray_cast_model_point() {
+    let wall_z = -6.0;
+    let ctx = context(&wall(
+        "display_shape = \"cylinder\"\ndisplay_radius = 0.2\ndisplay_segments = 48",
+        -wall_z,
+    ));
+    let scene = &ctx.scene;
+    // The obstacle frame is the world's here.
+    let probe = DVec3::new(0.3, -0.2, 0.7);
+    assert!((scene.obstacle.world_from_obstacle.transform_point3(probe) - probe).length() < 1e-12);
+    let eye = scene.eye();
+    let camera = scene.frontal.position();
+    let to_wall = |from: DVec3, dir: DVec3| from + dir * ((wall_z - from.z) / dir.z);
+    for (d2, worst_allowed) in [
+        (WorkingDistance::Metres(6.0), 2e-4),
+        (WorkingDistance::Metres(2.5), 2e-4),
+        (WorkingDistance::Infinity, 2e-4),
+    ] {
+        let r = run(&ctx, &ideal(d2)).unwrap();
+        let mask = display_mask(&ctx, &r.occluded);
+        let (mut checked, mut worst, mut largest_shift) = (0, 0.0f64, 0.0f64);
+        for i in (0..mask.len()).filter(|&i| mask[i]) {
+            // Where the driver's ray meets the display's surface.
+            let on_surface = r.occluded.position[i].as_dvec3();
+            let ray = on_surface - eye;
+            let expected = match d2 {
+                WorkingDistance::Metres(d2) => {
+                    let model = eye + ray * ((-d2 - eye.z) / ray.z);
+                    to_wall(camera, model - camera)
+                }
+                _ => to_wall(camera, ray),
+            };
+            assert_eq!(r.seethru.object_id[i], 1, "pixel {i} shows the wall");
+            let shown = r.seethru.position[i].as_dvec3();
+            worst = worst.max((shown - expected).length());
+            largest_shift = largest_shift.max((expected - r.truth.position[i].as_dvec3()).length());
+            checked += 1;
+        }
+        assert!(checked > 1000, "{checked}");
+        assert!(
+            worst < worst_allowed,
+            "{d2:?}: {worst} m from the ray-cast point"
+        );
+        // Off the wall the model misregisters by centimetres: the check above is not vacuous.
+        if d2 != WorkingDistance::Metres(6.0) {
+            assert!(largest_shift > 0.05, "{d2:?}: {largest_shift}");
+        } else {
+            assert!(largest_shift < worst_allowed, "{largest_shift}");
+        }
+    }
+}
+
+/// The binocular mismatch on a curved display is, per display pixel, the vergence of the
+/// pixel's point on the curved surface minus that of the scene point it shows — not of the
+/// flat reference rectangle's point (on this cylinder up to 5.4 cm nearer or farther).
+#[test]
+fn the_binocular_map_of_a_curved_display_uses_the_surface_points() {
+    use seethru::measure::binocular::binocular_map;
+    use seethru::system::eyes::{Eye, Eyes};
+    let (width, height, radius, segments) = (0.3, 0.2, 0.2, 48);
+    let ctx = context(&wall(
+        &format!(
+            "display_shape = \"cylinder\"\ndisplay_radius = {radius}\ndisplay_segments = {segments}"
+        ),
+        6.0,
+    ));
+    let scene = &ctx.scene;
+    let eyes = Eyes::default();
+    let (left, right) = (
+        eyes.position(&scene.driver, Eye::Left),
+        eyes.position(&scene.driver, Eye::Right),
+    );
+    let mut o = options(WorkingDistance::Metres(6.0));
+    o.eyes.view = Eye::Left;
+    let r = run(&ctx, &o).unwrap();
+    let map = binocular_map(&r.display, &scene.obstacle, left, right);
+    // The vergence at p: the angle between the directions to the two eyes, arc-minutes.
+    let vergence = |p: DVec3| {
+        let (a, b) = (left - p, right - p);
+        a.cross(b).length().atan2(a.dot(b)).to_degrees() * 60.0
+    };
+    let [w, h] = scene.obstacle.display_resolution;
+    let (mut checked, mut worst, mut flat_gap) = (0, 0.0f64, 0.0f64);
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let (u, v) = ((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+            let surface = cylinder_point(u, v, [width, height, radius], segments);
+            let flat = DVec3::new((u - 0.5) * width, (0.5 - v) * height, 0.0);
+            let shown = r.display.position[i].as_dvec3();
+            let expected = vergence(surface) - vergence(shown);
+            let got = map.mismatch_arcmin[i] as f64;
+            assert!(got.is_finite(), "pixel ({x}, {y})");
+            worst = worst.max((got - expected).abs());
+            flat_gap = flat_gap.max((vergence(flat) - vergence(shown) - expected).abs());
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, (w * h) as usize);
+    assert!(worst < 0.01, "{worst}′ from the vergence geometry");
+    // The flat rectangle's points would be many arc-minutes off at the display's edges.
+    assert!(flat_gap > 5.0, "{flat_gap}′");
+}
+
+/// `sequence --display ideal` on a curved display: a still head and vehicle with the model
+/// plane on the wall show the wall exactly in every frame (no resampling quantum, and the
+/// curved surface's own points through the model), as `run` does.
+#[test]
+fn a_sequence_shows_the_ideal_curved_display_exactly() {
+    use seethru::measure::sequence::{Measuring, run_sequence};
+    use seethru::system::sequence::head_motion::HeadMotion;
+    use seethru::system::sequence::predict::Prediction;
+    use seethru::system::sequence::system_loop::SequenceOptions;
+    use seethru::system::sequence::timeline::Timeline;
+    let text = wall(
+        "display_shape = \"cylinder\"\ndisplay_radius = 0.2\ndisplay_segments = 48",
+        6.0,
+    );
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let mean = |display| {
+        let o = SequenceOptions {
+            run: RunOptions {
+                display,
+                ..options(WorkingDistance::Metres(6.0))
+            },
+            timeline: Timeline {
+                duration: 0.1,
+                fps: 30.0,
+                display_hz: 30.0,
+                latency_camera: 0.05,
+                latency_tracking: 0.0,
+            },
+            speed: 0.0,
+            yaw_rate: 0.0,
+            head: HeadMotion::Still,
+            predict: Prediction::None,
+            reproject: false,
+            byo: Default::default(),
+        };
+        let how = Measuring {
+            metrics: true,
+            full_frames: false,
+            band: 5,
+            progress: false,
+        };
+        let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
+        assert!(run.records.len() >= 3);
+        run.records
+            .iter()
+            .map(|r| r.metrics.unwrap().mean_arcmin)
+            .fold(0.0, f64::max)
+    };
+    use seethru::system::display::DisplayModel;
+    let ideal = mean(DisplayModel::Ideal);
+    let pixels = mean(DisplayModel::Pixels);
+    assert!(ideal < 0.01, "ideal: {ideal}′");
+    // The physical display's pixels leave their quantum: the check above can tell.
+    assert!(pixels > 20.0 * ideal && pixels > 0.1, "pixels: {pixels}′");
 }

@@ -26,11 +26,13 @@ use crate::scene::world::{World, view_bit};
 use crate::system::calibration_json::calibration_json;
 use crate::system::capture::{HeadEstimate, check_display_input, display_from, fingerprint};
 use crate::system::compensation::Crop;
-use crate::system::display::{DisplayModel, DisplayPlacement, DisplaySurface, resample_through};
+use crate::system::display::{
+    DisplayModel, DisplayPlacement, DisplaySurface, IdealMap, resample_through,
+};
 use crate::system::frontal_map::FrontalMap;
 use crate::system::head::{detect, eye_from_detection, gaussian};
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
-use crate::system::pipeline::{crop_for, driver_camera, frontal_map};
+use crate::system::pipeline::{crop_for, driver_camera, frontal_map, ideal_map};
 use crate::system::sequence::byo::{Byo, RefreshInputs};
 use crate::system::sequence::head_motion::HeadMotion;
 use crate::system::sequence::predict::{Prediction, Predictor};
@@ -79,6 +81,9 @@ pub struct Shown {
     pub frontal: Camera,
     /// The believed frontal lens the display image went through (`None`: a pinhole).
     pub lens: Option<Lens>,
+    /// How the ideal display maps its points: through `crop` and `lens` on a flat display,
+    /// per surface point on a curved one.
+    pub ideal: IdealMap,
 }
 
 /// Wall time spent in each stage, seconds, summed over the frames.
@@ -296,11 +301,6 @@ impl SystemLoop {
         let at = || format!("at t = {} s", short(times.refresh_time));
         let curved =
             run.method == Method::Planar && geometry.obstacle.display_shape.curved().is_some();
-        if curved && run.display == DisplayModel::Ideal {
-            bail!(
-                "--display ideal works on a flat display; a curved display (display_shape) models its physical pixels (use --display pixels)"
-            );
-        }
         // A curved display's pixels may look beyond its reference rectangle's crop.
         let byo = self.options.byo.clone();
         if byo.maps.is_some() && (curved || run.display == DisplayModel::Ideal) {
@@ -416,6 +416,7 @@ impl SystemLoop {
             image: display,
             placement: DisplayPlacement::new(&capture.scene.obstacle),
         });
+        let ideal = ideal_map(&geometry, eye_world, d2_used, curved, crop, &map)?;
         self.shown = Some(Shown {
             times,
             eye_estimated,
@@ -425,6 +426,7 @@ impl SystemLoop {
             d2_used,
             frontal: frontal_camera,
             lens: map.lens,
+            ideal,
         });
         Ok(self.shown.as_ref().expect("just set"))
     }
@@ -453,10 +455,9 @@ impl SystemLoop {
                 DisplaySurface::Pixels { image, placement }
             }
             _ => DisplaySurface::Ideal {
-                crop: shown.crop,
+                map: shown.ideal.clone(),
                 frontal: shown.frontal,
                 placement,
-                lens: shown.lens,
             },
         };
         let region = ctx.difference_region(&driver, view_bit::TRUTH, view_bit::SEETHRU);
