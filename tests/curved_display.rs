@@ -568,3 +568,183 @@ fn a_sequence_shows_the_ideal_curved_display_exactly() {
     // The physical display's pixels leave their quantum: the check above can tell.
     assert!(pixels > 20.0 * ideal && pixels > 0.1, "pixels: {pixels}′");
 }
+
+/// A scene whose obstacle at the origin faces `facing` with a cylinder display (`radius`,
+/// 48 facets, 0.3 × 0.2 m at 150 × 100), the driver's eye at `eye_o` (obstacle frame) looking
+/// at the display, and `objects` (material `tex`: the street texture).
+fn curved_scene(facing: [f64; 3], radius: f64, eye_o: DVec3, objects: &str) -> RenderContext {
+    let text = format!(
+        r#"
+[obstacle]
+center = [0.0, 0.0, 0.0]
+facing = {facing:?}
+width = 0.3
+height = 0.2
+display_resolution = [150, 100]
+display_shape = "cylinder"
+display_radius = {radius}
+display_segments = 48
+
+[camera.driver]
+position = [0.0, 0.0, 0.7]
+look_at = [0.0, 0.0, -6.0]
+half_angle_deg = 25.0
+resolution = [200, 150]
+
+[camera.frontal]
+half_angle_deg = 45.0
+resolution = [640, 480]
+
+[camera.back]
+resolution = [32, 24]
+
+[[material]]
+name = "tex"
+texture = "../assets/street.png"
+uv_repeat = [6.0, 4.0]
+
+{objects}
+"#
+    );
+    let mut scene = common::parse_in(&common::repo_path("scenes"), "test.toml", &text).unwrap();
+    let w = scene.obstacle.world_from_obstacle;
+    scene.driver = seethru::geometry::camera::Camera::look_at(
+        w.transform_point3(eye_o),
+        w.transform_point3(DVec3::ZERO),
+        w.transform_vector3(DVec3::Y),
+        25f64.to_radians(),
+        200,
+        150,
+    )
+    .unwrap();
+    RenderContext::new(scene).unwrap()
+}
+
+/// Per display pixel of the driver's view of a cylinder display (`radius`, 48 facets) on a
+/// scene that is the plane `n · p = c`: the distance between the shown and the true point, and
+/// the resampling quantum there — half a display pixel along the pixel's facet (u) and the
+/// cylinder's axis (v), carried along the eye's ray to the plane, plus half a frontal pixel's
+/// footprint on the plane around the true point, all by ray casting.
+fn curved_errors_and_quanta(
+    ctx: &RenderContext,
+    r: &seethru::system::pipeline::RunResult,
+    radius: f64,
+    n: DVec3,
+    c: f64,
+) -> Vec<(f64, f64)> {
+    let scene = &ctx.scene;
+    let obstacle = &scene.obstacle;
+    let world_from_obstacle = obstacle.world_from_obstacle;
+    let obstacle_from_world = world_from_obstacle.inverse();
+    let [dw, dh] = obstacle.display_resolution.map(f64::from);
+    let segments = 48.0;
+    let half_angle = obstacle.width / (2.0 * radius);
+    let column = |k: f64| {
+        let a = (k / segments - 0.5) * 2.0 * half_angle;
+        DVec3::new(radius * a.sin(), 0.0, radius * a.cos() - radius)
+    };
+    let eye = scene.eye();
+    let to_plane = |from: DVec3, through: DVec3| {
+        let d = through - from;
+        from + d * ((c - n.dot(from)) / n.dot(d))
+    };
+    let frontal = &scene.frontal;
+    let mask = display_mask(ctx, &r.occluded);
+    (0..mask.len())
+        .filter(|&i| mask[i])
+        .map(|i| {
+            let t = r.truth.position[i].as_dvec3();
+            let s = r.seethru.position[i].as_dvec3();
+            let x = r.occluded.position[i].as_dvec3();
+            let local = obstacle_from_world.transform_point3(x);
+            let u = local.x.atan2(local.z + radius) / (2.0 * half_angle) + 0.5;
+            let k = (u * segments).floor().clamp(0.0, segments - 1.0);
+            let facet = column(k + 1.0) - column(k);
+            // One display pixel spans facet · segments / W along the facet.
+            let du = world_from_obstacle.transform_vector3(facet * (0.5 * segments / dw));
+            let dv = world_from_obstacle.transform_vector3(DVec3::Y * (0.5 * obstacle.height / dh));
+            let display = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
+                .map(|(a, b)| (to_plane(eye, x + du * a + dv * b) - to_plane(eye, x)).length())
+                .into_iter()
+                .fold(0.0, f64::max);
+            let q = frontal.project_point(t).unwrap();
+            let footprint = [(0.5, 0.5), (0.5, -0.5), (-0.5, 0.5), (-0.5, -0.5)]
+                .map(|(a, b)| {
+                    let (o, dir) = frontal.world_ray(q + DVec2::new(a, b));
+                    (to_plane(o, o + dir) - t).length()
+                })
+                .into_iter()
+                .fold(0.0, f64::max);
+            ((s - t).length(), display + footprint)
+        })
+        .collect()
+}
+
+/// Every compensation method works per display pixel on a curved display: with the scene
+/// model right (the plane on the wall, plane-fit on the wall, the ideal depth sensor, the
+/// ground on a road) every display pixel of the driver's view shows the true point within its
+/// resampling quantum; with the model wrong (d2 → ∞ before a wall 6 m away) most do not.
+#[test]
+fn every_compensation_method_registers_a_curved_display() {
+    use seethru::system::depth_sensor::SensorKind;
+    use seethru::system::options::Method;
+    let radius = 0.15;
+    let within = |errors: &[(f64, f64)]| {
+        let inside = errors.iter().filter(|(e, q)| *e <= q * 1.02 + 1e-5).count();
+        let worst = errors.iter().map(|(e, q)| e / q).fold(0.0, f64::max);
+        (inside, errors.len(), worst)
+    };
+    let method = |m: Method, d2: WorkingDistance| RunOptions {
+        method: m,
+        ..options(d2)
+    };
+    let wall = curved_scene(
+        [0.0, 0.0, 1.0],
+        radius,
+        DVec3::new(0.08, 0.03, 0.7),
+        "[[object]]\nname = \"wall\"\nkind = \"quad\"\nmaterial = \"tex\"\nsize = [80.0, 60.0]\ntranslate = [0.0, 0.0, -6.0]",
+    );
+    let mut depth = method(Method::Depth, WorkingDistance::Infinity);
+    depth.scene_model.sensor.kind = SensorKind::Ideal;
+    for (name, o) in [
+        (
+            "planar d2 = 6",
+            method(Method::Planar, WorkingDistance::Metres(6.0)),
+        ),
+        (
+            "plane-fit",
+            method(Method::PlaneFit, WorkingDistance::Infinity),
+        ),
+        ("depth", depth),
+    ] {
+        let r = run(&wall, &o).unwrap();
+        let (inside, checked, worst) =
+            within(&curved_errors_and_quanta(&wall, &r, radius, DVec3::Z, -6.0));
+        eprintln!("{name}: {inside} of {checked}, worst {worst:.2} quanta");
+        assert!(checked > 1000, "{name}: {checked}");
+        assert_eq!(inside, checked, "{name} on the wall, worst {worst} quanta");
+    }
+    let r = run(&wall, &method(Method::Planar, WorkingDistance::Infinity)).unwrap();
+    let (inside, checked, worst) =
+        within(&curved_errors_and_quanta(&wall, &r, radius, DVec3::Z, -6.0));
+    assert!(
+        inside < checked / 2 && worst > 2.0,
+        "planar d2 → ∞: {inside} of {checked}, worst {worst}"
+    );
+    // A road below an obstacle 1.2 m up that faces the driver and tilts up 31°: the display
+    // shows only road.
+    let road = curved_scene(
+        [0.0, 0.6, 1.0],
+        radius,
+        DVec3::new(0.05, 0.03, 0.7),
+        "[[object]]\nname = \"road\"\nkind = \"plane\"\nmaterial = \"tex\"\nsize = [200.0, 200.0]\ntranslate = [0.0, -1.2, 0.0]",
+    );
+    for m in [Method::Ground, Method::PlaneFit] {
+        let r = run(&road, &method(m, WorkingDistance::Infinity)).unwrap();
+        let (inside, checked, worst) =
+            within(&curved_errors_and_quanta(&road, &r, radius, DVec3::Y, -1.2));
+        eprintln!("{m:?} on the road: {inside} of {checked}, worst {worst:.2} quanta");
+        assert!(checked > 1000, "{m:?}: {checked}");
+        assert_eq!(inside, checked, "{m:?} on the road, worst {worst} quanta");
+    }
+}
