@@ -565,6 +565,24 @@ fn a_sequence_shows_the_ideal_curved_display_exactly() {
     let ideal = mean(DisplayModel::Ideal);
     let pixels = mean(DisplayModel::Pixels);
     assert!(ideal < 0.01, "ideal: {ideal}′");
+    // The sequence renders only the frontal pixels the curved display reads; its still
+    // frames are `run`'s, which renders the whole frontal image.
+    let ctx = RenderContext::new(scene.clone()).unwrap();
+    let r = run(&ctx, &options(WorkingDistance::Metres(6.0))).unwrap();
+    let (_, metrics) = seethru::measure::metrics::measure(
+        &ctx,
+        &ctx.scene,
+        ctx.scene.eye(),
+        [&r.truth, &r.seethru, &r.occluded],
+        5,
+    );
+    let single = metrics["display"]["misregistration_arcmin"]["mean"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        (pixels - single).abs() < 1e-9 * single,
+        "sequence {pixels}′, run {single}′"
+    );
     // The physical display's pixels leave their quantum: the check above can tell.
     assert!(pixels > 20.0 * ideal && pixels > 0.1, "pixels: {pixels}′");
 }

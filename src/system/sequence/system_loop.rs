@@ -25,7 +25,7 @@ use crate::scene::Scene;
 use crate::scene::world::{World, view_bit};
 use crate::system::calibration_json::calibration_json;
 use crate::system::capture::{HeadEstimate, check_display_input, display_from, fingerprint};
-use crate::system::compensation::Crop;
+use crate::system::compensation::{Crop, ModelPlane};
 use crate::system::display::{
     DisplayModel, DisplayPlacement, DisplaySurface, IdealMap, resample_through,
 };
@@ -33,10 +33,12 @@ use crate::system::frontal_map::FrontalMap;
 use crate::system::head::{detect, eye_from_detection, gaussian};
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use crate::system::pipeline::{crop_for, driver_camera, frontal_map, ideal_map};
+use crate::system::point_model::PointModel;
 use crate::system::sequence::byo::{Byo, RefreshInputs};
 use crate::system::sequence::head_motion::HeadMotion;
 use crate::system::sequence::predict::{Prediction, Predictor};
 use crate::system::sequence::timeline::{FrameTimes, Rig, Timeline};
+use crate::system::surface_map::display_points;
 use crate::system::tracker_model::WEBCAM_LANDMARKS;
 use crate::util::number::short;
 
@@ -287,6 +289,8 @@ impl SystemLoop {
         };
         let capture = self.context_at(times.capture)?;
         let start = Instant::now();
+        // The frontal render inside this stage is counted as `frontal`, not twice.
+        let frontal_before = self.seconds.frontal;
         // The compensation's geometry: the display where it is when the image is shown (with
         // re-projection by the known vehicle motion) or where it was at capture.
         let mut geometry = capture.scene.clone();
@@ -308,10 +312,10 @@ impl SystemLoop {
                 "--maps shows a map on a flat display's pixels: not with a curved display or --display ideal"
             );
         }
-        let full = run.method == Method::None
-            || run.d2 == WorkingDistance::Auto
-            || curved
-            || byo.needs_inputs();
+        // A curved display renders only the frontal pixels its model points read, as a flat
+        // display renders only its crop's.
+        let full =
+            run.method == Method::None || run.d2 == WorkingDistance::Auto || byo.needs_inputs();
         let frontal_camera = capture.scene.frontal;
         let settings = self.settings();
         let (crop, d2_used) = if full {
@@ -329,7 +333,11 @@ impl SystemLoop {
             crop_for(&geometry, eye_world, &self.frontal, run).with_context(at)?
         } else {
             let crop = crop_for(&geometry, eye_world, &self.frontal, run).with_context(at)?;
-            let rect = crop_rect(&frontal_map(&geometry, crop.0, run)?, &frontal_camera);
+            let rect = if curved {
+                curved_rect(&geometry, eye_world, crop.1, &frontal_camera).with_context(at)?
+            } else {
+                crop_rect(&frontal_map(&geometry, crop.0, run)?, &frontal_camera)
+            };
             let f = Instant::now();
             capture.render_rect(
                 &frontal_camera,
@@ -410,7 +418,8 @@ impl SystemLoop {
         } else {
             resample_through(&self.frontal, &map, run.filter)
         };
-        self.seconds.compensation += start.elapsed().as_secs_f64();
+        self.seconds.compensation +=
+            start.elapsed().as_secs_f64() - (self.seconds.frontal - frontal_before);
         self.inputs = inputs;
         self.surface = Some(DisplaySurface::Pixels {
             image: display,
@@ -479,6 +488,37 @@ impl SystemLoop {
 /// The frontal pixels a crop reads, with a margin for the filters, within the image.
 fn crop_rect(map: &FrontalMap, camera: &Camera) -> PixelRect {
     let (min, max) = map.bounds();
+    rect_around(min, max, camera)
+}
+
+/// The frontal pixels a curved display's planar model reads (every display pixel's model
+/// point for the eye at `eye`, world, and the model plane at `d2`), with a margin for the
+/// filters, within the image; empty when the camera sees none of them.
+fn curved_rect(scene: &Scene, eye: DVec3, d2: Option<f64>, camera: &Camera) -> Result<PixelRect> {
+    let plane = d2.map_or(ModelPlane::Infinity, ModelPlane::At);
+    let model = PointModel::new(scene, eye, plane)?;
+    let (min, max) = display_points(&scene.obstacle)
+        .into_iter()
+        .flatten()
+        .filter_map(|p| model.frontal_point(p))
+        .filter(|p| p.is_finite())
+        .fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(p), hi.max(p)),
+        );
+    if !(min.x <= max.x) {
+        return Ok(PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: 0,
+            y1: 0,
+        });
+    }
+    Ok(rect_around(min, max, camera))
+}
+
+/// The pixels of `camera` from `min` to `max` (continuous), with the filters' margin.
+fn rect_around(min: DVec2, max: DVec2, camera: &Camera) -> PixelRect {
     let lo = (min - DVec2::splat(CROP_MARGIN_PX)).floor();
     let hi = (max + DVec2::splat(CROP_MARGIN_PX)).ceil();
     let clamp = |v: f64, size: u32| v.clamp(0.0, size as f64) as u32;
