@@ -766,3 +766,54 @@ fn every_compensation_method_registers_a_curved_display() {
         assert_eq!(inside, checked, "{m:?} on the road, worst {worst} quanta");
     }
 }
+
+/// The border bands of a curved display are its pixel grid's (from the UVs), not the
+/// reference rectangle's: the driver's pixels in the left and right bands are those whose
+/// point lies within `band` display pixels of the arc's ends.
+#[test]
+fn the_border_bands_of_a_curved_display_follow_its_uvs() {
+    let (radius, band) = (0.12, 5u32);
+    let ctx = context(&wall(
+        &format!("display_shape = \"cylinder\"\ndisplay_radius = {radius}\ndisplay_segments = 48"),
+        6.0,
+    ));
+    let r = run(&ctx, &options(WorkingDistance::Metres(6.0))).unwrap();
+    let (_, metrics) = seethru::measure::metrics::measure(
+        &ctx,
+        &ctx.scene,
+        ctx.scene.eye(),
+        [&r.truth, &r.seethru, &r.occluded],
+        band,
+    );
+    let obstacle = &ctx.scene.obstacle;
+    let half = obstacle.width / (2.0 * radius);
+    let w = obstacle.display_resolution[0] as f64;
+    let mask = display_mask(&ctx, &r.occluded);
+    // u along the arc, from the point's angle round the cylinder's axis (the facets' chords
+    // differ from the arc by under a thousandth of a pixel's share here).
+    let u = |i: usize| {
+        let p = r.occluded.position[i].as_dvec3();
+        (p.x.atan2(p.z + radius) / (2.0 * half) + 0.5) * w
+    };
+    let count = |keep: &dyn Fn(f64) -> bool| {
+        (0..mask.len()).filter(|&i| mask[i] && keep(u(i))).count() as f64
+    };
+    let (left, right) = (
+        count(&|u| u < band as f64),
+        count(&|u| u >= w - band as f64),
+    );
+    let sides = &metrics["border_per_side"];
+    let (got_left, got_right) = (
+        sides["left"]["pixels"].as_f64().unwrap(),
+        sides["right"]["pixels"].as_f64().unwrap(),
+    );
+    assert!(left > 50.0 && right > 50.0, "{left} {right}");
+    assert!(
+        (got_left - left).abs() <= 0.03 * left + 2.0,
+        "left {got_left} vs {left}"
+    );
+    assert!(
+        (got_right - right).abs() <= 0.03 * right + 2.0,
+        "right {got_right} vs {right}"
+    );
+}
