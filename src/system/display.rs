@@ -173,7 +173,7 @@ pub enum IdealMap {
     /// A curved display: the point itself (where the display is now, in its obstacle frame)
     /// through the planar model ([`PointModel`]) — the eye's ray through it meets the model
     /// plane, projected into the believed frontal camera.
-    Surface(PointModel),
+    Surface(Box<PointModel>),
 }
 
 /// What the display shows where the `seethru` view meets it.

@@ -263,11 +263,11 @@ pub fn ideal_map(
     use crate::system::point_model::PointModel;
     Ok(if curved {
         let plane = d2.map_or(ModelPlane::Infinity, ModelPlane::At);
-        IdealMap::Surface(PointModel::new(scene, eye, plane)?)
+        IdealMap::Surface(Box::new(PointModel::new(scene, eye, plane)?))
     } else {
         IdealMap::Crop {
             crop,
-            lens: map.lens.clone(),
+            lens: map.lens,
         }
     })
 }

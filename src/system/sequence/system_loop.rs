@@ -506,7 +506,7 @@ fn curved_rect(scene: &Scene, eye: DVec3, d2: Option<f64>, camera: &Camera) -> R
             (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
             |(lo, hi), p| (lo.min(p), hi.max(p)),
         );
-    if !(min.x <= max.x) {
+    if min.x > max.x {
         return Ok(PixelRect {
             x0: 0,
             y0: 0,
