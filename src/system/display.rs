@@ -162,6 +162,8 @@ impl DisplayPlacement {
 }
 
 /// How an ideal display finds the frontal point of a point on its face.
+// One value per run (or refresh), borrowed by the renderer: the variants' sizes cost nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 pub enum IdealMap {
     /// A flat display: the point's continuous display coordinates through the crop's
@@ -173,7 +175,7 @@ pub enum IdealMap {
     /// A curved display: the point itself (where the display is now, in its obstacle frame)
     /// through the planar model ([`PointModel`]) — the eye's ray through it meets the model
     /// plane, projected into the believed frontal camera.
-    Surface(Box<PointModel>),
+    Surface(PointModel),
 }
 
 /// What the display shows where the `seethru` view meets it.

@@ -263,7 +263,7 @@ pub fn ideal_map(
     use crate::system::point_model::PointModel;
     Ok(if curved {
         let plane = d2.map_or(ModelPlane::Infinity, ModelPlane::At);
-        IdealMap::Surface(Box::new(PointModel::new(scene, eye, plane)?))
+        IdealMap::Surface(PointModel::new(scene, eye, plane)?)
     } else {
         IdealMap::Crop {
             crop,
