@@ -1,7 +1,7 @@
 //! The planar model per display point: the eye's ray through a point of the display's
 //! surface meets the model plane (z = −d2 in the obstacle frame, or d2 → ∞) and is projected
 //! into the believed frontal camera. A curved display's compensation
-//! ([`crate::system::surface_map`]) and its ideal display ([`crate::system::display`]) both
+//! (`system/surface_map.rs`) and its ideal display (`system/display.rs`) both
 //! map through it.
 
 use anyhow::{Result, bail};
