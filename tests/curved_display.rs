@@ -12,7 +12,8 @@ use seethru::scene::shapes::box_face;
 use seethru::system::compensation::ModelPlane;
 use seethru::system::options::{RunOptions, WorkingDistance};
 use seethru::system::pipeline::{crop_for, frontal_map, run};
-use seethru::system::surface_map::{PointModel, display_points};
+use seethru::system::point_model::PointModel;
+use seethru::system::surface_map::display_points;
 
 fn wall(keys: &str, d2: f64) -> String {
     common::WallScene {
@@ -379,4 +380,440 @@ fn the_cabin_runs_compares_and_sequences() {
         ],
     );
     assert!(ok, "{stderr}");
+}
+
+/// The point of a `segments`-facet cylinder display (radius `r`, `width` × `height`, obstacle
+/// frame) at UV (u, v), written out from the shape's definition: u is linear along each flat
+/// facet between the arc's columns at angles (u − ½)·width/r.
+fn cylinder_point(u: f64, v: f64, [width, height, r]: [f64; 3], segments: usize) -> DVec3 {
+    let half = width / (2.0 * r);
+    let column = |k: usize| {
+        let a = (k as f64 / segments as f64 - 0.5) * 2.0 * half;
+        DVec3::new(r * a.sin(), 0.0, r * a.cos() - r)
+    };
+    let k = ((u * segments as f64) as usize).min(segments - 1);
+    let t = u * segments as f64 - k as f64;
+    column(k).lerp(column(k + 1), t) + DVec3::Y * (0.5 - v) * height
+}
+
+fn ideal(d2: WorkingDistance) -> RunOptions {
+    RunOptions {
+        display: seethru::system::display::DisplayModel::Ideal,
+        ..options(d2)
+    }
+}
+
+/// The ideal display on a curved display shows, at every point of its surface, what the
+/// planar model says the eye sees through that point: the eye's ray through the point meets
+/// the model plane, and the frontal camera's ray through that model point meets the wall.
+/// Checked by ray casting for the model plane on the wall (then the truth itself), in front of
+/// it and at infinity, at every display pixel of the driver's view.
+#[test]
+fn the_ideal_display_on_a_curved_display_shows_the_ray_cast_model_point() {
+    let wall_z = -6.0;
+    let ctx = context(&wall(
+        "display_shape = \"cylinder\"\ndisplay_radius = 0.2\ndisplay_segments = 48",
+        -wall_z,
+    ));
+    let scene = &ctx.scene;
+    // The obstacle frame is the world's here.
+    let probe = DVec3::new(0.3, -0.2, 0.7);
+    assert!((scene.obstacle.world_from_obstacle.transform_point3(probe) - probe).length() < 1e-12);
+    let eye = scene.eye();
+    let camera = scene.frontal.position();
+    let to_wall = |from: DVec3, dir: DVec3| from + dir * ((wall_z - from.z) / dir.z);
+    for (d2, worst_allowed) in [
+        (WorkingDistance::Metres(6.0), 2e-4),
+        (WorkingDistance::Metres(2.5), 2e-4),
+        (WorkingDistance::Infinity, 2e-4),
+    ] {
+        let r = run(&ctx, &ideal(d2)).unwrap();
+        let mask = display_mask(&ctx, &r.occluded);
+        let (mut checked, mut worst, mut largest_shift) = (0, 0.0f64, 0.0f64);
+        for i in (0..mask.len()).filter(|&i| mask[i]) {
+            // Where the driver's ray meets the display's surface.
+            let on_surface = r.occluded.position[i].as_dvec3();
+            let ray = on_surface - eye;
+            let expected = match d2 {
+                WorkingDistance::Metres(d2) => {
+                    let model = eye + ray * ((-d2 - eye.z) / ray.z);
+                    to_wall(camera, model - camera)
+                }
+                _ => to_wall(camera, ray),
+            };
+            assert_eq!(r.seethru.object_id[i], 1, "pixel {i} shows the wall");
+            let shown = r.seethru.position[i].as_dvec3();
+            worst = worst.max((shown - expected).length());
+            largest_shift = largest_shift.max((expected - r.truth.position[i].as_dvec3()).length());
+            checked += 1;
+        }
+        assert!(checked > 1000, "{checked}");
+        assert!(
+            worst < worst_allowed,
+            "{d2:?}: {worst} m from the ray-cast point"
+        );
+        // Off the wall the model misregisters by centimetres: the check above is not vacuous.
+        if d2 != WorkingDistance::Metres(6.0) {
+            assert!(largest_shift > 0.05, "{d2:?}: {largest_shift}");
+        } else {
+            assert!(largest_shift < worst_allowed, "{largest_shift}");
+        }
+    }
+}
+
+/// The binocular mismatch on a curved display is, per display pixel, the vergence of the
+/// pixel's point on the curved surface minus that of the scene point it shows — not of the
+/// flat reference rectangle's point (on this cylinder up to 5.4 cm nearer or farther).
+#[test]
+fn the_binocular_map_of_a_curved_display_uses_the_surface_points() {
+    use seethru::measure::binocular::binocular_map;
+    use seethru::system::eyes::{Eye, Eyes};
+    let (width, height, radius, segments) = (0.3, 0.2, 0.2, 48);
+    let ctx = context(&wall(
+        &format!(
+            "display_shape = \"cylinder\"\ndisplay_radius = {radius}\ndisplay_segments = {segments}"
+        ),
+        6.0,
+    ));
+    let scene = &ctx.scene;
+    let eyes = Eyes::default();
+    let (left, right) = (
+        eyes.position(&scene.driver, Eye::Left),
+        eyes.position(&scene.driver, Eye::Right),
+    );
+    let mut o = options(WorkingDistance::Metres(6.0));
+    o.eyes.view = Eye::Left;
+    let r = run(&ctx, &o).unwrap();
+    let map = binocular_map(&r.display, &scene.obstacle, left, right);
+    // The vergence at p: the angle between the directions to the two eyes, arc-minutes.
+    let vergence = |p: DVec3| {
+        let (a, b) = (left - p, right - p);
+        a.cross(b).length().atan2(a.dot(b)).to_degrees() * 60.0
+    };
+    let [w, h] = scene.obstacle.display_resolution;
+    let (mut checked, mut worst, mut flat_gap) = (0, 0.0f64, 0.0f64);
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let (u, v) = ((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+            let surface = cylinder_point(u, v, [width, height, radius], segments);
+            let flat = DVec3::new((u - 0.5) * width, (0.5 - v) * height, 0.0);
+            let shown = r.display.position[i].as_dvec3();
+            let expected = vergence(surface) - vergence(shown);
+            let got = map.mismatch_arcmin[i] as f64;
+            assert!(got.is_finite(), "pixel ({x}, {y})");
+            worst = worst.max((got - expected).abs());
+            flat_gap = flat_gap.max((vergence(flat) - vergence(shown) - expected).abs());
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, (w * h) as usize);
+    assert!(worst < 0.01, "{worst}′ from the vergence geometry");
+    // The flat rectangle's points would be many arc-minutes off at the display's edges.
+    assert!(flat_gap > 5.0, "{flat_gap}′");
+}
+
+/// `sequence --display ideal` on a curved display: a still head and vehicle with the model
+/// plane on the wall show the wall exactly in every frame (no resampling quantum, and the
+/// curved surface's own points through the model), as `run` does.
+#[test]
+fn a_sequence_shows_the_ideal_curved_display_exactly() {
+    use seethru::measure::sequence::{Measuring, run_sequence};
+    use seethru::system::sequence::head_motion::HeadMotion;
+    use seethru::system::sequence::predict::Prediction;
+    use seethru::system::sequence::system_loop::SequenceOptions;
+    use seethru::system::sequence::timeline::Timeline;
+    let text = wall(
+        "display_shape = \"cylinder\"\ndisplay_radius = 0.2\ndisplay_segments = 48",
+        6.0,
+    );
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let mean = |display| {
+        let o = SequenceOptions {
+            run: RunOptions {
+                display,
+                ..options(WorkingDistance::Metres(6.0))
+            },
+            timeline: Timeline {
+                duration: 0.1,
+                fps: 30.0,
+                display_hz: 30.0,
+                latency_camera: 0.05,
+                latency_tracking: 0.0,
+            },
+            speed: 0.0,
+            yaw_rate: 0.0,
+            head: HeadMotion::Still,
+            predict: Prediction::None,
+            reproject: false,
+            byo: Default::default(),
+        };
+        let how = Measuring {
+            metrics: true,
+            full_frames: false,
+            band: 5,
+            progress: false,
+        };
+        let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
+        assert!(run.records.len() >= 3);
+        run.records
+            .iter()
+            .map(|r| r.metrics.unwrap().mean_arcmin)
+            .fold(0.0, f64::max)
+    };
+    use seethru::system::display::DisplayModel;
+    let ideal = mean(DisplayModel::Ideal);
+    let pixels = mean(DisplayModel::Pixels);
+    assert!(ideal < 0.01, "ideal: {ideal}′");
+    // The sequence renders only the frontal pixels the curved display reads; its still
+    // frames are `run`'s, which renders the whole frontal image.
+    let ctx = RenderContext::new(scene.clone()).unwrap();
+    let r = run(&ctx, &options(WorkingDistance::Metres(6.0))).unwrap();
+    let (_, metrics) = seethru::measure::metrics::measure(
+        &ctx,
+        &ctx.scene,
+        ctx.scene.eye(),
+        [&r.truth, &r.seethru, &r.occluded],
+        5,
+    );
+    let single = metrics["display"]["misregistration_arcmin"]["mean"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        (pixels - single).abs() < 1e-9 * single,
+        "sequence {pixels}′, run {single}′"
+    );
+    // The physical display's pixels leave their quantum: the check above can tell.
+    assert!(pixels > 20.0 * ideal && pixels > 0.1, "pixels: {pixels}′");
+}
+
+/// A scene whose obstacle at the origin faces `facing` with a cylinder display (`radius`,
+/// 48 facets, 0.3 × 0.2 m at 150 × 100), the driver's eye at `eye_o` (obstacle frame) looking
+/// at the display, and `objects` (material `tex`: the street texture).
+fn curved_scene(facing: [f64; 3], radius: f64, eye_o: DVec3, objects: &str) -> RenderContext {
+    let text = format!(
+        r#"
+[obstacle]
+center = [0.0, 0.0, 0.0]
+facing = {facing:?}
+width = 0.3
+height = 0.2
+display_resolution = [150, 100]
+display_shape = "cylinder"
+display_radius = {radius}
+display_segments = 48
+
+[camera.driver]
+position = [0.0, 0.0, 0.7]
+look_at = [0.0, 0.0, -6.0]
+half_angle_deg = 25.0
+resolution = [200, 150]
+
+[camera.frontal]
+half_angle_deg = 45.0
+resolution = [640, 480]
+
+[camera.back]
+resolution = [32, 24]
+
+[[material]]
+name = "tex"
+texture = "../assets/street.png"
+uv_repeat = [6.0, 4.0]
+
+{objects}
+"#
+    );
+    let mut scene = common::parse_in(&common::repo_path("scenes"), "test.toml", &text).unwrap();
+    let w = scene.obstacle.world_from_obstacle;
+    scene.driver = seethru::geometry::camera::Camera::look_at(
+        w.transform_point3(eye_o),
+        w.transform_point3(DVec3::ZERO),
+        w.transform_vector3(DVec3::Y),
+        25f64.to_radians(),
+        200,
+        150,
+    )
+    .unwrap();
+    RenderContext::new(scene).unwrap()
+}
+
+/// Per display pixel of the driver's view of a cylinder display (`radius`, 48 facets) on a
+/// scene that is the plane `n · p = c`: the distance between the shown and the true point, and
+/// the resampling quantum there — half a display pixel along the pixel's facet (u) and the
+/// cylinder's axis (v), carried along the eye's ray to the plane, plus half a frontal pixel's
+/// footprint on the plane around the true point, all by ray casting.
+fn curved_errors_and_quanta(
+    ctx: &RenderContext,
+    r: &seethru::system::pipeline::RunResult,
+    radius: f64,
+    n: DVec3,
+    c: f64,
+) -> Vec<(f64, f64)> {
+    let scene = &ctx.scene;
+    let obstacle = &scene.obstacle;
+    let world_from_obstacle = obstacle.world_from_obstacle;
+    let obstacle_from_world = world_from_obstacle.inverse();
+    let [dw, dh] = obstacle.display_resolution.map(f64::from);
+    let segments = 48.0;
+    let half_angle = obstacle.width / (2.0 * radius);
+    let column = |k: f64| {
+        let a = (k / segments - 0.5) * 2.0 * half_angle;
+        DVec3::new(radius * a.sin(), 0.0, radius * a.cos() - radius)
+    };
+    let eye = scene.eye();
+    let to_plane = |from: DVec3, through: DVec3| {
+        let d = through - from;
+        from + d * ((c - n.dot(from)) / n.dot(d))
+    };
+    let frontal = &scene.frontal;
+    let mask = display_mask(ctx, &r.occluded);
+    (0..mask.len())
+        .filter(|&i| mask[i])
+        .map(|i| {
+            let t = r.truth.position[i].as_dvec3();
+            let s = r.seethru.position[i].as_dvec3();
+            let x = r.occluded.position[i].as_dvec3();
+            let local = obstacle_from_world.transform_point3(x);
+            let u = local.x.atan2(local.z + radius) / (2.0 * half_angle) + 0.5;
+            let k = (u * segments).floor().clamp(0.0, segments - 1.0);
+            let facet = column(k + 1.0) - column(k);
+            // One display pixel spans facet · segments / W along the facet.
+            let du = world_from_obstacle.transform_vector3(facet * (0.5 * segments / dw));
+            let dv = world_from_obstacle.transform_vector3(DVec3::Y * (0.5 * obstacle.height / dh));
+            let display = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
+                .map(|(a, b)| (to_plane(eye, x + du * a + dv * b) - to_plane(eye, x)).length())
+                .into_iter()
+                .fold(0.0, f64::max);
+            let q = frontal.project_point(t).unwrap();
+            let footprint = [(0.5, 0.5), (0.5, -0.5), (-0.5, 0.5), (-0.5, -0.5)]
+                .map(|(a, b)| {
+                    let (o, dir) = frontal.world_ray(q + DVec2::new(a, b));
+                    (to_plane(o, o + dir) - t).length()
+                })
+                .into_iter()
+                .fold(0.0, f64::max);
+            ((s - t).length(), display + footprint)
+        })
+        .collect()
+}
+
+/// Every compensation method works per display pixel on a curved display: with the scene
+/// model right (the plane on the wall, plane-fit on the wall, the ideal depth sensor, the
+/// ground on a road) every display pixel of the driver's view shows the true point within its
+/// resampling quantum; with the model wrong (d2 → ∞ before a wall 6 m away) most do not.
+#[test]
+fn every_compensation_method_registers_a_curved_display() {
+    use seethru::system::depth_sensor::SensorKind;
+    use seethru::system::options::Method;
+    let radius = 0.15;
+    let within = |errors: &[(f64, f64)]| {
+        let inside = errors.iter().filter(|(e, q)| *e <= q * 1.02 + 1e-5).count();
+        let worst = errors.iter().map(|(e, q)| e / q).fold(0.0, f64::max);
+        (inside, errors.len(), worst)
+    };
+    let method = |m: Method, d2: WorkingDistance| RunOptions {
+        method: m,
+        ..options(d2)
+    };
+    let wall = curved_scene(
+        [0.0, 0.0, 1.0],
+        radius,
+        DVec3::new(0.08, 0.03, 0.7),
+        "[[object]]\nname = \"wall\"\nkind = \"quad\"\nmaterial = \"tex\"\nsize = [80.0, 60.0]\ntranslate = [0.0, 0.0, -6.0]",
+    );
+    let mut depth = method(Method::Depth, WorkingDistance::Infinity);
+    depth.scene_model.sensor.kind = SensorKind::Ideal;
+    for (name, o) in [
+        (
+            "planar d2 = 6",
+            method(Method::Planar, WorkingDistance::Metres(6.0)),
+        ),
+        (
+            "plane-fit",
+            method(Method::PlaneFit, WorkingDistance::Infinity),
+        ),
+        ("depth", depth),
+    ] {
+        let r = run(&wall, &o).unwrap();
+        let (inside, checked, worst) =
+            within(&curved_errors_and_quanta(&wall, &r, radius, DVec3::Z, -6.0));
+        eprintln!("{name}: {inside} of {checked}, worst {worst:.2} quanta");
+        assert!(checked > 1000, "{name}: {checked}");
+        assert_eq!(inside, checked, "{name} on the wall, worst {worst} quanta");
+    }
+    let r = run(&wall, &method(Method::Planar, WorkingDistance::Infinity)).unwrap();
+    let (inside, checked, worst) =
+        within(&curved_errors_and_quanta(&wall, &r, radius, DVec3::Z, -6.0));
+    assert!(
+        inside < checked / 2 && worst > 2.0,
+        "planar d2 → ∞: {inside} of {checked}, worst {worst}"
+    );
+    // A road below an obstacle 1.2 m up that faces the driver and tilts up 31°: the display
+    // shows only road.
+    let road = curved_scene(
+        [0.0, 0.6, 1.0],
+        radius,
+        DVec3::new(0.05, 0.03, 0.7),
+        "[[object]]\nname = \"road\"\nkind = \"plane\"\nmaterial = \"tex\"\nsize = [200.0, 200.0]\ntranslate = [0.0, -1.2, 0.0]",
+    );
+    for m in [Method::Ground, Method::PlaneFit] {
+        let r = run(&road, &method(m, WorkingDistance::Infinity)).unwrap();
+        let (inside, checked, worst) =
+            within(&curved_errors_and_quanta(&road, &r, radius, DVec3::Y, -1.2));
+        eprintln!("{m:?} on the road: {inside} of {checked}, worst {worst:.2} quanta");
+        assert!(checked > 1000, "{m:?}: {checked}");
+        assert_eq!(inside, checked, "{m:?} on the road, worst {worst} quanta");
+    }
+}
+
+/// The border bands of a curved display are its pixel grid's (from the UVs), not the
+/// reference rectangle's: the driver's pixels in the left and right bands are those whose
+/// point lies within `band` display pixels of the arc's ends.
+#[test]
+fn the_border_bands_of_a_curved_display_follow_its_uvs() {
+    let (radius, band) = (0.12, 5u32);
+    let ctx = context(&wall(
+        &format!("display_shape = \"cylinder\"\ndisplay_radius = {radius}\ndisplay_segments = 48"),
+        6.0,
+    ));
+    let r = run(&ctx, &options(WorkingDistance::Metres(6.0))).unwrap();
+    let (_, metrics) = seethru::measure::metrics::measure(
+        &ctx,
+        &ctx.scene,
+        ctx.scene.eye(),
+        [&r.truth, &r.seethru, &r.occluded],
+        band,
+    );
+    let obstacle = &ctx.scene.obstacle;
+    let half = obstacle.width / (2.0 * radius);
+    let w = obstacle.display_resolution[0] as f64;
+    let mask = display_mask(&ctx, &r.occluded);
+    // u along the arc, from the point's angle round the cylinder's axis (the facets' chords
+    // differ from the arc by under a thousandth of a pixel's share here).
+    let u = |i: usize| {
+        let p = r.occluded.position[i].as_dvec3();
+        (p.x.atan2(p.z + radius) / (2.0 * half) + 0.5) * w
+    };
+    let count = |keep: &dyn Fn(f64) -> bool| {
+        (0..mask.len()).filter(|&i| mask[i] && keep(u(i))).count() as f64
+    };
+    let (left, right) = (
+        count(&|u| u < band as f64),
+        count(&|u| u >= w - band as f64),
+    );
+    let sides = &metrics["border_per_side"];
+    let (got_left, got_right) = (
+        sides["left"]["pixels"].as_f64().unwrap(),
+        sides["right"]["pixels"].as_f64().unwrap(),
+    );
+    assert!(left > 50.0 && right > 50.0, "{left} {right}");
+    assert!(
+        (got_left - left).abs() <= 0.03 * left + 2.0,
+        "left {got_left} vs {left}"
+    );
+    assert!(
+        (got_right - right).abs() <= 0.03 * right + 2.0,
+        "right {got_right} vs {right}"
+    );
 }

@@ -1079,3 +1079,123 @@ fn every_flag_of_head_poses_changes_its_table_or_is_refused_with_its_range() {
         "{err}"
     );
 }
+
+/// `sweep --param eye=eyellipse`'s own flags, walked as `run`'s are: each changes an output
+/// (the rows, their eyes and metrics, the share of drivers under the bound); each is refused
+/// in one line without `eye=eyellipse`, and outside its range naming the range; and each
+/// reads a spaced value as the unspaced one, output for output. Nothing is written when
+/// refused.
+#[test]
+fn the_sweeps_eyellipse_flags_are_read_refused_and_take_spaced_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let cabin = common::repo_path("scenes/cabin.toml");
+    let cabin = cabin.to_str().unwrap();
+    let sweep = |out: &str, flags: &[&str]| -> (String, String) {
+        let mut args = vec!["sweep", cabin, "--out", out, "--width", "16"];
+        args.extend(flags);
+        let (code, err) = run_in(dir.path(), &args);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        let stem = out.trim_end_matches(".csv");
+        (
+            std::fs::read_to_string(dir.path().join(out)).unwrap(),
+            std::fs::read_to_string(dir.path().join(format!("{stem}_drivers.json"))).unwrap(),
+        )
+    };
+    let base = [
+        "--param",
+        "eye=eyellipse",
+        "--samples",
+        "2",
+        "--seed",
+        "3",
+        "--bound-arcmin",
+        "20",
+    ];
+    let (csv, shares) = sweep("base.csv", &base);
+    let rows = |csv: &str| csv.lines().skip(1).count();
+    let means = |csv: &str| -> Vec<String> {
+        csv.lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(2).unwrap().to_string())
+            .collect()
+    };
+    let under = |json: &str| {
+        let v: serde_json::Value = serde_json::from_str(json).unwrap();
+        v["groups"][0]["mean_misregistration"]["under_bound"]
+            .as_u64()
+            .unwrap()
+    };
+    assert_eq!(rows(&csv), 2, "{csv}");
+    fn with<'a>(base: &[&'a str], flag: &str, value: &'a str) -> Vec<&'a str> {
+        let mut flags = base.to_vec();
+        let at = flags.iter().position(|f| *f == flag).unwrap();
+        flags[at + 1] = value;
+        flags
+    }
+    // --samples: one row per driver.
+    let (more, _) = sweep("samples.csv", &with(&base, "--samples", "3"));
+    assert_eq!(rows(&more), 3, "{more}");
+    // --seed: other drivers, other metrics.
+    let (other, _) = sweep("seed.csv", &with(&base, "--seed", "4"));
+    assert!(
+        means(&other).iter().all(|m| !means(&csv).contains(m)),
+        "{other}\n{csv}"
+    );
+    // --bound-arcmin: the same rows, another share (the two drivers' means straddle 20′).
+    let m: Vec<f64> = means(&csv).iter().map(|m| m.parse().unwrap()).collect();
+    let expected = |bound: f64| m.iter().filter(|&&v| v <= bound).count() as u64;
+    assert_eq!(under(&shares), expected(20.0), "{csv}");
+    let (same, wide) = sweep("bound.csv", &with(&base, "--bound-arcmin", "1000"));
+    assert_eq!(same, csv.replace("base.csv", "bound.csv"));
+    assert_eq!(under(&wide), 2);
+    assert_ne!(
+        expected(20.0),
+        2,
+        "the base bound must leave a driver out: {m:?}"
+    );
+    // Spaced values are the values.
+    let spaced = [
+        "--param",
+        " eye = eyellipse ",
+        "--samples",
+        " 2 ",
+        "--seed",
+        " 3",
+        "--bound-arcmin",
+        "20 ",
+    ];
+    assert_eq!(sweep("base.csv", &spaced), (csv.clone(), shares.clone()));
+
+    // Refused without eye=eyellipse, and out of range, in one line, writing nothing.
+    for (flag, value) in [("--samples", "3"), ("--seed", "2"), ("--bound-arcmin", "5")] {
+        common::refusal::refused(
+            dir.path(),
+            &[
+                "sweep", cabin, "--out", "no.csv", "--width", "16", "--param", "d2=3,4", flag,
+                value,
+            ],
+            1,
+            &[flag, "eye=eyellipse"],
+        );
+    }
+    for (flag, value, range) in [
+        ("--samples", "0", "[1, 10000]"),
+        ("--samples", "10001", "[1, 10000]"),
+        ("--samples", "1.5", "[1, 10000]"),
+        ("--samples", "", "[1, 10000]"),
+        ("--seed", "-1", "[0, 4294967295]"),
+        ("--seed", "4294967296", "[0, 4294967295]"),
+        ("--seed", "x", "[0, 4294967295]"),
+        ("--bound-arcmin", "0", "[1e-6, 10800]"),
+        ("--bound-arcmin", "10801", "[1e-6, 10800]"),
+        ("--bound-arcmin", "nan", "[1e-6, 10800]"),
+        ("--bound-arcmin", "-inf", "[1e-6, 10800]"),
+    ] {
+        let flags = with(&base, flag, value);
+        let mut args = vec!["sweep", cabin, "--out", "no.csv", "--width", "16"];
+        args.extend(flags);
+        common::refusal::refused(dir.path(), &args, 2, &[flag, range, &format!("'{value}'")]);
+    }
+    assert!(!dir.path().join("no.csv").exists());
+    assert!(!dir.path().join("no_drivers.json").exists());
+}

@@ -8,7 +8,9 @@ use seethru::analysis::paper::{CropParams, Side};
 use seethru::render::views::View;
 use seethru::render::{integrator::RenderContext, settings::RenderSettings};
 use seethru::scene::shapes::box_face;
-use seethru::system::display::{DisplayModel, DisplayPlacement, DisplaySurface, MISSING_ID};
+use seethru::system::display::{
+    DisplayModel, DisplayPlacement, DisplaySurface, IdealMap, MISSING_ID,
+};
 use seethru::system::head::{detect, eye_from_detection};
 use seethru::system::{
     options::{HeadSource, Outside, RunOptions, WorkingDistance},
@@ -494,10 +496,12 @@ fn driver_views_rendered_over_the_truth_equal_separate_renders() {
                 placement,
             },
             DisplayModel::Ideal => DisplaySurface::Ideal {
-                crop: r.crop,
+                map: IdealMap::Crop {
+                    crop: r.crop,
+                    lens: None,
+                },
                 frontal,
                 placement,
-                lens: None,
             },
         };
         let (seethru, _) = ctx.render_seethru(&driver, &surface, settings);

@@ -58,7 +58,8 @@ pub enum Command {
     /// Reproduce the paper's §5: report.md, a self-contained report.html and report.json.
     Reproduce(reproduce::Reproduce),
     /// Metrics for every combination of parameter values, as CSV and a plot; resumable.
-    /// Parameters: theta_f, d2, display_width, eye_x, eye_z, head_bias_x_cm, frontal_width.
+    /// Parameters: theta_f, d2, display_width, eye_x, eye_z, head_bias_x_cm, frontal_width, and
+    /// eye=eyellipse (drivers' eyes drawn from the scene's [eyellipse]).
     Sweep(sweep::Sweep),
     /// Join the CSVs of a sweep run in parts (`sweep --shard K/N`) into one CSV and its plot.
     SweepMerge(sweep::SweepMerge),

@@ -22,7 +22,8 @@ use crate::cli::args::{
 pub struct Sweep {
     /// Scene file (TOML).
     scene: PathBuf,
-    /// name=start:stop:step or name=v1,v2,... (repeat for a grid).
+    /// name=start:stop:step or name=v1,v2,... (repeat for a grid); eye=eyellipse: --samples
+    /// drivers' eyes from the scene's [eyellipse].
     #[arg(long = "param", required = true)]
     params: Vec<String>,
     /// Output CSV (a plot goes beside it); an existing one is resumed.

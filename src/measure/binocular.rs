@@ -1,5 +1,6 @@
-//! The binocular mismatch of a flat display (`run --eyes both`): for each display pixel, the
-//! vergence of the point shown — it lies on the display plane — minus the vergence the scene
+//! The binocular mismatch of a display (`run --eyes both`): for each display pixel, the
+//! vergence of the point shown — the pixel's centre on the display's surface, the flat face
+//! or a curved display's point at the pixel's UV — minus the vergence the scene
 //! point it shows has (the display frame's world point, what the frontal camera sees there;
 //! a sky direction has vergence 0), for the true left and right eyes, in arc-minutes. And a
 //! red–cyan anaglyph of the two `seethru` views.
@@ -18,6 +19,7 @@ use crate::measure::maps::heat_color;
 use crate::render::frame::Frame;
 use crate::scene::Obstacle;
 use crate::system::display::MISSING_ID;
+use crate::system::surface_map::display_points;
 use crate::util::color::encode_srgb8;
 
 const ARCMIN_PER_RAD: f64 = 60.0 * 180.0 / std::f64::consts::PI;
@@ -32,17 +34,6 @@ pub struct BinocularMap {
     pub scene_depth: Vec<f32>,
 }
 
-/// World point of the centre of display pixel (x, y).
-fn display_point(obstacle: &Obstacle, x: u32, y: u32) -> DVec3 {
-    let [w, h] = obstacle.display_resolution.map(f64::from);
-    let local = DVec3::new(
-        ((x as f64 + 0.5) / w - 0.5) * obstacle.width,
-        (0.5 - (y as f64 + 0.5) / h) * obstacle.height,
-        0.0,
-    );
-    obstacle.world_from_obstacle.transform_point3(local)
-}
-
 /// The mismatch map of the display frame `display` for eyes at `left` and `right` (world).
 pub fn binocular_map(
     display: &Frame,
@@ -50,17 +41,26 @@ pub fn binocular_map(
     left: DVec3,
     right: DVec3,
 ) -> BinocularMap {
+    assert_eq!(
+        [display.width, display.height],
+        obstacle.display_resolution,
+        "a display frame of the obstacle's resolution"
+    );
+    // Each pixel's centre on the display's surface: the flat face, or a curved display's
+    // point at the pixel's UV.
+    let points = display_points(obstacle);
     let mut mismatch = Vec::with_capacity(display.color.len());
     let mut depth = Vec::with_capacity(display.color.len());
     for y in 0..display.height {
         for x in 0..display.width {
             let i = display.index(x, y);
-            if display.object_id[i] == MISSING_ID {
+            let point = points[(y * display.width + x) as usize];
+            let Some(point) = point.filter(|_| display.object_id[i] != MISSING_ID) else {
                 mismatch.push(f32::NAN);
                 depth.push(f32::NAN);
                 continue;
-            }
-            let on_display = vergence(left, right, display_point(obstacle, x, y));
+            };
+            let on_display = vergence(left, right, point);
             let p = display.position[i];
             let (shown, d) = if p.is_finite() {
                 let p = p.as_dvec3();

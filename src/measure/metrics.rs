@@ -255,7 +255,7 @@ pub fn measure(
     let [truth, seethru, occluded] = frames;
     let (w, h) = (truth.width as usize, truth.height as usize);
     let obstacle = &scene.obstacle;
-    let obstacle_from_world = obstacle.world_from_obstacle.inverse();
+    let placement = crate::system::display::DisplayPlacement::new(obstacle);
     let [dw, dh] = obstacle.display_resolution;
     let display: Vec<bool> = occluded
         .object_id
@@ -286,9 +286,9 @@ pub fn measure(
             class: PixelClass::default(),
             sides: [false; 4],
         };
-        let on_display = obstacle_from_world.transform_point3(occluded.position[i].as_dvec3());
-        let u = (on_display.x / obstacle.width + 0.5) * dw as f64;
-        let v = (0.5 - on_display.y / obstacle.height) * dh as f64;
+        // The display pixel coordinates of the point: a curved display's from its UVs.
+        let uv = placement.pixel_coords(occluded.position[i]);
+        let (u, v) = (uv.x, uv.y);
         out.sides = [
             u < band as f64,
             u >= (dw - band) as f64,

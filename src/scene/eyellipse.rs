@@ -9,10 +9,12 @@
 //! mm): X = L1 + 664 + 0.587·L6 − 0.176·H30 − 12.5·t, Y = W20, Z = H8 + 638, with L1 the ball of
 //! foot's X, L6 the steering-wheel centre's X distance from the ball of foot, H30 the SgRP's
 //! height above the heel, t = 1 with a clutch pedal, W20 and H8 the SgRP's Y and Z.
-//! The standard's text was not available here: the axis lengths and the 2010 edition's
-//! "editorial changes only" come from public summaries of it; the centre coefficients and the
-//! 12° tilt are as commonly quoted and are unverified against the standard (the 2002 revision
-//! makes the tilt depend on seat height, which is not modelled).
+//! The standard's text was not available here. Checked against public sources (listed in
+//! docs/guide/cabin-pillar.md): the 2010 edition's "editorial changes only", the
+//! tangent-cutoff meaning, the axes parallel to the grid in plan and rear view, and the 2002
+//! axis-length changes (x +7.5, y −44.6, z +7.4 mm) that lead to the lengths used. The centre
+//! coefficients and the 12° tilt are as commonly quoted and unverified against the standard
+//! (the 2002 revision makes the tilt depend on seat height, which is not modelled).
 //!
 //! Sampling: the standard's ellipse is a tangent-cutoff ellipse: 95 % of eyes lie on the near
 //! side of any one of its tangent planes. For a trivariate normal that fixes σ along each axis

@@ -9,6 +9,7 @@ use crate::render::screen::{Screen, Shown};
 use crate::scene::Obstacle;
 use crate::system::compensation::Crop;
 use crate::system::frontal_map::FrontalMap;
+use crate::system::point_model::PointModel;
 
 /// Object id of display pixels that show nothing because the frontal camera does not see
 /// their model point (outside its view). They are black.
@@ -161,6 +162,23 @@ impl DisplayPlacement {
     }
 }
 
+/// How an ideal display finds the frontal point of a point on its face.
+// One value per run (or refresh), borrowed by the renderer: the variants' sizes cost nothing.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug)]
+pub enum IdealMap {
+    /// A flat display: the point's continuous display coordinates through the crop's
+    /// homography, then the believed frontal lens ([`FrontalMap`]; `None`: a pinhole).
+    Crop {
+        crop: Crop,
+        lens: Option<crate::geometry::lens::Lens>,
+    },
+    /// A curved display: the point itself (where the display is now, in its obstacle frame)
+    /// through the planar model ([`PointModel`]) — the eye's ray through it meets the model
+    /// plane, projected into the believed frontal camera.
+    Surface(PointModel),
+}
+
 /// What the display shows where the `seethru` view meets it.
 // One value per run, borrowed by the renderer: the ideal variant's size (a camera with its
 // lens, the crop) costs nothing.
@@ -172,15 +190,12 @@ pub enum DisplaySurface {
         placement: DisplayPlacement,
     },
     /// An ideal display and frontal camera of unlimited resolution: the exact point hit is
-    /// mapped through the crop into the frontal camera, and a ray from there finds what it
-    /// sees. This isolates the planar model's error from resampling.
+    /// mapped through the compensation (`map`) into the frontal camera, and a ray from there
+    /// finds what it sees. This isolates the planar model's error from resampling.
     Ideal {
-        crop: Crop,
+        map: IdealMap,
         frontal: Camera,
         placement: DisplayPlacement,
-        /// The believed frontal lens that the crop's point goes through ([`FrontalMap`]);
-        /// `None` for the ideal pinhole.
-        lens: Option<crate::geometry::lens::Lens>,
     },
 }
 
@@ -194,13 +209,24 @@ impl Screen for DisplaySurface {
                 Shown::Pixel(image.pixel(x, y))
             }
             DisplaySurface::Ideal {
-                crop,
+                map,
                 frontal,
                 placement,
-                lens,
             } => {
-                let p = crop.frontal_point(placement.pixel_coords(world));
-                let p = lens.as_ref().map_or(p, |l| l.distort_pixel(p));
+                let p = match map {
+                    IdealMap::Crop { crop, lens } => {
+                        let p = crop.frontal_point(placement.pixel_coords(world));
+                        lens.as_ref().map_or(p, |l| l.distort_pixel(p))
+                    }
+                    IdealMap::Surface(model) => {
+                        let local = placement
+                            .obstacle_from_world
+                            .transform_point3(world.as_dvec3());
+                        // No model point (the ray misses the plane, or the point is behind
+                        // the camera): shown as missing below.
+                        model.frontal_point_local(local).unwrap_or(DVec2::NAN)
+                    }
+                };
                 if !(p.x >= 0.0
                     && p.y >= 0.0
                     && p.x < frontal.width as f64
@@ -224,7 +250,8 @@ impl Screen for DisplaySurface {
 pub enum DisplayModel {
     /// The physical display's pixels, resampled from the frontal image.
     Pixels,
-    /// Unlimited display and frontal resolution: only the planar model's error remains.
+    /// Unlimited display and frontal resolution: only the planar model's error remains (on
+    /// a curved display, per point of its surface).
     Ideal,
 }
 

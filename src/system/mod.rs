@@ -17,6 +17,7 @@ pub mod memory;
 pub mod obstruction;
 pub mod options;
 pub mod pipeline;
+pub mod point_model;
 pub mod reads;
 pub mod report;
 pub mod scene_model;

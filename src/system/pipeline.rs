@@ -18,7 +18,7 @@ use crate::scene::world::view_bit;
 use crate::scene::{Obstacle, Scene};
 use crate::system::compensation::{Crop, ModelPlane, compute_crop};
 use crate::system::display::{
-    DisplayModel, DisplayPlacement, DisplaySurface, MISSING_ID, resample_through,
+    DisplayModel, DisplayPlacement, DisplaySurface, IdealMap, MISSING_ID, resample_through,
 };
 use crate::system::frontal_map::FrontalMap;
 use crate::system::head::{FaceDetection, detect, eye_from_detection, gaussian};
@@ -236,7 +236,8 @@ pub fn curved_planar_display(
     frontal: &Frame,
     options: &RunOptions,
 ) -> Result<Frame> {
-    use crate::system::surface_map::{PointModel, curved_display};
+    use crate::system::point_model::PointModel;
+    use crate::system::surface_map::curved_display;
     let plane = d2.map_or(ModelPlane::Infinity, ModelPlane::At);
     let model = PointModel::new(scene, eye, plane)?;
     let (display, missing) = curved_display(frontal, &scene.obstacle, &model, options.filter);
@@ -247,6 +248,28 @@ pub fn curved_planar_display(
         );
     }
     Ok(display)
+}
+
+/// How the ideal display of the planar compensation (or none) maps its points into the
+/// frontal camera: a curved display per point of its surface, a flat one through the crop.
+pub fn ideal_map(
+    scene: &Scene,
+    eye: DVec3,
+    d2: Option<f64>,
+    curved: bool,
+    crop: Crop,
+    map: &FrontalMap,
+) -> Result<IdealMap> {
+    use crate::system::point_model::PointModel;
+    Ok(if curved {
+        let plane = d2.map_or(ModelPlane::Infinity, ModelPlane::At);
+        IdealMap::Surface(PointModel::new(scene, eye, plane)?)
+    } else {
+        IdealMap::Crop {
+            crop,
+            lens: map.lens,
+        }
+    })
 }
 
 /// Runs the system on a loaded scene; renders every view. A display that covers no pixel of
@@ -369,11 +392,6 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
     // A curved display is compensated per pixel; its crop is only its reference rectangle's.
     let curved =
         options.method == Method::Planar && scene.obstacle.display_shape.curved().is_some();
-    if curved && options.display == DisplayModel::Ideal {
-        bail!(
-            "--display ideal works on a flat display; a curved display (display_shape) models its physical pixels (use --display pixels)"
-        );
-    }
     if options.method == Method::Planar
         && given.display.is_none()
         && !curved
@@ -461,10 +479,9 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
             placement,
         },
         DisplayModel::Ideal => DisplaySurface::Ideal {
-            crop,
+            map: ideal_map(scene, eye_used, d2_used, curved, crop, &map)?,
             frontal: scene.frontal,
             placement,
-            lens: map.lens,
         },
     };
     let (seethru, stats) = ctx.render_over(

@@ -1,19 +1,16 @@
 //! The planar compensation per display pixel, for a curved display (one that is not the
 //! obstacle's flat face): the eye's ray through each display pixel's point on the surface meets
 //! the model plane (z = −d2 in the obstacle frame, or d2 → ∞) and is projected into the
-//! believed frontal camera. On a flat display this is the crop's homography, pixel by pixel
-//! (tested); the homography stays the fast path there.
+//! believed frontal camera ([`PointModel`]). On a flat display this is the crop's homography,
+//! pixel by pixel (tested); the homography stays the fast path there.
 
-use anyhow::{Result, bail};
-use glam::{DAffine3, DVec2, DVec3};
+use glam::DVec3;
 
-use crate::geometry::camera::Camera;
-use crate::geometry::lens::Lens;
 use crate::render::frame::{Frame, Pixel};
+use crate::scene::Obstacle;
 use crate::scene::display_keys::pixel_uv;
-use crate::scene::{Obstacle, Scene};
-use crate::system::compensation::ModelPlane;
 use crate::system::display::{Filter, MISSING_ID, sample};
+use crate::system::point_model::PointModel;
 
 /// The world point of every display pixel's centre (row-major); `None` where a curved
 /// display's UVs do not cover the pixel.
@@ -35,69 +32,6 @@ pub fn display_points(obstacle: &Obstacle) -> Vec<Option<DVec3>> {
             local.map(|p| obstacle.world_from_obstacle.transform_point3(p))
         })
         .collect()
-}
-
-/// Display point → frontal pixel under the planar model, for one eye.
-#[derive(Clone, Debug)]
-pub struct PointModel {
-    /// The eye the compensation uses, obstacle frame, metres.
-    eye: DVec3,
-    plane: ModelPlane,
-    obstacle_from_world: DAffine3,
-    world_from_obstacle: DAffine3,
-    /// The believed frontal camera without its distortion.
-    pinhole: Camera,
-    /// The believed frontal lens; `None` for a pinhole.
-    lens: Option<Lens>,
-}
-
-impl PointModel {
-    /// The model of `scene`'s believed frontal camera ([calibration]) for the eye at `eye`
-    /// (world).
-    pub fn new(scene: &Scene, eye: DVec3, plane: ModelPlane) -> Result<Self> {
-        let believed = scene.calibration.frontal.apply(&scene.frontal)?;
-        let obstacle_from_world = scene.obstacle.world_from_obstacle.inverse();
-        let eye = obstacle_from_world.transform_point3(eye);
-        if eye.z <= 0.0 {
-            bail!(
-                "the eye the compensation uses must be in front of the display (d1 > 0), got d1 = {} m",
-                crate::util::number::short(eye.z)
-            );
-        }
-        Ok(PointModel {
-            eye,
-            plane,
-            obstacle_from_world,
-            world_from_obstacle: scene.obstacle.world_from_obstacle,
-            pinhole: believed.undistorted(),
-            lens: believed.lens,
-        })
-    }
-
-    /// The frontal pixel (continuous, distorted by the believed lens) that the display point
-    /// `on_display` (world) shows; `None` where the eye's ray misses the model plane or the
-    /// model point is behind the camera.
-    pub fn frontal_point(&self, on_display: DVec3) -> Option<DVec2> {
-        let s = self.obstacle_from_world.transform_point3(on_display);
-        let ray = s - self.eye;
-        let undistorted = match self.plane {
-            ModelPlane::At(d2) => {
-                if ray.z >= 0.0 {
-                    return None;
-                }
-                let p = self.eye + ray * ((-d2 - self.eye.z) / ray.z);
-                self.pinhole
-                    .project_point(self.world_from_obstacle.transform_point3(p))?
-            }
-            ModelPlane::Infinity => self
-                .pinhole
-                .project_direction(self.world_from_obstacle.transform_vector3(ray))?,
-        };
-        Some(match &self.lens {
-            None => undistorted,
-            Some(lens) => lens.distort_pixel(undistorted),
-        })
-    }
 }
 
 /// The display image of a curved display: every pixel's point through `model` into the

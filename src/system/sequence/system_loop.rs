@@ -25,16 +25,20 @@ use crate::scene::Scene;
 use crate::scene::world::{World, view_bit};
 use crate::system::calibration_json::calibration_json;
 use crate::system::capture::{HeadEstimate, check_display_input, display_from, fingerprint};
-use crate::system::compensation::Crop;
-use crate::system::display::{DisplayModel, DisplayPlacement, DisplaySurface, resample_through};
+use crate::system::compensation::{Crop, ModelPlane};
+use crate::system::display::{
+    DisplayModel, DisplayPlacement, DisplaySurface, IdealMap, resample_through,
+};
 use crate::system::frontal_map::FrontalMap;
 use crate::system::head::{DetectError, FaceDetection, detect_in, eye_from_detection, gaussian};
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
-use crate::system::pipeline::{crop_for, driver_camera, frontal_map};
+use crate::system::pipeline::{crop_for, driver_camera, frontal_map, ideal_map};
+use crate::system::point_model::PointModel;
 use crate::system::sequence::byo::{Byo, RefreshInputs};
 use crate::system::sequence::head_motion::HeadMotion;
 use crate::system::sequence::predict::{Prediction, Predictor};
 use crate::system::sequence::timeline::{FrameTimes, Rig, Timeline};
+use crate::system::surface_map::display_points;
 use crate::system::tracker_model::WEBCAM_LANDMARKS;
 use crate::util::number::short;
 
@@ -79,6 +83,9 @@ pub struct Shown {
     pub frontal: Camera,
     /// The believed frontal lens the display image went through (`None`: a pinhole).
     pub lens: Option<Lens>,
+    /// How the ideal display maps its points: through `crop` and `lens` on a flat display,
+    /// per surface point on a curved one.
+    pub ideal: IdealMap,
 }
 
 /// Wall time spent in each stage, seconds, summed over the frames.
@@ -311,11 +318,6 @@ impl SystemLoop {
         let at = || format!("at t = {} s", short(times.refresh_time));
         let curved =
             run.method == Method::Planar && geometry.obstacle.display_shape.curved().is_some();
-        if curved && run.display == DisplayModel::Ideal {
-            bail!(
-                "--display ideal works on a flat display; a curved display (display_shape) models its physical pixels (use --display pixels)"
-            );
-        }
         // A curved display's pixels may look beyond its reference rectangle's crop.
         let byo = self.options.byo.clone();
         if byo.maps.is_some() && (curved || run.display == DisplayModel::Ideal) {
@@ -323,10 +325,10 @@ impl SystemLoop {
                 "--maps shows a map on a flat display's pixels: not with a curved display or --display ideal"
             );
         }
-        let full = run.method == Method::None
-            || run.d2 == WorkingDistance::Auto
-            || curved
-            || byo.needs_inputs();
+        // A curved display renders only the frontal pixels its model points read, as a flat
+        // display renders only its crop's.
+        let full =
+            run.method == Method::None || run.d2 == WorkingDistance::Auto || byo.needs_inputs();
         let frontal_camera = capture.scene.frontal;
         let settings = self.settings();
         // The frontal render is its own stage, not part of the compensation's time.
@@ -346,7 +348,11 @@ impl SystemLoop {
             crop_for(&geometry, eye_world, &self.frontal, run).with_context(at)?
         } else {
             let crop = crop_for(&geometry, eye_world, &self.frontal, run).with_context(at)?;
-            let rect = crop_rect(&frontal_map(&geometry, crop.0, run)?, &frontal_camera);
+            let rect = if curved {
+                curved_rect(&geometry, eye_world, crop.1, &frontal_camera).with_context(at)?
+            } else {
+                crop_rect(&frontal_map(&geometry, crop.0, run)?, &frontal_camera)
+            };
             let f = Instant::now();
             capture.render_rect(
                 &frontal_camera,
@@ -434,6 +440,7 @@ impl SystemLoop {
             image: display,
             placement: DisplayPlacement::new(&capture.scene.obstacle),
         });
+        let ideal = ideal_map(&geometry, eye_world, d2_used, curved, crop, &map)?;
         self.shown = Some(Shown {
             times,
             eye_estimated,
@@ -443,6 +450,7 @@ impl SystemLoop {
             d2_used,
             frontal: frontal_camera,
             lens: map.lens,
+            ideal,
         });
         Ok(self.shown.as_ref().expect("just set"))
     }
@@ -471,10 +479,9 @@ impl SystemLoop {
                 DisplaySurface::Pixels { image, placement }
             }
             _ => DisplaySurface::Ideal {
-                crop: shown.crop,
+                map: shown.ideal.clone(),
                 frontal: shown.frontal,
                 placement,
-                lens: shown.lens,
             },
         };
         let region = ctx.difference_region(&driver, view_bit::TRUTH, view_bit::SEETHRU);
@@ -497,6 +504,37 @@ impl SystemLoop {
 /// The frontal pixels a crop reads, with a margin for the filters, within the image.
 fn crop_rect(map: &FrontalMap, camera: &Camera) -> PixelRect {
     let (min, max) = map.bounds();
+    rect_around(min, max, camera)
+}
+
+/// The frontal pixels a curved display's planar model reads (every display pixel's model
+/// point for the eye at `eye`, world, and the model plane at `d2`), with a margin for the
+/// filters, within the image; empty when the camera sees none of them.
+fn curved_rect(scene: &Scene, eye: DVec3, d2: Option<f64>, camera: &Camera) -> Result<PixelRect> {
+    let plane = d2.map_or(ModelPlane::Infinity, ModelPlane::At);
+    let model = PointModel::new(scene, eye, plane)?;
+    let (min, max) = display_points(&scene.obstacle)
+        .into_iter()
+        .flatten()
+        .filter_map(|p| model.frontal_point(p))
+        .filter(|p| p.is_finite())
+        .fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(p), hi.max(p)),
+        );
+    if min.x > max.x {
+        return Ok(PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: 0,
+            y1: 0,
+        });
+    }
+    Ok(rect_around(min, max, camera))
+}
+
+/// The pixels of `camera` from `min` to `max` (continuous), with the filters' margin.
+fn rect_around(min: DVec2, max: DVec2, camera: &Camera) -> PixelRect {
     let lo = (min - DVec2::splat(CROP_MARGIN_PX)).floor();
     let hi = (max + DVec2::splat(CROP_MARGIN_PX)).ceil();
     let clamp = |v: f64, size: u32| v.clamp(0.0, size as f64) as u32;
