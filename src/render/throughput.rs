@@ -1,6 +1,11 @@
 //! Trace-only workloads for `seethru bench`: batches of rays traced without shading, the way
 //! ray tracing kernels (Embree's `rtcIntersect1`/`rtcOccluded1` over arrays of rays) are
 //! measured. Rays are made before the clock starts; tracing runs on the rayon pool.
+//!
+//! Camera rays come in 4×4 tiles of pixels, so that [`PACKET`] consecutive rays of a batch
+//! are a tile: [`trace_closest`] and [`trace_any`] trace them as packets (Embree's
+//! `rtcIntersect16` on 4×4 tiles), [`trace_closest_per_ray`] and [`trace_any_per_ray`] one by
+//! one.
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -8,9 +13,11 @@ use rayon::prelude::*;
 use crate::geometry::camera::Camera;
 use crate::render::accel::{Accel, Hit, make_ray};
 use crate::render::bvh::Stack;
+use crate::render::bvh_packet::{PACKET, PacketStack, RayPacket};
 use crate::render::camera_rays::CameraRays;
 use crate::render::integrator::shadow_ray;
 use crate::render::ray::TraceRay;
+use crate::render::simd::Isa;
 use crate::scene::world::World;
 use crate::util::sampling::{hash_words, unit_float};
 
@@ -23,11 +30,25 @@ pub struct Batch {
     pub view: u8,
 }
 
-/// One ray through each pixel centre, row by row.
+/// Side of the square tiles of [`camera_batch`], pixels.
+pub const TILE: u32 = 4;
+const _: () = assert!((TILE * TILE) as usize == PACKET);
+
+/// The pixels of a `width`×`height` image in 4×4 tiles: tiles row by row, and the pixels of
+/// a tile row by row (the last tiles of a row and column are cut by the image's edge).
+pub fn tile_order(width: u32, height: u32) -> impl Iterator<Item = (u32, u32)> {
+    (0..height.div_ceil(TILE)).flat_map(move |ty| {
+        (0..width.div_ceil(TILE)).flat_map(move |tx| {
+            (ty * TILE..((ty + 1) * TILE).min(height))
+                .flat_map(move |y| (tx * TILE..((tx + 1) * TILE).min(width)).map(move |x| (x, y)))
+        })
+    })
+}
+
+/// One ray through each pixel centre, in [`tile_order`].
 pub fn camera_batch(camera: &Camera, view: u8) -> Batch {
     let camera_rays = CameraRays::new(camera);
-    let rays = (0..camera.height)
-        .flat_map(|y| (0..camera.width).map(move |x| (x, y)))
+    let rays = tile_order(camera.width, camera.height)
         .map(|(x, y)| {
             let dir = camera_rays.direction(x as f32 + 0.5, y as f32 + 0.5);
             make_ray(camera_rays.origin, dir, 0.0, f32::INFINITY)
@@ -36,8 +57,49 @@ pub fn camera_batch(camera: &Camera, view: u8) -> Batch {
     Batch { rays, view }
 }
 
-/// Closest hits of `batch` into `out` (same length).
-pub fn trace_closest(accel: &Accel, batch: &Batch, out: &mut [Option<Hit>]) {
+/// Closest hits of `batch` into `out` (same length), [`PACKET`] consecutive rays at a time
+/// on `isa`'s packet kernels.
+pub fn trace_closest(accel: &Accel, batch: &Batch, isa: Isa, out: &mut [Option<Hit>]) {
+    batch
+        .rays
+        .par_chunks(CHUNK)
+        .zip(out.par_chunks_mut(CHUNK))
+        .for_each_init(PacketStack::new, |stack, (rays, out)| {
+            for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+                let mut packet = RayPacket::new();
+                for (lane, ray) in rays.iter().enumerate() {
+                    packet.set(lane, ray);
+                }
+                accel.closest_packet(&mut packet, batch.view, isa, stack);
+                for (lane, out) in out.iter_mut().enumerate() {
+                    *out = packet.hit(lane);
+                }
+            }
+        });
+}
+
+/// Whether each ray of `batch` is blocked, into `out` (same length), as [`trace_closest`].
+pub fn trace_any(accel: &Accel, batch: &Batch, isa: Isa, out: &mut [bool]) {
+    batch
+        .rays
+        .par_chunks(CHUNK)
+        .zip(out.par_chunks_mut(CHUNK))
+        .for_each_init(PacketStack::new, |stack, (rays, out)| {
+            for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+                let mut packet = RayPacket::new();
+                for (lane, ray) in rays.iter().enumerate() {
+                    packet.set(lane, ray);
+                }
+                let blocked = accel.occluded_packet(&packet, batch.view, isa, stack);
+                for (lane, out) in out.iter_mut().enumerate() {
+                    *out = blocked >> lane & 1 != 0;
+                }
+            }
+        });
+}
+
+/// Closest hits of `batch` into `out` (same length), one ray at a time.
+pub fn trace_closest_per_ray(accel: &Accel, batch: &Batch, out: &mut [Option<Hit>]) {
     batch
         .rays
         .par_chunks(CHUNK)
@@ -49,8 +111,8 @@ pub fn trace_closest(accel: &Accel, batch: &Batch, out: &mut [Option<Hit>]) {
         });
 }
 
-/// Whether each ray of `batch` is blocked, into `out` (same length).
-pub fn trace_any(accel: &Accel, batch: &Batch, out: &mut [bool]) {
+/// Whether each ray of `batch` is blocked, into `out` (same length), one ray at a time.
+pub fn trace_any_per_ray(accel: &Accel, batch: &Batch, out: &mut [bool]) {
     batch
         .rays
         .par_chunks(CHUNK)
