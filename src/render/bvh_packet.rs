@@ -111,7 +111,7 @@ impl RayPacket {
 /// allocated once per thread and reused.
 pub struct PacketStack {
     nodes: Vec<u32>,
-    masks: Vec<u32>,
+    masks: Vec<[bool; PACKET]>,
     entries: Vec<[f32; PACKET]>,
 }
 
@@ -186,9 +186,14 @@ fn max(a: f32, b: f32) -> f32 {
     if a > b { a } else { b }
 }
 
-/// Bit i set where `c[i]`.
+/// Lanes of a kernel: `true` where the lane's ray takes part. Kept as one `bool` per lane, not
+/// as bits: the compiler turns these loops into vector compares and blends, where building
+/// an integer of bits cost a dozen instructions per box test.
+type Mask<const N: usize> = [bool; N];
+
+/// Bit i set where `c[i]` (once per packet, at the end).
 #[inline(always)]
-fn mask_of<const N: usize>(c: [bool; N]) -> u32 {
+fn bits_of<const N: usize>(c: Mask<N>) -> u32 {
     let mut m = 0u32;
     for (i, &b) in c.iter().enumerate() {
         m |= u32::from(b) << i;
@@ -198,14 +203,30 @@ fn mask_of<const N: usize>(c: [bool; N]) -> u32 {
 
 /// `c[i]` where bit i of `mask` is set.
 #[inline(always)]
-fn lanes_of<const N: usize>(mask: u32) -> [bool; N] {
+fn lanes_of<const N: usize>(mask: u32) -> Mask<N> {
     std::array::from_fn(|i| (mask >> i) & 1 != 0)
+}
+
+#[inline(always)]
+fn and<const N: usize>(a: Mask<N>, b: Mask<N>) -> Mask<N> {
+    std::array::from_fn(|i| a[i] & b[i])
+}
+
+/// Whether any lane is set (a reduction, without early exit, so that it vectorises).
+#[inline(always)]
+fn any_set<const N: usize>(c: &Mask<N>) -> bool {
+    c.iter().fold(false, |a, &b| a | b)
 }
 
 /// Which lanes enter child `c` of `node` within their [tmin, tmax], and where: the box test
 /// of `bvh.rs`'s `Node::intersect`, per lane.
 #[inline(always)]
-fn child_hits<const N: usize>(node: &Node, c: usize, l: &Lanes<N>, entry: &mut [f32; N]) -> u32 {
+fn child_hits<const N: usize>(
+    node: &Node,
+    c: usize,
+    l: &Lanes<N>,
+    entry: &mut [f32; N],
+) -> Mask<N> {
     let b = &node.bounds;
     let (bx0, bx1, by0, by1, bz0, bz1) = (b[0][c], b[1][c], b[2][c], b[3][c], b[4][c], b[5][c]);
     let mut hit = [false; N];
@@ -227,7 +248,7 @@ fn child_hits<const N: usize>(node: &Node, c: usize, l: &Lanes<N>, entry: &mut [
         entry[i] = e;
         hit[i] = e <= x * EXIT_ROUND_UP;
     }
-    mask_of(hit)
+    hit
 }
 
 /// The triangle test of [`Triangles4`] (obvhs' `RtTriangle::intersect`) for lane `j` of
@@ -238,7 +259,7 @@ fn triangle_hits<const N: usize>(
     j: usize,
     l: &Lanes<N>,
     t_out: &mut [f32; N],
-) -> [bool; N] {
+) -> Mask<N> {
     let [v0x, v0y, v0z] = packet.v0.map(|v| v[j]);
     let [e1x, e1y, e1z] = packet.e1.map(|v| v[j]);
     let [e2x, e2y, e2z] = packet.e2.map(|v| v[j]);
@@ -272,13 +293,12 @@ fn used_lanes(packet: &Triangles4) -> usize {
         .unwrap_or(TRI_LANES)
 }
 
-/// Tests the rays of `mask` against leaf `leaf`'s primitives for their closest hits.
+/// Tests the rays of `on` against leaf `leaf`'s primitives for their closest hits.
 #[inline(always)]
-fn leaf_closest<const N: usize>(bvh: &Bvh, leaf: u32, l: &mut Lanes<N>, mask: u32) {
+fn leaf_closest<const N: usize>(bvh: &Bvh, leaf: u32, l: &mut Lanes<N>, on: Mask<N>) {
     let first = (leaf & FIRST_MASK) as usize;
     let count = ((leaf >> COUNT_SHIFT) & COUNT_MASK) as usize + 1;
     if leaf & ELLIPSOIDS == 0 {
-        let on: [bool; N] = lanes_of(mask);
         for packet in &bvh.triangles[first..first + count] {
             for j in 0..used_lanes(packet) {
                 let prim = packet.prim[j];
@@ -293,10 +313,7 @@ fn leaf_closest<const N: usize>(bvh: &Bvh, leaf: u32, l: &mut Lanes<N>, mask: u3
         }
     } else {
         for e in &bvh.ellipsoids[first..first + count] {
-            let mut rest = mask;
-            while rest != 0 {
-                let i = rest.trailing_zeros() as usize;
-                rest &= rest - 1;
+            for i in (0..N).filter(|&i| on[i]) {
                 let (o, d) = (lane_vec(&l.o, i), lane_vec(&l.d, i));
                 let t = e.ellipsoid.intersect(o, d, l.tmin[i], l.tmax[i]);
                 if t.is_finite() && closer(t, e.prim, l.tmax[i], l.prim[i]) {
@@ -308,39 +325,44 @@ fn leaf_closest<const N: usize>(bvh: &Bvh, leaf: u32, l: &mut Lanes<N>, mask: u3
     }
 }
 
-/// Which rays of `mask` hit a primitive of leaf `leaf` in their [tmin, tmax].
+/// Adds to `blocked` the rays of `on` that hit a primitive of leaf `leaf` in their
+/// [tmin, tmax].
 #[inline(always)]
-fn leaf_any<const N: usize>(bvh: &Bvh, leaf: u32, l: &Lanes<N>, mask: u32) -> u32 {
+fn leaf_any<const N: usize>(
+    bvh: &Bvh,
+    leaf: u32,
+    l: &Lanes<N>,
+    on: Mask<N>,
+    blocked: &mut Mask<N>,
+) {
     let first = (leaf & FIRST_MASK) as usize;
     let count = ((leaf >> COUNT_SHIFT) & COUNT_MASK) as usize + 1;
-    let mut blocked = 0;
     if leaf & ELLIPSOIDS == 0 {
         for packet in &bvh.triangles[first..first + count] {
             for j in 0..used_lanes(packet) {
                 let mut t = [0.0; N];
-                blocked |= mask_of(triangle_hits(packet, j, l, &mut t)) & mask;
-                if blocked == mask {
-                    return blocked;
+                let hit = triangle_hits(packet, j, l, &mut t);
+                for i in 0..N {
+                    blocked[i] |= hit[i] & on[i];
                 }
             }
         }
     } else {
         for e in &bvh.ellipsoids[first..first + count] {
-            let mut rest = mask & !blocked;
-            while rest != 0 {
-                let i = rest.trailing_zeros() as usize;
-                rest &= rest - 1;
+            for i in 0..N {
+                if !on[i] || blocked[i] {
+                    continue;
+                }
                 let (o, d) = (lane_vec(&l.o, i), lane_vec(&l.d, i));
                 if e.ellipsoid
                     .intersect(o, d, l.tmin[i], l.tmax[i])
                     .is_finite()
                 {
-                    blocked |= 1 << i;
+                    blocked[i] = true;
                 }
             }
         }
     }
-    blocked
 }
 
 #[inline(always)]
@@ -348,32 +370,39 @@ fn lane_vec<const N: usize>(a: &[[f32; N]; 3], i: usize) -> Vec3A {
     Vec3A::new(a[0][i], a[1][i], a[2][i])
 }
 
-/// Closest hits of the rays of `mask` in `l`, as [`Bvh::closest`] per ray.
+/// Closest hits of the rays of `on` in `l`, as [`Bvh::closest`] per ray.
 #[inline(always)]
-fn closest_lanes<const N: usize>(bvh: &Bvh, l: &mut Lanes<N>, mask: u32, stack: &mut PacketStack) {
+fn closest_lanes<const N: usize>(
+    bvh: &Bvh,
+    l: &mut Lanes<N>,
+    on: Mask<N>,
+    stack: &mut PacketStack,
+) {
     stack.clear();
     let mut entry = [0.0; PACKET];
     entry[..N].copy_from_slice(&l.tmin);
+    let mut mask = [false; PACKET];
+    mask[..N].copy_from_slice(&on);
     stack.nodes.push(0);
     stack.masks.push(mask);
     stack.entries.push(entry);
     while let Some(current) = stack.nodes.pop() {
-        let mask = stack.masks.pop().unwrap_or(0);
+        let mask: Mask<N> = part(&stack.masks.pop().unwrap_or([false; PACKET]), 0);
         let entry: [f32; N] = part(&stack.entries.pop().unwrap_or([0.0; PACKET]), 0);
         // Lanes whose closest hit so far is nearer than the subtree are done with it.
-        let near: [bool; N] = std::array::from_fn(|i| entry[i] <= l.tmax[i] * EXIT_ROUND_UP);
-        let mask = mask & mask_of(near);
-        if mask == 0 {
+        let on: Mask<N> =
+            std::array::from_fn(|i| mask[i] & (entry[i] <= l.tmax[i] * EXIT_ROUND_UP));
+        if !any_set(&on) {
             continue;
         }
         if current & LEAF != 0 {
-            leaf_closest(bvh, current, l, mask);
+            leaf_closest(bvh, current, l, on);
             continue;
         }
         let node = &bvh.nodes[current as usize];
-        // The children any lane enters, sorted far to near by the first lane's entry.
+        // The children any lane enters, sorted far to near by their nearest lane's entry.
         let mut keys = [u64::MAX; WIDTH];
-        let mut masks = [0u32; WIDTH];
+        let mut masks = [[false; PACKET]; WIDTH];
         let mut entries = [[0.0f32; PACKET]; WIDTH];
         let mut n = 0;
         for c in 0..WIDTH {
@@ -381,18 +410,31 @@ fn closest_lanes<const N: usize>(bvh: &Bvh, l: &mut Lanes<N>, mask: u32, stack: 
                 break;
             }
             let mut e = [0.0; N];
-            let m = child_hits(node, c, l, &mut e) & mask;
-            if m == 0 {
+            let m = and(child_hits(node, c, l, &mut e), on);
+            if !any_set(&m) {
                 continue;
             }
-            let first = e[m.trailing_zeros() as usize];
             // Entries are at least tmin ≥ 0: non-negative floats order as their bits.
-            keys[n] = (u64::from(first.max(0.0).to_bits()) << 32) | c as u64;
-            masks[c] = m;
+            let nearest = (0..N).fold(u32::MAX, |a, i| {
+                a.min(if m[i] {
+                    e[i].to_bits() & 0x7fff_ffff
+                } else {
+                    u32::MAX
+                })
+            });
+            keys[n] = (u64::from(nearest) << 32) | c as u64;
+            masks[c][..N].copy_from_slice(&m);
             entries[c][..N].copy_from_slice(&e);
             n += 1;
         }
-        keys[..n].sort_unstable_by(|a, b| b.cmp(a));
+        // Far to near (a sorting network would do; four keys at most).
+        for a in 1..n {
+            let mut b = a;
+            while b > 0 && keys[b - 1] < keys[b] {
+                keys.swap(b - 1, b);
+                b -= 1;
+            }
+        }
         for &k in &keys[..n] {
             let c = (k & 0xff) as usize;
             stack.nodes.push(node.children[c]);
@@ -402,22 +444,31 @@ fn closest_lanes<const N: usize>(bvh: &Bvh, l: &mut Lanes<N>, mask: u32, stack: 
     }
 }
 
-/// Which rays of `mask` in `l` are blocked, as [`Bvh::any`] per ray.
+/// Which rays of `on` in `l` are blocked, as [`Bvh::any`] per ray.
 #[inline(always)]
-fn any_lanes<const N: usize>(bvh: &Bvh, l: &Lanes<N>, mask: u32, stack: &mut PacketStack) -> u32 {
+fn any_lanes<const N: usize>(
+    bvh: &Bvh,
+    l: &Lanes<N>,
+    on: Mask<N>,
+    stack: &mut PacketStack,
+) -> Mask<N> {
     stack.clear();
+    let mut mask = [false; PACKET];
+    mask[..N].copy_from_slice(&on);
     stack.nodes.push(0);
     stack.masks.push(mask);
-    let mut blocked = 0;
+    let mut blocked = [false; N];
     let mut scratch = [0.0; N];
     while let Some(current) = stack.nodes.pop() {
-        let m = stack.masks.pop().unwrap_or(0) & !blocked;
-        if m == 0 {
+        let m: Mask<N> = part(&stack.masks.pop().unwrap_or([false; PACKET]), 0);
+        let m: Mask<N> = std::array::from_fn(|i| m[i] & !blocked[i]);
+        if !any_set(&m) {
             continue;
         }
         if current & LEAF != 0 {
-            blocked |= leaf_any(bvh, current, l, m);
-            if blocked == mask {
+            leaf_any(bvh, current, l, m, &mut blocked);
+            let open: Mask<N> = std::array::from_fn(|i| on[i] & !blocked[i]);
+            if !any_set(&open) {
                 return blocked;
             }
             continue;
@@ -427,10 +478,12 @@ fn any_lanes<const N: usize>(bvh: &Bvh, l: &Lanes<N>, mask: u32, stack: &mut Pac
             if node.children[c] == EMPTY {
                 break;
             }
-            let cm = child_hits(node, c, l, &mut scratch) & m;
-            if cm != 0 {
+            let cm = and(child_hits(node, c, l, &mut scratch), m);
+            if any_set(&cm) {
+                let mut wide = [false; PACKET];
+                wide[..N].copy_from_slice(&cm);
                 stack.nodes.push(node.children[c]);
-                stack.masks.push(cm);
+                stack.masks.push(wide);
             }
         }
     }
@@ -448,7 +501,7 @@ pub(crate) fn closest<const N: usize>(bvh: &Bvh, packet: &mut RayPacket, stack: 
         let mask = (packet.active >> base) & (u32::MAX >> (32 - N));
         if mask != 0 {
             let mut l = Lanes::<N>::load(packet, base);
-            closest_lanes(bvh, &mut l, mask, stack);
+            closest_lanes(bvh, &mut l, lanes_of(mask), stack);
             l.store(packet, base);
         }
     }
@@ -466,7 +519,7 @@ pub(crate) fn any<const N: usize>(bvh: &Bvh, packet: &RayPacket, stack: &mut Pac
         let mask = (packet.active >> base) & (u32::MAX >> (32 - N));
         if mask != 0 {
             let l = Lanes::<N>::load(packet, base);
-            blocked |= any_lanes(bvh, &l, mask, stack) << base;
+            blocked |= bits_of(any_lanes(bvh, &l, lanes_of(mask), stack)) << base;
         }
     }
     blocked
