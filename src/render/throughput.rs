@@ -26,8 +26,33 @@ const CHUNK: usize = 4096;
 
 /// Rays of one kind, all for one view ([`crate::scene::world::view_bit`]).
 pub struct Batch {
-    pub rays: Vec<TraceRay>,
+    pub rays: Vec<BatchRay>,
     pub view: u8,
+}
+
+/// A ray of a batch, searched over [0, ∞): 24 bytes, as compact as Embree's inputs, so that
+/// reading the batch costs no more memory traffic than theirs; the tracers prepare it
+/// ([`TraceRay`], its reciprocal direction) as they go, as Embree does.
+#[derive(Clone, Copy, Debug)]
+pub struct BatchRay {
+    /// Origin, world frame, metres.
+    pub origin: Vec3,
+    /// Unit direction, world frame.
+    pub dir: Vec3,
+}
+
+impl BatchRay {
+    #[inline]
+    pub fn ray(&self) -> TraceRay {
+        make_ray(self.origin, self.dir, 0.0, f32::INFINITY)
+    }
+
+    fn of(ray: &TraceRay) -> BatchRay {
+        BatchRay {
+            origin: ray.origin.into(),
+            dir: ray.dir.into(),
+        }
+    }
 }
 
 /// Side of the square tiles of [`camera_batch`], pixels.
@@ -51,7 +76,10 @@ pub fn camera_batch(camera: &Camera, view: u8) -> Batch {
     let rays = tile_order(camera.width, camera.height)
         .map(|(x, y)| {
             let dir = camera_rays.direction(x as f32 + 0.5, y as f32 + 0.5);
-            make_ray(camera_rays.origin, dir, 0.0, f32::INFINITY)
+            BatchRay {
+                origin: camera_rays.origin,
+                dir,
+            }
         })
         .collect();
     Batch { rays, view }
@@ -68,7 +96,7 @@ pub fn trace_closest(accel: &Accel, batch: &Batch, isa: Isa, out: &mut [Option<H
             for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
                 let mut packet = RayPacket::new();
                 for (lane, ray) in rays.iter().enumerate() {
-                    packet.set(lane, ray);
+                    packet.set(lane, &ray.ray());
                 }
                 accel.closest_packet(&mut packet, batch.view, isa, stack);
                 for (lane, out) in out.iter_mut().enumerate() {
@@ -88,7 +116,7 @@ pub fn trace_any(accel: &Accel, batch: &Batch, isa: Isa, out: &mut [bool]) {
             for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
                 let mut packet = RayPacket::new();
                 for (lane, ray) in rays.iter().enumerate() {
-                    packet.set(lane, ray);
+                    packet.set(lane, &ray.ray());
                 }
                 let blocked = accel.occluded_packet(&packet, batch.view, isa, stack);
                 for (lane, out) in out.iter_mut().enumerate() {
@@ -106,7 +134,7 @@ pub fn trace_closest_per_ray(accel: &Accel, batch: &Batch, out: &mut [Option<Hit
         .zip(out.par_chunks_mut(CHUNK))
         .for_each_init(Stack::new, |stack, (rays, out)| {
             for (ray, out) in rays.iter().zip(out) {
-                *out = accel.closest_with(ray, batch.view, stack);
+                *out = accel.closest_with(&ray.ray(), batch.view, stack);
             }
         });
 }
@@ -119,7 +147,7 @@ pub fn trace_any_per_ray(accel: &Accel, batch: &Batch, out: &mut [bool]) {
         .zip(out.par_chunks_mut(CHUNK))
         .for_each_init(Stack::new, |stack, (rays, out)| {
             for (ray, out) in rays.iter().zip(out) {
-                *out = accel.occluded_with(ray, batch.view, stack);
+                *out = accel.occluded_with(&ray.ray(), batch.view, stack);
             }
         });
 }
@@ -137,7 +165,7 @@ fn hit_points<'a>(
         .enumerate()
         .filter_map(|(i, (ray, hit))| {
             let hit = (*hit)?;
-            let s = world.surface(hit.prim, ray.origin.into(), ray.dir.into(), hit.t);
+            let s = world.surface(hit.prim, ray.origin, ray.dir, hit.t);
             Some((i, s.position, s.normal))
         })
 }
@@ -147,7 +175,7 @@ fn hit_points<'a>(
 pub fn shadow_batch(world: &World, batch: &Batch, hits: &[Option<Hit>], sun: Vec3) -> Batch {
     let rays = hit_points(world, batch, hits)
         .filter(|(_, _, n)| n.dot(sun) > 0.0)
-        .map(|(_, p, n)| shadow_ray(p, n, sun))
+        .map(|(_, p, n)| BatchRay::of(&shadow_ray(p, n, sun)))
         .collect();
     Batch {
         rays,
@@ -169,7 +197,7 @@ pub fn cosine_batch(world: &World, batch: &Batch, hits: &[Option<Hit>]) -> Batch
             let (t, b) = n.any_orthonormal_pair();
             let dir =
                 (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).sqrt()).normalize();
-            shadow_ray(p, n, dir)
+            BatchRay::of(&shadow_ray(p, n, dir))
         })
         .collect();
     Batch {
