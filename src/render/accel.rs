@@ -24,12 +24,7 @@ use crate::render::ray::TraceRay;
 use crate::render::simd::{self, Isa};
 use crate::scene::world::World;
 
-/// A closest-hit answer: which primitive of the [`World`], at which distance (metres).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hit {
-    pub prim: usize,
-    pub t: f32,
-}
+pub use crate::render::ray::Hit;
 
 /// The primitives of one visibility class and their hierarchy.
 struct Group {

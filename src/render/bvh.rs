@@ -45,9 +45,7 @@ const _: () = assert!(bvh_build::MAX_DEPTH * WIDTH <= STACK);
 /// Box exits are scaled by this before comparison: 8 ulps of headroom for the rounding of
 /// the slab distances against the exact primitive tests.
 pub(crate) const EXIT_ROUND_UP: f32 = 1.0 + 8.0 * f32::EPSILON;
-/// No primitive found (yet): the closest-hit queries keep the primitive of the closest hit
-/// so far, this where there is none.
-pub const NO_PRIM: u32 = u32::MAX;
+pub use crate::render::packets::NO_PRIM;
 
 /// What the box test needs of a ray, in every lane: computed once per traversal.
 struct RayLanes {

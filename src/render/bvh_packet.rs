@@ -5,7 +5,7 @@
 //! SIMD lane, and a child is entered if any active ray enters it, with the mask of the rays
 //! that do; a leaf's triangles are tested one at a time against all of them. The kernels are
 //! plain loops over fixed-size arrays (`[f32; N]`), generic over the lane count `N`, that the
-//! compiler vectorises: [`crate::render::simd`] compiles them for AVX-512 (16 lanes), AVX2
+//! compiler vectorises: `render/simd.rs` compiles them for AVX-512 (16 lanes), AVX2
 //! (8 lanes) and baseline x86-64 or any other target (4 lanes) and picks one at run time.
 //!
 //! Every lane computes what the per-ray traversal ([`crate::render::bvh::Bvh::closest`])
@@ -16,13 +16,12 @@
 
 use glam::Vec3A;
 
-use crate::render::accel::Hit;
 use crate::render::bvh::{
     Bvh, COUNT_MASK, COUNT_SHIFT, ELLIPSOIDS, EMPTY, EXIT_ROUND_UP, FIRST_MASK, LEAF, NO_PRIM,
     Node, STACK, WIDTH,
 };
 use crate::render::packets::{TRI_LANES, Triangles4, closer};
-use crate::render::ray::TraceRay;
+use crate::render::ray::{Hit, TraceRay};
 
 /// Rays per packet: a 4×4 tile of pixels.
 pub const PACKET: usize = 16;

@@ -6,14 +6,17 @@
 //! it returns the same distance bit for bit: the brute-force twin in `tests/accel.rs` checks it.
 //!
 //! Which hit is the closest does not depend on the order the primitives are tested in
-//! ([`closer`]): the per-ray and the packet traversals ([`crate::render::bvh_packet`]) visit
+//! ([`closer`]): the per-ray and the packet traversals (`render/bvh_packet.rs`) visit
 //! them in different orders and give the same primitive.
 
 use glam::Vec4;
 use obvhs::rt_triangle::RtTriangle;
 
-use crate::render::bvh::NO_PRIM;
 use crate::render::ray::TraceRay;
+
+/// No primitive found (yet): the closest-hit queries keep the primitive of the closest hit
+/// so far, this where there is none.
+pub const NO_PRIM: u32 = u32::MAX;
 use crate::scene::world::Ellipsoid;
 
 /// Whether a hit of primitive `prim` at distance `t` (in the ray's [tmin, tmax]) replaces the
