@@ -1,14 +1,18 @@
 //! Every accelerated query against its brute-force twin: random rays over the das scene,
 //! rays along the axes and grazing the ground (zero direction components, flat boxes), the
-//! cameras' own rays, and finite `tmax`.
+//! cameras' own rays, and finite `tmax`; and the packet traversal on every instruction set
+//! the CPU has, ray for ray against the same brute force.
 
 mod common;
 
 use glam::Vec3;
 use seethru::geometry::camera::Camera;
-use seethru::render::accel::{Accel, closest_brute_force, make_ray, occluded_brute_force};
+use seethru::render::accel::{Accel, Hit, closest_brute_force, make_ray, occluded_brute_force};
 use seethru::render::bvh_build::Builder;
+use seethru::render::bvh_packet::{PACKET, PacketStack, RayPacket};
 use seethru::render::camera_rays::CameraRays;
+use seethru::render::ray::TraceRay;
+use seethru::render::simd::Isa;
 use seethru::render::views::View;
 use seethru::scene::world::{World, view_bit};
 use seethru::util::sampling::{hash_words, unit_float};
@@ -77,9 +81,11 @@ fn camera_rays(camera: &Camera) -> Vec<(Vec3, Vec3)> {
 }
 
 /// Checks `closest` and `occluded` against the brute force for each ray in each given view
-/// (cycling), every fifth with a finite `tmax`; returns how many rays hit.
+/// (cycling), every fifth with a finite `tmax`, one ray at a time and in packets on every
+/// available ISA; returns how many rays hit.
 fn compare(world: &World, accel: &Accel, rays: &[(Vec3, Vec3)], views: &[u8]) -> usize {
     let mut hits = 0;
+    let mut expected: Vec<(TraceRay, Option<Hit>, bool)> = Vec::new();
     for (i, &(origin, dir)) in rays.iter().enumerate() {
         let view = views[i % views.len()];
         let tmax = if i % 5 == 0 { 7.5 } else { f32::INFINITY };
@@ -90,22 +96,72 @@ fn compare(world: &World, accel: &Accel, rays: &[(Vec3, Vec3)], views: &[u8]) ->
             (None, None) => {}
             (Some(f), Some(s)) => {
                 hits += 1;
-                // The same distance, bit for bit; at an exact tie (a shared edge) either
-                // primitive is a correct answer.
+                // The same distance, bit for bit, and the same primitive: at an exact tie (a
+                // shared edge) the first in world order, as the brute force.
                 assert_eq!(f.t.to_bits(), s.t.to_bits(), "ray {i}: {f:?} vs {s:?}");
-                if f.prim != s.prim {
-                    assert_eq!(world.intersect(f.prim, &ray.as_obvhs()), s.t, "ray {i}");
-                }
+                assert_eq!(f.prim, s.prim, "ray {i}: {f:?} vs {s:?}");
             }
             _ => panic!("ray {i} ({origin}, {dir}): accelerated {fast:?}, brute force {slow:?}"),
         }
+        let blocked = occluded_brute_force(world, &ray, view);
         assert_eq!(
             accel.occluded(&ray, view),
-            occluded_brute_force(world, &ray, view),
+            blocked,
             "ray {i} ({origin}, {dir})"
         );
+        expected.push((ray, slow, blocked));
     }
+    compare_packets(accel, &expected, views);
     hits
+}
+
+/// Packets of the rays of each view (ray i is in view i mod the views), every third with
+/// lane 5 left empty, on every ISA this CPU has: each lane's closest hit (primitive and
+/// distance, bit for bit) and shadow answer equal the brute force's; empty lanes find nothing.
+fn compare_packets(accel: &Accel, expected: &[(TraceRay, Option<Hit>, bool)], views: &[u8]) {
+    let mut stack = PacketStack::new();
+    let isas: Vec<Isa> = Isa::ALL.into_iter().filter(|i| i.available()).collect();
+    assert!(isas.contains(&Isa::Portable));
+    for isa in isas {
+        for (k, &view) in views.iter().enumerate() {
+            let mine: Vec<usize> = (k..expected.len()).step_by(views.len()).collect();
+            for (p, chunk) in mine.chunks(PACKET).enumerate() {
+                let mut packet = RayPacket::new();
+                for (lane, &i) in chunk.iter().enumerate() {
+                    if !(p % 3 == 1 && lane == 5) {
+                        packet.set(lane, &expected[i].0);
+                    }
+                }
+                let mut closest = packet;
+                accel.closest_packet(&mut closest, view, isa, &mut stack);
+                let blocked = accel.occluded_packet(&packet, view, isa, &mut stack);
+                for (lane, &i) in chunk.iter().enumerate() {
+                    let (want_hit, want_blocked) = if packet.active >> lane & 1 != 0 {
+                        (expected[i].1, expected[i].2)
+                    } else {
+                        (None, false)
+                    };
+                    let got = closest.hit(lane);
+                    let bits = |h: Option<Hit>| h.map(|h| (h.prim, h.t.to_bits()));
+                    assert_eq!(bits(got), bits(want_hit), "{isa:?} ray {i} (lane {lane})");
+                    assert_eq!(
+                        blocked >> lane & 1 != 0,
+                        want_blocked,
+                        "{isa:?} ray {i} (lane {lane}) shadow"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Camera rays in 4×4 tiles: packets as the integrator makes them.
+fn tiled_camera_rays(camera: &Camera) -> Vec<(Vec3, Vec3)> {
+    let camera = camera.with_resolution(160, (160 * camera.height / camera.width).max(1));
+    let rays = CameraRays::new(&camera);
+    seethru::render::throughput::tile_order(camera.width, camera.height)
+        .map(|(x, y)| (rays.origin, rays.direction(x as f32 + 0.5, y as f32 + 0.5)))
+        .collect()
 }
 
 const ALL_VIEWS: [u8; 4] = [
@@ -154,6 +210,35 @@ fn camera_rays_of_every_view_equal_brute_force() {
         let rays = camera_rays(&view.camera(&scene));
         let hits = compare(&world, &accel, &rays, &[view.bit()]);
         assert!(hits > rays.len() / 3, "{view:?}: {hits} of {}", rays.len());
+    }
+}
+
+#[test]
+fn coherent_packets_of_every_view_and_their_shadow_rays_equal_brute_force() {
+    // Whole tiles of camera rays (the integrator's packets), then the shadow rays toward the
+    // sun from their hits, as the integrator casts them.
+    let scene = common::das();
+    let world = World::build(&scene).unwrap();
+    let accel = Accel::build(&world).unwrap();
+    let sun = seethru::render::sky::SkyModel::new(&scene.sky, &scene.sun).sun_direction;
+    for view in View::ALL {
+        let rays = tiled_camera_rays(&view.camera(&scene));
+        let hits = compare(&world, &accel, &rays, &[view.bit()]);
+        assert!(hits > rays.len() / 3, "{view:?}: {hits} of {}", rays.len());
+        let shadow: Vec<(Vec3, Vec3)> = rays
+            .iter()
+            .filter_map(|&(o, d)| {
+                let h = accel.closest(&make_ray(o, d, 0.0, f32::INFINITY), view.bit())?;
+                let s = world.surface(h.prim, o, d, h.t);
+                (s.normal.dot(sun) > 0.0).then(|| {
+                    let r = seethru::render::integrator::shadow_ray(s.position, s.normal, sun);
+                    (Vec3::from(r.origin), sun)
+                })
+            })
+            .collect();
+        // Shadow rays' tmax is infinite in the integrator: every fifth here is finite too.
+        compare(&world, &accel, &shadow, &[view.bit()]);
+        assert!(shadow.len() > rays.len() / 4, "{view:?}: {}", shadow.len());
     }
 }
 

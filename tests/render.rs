@@ -218,3 +218,149 @@ fn more_samples_smooth_edges_but_keep_centre_aovs() {
         .count();
     assert!(changed > 0 && changed < one.color.len() / 4, "{changed}");
 }
+
+/// Every tracer: one ray at a time, and 4×4 packets on each instruction set this CPU has.
+fn tracers() -> Vec<seethru::render::integrator::Tracer> {
+    use seethru::render::integrator::Tracer;
+    use seethru::render::simd::Isa;
+    let mut out = vec![Tracer::PerRay];
+    out.extend(
+        Isa::ALL
+            .into_iter()
+            .filter(|i| i.available())
+            .map(Tracer::Packets),
+    );
+    out
+}
+
+/// `job` on a pool of `threads` worker threads.
+fn on_threads<T: Send>(threads: usize, job: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(job)
+}
+
+#[test]
+fn packets_render_every_view_as_the_per_ray_path_does_on_every_isa_and_thread_count() {
+    use seethru::system::display::{DisplayModel, DisplayPlacement, DisplaySurface};
+    use seethru::system::{options::RunOptions, pipeline::run};
+    let ctx = RenderContext::new(common::das()).unwrap();
+    // Sizes that cut the last tiles of a band; three samples per pixel.
+    let settings = RenderSettings {
+        spp: 3,
+        progress: false,
+    };
+    let tracers = tracers();
+    for view in [View::Truth, View::Occluded, View::Frontal, View::Back] {
+        let camera = view.camera(&ctx.scene).with_resolution(70, 41);
+        let want = on_threads(1, || {
+            ctx.render_traced(&camera, view.bit(), settings, tracers[0])
+        });
+        for &tracer in &tracers {
+            for threads in [1, 3] {
+                let got = on_threads(threads, || {
+                    ctx.render_traced(&camera, view.bit(), settings, tracer)
+                });
+                assert!(
+                    got.bit_identical(&want),
+                    "{view:?} {tracer:?} on {threads} threads"
+                );
+            }
+        }
+    }
+    // The seethru view: where a ray meets the display, its image (pixels) or the frontal
+    // camera's own ray and shading (ideal), traced one by one inside the packets.
+    for display in [DisplayModel::Pixels, DisplayModel::Ideal] {
+        let options = RunOptions {
+            width: Some(64),
+            display,
+            back_width: Some(32),
+            frontal_width: Some(160),
+            ..RunOptions::default()
+        };
+        let r = run(&ctx, &options).unwrap();
+        let placement = DisplayPlacement::new(&ctx.scene.obstacle);
+        let mut frontal = ctx.scene.frontal;
+        frontal = frontal.with_resolution(160, 160 * frontal.height / frontal.width);
+        let surface = match display {
+            DisplayModel::Pixels => DisplaySurface::Pixels {
+                image: r.display.clone(),
+                placement,
+            },
+            DisplayModel::Ideal => DisplaySurface::Ideal {
+                crop: r.crop,
+                frontal,
+                placement,
+                lens: None,
+            },
+        };
+        let driver = ctx.scene.driver.with_resolution(70, 41);
+        let want = ctx.render_seethru_traced(&driver, &surface, settings, tracers[0]);
+        // The display covers some pixels: the comparison sees it.
+        let shown = want
+            .object_id
+            .iter()
+            .zip(
+                &ctx.render_traced(&driver, View::Occluded.bit(), settings, tracers[0])
+                    .object_id,
+            )
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(shown > 20, "{display:?}: {shown}");
+        for &tracer in &tracers {
+            let got = on_threads(2, || {
+                ctx.render_seethru_traced(&driver, &surface, settings, tracer)
+            });
+            assert!(got.bit_identical(&want), "{display:?} {tracer:?}");
+        }
+    }
+}
+
+#[test]
+fn packets_trace_a_sequences_moving_part_as_the_per_ray_path_does() {
+    use seethru::system::options::RunOptions;
+    use seethru::system::sequence::head_motion::HeadMotion;
+    use seethru::system::sequence::predict::Prediction;
+    use seethru::system::sequence::system_loop::{SequenceOptions, SystemLoop};
+    use seethru::system::sequence::timeline::Timeline;
+    // The ball rolls, the head leans and the rig drives and turns: as tests/sequence.rs.
+    let options = SequenceOptions {
+        run: RunOptions::default(),
+        timeline: Timeline {
+            duration: 2.0,
+            fps: 10.0,
+            display_hz: 10.0,
+            latency_camera: 0.0,
+            latency_tracking: 0.0,
+        },
+        speed: 50.0 / 3.6,
+        yaw_rate: 0.1,
+        head: HeadMotion::Lean {
+            distance: 0.1,
+            duration: 0.3,
+            start: 0.0,
+        },
+        predict: Prediction::None,
+        reproject: false,
+        byo: Default::default(),
+    };
+    let mut system = SystemLoop::new(&common::das(), options).unwrap();
+    let layered = system.context_at(1.5).unwrap();
+    assert!(layered.moving.is_some());
+    let settings = RenderSettings::default();
+    let s = &layered.scene;
+    let tracers = tracers();
+    for (camera, view) in [
+        (s.frontal.with_resolution(90, 50), view_bit::FRONTAL),
+        (s.driver.with_resolution(90, 50), view_bit::OCCLUDED),
+        (s.back.with_resolution(66, 50), view_bit::BACK),
+    ] {
+        let want = layered.render_traced(&camera, view, settings, tracers[0]);
+        for &tracer in &tracers[1..] {
+            let got = layered.render_traced(&camera, view, settings, tracer);
+            assert!(got.bit_identical(&want), "view {view} {tracer:?}");
+        }
+    }
+}

@@ -9,8 +9,10 @@ use seethru::render::accel::Accel;
 use seethru::render::frame::Frame;
 use seethru::render::integrator::RenderContext;
 use seethru::render::settings::{RenderSettings, check_resolution};
+use seethru::render::simd::Isa;
 use seethru::render::throughput::{
-    Batch, camera_batch, cosine_batch, shadow_batch, trace_any, trace_closest,
+    Batch, camera_batch, cosine_batch, shadow_batch, trace_any, trace_any_per_ray, trace_closest,
+    trace_closest_per_ray,
 };
 use seethru::render::views::View;
 use seethru::scene::Scene;
@@ -146,7 +148,12 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         ctx.accel.bytes() as f64 / 1e6
     ));
     let threads = rayon::current_num_threads();
-    say(format!("threads      {threads}"));
+    let isa = Isa::best();
+    say(format!(
+        "threads      {threads}; packets of 16 rays on {} ({} lanes)",
+        isa.name(),
+        isa.lanes()
+    ));
 
     let camera = View::Truth
         .camera(&ctx.scene)
@@ -154,27 +161,42 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
     let primary = camera_batch(&camera, View::Truth.bit());
     let mut hits = vec![None; primary.rays.len()];
     let primary_s = timed(options.repeat, || {
-        trace_closest(&ctx.accel, &primary, &mut hits)
+        trace_closest(&ctx.accel, &primary, isa, &mut hits)
     });
+    let mut single_hits = vec![None; primary.rays.len()];
+    let primary_single_s = timed(options.repeat, || {
+        trace_closest_per_ray(&ctx.accel, &primary, &mut single_hits)
+    });
+    if hits != single_hits {
+        anyhow::bail!("internal error: the packet and per-ray traversals found different hits");
+    }
     let shadow = shadow_batch(world, &primary, &hits, ctx.sky.sun_direction);
+    let mut blocked = vec![false; shadow.rays.len()];
+    let shadow_s = timed(options.repeat, || {
+        trace_any(&ctx.accel, &shadow, isa, &mut blocked)
+    });
+    let mut single_blocked = vec![false; shadow.rays.len()];
+    let shadow_single_s = timed(options.repeat, || {
+        trace_any_per_ray(&ctx.accel, &shadow, &mut single_blocked)
+    });
+    if blocked != single_blocked {
+        anyhow::bail!("internal error: the packet and per-ray traversals found different shadows");
+    }
     let any_hit = |batch: &Batch| {
         let mut blocked = vec![false; batch.rays.len()];
         timed(options.repeat, || {
-            trace_any(&ctx.accel, batch, &mut blocked)
+            trace_any_per_ray(&ctx.accel, batch, &mut blocked)
         })
     };
-    let shadow_s = any_hit(&shadow);
     let incoherent = cosine_batch(world, &primary, &hits);
     let mut incoherent_hits = vec![None; incoherent.rays.len()];
     let incoherent_closest_s = timed(options.repeat, || {
-        trace_closest(&ctx.accel, &incoherent, &mut incoherent_hits)
+        trace_closest_per_ray(&ctx.accel, &incoherent, &mut incoherent_hits)
     });
     let incoherent_any_s = any_hit(&incoherent);
-    let both: Vec<f64> = primary_s
-        .iter()
-        .zip(&shadow_s)
-        .map(|(a, b)| a + b)
-        .collect();
+    let sum = |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(a, b)| a + b).collect() };
+    let both = sum(&primary_s, &shadow_s);
+    let both_single = sum(&primary_single_s, &shadow_single_s);
     let rows = [
         (
             "primary",
@@ -193,6 +215,18 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
             "primary + shadow",
             primary.rays.len() + shadow.rays.len(),
             both,
+        ),
+        (
+            "primary_per_ray",
+            "primary, per ray",
+            primary.rays.len(),
+            primary_single_s,
+        ),
+        (
+            "primary_shadow_per_ray",
+            "primary + shadow, per ray",
+            primary.rays.len() + shadow.rays.len(),
+            both_single,
         ),
         (
             "incoherent_closest",
@@ -268,6 +302,7 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         "bvh_build_ms": build.json(),
         "bvh_bytes": ctx.accel.bytes(),
         "threads": threads,
+        "isa": isa.name(),
         "repeat": options.repeat,
         "width": options.width,
         "height": options.height,

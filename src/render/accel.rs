@@ -18,16 +18,13 @@ use obvhs::triangle::Triangle;
 
 use std::cell::RefCell;
 
-use crate::render::bvh::{Bvh, Stack};
+use crate::render::bvh::{Bvh, NO_PRIM, Stack};
+use crate::render::bvh_packet::{PacketStack, RayPacket};
 use crate::render::ray::TraceRay;
+use crate::render::simd::{self, Isa};
 use crate::scene::world::World;
 
-/// A closest-hit answer: which primitive of the [`World`], at which distance (metres).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hit {
-    pub prim: usize,
-    pub t: f32,
-}
+pub use crate::render::ray::Hit;
 
 /// The primitives of one visibility class and their hierarchy.
 struct Group {
@@ -157,16 +154,56 @@ impl Accel {
     #[inline]
     pub fn closest_with(&self, ray: &TraceRay, view: u8, stack: &mut Stack) -> Option<Hit> {
         let mut ray = *ray;
-        let mut prim = None;
+        let mut best = NO_PRIM;
         for group in self.groups.iter().filter(|g| g.views & view != 0) {
-            if let Some(p) = group.bvh.closest(&mut ray, stack) {
-                prim = Some(p);
-            }
+            group.bvh.closest(&mut ray, &mut best, stack);
         }
-        prim.map(|p| Hit {
-            prim: p as usize,
+        (best != NO_PRIM).then_some(Hit {
+            prim: best as usize,
             t: ray.tmax,
         })
+    }
+
+    /// [`Accel::closest_with`] for every active ray of `packet` at once, on `isa`'s kernels:
+    /// each lane's `prim` and `tmax` become its closest hit ([`RayPacket::hit`]), the one
+    /// the per-ray query gives, bit for bit.
+    #[inline]
+    pub fn closest_packet(
+        &self,
+        packet: &mut RayPacket,
+        view: u8,
+        isa: Isa,
+        stack: &mut PacketStack,
+    ) {
+        for group in self.groups.iter().filter(|g| g.views & view != 0) {
+            simd::closest(isa, &group.bvh, packet, stack);
+        }
+    }
+
+    /// [`Accel::occluded_with`] for every active ray of `packet`: bit i is set where lane
+    /// i's ray is blocked.
+    #[inline]
+    pub fn occluded_packet(
+        &self,
+        packet: &RayPacket,
+        view: u8,
+        isa: Isa,
+        stack: &mut PacketStack,
+    ) -> u32 {
+        let mut rest = *packet;
+        let mut blocked = 0;
+        for g in self
+            .groups
+            .iter()
+            .filter(|g| g.views & view != 0 && g.casts_shadow)
+        {
+            blocked |= simd::any(isa, &g.bvh, &rest, stack);
+            rest.active = packet.active & !blocked;
+            if rest.active == 0 {
+                break;
+            }
+        }
+        blocked
     }
 
     /// Whether any shadow-casting primitive visible in `view` blocks `ray` in [tmin, tmax].

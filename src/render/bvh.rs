@@ -24,26 +24,28 @@ use crate::render::ray::TraceRay;
 use crate::scene::world::World;
 
 /// Children per node: one per lane of a `Vec4`.
-const WIDTH: usize = 4;
+pub(crate) const WIDTH: usize = 4;
 
 /// Child reference: a leaf (else an inner node's index) ...
-const LEAF: u32 = 1 << 31;
+pub(crate) const LEAF: u32 = 1 << 31;
 /// ... of ellipsoids (else of triangle packets) ...
-const ELLIPSOIDS: u32 = 1 << 30;
+pub(crate) const ELLIPSOIDS: u32 = 1 << 30;
 /// ... with (packets − 1) in these bits, and the first packet's index below them.
-const COUNT_SHIFT: u32 = 27;
-const COUNT_MASK: u32 = 0b111;
-const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
+pub(crate) const COUNT_SHIFT: u32 = 27;
+pub(crate) const COUNT_MASK: u32 = 0b111;
+pub(crate) const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 /// Most packets in one leaf.
 const MAX_LEAF_PACKETS: usize = COUNT_MASK as usize + 1;
-/// An unused child slot (its box is empty, so it is never entered).
-const EMPTY: u32 = u32::MAX;
+/// An unused child slot (its box is empty, so it is never entered); unused slots follow the
+/// used ones.
+pub(crate) const EMPTY: u32 = u32::MAX;
 /// Traversal stack entries; a hierarchy that could need more is refused at build time.
-const STACK: usize = 512;
+pub(crate) const STACK: usize = 512;
 const _: () = assert!(bvh_build::MAX_DEPTH * WIDTH <= STACK);
 /// Box exits are scaled by this before comparison: 8 ulps of headroom for the rounding of
 /// the slab distances against the exact primitive tests.
-const EXIT_ROUND_UP: f32 = 1.0 + 8.0 * f32::EPSILON;
+pub(crate) const EXIT_ROUND_UP: f32 = 1.0 + 8.0 * f32::EPSILON;
+pub use crate::render::packets::NO_PRIM;
 
 /// What the box test needs of a ray, in every lane: computed once per traversal.
 struct RayLanes {
@@ -64,10 +66,10 @@ impl RayLanes {
 /// Four child boxes, structure of arrays, and the child references.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-struct Node {
+pub(crate) struct Node {
     /// Per child: [min x, max x, min y, max y, min z, max z].
-    bounds: [Vec4; 6],
-    children: [u32; WIDTH],
+    pub(crate) bounds: [Vec4; 6],
+    pub(crate) children: [u32; WIDTH],
 }
 
 impl Node {
@@ -158,9 +160,9 @@ fn key_entry(key: u64) -> f32 {
 pub struct Bvh {
     /// Which builder made the binary hierarchy (None: no primitives).
     pub builder: Option<bvh_build::Builder>,
-    nodes: Vec<Node>,
-    triangles: Vec<Triangles4>,
-    ellipsoids: Vec<EllipsoidLeaf>,
+    pub(crate) nodes: Vec<Node>,
+    pub(crate) triangles: Vec<Triangles4>,
+    pub(crate) ellipsoids: Vec<EllipsoidLeaf>,
 }
 
 impl Bvh {
@@ -192,26 +194,21 @@ impl Bvh {
         Ok(bvh)
     }
 
-    /// Tests the primitives of leaf `leaf` for the closest hit; shrinks `ray.tmax`.
+    /// Tests the primitives of leaf `leaf` for the closest hit; shrinks `ray.tmax` and sets
+    /// `best` (see [`closer`]).
     #[inline(always)]
-    fn leaf_closest(&self, leaf: u32, ray: &mut TraceRay) -> Option<u32> {
+    fn leaf_closest(&self, leaf: u32, ray: &mut TraceRay, best: &mut u32) {
         let first = (leaf & FIRST_MASK) as usize;
         let count = ((leaf >> COUNT_SHIFT) & COUNT_MASK) as usize + 1;
-        let mut found = None;
         if leaf & ELLIPSOIDS == 0 {
             for packet in &self.triangles[first..first + count] {
-                if let Some(prim) = packet.closest(ray) {
-                    found = Some(prim);
-                }
+                packet.closest(ray, best);
             }
         } else {
             for ellipsoid in &self.ellipsoids[first..first + count] {
-                if let Some(prim) = ellipsoid.closest(ray) {
-                    found = Some(prim);
-                }
+                ellipsoid.closest(ray, best);
             }
         }
-        found
     }
 
     #[inline(always)]
@@ -229,14 +226,15 @@ impl Bvh {
         }
     }
 
-    /// Closest primitive hit in [tmin, tmax); shrinks `ray.tmax` to its distance.
+    /// Closest primitive hit in [tmin, tmax): shrinks `ray.tmax` to its distance and sets
+    /// `best` to it, where it is closer than `best` at `ray.tmax` ([`closer`]; `best` is
+    /// [`NO_PRIM`] where nothing was found yet).
     #[inline]
-    pub fn closest(&self, ray: &mut TraceRay, stack: &mut Stack) -> Option<u32> {
+    pub fn closest(&self, ray: &mut TraceRay, best: &mut u32, stack: &mut Stack) {
         if self.nodes.is_empty() {
-            return None;
+            return;
         }
         let lanes = RayLanes::new(ray);
-        let mut found = None;
         stack.len = 0;
         let mut current = 0u32;
         'visit: loop {
@@ -284,10 +282,8 @@ impl Bvh {
                 }
                 current = keys[0] as u32;
             }
-            if current & LEAF != 0
-                && let Some(prim) = self.leaf_closest(current, ray)
-            {
-                found = Some(prim);
+            if current & LEAF != 0 {
+                self.leaf_closest(current, ray, best);
             }
             // The next stacked subtree that starts before the closest hit so far.
             while let Some(k) = stack.pop() {
@@ -296,7 +292,7 @@ impl Bvh {
                     continue 'visit;
                 }
             }
-            return found;
+            return;
         }
     }
 

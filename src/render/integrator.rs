@@ -6,6 +6,11 @@
 //! same for any number of threads. Views of one camera that differ only by a few primitives
 //! (`truth`, `occluded`, `seethru`) are rendered once and re-rendered only where those
 //! primitives can be seen ([`RenderContext::render_over`]).
+//!
+//! Within a band, pixels are traced in 4×4 tiles ([`Tracer::Packets`]): the tile's camera rays
+//! as one packet ([`crate::render::bvh_packet`]), then the shadow rays toward the sun from its
+//! lit hits as another. The per-ray path ([`Tracer::PerRay`]) gives the same image bit for bit
+//! and is the packets' twin in tests.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -17,6 +22,7 @@ use rayon::prelude::*;
 use crate::geometry::camera::Camera;
 use crate::render::accel::{Accel, Difference, make_ray};
 use crate::render::bvh::Stack;
+use crate::render::bvh_packet::{PACKET, PacketStack, RayPacket};
 use crate::render::camera_rays::CameraRays;
 use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::{Frame, Pixel};
@@ -24,6 +30,7 @@ use crate::render::moving::MovingLayer;
 use crate::render::ray::TraceRay;
 use crate::render::screen::{Screen, Shown};
 use crate::render::settings::RenderSettings;
+use crate::render::simd::Isa;
 use crate::render::sky::SkyModel;
 use crate::scene::Scene;
 use crate::scene::texture::Texture;
@@ -36,8 +43,36 @@ thread_local! {
     static STACK: std::cell::RefCell<Stack> = std::cell::RefCell::new(Stack::new());
 }
 
-/// Rows per rayon task: small enough to balance many threads, large enough to amortise.
+/// Rows per rayon task: small enough to balance many threads, large enough to amortise; a
+/// band is one row of tiles.
 const BAND_ROWS: u32 = 4;
+/// Columns of a tile: a band's rows × these make one packet.
+const TILE_COLUMNS: u32 = PACKET as u32 / BAND_ROWS;
+
+/// How a render traces its camera rays and the sun's shadow rays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tracer {
+    /// One ray at a time: the packets' twin.
+    PerRay,
+    /// 4×4 tiles of pixels as packets of 16 rays, on the given instruction set's kernels.
+    Packets(Isa),
+}
+
+impl Tracer {
+    /// Packets on the CPU's widest instruction set: what every render uses.
+    pub fn best() -> Tracer {
+        Tracer::Packets(Isa::best())
+    }
+}
+
+/// The parts of Lambert shading known before the shadow ray is traced.
+struct Shading {
+    albedo: Vec3,
+    /// Sky ambient.
+    light: Vec3,
+    /// Cosine of the sun to the normal: a shadow ray is traced where it is positive.
+    cos: f32,
+}
 
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RenderStats {
@@ -211,6 +246,63 @@ impl RenderContext {
         frame: &mut Frame,
         label: &str,
     ) -> RenderStats {
+        let tracer = Tracer::best();
+        self.render_rect_traced(
+            camera, view, display, settings, region, frame, label, tracer,
+        )
+    }
+
+    /// [`RenderContext::render`] traced by `tracer`: every tracer gives the same frame.
+    pub fn render_traced(
+        &self,
+        camera: &Camera,
+        view: u8,
+        settings: RenderSettings,
+        tracer: Tracer,
+    ) -> Frame {
+        let mut frame = Frame::new(camera.width, camera.height);
+        let region = PixelRect::full(camera);
+        self.render_rect_traced(camera, view, None, settings, region, &mut frame, "", tracer);
+        frame
+    }
+
+    /// [`RenderContext::render_seethru`] traced by `tracer`.
+    pub fn render_seethru_traced(
+        &self,
+        camera: &Camera,
+        display: &dyn Screen,
+        settings: RenderSettings,
+        tracer: Tracer,
+    ) -> Frame {
+        let mut frame = Frame::new(camera.width, camera.height);
+        let region = PixelRect::full(camera);
+        let view = view_bit::SEETHRU;
+        self.render_rect_traced(
+            camera,
+            view,
+            Some(display),
+            settings,
+            region,
+            &mut frame,
+            "",
+            tracer,
+        );
+        frame
+    }
+
+    /// [`RenderContext::render_rect`] traced by `tracer`.
+    #[allow(clippy::too_many_arguments)]
+    fn render_rect_traced(
+        &self,
+        camera: &Camera,
+        view: u8,
+        display: Option<&dyn Screen>,
+        settings: RenderSettings,
+        region: PixelRect,
+        frame: &mut Frame,
+        label: &str,
+        tracer: Tracer,
+    ) -> RenderStats {
         assert_eq!((frame.width, frame.height), (camera.width, camera.height));
         let start = Instant::now();
         let job = PixelJob {
@@ -228,25 +320,55 @@ impl RenderContext {
         let progress = Progress::new(format!("rendering {label}"), bands.len(), settings.progress);
         let shadow_rays: u64 = bands
             .into_par_iter()
-            .map_init(Stack::new, |stack, mut band| {
-                let mut shadows = 0;
-                // A cancelled render (render/cancel.rs) leaves its remaining bands as they are.
-                if crate::render::cancel::requested() {
-                    return shadows;
-                }
-                for row in 0..band.len() {
-                    let y = band.y + row;
-                    if y < region.y0 || y >= region.y1 {
-                        continue;
+            .map_init(
+                || (Stack::new(), PacketStack::new()),
+                |(stack, packet_stack), mut band| {
+                    let mut shadows = 0;
+                    // A cancelled render (render/cancel.rs) leaves its remaining bands as they are.
+                    if crate::render::cancel::requested() {
+                        return shadows;
                     }
-                    for x in region.x0..region.x1 {
-                        let pixel = self.render_pixel(&job, x, y, stack, &mut shadows);
-                        band.set(x, row, pixel);
+                    // The band's rows inside the region.
+                    let rows =
+                        region.y0.max(band.y) - band.y..region.y1.min(band.y + band.len()) - band.y;
+                    match tracer {
+                        Tracer::PerRay => {
+                            for row in rows {
+                                for x in region.x0..region.x1 {
+                                    let pixel = self.render_pixel(
+                                        &job,
+                                        x,
+                                        band.y + row,
+                                        stack,
+                                        &mut shadows,
+                                    );
+                                    band.set(x, row, pixel);
+                                }
+                            }
+                        }
+                        Tracer::Packets(isa) => {
+                            for x0 in (region.x0..region.x1).step_by(TILE_COLUMNS as usize) {
+                                let tile = Tile {
+                                    isa,
+                                    y: band.y,
+                                    rows: rows.clone(),
+                                    columns: x0..(x0 + TILE_COLUMNS).min(region.x1),
+                                };
+                                self.render_tile(
+                                    &job,
+                                    &tile,
+                                    &mut band,
+                                    stack,
+                                    packet_stack,
+                                    &mut shadows,
+                                );
+                            }
+                        }
                     }
-                }
-                progress.advance(1);
-                shadows
-            })
+                    progress.advance(1);
+                    shadows
+                },
+            )
             .sum();
         progress.finish();
         RenderStats {
@@ -283,45 +405,150 @@ impl RenderContext {
                 (Some(s), None) => self.shade(s, job.view, stack, shadows),
                 (None, None) => self.sky.radiance(dir),
             };
-            if sample != 0 {
-                continue;
+            if sample == 0 {
+                pixel = sample_aovs(job, origin, dir, hit, shown);
             }
-            pixel = match (hit, shown) {
-                (_, Some(d)) => {
-                    // The AOVs of what the display shows, measured from this eye.
-                    let finite = d.position.is_finite();
-                    Pixel {
-                        depth: if finite {
-                            (d.position - origin).length()
-                        } else {
-                            f32::INFINITY
-                        },
-                        camera_z: if finite {
-                            axial_depth(&job.camera_from_world, d.position)
-                        } else {
-                            f32::INFINITY
-                        },
-                        ..d
-                    }
-                }
-                (Some(s), None) => Pixel {
-                    color: Vec3::ZERO,
-                    depth: s.t,
-                    camera_z: axial_depth(&job.camera_from_world, s.position),
-                    position: s.position,
-                    normal: s.normal,
-                    object_id: s.object,
-                    part_id: s.part,
-                },
-                // The sky direction travels with the pixel, as a world point does.
-                (None, None) => Pixel {
-                    normal: -dir,
-                    ..Pixel::SKY
-                },
-            };
         }
         pixel.color = sum / job.spp as f32;
         pixel
+    }
+
+    /// The pixels of `tile` of `band`, as [`RenderContext::render_pixel`] gives each: its
+    /// camera rays traced as one packet, then the sun's shadow rays from its lit hits as
+    /// another, sample by sample.
+    fn render_tile(
+        &self,
+        job: &PixelJob,
+        tile: &Tile,
+        band: &mut crate::render::frame::Rows,
+        stack: &mut Stack,
+        packet_stack: &mut PacketStack,
+        shadows: &mut u64,
+    ) {
+        let mut at = [(0u32, 0u32); PACKET];
+        let mut n = 0;
+        for row in tile.rows.clone() {
+            for x in tile.columns.clone() {
+                at[n] = (x, row);
+                n += 1;
+            }
+        }
+        let origin = job.rays.origin;
+        let mut pixels = [Pixel::SKY; PACKET];
+        let mut sums = [Vec3::ZERO; PACKET];
+        let mut dirs = [Vec3::ZERO; PACKET];
+        let mut camera = RayPacket::new();
+        let mut shadow = RayPacket::new();
+        for sample in 0..job.spp {
+            camera.clear();
+            for (lane, &(x, row)) in at[..n].iter().enumerate() {
+                let y = tile.y + row;
+                let (dx, dy) = pixel_offset(x, y, sample);
+                dirs[lane] = job.rays.direction(x as f32 + dx, y as f32 + dy);
+                camera.set(lane, &make_ray(origin, dirs[lane], 0.0, f32::INFINITY));
+            }
+            let hits = self.trace_packet(&dirs, &mut camera, job.view, tile.isa, packet_stack);
+            let mut shown = [None; PACKET];
+            let mut shading: [Option<Shading>; PACKET] = std::array::from_fn(|_| None);
+            shadow.clear();
+            for lane in 0..n {
+                match (&hits[lane], job.display) {
+                    (Some(s), Some(d)) if self.world.is_display(s.object, s.part) => {
+                        shown[lane] = Some(self.display_content(d, s.position, stack, shadows));
+                    }
+                    (Some(s), _) => {
+                        let sh = self.shade_begin(s);
+                        if sh.cos > 0.0 {
+                            *shadows += 1;
+                            let ray = shadow_ray(s.position, s.normal, self.sky.sun_direction);
+                            shadow.set(lane, &ray);
+                        }
+                        shading[lane] = Some(sh);
+                    }
+                    (None, _) => {}
+                }
+            }
+            let blocked = self.occluded_packet(&shadow, job.view, tile.isa, packet_stack);
+            for lane in 0..n {
+                // A display emits its image: no shading.
+                sums[lane] += match (&shown[lane], shading[lane].take()) {
+                    (Some(d), _) => d.color,
+                    (None, Some(sh)) => {
+                        self.shade_end(sh, (shadow.active & !blocked) >> lane & 1 != 0)
+                    }
+                    (None, None) => self.sky.radiance(dirs[lane]),
+                };
+                if sample == 0 {
+                    pixels[lane] = sample_aovs(job, origin, dirs[lane], hits[lane], shown[lane]);
+                }
+            }
+        }
+        for (lane, &(x, row)) in at[..n].iter().enumerate() {
+            let mut pixel = pixels[lane];
+            pixel.color = sums[lane] / job.spp as f32;
+            band.set(x, row, pixel);
+        }
+    }
+
+    /// [`RenderContext::trace_with`] for the rays of `packet` (directions `dirs`, from one
+    /// origin): the surface each lane's ray meets.
+    fn trace_packet(
+        &self,
+        dirs: &[Vec3; PACKET],
+        packet: &mut RayPacket,
+        view: u8,
+        isa: Isa,
+        stack: &mut PacketStack,
+    ) -> [Option<SurfaceHit>; PACKET] {
+        self.accel.closest_packet(packet, view, isa, stack);
+        let mut moving_hits = [None; PACKET];
+        if let Some(m) = &self.moving {
+            // From the static hit on (as trace_with), keeping the static answers apart.
+            let mut rest = *packet;
+            rest.prim = [crate::render::bvh::NO_PRIM; PACKET];
+            m.accel.closest_packet(&mut rest, view, isa, stack);
+            moving_hits = std::array::from_fn(|lane| rest.hit(lane));
+        }
+        std::array::from_fn(|lane| {
+            if packet.active >> lane & 1 == 0 {
+                return None;
+            }
+            let ray = packet.ray(lane);
+            let (origin, dir) = (Vec3::from(ray.origin), dirs[lane]);
+            let hit = packet.hit(lane);
+            if let Some(m) = &self.moving
+                && let Some(h) = moving_hits[lane]
+                && hit.is_none_or(|s| h.t < s.t)
+            {
+                let mut s = m.world.surface(h.prim, origin, dir, h.t);
+                s.material += self.world.materials.len() as u32;
+                return Some(s);
+            }
+            hit.map(|h| self.world.surface(h.prim, origin, dir, h.t))
+        })
+    }
+
+    /// Which rays of `packet` a shadow-casting primitive visible in `view` blocks (bit i for
+    /// lane i), as [`Accel::occluded_with`] and the moving layer's per ray.
+    fn occluded_packet(
+        &self,
+        packet: &RayPacket,
+        view: u8,
+        isa: Isa,
+        stack: &mut PacketStack,
+    ) -> u32 {
+        if packet.active == 0 {
+            return 0;
+        }
+        let mut blocked = self.accel.occluded_packet(packet, view, isa, stack);
+        if let Some(m) = &self.moving {
+            let mut rest = *packet;
+            rest.active &= !blocked;
+            if rest.active != 0 {
+                blocked |= m.accel.occluded_packet(&rest, view, isa, stack);
+            }
+        }
+        blocked
     }
 
     /// What the display shows at a world point on its face: a display pixel, or — for the
@@ -402,14 +629,9 @@ impl RenderContext {
 
     /// Lambert shading: albedo × (sun × cos × visibility + sky ambient).
     fn shade(&self, s: &SurfaceHit, view: u8, stack: &mut Stack, shadows: &mut u64) -> Vec3 {
-        let (material, textures) = self.material(s.material);
-        let mut albedo = material.albedo;
-        if let Some(t) = material.texture {
-            albedo *= textures[t].sample(s.uv * material.uv_repeat);
-        }
-        let mut light = self.sky.ambient(s.normal);
-        let cos = s.normal.dot(self.sky.sun_direction);
-        if cos > 0.0 {
+        let sh = self.shade_begin(s);
+        let mut lit = false;
+        if sh.cos > 0.0 {
             *shadows += 1;
             let ray = shadow_ray(s.position, s.normal, self.sky.sun_direction);
             let blocked = self.accel.occluded_with(&ray, view, stack)
@@ -417,11 +639,87 @@ impl RenderContext {
                     .moving
                     .as_ref()
                     .is_some_and(|m| m.accel.occluded_with(&ray, view, stack));
-            if !blocked {
-                light += self.sky.sun_irradiance * cos;
+            lit = !blocked;
+        }
+        self.shade_end(sh, lit)
+    }
+
+    /// The albedo, the ambient light and the sun's cosine at `s`.
+    #[inline]
+    fn shade_begin(&self, s: &SurfaceHit) -> Shading {
+        let (material, textures) = self.material(s.material);
+        let mut albedo = material.albedo;
+        if let Some(t) = material.texture {
+            albedo *= textures[t].sample(s.uv * material.uv_repeat);
+        }
+        Shading {
+            albedo,
+            light: self.sky.ambient(s.normal),
+            cos: s.normal.dot(self.sky.sun_direction),
+        }
+    }
+
+    /// The shaded colour, with the sun where `lit` (its cosine positive, its ray unblocked).
+    #[inline]
+    fn shade_end(&self, sh: Shading, lit: bool) -> Vec3 {
+        let mut light = sh.light;
+        if lit {
+            light += self.sky.sun_irradiance * sh.cos;
+        }
+        sh.albedo * light
+    }
+}
+
+/// The pixels of one packet: a band's `rows` (counted from the band's first row, frame row
+/// `y`) × `columns`.
+struct Tile {
+    isa: Isa,
+    y: u32,
+    rows: std::ops::Range<u32>,
+    columns: std::ops::Range<u32>,
+}
+
+/// The AOVs of a pixel's centre sample (its colour is set after): the surface `hit` along
+/// the ray from `origin` in `dir`, or what the display shows there (`shown`), or the sky.
+fn sample_aovs(
+    job: &PixelJob,
+    origin: Vec3,
+    dir: Vec3,
+    hit: Option<SurfaceHit>,
+    shown: Option<Pixel>,
+) -> Pixel {
+    match (hit, shown) {
+        (_, Some(d)) => {
+            // The AOVs of what the display shows, measured from this eye.
+            let finite = d.position.is_finite();
+            Pixel {
+                depth: if finite {
+                    (d.position - origin).length()
+                } else {
+                    f32::INFINITY
+                },
+                camera_z: if finite {
+                    axial_depth(&job.camera_from_world, d.position)
+                } else {
+                    f32::INFINITY
+                },
+                ..d
             }
         }
-        albedo * light
+        (Some(s), None) => Pixel {
+            color: Vec3::ZERO,
+            depth: s.t,
+            camera_z: axial_depth(&job.camera_from_world, s.position),
+            position: s.position,
+            normal: s.normal,
+            object_id: s.object,
+            part_id: s.part,
+        },
+        // The sky direction travels with the pixel, as a world point does.
+        (None, None) => Pixel {
+            normal: -dir,
+            ..Pixel::SKY
+        },
     }
 }
 

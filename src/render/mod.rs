@@ -4,6 +4,7 @@
 pub mod accel;
 pub mod bvh;
 pub mod bvh_build;
+pub mod bvh_packet;
 pub mod camera_rays;
 pub mod cancel;
 pub mod footprint;
@@ -14,6 +15,7 @@ pub mod packets;
 pub mod ray;
 pub mod screen;
 pub mod settings;
+pub mod simd;
 pub mod sky;
 pub mod throughput;
 pub mod views;

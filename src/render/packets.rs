@@ -4,12 +4,30 @@
 //! The triangle test is obvhs' `RtTriangle::intersect` (Möller–Trumbore in the layout of
 //! madmann91's bvh), computed lane by lane with the same operations in the same order, so that
 //! it returns the same distance bit for bit: the brute-force twin in `tests/accel.rs` checks it.
+//!
+//! Which hit is the closest does not depend on the order the primitives are tested in
+//! ([`closer`]): the per-ray and the packet traversals (`render/bvh_packet.rs`) visit
+//! them in different orders and give the same primitive.
 
 use glam::Vec4;
 use obvhs::rt_triangle::RtTriangle;
 
 use crate::render::ray::TraceRay;
+
+/// No primitive found (yet): the closest-hit queries keep the primitive of the closest hit
+/// so far, this where there is none.
+pub const NO_PRIM: u32 = u32::MAX;
 use crate::scene::world::Ellipsoid;
+
+/// Whether a hit of primitive `prim` at distance `t` (in the ray's [tmin, tmax]) replaces the
+/// closest so far, `best` at `tmax` ([`NO_PRIM`]: none yet, `tmax` the ray's own): nearer,
+/// or as near and of a lower index. So the answer is the brute force's — the first primitive
+/// in world order among the nearest — whatever order the traversal tests them in; at a
+/// shared edge hit by a ray, both triangles can give the same distance.
+#[inline(always)]
+pub fn closer(t: f32, prim: u32, tmax: f32, best: u32) -> bool {
+    t < tmax || (t == tmax && best != NO_PRIM && prim < best)
+}
 
 /// Triangles per packet.
 pub const TRI_LANES: usize = 4;
@@ -18,11 +36,12 @@ pub const TRI_LANES: usize = 4;
 /// the unnormalised normal of [`RtTriangle`]; and each lane's primitive index.
 #[derive(Clone, Copy, Debug)]
 pub struct Triangles4 {
-    v0: [Vec4; 3],
-    e1: [Vec4; 3],
-    e2: [Vec4; 3],
-    ng: [Vec4; 3],
-    prim: [u32; TRI_LANES],
+    pub(crate) v0: [Vec4; 3],
+    pub(crate) e1: [Vec4; 3],
+    pub(crate) e2: [Vec4; 3],
+    pub(crate) ng: [Vec4; 3],
+    /// Primitive index of each lane; unused lanes repeat lane 0's.
+    pub(crate) prim: [u32; TRI_LANES],
 }
 
 impl Triangles4 {
@@ -81,21 +100,19 @@ impl Triangles4 {
 }
 
 impl Triangles4 {
-    /// If a lane's triangle is hit in [tmin, tmax), shrinks `ray.tmax` to the closest such
-    /// hit and returns its primitive index.
+    /// Where a lane's triangle is hit [`closer`] than `best` at `ray.tmax`, shrinks
+    /// `ray.tmax` to that hit and sets `best` to its primitive index.
     #[inline(always)]
-    pub fn closest(&self, ray: &mut TraceRay) -> Option<u32> {
+    pub fn closest(&self, ray: &mut TraceRay, best: &mut u32) {
         let (t, mut valid) = self.hits(ray);
-        let mut found = None;
         while valid != 0 {
             let lane = valid.trailing_zeros() as usize;
             valid &= valid - 1;
-            if t[lane] < ray.tmax {
+            if closer(t[lane], self.prim[lane], ray.tmax, *best) {
                 ray.tmax = t[lane];
-                found = Some(self.prim[lane]);
+                *best = self.prim[lane];
             }
         }
-        found
     }
 
     /// Whether any lane's triangle is hit in [tmin, tmax].
@@ -115,14 +132,16 @@ pub struct EllipsoidLeaf {
 impl EllipsoidLeaf {
     /// As [`Triangles4::closest`].
     #[inline]
-    pub fn closest(&self, ray: &mut TraceRay) -> Option<u32> {
+    pub fn closest(&self, ray: &mut TraceRay, best: &mut u32) {
         let t = self
             .ellipsoid
             .intersect(ray.origin, ray.dir, ray.tmin, ray.tmax);
-        (t < ray.tmax).then(|| {
+        // A miss is infinite: never closer than a finite tmax, and refused at an infinite one
+        // (`closer` takes a tie only where a hit was found).
+        if t.is_finite() && closer(t, self.prim, ray.tmax, *best) {
             ray.tmax = t;
-            self.prim
-        })
+            *best = self.prim;
+        }
     }
 
     #[inline]

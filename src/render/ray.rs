@@ -37,3 +37,10 @@ impl TraceRay {
         Ray::new(self.origin, self.dir, self.tmin, self.tmax)
     }
 }
+
+/// A closest-hit answer: which primitive of the world, at which distance (metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub prim: usize,
+    pub t: f32,
+}

@@ -1,0 +1,147 @@
+//! The instruction set the packet kernels run on, chosen at run time: the crate's only
+//! `unsafe` code.
+//!
+//! The kernels of [`crate::render::bvh_packet`] are safe, generic loops over `[f32; N]`. This
+//! module compiles them three times — for AVX-512 (16 lanes: one packet in one traversal),
+//! AVX2 (8 lanes: two half packets) and the target's baseline (4 lanes: SSE2 on x86-64, or
+//! any other architecture) — with `#[target_feature]`, and calls the best one the CPU has.
+//! Calling a `#[target_feature]` function is `unsafe` because running it on a CPU without
+//! those instructions is undefined behaviour; each call below is made only for an [`Isa`]
+//! that [`Isa::available`] confirmed with `is_x86_feature_detected!`, which every caller goes
+//! through ([`Isa::check`]). Nothing else here is unsafe: no pointers, no unchecked indexing.
+//!
+//! Every ISA gives every ray the same hit, bit for bit, as the per-ray traversal (its
+//! brute-force twin): `tests/accel.rs` runs each available ISA against it.
+#![allow(unsafe_code)]
+
+use std::sync::OnceLock;
+
+use crate::render::bvh::Bvh;
+use crate::render::bvh_packet::{self, PacketStack, RayPacket};
+
+/// An instruction set the packet kernels are compiled for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Isa {
+    /// AVX-512 (F, VL, BW, DQ): 16 lanes.
+    Avx512,
+    /// AVX2: 8 lanes.
+    Avx2,
+    /// The target's baseline (SSE2 on x86-64): 4 lanes.
+    Portable,
+}
+
+impl Isa {
+    pub const ALL: [Isa; 3] = [Isa::Avx512, Isa::Avx2, Isa::Portable];
+
+    /// Whether this CPU runs the kernels of `self`.
+    pub fn available(self) -> bool {
+        match self {
+            Isa::Portable => true,
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => {
+                std::arch::is_x86_feature_detected!("avx512f")
+                    && std::arch::is_x86_feature_detected!("avx512vl")
+                    && std::arch::is_x86_feature_detected!("avx512bw")
+                    && std::arch::is_x86_feature_detected!("avx512dq")
+                    && std::arch::is_x86_feature_detected!("avx2")
+            }
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
+            #[cfg(not(target_arch = "x86_64"))]
+            _ => false,
+        }
+    }
+
+    /// The widest available ISA (detected once).
+    pub fn best() -> Isa {
+        static BEST: OnceLock<Isa> = OnceLock::new();
+        *BEST.get_or_init(|| {
+            Isa::ALL
+                .into_iter()
+                .find(|isa| isa.available())
+                .unwrap_or(Isa::Portable)
+        })
+    }
+
+    /// Rays per traversal.
+    pub fn lanes(self) -> usize {
+        match self {
+            Isa::Avx512 => 16,
+            Isa::Avx2 => 8,
+            Isa::Portable => 4,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Isa::Avx512 => "avx512",
+            Isa::Avx2 => "avx2",
+            Isa::Portable => "portable",
+        }
+    }
+
+    /// `self` where this CPU has it, else the portable kernels.
+    #[inline]
+    fn check(self) -> Isa {
+        match self {
+            Isa::Portable => Isa::Portable,
+            _ if self == Isa::best() || self.available() => self,
+            _ => Isa::Portable,
+        }
+    }
+}
+
+/// [`bvh_packet::closest`] on `isa`'s kernels (the portable ones where the CPU lacks `isa`).
+#[inline]
+pub fn closest(isa: Isa, bvh: &Bvh, packet: &mut RayPacket, stack: &mut PacketStack) {
+    match isa.check() {
+        // SAFETY: `check` returned the ISA only because this CPU has its features.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { x86::closest_avx512(bvh, packet, stack) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { x86::closest_avx2(bvh, packet, stack) },
+        _ => bvh_packet::closest::<4>(bvh, packet, stack),
+    }
+}
+
+/// [`bvh_packet::any`] on `isa`'s kernels (the portable ones where the CPU lacks `isa`).
+#[inline]
+pub fn any(isa: Isa, bvh: &Bvh, packet: &RayPacket, stack: &mut PacketStack) -> u32 {
+    match isa.check() {
+        // SAFETY: `check` returned the ISA only because this CPU has its features.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { x86::any_avx512(bvh, packet, stack) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { x86::any_avx2(bvh, packet, stack) },
+        _ => bvh_packet::any::<4>(bvh, packet, stack),
+    }
+}
+
+/// The kernels compiled per ISA (no fused multiply-add: `fma` is not enabled, and Rust
+/// never fuses a multiply and an add on its own, so every lane rounds as the per-ray path).
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use super::*;
+
+    #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx2,avx,bmi1,bmi2,lzcnt,popcnt")]
+    pub(super) fn closest_avx512(bvh: &Bvh, packet: &mut RayPacket, stack: &mut PacketStack) {
+        bvh_packet::closest::<16>(bvh, packet, stack)
+    }
+
+    #[target_feature(enable = "avx2,avx,bmi1,bmi2,lzcnt,popcnt")]
+    pub(super) fn closest_avx2(bvh: &Bvh, packet: &mut RayPacket, stack: &mut PacketStack) {
+        bvh_packet::closest::<8>(bvh, packet, stack)
+    }
+
+    #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx2,avx,bmi1,bmi2,lzcnt,popcnt")]
+    pub(super) fn any_avx512(bvh: &Bvh, packet: &RayPacket, stack: &mut PacketStack) -> u32 {
+        bvh_packet::any::<16>(bvh, packet, stack)
+    }
+
+    #[target_feature(enable = "avx2,avx,bmi1,bmi2,lzcnt,popcnt")]
+    pub(super) fn any_avx2(bvh: &Bvh, packet: &RayPacket, stack: &mut PacketStack) -> u32 {
+        bvh_packet::any::<8>(bvh, packet, stack)
+    }
+}
