@@ -101,14 +101,16 @@ fn obj_inputs_found_by_fuzzing_are_refused_naming_the_line_and_in_time() {
 #[test]
 fn display_map_inputs_found_by_fuzzing_are_refused_in_one_line() {
     // (2³², 2³², 2) multiplied to 2⁶⁴ pixels: a panic with overflow checks, and without them
-    // the count wrapped to 0, which passed the size check and read as an empty 0×0 map.
+    // the count wrapped to 0, which passed the size check and read as an empty 0×0 map. A
+    // shape holding a line break and NULs was echoed raw by the "not a tuple" message.
     for (path, bytes) in inputs("display_map") {
         let shown = match seethru::io::display_map::parse_npy(&bytes) {
             Ok(m) => panic!("{}: read as a {}×{} map", path.display(), m.width, m.height),
             Err(e) => format!("{e:#}"),
         };
         assert!(
-            !shown.contains('\n') && shown.contains("pixels"),
+            !shown.chars().any(char::is_control)
+                && (shown.contains("pixels") || shown.contains("is not a tuple of integers")),
             "{}: {shown}",
             path.display()
         );
@@ -162,6 +164,45 @@ fn expectation_files_echoing_a_line_break_are_refused_in_one_line() {
         assert!(
             shown.starts_with(&format!("{}:", path.display()))
                 && !shown.contains(['\n', '\r', '\u{1b}'])
+                && shown.contains("\\n"),
+            "{}: {shown}",
+            path.display()
+        );
+    }
+}
+
+#[test]
+fn head_paths_echoing_a_line_break_are_refused_in_one_line() {
+    // A quoted CSV field holding a line break (and a NUL) was echoed raw by the "must be a
+    // finite number" message: two lines, and a control character on the terminal.
+    for (path, bytes) in inputs("head_path") {
+        let shown = match seethru::scene::head_path::HeadPath::parse(&bytes, "path.csv") {
+            Ok(p) => panic!("{}: read as {} samples", path.display(), p.samples.len()),
+            Err(e) => format!("{e:#}"),
+        };
+        assert!(
+            shown.starts_with("path.csv:1: `x` must be a finite number")
+                && !shown.chars().any(char::is_control)
+                && shown.contains("\\n"),
+            "{}: {shown}",
+            path.display()
+        );
+    }
+}
+
+#[test]
+fn scenes_echoing_a_line_break_are_refused_in_one_line() {
+    // A choice (`kind = "pla\ne"`) was echoed raw by "is not one of": two lines.
+    for (path, bytes) in inputs("scene") {
+        let text = String::from_utf8(bytes).unwrap();
+        let file = seethru::scene::source::SourceFile::from_text(Path::new("scene.toml"), text);
+        let shown = match seethru::scene::Scene::from_source(&file) {
+            Ok(_) => panic!("{}: accepted", path.display()),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            shown.starts_with("scene.toml:")
+                && !shown.chars().any(char::is_control)
                 && shown.contains("\\n"),
             "{}: {shown}",
             path.display()

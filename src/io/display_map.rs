@@ -13,6 +13,8 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 use exr::prelude::*;
 
+use crate::util::message::printable;
+
 /// A map as read: width, height, and row-major (x, y) per pixel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MapFile {
@@ -122,6 +124,8 @@ pub fn parse_npy(bytes: &[u8]) -> Result<MapFile> {
         _ => bail!("the .npy header has no fortran_order True/False"),
     };
     let shape_text = dict_value(header, "shape").context("the .npy header has no 'shape'")?;
+    // The header's text is echoed in messages: its line breaks and escapes shown, not obeyed.
+    let (shape_shown, descr_shown) = (printable(&shape_text), printable(descr));
     let shape: Vec<u64> = shape_text
         .trim_matches(|c| c == '(' || c == ')')
         .split(',')
@@ -129,24 +133,24 @@ pub fn parse_npy(bytes: &[u8]) -> Result<MapFile> {
         .filter(|s| !s.is_empty())
         .map(|s| s.parse::<u64>())
         .collect::<Result<_, _>>()
-        .with_context(|| format!("the .npy shape {shape_text} is not a tuple of integers"))?;
+        .with_context(|| format!("the .npy shape {shape_shown} is not a tuple of integers"))?;
     let (elem, big) = match descr {
         "<f4" | "=f4" => (4, false),
         ">f4" => (4, true),
         "<f8" | "=f8" => (8, false),
         ">f8" => (8, true),
         _ => bail!(
-            "the map's dtype is {descr}: float32 or float64 expected (numpy: map.astype(np.float32))"
+            "the map's dtype is {descr_shown}: float32 or float64 expected (numpy: map.astype(np.float32))"
         ),
     };
     let [h, w, c] = shape[..] else {
         bail!(
-            "the map has shape {shape_text}: (display height, display width, 2) expected, with [..., 0] = x and [..., 1] = y"
+            "the map has shape {shape_shown}: (display height, display width, 2) expected, with [..., 0] = x and [..., 1] = y"
         );
     };
     if c != 2 {
         bail!(
-            "the map has {c} channels (shape {shape_text}): 2 expected, [..., 0] = x and [..., 1] = y"
+            "the map has {c} channels (shape {shape_shown}): 2 expected, [..., 0] = x and [..., 1] = y"
         );
     }
     if w == 0 || h == 0 || w.saturating_mul(h) > MAX_MAP_PIXELS {
@@ -156,7 +160,7 @@ pub fn parse_npy(bytes: &[u8]) -> Result<MapFile> {
     let count = (w * h * 2) as usize;
     if data.len() != count * elem {
         bail!(
-            "the .npy data holds {} bytes, its shape {shape_text} of {descr} needs {}",
+            "the .npy data holds {} bytes, its shape {shape_shown} of {descr_shown} needs {}",
             data.len(),
             count * elem
         );

@@ -59,8 +59,10 @@ impl HeadPath {
                 let field = &record[k];
                 values[k] = match field.parse::<f64>() {
                     Ok(v) if v.is_finite() && v.abs() <= 1e6 => v,
+                    // A quoted field may hold line breaks and escapes: shown, not obeyed.
                     _ => bail!(
-                        "{name}:{line}: `{column}` must be a finite number in [-1000000, 1000000], got `{field}`"
+                        "{name}:{line}: `{column}` must be a finite number in [-1000000, 1000000], got `{}`",
+                        crate::util::message::printable(field)
                     ),
                 };
             }

@@ -12,6 +12,7 @@ use toml_edit::{ImDocument, Item, TableLike};
 
 use crate::scene::limits::{MAX_COORDINATE, MAX_PIXELS, MAX_RESOLUTION};
 use crate::scene::source::{SceneError, SourceFile};
+use crate::util::message::controls_escaped;
 use crate::util::number::{short, short_list};
 
 /// A string of a TOML array and its byte span in the file.
@@ -70,12 +71,14 @@ impl<'a> TableReader<'a> {
         key: String,
         message: impl Into<String>,
     ) -> SceneError {
+        // Keys and messages echo the file's text (a choice, a key name), which may hold a
+        // TOML `\n` or an escape: shown, not obeyed, so that the error stays one line.
         SceneError {
             path: self.file.path.clone(),
             line: at.map(|a| a.0),
             column: at.map(|a| a.1),
-            key,
-            message: message.into(),
+            key: controls_escaped(&key),
+            message: controls_escaped(&message.into()),
         }
     }
 

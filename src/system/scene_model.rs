@@ -239,4 +239,111 @@ mod tests {
         assert_eq!(pixels[13].depth, 4.0);
         assert_eq!(pixels[12].depth, 4.0);
     }
+
+    /// The fill as the doc comment states it, written out on (x, y) with signed coordinates:
+    /// a brute-force twin of `inpaint` for any hole pattern.
+    fn inpaint_by_layers(pixels: &[Pixel], holes: &[bool], width: usize) -> Vec<Pixel> {
+        let height = pixels.len() / width;
+        let mut out = pixels.to_vec();
+        let mut known: Vec<Vec<bool>> = (0..height)
+            .map(|y| (0..width).map(|x| !holes[y * width + x]).collect())
+            .collect();
+        loop {
+            let mut layer = Vec::new();
+            for y in 0..height as i64 {
+                for x in 0..width as i64 {
+                    if known[y as usize][x as usize] {
+                        continue;
+                    }
+                    let mut around: Vec<Pixel> = Vec::new();
+                    for (nx, ny) in [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)] {
+                        let inside =
+                            (0..width as i64).contains(&nx) && (0..height as i64).contains(&ny);
+                        if inside && known[ny as usize][nx as usize] {
+                            let q = out[ny as usize * width + nx as usize];
+                            if q.object_id != MISSING_ID {
+                                around.push(q);
+                            }
+                        }
+                    }
+                    if around.is_empty() {
+                        continue;
+                    }
+                    let mut p = around[0];
+                    for q in &around {
+                        if q.depth > p.depth {
+                            p = *q;
+                        }
+                    }
+                    let mut sum = glam::Vec3::ZERO;
+                    for q in &around {
+                        sum += q.color;
+                    }
+                    p.color = sum / around.len() as f32;
+                    layer.push((y as usize * width + x as usize, p));
+                }
+            }
+            if layer.is_empty() {
+                return out;
+            }
+            for (i, p) in layer {
+                out[i] = p;
+                known[i / width][i % width] = true;
+            }
+        }
+    }
+
+    #[test]
+    fn inpainting_equals_its_twin_at_the_borders_and_beside_pixels_outside_the_frontal_image() {
+        // 7 × 5, holes (H) on every border and in two corners, known pixels outside the
+        // frontal image (O, MISSING_ID) beside holes, and a hole (h) walled in by those that
+        // no known pixel reaches:
+        //   H H . . . O H
+        //   H . . O . . H
+        //   . . H H O O O
+        //   . O . H O h O
+        //   H . . . . O O
+        let rows = ["HH...OH", "H..O..H", "..HHOOO", ".O.HOhO", "H....OO"];
+        let width = 7;
+        let mut pixels = Vec::new();
+        let mut holes = Vec::new();
+        for (y, row) in rows.iter().enumerate() {
+            for (x, c) in row.chars().enumerate() {
+                let i = (y * width + x) as f32;
+                // Distinct colours and depths: a neighbour taken from the wrong place, or a
+                // farthest one chosen wrongly, shows.
+                let known = Pixel {
+                    color: glam::Vec3::new(i, 2.0 * i + 1.0, 35.0 - i),
+                    depth: 1.0 + ((7 * y + 3 * x) % 11) as f32 + 0.01 * i,
+                    object_id: 1 + (x + y) as u32,
+                    ..Pixel::SKY
+                };
+                pixels.push(match c {
+                    '.' => known,
+                    _ => blank(),
+                });
+                holes.push(matches!(c, 'H' | 'h'));
+            }
+        }
+        let expected = inpaint_by_layers(&pixels, &holes, width);
+        inpaint(&mut pixels, &holes, width);
+        for (i, (got, want)) in pixels.iter().zip(&expected).enumerate() {
+            assert_eq!(got.object_id, want.object_id, "pixel {i}");
+            assert_eq!(got.depth, want.depth, "pixel {i}");
+            assert!(
+                (got.color - want.color).abs().max_element() < 1e-5,
+                "pixel {i}: {} vs {}",
+                got.color,
+                want.color
+            );
+        }
+        // Every hole a known pixel reaches is filled; the walled-in one stays blank, as do
+        // the pixels outside the frontal image.
+        let layout: String = rows.concat();
+        for (i, c) in layout.chars().enumerate() {
+            let blank_after = matches!(c, 'O' | 'h');
+            assert_eq!(pixels[i].object_id == MISSING_ID, blank_after, "pixel {i}");
+            assert_eq!(pixels[i].depth.is_finite(), !blank_after, "pixel {i}");
+        }
+    }
 }

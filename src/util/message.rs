@@ -8,8 +8,12 @@ use crate::util::number::clip_long_numbers;
 /// no longer splits the message, an escape sequence no longer reaches the terminal) and
 /// every overlong number clipped.
 pub fn printable(text: &str) -> String {
-    let escaped: String = text
-        .chars()
+    clip_long_numbers(&controls_escaped(text))
+}
+
+/// `text` with every control character escaped (`\n`, `\u{1b}`), nothing else changed.
+pub fn controls_escaped(text: &str) -> String {
+    text.chars()
         .flat_map(|c| {
             let shown: Vec<char> = if c.is_control() {
                 c.escape_default().collect()
@@ -18,8 +22,7 @@ pub fn printable(text: &str) -> String {
             };
             shown
         })
-        .collect();
-    clip_long_numbers(&escaped)
+        .collect()
 }
 
 /// An error and its causes as one line, `outer: inner: …`, each cause said once: a cause
