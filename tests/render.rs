@@ -244,7 +244,7 @@ fn on_threads<T: Send>(threads: usize, job: impl FnOnce() -> T + Send) -> T {
 
 #[test]
 fn packets_render_every_view_as_the_per_ray_path_does_on_every_isa_and_thread_count() {
-    use seethru::system::display::{DisplayModel, DisplayPlacement, DisplaySurface};
+    use seethru::system::display::{DisplayModel, DisplayPlacement, DisplaySurface, IdealMap};
     use seethru::system::{options::RunOptions, pipeline::run};
     let ctx = RenderContext::new(common::das()).unwrap();
     // Sizes that cut the last tiles of a band; three samples per pixel.
@@ -290,10 +290,12 @@ fn packets_render_every_view_as_the_per_ray_path_does_on_every_isa_and_thread_co
                 placement,
             },
             DisplayModel::Ideal => DisplaySurface::Ideal {
-                crop: r.crop,
+                map: IdealMap::Crop {
+                    crop: r.crop,
+                    lens: None,
+                },
                 frontal,
                 placement,
-                lens: None,
             },
         };
         let driver = ctx.scene.driver.with_resolution(70, 41);
