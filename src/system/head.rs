@@ -221,24 +221,30 @@ pub struct InRegion {
     pub whole: bool,
 }
 
-/// The detection from the pixels of `region` only (the others read as black, not skin), and
-/// the rectangle of pixels it depended on (see [`detect_in`]).
-fn detect_with(
-    frame: &Frame,
-    region: PixelRect,
-) -> Result<(FaceDetection, PixelRect), DetectError> {
-    let (w, h) = (frame.width as usize, frame.height as usize);
-    let region = Rect::of(region, w, h);
-    let mut rgb: Vec<[u8; 3]> = vec![[0; 3]; w * h];
-    let mut skin: Vec<bool> = vec![false; w * h];
-    for y in region.y0..region.y1 {
-        for i in y * w + region.x0..y * w + region.x1 {
-            rgb[i] = encode_srgb8(frame.color[i]);
-            skin[i] = is_skin(rgb[i]);
-        }
-    }
-    // The face: the largest skin region.
-    let face = components(&skin, w, h, region)
+/// The face and the box its pupils are searched in, as both detectors find them.
+pub(crate) struct FaceRegion {
+    /// The face's pixels (the largest skin region, at least 20), image indices.
+    pub face: Vec<usize>,
+    /// The face's bounding box, [x0, y0, x1, y1), pixels.
+    pub face_box: [u32; 4],
+    /// The face's median luminance (sRGB 8-bit scale).
+    pub face_lum: f32,
+    /// The pupil search box: the face box grown by an eighth of its size (at least 2 px; an
+    /// eye near the silhouette may touch the background), within the image, [x0, y0, x1, y1).
+    pub search: [usize; 4],
+    /// The search box's pixels (row by row within it) darker than 0.3 × `face_lum`.
+    pub dark: Vec<bool>,
+}
+
+/// [`FaceRegion`] of an image's sRGB pixels and skin mask, from the pixels of `region`.
+pub(crate) fn face_region(
+    rgb: &[[u8; 3]],
+    skin: &[bool],
+    w: usize,
+    h: usize,
+    region: Rect,
+) -> Result<FaceRegion, DetectError> {
+    let face = components(skin, w, h, region)
         .into_iter()
         .max_by_key(Vec::len)
         .filter(|c| c.len() >= 20)
@@ -258,32 +264,37 @@ fn detect_with(
         l.sort_by(f32::total_cmp);
         l[l.len() / 2]
     };
-    // Pupil candidates: small, very dark blobs inside the face box grown by a margin (an eye
-    // near the silhouette may touch the background), not touching that box's border. Hair
-    // is dark too, but large: blobs over 3% of the face are not pupils.
     let margin = ((x1 - x0).max(y1 - y0) / 8).max(2);
-    let (x0, y0, x1, y1) = (
+    let search = [
         x0.saturating_sub(margin),
         y0.saturating_sub(margin),
         (x1 + margin).min(w),
         (y1 + margin).min(h),
-    );
-    let (bw, bh) = (x1 - x0, y1 - y0);
-    let dark: Vec<bool> = (0..bw * bh)
-        .map(|k| luminance(rgb[(y0 + k / bw) * w + x0 + k % bw]) < 0.3 * face_lum)
+    ];
+    let [bx0, by0, bx1, by1] = search;
+    let bw = bx1 - bx0;
+    let dark = (0..bw * (by1 - by0))
+        .map(|k| luminance(rgb[(by0 + k / bw) * w + bx0 + k % bw]) < 0.3 * face_lum)
         .collect();
-    let max_area = (face.len() / 33).max(4);
-    let whole = Rect::whole(bw, bh);
-    // What the detection reads: the pupil search box, and two pixels beyond it for the
-    // rings of the centroids (a blob stays a pixel inside the box, its rim one more, the
-    // ring two more), within the image.
-    let mut used = Rect {
-        x0: x0.saturating_sub(2),
-        y0: y0.saturating_sub(2),
-        x1: (x1 + 2).min(w),
-        y1: (y1 + 2).min(h),
-    };
-    let mut holes: Vec<Vec<usize>> = components(&dark, bw, bh, whole)
+    Ok(FaceRegion {
+        face,
+        face_box,
+        face_lum,
+        search,
+        dark,
+    })
+}
+
+/// The dark blobs of a search box (`dark`, as in [`FaceRegion`]) of at most `max_area`
+/// pixels that do not touch the box's border, as image pixel indices (`w`: image width).
+pub(crate) fn inner_blobs(
+    dark: &[bool],
+    [x0, y0, x1, y1]: [usize; 4],
+    w: usize,
+    max_area: usize,
+) -> Vec<Vec<usize>> {
+    let (bw, bh) = (x1 - x0, y1 - y0);
+    components(dark, bw, bh, Rect::whole(bw, bh))
         .into_iter()
         .filter(|c| {
             c.len() <= max_area
@@ -293,9 +304,47 @@ fn detect_with(
         .map(|c| {
             c.into_iter()
                 .map(|k| (y0 + k / bw) * w + x0 + k % bw)
-                .collect::<Vec<_>>()
+                .collect()
         })
-        .collect();
+        .collect()
+}
+
+/// The detection from the pixels of `region` only (the others read as black, not skin), and
+/// the rectangle of pixels it depended on (see [`detect_in`]).
+fn detect_with(
+    frame: &Frame,
+    region: PixelRect,
+) -> Result<(FaceDetection, PixelRect), DetectError> {
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let region = Rect::of(region, w, h);
+    let mut rgb: Vec<[u8; 3]> = vec![[0; 3]; w * h];
+    let mut skin: Vec<bool> = vec![false; w * h];
+    for y in region.y0..region.y1 {
+        for i in y * w + region.x0..y * w + region.x1 {
+            rgb[i] = encode_srgb8(frame.color[i]);
+            skin[i] = is_skin(rgb[i]);
+        }
+    }
+    let FaceRegion {
+        face,
+        face_box,
+        face_lum,
+        search: [x0, y0, x1, y1],
+        dark,
+    } = face_region(&rgb, &skin, w, h, region)?;
+    // Pupil candidates: small, very dark blobs inside the search box. Hair is dark too, but
+    // large: blobs over 3% of the face are not pupils.
+    let max_area = (face.len() / 33).max(4);
+    // What the detection reads: the pupil search box, and two pixels beyond it for the
+    // rings of the centroids (a blob stays a pixel inside the box, its rim one more, the
+    // ring two more), within the image.
+    let mut used = Rect {
+        x0: x0.saturating_sub(2),
+        y0: y0.saturating_sub(2),
+        x1: (x1 + 2).min(w),
+        y1: (y1 + 2).min(h),
+    };
+    let mut holes: Vec<Vec<usize>> = inner_blobs(&dark, [x0, y0, x1, y1], w, max_area);
     holes.sort_by_key(|c| std::cmp::Reverse(c.len()));
     if holes.len() < 2 {
         return Err(DetectError::Pupils(holes.len()));

@@ -12,8 +12,8 @@ use glam::DVec2;
 
 use crate::render::frame::Frame;
 use crate::system::head::{
-    DetectError, FaceDetection, HeadConfidence, OUTLINE_CANDIDATES, Rect, components, is_skin,
-    luminance, pupil_centroid,
+    DetectError, FaceDetection, FaceRegion, HeadConfidence, OUTLINE_CANDIDATES, Rect, face_region,
+    inner_blobs, is_skin, luminance, pupil_centroid,
 };
 use crate::util::color::encode_srgb8;
 
@@ -44,52 +44,19 @@ pub fn detect_turned(frame: &Frame) -> Result<FaceDetection, DetectError> {
     let (w, h) = (frame.width as usize, frame.height as usize);
     let rgb: Vec<[u8; 3]> = frame.color.iter().map(|&c| encode_srgb8(c)).collect();
     let skin: Vec<bool> = rgb.iter().map(|&c| is_skin(c)).collect();
-    let face = components(&skin, w, h, Rect::whole(w, h))
-        .into_iter()
-        .max_by_key(Vec::len)
-        .filter(|c| c.len() >= 20)
-        .ok_or(DetectError::NoFace)?;
-    let (mut x0, mut y0, mut x1, mut y1) = (w, h, 0, 0);
-    for &i in &face {
-        (x0, y0, x1, y1) = (
-            x0.min(i % w),
-            y0.min(i / w),
-            x1.max(i % w + 1),
-            y1.max(i / w + 1),
-        );
-    }
-    let face_box = [x0 as u32, y0 as u32, x1 as u32, y1 as u32];
-    let face_w = (x1 - x0) as f64;
-    let face_lum = {
-        let mut l: Vec<f32> = face.iter().map(|&i| luminance(rgb[i])).collect();
-        l.sort_by(f32::total_cmp);
-        l[l.len() / 2]
-    };
-    let margin = ((x1 - x0).max(y1 - y0) / 8).max(2);
-    let (bx0, by0, bx1, by1) = (
-        x0.saturating_sub(margin),
-        y0.saturating_sub(margin),
-        (x1 + margin).min(w),
-        (y1 + margin).min(h),
-    );
-    let (bw, bh) = (bx1 - bx0, by1 - by0);
-    let dark: Vec<bool> = (0..bw * bh)
-        .map(|k| luminance(rgb[(by0 + k / bw) * w + bx0 + k % bw]) < 0.3 * face_lum)
-        .collect();
+    let FaceRegion {
+        face_box,
+        face_lum,
+        search,
+        dark,
+        ..
+    } = face_region(&rgb, &skin, w, h, Rect::whole(w, h))?;
+    let face_w = f64::from(face_box[2] - face_box[0]);
     let iris_max = ((0.15 * face_w).powi(2) as usize).max(4);
     let radius = (0.08 * face_w).max(2.5);
-    let mut candidates: Vec<Candidate> = components(&dark, bw, bh, Rect::whole(bw, bh))
+    let mut candidates: Vec<Candidate> = inner_blobs(&dark, search, w, iris_max)
         .into_iter()
-        .filter(|c| {
-            c.len() <= iris_max
-                && c.iter()
-                    .all(|&k| k % bw > 0 && k % bw + 1 < bw && k / bw > 0 && k / bw + 1 < bh)
-        })
-        .map(|c| {
-            let pixels: Vec<usize> = c
-                .into_iter()
-                .map(|k| (by0 + k / bw) * w + bx0 + k % bw)
-                .collect();
+        .map(|pixels| {
             let centre = pixels.iter().fold(DVec2::ZERO, |a, &i| {
                 a + DVec2::new((i % w) as f64 + 0.5, (i / w) as f64 + 0.5)
             }) / pixels.len() as f64;
