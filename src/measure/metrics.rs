@@ -18,7 +18,7 @@ use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
 use crate::scene::world::view_bit;
-use crate::system::display::MISSING_ID;
+use crate::system::display::{DisplayPlacement, MISSING_ID};
 use crate::util::color::encode_srgb8;
 
 /// Per-pixel results over the driver's view (NaN / false outside the display region).
@@ -255,7 +255,7 @@ pub fn measure(
     let [truth, seethru, occluded] = frames;
     let (w, h) = (truth.width as usize, truth.height as usize);
     let obstacle = &scene.obstacle;
-    let placement = crate::system::display::DisplayPlacement::new(obstacle);
+    let placement = DisplayPlacement::new(obstacle);
     let [dw, dh] = obstacle.display_resolution;
     let display: Vec<bool> = occluded
         .object_id

@@ -88,26 +88,31 @@ pub fn camera_batch(camera: &Camera, view: u8) -> Batch {
 /// Closest hits of `batch` into `out` (same length), [`PACKET`] consecutive rays at a time
 /// on `isa`'s packet kernels.
 pub fn trace_closest(accel: &Accel, batch: &Batch, isa: Isa, out: &mut [Option<Hit>]) {
-    batch
-        .rays
-        .par_chunks(CHUNK)
-        .zip(out.par_chunks_mut(CHUNK))
-        .for_each_init(PacketStack::new, |stack, (rays, out)| {
-            for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
-                let mut packet = RayPacket::new();
-                for (lane, ray) in rays.iter().enumerate() {
-                    packet.set(lane, &ray.ray());
-                }
-                accel.closest_packet(&mut packet, batch.view, isa, stack);
-                for (lane, out) in out.iter_mut().enumerate() {
-                    *out = packet.hit(lane);
-                }
-            }
-        });
+    by_packets(batch, out, |packet, stack, out| {
+        accel.closest_packet(packet, batch.view, isa, stack);
+        for (lane, out) in out.iter_mut().enumerate() {
+            *out = packet.hit(lane);
+        }
+    });
 }
 
 /// Whether each ray of `batch` is blocked, into `out` (same length), as [`trace_closest`].
 pub fn trace_any(accel: &Accel, batch: &Batch, isa: Isa, out: &mut [bool]) {
+    by_packets(batch, out, |packet, stack, out| {
+        let blocked = accel.occluded_packet(packet, batch.view, isa, stack);
+        for (lane, out) in out.iter_mut().enumerate() {
+            *out = blocked >> lane & 1 != 0;
+        }
+    });
+}
+
+/// Calls `trace` on each run of [`PACKET`] consecutive rays of `batch`, packed, with the
+/// matching run of `out`; chunks of [`CHUNK`] rays go to the worker threads.
+fn by_packets<T: Send>(
+    batch: &Batch,
+    out: &mut [T],
+    trace: impl Fn(&mut RayPacket, &mut PacketStack, &mut [T]) + Sync,
+) {
     batch
         .rays
         .par_chunks(CHUNK)
@@ -118,10 +123,7 @@ pub fn trace_any(accel: &Accel, batch: &Batch, isa: Isa, out: &mut [bool]) {
                 for (lane, ray) in rays.iter().enumerate() {
                     packet.set(lane, &ray.ray());
                 }
-                let blocked = accel.occluded_packet(&packet, batch.view, isa, stack);
-                for (lane, out) in out.iter_mut().enumerate() {
-                    *out = blocked >> lane & 1 != 0;
-                }
+                trace(&mut packet, stack, out);
             }
         });
 }
