@@ -179,14 +179,7 @@ fn window(system: &SystemLoop) -> PixelRect {
         }));
     }
     let camera = system.rig.base.driver;
-    let r = r.unwrap_or(PixelRect::full(&camera));
-    let (gx, gy) = ((r.x1 - r.x0) / 5 + 2, (r.y1 - r.y0) / 5 + 2);
-    PixelRect {
-        x0: r.x0.saturating_sub(gx),
-        y0: r.y0.saturating_sub(gy),
-        x1: (r.x1 + gx).min(camera.width),
-        y1: (r.y1 + gy).min(camera.height),
-    }
+    r.unwrap_or(PixelRect::full(&camera)).grown(5, 2, &camera)
 }
 
 /// Runs and measures a sequence; `on_frame` gets every measured frame's images in order.

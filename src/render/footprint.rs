@@ -16,6 +16,21 @@ pub struct PixelRect {
 }
 
 impl PixelRect {
+    /// The rectangle grown on each side by its size / `divisor` plus `extra` pixels (each
+    /// axis on its own), within the image of `camera`.
+    pub fn grown(self, divisor: u32, extra: u32, camera: &Camera) -> PixelRect {
+        let (gx, gy) = (
+            (self.x1 - self.x0) / divisor + extra,
+            (self.y1 - self.y0) / divisor + extra,
+        );
+        PixelRect {
+            x0: self.x0.saturating_sub(gx),
+            y0: self.y0.saturating_sub(gy),
+            x1: (self.x1 + gx).min(camera.width),
+            y1: (self.y1 + gy).min(camera.height),
+        }
+    }
+
     /// Every pixel of `camera`.
     pub fn full(camera: &Camera) -> PixelRect {
         PixelRect {

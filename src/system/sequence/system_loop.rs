@@ -602,18 +602,8 @@ impl BackTracker {
                 }
             }
         };
-        self.region = Some(grow_region(found.used, &back));
+        // The next search: the pixels used, grown by a quarter of their size and 4 px a side.
+        self.region = Some(found.used.grown(4, 4, &back));
         (Ok(found.detection), pixels)
-    }
-}
-
-/// `r` grown by a quarter of its size and 4 px on each side, within the image of `camera`.
-fn grow_region(r: PixelRect, camera: &Camera) -> PixelRect {
-    let (gx, gy) = ((r.x1 - r.x0) / 4 + 4, (r.y1 - r.y0) / 4 + 4);
-    PixelRect {
-        x0: r.x0.saturating_sub(gx),
-        y0: r.y0.saturating_sub(gy),
-        x1: (r.x1 + gx).min(camera.width),
-        y1: (r.y1 + gy).min(camera.height),
     }
 }
