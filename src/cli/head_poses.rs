@@ -1,12 +1,13 @@
 //! `seethru head-poses`: the head tracker against the true eye over a grid of head poses
 //! (yaw, pitch, distance), the error distribution of the frontal equations and of the yaw
-//! fit as one Markdown table on stdout.
+//! fit as one Markdown table on stdout, and the fit's time per frame on stderr.
 
 use std::path::PathBuf;
 
 use anyhow::Result;
-use seethru::measure::head_poses::{pose_grid, pose_table};
+use seethru::measure::head_poses::{fit_time_line, pose_grid, pose_table};
 use seethru::scene::Scene;
+use seethru::system::head_pose::prepare_fit;
 
 use crate::cli::args::{pixels, real, threads, with_threads};
 
@@ -38,6 +39,9 @@ pub struct HeadPoses {
 impl HeadPoses {
     pub fn run(self) -> Result<()> {
         let scene = Scene::load(&self.scene)?;
+        let started = std::time::Instant::now();
+        prepare_fit();
+        let setup_s = started.elapsed().as_secs_f64();
         let results = with_threads(self.threads, || {
             pose_grid(
                 &scene,
@@ -48,6 +52,9 @@ impl HeadPoses {
             )
         })??;
         print!("{}", pose_table(&results));
+        if let Some(line) = fit_time_line(&results, setup_s) {
+            seethru::util::progress::summary(line);
+        }
         Ok(())
     }
 }

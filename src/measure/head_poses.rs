@@ -5,9 +5,13 @@
 //! eye estimated by the paper's frontal equations (eqs. d1, b_h) and by the yaw fit.
 //! Poses where no face or no two pupils are found are counted, never dropped silently.
 
+use std::time::Instant;
+
 use anyhow::Result;
 use glam::{DAffine3, DVec3};
 
+use crate::geometry::camera::Camera;
+use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::render::settings::RenderSettings;
 use crate::render::views::View;
@@ -36,18 +40,19 @@ pub struct PoseResult {
     pub frontal_confidence: Option<f64>,
     /// The fitted yaw from facing the back camera, degrees.
     pub fitted_yaw_deg: Option<f64>,
+    /// Fitted minus true yaw about the world's vertical, degrees (`None`: no detection).
+    pub yaw_error_deg: Option<f64>,
+    /// The true eye and the fitted one, world frame, metres.
+    pub eye_m: [f64; 3],
+    pub fitted_eye_m: Option<[f64; 3]>,
+    /// Wall time of the fit (`detect_turned` and `locate`) on one thread, seconds; a
+    /// measurement, not deterministic.
+    pub fit_s: f64,
 }
 
-/// The grid: every yaw × pitch × distance scale (the scene's eye distance from the back
-/// camera times the scale); the back camera `back_width` pixels wide.
-pub fn pose_grid(
-    scene: &Scene,
-    yaws: &[f64],
-    pitches: &[f64],
-    distance_scales: &[f64],
-    back_width: Option<u32>,
-) -> Result<Vec<PoseResult>> {
-    let back = match back_width {
+/// The back camera of a pose grid: the scene's, `back_width` pixels wide (aspect kept).
+pub fn grid_camera(scene: &Scene, back_width: Option<u32>) -> Camera {
+    match back_width {
         Some(w) => {
             let h = ((w as f64 * scene.back.height as f64 / scene.back.width as f64).round()
                 as u32)
@@ -55,7 +60,22 @@ pub fn pose_grid(
             scene.back.with_resolution(w, h)
         }
         None => scene.back,
-    };
+    }
+}
+
+/// The back camera's view of the scene's head turned about its neck by `yaw_deg` (from
+/// facing the camera) and `pitch_deg`, its eye moved along the camera's line of sight to
+/// `scale` times the scene's distance; with the true eye (world frame, metres) and the head's
+/// yaw about the world's vertical (degrees, as [`HeadPose::world_yaw_deg`]).
+///
+/// [`HeadPose::world_yaw_deg`]: crate::system::head_pose::HeadPose::world_yaw_deg
+pub fn posed_view(
+    scene: &Scene,
+    back: &Camera,
+    yaw_deg: f64,
+    pitch_deg: f64,
+    scale: f64,
+) -> Result<(Frame, DVec3, f64)> {
     let eye0 = scene.eye();
     if !scene
         .objects
@@ -68,44 +88,76 @@ pub fn pose_grid(
     // Yaw 0 faces the back camera: the world yaw whose −z axis points from the eye at it.
     let to_camera = camera - eye0;
     let facing_deg = (-to_camera.x).atan2(-to_camera.z).to_degrees();
+    let rotation = head_rotation(facing_deg + yaw_deg, pitch_deg);
+    let start = camera + (eye0 - camera) * scale;
+    let eye = eye_turned_about_neck(start, rotation);
+    let head_from_start = DAffine3::from_translation(eye)
+        * DAffine3::from_mat3(rotation)
+        * DAffine3::from_translation(-eye0);
+    let mut posed = scene.clone();
+    for o in &mut posed.objects {
+        if o.motion.moves_with == MovesWith::Head {
+            o.world_from_object = head_from_start * o.world_from_object;
+        }
+    }
+    posed.driver.world_from_camera.translation = eye;
+    let ctx = RenderContext::new(posed)?;
+    let settings = RenderSettings {
+        spp: 1,
+        progress: false,
+    };
+    let (frame, _) = ctx.render(back, View::Back.bit(), settings, "back");
+    Ok((frame, eye, facing_deg + yaw_deg))
+}
+
+/// The tracker's estimates from one back-camera frame against the true eye; the fit
+/// (`detect_turned` and `locate`) timed on the calling thread.
+pub fn estimate_pose(
+    frame: &Frame,
+    back: &Camera,
+    eye: DVec3,
+    [yaw_deg, pitch_deg, world_yaw_deg]: [f64; 3],
+) -> PoseResult {
+    let started = Instant::now();
+    let detection = detect_turned(frame).ok();
+    let located = detection.as_ref().map(|d| locate(d, back, 0.064));
+    let fit_s = started.elapsed().as_secs_f64();
+    let error = |e: DVec3| (e - eye).length();
+    PoseResult {
+        yaw_deg,
+        pitch_deg,
+        distance_m: (eye - back.position()).length(),
+        frontal_error_m: detection
+            .as_ref()
+            .map(|d| error(eye_from_detection(d, back, 0.064))),
+        frontal_confidence: detection.as_ref().map(|d| d.confidence.value),
+        fitted_error_m: located.map(|(_, p)| error(DVec3::from(p.eye))),
+        confidence: located.map(|(d, _)| d.confidence.value),
+        fitted_yaw_deg: located.map(|(_, p)| p.yaw_deg),
+        yaw_error_deg: located
+            .map(|(_, p)| (p.world_yaw_deg - world_yaw_deg + 540.0).rem_euclid(360.0) - 180.0),
+        eye_m: eye.to_array(),
+        fitted_eye_m: located.map(|(_, p)| p.eye),
+        fit_s,
+    }
+}
+
+/// The grid: every yaw × pitch × distance scale (the scene's eye distance from the back
+/// camera times the scale); the back camera `back_width` pixels wide.
+pub fn pose_grid(
+    scene: &Scene,
+    yaws: &[f64],
+    pitches: &[f64],
+    distance_scales: &[f64],
+    back_width: Option<u32>,
+) -> Result<Vec<PoseResult>> {
+    let back = grid_camera(scene, back_width);
     let mut out = Vec::new();
     for &scale in distance_scales {
         for &pitch in pitches {
             for &yaw in yaws {
-                let rotation = head_rotation(facing_deg + yaw, pitch);
-                let start = camera + (eye0 - camera) * scale;
-                let eye = eye_turned_about_neck(start, rotation);
-                let head_from_start = DAffine3::from_translation(eye)
-                    * DAffine3::from_mat3(rotation)
-                    * DAffine3::from_translation(-eye0);
-                let mut posed = scene.clone();
-                for o in &mut posed.objects {
-                    if o.motion.moves_with == MovesWith::Head {
-                        o.world_from_object = head_from_start * o.world_from_object;
-                    }
-                }
-                posed.driver.world_from_camera.translation = eye;
-                let ctx = RenderContext::new(posed)?;
-                let settings = RenderSettings {
-                    spp: 1,
-                    progress: false,
-                };
-                let (frame, _) = ctx.render(&back, View::Back.bit(), settings, "back");
-                let detection = detect_turned(&frame).ok();
-                let located = detection.as_ref().map(|d| locate(d, &back, 0.064));
-                let error = |e: DVec3| (e - eye).length();
-                out.push(PoseResult {
-                    yaw_deg: yaw,
-                    pitch_deg: pitch,
-                    distance_m: (eye - camera).length(),
-                    frontal_error_m: detection
-                        .as_ref()
-                        .map(|d| error(eye_from_detection(d, &back, 0.064))),
-                    frontal_confidence: detection.as_ref().map(|d| d.confidence.value),
-                    fitted_error_m: located.map(|(_, p)| error(DVec3::from(p.eye))),
-                    confidence: located.map(|(d, _)| d.confidence.value),
-                    fitted_yaw_deg: located.map(|(_, p)| p.yaw_deg),
-                });
+                let (frame, eye, world_yaw) = posed_view(scene, &back, yaw, pitch, scale)?;
+                out.push(estimate_pose(&frame, &back, eye, [yaw, pitch, world_yaw]));
             }
         }
     }
@@ -123,47 +175,62 @@ pub fn spread(values: &[f64]) -> Option<[f64; 3]> {
     Some([rank(0.5), rank(0.95), v[v.len() - 1]])
 }
 
-/// The error table (Markdown): one row per estimator, cm, with the poses flagged unconfident
-/// and those without a detection.
+/// The fit's wall time per frame (`detect_turned` and `locate`, one thread) over a grid, one
+/// line: median, p95 and max in ms, and `setup_s`, the one-time set-up
+/// ([`prepare_fit`](crate::system::head_pose::prepare_fit)) not in them. A measurement, not
+/// deterministic: kept out of [`pose_table`].
+pub fn fit_time_line(results: &[PoseResult], setup_s: f64) -> Option<String> {
+    let ms: Vec<f64> = results.iter().map(|r| 1e3 * r.fit_s).collect();
+    spread(&ms).map(|[median, p95, max]| {
+        format!(
+            "fit time per frame (detect_turned + locate, one thread, {} frames): median {median:.1} ms, p95 {p95:.1} ms, max {max:.1} ms; one-time set-up {:.1} ms (not included)",
+            ms.len(),
+            1e3 * setup_s
+        )
+    })
+}
+
+/// The error table (Markdown): one row per estimator and confidence class, cm, with the
+/// poses flagged unconfident and those without a detection counted.
 pub fn pose_table(results: &[PoseResult]) -> String {
     let confident = |r: &PoseResult| {
         r.confidence
             .is_some_and(|c| c >= crate::system::head::CONFIDENT_HEAD)
     };
-    let unconfident = results
-        .iter()
-        .filter(|r| r.confidence.is_some() && !confident(r))
-        .count();
+    let unconfident = |r: &PoseResult| r.confidence.is_some() && !confident(r);
     let missed = results.iter().filter(|r| r.confidence.is_none()).count();
     let mut s = format!(
-        "{} poses: {} unconfident (confidence < {}), {} without a detection (not in the errors)\n\n| estimator | median cm | p95 cm | max cm | median cm, confident only | max cm, confident only |\n|---|---:|---:|---:|---:|---:|\n",
+        "{} poses: {} confident, {} unconfident (confidence < {}), {} without a detection (not in the errors)\n",
         results.len(),
-        unconfident,
+        results.iter().filter(|r| confident(r)).count(),
+        results.iter().filter(|r| unconfident(r)).count(),
         crate::system::head::CONFIDENT_HEAD,
         missed
     );
+    s += "\n| estimator (poses with a detection) | poses | median cm | p95 cm | max cm |\n|---|---:|---:|---:|---:|\n";
     let cm = |x: Option<f64>| x.map_or("—".to_string(), |v| format!("{:.2}", 100.0 * v));
-    for (name, pick) in [
-        (
-            "frontal equations (d1, b_h)",
-            (|r: &PoseResult| r.frontal_error_m) as fn(&PoseResult) -> Option<f64>,
-        ),
-        ("yaw fit", |r: &PoseResult| r.fitted_error_m),
-    ] {
-        let all: Vec<f64> = results.iter().filter_map(pick).collect();
-        let sure: Vec<f64> = results
-            .iter()
-            .filter(|r| confident(r))
-            .filter_map(pick)
-            .collect();
-        let (a, c) = (spread(&all), spread(&sure));
+    type Row = (&'static str, fn(&PoseResult) -> Option<f64>);
+    let rows: [Row; 4] = [
+        ("frontal equations (d1, b_h)", |r| r.frontal_error_m),
+        ("yaw fit", |r| r.fitted_error_m),
+        ("yaw fit, confident", |r| {
+            r.fitted_error_m
+                .filter(|_| r.confidence.unwrap_or(0.0) >= crate::system::head::CONFIDENT_HEAD)
+        }),
+        ("yaw fit, unconfident", |r| {
+            r.fitted_error_m
+                .filter(|_| r.confidence.unwrap_or(1.0) < crate::system::head::CONFIDENT_HEAD)
+        }),
+    ];
+    for (name, pick) in rows {
+        let errors: Vec<f64> = results.iter().filter_map(pick).collect();
+        let a = spread(&errors);
         s += &format!(
-            "| {name} | {} | {} | {} | {} | {} |\n",
+            "| {name} | {} | {} | {} | {} |\n",
+            errors.len(),
             cm(a.map(|x| x[0])),
             cm(a.map(|x| x[1])),
             cm(a.map(|x| x[2])),
-            cm(c.map(|x| x[0])),
-            cm(c.map(|x| x[2])),
         );
     }
     s

@@ -271,11 +271,7 @@ pub(crate) fn face_region(
         (x1 + margin).min(w),
         (y1 + margin).min(h),
     ];
-    let [bx0, by0, bx1, by1] = search;
-    let bw = bx1 - bx0;
-    let dark = (0..bw * (by1 - by0))
-        .map(|k| luminance(rgb[(by0 + k / bw) * w + bx0 + k % bw]) < 0.3 * face_lum)
-        .collect();
+    let dark = dark_mask(rgb, w, search, face_lum);
     Ok(FaceRegion {
         face,
         face_box,
@@ -283,6 +279,20 @@ pub(crate) fn face_region(
         search,
         dark,
     })
+}
+
+/// The pixels of the box `[x0, y0, x1, y1)` (row by row within it) darker than
+/// 0.3 × `face_lum` ([`FaceRegion::dark`]).
+pub(crate) fn dark_mask(
+    rgb: &[[u8; 3]],
+    w: usize,
+    [x0, y0, x1, y1]: [usize; 4],
+    face_lum: f32,
+) -> Vec<bool> {
+    let bw = x1 - x0;
+    (0..bw * (y1 - y0))
+        .map(|k| luminance(rgb[(y0 + k / bw) * w + x0 + k % bw]) < 0.3 * face_lum)
+        .collect()
 }
 
 /// The dark blobs of a search box (`dark`, as in [`FaceRegion`]) of at most `max_area`

@@ -18,6 +18,9 @@ pub const CONFIDENT_HEAD: f64 = 0.5;
 /// pupils 0.064 m apart). Real adults: about 14 cm bizygomatic over 6.3 cm, 2.2.
 pub const FACE_OVER_FEATURE: f64 = 0.15 / 0.064;
 
+/// Iris radius over face width of the shipped head model (a 12 mm iris, a 0.15 m face).
+pub const IRIS_OVER_FACE: f64 = 0.006 / 0.15;
+
 /// The cue scores and what they were computed from.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct HeadConfidence {
@@ -34,7 +37,8 @@ pub struct HeadConfidence {
     /// The pupils' midpoint off the face box's centre, in face widths: 1 at ≤ 0.35, 0 at
     /// ≥ 0.5 (the head seen from the side shifts it: das has 0.26).
     pub symmetry: f64,
-    /// Smaller over larger pupil blob area: 0 at ≤ 0.2, 1 at ≥ 0.5.
+    /// Smaller over larger pupil blob area: 0 at ≤ 0.2, 1 at ≥ 0.5 (with the fit: the smaller
+    /// blob over an iris disc, [`HeadConfidence::with_fit`]).
     pub pupil_sizes: f64,
     /// Face box width, pixels.
     pub face_width_px: f64,
@@ -44,7 +48,8 @@ pub struct HeadConfidence {
     pub pupil_height_in_face: f64,
     /// |pupils' midpoint − face box centre| / face width.
     pub centre_offset_in_face: f64,
-    /// Smaller over larger pupil blob area, (0, 1].
+    /// Smaller over larger pupil blob area, (0, 1]; with the fit, the smaller blob's area
+    /// over an iris disc's expected area, [0, ∞).
     pub pupil_area_ratio: f64,
     /// Whether the cues are the yaw fit's ([`HeadConfidence::with_fit`]): then
     /// `distance_ratio` holds the outline residual over the face width,
@@ -98,19 +103,32 @@ impl HeadConfidence {
     /// outline's fit (`edge_rms_px`, the outline's RMS residual, over the face's width: 1 at
     /// ≤ 0.015, 0 at ≥ 0.04); the symmetry cue the fitted yaw (1 at |yaw| ≤ 40°, 0 at ≥ 55°:
     /// beyond, the far eye slips behind the nose) times the fit's `margin` (1 at ≥ 0.03, 0 at
-    /// 0: another yaw fits as well); the pupil-height and pupil-size cues are set to 1 (the
-    /// mesh's skin region includes its neck, and a turned iris is foreshortened by design).
+    /// 0: another yaw fits as well); the pupil-height cue is set to 1 (the mesh's skin region
+    /// includes its neck).
     /// In this form `distance_ratio` holds the residual over the face width,
     /// `centre_offset_in_face` the fitted yaw in degrees and `pupil_height_in_face` the margin.
-    pub fn with_fit(&self, edge_rms_px: f64, yaw_deg: f64, margin: f64) -> Self {
+    ///
+    /// The pupil-size cue becomes the smaller pupil blob's area over an iris disc's expected
+    /// area (a 12 mm iris on the 150 mm face: radius [`IRIS_OVER_FACE`] face widths), 0 at
+    /// ≤ 0.25, 1 at ≥ 0.35: an iris under a third of its size is half hidden by a lid or the
+    /// nose, and its centroid is biased (the ratio is held in `pupil_area_ratio`).
+    pub fn with_fit(
+        &self,
+        edge_rms_px: f64,
+        yaw_deg: f64,
+        margin: f64,
+        smaller_pupil_px: u32,
+    ) -> Self {
         let mut c = *self;
+        let iris_disc = std::f64::consts::PI * (IRIS_OVER_FACE * self.face_width_px).powi(2);
+        c.pupil_area_ratio = f64::from(smaller_pupil_px) / iris_disc;
+        c.pupil_sizes = ramp(c.pupil_area_ratio, 0.25, 0.35);
         c.distance_ratio = edge_rms_px / self.face_width_px;
         c.distance_agreement = ramp(c.distance_ratio, 0.04, 0.015);
         c.centre_offset_in_face = yaw_deg;
         c.pupil_height_in_face = margin;
         c.symmetry = ramp(yaw_deg.abs(), 55.0, 40.0) * ramp(margin, 0.0, 0.03);
         c.pupil_height = 1.0;
-        c.pupil_sizes = 1.0;
         c.fitted = true;
         c.value = c.face_size * c.distance_agreement * c.pupil_height * c.symmetry * c.pupil_sizes;
         c
@@ -162,7 +180,12 @@ impl HeadConfidence {
                 pct(self.centre_offset_in_face)
             ));
         }
-        if self.pupil_sizes < 1.0 {
+        if self.pupil_sizes < 1.0 && self.fitted {
+            out.push(format!(
+                "a pupil blob only {} of an iris's area (half hidden by a lid or the nose)",
+                pct(self.pupil_area_ratio)
+            ));
+        } else if self.pupil_sizes < 1.0 {
             out.push(format!(
                 "one pupil blob {} the size of the other",
                 pct(self.pupil_area_ratio)

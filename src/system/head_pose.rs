@@ -32,9 +32,12 @@ pub fn locate(
 ) -> (FaceDetection, HeadPose) {
     let pose = fit_head_pose(detection, back, feature_width);
     let scored = FaceDetection {
-        confidence: detection
-            .confidence
-            .with_fit(pose.edge_rms_px, pose.yaw_deg, pose.margin),
+        confidence: detection.confidence.with_fit(
+            pose.edge_rms_px,
+            pose.yaw_deg,
+            pose.margin,
+            detection.pupil_areas_px[0].min(detection.pupil_areas_px[1]),
+        ),
         ..*detection
     };
     (scored, pose)
@@ -49,6 +52,9 @@ pub struct HeadPose {
     /// in [−80, 80]; positive turns the face towards the driver's left (world −x for a driver
     /// looking along −z).
     pub yaw_deg: f64,
+    /// The same yaw about the world's vertical, degrees in (−180, 180]: 0 when the face looks
+    /// along the world's −z, positive towards −x (the rotation `rotate_deg = [0, yaw, 0]`).
+    pub world_yaw_deg: f64,
     /// RMS of the two outline residuals at the fitted yaw (each capped at 5% of the face's
     /// width), back-camera pixels.
     pub edge_rms_px: f64,
@@ -57,8 +63,10 @@ pub struct HeadPose {
     pub margin: f64,
 }
 
-/// The search's half range about facing the camera, and the ambiguity test's distance, degrees.
+/// The search's half range about facing the camera, its coarse step, and the ambiguity
+/// test's distance, degrees.
 const YAW_RANGE_DEG: i32 = 80;
+const COARSE_STEP_DEG: i32 = 2;
 const AMBIGUITY_DEG: f64 = 10.0;
 
 /// Head frame → world for a yaw ψ about the world's +y (ψ = 0: the face looks along −z).
@@ -66,10 +74,163 @@ fn world_from_head(yaw: f64) -> DMat3 {
     DMat3::from_rotation_y(yaw)
 }
 
+/// The skin's wireframe (`skin_wireframe`), built once: `coarse` for the yaw scan, `fine`
+/// for the refinement and the fitted outline.
+struct Wireframes {
+    coarse: Wireframe,
+    fine: Wireframe,
+}
+
+struct Wireframe {
+    /// Head frame, metres (the shipped head's size).
+    vertices: Vec<DVec3>,
+    edges: Vec<[u32; 2]>,
+}
+
+impl Wireframe {
+    fn new(columns: usize, rows: usize) -> Self {
+        let (vertices, edges) = skin_wireframe(columns, rows);
+        Wireframe {
+            vertices,
+            edges: edges.iter().map(|e| e.map(|i| i as u32)).collect(),
+        }
+    }
+}
+
+/// Builds what every fit shares, once per process: the head's wireframes and the sRGB
+/// encoding table of `detect_turned` (tens of ms; otherwise the first frame pays it).
+pub fn prepare_fit() {
+    wireframes();
+    crate::util::color::encode_srgb8_table(glam::Vec3::ZERO);
+}
+
+fn wireframes() -> &'static Wireframes {
+    static WIREFRAMES: std::sync::OnceLock<Wireframes> = std::sync::OnceLock::new();
+    WIREFRAMES.get_or_init(|| Wireframes {
+        coarse: Wireframe::new(44, 30),
+        fine: Wireframe::new(88, 60),
+    })
+}
+
+/// What a fit knows of the detection: the pupils' rays and the plane they span with the
+/// camera's centre (its image is the pupils' line), the outline candidates along that line.
+struct Fit<'a> {
+    back: &'a Camera,
+    camera_from_world: glam::DAffine3,
+    origin: DVec3,
+    rays: [DVec3; 2],
+    /// The plane through the camera's centre and both pupils: its unit normal, and two unit
+    /// vectors in it, `forward` between the rays and `across` towards the right pupil's ray;
+    /// across/forward is monotone along the pupils' image line.
+    normal: DVec3,
+    forward: DVec3,
+    across: DVec3,
+    /// The pupils' image line: midpoint and direction (ideal pixels).
+    mid: DVec2,
+    along: DVec2,
+    /// Outline candidates along the line from `mid`, left and right, ideal pixels.
+    measured: [Vec<f64>; 2],
+    cap: f64,
+    feature_width: f64,
+    /// Head model metres → metres for this feature width.
+    scale: f64,
+}
+
+impl Fit<'_> {
+    /// The eye for a yaw: the points on the two pupil rays whose difference is the
+    /// interpupillary vector (image-left is the head's +x pupil), least squares.
+    fn eye_at(&self, yaw: f64) -> DVec3 {
+        let across = world_from_head(yaw) * DVec3::X * self.feature_width;
+        let (a, b) = (self.rays[0], -self.rays[1]);
+        let (aa, ab, bb) = (a.dot(a), a.dot(b), b.dot(b));
+        let (ca, cb) = (a.dot(across), b.dot(across));
+        let det = aa * bb - ab * ab;
+        let s = (ca * bb - cb * ab) / det;
+        let t = (aa * cb - ab * ca) / det;
+        self.origin + (self.rays[0] * s + self.rays[1] * t) / 2.0
+    }
+
+    /// The predicted outline for a yaw: where the wireframe placed at the yaw's eye crosses
+    /// the pupils' plane farthest to either side (in front of the camera), as positions along
+    /// the pupils' image line; and that eye. The crossings are found in the head's frame (the
+    /// plane moved into it), so only the two extreme points are projected.
+    fn outline(
+        &self,
+        wire: &Wireframe,
+        yaw: f64,
+        distance: &mut Vec<f64>,
+    ) -> Option<(f64, f64, DVec3)> {
+        let eye = self.eye_at(yaw);
+        let rotation = world_from_head(yaw);
+        let to_head = |v: DVec3| rotation.transpose() * v * self.scale;
+        let offset = eye - self.origin;
+        let (n, n0) = (to_head(self.normal), self.normal.dot(offset));
+        let (f, f0) = (to_head(self.forward), self.forward.dot(offset));
+        let (u, u0) = (to_head(self.across), self.across.dot(offset));
+        distance.clear();
+        distance.extend(wire.vertices.iter().map(|v| n.dot(*v) + n0));
+        let (mut lo, mut hi) = (
+            (f64::INFINITY, DVec3::ZERO),
+            (f64::NEG_INFINITY, DVec3::ZERO),
+        );
+        for &[i, j] in &wire.edges {
+            let (di, dj) = (distance[i as usize], distance[j as usize]);
+            if (di > 0.0) == (dj > 0.0) {
+                continue;
+            }
+            let (vi, vj) = (wire.vertices[i as usize], wire.vertices[j as usize]);
+            let x = vi + (vj - vi) * (di / (di - dj));
+            let depth = f.dot(x) + f0;
+            if depth <= 0.0 {
+                continue;
+            }
+            let t = (u.dot(x) + u0) / depth;
+            if t < lo.0 {
+                lo = (t, x);
+            }
+            if t > hi.0 {
+                hi = (t, x);
+            }
+        }
+        if lo.0 > hi.0 {
+            return None;
+        }
+        let pin = self.back.undistorted();
+        let on_line = |x: DVec3| {
+            let world = eye + rotation * (x * self.scale);
+            pin.project_camera(self.camera_from_world.transform_point3(world))
+                .map(|p| (p - self.mid).dot(self.along))
+        };
+        Some((on_line(lo.1)?, on_line(hi.1)?, eye))
+    }
+
+    /// Distance of a predicted outline position to the nearest candidate, capped.
+    fn nearest(&self, side: usize, s: f64) -> f64 {
+        self.measured[side]
+            .iter()
+            .map(|m| (s - m).abs())
+            .fold(self.cap, f64::min)
+    }
+
+    /// The squared residuals' sum for a yaw, and the residuals and eye.
+    fn cost(&self, wire: &Wireframe, yaw: f64, distance: &mut Vec<f64>) -> (f64, f64, f64, DVec3) {
+        match self.outline(wire, yaw, distance) {
+            Some((lo, hi, eye)) => {
+                let (a, b) = (self.nearest(0, lo), self.nearest(1, hi));
+                (a * a + b * b, a, b, eye)
+            }
+            None => (f64::INFINITY, self.cap, self.cap, self.eye_at(yaw)),
+        }
+    }
+}
+
 /// The fitted pose of a detection; `feature_width` is A in metres.
+///
+/// The yaw is scanned over ±80° about facing the camera in 2° steps on a coarse wireframe
+/// (44 × 30 quads), then refined by golden section within ±2° of the best on the fine one
+/// (88 × 60); the margin compares the scan's best yaw at least 10° away.
 pub fn fit_head_pose(detection: &FaceDetection, back: &Camera, feature_width: f64) -> HeadPose {
     let pin = back.undistorted();
-    let camera_from_world = back.world_from_camera.inverse();
     let pupils = detection.pupils.map(|p| back.ideal_pixel(DVec2::from(p)));
     let origin = back.position();
     let rays = pupils.map(|p| {
@@ -77,8 +238,14 @@ pub fn fit_head_pose(detection: &FaceDetection, back: &Camera, feature_width: f6
             .transform_vector3(pin.camera_direction(p))
     });
     let along = (pupils[1] - pupils[0]).normalize_or(DVec2::X);
-    let normal = DVec2::new(-along.y, along.x);
     let mid = (pupils[0] + pupils[1]) / 2.0;
+    let normal = rays[0].cross(rays[1]).normalize_or(DVec3::Y);
+    let forward =
+        (rays[0].normalize_or_zero() + rays[1].normalize_or_zero()).normalize_or(DVec3::NEG_Z);
+    let mut across = normal.cross(forward).normalize_or(DVec3::X);
+    if across.dot(rays[1]) < across.dot(rays[0]) {
+        across = -across;
+    }
     let measured: [Vec<f64>; 2] = [0, 1].map(|k| {
         detection.outline_candidates[k]
             .iter()
@@ -87,61 +254,31 @@ pub fn fit_head_pose(detection: &FaceDetection, back: &Camera, feature_width: f6
             .collect()
     });
     let face_w = f64::from(detection.face_box[2] - detection.face_box[0]).max(1.0);
-    let cap = (0.05 * face_w).max(1.5);
-    let nearest = |k: usize, s: f64| {
-        measured[k]
-            .iter()
-            .map(|m| (s - m).abs())
-            .fold(cap, f64::min)
+    let fit = Fit {
+        back,
+        camera_from_world: back.world_from_camera.inverse(),
+        origin,
+        rays,
+        normal,
+        forward,
+        across,
+        mid,
+        along,
+        measured,
+        cap: (0.05 * face_w).max(1.5),
+        feature_width,
+        scale: feature_width / (2.0 * HALF_IPD),
     };
-    let (vertices, edges) = skin_wireframe(88, 60);
-    let scale = feature_width / (2.0 * HALF_IPD);
-    // The eye for a yaw: the points on the two pupil rays whose difference is the
-    // interpupillary vector (image-left is the head's +x pupil), least squares.
-    let eye_at = |yaw: f64| {
-        let across = world_from_head(yaw) * DVec3::X * feature_width;
-        let (a, b) = (rays[0], -rays[1]);
-        let (aa, ab, bb) = (a.dot(a), a.dot(b), b.dot(b));
-        let (ca, cb) = (a.dot(across), b.dot(across));
-        let det = aa * bb - ab * ab;
-        let s = (ca * bb - cb * ab) / det;
-        let t = (aa * cb - ab * ca) / det;
-        origin + (rays[0] * s + rays[1] * t) / 2.0
-    };
-    // The residuals of the predicted outline and the eye, for a yaw.
-    let residuals = |yaw: f64| -> Option<(f64, f64, DVec3)> {
-        let eye = eye_at(yaw);
-        let rotation = world_from_head(yaw);
-        let projected: Vec<Option<DVec2>> = vertices
-            .iter()
-            .map(|v| {
-                pin.project_camera(
-                    camera_from_world.transform_point3(eye + rotation * (*v * scale)),
-                )
-            })
-            .collect();
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for [i, j] in &edges {
-            let (Some(p), Some(q)) = (projected[*i], projected[*j]) else {
-                continue;
-            };
-            let (dp, dq) = ((p - mid).dot(normal), (q - mid).dot(normal));
-            if (dp > 0.0) == (dq > 0.0) {
-                continue;
-            }
-            let s = (p + (q - p) * (dp / (dp - dq)) - mid).dot(along);
-            (lo, hi) = (lo.min(s), hi.max(s));
-        }
-        (lo <= hi).then(|| (nearest(0, lo), nearest(1, hi), eye))
-    };
-    let cost = |yaw: f64| residuals(yaw).map_or(f64::INFINITY, |(a, b, _)| a * a + b * b);
+    let Wireframes { coarse, fine } = wireframes();
+    let mut distance = Vec::with_capacity(fine.vertices.len());
     // Facing the camera: the yaw whose −z axis points from the frontal eye at the camera.
-    let to_camera = origin - eye_at(0.0);
+    let to_camera = origin - fit.eye_at(0.0);
     let facing = (-to_camera.x).atan2(-to_camera.z);
-    let scan: Vec<(f64, f64)> = (-YAW_RANGE_DEG..=YAW_RANGE_DEG)
+    let scan: Vec<(f64, f64)> = (-YAW_RANGE_DEG / COARSE_STEP_DEG
+        ..=YAW_RANGE_DEG / COARSE_STEP_DEG)
         .map(|k| {
-            let yaw = facing + f64::from(k).to_radians();
-            (yaw, cost(yaw))
+            let yaw = facing + f64::from(k * COARSE_STEP_DEG).to_radians();
+            (yaw, fit.cost(coarse, yaw, &mut distance).0)
         })
         .collect();
     let best = scan
@@ -151,20 +288,29 @@ pub fn fit_head_pose(detection: &FaceDetection, back: &Camera, feature_width: f6
             |b, &s| if s.1 < b.1 { s } else { b },
         )
         .0;
-    let step = 1f64.to_radians();
-    let (mut a, mut b) = (best - step, best + step);
+    // Golden section on the fine wireframe, one new cost per step.
+    let step = f64::from(COARSE_STEP_DEG).to_radians();
     let g = (5f64.sqrt() - 1.0) / 2.0;
-    for _ in 0..30 {
-        let (c, d) = (b - g * (b - a), a + g * (b - a));
-        if cost(c) < cost(d) {
-            b = d;
+    let (mut a, mut b) = (best - step, best + step);
+    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
+    let (mut fc, mut fd) = (
+        fit.cost(fine, c, &mut distance).0,
+        fit.cost(fine, d, &mut distance).0,
+    );
+    for _ in 0..24 {
+        if fc < fd {
+            (b, d, fd) = (d, c, fc);
+            c = b - g * (b - a);
+            fc = fit.cost(fine, c, &mut distance).0;
         } else {
-            a = c;
+            (a, c, fc) = (c, d, fd);
+            d = a + g * (b - a);
+            fd = fit.cost(fine, d, &mut distance).0;
         }
     }
     let yaw = (a + b) / 2.0;
-    let (r0, r1, eye) = residuals(yaw).unwrap_or((cap, cap, eye_at(yaw)));
-    let best_cost = r0 * r0 + r1 * r1;
+    let (best_cost, _, _, eye) = fit.cost(fine, yaw, &mut distance);
+    let best_cost = best_cost.min(2.0 * fit.cap * fit.cap);
     let other = scan
         .iter()
         .filter(|s| (s.0 - yaw).abs() >= AMBIGUITY_DEG.to_radians())
@@ -173,6 +319,7 @@ pub fn fit_head_pose(detection: &FaceDetection, back: &Camera, feature_width: f6
     HeadPose {
         eye: eye.to_array(),
         yaw_deg: (yaw - facing).to_degrees(),
+        world_yaw_deg: yaw.to_degrees(),
         edge_rms_px: (best_cost / 2.0).sqrt(),
         margin: (((other - best_cost) / 2.0).max(0.0).sqrt() / face_w).min(0.05),
     }
@@ -201,13 +348,15 @@ mod tests {
         let facing = (-to_camera.x).atan2(-to_camera.z);
         for turn in [-30.0f64, 0.0, 20.0] {
             let yaw = facing + turn.to_radians();
-            let r = world_from_head(yaw);
+            // The scene's rotation convention (what the renderer turns the mesh by).
+            let r = crate::scene::head_model::head_rotation(yaw.to_degrees(), 0.0);
             let pupils = [1.0, -1.0].map(|s| {
                 back.project_point(eye + r * DVec3::X * s * HALF_IPD)
                     .unwrap()
             });
-            // The outline: the wireframe's extreme crossings of the pupils' line, as the fit
-            // computes them, placed by brute force over a fine sampling of the line.
+            // The outline, by brute force: every vertex of the fine wireframe projected, the
+            // extreme crossings of the projected edges with the pupils' image line (the fit
+            // intersects the pupils' plane in the head's frame instead and projects two points).
             let (vertices, edges) = skin_wireframe(88, 60);
             let along = (pupils[1] - pupils[0]).normalize();
             let normal = DVec2::new(-along.y, along.x);
