@@ -352,3 +352,21 @@ fn the_tracked_mesh_face_estimates_are_the_whole_images() {
         "tracked {tracked_pixels} of {whole_pixels} back pixels"
     );
 }
+
+/// A sweep's eye parameter moves the driver's head with the eye (`Scene::move_eye`), so
+/// `--head estimated` measures the swept eye: das with eye_x = 0.06 m is estimated within
+/// 2 cm of the moved eye, not 6 cm off at the seat's.
+#[test]
+fn a_swept_eye_carries_the_head() {
+    let base = common::das();
+    let (scene, options) = seethru::measure::sweep_grid::configure(
+        &base,
+        &estimated(),
+        &[("eye_x".to_string(), "0.06".to_string())],
+    )
+    .unwrap();
+    assert!((scene.eye() - base.eye() - DVec3::new(0.06, 0.0, 0.0)).length() < 1e-12);
+    let result = run(&RenderContext::new(scene).unwrap(), &options).unwrap();
+    let error = result.report["eye_used"]["error_m"].as_f64().unwrap();
+    assert!(error < 0.02, "{error} m from the swept eye");
+}

@@ -272,6 +272,19 @@ impl Scene {
     pub fn eye(&self) -> DVec3 {
         self.driver.position()
     }
+
+    /// Moves the driver's eye to `eye` (world, m), keeping the driver camera's orientation,
+    /// and the driver's head with it: every object riding with the head (the face the back
+    /// camera films, `moves_with = "head"`) moves by the same offset, as in a sequence.
+    pub fn move_eye(&mut self, eye: DVec3) {
+        let moved = eye - self.eye();
+        self.driver.world_from_camera.translation = eye;
+        for object in &mut self.objects {
+            if object.motion.moves_with == motion::MovesWith::Head {
+                object.world_from_object.translation += moved;
+            }
+        }
+    }
 }
 
 impl Default for Sun {
