@@ -87,7 +87,8 @@ def sequence(scene: Scene, predictor=None, **options) -> Sequence:
     ``eye_at_head_time`` (obstacle frame, m). It returns the eye (x, y, z, obstacle frame,
     m) the compensation uses, or None for the system's own estimate (``head_source``, then
     ``predict``). Each :class:`Step` has frames.csv's row: the times, ``eye_true``,
-    ``eye_estimated``, ``eye_used``, ``head_confidence``, ``d2_used``,
+    ``eye_estimated``, ``eye_used``, ``head_confidence`` (and on the mesh face
+    ``head_yaw_deg``, ``head_fit_margin``, ``head_yaw_true_deg``), ``d2_used``,
     ``vehicle_position``, ``vehicle_yaw_deg``, ``hazards``, with ``metrics``
     (metrics.json's content for that instant), ``truth`` and ``seethru`` (:class:`Frame`)
     and ``misregistration`` ((h, w) float32, arcmin).

@@ -194,6 +194,9 @@ class Step:
     eye_estimated: tuple[float, float, float]  # the system's head estimate, m
     eye_used: tuple[float, float, float]  # what the compensation used, m
     head_confidence: float | None  # [0, 1], image-based head estimates only
+    head_yaw_deg: float | None  # the mesh face's fitted yaw from facing the back camera, degrees
+    head_fit_margin: float | None  # the yaw fit's margin, [0, 0.05] (mesh face only)
+    head_yaw_true_deg: float | None  # the mesh face's true yaw from facing the back camera
     d2_used: float | None  # m, the working distance chosen with d2="auto"
     vehicle_position: tuple[float, float, float]  # the pivot, world, m
     vehicle_yaw_deg: float

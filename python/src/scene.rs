@@ -143,7 +143,8 @@ impl PyScene {
     }
 
     /// The driver's eye, world frame, metres: the driver camera's centre. Setting it moves
-    /// the driver camera, keeping its orientation.
+    /// the driver camera, keeping its orientation, and the driver's head (the objects riding
+    /// with it, the face the back camera films) with it.
     #[getter]
     fn eye(&self) -> (f64, f64, f64) {
         self.scene.eye().into()
@@ -153,7 +154,7 @@ impl PyScene {
     fn set_eye(&mut self, eye: (f64, f64, f64)) -> PyResult<()> {
         let p = DVec3::from(eye);
         check_point("eye", p)?;
-        self.scene.driver.world_from_camera.translation = p;
+        self.scene.move_eye(p);
         Ok(())
     }
 

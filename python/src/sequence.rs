@@ -97,6 +97,18 @@ pub struct PyStep {
     /// The image-based head estimate's confidence in [0, 1]; None for another head source.
     #[pyo3(get)]
     head_confidence: Option<f64>,
+    /// The yaw fit of the image-based estimate on the mesh face (`[camera.driver] face =
+    /// "mesh"`): the fitted yaw from facing the back camera, degrees (positive towards the
+    /// driver's left), and its margin in [0, 0.05]; None for the ellipsoid face or another
+    /// head source.
+    #[pyo3(get)]
+    head_yaw_deg: Option<f64>,
+    #[pyo3(get)]
+    head_fit_margin: Option<f64>,
+    /// The mesh face's true yaw from facing the back camera at `head_time`, degrees; None
+    /// for the ellipsoid face.
+    #[pyo3(get)]
+    head_yaw_true_deg: Option<f64>,
     /// The working distance the compensation used, m (d2 auto); None otherwise.
     #[pyo3(get)]
     d2_used: Option<f64>,
@@ -244,6 +256,9 @@ impl PySequence {
             eye_estimated: triple(record.eye_estimated),
             eye_used: triple(record.eye_used),
             head_confidence: record.head_confidence,
+            head_yaw_deg: record.head_pose.map(|p| p.yaw_deg),
+            head_fit_margin: record.head_pose.map(|p| p.margin),
+            head_yaw_true_deg: record.head_yaw_true_deg,
             d2_used: record.d2_used,
             vehicle_position: triple(record.vehicle_position),
             vehicle_yaw_deg: record.vehicle_yaw_deg,

@@ -61,6 +61,11 @@ def same_as_cli(steps, rows):
         assert (s.head_confidence is None) == math.isnan(confidence), at
         if s.head_confidence is not None:
             assert s.head_confidence == confidence, at
+        for name in ("head_yaw_deg", "head_fit_margin", "head_yaw_true_deg"):
+            value = float(r[name])
+            assert (getattr(s, name) is None) == math.isnan(value), (at, name)
+            if getattr(s, name) is not None:
+                assert getattr(s, name) == value, (at, name)
         m = s.metrics["display"]["misregistration_arcmin"]
         assert m["mean"] == float(r["misregistration_mean_arcmin"]), at
         assert m["p95"] == float(r["misregistration_p95_arcmin"]), at
@@ -88,6 +93,26 @@ def test_the_estimated_head_options_give_the_cli_frames(tmp_path):
     same_as_cli(steps, cli_rows(tmp_path, ESTIMATED_CLI))
     assert all(s.head_confidence is not None and s.d2_used is not None for s in steps)
     assert steps[0].truth.width == 96 and steps[0].truth.height == 60
+
+
+def test_the_mesh_face_steps_carry_the_yaw_fit(tmp_path):
+    # das_mesh_head ([camera.driver] face = "mesh"): the estimate is the yaw fit's, its yaw
+    # and margin on each Step as in frames.csv; das's ellipsoid face has none.
+    mesh = REPO / "scenes" / "das_mesh_head.toml"
+    options = dict(duration=0.05, fps=40, width=96, height=60, frontal_width=128,
+                   head_source="estimated", head="sway", sway_cm=5)
+    steps = list(seethru.sequence(seethru.Scene.load(mesh), **options))
+    done = seethru_cli("sequence", str(mesh), "--duration", "0.05", "--fps", "40", "--width", "96",
+                       "--height", "60", "--frontal-width", "128", "--head-source", "estimated",
+                       "--head", "sway", "--sway-cm", "5", "--frames", "exr", "--out", str(tmp_path))
+    assert done.returncode == 0, done.stderr
+    with open(tmp_path / "latency_0ms" / "frames.csv") as f:
+        same_as_cli(steps, list(csv.DictReader(f)))
+    assert all(s.head_yaw_deg is not None and s.head_fit_margin is not None for s in steps)
+    assert all(abs(s.head_yaw_deg - s.head_yaw_true_deg) < 2.0 for s in steps)
+    plain = next(iter(seethru.sequence(seethru.Scene.load(SCENE), duration=0.025, fps=40,
+                                       width=32, head_source="estimated")))
+    assert plain.head_yaw_deg is None and plain.head_yaw_true_deg is None
 
 
 def test_a_predictor_replaces_the_prediction_of_every_latency():

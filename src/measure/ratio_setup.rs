@@ -339,5 +339,6 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
         back,
         calibration: Default::default(),
         eyellipse: None,
+        face: crate::scene::DriverFace::Ellipsoids,
     })
 }

@@ -20,6 +20,8 @@ use crate::scene::world::view_bit;
 use crate::scene::{Obstacle, Scene};
 use crate::system::capture::{Capture, CaptureTruth};
 use crate::system::head::CONFIDENT_HEAD;
+use crate::system::head_estimate::true_yaw_from_camera_deg;
+use crate::system::head_pose::HeadPose;
 use crate::system::sequence::system_loop::{SequenceOptions, StageSeconds, SystemLoop};
 use crate::system::sequence::timeline::FrameTimes;
 use crate::util::number::short;
@@ -76,6 +78,13 @@ pub struct FrameRecord {
     pub eye_used: DVec3,
     /// The image-based head estimate's confidence, [0, 1] (`None`: another head source).
     pub head_confidence: Option<f64>,
+    /// The yaw fit of the image-based estimate on the mesh face: the fitted yaw from facing
+    /// the back camera (degrees, positive towards the driver's left) and its margin, [0, 0.05]
+    /// (`None`: the ellipsoid face or another head source).
+    pub head_pose: Option<HeadPose>,
+    /// The mesh face's true yaw from facing the back camera at the head sample's time,
+    /// degrees, the convention of `head_pose` (`None`: the ellipsoid face).
+    pub head_yaw_true_deg: Option<f64>,
     /// The vehicle's pivot (the eye at t = 0 carried along), world, m; its yaw, degrees.
     pub vehicle_position: DVec3,
     pub vehicle_yaw_deg: f64,
@@ -375,6 +384,16 @@ impl SequenceStepper {
             eye_estimated: shown.eye_estimated,
             eye_used: shown.eye_used,
             head_confidence: shown.head_confidence,
+            head_pose: shown.head_pose,
+            head_yaw_true_deg: {
+                let base = &system.rig.base;
+                let eye = system.rig.eye_in_obstacle(shown.times.head);
+                true_yaw_from_camera_deg(
+                    base.face,
+                    base.obstacle.world_from_obstacle.transform_point3(eye),
+                    base.back.position(),
+                )
+            },
             vehicle_position: rig.transform_point3(system.rig.vehicle.pivot),
             vehicle_yaw_deg: (system.rig.vehicle.yaw_rate * times.display).to_degrees(),
             d2_used: shown.d2_used,

@@ -18,7 +18,7 @@ use crate::system::sequence::timeline::Timeline;
 use crate::util::color::encode_srgb8;
 
 /// The columns of `frames.csv`.
-pub const FRAME_COLUMNS: [&str; 39] = [
+pub const FRAME_COLUMNS: [&str; 42] = [
     "frame",
     "t_s",
     "refresh_s",
@@ -58,6 +58,9 @@ pub const FRAME_COLUMNS: [&str; 39] = [
     "eye_x_velocity_m_s",
     "eye_z_velocity_m_s",
     "head_confidence",
+    "head_yaw_deg",
+    "head_fit_margin",
+    "head_yaw_true_deg",
 ];
 
 /// The columns of `frames.csv` for each hazard object, after [`FRAME_COLUMNS`], each named
@@ -146,6 +149,9 @@ pub fn frames_csv(records: &[FrameRecord], timeline: &Timeline) -> Result<String
             velocity.x,
             velocity.z,
             r.head_confidence.unwrap_or(f64::NAN),
+            r.head_pose.map_or(f64::NAN, |p| p.yaw_deg),
+            r.head_pose.map_or(f64::NAN, |p| p.margin),
+            r.head_yaw_true_deg.unwrap_or(f64::NAN),
         ]
         .iter()
         .map(|v| format!("{v}"))

@@ -306,7 +306,8 @@ pub fn configure(
                     .obstacle
                     .world_from_obstacle
                     .transform_vector3(axis * number(name, v)?);
-                scene.driver.world_from_camera.translation += shift;
+                // The driver's head moves with the eye (`--head estimated` measures it).
+                scene.move_eye(scene.eye() + shift);
             }
             "eye" => {
                 let (seed, index) = eyellipse_sample(v)?;
@@ -316,8 +317,8 @@ pub fn configure(
                         base.path.display()
                     )
                 })?;
-                // The driver's view keeps its orientation; only the eye moves, as for eye_x.
-                scene.driver.world_from_camera.translation = ellipse.sample(seed, index);
+                // The driver's view keeps its orientation; the eye and the head move, as for eye_x.
+                scene.move_eye(ellipse.sample(seed, index));
             }
             "head_bias_x_cm" => options.head_bias_cm[0] = number(name, v)?,
             "frontal_width" => options.frontal_width = Some(number(name, v)? as u32),

@@ -45,6 +45,12 @@ pub fn fingerprint(scene: &Scene) -> Result<String> {
             }
             *path = PathBuf::new();
         }
+        if object.shape == Shape::HeadMesh {
+            // The built-in head: the files built into the binary.
+            for bytes in crate::scene::mesh_io::BUILTIN_HEAD {
+                hash.bytes(bytes);
+            }
+        }
     }
     for material in &mut key.materials {
         if let Some(path) = &mut material.texture {

@@ -61,6 +61,40 @@ pub fn load_mesh(path: &Path) -> Result<LoadedMesh> {
     mesh.with_context(|| format!("mesh {}", path.display()))
 }
 
+/// The triangles a shape places from a mesh: its file's ([`load_mesh`]) or the built-in head's
+/// ([`builtin_head`]); `None` for the analytic shapes.
+pub fn shape_mesh(shape: &crate::scene::Shape) -> Option<Result<LoadedMesh>> {
+    match shape {
+        crate::scene::Shape::Mesh { path } => Some(load_mesh(path)),
+        crate::scene::Shape::HeadMesh => Some(Ok(builtin_head().clone())),
+        _ => None,
+    }
+}
+
+/// The built-in head mesh: `assets/head.obj` and `head.mtl` as built into the binary (the
+/// text `scene::head_model::head_obj` generates; `tests/assets.rs` checks they agree), parsed
+/// once per process.
+pub fn builtin_head() -> &'static LoadedMesh {
+    static HEAD: std::sync::OnceLock<LoadedMesh> = std::sync::OnceLock::new();
+    HEAD.get_or_init(|| {
+        let [obj, mtl] = BUILTIN_HEAD;
+        let read = |p: &Path| {
+            if p.file_name() == Some(std::ffi::OsStr::new("head.mtl")) {
+                Ok(mtl.to_vec())
+            } else {
+                Err(std::io::Error::from(std::io::ErrorKind::NotFound))
+            }
+        };
+        parse_obj(obj, Path::new("head.obj"), &read).expect("the built-in head mesh parses")
+    })
+}
+
+/// The built-in head mesh's files: OBJ, then MTL.
+pub const BUILTIN_HEAD: [&[u8]; 2] = [
+    include_bytes!("../../assets/head.obj"),
+    include_bytes!("../../assets/head.mtl"),
+];
+
 /// Checks what every loader must deliver: some triangles with an area, within the limits,
 /// finite vertices inside the world, colours in [0, 1].
 fn checked(mesh: LoadedMesh) -> Result<LoadedMesh> {

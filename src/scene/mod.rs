@@ -98,6 +98,9 @@ pub enum Shape {
     Quad { size: [f64; 2] },
     /// Triangle mesh from an OBJ or glTF/GLB file.
     Mesh { path: PathBuf },
+    /// The built-in head mesh (`scene/head_model.rs`, the triangles of `assets/head.obj`,
+    /// built into the binary): the driver's face of `[camera.driver] face = "mesh"`.
+    HeadMesh,
 }
 
 impl Shape {
@@ -110,7 +113,7 @@ impl Shape {
             Shape::Cylinder { .. } => "cylinder",
             Shape::Cone { .. } => "cone",
             Shape::Quad { .. } => "quad",
-            Shape::Mesh { .. } => "mesh",
+            Shape::Mesh { .. } | Shape::HeadMesh => "mesh",
         }
     }
 }
@@ -237,12 +240,50 @@ pub struct Scene {
     /// The SAE J941 eyellipse of the scene's `[eyellipse]` seat package, if it has one: the
     /// driver's eye defaults to its centre, and `sweep --param eye=eyellipse` samples it.
     pub eyellipse: Option<eyellipse::Eyellipse>,
+    /// The driver's face the back camera films (`[camera.driver] face`); it chooses the head
+    /// tracker of `--head estimated`.
+    pub face: DriverFace,
+}
+
+/// The driver's face (`[camera.driver] face`), and with it the head tracker `--head
+/// estimated` runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DriverFace {
+    /// `"ellipsoids"`: the face is the scene's own `[[object]]`s (das's ellipsoid head, hair
+    /// and two pupil spheres); the frontal detector and the paper's eqs. d1, b_h find the eye.
+    Ellipsoids,
+    /// `"mesh"`: the built-in head mesh ([`Shape::HeadMesh`]) is added as the object `head`,
+    /// its eye point at the driver's eye, hidden from the driver and riding with the head in
+    /// sequences; the side-angle detector and the yaw fit find the eye.
+    Mesh {
+        /// The head's yaw about the world's +y, degrees in [−80, 80]; 0 faces world −z (the
+        /// car's forward at rest), positive turns the face towards −x (the driver's left).
+        yaw_deg: f64,
+    },
+}
+
+impl DriverFace {
+    /// The values of the `face` key.
+    pub const NAMES: [&'static str; 2] = ["ellipsoids", "mesh"];
 }
 
 impl Scene {
     /// The driver's eye position, world frame.
     pub fn eye(&self) -> DVec3 {
         self.driver.position()
+    }
+
+    /// Moves the driver's eye to `eye` (world, m), keeping the driver camera's orientation,
+    /// and the driver's head with it: every object riding with the head (the face the back
+    /// camera films, `moves_with = "head"`) moves by the same offset, as in a sequence.
+    pub fn move_eye(&mut self, eye: DVec3) {
+        let moved = eye - self.eye();
+        self.driver.world_from_camera.translation = eye;
+        for object in &mut self.objects {
+            if object.motion.moves_with == motion::MovesWith::Head {
+                object.world_from_object.translation += moved;
+            }
+        }
     }
 }
 

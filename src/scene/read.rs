@@ -14,7 +14,7 @@ use crate::scene::limits::{
 use crate::scene::motion::read_object_motion;
 use crate::scene::source::{SceneError, SourceFile};
 use crate::scene::table_reader::TableReader;
-use crate::scene::{CameraKind, Material, Object, Obstacle, Scene, Shape, Sky, Sun};
+use crate::scene::{CameraKind, DriverFace, Material, Object, Obstacle, Scene, Shape, Sky, Sun};
 
 const OBJECT_KINDS: [&str; 7] = ["plane", "box", "sphere", "cylinder", "cone", "quad", "mesh"];
 
@@ -31,7 +31,7 @@ impl Scene {
         let sun = read_sun(&root)?;
         let sky = read_sky(&root)?;
         let materials = read_materials(&root, file)?;
-        let objects = read_objects(&root, &materials, file)?;
+        let mut objects = read_objects(&root, &materials, file)?;
         let obstacle_table = root
             .table("obstacle")?
             .ok_or_else(|| root.error("obstacle", "the scene needs an [obstacle] table"))?;
@@ -44,7 +44,10 @@ impl Scene {
             )
         })?;
         let eyellipse = crate::scene::eyellipse_keys::read_eyellipse(&root)?;
-        let driver = read_driver(&cameras, &obstacle, eyellipse.as_ref())?;
+        let (driver, face) = read_driver(&cameras, &obstacle, eyellipse.as_ref(), &objects)?;
+        if let Some(head) = face_object(face, driver.position()) {
+            objects.push(head);
+        }
         let frontal = read_frontal(&cameras, &obstacle)?;
         let back = read_back(&cameras, &obstacle)?;
         cameras.finish()?;
@@ -63,6 +66,7 @@ impl Scene {
             back,
             calibration,
             eyellipse,
+            face,
         })
     }
 }
@@ -262,7 +266,7 @@ fn triangle_count(shape: &Shape) -> usize {
     match shape {
         Shape::Plane { .. } | Shape::Quad { .. } => 2,
         Shape::Box { .. } => 12,
-        Shape::Sphere { .. } | Shape::Mesh { .. } => 0,
+        Shape::Sphere { .. } | Shape::Mesh { .. } | Shape::HeadMesh => 0,
         Shape::Cylinder { segments, .. } => 4 * segments,
         Shape::Cone { segments, .. } => 2 * segments,
     }
@@ -284,7 +288,7 @@ fn object_bounds(shape: &Shape) -> Vec<DVec3> {
         Shape::Quad { size: [x, y] } => {
             (DVec3::new(-x, -y, 0.0) / 2.0, DVec3::new(x, y, 0.0) / 2.0)
         }
-        Shape::Mesh { .. } => return Vec::new(),
+        Shape::Mesh { .. } | Shape::HeadMesh => return Vec::new(),
     };
     (0..8)
         .map(|i| {
@@ -455,11 +459,15 @@ fn camera_table<'a>(cameras: &TableReader<'a>, name: &str) -> Result<TableReader
         .ok_or_else(|| cameras.error(name, format!("the scene needs a [camera.{name}] table")))
 }
 
+/// The driver's eye (`[camera.driver]`) and face (`face`, `face_yaw_deg`). `objects` are the
+/// file's own: with the mesh face, none of them may be named `head` (that is the mesh's name;
+/// an object `head` is a face of the file's own, as das's ellipsoid head is).
 fn read_driver(
     cameras: &TableReader,
     obstacle: &Obstacle,
     eyellipse: Option<&crate::scene::eyellipse::Eyellipse>,
-) -> Result<Camera, SceneError> {
+    objects: &[Object],
+) -> Result<(Camera, DriverFace), SceneError> {
     let t = camera_table(cameras, "driver")?;
     // Without a position, the eye is the eyellipse's centre (the cyclopean eye J941 places).
     let eye = t.point("position", eyellipse.map(|e| e.centre.to_array()))?;
@@ -479,8 +487,61 @@ fn read_driver(
             format!("the driver's eye must be on the display's side of the obstacle (d1 > 0 m along the display normal), got d1 = {} m", crate::util::number::short(d1)),
         ));
     }
+    let face = match t.choice("face", "ellipsoids", &DriverFace::NAMES)? {
+        "mesh" => {
+            if objects.iter().any(|o| o.name == FACE_MESH_NAME) {
+                return Err(t.error(
+                    "face",
+                    format!("`mesh` adds the head mesh as the object `{FACE_MESH_NAME}`, but the scene has an [[object]] named `{FACE_MESH_NAME}` (a face of its own): remove the file's face objects, or rename that object"),
+                ));
+            }
+            DriverFace::Mesh {
+                yaw_deg: t.f64_in("face_yaw_deg", 0.0, -MAX_FACE_YAW_DEG, MAX_FACE_YAW_DEG)?,
+            }
+        }
+        _ => {
+            if t.has("face_yaw_deg") {
+                return Err(t.error(
+                    "face_yaw_deg",
+                    "turns the head mesh: only with face = \"mesh\" (the ellipsoid face is the file's own objects; turn them with rotate_deg)",
+                ));
+            }
+            DriverFace::Ellipsoids
+        }
+    };
     t.finish()?;
-    Ok(camera)
+    Ok((camera, face))
+}
+
+/// The object the mesh face adds ([`DriverFace::Mesh`]).
+pub const FACE_MESH_NAME: &str = "head";
+
+/// Largest `face_yaw_deg`, degrees: the yaw fit's search range about facing the back camera.
+pub const MAX_FACE_YAW_DEG: f64 = 80.0;
+
+/// The head mesh of the mesh face: its eye point (the midpoint of the pupils, the mesh's
+/// origin) at the driver's eye `eye` (world), turned by the face's yaw, hidden from the
+/// driver, riding with the head in sequences. `None` for the ellipsoid face.
+pub fn face_object(face: DriverFace, eye: DVec3) -> Option<Object> {
+    let DriverFace::Mesh { yaw_deg } = face else {
+        return None;
+    };
+    Some(Object {
+        name: FACE_MESH_NAME.to_string(),
+        shape: Shape::HeadMesh,
+        material: None,
+        world_from_object: DAffine3::from_translation(eye)
+            * DAffine3::from_rotation_y(yaw_deg.to_radians()),
+        visible_to: 0b111 & !CameraKind::Driver.bit(),
+        casts_shadow: true,
+        hazard: false,
+        motion: crate::scene::motion::ObjectMotion {
+            moves_with: crate::scene::motion::MovesWith::Head,
+            keyframes: Vec::new(),
+            scale: DVec3::ONE,
+            places: Vec::new(),
+        },
+    })
 }
 
 /// A camera mounted on the obstacle: pose from an offset (obstacle frame) and yaw/pitch about

@@ -11,7 +11,7 @@ use obvhs::ray::Ray;
 use obvhs::rt_triangle::RtTriangle;
 
 use crate::scene::limits::check_placed_mesh;
-use crate::scene::mesh_io::{LoadedMesh, load_mesh};
+use crate::scene::mesh_io::{LoadedMesh, shape_mesh};
 use crate::scene::motion::check_keyframed_mesh;
 use crate::scene::shapes::{Tri, box_face, cuboid, frustum, plane_xz, quad_xy};
 use crate::scene::texture::Texture;
@@ -201,10 +201,16 @@ impl World {
                     segments,
                 } => frustum(*radius as f32, 0.0, *height as f32, *segments),
                 Shape::Quad { size } => quad_xy(size2(*size), 0),
-                Shape::Mesh { path } => {
+                Shape::Mesh { .. } | Shape::HeadMesh => {
+                    let path = match &object.shape {
+                        Shape::Mesh { path } => path.clone(),
+                        _ => PathBuf::from("(built-in head mesh)"),
+                    };
+                    let path = &path;
                     // Each file is read once, however many objects place it.
                     if !meshes.contains_key(path) {
-                        meshes.insert(path.clone(), load_mesh(path)?);
+                        let mesh = shape_mesh(&object.shape).expect("a mesh shape")?;
+                        meshes.insert(path.clone(), mesh);
                     }
                     let mesh = &meshes[path];
                     check_placed_mesh(

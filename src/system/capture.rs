@@ -41,6 +41,10 @@ pub struct HeadEstimate {
     /// What the detector found in the back image (`None` with the oracle): every field of
     /// `system::head::FaceDetection`, serialised as it is.
     pub detection: Option<FaceDetection>,
+    /// The yaw fit of the mesh face ([`crate::scene::DriverFace::Mesh`]): the fitted eye,
+    /// yaw, outline residual and margin; absent for the ellipsoid face and the oracle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pose: Option<crate::system::head_pose::HeadPose>,
 }
 
 /// What a method must not read: the driver's true eye and the truth view from it.
@@ -90,7 +94,7 @@ pub fn capture(ctx: &RenderContext, options: &RunOptions, with_depth: bool) -> R
     let render = |camera, view: View| ctx.render(camera, view.bit(), settings, view.name()).0;
     let back = render(&scene.back, View::Back);
     let frontal = render(&scene.frontal, View::Frontal);
-    let (eye, detection) = eye_for_compensation(scene, &back, options)?;
+    let (eye, fix) = eye_for_compensation(scene, &back, options)?;
     let depth = if with_depth {
         let model = SensorModel::resolve(&options.scene_model.sensor, &scene.frontal)?;
         Some(sense(ctx, &scene.frontal, &frontal, model, options.seed))
@@ -101,7 +105,8 @@ pub fn capture(ctx: &RenderContext, options: &RunOptions, with_depth: bool) -> R
         source: options.head,
         eye_world_m: eye.to_array(),
         eye_obstacle_m: scene.obstacle.in_obstacle_frame(eye).to_array(),
-        detection,
+        detection: fix.map(|f| f.detection),
+        pose: fix.and_then(|f| f.pose),
     };
     let mut calibration = calibration_json(scene)?;
     // Before the depth sensor is added: a map made from a capture with depth fits the same

@@ -11,6 +11,7 @@ pub mod eyes;
 pub mod frontal_map;
 pub mod head;
 pub mod head_confidence;
+pub mod head_estimate;
 pub mod head_pose;
 pub mod head_side;
 pub mod memory;

@@ -21,7 +21,9 @@ use crate::system::display::{
     DisplayModel, DisplayPlacement, DisplaySurface, IdealMap, MISSING_ID, resample_through,
 };
 use crate::system::frontal_map::FrontalMap;
-use crate::system::head::{FaceDetection, detect, eye_from_detection, gaussian};
+use crate::system::head::{FaceDetection, gaussian};
+use crate::system::head_estimate::{HeadFix, estimate};
+use crate::system::head_pose::HeadPose;
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use crate::system::report::report;
 use crate::system::scene_model::{check_scene_model, scene_model_display};
@@ -41,6 +43,8 @@ pub struct RunResult {
     /// The eye the compensation used, world frame.
     pub eye_used: DVec3,
     pub detection: Option<FaceDetection>,
+    /// The yaw fit of `--head estimated` on the mesh face ([`crate::scene::DriverFace`]).
+    pub head_pose: Option<HeadPose>,
     /// Display pixels (row-major) that are disocclusion holes: `--method depth` only.
     pub holes: Option<Vec<bool>>,
     /// `run.json`.
@@ -52,24 +56,24 @@ pub fn eye_for_compensation(
     scene: &Scene,
     back: &Frame,
     options: &RunOptions,
-) -> Result<(DVec3, Option<FaceDetection>)> {
+) -> Result<(DVec3, Option<HeadFix>)> {
     let eyes = &options.eyes;
-    let (eye, detection) = match options.head {
+    let (eye, fix) = match options.head {
         HeadSource::Oracle => (eyes.position(&scene.driver, eyes.target), None),
         HeadSource::Estimated => {
-            let detection = detect(back)?;
-            if options.require_confident_head && !detection.confidence.is_confident() {
+            // The believed back camera ([calibration]), not the true one; the tracker the
+            // scene's face calls for.
+            let believed = scene.calibration.back.apply(&scene.back)?;
+            let fix = estimate(scene.face, back, &believed, options.feature_width)?;
+            if options.require_confident_head && !fix.detection.confidence.is_confident() {
                 bail!(
                     "--require-confident-head: {}",
-                    detection.confidence.warning("")
+                    fix.detection.confidence.warning("")
                 );
             }
-            // The believed back camera ([calibration]), not the true one.
-            let believed = scene.calibration.back.apply(&scene.back)?;
-            let cyclopean = eye_from_detection(&detection, &believed, options.feature_width);
             (
-                eyes.target_from_estimate(cyclopean, &scene.obstacle),
-                Some(detection),
+                eyes.target_from_estimate(fix.eye, &scene.obstacle),
+                Some(fix),
             )
         }
         HeadSource::Model => {
@@ -92,7 +96,7 @@ pub fn eye_for_compensation(
             .obstacle
             .world_from_obstacle
             .transform_vector3(error_obstacle),
-        detection,
+        fix,
     ))
 }
 
@@ -384,7 +388,7 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
         Some(f) => f.clone(),
         None => timed(&mut timings, &scene.frontal, View::Frontal),
     };
-    let (eye_used, detection) = eye_for_compensation(scene, &back, options)?;
+    let (eye_used, head_fix) = eye_for_compensation(scene, &back, options)?;
     let (crop, d2_used) = crop_for(scene, eye_used, &frontal, options)?;
     let map = frontal_map(scene, crop, options)?;
 
@@ -500,7 +504,7 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
         options,
         &crop,
         eye_used,
-        detection.as_ref(),
+        head_fix.as_ref(),
         d2_used,
         missing,
         &out,
@@ -526,7 +530,8 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
         seethru,
         crop,
         eye_used,
-        detection,
+        detection: head_fix.map(|f| f.detection),
+        head_pose: head_fix.and_then(|f| f.pose),
         holes: scene_model.map(|m| m.holes),
         report,
     })

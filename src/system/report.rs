@@ -5,9 +5,10 @@ use glam::DVec3;
 use serde_json::json;
 
 use crate::analysis::paper::k_px;
+use crate::scene::DriverFace;
 use crate::scene::Scene;
 use crate::system::compensation::Crop;
-use crate::system::head::FaceDetection;
+use crate::system::head_estimate::HeadFix;
 use crate::system::options::{HeadSource, RunOptions, WorkingDistance};
 use crate::system::tracker_model::WEBCAM_LANDMARKS;
 
@@ -17,7 +18,7 @@ pub fn report(
     options: &RunOptions,
     crop: &Crop,
     eye_used: DVec3,
-    detection: Option<&FaceDetection>,
+    head: Option<&HeadFix>,
     d2_used: Option<f64>,
     missing: f64,
     overflow: &[(&str, f64); 4],
@@ -50,7 +51,10 @@ pub fn report(
         "eye_true": {"world_m": scene.eye().to_array(), "obstacle_m": true_o.to_array(), "paper": paper(true_o)},
         "eye_used": {"world_m": eye_used.to_array(), "obstacle_m": used_o.to_array(), "paper": paper(used_o), "error_m": (eye_used - scene.eye()).length()},
         "head_model": (options.head == HeadSource::Model).then_some(WEBCAM_LANDMARKS),
-        "head_detection": detection.map(|d| json!({"face_box_px": d.face_box, "pupils_px": d.pupils, "feature_px": d.feature_px(), "pupil_areas_px": d.pupil_areas_px, "confidence": d.confidence})),
+        "head_detection": head.map(|h| {
+            let d = &h.detection;
+            json!({"face_box_px": d.face_box, "pupils_px": d.pupils, "feature_px": d.feature_px(), "pupil_areas_px": d.pupil_areas_px, "confidence": d.confidence, "face": face_name(scene.face), "tracker": tracker_name(scene.face), "fit": h.pose})
+        }),
         "d2_m": d2_used.map_or(json!("inf"), |d| json!(d)),
         "frontal_half_angle_deg": scene.frontal.half_angle_x.to_degrees(),
         "crop": {
@@ -64,4 +68,20 @@ pub fn report(
         "missing_fraction": missing,
         "timings_s": timings,
     })
+}
+
+/// The `[camera.driver] face` value of a face.
+pub fn face_name(face: DriverFace) -> &'static str {
+    match face {
+        DriverFace::Ellipsoids => "ellipsoids",
+        DriverFace::Mesh { .. } => "mesh",
+    }
+}
+
+/// What `--head estimated` runs on a face (run.json's `head_detection.tracker`).
+pub fn tracker_name(face: DriverFace) -> &'static str {
+    match face {
+        DriverFace::Ellipsoids => "frontal detector, eqs. d1 and b_h",
+        DriverFace::Mesh { .. } => "side-angle detector, yaw fit",
+    }
 }

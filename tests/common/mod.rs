@@ -37,8 +37,8 @@ pub fn das() -> Scene {
     Scene::load(&repo_path("scenes/das.toml")).expect("das.toml loads")
 }
 
-/// das with its ellipsoid face (head, hair, two pupils) replaced by the head mesh
-/// (`assets/head.obj`, eye point at the driver's eye): what `scenes/das_mesh_head.toml` holds.
+/// das with its ellipsoid face (head, hair, two pupils) replaced by the mesh face
+/// (`[camera.driver] face = "mesh"`): what `scenes/das_mesh_head.toml` holds.
 pub fn das_with_mesh_head() -> String {
     let das = std::fs::read_to_string(repo_path("scenes/das.toml")).unwrap();
     let start = das
@@ -46,17 +46,18 @@ pub fn das_with_mesh_head() -> String {
         .unwrap();
     let end = das.find("# Trees on both sides").unwrap();
     let first = das.find('\n').unwrap();
-    let mesh = "# The driver's head: the head mesh (scene/head_model.rs) instead of das's ellipsoid face,\n\
-                # its origin at the eye point. Otherwise this file is scenes/das.toml: tests/head_poses.rs\n\
-                # checks that it stays so.\n\
-                [[object]]\nname = \"head\"\nkind = \"mesh\"\npath = \"../assets/head.obj\"\n\
-                translate = [1.4, 1.2, 0.0]\nhidden_from = [\"driver\"]\nmoves_with = \"head\"          \
-                # rides with the driver's head in `sequence`\n\n";
-    format!(
-        "# das (scenes/das.toml) with the head mesh as the driver's face: the side-angle head tracker's scene.{}{mesh}{}",
+    let driver = "[camera.driver]\n";
+    let face = "# The driver's face: the head mesh (scene/head_model.rs, assets/head.obj) at the eye,\n\
+                # instead of das's ellipsoid face objects; `--head estimated` fits its yaw. Otherwise\n\
+                # this file is scenes/das.toml: tests/head_poses.rs checks that it stays so.\n\
+                face = \"mesh\"\n";
+    let text = format!(
+        "# das (scenes/das.toml) with the head mesh as the driver's face: the side-angle head tracker's scene.{}{}",
         &das[first..start],
         &das[end..]
-    )
+    );
+    assert!(text.contains(driver));
+    text.replacen(driver, &format!("{driver}{face}"), 1)
 }
 
 /// [`das_with_mesh_head`] with absolute asset paths, so the text can be written anywhere.

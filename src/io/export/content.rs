@@ -14,7 +14,7 @@ use serde_json::json;
 use crate::geometry::camera::Camera;
 use crate::io::atomic::write_atomically;
 use crate::render::sky::SkyModel;
-use crate::scene::mesh_io::load_mesh;
+use crate::scene::mesh_io::shape_mesh;
 use crate::scene::texture::Texture;
 use crate::scene::world::{Ellipsoid, TriAttr, World, view_bit};
 use crate::scene::{Scene, Shape};
@@ -349,8 +349,8 @@ fn ellipsoid_mesh(el: &Ellipsoid, repeat: Vec2) -> Primitive {
 fn material_names(scene: &Scene, world: &World) -> Result<Vec<String>> {
     let mut names: Vec<String> = scene.materials.iter().map(|m| m.name.clone()).collect();
     for object in &scene.objects {
-        if let Shape::Mesh { path } = &object.shape {
-            let file = load_mesh(path)?;
+        if let Some(file) = shape_mesh(&object.shape) {
+            let file = file?;
             names.extend(
                 file.materials
                     .iter()

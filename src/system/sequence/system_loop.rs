@@ -21,6 +21,7 @@ use crate::render::integrator::RenderContext;
 use crate::render::moving::MovingParts;
 use crate::render::settings::{RenderSettings, check_spp};
 use crate::render::sky::SkyModel;
+use crate::scene::DriverFace;
 use crate::scene::Scene;
 use crate::scene::world::{World, view_bit};
 use crate::system::calibration_json::calibration_json;
@@ -30,7 +31,9 @@ use crate::system::display::{
     DisplayModel, DisplayPlacement, DisplaySurface, IdealMap, resample_through,
 };
 use crate::system::frontal_map::FrontalMap;
-use crate::system::head::{DetectError, FaceDetection, detect_in, eye_from_detection, gaussian};
+use crate::system::head::{DetectError, FaceDetection, detect_in, gaussian};
+use crate::system::head_estimate::{detect_face, fix_from, turned_reads};
+use crate::system::head_pose::HeadPose;
 use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
 use crate::system::pipeline::{crop_for, driver_camera, frontal_map, ideal_map};
 use crate::system::point_model::PointModel;
@@ -74,6 +77,9 @@ pub struct Shown {
     pub eye_estimated: DVec3,
     /// The image-based estimate's confidence, [0, 1] (`None` for other head sources).
     pub head_confidence: Option<f64>,
+    /// The yaw fit of the image-based estimate on the mesh face (`None`: the ellipsoid face,
+    /// or another head source).
+    pub head_pose: Option<HeadPose>,
     /// The eye the compensation used (predicted to the refresh time), obstacle frame, m.
     pub eye_used: DVec3,
     pub crop: Crop,
@@ -223,10 +229,15 @@ impl SystemLoop {
     }
 
     /// The head estimate of time `t` (obstacle frame) for refresh `refresh`, and the
-    /// image-based estimate's confidence.
-    fn estimate_head(&mut self, t: f64, refresh: i64) -> Result<(DVec3, Option<f64>)> {
+    /// image-based estimate's confidence and yaw fit.
+    fn estimate_head(
+        &mut self,
+        t: f64,
+        refresh: i64,
+    ) -> Result<(DVec3, Option<f64>, Option<HeadPose>)> {
         let run = self.options.run.clone();
         let mut confidence = None;
+        let mut pose = None;
         let eye = match run.head {
             HeadSource::Oracle => self.rig.eye_in_obstacle(t),
             HeadSource::Model => {
@@ -252,24 +263,27 @@ impl SystemLoop {
                 if !self.track_face {
                     self.back_tracker.region = None;
                 }
-                let (detection, pixels) = self.back_tracker.detect(&ctx, settings);
+                let face = ctx.scene.face;
+                let (detection, pixels) = self.back_tracker.detect(&ctx, face, settings);
                 self.back_pixels += pixels;
                 let detection =
                     detection.with_context(|| format!("head estimate at t = {} s", short(t)))?;
-                if run.require_confident_head && !detection.confidence.is_confident() {
+                // The believed back camera ([calibration]), not the true one; the tracker the
+                // scene's face calls for.
+                let believed = ctx.scene.calibration.back.apply(&back)?;
+                let fix = fix_from(face, detection, &believed, run.feature_width);
+                if run.require_confident_head && !fix.detection.confidence.is_confident() {
                     bail!(
                         "--require-confident-head: {}",
-                        detection
+                        fix.detection
                             .confidence
                             .warning(&format!("at t = {} s: ", short(t)))
                     );
                 }
-                confidence = Some(detection.confidence.value);
-                // The believed back camera ([calibration]), not the true one.
-                let believed = ctx.scene.calibration.back.apply(&back)?;
-                let world = eye_from_detection(&detection, &believed, run.feature_width);
+                confidence = Some(fix.detection.confidence.value);
+                pose = fix.pose;
                 self.seconds.head += start.elapsed().as_secs_f64();
-                ctx.scene.obstacle.in_obstacle_frame(world)
+                ctx.scene.obstacle.in_obstacle_frame(fix.eye)
             }
         };
         let index = (refresh.max(0) as u32).wrapping_mul(3);
@@ -281,6 +295,7 @@ impl SystemLoop {
         Ok((
             eye + (DVec3::from_array(run.head_bias_cm) + jitter) / 100.0,
             confidence,
+            pose,
         ))
     }
 
@@ -295,7 +310,8 @@ impl SystemLoop {
         {
             return Ok(self.shown.as_ref().expect("just checked"));
         }
-        let (eye_estimated, head_confidence) = self.estimate_head(times.head, times.refresh)?;
+        let (eye_estimated, head_confidence, head_pose) =
+            self.estimate_head(times.head, times.refresh)?;
         self.predictor.observe(times.head, eye_estimated);
         let eye_used = match (self.eye_given.take(), self.options.predict) {
             (Some(given), _) => given,
@@ -396,6 +412,7 @@ impl SystemLoop {
                 eye_world_m: eye_world.to_array(),
                 eye_obstacle_m: eye_used.to_array(),
                 detection: None,
+                pose: None,
             };
             let calibration = calibration_json(&geometry)?;
             let fingerprint = fingerprint(&self.frontal, &back, &head, &calibration)?;
@@ -445,6 +462,7 @@ impl SystemLoop {
             times,
             eye_estimated,
             head_confidence,
+            head_pose,
             eye_used,
             crop,
             d2_used,
@@ -547,12 +565,14 @@ fn rect_around(min: DVec2, max: DVec2, camera: &Camera) -> PixelRect {
 }
 
 /// The back camera's image of the head, rendered only where the face can be: the pixels the
-/// last detection depended on ([`detect_in`]), grown by a quarter of their size and 4 px on
-/// each side for the head's motion until the next sample. When the face is not found there
-/// whole, or on the first sample, the whole image is rendered and searched, as
-/// [`crate::system::head::detect`] does. So every estimate is bit for bit the whole image's (but for a skin region larger
-/// than the face wholly outside the region, which the whole image's detector would take for
-/// the face), and each sample depends only on the one before: deterministic.
+/// last detection depended on ([`detect_in`] reports them for the ellipsoid face; for the mesh
+/// face [`turned_reads`] bounds what [`detect_face`] reads, and the pixels outside the region
+/// are blanked), grown by a quarter of their size and 4 px on each side for the head's motion
+/// until the next sample. When the face is not found there whole, or on the first sample, the
+/// whole image is rendered and searched, as [`crate::system::head::detect`] does. So every
+/// estimate is bit for bit the whole image's (but for a skin region larger than the face
+/// wholly outside the region, which the whole image's detector would take for the face), and
+/// each sample depends only on the one before: deterministic.
 struct BackTracker {
     frame: Frame,
     region: Option<PixelRect>,
@@ -566,11 +586,12 @@ impl BackTracker {
         }
     }
 
-    /// The head detection in the back camera's image of `ctx` (its true back camera), and the
-    /// pixels rendered for it.
+    /// The head detection of `face` in the back camera's image of `ctx` (its true back
+    /// camera), and the pixels rendered for it.
     fn detect(
         &mut self,
         ctx: &RenderContext,
+        face: DriverFace,
         settings: RenderSettings,
     ) -> (Result<FaceDetection, DetectError>, u64) {
         let back = ctx.scene.back;
@@ -581,29 +602,57 @@ impl BackTracker {
         let render = |frame: &mut Frame, region: PixelRect| {
             ctx.render_rect(&back, view_bit::BACK, None, settings, region, frame, "back");
         };
+        // The detection in `region` and the pixels it depended on, if they lie inside it.
+        let find = |frame: &mut Frame, region: PixelRect| match face {
+            DriverFace::Ellipsoids => {
+                detect_in(frame, region).map(|found| (found.detection, found.used, found.whole))
+            }
+            DriverFace::Mesh { .. } => {
+                // Only the region's pixels: the rest blank (no skin, no colour step).
+                blank_outside(frame, region);
+                detect_face(face, frame).map(|d| {
+                    let used = turned_reads(&d, &back);
+                    (d, used, contains(region, used))
+                })
+            }
+        };
         let mut pixels = 0;
         let tracked = self.region.and_then(|region| {
             render(&mut self.frame, region);
             pixels += region.pixels();
-            detect_in(&self.frame, region)
-                .ok()
-                .filter(|found| found.whole)
+            find(&mut self.frame, region).ok().filter(|found| found.2)
         });
-        let found = match tracked {
-            Some(found) => found,
+        let (detection, used) = match tracked {
+            Some((detection, used, _)) => (detection, used),
             None => {
                 self.region = None;
                 let full = PixelRect::full(&back);
                 render(&mut self.frame, full);
                 pixels += full.pixels();
-                match detect_in(&self.frame, full) {
-                    Ok(found) => found,
+                match find(&mut self.frame, full) {
+                    Ok((detection, used, _)) => (detection, used),
                     Err(e) => return (Err(e), pixels),
                 }
             }
         };
         // The next search: the pixels used, grown by a quarter of their size and 4 px a side.
-        self.region = Some(found.used.grown(4, 4, &back));
-        (Ok(found.detection), pixels)
+        self.region = Some(used.grown(4, 4, &back));
+        (Ok(detection), pixels)
     }
+}
+
+/// Sets the colour of every pixel outside `region` to black.
+fn blank_outside(frame: &mut Frame, region: PixelRect) {
+    let w = frame.width as usize;
+    for (i, c) in frame.color.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as u32, (i / w) as u32);
+        if x < region.x0 || x >= region.x1 || y < region.y0 || y >= region.y1 {
+            *c = glam::Vec3::ZERO;
+        }
+    }
+}
+
+/// Whether `outer` holds every pixel of `inner`.
+fn contains(outer: PixelRect, inner: PixelRect) -> bool {
+    inner.x0 >= outer.x0 && inner.y0 >= outer.y0 && inner.x1 <= outer.x1 && inner.y1 <= outer.y1
 }
