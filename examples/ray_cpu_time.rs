@@ -54,15 +54,28 @@ fn number<T: std::str::FromStr>(
     }
 }
 
-fn main() -> Result<()> {
+fn main() {
+    if let Err(e) = measure() {
+        eprintln!("error: {e:#}");
+        std::process::exit(2);
+    }
+}
+
+fn measure() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let Some(scene) = args.first() else {
         bail!("usage: ray_cpu_time SCENE [REPEATS in [1, 1000]] [GROW in [1, 1000]]");
     };
     let repeats: usize = number(args.get(1), "REPEATS", 7, "[1, 1000]")?;
     let factor: f64 = number(args.get(2), "GROW", 1.0, "[1, 1000]")?;
-    if !(1..=1000).contains(&repeats) || !(1.0..=1000.0).contains(&factor) || args.len() > 3 {
-        bail!("REPEATS and GROW must be in [1, 1000], and nothing follows them");
+    if !(1..=1000).contains(&repeats) {
+        bail!("REPEATS {repeats} is outside [1, 1000]");
+    }
+    if !(1.0..=1000.0).contains(&factor) {
+        bail!("GROW {factor} is outside [1, 1000]");
+    }
+    if let Some(extra) = args.get(3) {
+        bail!("unexpected argument '{extra}' after GROW");
     }
     rayon::ThreadPoolBuilder::new()
         .num_threads(1)

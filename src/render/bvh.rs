@@ -26,7 +26,7 @@ use crate::scene::world::World;
 
 /// Children per node, a multiple of four (a `Vec4` per four). 8 against 4, measured in CPU
 /// time per ray on one thread (docs/reference/benchmark.md): camera-ray packets 3 % cheaper on
-/// das and 9 % on das grown 10×, single incoherent rays 4–14 %, sun-shadow packets 2–5 %
+/// das and 9 % on das grown 10×, single incoherent rays 4–8 %, sun-shadow packets 2–5 %
 /// dearer; the nodes take 256 bytes (four cache lines) instead of 128.
 pub(crate) const WIDTH: usize = 8;
 const _: () = assert!(WIDTH.is_multiple_of(4));
