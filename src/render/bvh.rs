@@ -1,11 +1,11 @@
 //! A wide bounding volume hierarchy laid out for SIMD traversal of single rays.
 //!
 //! obvhs builds a binary BVH (PLOC, spatial pre-splits, reinsertion; a top-down build where
-//! PLOC would degenerate: [`crate::render::bvh_build`]); this module collapses it
-//! into nodes of [`WIDTH`] = 8 children whose boxes are stored structure-of-arrays, so that
-//! one ray is tested against four of them with a few SSE instructions (glam's `Vec4`, any
-//! x86-64), and a packet of rays against each child in vector lanes
-//! ([`crate::render::bvh_packet`]); and into leaves of primitive packets — four triangles tested together, or single ellipsoids
+//! PLOC would degenerate: [`crate::render::bvh_build`]); this module collapses it into nodes
+//! of [`WIDTH`] = 8 children whose boxes are stored structure-of-arrays, so that one ray is
+//! tested against four of them with a few SSE instructions (glam's `Vec4`, any x86-64), and a
+//! packet of rays against each child in vector lanes (`render/bvh_packet.rs`); and into
+//! leaves of primitive packets — four triangles tested together, or single ellipsoids
 //! ([`crate::render::packets`]).
 //!
 //! Traversal keeps the ray's `tmax` at the closest hit so far, visits children near to far,
