@@ -18,7 +18,7 @@ use glam::Vec3A;
 
 use crate::render::bvh::{
     Bvh, COUNT_MASK, COUNT_SHIFT, ELLIPSOIDS, EMPTY, EXIT_ROUND_UP, FIRST_MASK, LEAF, NO_PRIM,
-    Node, STACK, WIDTH,
+    Node, STACK, WIDTH, max, min,
 };
 use crate::render::packets::{TRI_LANES, Triangles4, closer};
 use crate::render::ray::{Hit, TraceRay};
@@ -172,17 +172,6 @@ impl<const N: usize> Lanes<N> {
         p.tmax[base..base + N].copy_from_slice(&self.tmax);
         p.prim[base..base + N].copy_from_slice(&self.prim);
     }
-}
-
-/// SSE's `minps`/`maxps` (the second operand where either is NaN), as `bvh.rs`'s box test.
-#[inline(always)]
-fn min(a: f32, b: f32) -> f32 {
-    if a < b { a } else { b }
-}
-
-#[inline(always)]
-fn max(a: f32, b: f32) -> f32 {
-    if a > b { a } else { b }
 }
 
 /// Lanes of a kernel: `true` where the lane's ray takes part. Kept as one `bool` per lane, not
@@ -426,7 +415,7 @@ fn closest_lanes<const N: usize>(
             entries[c][..N].copy_from_slice(&e);
             n += 1;
         }
-        // Far to near (a sorting network would do; four keys at most).
+        // Far to near (insertion sort: a few keys).
         for a in 1..n {
             let mut b = a;
             while b > 0 && keys[b - 1] < keys[b] {
