@@ -4,7 +4,8 @@
     python3 -m venv /tmp/exr && /tmp/exr/bin/pip install "opencv-python-headless<5" OpenEXR numpy
     /tmp/exr/bin/python tools/check_exr.py out/
 
-OpenCV (IMREAD_UNCHANGED) must return the colour as a 4-channel float32 image; the OpenEXR
+OpenCV (IMREAD_UNCHANGED) must return the colour as a float32 image (4 channels, or 3 for the
+lean set, which has no A); the OpenEXR
 binding must list the AOV layers docs/reference/outputs.md documents (every AOV of `--exr all`,
 or the lean set of `run`'s default `--exr lean`). Exits 1 when a reader fails.
 """
