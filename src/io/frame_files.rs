@@ -174,7 +174,7 @@ pub fn write_colour_exr(frame: &Frame, path: &Path) -> Result<()> {
 
 /// The lossless compression of every EXR seethru writes: ZIP over blocks of 16 scan lines
 /// (exact for f32 and u32 samples), deflated fast and in parallel by [`exr_zip`]. On das's
-/// `run` it took a quarter of PIZ's CPU for a folder 14 % larger (docs/guide/performance.md
+/// `run` it took about a third of PIZ's CPU for a folder 14 % larger (docs/guide/performance.md
 /// has the figures). Every OpenEXR reader (OpenCV, imageio, Blender, Nuke) reads it.
 pub const EXR_COMPRESSION: Compression = exr_zip::COMPRESSION;
 
