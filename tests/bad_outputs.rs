@@ -8,10 +8,11 @@ use std::process::Command;
 
 use common::refusal::{RENDER, listing, refused, run_in};
 
-/// A finished run of the minimal scene in `dir/run` (truth, seethru and occluded EXRs).
+/// A finished run of the minimal scene in `dir/run` (truth, seethru and occluded EXRs with
+/// every AOV, as `measure` reads them).
 fn finished_run(dir: &Path) -> PathBuf {
     std::fs::write(dir.join("scene.toml"), common::MINIMAL).unwrap();
-    let (code, err) = run_in(dir, &["run", "scene.toml", "--out", "run"]);
+    let (code, err) = run_in(dir, &["run", "scene.toml", "--out", "run", "--exr", "all"]);
     assert_eq!(code, 0, "{err}");
     dir.join("run")
 }

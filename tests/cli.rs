@@ -184,6 +184,8 @@ fn run_writes_six_views_run_json_and_metrics_and_measure_recomputes_them() {
         "1",
         "--head",
         "oracle",
+        "--exr",
+        "all",
     ]);
     assert!(ok, "{err}");
     for view in ["truth", "occluded", "frontal", "back", "display", "seethru"] {

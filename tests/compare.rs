@@ -167,6 +167,8 @@ fn compare_writes_one_row_and_one_strip_per_method_as_run_measures_them() {
                 run_out.to_str().unwrap(),
                 "--method",
                 "depth",
+                "--exr",
+                "all",
             ],
             small.to_vec(),
         ]

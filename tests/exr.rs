@@ -143,13 +143,41 @@ fn exr_content_writes_what_it_names() {
     let (out, all) = names(ExrContent::All);
     assert_eq!(all, colour);
     assert!(frame.bit_identical(&read_exr(&out.join("truth.exr")).unwrap()));
+    let all_channels = channels(&out.join("truth.exr"));
+    // Lean: the channels of `all` less A, P and camera_z.Z, every bit of them.
+    let (out, lean) = names(ExrContent::Lean);
+    assert_eq!(lean, colour);
+    let read = channels(&out.join("truth.exr"));
+    let mut read_names: Vec<&str> = read.iter().map(|(n, _)| n.as_str()).collect();
+    read_names.sort();
+    assert_eq!(
+        read_names,
+        [
+            "B",
+            "G",
+            "N.X",
+            "N.Y",
+            "N.Z",
+            "R",
+            "Z",
+            "id.object",
+            "id.part"
+        ]
+    );
+    for (name, samples) in &read {
+        let (_, full) = all_channels.iter().find(|(n, _)| n == name).unwrap();
+        assert_eq!(bits(samples), bits(full), "channel {name}");
+    }
+    let (_, z) = read.iter().find(|(n, _)| n == "Z").unwrap();
+    let depth: Vec<u32> = frame.depth.iter().map(|d| d.to_bits()).collect();
+    assert_eq!(bits(z), depth);
 }
 
 #[test]
 fn measuring_a_run_without_aovs_names_the_flag() {
     let frame = rendered();
     let dir = tempfile::tempdir().unwrap();
-    for content in [ExrContent::Colour, ExrContent::None] {
+    for content in [ExrContent::Lean, ExrContent::Colour, ExrContent::None] {
         let out = dir.path().join(format!("{content:?}"));
         for view in ["truth", "seethru", "occluded"] {
             write_frame(&frame, &out, view, content).unwrap();
@@ -166,6 +194,102 @@ fn measuring_a_run_without_aovs_names_the_flag() {
         write_frame(&frame, &out, view, ExrContent::All).unwrap();
     }
     assert!(read_measured_frames(&out).unwrap()[0].bit_identical(&frame));
+}
+
+#[test]
+fn seethru_zip_matches_the_exr_crates_zip_and_ignores_the_thread_count() {
+    use seethru::io::exr_zip;
+    // A rendered frame's every AOV, at a height that leaves a partial block of 16 lines.
+    let frame = rendered();
+    assert_ne!(frame.height % 16, 0);
+    let dir = tempfile::tempdir().unwrap();
+    let ours = dir.path().join("ours.exr");
+    write_frame(&frame, dir.path(), "ours", ExrContent::All).unwrap();
+    let meta = exr::meta::MetaData::read_from_file(&ours, false).unwrap();
+    assert_eq!(meta.headers[0].compression, Compression::ZIP16);
+    assert_eq!(exr_zip::COMPRESSION, Compression::ZIP16);
+    assert!(frame.bit_identical(&read_exr(&ours).unwrap()));
+    // The twin: the frame's channels through the exr crate's own ZIP16 writer.
+    let theirs = dir.path().join("theirs.exr");
+    let f32s = |name: &'static str, v: Vec<f32>| AnyChannel::new(name, FlatSamples::F32(v));
+    let axis = |v: &[glam::Vec3], k: usize| v.iter().map(|p| p[k]).collect::<Vec<f32>>();
+    let mut list = vec![
+        f32s("A", vec![1.0; frame.color.len()]),
+        f32s("Z", frame.depth.clone()),
+        f32s("camera_z.Z", frame.camera_z.clone()),
+        AnyChannel::new("id.object", FlatSamples::U32(frame.object_id.clone())),
+        AnyChannel::new("id.part", FlatSamples::U32(frame.part_id.clone())),
+    ];
+    for (k, [c, p, n]) in [
+        ["R", "P.X", "N.X"],
+        ["G", "P.Y", "N.Y"],
+        ["B", "P.Z", "N.Z"],
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        list.push(f32s(c, axis(&frame.color, k)));
+        list.push(f32s(p, axis(&frame.position, k)));
+        list.push(f32s(n, axis(&frame.normal, k)));
+    }
+    let copy = Layer::new(
+        (frame.width as usize, frame.height as usize),
+        LayerAttributes::default(),
+        Encoding {
+            compression: Compression::ZIP16,
+            ..Encoding::UNCOMPRESSED
+        },
+        AnyChannels::sort(SmallVec::from_vec(list)),
+    );
+    Image::from_layer(copy).write().to_file(&theirs).unwrap();
+    let (a, b) = (channels(&ours), channels(&theirs));
+    assert_eq!(a.len(), 14);
+    for ((na, sa), (nb, sb)) in a.iter().zip(&b) {
+        assert_eq!(na, nb);
+        assert_eq!(bits(sa), bits(sb), "channel {na}");
+    }
+    // Faster than the exr crate's deflate, so not its bytes; smaller than raw samples.
+    let (size_ours, size_theirs) = (
+        std::fs::metadata(&ours).unwrap().len(),
+        std::fs::metadata(&theirs).unwrap().len(),
+    );
+    assert!(size_ours < 14 * 4 * frame.color.len() as u64 * 3 / 4);
+    assert!(
+        size_ours < size_theirs * 3 / 2,
+        "{size_ours} vs {size_theirs}"
+    );
+    // The same bytes on one thread and on three.
+    let bytes_on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let path = dir.path().join(format!("t{threads}.exr"));
+        pool.install(|| write_frame(&frame, dir.path(), &format!("t{threads}"), ExrContent::All))
+            .unwrap();
+        std::fs::read(path).unwrap()
+    };
+    let one = bytes_on(1);
+    assert!(one == std::fs::read(&ours).unwrap(), "bytes differ");
+    assert!(one == bytes_on(3), "bytes differ on 3 threads");
+    // Many blocks (38 of 16 lines), more than one thread's share of them at a time.
+    let (width, height) = (131usize, 600usize);
+    let noise: Vec<f32> = (0..width * height)
+        .map(|i| (hash_u32(i as u32) % 1000) as f32 * 0.01)
+        .collect();
+    let tall_on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let path = dir.path().join(format!("tall{threads}.exr"));
+        let list = vec![AnyChannel::new("Y", FlatSamples::F32(noise.clone()))];
+        pool.install(|| write_exr_channels(&path, width as u32, height as u32, list))
+            .unwrap();
+        std::fs::read(path).unwrap()
+    };
+    assert!(tall_on(1) == tall_on(3), "bytes differ on 3 threads");
+    assert!(tall_on(1) == tall_on(16), "bytes differ on 16 threads");
 }
 
 /// The R, G, B bits of an EXR's channels, for comparing the colour of two files.

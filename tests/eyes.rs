@@ -205,7 +205,16 @@ fn analyze_prints_the_mismatch_the_renderer_measures_on_a_plane() {
 fn measure_recomputes_a_one_eye_run_from_that_eye() {
     let out = tempfile::tempdir().unwrap();
     let dir = out.path().to_str().unwrap();
-    let args = ["run", "scenes/wall_brown.toml", "--out", dir, "--d2", "6"];
+    let args = [
+        "run",
+        "scenes/wall_brown.toml",
+        "--out",
+        dir,
+        "--d2",
+        "6",
+        "--exr",
+        "all",
+    ];
     let (ok, _, err) = common::seethru(&[&args[..], &["--eyes", "left", "--quiet"]].concat());
     assert!(ok, "{err}");
     let written = std::fs::read_to_string(out.path().join("metrics.json")).unwrap();

@@ -121,6 +121,48 @@ fn estimates_grow_with_what_they_count() {
 }
 
 #[test]
+fn the_bench_estimate_counts_its_batches_at_their_size() {
+    use seethru::render::integrator::RenderContext;
+    use seethru::render::throughput::{
+        BatchRay, camera_batch, cosine_batch, shadow_batch, trace_closest_per_ray,
+    };
+    use seethru::render::views::View;
+    // The buffers `bench` holds, built as it builds them on das's truth view.
+    let ctx = RenderContext::new(das()).unwrap();
+    let (w, h) = (160, 90);
+    let camera = View::Truth.camera(&ctx.scene).with_resolution(w, h);
+    let primary = camera_batch(&camera, View::Truth.bit());
+    let mut hits = vec![None; primary.rays.len()];
+    trace_closest_per_ray(&ctx.accel, &primary, &mut hits);
+    let world = &ctx.world;
+    let shadow = shadow_batch(world, &primary, &hits, ctx.sky.sun_direction);
+    let incoherent = cosine_batch(world, &primary, &hits);
+    let rays = primary.rays.len() + shadow.rays.len() + incoherent.rays.len();
+    // Packet and per-ray primary hits, incoherent hits; two shadow flags, incoherent flags.
+    let held = rays * size_of::<BatchRay>()
+        + (2 * primary.rays.len() + incoherent.rays.len())
+            * size_of::<Option<seethru::render::accel::Hit>>()
+        + 2 * shadow.rays.len()
+        + incoherent.rays.len();
+    let pixels = (w * h) as f64;
+    let held = held as f64 / pixels;
+    let scene = das();
+    let bench = |w, h| bench_estimate(&scene, w, h, 1.0).unwrap().bytes;
+    let frame = seethru::render::frame::Frame::BYTES_PER_PIXEL as f64;
+    let counted = (bench(2000, 1000) - bench(1000, 1000)) as f64 / 1e6 - frame;
+    // An upper bound (a shadow or incoherent ray at every pixel), and not a loose one: das's
+    // view has sky and unlit pixels, which hold no such ray.
+    assert!(
+        counted >= held,
+        "{counted} bytes per pixel counted, {held} held"
+    );
+    assert!(
+        counted < 1.5 * held,
+        "{counted} bytes per pixel counted, {held} held"
+    );
+}
+
+#[test]
 fn a_limit_below_the_estimate_refuses_before_anything_is_written() {
     let scratch = tempfile::tempdir().unwrap();
     let out = scratch.path().join("report");

@@ -70,7 +70,7 @@ def cli_run(tmp_path_factory) -> pathlib.Path:
     out = tmp_path_factory.mktemp("run")
     done = seethru_cli(
         "run", str(SCENE), "--width", str(WIDTH), "--spp", str(SPP),
-        "--method", "planar", "--d2", "auto", "--out", str(out),
+        "--method", "planar", "--d2", "auto", "--out", str(out), "--exr", "all",
     )
     assert done.returncode == 0, done.stderr
     return out

@@ -55,7 +55,7 @@ fn run_once(scene: &Path, out: &Path, exr: &str) -> Result<()> {
 }
 
 /// The report lines and the JSON of the run benchmark: `repeat` (at most 3) timed runs with
-/// the default `--exr all`, then one with `--exr colour` and one with `--exr none`.
+/// the default `--exr lean`, then one each with `--exr all`, `colour` and `none`.
 pub fn bench_run(scene: &Path, repeat: usize) -> Result<(Vec<String>, serde_json::Value)> {
     let scratch: PathBuf =
         std::env::temp_dir().join(format!("seethru-bench-run-{}", std::process::id()));
@@ -66,7 +66,13 @@ pub fn bench_run(scene: &Path, repeat: usize) -> Result<(Vec<String>, serde_json
             "run          seethru run SCENE (its defaults) into a scratch folder; wall s, CPU s (user + system, all threads), folder MB".to_string(),
         ];
         let mut out = serde_json::Map::new();
-        for (exr, times) in [("all", repeat.clamp(1, 3)), ("colour", 1), ("none", 1)] {
+        let runs = [
+            ("lean", repeat.clamp(1, 3)),
+            ("all", 1),
+            ("colour", 1),
+            ("none", 1),
+        ];
+        for (exr, times) in runs {
             let (mut walls, mut cpus) = (Vec::new(), Vec::new());
             for _ in 0..times {
                 let _ = std::fs::remove_dir_all(&scratch);

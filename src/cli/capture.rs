@@ -9,9 +9,7 @@ use anyhow::{Result, bail};
 use exr::prelude::{AnyChannel, FlatSamples};
 use seethru::io::atomic::write_text;
 use seethru::io::display_map::write_npy_f32;
-use seethru::io::frame_files::{
-    ExrContent, write_color_png, write_colour_exr as write_rgba_exr, write_exr, write_exr_channels,
-};
+use seethru::io::frame_files::{ExrContent, write_color_png, write_exr_channels, write_view_exr};
 use seethru::io::staged::StagedDir;
 use seethru::render::frame::Frame;
 use seethru::render::integrator::RenderContext;
@@ -83,8 +81,9 @@ pub struct CaptureArgs {
     #[command(flatten)]
     pub scene_model: SceneModelArgs,
     /// Which EXRs the capture writes: all (frontal.exr and back.exr in colour, depth.exr with
-    /// --depth, truth/truth.exr with every AOV), colour (the colour EXRs only: truth/truth.exr
-    /// is R, G, B, A, no depth.exr) or none (PNGs, depth.npy and the JSON files only).
+    /// --depth, truth/truth.exr with every AOV), lean (as all, truth/truth.exr with R, G, B,
+    /// Z, N and the ids), colour (the colour EXRs only: truth/truth.exr is R, G, B, A, no
+    /// depth.exr) or none (PNGs, depth.npy and the JSON files only).
     #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
     pub exr: ExrContent,
     /// Sizes of the driver's view (the truth), samples, threads.
@@ -240,8 +239,9 @@ pub fn write_capture(
             .collect();
         let [w, h] = [d.camera.width, d.camera.height];
         write_npy_f32(&out.join("depth.npy"), &[h as usize, w as usize], &depth)?;
-        // depth.exr is no colour: only `--exr all` writes it (depth.npy holds the same).
-        if exr == ExrContent::All {
+        // depth.exr is no colour: only `--exr lean` and `all` write it (depth.npy holds the
+        // same).
+        if matches!(exr, ExrContent::Lean | ExrContent::All) {
             write_exr_channels(
                 &out.join("depth.exr"),
                 w,
@@ -265,11 +265,7 @@ pub fn write_capture(
         &serde_json::to_string_pretty(&c.calibration)?,
     )?;
     let truth = out.join("truth");
-    match exr {
-        ExrContent::None => {}
-        ExrContent::Colour => write_rgba_exr(&c.truth.truth, &truth.join("truth.exr"))?,
-        ExrContent::All => write_exr(&c.truth.truth, &truth.join("truth.exr"))?,
-    }
+    write_view_exr(&c.truth.truth, &truth.join("truth.exr"), exr)?;
     write_color_png(&c.truth.truth, &truth.join("truth.png"))?;
     write_text(
         &truth.join("truth.json"),

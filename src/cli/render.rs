@@ -24,7 +24,8 @@ pub struct Render {
     /// Output directory.
     #[arg(long)]
     out: PathBuf,
-    /// What each view's EXR holds: none, colour (R, G, B, A) or all (every AOV).
+    /// What each view's EXR holds: none, colour (R, G, B, A), lean (R, G, B, Z, N and the
+    /// ids) or all (every AOV).
     #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
     exr: ExrContent,
     #[command(flatten)]
@@ -90,11 +91,7 @@ fn render_views(
     seethru::util::progress::summary(format!(
         "rendered {} ({} each) → {}",
         rendered.join(", "),
-        match exr {
-            ExrContent::None => "PNG, ids PNG",
-            ExrContent::Colour => "PNG, ids PNG, colour EXR",
-            ExrContent::All => "PNG, ids PNG, EXR",
-        },
+        exr.files(),
         out.display()
     ));
     Ok(())

@@ -81,9 +81,10 @@ pub struct Run {
     /// The eye the compensation serves.
     #[arg(long = "target-eye", value_enum, value_parser = choice::<Eye>(), default_value_t = Eye::Cyclopean)]
     target_eye: Eye,
-    /// What each view's EXR holds: none, colour (R, G, B, A) or all (every AOV, what
+    /// What each view's EXR holds: none; colour (R, G, B, A); lean (R, G, B, Z, N and the
+    /// ids: every AOV that no other channel gives); all (lean with A, P and camera_z.Z: what
     /// `seethru measure` reads back).
-    #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
+    #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::Lean)]
     exr: ExrContent,
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     #[arg(long, default_value_t = 5, value_parser = band)]
@@ -221,11 +222,7 @@ fn run_command(
         })?
     } else {
         write_run(&ctx, staged.path(), options, writes)?;
-        let files = match writes.exr {
-            ExrContent::None => "PNG, ids PNG",
-            ExrContent::Colour => "PNG, ids PNG, colour EXR",
-            ExrContent::All => "PNG, ids PNG, EXR",
-        };
+        let files = writes.exr.files();
         let (kind, metrics) = read_results(staged.path())?;
         format!(
             "{}; wrote the six views ({files}), run.json and the metrics to {}",

@@ -47,7 +47,7 @@ pub struct Score {
     #[arg(long, value_parser = threads)]
     threads: Option<usize>,
     /// What each view's EXR holds, as `run --exr`: all (every AOV, what `measure` reads),
-    /// colour (R, G, B, A only) or none (the PNGs only).
+    /// lean (R, G, B, Z, N and the ids), colour (R, G, B, A only) or none (the PNGs only).
     #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
     exr: ExrContent,
 }

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use seethru::io::atomic::write_text;
-use seethru::io::frame_files::{ExrContent, write_color_png, write_colour_exr, write_exr};
+use seethru::io::frame_files::{ExrContent, write_color_png, write_view_exr};
 use seethru::io::staged::StagedDir;
 use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
 use seethru::measure::headline::{RunKind, summary_text};
@@ -143,7 +143,8 @@ pub struct Sequence {
     #[arg(long, value_enum, value_parser = choice::<FramesFormat>(), default_value_t = FramesFormat::None)]
     frames: FramesFormat,
     /// What the EXRs of --frames exr and of --capture's folders hold, as `capture --exr`:
-    /// all (every AOV), colour (R, G, B, A only) or none (--capture: PNGs and JSON only).
+    /// all (every AOV), lean (R, G, B, Z, N and the ids), colour (R, G, B, A only) or none
+    /// (--capture: PNGs and JSON only).
     #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
     exr: ExrContent,
     /// none: the whole frontal image in the display; planar: the paper's compensation.
@@ -389,13 +390,9 @@ impl Sequence {
                         write_color_png(f.truth, &name("truth", "png"))?;
                         write_color_png(f.seethru, &name("seethru", "png"))
                     }
-                    FramesFormat::Exr if self.exr == ExrContent::Colour => {
-                        write_colour_exr(f.truth, &name("truth", "exr"))?;
-                        write_colour_exr(f.seethru, &name("seethru", "exr"))
-                    }
                     FramesFormat::Exr => {
-                        write_exr(f.truth, &name("truth", "exr"))?;
-                        write_exr(f.seethru, &name("seethru", "exr"))
+                        write_view_exr(f.truth, &name("truth", "exr"), self.exr)?;
+                        write_view_exr(f.seethru, &name("seethru", "exr"), self.exr)
                     }
                 }
             })?;

@@ -9,6 +9,7 @@ use exr::prelude::*;
 use glam::Vec3;
 
 use crate::io::atomic::write_atomically;
+use crate::io::exr_zip;
 use crate::render::frame::Frame;
 use crate::scene::limits::{MAX_COORDINATE, MAX_PIXELS, MAX_RESOLUTION};
 use crate::util::color::encode_srgb8;
@@ -92,32 +93,65 @@ pub enum ExrContent {
     None,
     /// The colour only: `R`, `G`, `B`, `A` (linear f32), about a quarter of `all`.
     Colour,
+    /// The AOVs no other channel gives: `R`, `G`, `B`, `Z`, `N`, `id.object`, `id.part`
+    /// (no `A`, every pixel being opaque; no `P` or `camera_z.Z`, which follow from `Z`
+    /// and the camera to f32 rounding), about 70 % of `all`: `run`'s default.
+    Lean,
     /// Every AOV ([`channel`]): what `seethru measure` reads back.
     #[default]
     All,
 }
 
+impl ExrContent {
+    /// The files each view gets, for a command's summary line.
+    pub fn files(self) -> &'static str {
+        match self {
+            ExrContent::None => "PNG, ids PNG",
+            ExrContent::Colour => "PNG, ids PNG, colour EXR",
+            ExrContent::Lean => "PNG, ids PNG, lean EXR",
+            ExrContent::All => "PNG, ids PNG, EXR",
+        }
+    }
+}
+
 /// Every AOV in one EXR, under the names of [`channel`].
 pub fn write_exr(frame: &Frame, path: &Path) -> Result<()> {
-    let mut channels = colour_channels(frame);
-    channels.push(AnyChannel::new(
-        channel::Z,
-        FlatSamples::F32(frame.depth.clone()),
-    ));
-    channels.push(AnyChannel::new(
-        channel::CAMERA_Z,
-        FlatSamples::F32(frame.camera_z.clone()),
-    ));
-    channels.extend(vec_channels(channel::P, &frame.position));
-    channels.extend(vec_channels(channel::N, &frame.normal));
-    channels.push(AnyChannel::new(
-        channel::OBJECT_ID,
-        FlatSamples::U32(frame.object_id.clone()),
-    ));
-    channels.push(AnyChannel::new(
-        channel::PART_ID,
-        FlatSamples::U32(frame.part_id.clone()),
-    ));
+    write_view_exr(frame, path, ExrContent::All)
+}
+
+/// The channels of `content` in one EXR at `path`; nothing for [`ExrContent::None`].
+pub fn write_view_exr(frame: &Frame, path: &Path, content: ExrContent) -> Result<()> {
+    let mut channels = match content {
+        ExrContent::None => return Ok(()),
+        ExrContent::Lean => vec_channels(
+            [channel::RGBA[0], channel::RGBA[1], channel::RGBA[2]],
+            &frame.color,
+        )
+        .into(),
+        ExrContent::Colour | ExrContent::All => colour_channels(frame),
+    };
+    if matches!(content, ExrContent::Lean | ExrContent::All) {
+        channels.push(AnyChannel::new(
+            channel::Z,
+            FlatSamples::F32(frame.depth.clone()),
+        ));
+        channels.extend(vec_channels(channel::N, &frame.normal));
+        channels.push(AnyChannel::new(
+            channel::OBJECT_ID,
+            FlatSamples::U32(frame.object_id.clone()),
+        ));
+        channels.push(AnyChannel::new(
+            channel::PART_ID,
+            FlatSamples::U32(frame.part_id.clone()),
+        ));
+    }
+    if content == ExrContent::All {
+        channels.push(AnyChannel::new(
+            channel::CAMERA_Z,
+            FlatSamples::F32(frame.camera_z.clone()),
+        ));
+        channels.extend(vec_channels(channel::P, &frame.position));
+    }
     write_exr_channels(path, frame.width, frame.height, channels)
 }
 
@@ -135,15 +169,14 @@ fn colour_channels(frame: &Frame) -> Vec<AnyChannel<FlatSamples>> {
 
 /// The colour alone in one EXR (`R`, `G`, `B`, `A`): what image viewers show.
 pub fn write_colour_exr(frame: &Frame, path: &Path) -> Result<()> {
-    write_exr_channels(path, frame.width, frame.height, colour_channels(frame))
+    write_view_exr(frame, path, ExrContent::Colour)
 }
 
-/// The lossless compression of every EXR seethru writes: PIZ (wavelet + Huffman, exact for
-/// f32 and u32 samples). On das's `run` it gave the smallest folder of RLE, ZIP1, ZIP16 and
-/// PIZ (89 MB against ZIP16's 95 and 230 uncompressed) for the least CPU of the three
-/// compressors that beat RLE (docs/guide/performance.md has the figures). Every OpenEXR
-/// reader (OpenCV, imageio, Blender, Nuke) reads it.
-pub const EXR_COMPRESSION: Compression = Compression::PIZ;
+/// The lossless compression of every EXR seethru writes: ZIP over blocks of 16 scan lines
+/// (exact for f32 and u32 samples), deflated fast and in parallel by [`exr_zip`]. On das's
+/// `run` it took about a third of PIZ's CPU for a folder 14 % larger (docs/guide/performance.md
+/// has the figures). Every OpenEXR reader (OpenCV, imageio, Blender, Nuke) reads it.
+pub const EXR_COMPRESSION: Compression = exr_zip::COMPRESSION;
 
 /// Writes named channels of a `width`×`height` image as one single-part EXR (no layer name,
 /// so that readers of the "first RGBA layer" find plain `R`, `G`, `B`).
@@ -164,7 +197,7 @@ pub fn write_exr_channels(
         AnyChannels::sort(SmallVec::from_vec(channels)),
     );
     let image = Image::from_layer(layer);
-    write_atomically(path, |file| Ok(image.write().to_buffered(file)?))
+    write_atomically(path, |file| Ok(exr_zip::write(&image, file)?))
 }
 
 /// Most channels an EXR may have to be read as a frame (seethru writes 14).
@@ -269,7 +302,9 @@ pub fn read_exr_from<R: std::io::Read + std::io::Seek + Send>(
             .iter()
             .find(|c| c.name.to_string() == name)
             .map(|c| &c.sample_data)
-            .with_context(|| format!("no channel `{name}` (not written by seethru?)"))?;
+            .with_context(|| {
+                format!("no channel `{name}` (not written by seethru with `--exr all`?)")
+            })?;
         if samples.len() != pixels {
             bail!(
                 "channel `{name}` has {} samples for {width}×{height} pixels",
@@ -375,10 +410,5 @@ fn sample_type(samples: &FlatSamples) -> &'static str {
 pub fn write_frame(frame: &Frame, dir: &Path, name: &str, exr: ExrContent) -> Result<()> {
     write_color_png(frame, &dir.join(format!("{name}.png")))?;
     write_id_png(frame, &dir.join(format!("{name}_ids.png")))?;
-    let path = dir.join(format!("{name}.exr"));
-    match exr {
-        ExrContent::None => Ok(()),
-        ExrContent::Colour => write_colour_exr(frame, &path),
-        ExrContent::All => write_exr(frame, &path),
-    }
+    write_view_exr(frame, &dir.join(format!("{name}.exr")), exr)
 }

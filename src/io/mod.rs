@@ -7,6 +7,7 @@ pub mod caption;
 pub mod colour_bar;
 pub mod display_map;
 pub mod export;
+pub mod exr_zip;
 pub mod frame_files;
 pub mod junit;
 pub mod plot;

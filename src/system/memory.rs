@@ -9,7 +9,7 @@ use std::mem::size_of;
 use crate::geometry::camera::Camera;
 use crate::render::accel::Hit;
 use crate::render::frame::Frame;
-use crate::render::ray::TraceRay;
+use crate::render::throughput::BatchRay;
 use crate::scene::Scene;
 use crate::scene::world::World;
 use crate::system::options::RunOptions;
@@ -148,15 +148,16 @@ pub fn sequence_estimate(
 /// 333 bytes on das grown 50×, 576 grown 1000×, docs/reference/benchmark.md).
 const GROWN_TRIANGLE_BYTES: u64 = 640;
 
-/// `bench`: the trace-only batches at `width`×`height` (primary, shadow and incoherent rays,
-/// their hits and any-hit flags) and one shaded frame, all held while the scene grown
+/// `bench`: the trace-only batches at `width`×`height` (primary, shadow and incoherent rays
+/// of 24 bytes, at most one of each per pixel; the packet and per-ray primary hits and the
+/// incoherent hits; the packet and per-ray shadow flags and the incoherent ones) and one shaded frame, all held while the scene grown
 /// `grow`× is traced; then the `run` it times at the scene's own sizes, with the batches
 /// still held.
 pub fn bench_estimate(scene: &Scene, width: u32, height: u32, grow: f64) -> Result<MemoryEstimate> {
     let pixels = width as u64 * height as u64;
-    let per_pixel = 3 * size_of::<TraceRay>() as u64
-        + 2 * size_of::<Option<Hit>>() as u64
-        + 1
+    let per_pixel = 3 * size_of::<BatchRay>() as u64
+        + 3 * size_of::<Option<Hit>>() as u64
+        + 3 * size_of::<bool>() as u64
         + FRAME_BYTES_PER_PIXEL;
     let triangles = World::build(scene)?.triangles.len() as u64;
     let grown = (triangles as f64 * grow).ceil() as u64;
