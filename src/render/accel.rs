@@ -27,6 +27,7 @@ use crate::scene::world::World;
 pub use crate::render::ray::Hit;
 
 /// The primitives of one visibility class and their hierarchy.
+#[derive(Clone)]
 struct Group {
     /// Views that show the group ([`crate::scene::world::view_bit`]).
     views: u8,
@@ -66,10 +67,11 @@ thread_local! {
     static STACK: RefCell<Stack> = RefCell::new(Stack::new());
 }
 
+#[derive(Clone)]
 pub struct Accel {
     /// Largest group first, so that the others are searched with a short `tmax`.
     groups: Vec<Group>,
-    /// Wall time of the hierarchy build.
+    /// Wall time of the hierarchy build (or refit).
     pub build_time: Duration,
 }
 
@@ -142,6 +144,25 @@ impl Accel {
             groups,
             build_time: start.elapsed(),
         })
+    }
+
+    /// These hierarchies carried over to `world`, the world they were built on with its
+    /// primitives moved (same primitives, indices and visibility): [`Bvh::refit`] per group.
+    /// Every query answers as [`Accel::build`] of `world` would, bit for bit; the boxes are
+    /// looser where primitives moved apart or were split at build ([`Accel::area`]).
+    pub fn refit(&self, world: &World) -> Accel {
+        let start = Instant::now();
+        let mut refitted = self.clone();
+        for group in &mut refitted.groups {
+            group.bounds = group.bvh.refit(world).0;
+        }
+        refitted.build_time = start.elapsed();
+        refitted
+    }
+
+    /// Summed half-areas of the hierarchies' child boxes, m² ([`Bvh::area`]).
+    pub fn area(&self) -> f32 {
+        self.groups.iter().map(|g| g.bvh.area()).sum()
     }
 
     /// Closest primitive visible in `view` that `ray` hits in [tmin, tmax).

@@ -188,6 +188,7 @@ fn key_entry(key: u64) -> f32 {
 }
 
 /// A wide BVH over the triangles and ellipsoids of a world.
+#[derive(Clone)]
 pub struct Bvh {
     /// Which builder made the binary hierarchy (None: no primitives).
     pub builder: Option<bvh_build::Builder>,
@@ -223,6 +224,86 @@ impl Bvh {
         let root = builder.reserve();
         builder.fill(root, &[0], 1)?;
         Ok(bvh)
+    }
+
+    /// Carries the hierarchy over to `world`, which holds the same primitives at the same
+    /// indices, moved: the leaves take the moved primitives and every child box is recomputed
+    /// bottom-up from their boxes (same topology). A primitive that the build split into
+    /// several tight boxes now has its whole box in each of its leaves: looser, still
+    /// conservative, so every query answers as a fresh build over `world` would, bit for bit
+    /// (the tests hold it to both). Returns the world box of all primitives (unpadded) and the
+    /// summed half-areas of the child boxes ([`Bvh::area`]).
+    pub fn refit(&mut self, world: &World) -> (Aabb, f32) {
+        for packet in &mut self.triangles {
+            *packet = Triangles4::new(&world.triangles, &packet.prim);
+        }
+        let offset = world.triangles.len();
+        for leaf in &mut self.ellipsoids {
+            leaf.ellipsoid = world.ellipsoids[leaf.prim as usize - offset];
+        }
+        // An inner child is reserved after its parent (`Builder::fill`): in reverse index
+        // order every child's box is known before its parent's.
+        let mut node_boxes = vec![Aabb::empty(); self.nodes.len()];
+        for i in (0..self.nodes.len()).rev() {
+            let mut node_box = Aabb::empty();
+            for slot in 0..WIDTH {
+                let child = self.nodes[i].children[slot];
+                if child == EMPTY {
+                    continue;
+                }
+                let aabb = if child & LEAF != 0 {
+                    self.leaf_box(child, world)
+                } else {
+                    debug_assert!(child as usize > i);
+                    node_boxes[child as usize]
+                };
+                let pad = aabb.min.abs().max(aabb.max.abs()) * (4.0 * f32::EPSILON);
+                let bounds = &mut self.nodes[i].bounds;
+                for axis in 0..3 {
+                    bounds[2 * axis][slot] = aabb.min[axis] - pad[axis];
+                    bounds[2 * axis + 1][slot] = aabb.max[axis] + pad[axis];
+                }
+                node_box = node_box.union(&aabb);
+            }
+            node_boxes[i] = node_box;
+        }
+        let root = node_boxes.first().copied().unwrap_or_else(Aabb::empty);
+        (root, self.area())
+    }
+
+    /// World box of the primitives of leaf reference `leaf`.
+    fn leaf_box(&self, leaf: u32, world: &World) -> Aabb {
+        let first = (leaf & FIRST_MASK) as usize;
+        let count = ((leaf >> COUNT_SHIFT) & COUNT_MASK) as usize + 1;
+        let mut aabb = Aabb::empty();
+        if leaf & ELLIPSOIDS == 0 {
+            for packet in &self.triangles[first..first + count] {
+                for &p in &packet.prim {
+                    aabb = aabb.union(&world.aabb(p as usize));
+                }
+            }
+        } else {
+            for e in &self.ellipsoids[first..first + count] {
+                aabb = aabb.union(&world.aabb(e.prim as usize));
+            }
+        }
+        aabb
+    }
+
+    /// Summed half-areas of every used child box, m²: the surface-area cost a traversal pays
+    /// per unit of ray density, which loosened (refitted) boxes raise.
+    pub fn area(&self) -> f32 {
+        let mut area = 0.0;
+        for node in &self.nodes {
+            for slot in 0..WIDTH {
+                if node.children[slot] != EMPTY {
+                    let b = &node.bounds;
+                    let d = [0, 1, 2].map(|a| b[2 * a + 1][slot] - b[2 * a][slot]);
+                    area += d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
+                }
+            }
+        }
+        area
     }
 
     /// Tests the primitives of leaf `leaf` for the closest hit; shrinks `ray.tmax` and sets

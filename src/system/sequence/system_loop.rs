@@ -4,7 +4,7 @@
 //!
 //! The static world and its hierarchy are built once; what moves (the obstacle, what rides
 //! with the vehicle or the head, objects on keyframed paths) is a small world of its own whose
-//! hierarchy is rebuilt for each instant ([`MovingParts::at`]).
+//! hierarchy is refitted for each instant ([`MovingParts::at`]).
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -213,7 +213,7 @@ impl SystemLoop {
     }
 
     /// The scene at `t`, ready to render: the static hierarchy shared, the moving part
-    /// placed and its hierarchy rebuilt.
+    /// placed and its hierarchy refitted.
     pub fn context_at(&mut self, t: f64) -> Result<RenderContext> {
         let start = Instant::now();
         let rig = &self.rig;
