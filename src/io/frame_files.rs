@@ -119,8 +119,43 @@ pub fn write_exr(frame: &Frame, path: &Path) -> Result<()> {
     write_view_exr(frame, path, ExrContent::All)
 }
 
-/// The channels of `content` in one EXR at `path`; nothing for [`ExrContent::None`].
+/// The channels of `content` in one EXR at `path`; nothing for [`ExrContent::None`]. The
+/// samples are read block by block from the frame's buffers ([`exr_zip::write_planes`]).
 pub fn write_view_exr(frame: &Frame, path: &Path, content: ExrContent) -> Result<()> {
+    use exr_zip::Plane;
+    fn vec<'a>(names: [&'static str; 3], values: &'a [Vec3]) -> [(&'static str, Plane<'a>); 3] {
+        [0, 1, 2].map(|i| (names[i], Plane::Component(values, i)))
+    }
+    let [r, g, b, a] = channel::RGBA;
+    let mut planes: Vec<(&str, Plane)> = match content {
+        ExrContent::None => return Ok(()),
+        ExrContent::Lean => vec([r, g, b], &frame.color).into(),
+        ExrContent::Colour | ExrContent::All => {
+            let mut planes: Vec<_> = vec([r, g, b], &frame.color).into();
+            planes.push((a, Plane::Constant(1.0)));
+            planes
+        }
+    };
+    if matches!(content, ExrContent::Lean | ExrContent::All) {
+        planes.push((channel::Z, Plane::F32(&frame.depth)));
+        planes.extend(vec(channel::N, &frame.normal));
+        planes.push((channel::OBJECT_ID, Plane::U32(&frame.object_id)));
+        planes.push((channel::PART_ID, Plane::U32(&frame.part_id)));
+    }
+    if content == ExrContent::All {
+        planes.push((channel::CAMERA_Z, Plane::F32(&frame.camera_z)));
+        planes.extend(vec(channel::P, &frame.position));
+    }
+    let (width, height) = (frame.width as usize, frame.height as usize);
+    write_atomically(path, |file| {
+        Ok(exr_zip::write_planes(width, height, &planes, file)?)
+    })
+}
+
+/// [`write_view_exr`]'s twin through the exr crate's own block extraction: every channel
+/// copied into owned samples, then written by [`write_exr_channels`] (the tests compare the
+/// bytes).
+pub fn write_view_exr_copied(frame: &Frame, path: &Path, content: ExrContent) -> Result<()> {
     let mut channels = match content {
         ExrContent::None => return Ok(()),
         ExrContent::Lean => vec_channels(
