@@ -158,7 +158,7 @@ pub fn write_planes(
         .map(|c| {
             planes
                 .iter()
-                .find(|(name, _)| c.name.eq(*name))
+                .find(|(name, _)| c.name.eq(name))
                 .map(|(_, p)| *p)
                 .expect("every sorted channel is one of the planes")
         })

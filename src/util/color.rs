@@ -71,7 +71,7 @@ pub fn encode_srgb8_table(c: Vec3) -> [u8; 3] {
     });
     let q = |v: f32| {
         // NaN and v ≤ 0: no threshold is ≤ it, code 0, as encode_srgb8; v ≥ 1: all 255.
-        if !(v > 0.0) {
+        if v.is_nan() || v <= 0.0 {
             return 0;
         }
         if v >= 1.0 {
