@@ -292,6 +292,84 @@ fn seethru_zip_matches_the_exr_crates_zip_and_ignores_the_thread_count() {
     assert!(tall_on(1) == tall_on(16), "bytes differ on 16 threads");
 }
 
+#[test]
+fn exrs_read_from_the_frame_are_the_bytes_of_its_copied_channels() {
+    use seethru::io::exr_zip::{Plane, write_planes};
+    use seethru::io::frame_files::{write_view_exr, write_view_exr_copied};
+    // Every content, a partial last block (61 lines), awkward samples in every AOV.
+    let mut frame = rendered();
+    assert_ne!(frame.height % 16, 0);
+    for (i, id) in frame.part_id.iter_mut().enumerate() {
+        *id = hash_u32(i as u32);
+    }
+    frame.depth[3] = f32::INFINITY;
+    frame.color[5].y = -0.0;
+    let dir = tempfile::tempdir().unwrap();
+    for content in [
+        ExrContent::None,
+        ExrContent::Colour,
+        ExrContent::Lean,
+        ExrContent::All,
+    ] {
+        let (ours, twin) = (dir.path().join("ours.exr"), dir.path().join("twin.exr"));
+        let _ = std::fs::remove_file(&ours);
+        let _ = std::fs::remove_file(&twin);
+        write_view_exr(&frame, &ours, content).unwrap();
+        write_view_exr_copied(&frame, &twin, content).unwrap();
+        if content == ExrContent::None {
+            assert!(!ours.exists() && !twin.exists());
+            continue;
+        }
+        let (a, b) = (std::fs::read(&ours).unwrap(), std::fs::read(&twin).unwrap());
+        assert!(
+            a == b,
+            "{content:?}: {} bytes vs the twin's {}",
+            a.len(),
+            b.len()
+        );
+    }
+    // Many blocks (38), two planes, on 1 and 3 threads: the owned-channel writer's bytes.
+    let (width, height) = (131usize, 600usize);
+    let noise: Vec<f32> = (0..width * height)
+        .map(|i| (hash_u32(i as u32) % 1000) as f32 * 0.01)
+        .collect();
+    let ids: Vec<u32> = (0..width * height)
+        .map(|i| hash_u32(7 + i as u32) % 5)
+        .collect();
+    let twin = dir.path().join("tall_twin.exr");
+    let list = vec![
+        AnyChannel::new("Y", FlatSamples::F32(noise.clone())),
+        AnyChannel::new("id", FlatSamples::U32(ids.clone())),
+    ];
+    write_exr_channels(&twin, width as u32, height as u32, list).unwrap();
+    let twin = std::fs::read(twin).unwrap();
+    for threads in [1, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        let planes = [("id", Plane::U32(&ids)), ("Y", Plane::F32(&noise))];
+        pool.install(|| write_planes(width, height, &planes, &mut bytes))
+            .unwrap();
+        assert!(
+            bytes.into_inner() == twin,
+            "bytes differ on {threads} threads"
+        );
+    }
+    // A plane of the wrong length, or two channels of one name: refused, not written.
+    let short = &noise[1..];
+    let refused = [
+        vec![("Y", Plane::F32(short))],
+        vec![("Y", Plane::F32(&noise)), ("Y", Plane::U32(&ids))],
+    ];
+    for planes in refused {
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        let error = write_planes(width, height, &planes, &mut bytes).unwrap_err();
+        assert!(error.to_string().contains('Y') || error.to_string().contains("duplicate"));
+    }
+}
+
 /// The R, G, B bits of an EXR's channels, for comparing the colour of two files.
 fn rgb_bits(path: &std::path::Path) -> Vec<Vec<u32>> {
     let read = channels(path);

@@ -19,6 +19,7 @@ use exr::block::writer::ChunksWriter;
 use exr::image::write::layers::{LayersWriter, WritableLayers};
 use exr::meta::header::Header;
 use exr::prelude::*;
+use glam::Vec3;
 use rayon::prelude::*;
 
 /// The compression written in the header: ZIP over blocks of 16 scan lines.
@@ -48,6 +49,140 @@ pub fn write(
                 .par_iter()
                 .map(|&(at, index)| {
                     let data = layers.extract_uncompressed_block(&meta.headers, index);
+                    (
+                        at,
+                        zip_chunk(UncompressedBlock { index, data }, &meta.headers),
+                    )
+                })
+                .collect();
+            for (at, chunk) in chunks {
+                chunk_writer.write_chunk(at, chunk)?;
+            }
+        }
+        Ok(())
+    })
+}
+
+/// One channel's samples, borrowed from where they live (a frame's buffers): what
+/// [`write_planes`] reads block by block instead of copying whole channels first.
+#[derive(Clone, Copy, Debug)]
+pub enum Plane<'a> {
+    /// f32 samples, one per pixel, row-major.
+    F32(&'a [f32]),
+    /// u32 samples, one per pixel, row-major.
+    U32(&'a [u32]),
+    /// Component 0, 1 or 2 (x, y, z) of vectors, one per pixel, row-major; written as f32.
+    Component(&'a [Vec3], usize),
+    /// The same f32 at every pixel.
+    Constant(f32),
+}
+
+impl Plane<'_> {
+    fn sample_type(&self) -> FlatSamples {
+        match self {
+            Plane::U32(_) => FlatSamples::U32(Vec::new()),
+            _ => FlatSamples::F32(Vec::new()),
+        }
+    }
+
+    /// Appends the samples of pixels `from..from + count` as little-endian bytes.
+    fn append_le(&self, from: usize, count: usize, out: &mut Vec<u8>) {
+        let range = from..from + count;
+        match *self {
+            Plane::F32(v) => out.extend(v[range].iter().flat_map(|s| s.to_le_bytes())),
+            Plane::U32(v) => out.extend(v[range].iter().flat_map(|s| s.to_le_bytes())),
+            Plane::Component(v, axis) => {
+                out.extend(v[range].iter().flat_map(|s| s[axis].to_le_bytes()))
+            }
+            Plane::Constant(c) => {
+                let bytes = c.to_le_bytes();
+                out.extend((0..count).flat_map(|_| bytes))
+            }
+        }
+    }
+
+    fn len(&self) -> Option<usize> {
+        match self {
+            Plane::F32(v) => Some(v.len()),
+            Plane::U32(v) => Some(v.len()),
+            Plane::Component(v, _) => Some(v.len()),
+            Plane::Constant(_) => None,
+        }
+    }
+}
+
+/// Writes named channels of a `width`×`height` image as one single-part, unnamed-layer EXR
+/// with [`COMPRESSION`], reading each block's samples straight from `planes`: the same bytes
+/// as [`write`] given the channels as owned samples (its twin in the tests), without a copy of
+/// every channel. The samples are written little-endian on any machine.
+pub fn write_planes(
+    width: usize,
+    height: usize,
+    planes: &[(&str, Plane<'_>)],
+    write: impl std::io::Write + std::io::Seek,
+) -> exr::error::Result<()> {
+    let pixels = width * height;
+    if let Some((name, plane)) = planes
+        .iter()
+        .find(|(_, p)| p.len().is_some_and(|n| n != pixels))
+    {
+        return Err(exr::error::Error::Invalid(
+            format!(
+                "channel {name} has {} samples for {width}×{height} pixels",
+                plane.len().unwrap_or(0)
+            )
+            .into(),
+        ));
+    }
+    // The header as the exr crate infers it, from channels without samples.
+    let channels = planes
+        .iter()
+        .map(|(name, plane)| AnyChannel::new(*name, plane.sample_type()))
+        .collect();
+    let layer = Layer::new(
+        (width, height),
+        LayerAttributes::default(),
+        Encoding {
+            compression: COMPRESSION,
+            ..Encoding::UNCOMPRESSED
+        },
+        AnyChannels::sort(channels),
+    );
+    let image = Image::from_layer(layer);
+    // The planes in the file's channel order (sorted by name).
+    let sorted: Vec<Plane> = image
+        .layer_data
+        .channel_data
+        .list
+        .iter()
+        .map(|c| {
+            planes
+                .iter()
+                .find(|(name, _)| c.name.eq(name))
+                .map(|(_, p)| *p)
+                .expect("every sorted channel is one of the planes")
+        })
+        .collect();
+    let names = &image.layer_data.channel_data.list;
+    if names.windows(2).any(|pair| pair[0].name == pair[1].name) {
+        return Err(exr::error::Error::Invalid("duplicate channel name".into()));
+    }
+    let headers = image.layer_data.infer_headers(&image.attributes);
+    exr::block::write(write, headers, true, |meta, chunk_writer| {
+        let blocks: Vec<_> = meta.enumerate_ordered_header_block_indices().collect();
+        let group = 4 * rayon::current_num_threads();
+        for blocks in blocks.chunks(group) {
+            let chunks: Vec<(usize, Chunk)> = blocks
+                .par_iter()
+                .map(|&(at, index)| {
+                    let (x0, y0) = (index.pixel_position.x(), index.pixel_position.y());
+                    let (w, h) = (index.pixel_size.width(), index.pixel_size.height());
+                    let mut data = Vec::with_capacity(w * h * 4 * sorted.len());
+                    for y in y0..y0 + h {
+                        for plane in &sorted {
+                            plane.append_le(y * width + x0, w, &mut data);
+                        }
+                    }
                     (
                         at,
                         zip_chunk(UncompressedBlock { index, data }, &meta.headers),

@@ -37,7 +37,8 @@ pub fn encode_srgb8(c: Vec3) -> [u8; 3] {
 
 /// [`encode_srgb8`] by table: each channel is the count of the 255 code thresholds (the
 /// smallest linear value that [`encode_srgb8`] encodes to each code 1…255, found once by
-/// bisection over the f32 values) at or below it — 8 comparisons instead of a `powf`. Equal
+/// bisection over the f32 values) at or below it, counted from a second table indexed by the
+/// value's top 16 bits — a lookup and a comparison or two instead of a `powf`. Equal
 /// to [`encode_srgb8`] wherever that is monotone (`tests` checks every threshold's
 /// neighbourhood and a dense sweep).
 pub fn encode_srgb8_table(c: Vec3) -> [u8; 3] {
@@ -59,8 +60,29 @@ pub fn encode_srgb8_table(c: Vec3) -> [u8; 3] {
             f32::from_bits(hi)
         })
     });
-    // NaN: no threshold is ≤ it, code 0, as encode_srgb8.
-    let q = |v: f32| t.partition_point(|&x| x <= v) as u8;
+    // The count of thresholds at or below the first f32 of each bucket of 2^16 bit patterns
+    // in [0, 1]: where the count for a value in that bucket starts (one or two thresholds
+    // further at most, the codes being ≥ 1/255 apart in sRGB).
+    static STARTS: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+    let starts = STARTS.get_or_init(|| {
+        (0..=1f32.to_bits() >> 16)
+            .map(|b| t.partition_point(|&x| x <= f32::from_bits(b << 16)) as u8)
+            .collect()
+    });
+    let q = |v: f32| {
+        // NaN and v ≤ 0: no threshold is ≤ it, code 0, as encode_srgb8; v ≥ 1: all 255.
+        if v.is_nan() || v <= 0.0 {
+            return 0;
+        }
+        if v >= 1.0 {
+            return 255;
+        }
+        let mut code = starts[(v.to_bits() >> 16) as usize] as usize;
+        while code < t.len() && t[code] <= v {
+            code += 1;
+        }
+        code as u8
+    };
     [q(c.x), q(c.y), q(c.z)]
 }
 
