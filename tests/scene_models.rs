@@ -214,6 +214,56 @@ fn a_tilted_wall_and_a_ground_plane_are_registered_by_plane_fit_and_ground() {
     );
 }
 
+/// `plane-fit` fits its plane to the sensor pixels under the display's d2 → ∞ crop, whatever
+/// the sensor's resolution: on a wall that fills the frontal view every return there is an
+/// inlier, so the inlier count is that rectangle's pixel count — found here from the display's
+/// corners seen from the eye, scaled to the sensor (the frontal camera's field of view at
+/// another resolution). A region taken in frontal pixels, or shifted, counts other pixels.
+#[test]
+fn plane_fit_takes_the_sensor_pixels_under_the_crop_at_any_sensor_resolution() {
+    let wall = scene(
+        [0.0, 0.0, 1.0],
+        [0.5, 0.3],
+        [250, 150],
+        "[[object]]\nname = \"wall\"\nkind = \"quad\"\nmaterial = \"tex\"\nsize = [80.0, 60.0]\nrotate_deg = [0.0, 40.0, 0.0]\ntranslate = [0.0, 0.0, -6.0]",
+    );
+    let ctx = with_eye(wall, DVec3::new(0.08, 0.03, 0.7), 25.0);
+    let scene = &ctx.scene;
+    let (eye, frontal) = (scene.eye(), &scene.frontal);
+    assert_eq!((frontal.width, frontal.height), (640, 480));
+    let corners = scene
+        .obstacle
+        .display_corners()
+        .map(|c| frontal.project_direction(c - eye).unwrap());
+    let min = corners.iter().fold(DVec2::INFINITY, |a, c| a.min(*c));
+    let max = corners.iter().fold(DVec2::NEG_INFINITY, |a, c| a.max(*c));
+    // The region is well inside the frontal view, so no clipping enters the count.
+    assert!(min.cmpgt(DVec2::splat(20.0)).all() && max.cmplt(DVec2::new(620.0, 460.0)).all());
+    for (kind, width, least) in [
+        (SensorKind::Ideal, 640, 1.0),
+        (SensorKind::Tof, 320, 0.9),
+        (SensorKind::Tof, 160, 0.9),
+    ] {
+        let mut o = options(Method::PlaneFit);
+        o.scene_model.sensor.kind = kind;
+        o.scene_model.sensor.width = (kind != SensorKind::Ideal).then_some(width);
+        let r = run(&ctx, &o).unwrap();
+        let inliers = r.report["scene_model"]["plane_fit_inliers"]
+            .as_f64()
+            .unwrap();
+        let scale = width as f64 / 640.0;
+        let (lo, hi) = (min * scale, max * scale);
+        let inner = (hi.x.floor() - lo.x.ceil()) * (hi.y.floor() - lo.y.ceil());
+        let outer = (hi.x.ceil() - lo.x.floor()) * (hi.y.ceil() - lo.y.floor());
+        eprintln!("{kind:?} {width}: {inliers} inliers, region {inner}..{outer} px");
+        assert!(inner > 300.0, "{inner}");
+        assert!(
+            inliers <= outer && inliers >= least * inner,
+            "{kind:?} at {width} px: {inliers} inliers, the crop's region has {inner}..{outer} px"
+        );
+    }
+}
+
 /// A wall 8 m behind the display with a box in front of it: `box_size` at `box_at`.
 fn wall_and_box(box_size: [f64; 3], box_at: [f64; 3]) -> Scene {
     scene(
