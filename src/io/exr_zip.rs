@@ -13,9 +13,9 @@
 //! blocks are written in order. On a big-endian machine the exr crate's own ZIP writer is used
 //! (the layout above is little-endian); the tests compare the two (`tests/exr.rs`).
 
-use exr::block::UncompressedBlock;
 use exr::block::chunk::{Chunk, CompressedBlock, CompressedScanLineBlock};
 use exr::block::writer::ChunksWriter;
+use exr::block::{BlockIndex, UncompressedBlock};
 use exr::image::write::layers::{LayersWriter, WritableLayers};
 use exr::meta::header::Header;
 use exr::prelude::*;
@@ -39,6 +39,18 @@ pub fn write(
     }
     let headers = image.layer_data.infer_headers(&image.attributes);
     let layers = image.layer_data.create_writer(&headers);
+    write_blocks(write, headers, |meta, index| {
+        layers.extract_uncompressed_block(meta, index)
+    })
+}
+
+/// Writes the file's blocks in order, each one's samples from `samples` (little-endian, line
+/// by line, channel by channel) zipped on rayon's threads.
+fn write_blocks(
+    write: impl std::io::Write + std::io::Seek,
+    headers: exr::meta::Headers,
+    samples: impl Fn(&[Header], BlockIndex) -> Vec<u8> + Sync,
+) -> exr::error::Result<()> {
     exr::block::write(write, headers, true, |meta, chunk_writer| {
         let blocks: Vec<_> = meta.enumerate_ordered_header_block_indices().collect();
         // A few blocks per thread at a time: the compressed chunks wait for their turn in
@@ -48,7 +60,7 @@ pub fn write(
             let chunks: Vec<(usize, Chunk)> = blocks
                 .par_iter()
                 .map(|&(at, index)| {
-                    let data = layers.extract_uncompressed_block(&meta.headers, index);
+                    let data = samples(&meta.headers, index);
                     (
                         at,
                         zip_chunk(UncompressedBlock { index, data }, &meta.headers),
@@ -168,32 +180,16 @@ pub fn write_planes(
         return Err(exr::error::Error::Invalid("duplicate channel name".into()));
     }
     let headers = image.layer_data.infer_headers(&image.attributes);
-    exr::block::write(write, headers, true, |meta, chunk_writer| {
-        let blocks: Vec<_> = meta.enumerate_ordered_header_block_indices().collect();
-        let group = 4 * rayon::current_num_threads();
-        for blocks in blocks.chunks(group) {
-            let chunks: Vec<(usize, Chunk)> = blocks
-                .par_iter()
-                .map(|&(at, index)| {
-                    let (x0, y0) = (index.pixel_position.x(), index.pixel_position.y());
-                    let (w, h) = (index.pixel_size.width(), index.pixel_size.height());
-                    let mut data = Vec::with_capacity(w * h * 4 * sorted.len());
-                    for y in y0..y0 + h {
-                        for plane in &sorted {
-                            plane.append_le(y * width + x0, w, &mut data);
-                        }
-                    }
-                    (
-                        at,
-                        zip_chunk(UncompressedBlock { index, data }, &meta.headers),
-                    )
-                })
-                .collect();
-            for (at, chunk) in chunks {
-                chunk_writer.write_chunk(at, chunk)?;
+    write_blocks(write, headers, |_, index| {
+        let (x0, y0) = (index.pixel_position.x(), index.pixel_position.y());
+        let (w, h) = (index.pixel_size.width(), index.pixel_size.height());
+        let mut data = Vec::with_capacity(w * h * 4 * sorted.len());
+        for y in y0..y0 + h {
+            for plane in &sorted {
+                plane.append_le(y * width + x0, w, &mut data);
             }
         }
-        Ok(())
+        data
     })
 }
 
