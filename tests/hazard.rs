@@ -13,13 +13,7 @@ use seethru::system::pipeline::run;
 /// rolled, and the detector takes a shadowed silhouette for a pupil in the face's lower half.
 /// The textures and meshes are given as absolute paths so the text can live anywhere.
 fn slanted_text() -> String {
-    let das = std::fs::read_to_string(common::repo_path("scenes/das.toml")).unwrap();
-    let assets = common::repo_path("assets");
-    das.replace(
-        "facing = [0.0, 0.0, 1.0]",
-        "facing = [0.6, 0.0, 1.0]\nup = [0.0, 1.0, 1.5]",
-    )
-    .replace("../assets", assets.to_str().unwrap())
+    common::slanted_scene_text("das.toml")
 }
 
 fn slanted() -> Scene {
@@ -75,24 +69,7 @@ fn an_unreliable_estimate_warns_in_one_line_and_can_be_made_an_error() {
     let scene = dir.path().join("slanted.toml");
     std::fs::write(&scene, slanted_text()).unwrap();
     let args = |out: &str, extra: &[&str]| {
-        let mut a: Vec<String> = [
-            "run",
-            scene.to_str().unwrap(),
-            "--out",
-            dir.path().join(out).to_str().unwrap(),
-            "--head",
-            "estimated",
-            "--outside",
-            "black",
-            "--width",
-            "48",
-            "--spp",
-            "1",
-        ]
-        .map(String::from)
-        .to_vec();
-        a.extend(extra.iter().map(|s| s.to_string()));
-        a
+        common::estimated_run_args(&scene, &dir.path().join(out), extra)
     };
     let (ok, _, err) = common::seethru(&args("warned", &[]));
     assert!(ok, "{err}");

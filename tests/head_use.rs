@@ -86,33 +86,9 @@ fn the_mesh_face_is_tracked_by_the_yaw_fit() {
 fn the_mesh_face_on_a_slanted_pillar_warns() {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("slanted_mesh.toml");
-    let text = std::fs::read_to_string(common::repo_path("scenes/das_mesh_head.toml"))
-        .unwrap()
-        .replace(
-            "facing = [0.0, 0.0, 1.0]",
-            "facing = [0.6, 0.0, 1.0]\nup = [0.0, 1.0, 1.5]",
-        )
-        .replace("../assets", common::repo_path("assets").to_str().unwrap());
-    std::fs::write(&scene, text).unwrap();
+    std::fs::write(&scene, common::slanted_scene_text("das_mesh_head.toml")).unwrap();
     let args = |out: &str, extra: &[&str]| {
-        let mut a: Vec<String> = [
-            "run",
-            scene.to_str().unwrap(),
-            "--out",
-            dir.path().join(out).to_str().unwrap(),
-            "--head",
-            "estimated",
-            "--outside",
-            "black",
-            "--width",
-            "48",
-            "--spp",
-            "1",
-        ]
-        .map(String::from)
-        .to_vec();
-        a.extend(extra.iter().map(|s| s.to_string()));
-        a
+        common::estimated_run_args(&scene, &dir.path().join(out), extra)
     };
     let (ok, _, err) = common::seethru(&args("warned", &[]));
     assert!(ok, "{err}");

@@ -33,6 +33,40 @@ pub fn repo_path(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
 }
 
+/// A shipped scene (`scenes/<name>`) with its pillar slanted as the new user tried
+/// (turned 31° towards the driver, leaning back), its asset paths made absolute.
+pub fn slanted_scene_text(name: &str) -> String {
+    let text = std::fs::read_to_string(repo_path("scenes").join(name)).unwrap();
+    text.replace(
+        "facing = [0.0, 0.0, 1.0]",
+        "facing = [0.6, 0.0, 1.0]\nup = [0.0, 1.0, 1.5]",
+    )
+    .replace("../assets", repo_path("assets").to_str().unwrap())
+}
+
+/// `run SCENE --out OUT --head estimated` small and fast (48 px wide, 1 spp, black outside
+/// the display), then `extra`.
+pub fn estimated_run_args(scene: &Path, out: &Path, extra: &[&str]) -> Vec<String> {
+    let mut args: Vec<String> = [
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--head",
+        "estimated",
+        "--outside",
+        "black",
+        "--width",
+        "48",
+        "--spp",
+        "1",
+    ]
+    .map(String::from)
+    .to_vec();
+    args.extend(extra.iter().map(|s| s.to_string()));
+    args
+}
+
 pub fn das() -> Scene {
     Scene::load(&repo_path("scenes/das.toml")).expect("das.toml loads")
 }
