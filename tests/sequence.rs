@@ -476,6 +476,78 @@ fn a_late_head_estimate_costs_what_the_formula_says() {
     assert!(checked >= 6, "{checked}");
 }
 
+/// A turning vehicle and a swaying head at once: each frame's measured error is the formula's
+/// *signed* sum of the two terms. The sway reverses, so the head term in turn adds to the yaw
+/// term and takes from it; a sign error between them would swap those frames' errors (up to
+/// 58′ against 2′ here). Tolerances as in the two tests above: 2 % of the yaw term, 8 % of
+/// the head term (paraxial: off the display's axis a lateral eye error costs cos² less).
+#[test]
+fn the_yaw_and_head_terms_add_with_their_signs() {
+    let wall = common::WallScene::default();
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let eye = scene.obstacle.in_obstacle_frame(scene.eye());
+    let (amplitude, frequency, latency, tracking) = (0.008, 1.0, 0.1, 0.03);
+    let yaw_rate = 5f64.to_radians();
+    let mut o = options(latency, 20.0, 20.0, yaw_rate);
+    o.timeline.duration = 1.0;
+    o.timeline.latency_tracking = tracking;
+    o.run.display = seethru::system::display::DisplayModel::Ideal;
+    o.head = HeadMotion::Sway {
+        amplitude,
+        frequency,
+    };
+    let sway = o.head.clone();
+    let how = Measuring {
+        metrics: true,
+        full_frames: false,
+        band: 5,
+        progress: false,
+    };
+    let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
+    let (mut adding, mut opposing) = (0, 0);
+    for r in &run.records {
+        let t = r.times;
+        // The eye's mean speed over the estimate's age: speed × age is its displacement.
+        let moved = sway.eye(eye, t.display).x - sway.eye(eye, t.head).x;
+        let motion = Motion {
+            speed: 0.0,
+            yaw_rate,
+            eye_speed: moved / (t.display - t.head),
+            latency: t.display - t.capture,
+            tracking_latency: t.capture - t.head,
+        };
+        let term = |m: Motion| {
+            dynamic_misregistration(6.0 - eye.z, 0.0, r.eye_true.z, 6.0, &m) * ARCMIN_PER_RAD
+        };
+        let yaw_term = term(Motion {
+            eye_speed: 0.0,
+            ..motion
+        });
+        let head_term = term(Motion {
+            yaw_rate: 0.0,
+            ..motion
+        });
+        let predicted = term(motion).abs();
+        let measured = r.metrics.unwrap().mean_arcmin;
+        let tolerance = 0.02 * yaw_term.abs() + 0.08 * head_term.abs();
+        assert!(
+            (measured - predicted).abs() <= tolerance,
+            "frame {}: measured {measured:.2}′, formula {predicted:.2}′ (yaw {yaw_term:.2}′, head {head_term:.2}′)",
+            r.frame
+        );
+        if head_term.abs() > 0.5 * yaw_term.abs() {
+            match head_term.signum() == yaw_term.signum() {
+                true => adding += 1,
+                false => opposing += 1,
+            }
+        }
+    }
+    assert!(
+        adding >= 4 && opposing >= 4,
+        "{adding} adding, {opposing} opposing"
+    );
+}
+
 /// A fisheye frontal camera: the display goes through the believed lens in every frame, as
 /// `run` does, so a still sequence misregisters as the single run of the same instant.
 #[test]
