@@ -168,7 +168,21 @@ fn a_limit_below_the_estimate_refuses_before_anything_is_written() {
     let out = scratch.path().join("report");
     let out = out.to_str().unwrap();
     let ratio = [&OCCLUSION[..], &["--width", "4096", "--max-memory", "1"]].concat();
-    let cases: [(&[&str], &str); 4] = [
+    let sequence = [
+        "sequence",
+        "scenes/das.toml",
+        "--out",
+        out,
+        "--width",
+        "64",
+        "--height",
+        "36",
+        "--duration",
+        "0.2",
+        "--max-memory",
+        "0.001",
+    ];
+    let cases: [(&[&str], &str); 5] = [
         (&ratio, "4096×1024 driver views"),
         (
             &[
@@ -202,6 +216,8 @@ fn a_limit_below_the_estimate_refuses_before_anything_is_written() {
             &["reproduce", "--out", out, "--max-memory", "0.2"],
             "a car case: three 1280×720 driver views",
         ),
+        // A need far below 1 GiB is still stated in figures that exceed the limit.
+        (&sequence, "three 64×36 driver views"),
     ];
     for (args, counted) in cases {
         let (ok, stdout, err) = seethru(args);
@@ -213,6 +229,12 @@ fn a_limit_below_the_estimate_refuses_before_anything_is_written() {
                 && err.contains("more than --max-memory"),
             "{args:?}: {err}"
         );
+        let gib_after = |prefix: &str| -> f64 {
+            let rest = &err[err.find(prefix).unwrap() + prefix.len()..];
+            rest.split(' ').next().unwrap().parse().unwrap()
+        };
+        let (needed, limit) = (gib_after("needs about "), gib_after("--max-memory "));
+        assert!(needed > limit, "{args:?}: {err}");
     }
     assert!(!Path::new(out).exists());
     // The default limit (8 GiB) lets the default sizes through: the estimate is no wall.

@@ -189,8 +189,10 @@ pub fn largest(estimates: impl IntoIterator<Item = MemoryEstimate>) -> MemoryEst
 pub fn check_memory(estimate: &MemoryEstimate, limit_gib: f64) -> Result<()> {
     let gib = estimate.bytes as f64 / (1u64 << 30) as f64;
     if gib > limit_gib {
+        // Three significant digits: a small limit must not read "needs 0.0 GiB, more than 0.001".
+        let decimals = (2.0 - gib.log10().floor()).clamp(1.0, 9.0) as usize;
         bail!(
-            "this needs about {gib:.1} GiB ({}), more than --max-memory {limit_gib} GiB: lower the resolution, or raise --max-memory if the machine has the memory",
+            "this needs about {gib:.decimals$} GiB ({}), more than --max-memory {limit_gib} GiB: lower the resolution, or raise --max-memory if the machine has the memory",
             estimate.what
         );
     }
