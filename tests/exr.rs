@@ -561,10 +561,25 @@ fn a_run_writes_the_same_files_on_any_thread_count_and_views_as_written_alone() 
             "{name} differs between 1 and 3 threads"
         );
     }
-    // Every view's EXR is the file its channels give written alone (the exr crate's block
+    // Every view's EXR holds that view (its colour is its PNG's, written from the frame on
+    // its own) and is the file its channels give written alone (the exr crate's block
     // extraction, seethru's ZIP).
     for view in ["truth", "occluded", "seethru", "frontal", "back", "display"] {
         let path = one.join(format!("{view}.exr"));
+        let rgb = rgb_bits(&path);
+        let srgb: Vec<u8> = (0..rgb[0].len())
+            .flat_map(|i| {
+                let c = [0, 1, 2].map(|k| f32::from_bits(rgb[k][i]));
+                seethru::util::color::encode_srgb8_table(glam::Vec3::from_array(c))
+            })
+            .collect();
+        let png = image::open(one.join(format!("{view}.png")))
+            .unwrap()
+            .to_rgb8();
+        assert!(
+            srgb == png.into_raw(),
+            "{view}.exr does not hold {view}.png's colour"
+        );
         let (width, height) = seethru::io::frame_files::exr_size(&path).unwrap();
         let list = channels(&path)
             .into_iter()
