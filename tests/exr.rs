@@ -520,3 +520,76 @@ fn sequence_writes_colour_exr_frames_and_refuses_exr_where_it_writes_none() {
     refused(dir.path(), &args, 1, &["--exr none", "--frames png"]);
     assert!(!dir.path().join("x").exists());
 }
+
+#[test]
+fn a_run_writes_the_same_files_on_any_thread_count_and_views_as_written_alone() {
+    // `run` writes each view as soon as it is made, beside the next renders and the metrics,
+    // and takes truth's compressed blocks for occluded and seethru where their samples are
+    // truth's: neither the order nor the reuse may show in the files.
+    let dir = tempfile::tempdir().unwrap();
+    let das = common::repo_path("scenes/das.toml");
+    let run = |threads: &str| {
+        let out = dir.path().join(format!("t{threads}"));
+        let (ok, _, err) = common::seethru(&[
+            "run",
+            das.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--width",
+            "192",
+            "--frontal-width",
+            "192",
+            "--back-width",
+            "64",
+            "--threads",
+            threads,
+        ]);
+        assert!(ok, "{err}");
+        out
+    };
+    let (one, three) = (run("1"), run("3"));
+    let mut names: Vec<String> = std::fs::read_dir(&one)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into())
+        .collect();
+    names.sort();
+    assert!(names.len() >= 20, "{names:?}");
+    for name in names.iter().filter(|n| *n != "run.json") {
+        let (a, b) = (one.join(name), three.join(name));
+        assert!(
+            std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
+            "{name} differs between 1 and 3 threads"
+        );
+    }
+    // Every view's EXR holds that view (its colour is its PNG's, written from the frame on
+    // its own) and is the file its channels give written alone (the exr crate's block
+    // extraction, seethru's ZIP).
+    for view in ["truth", "occluded", "seethru", "frontal", "back", "display"] {
+        let path = one.join(format!("{view}.exr"));
+        let rgb = rgb_bits(&path);
+        let srgb: Vec<u8> = (0..rgb[0].len())
+            .flat_map(|i| {
+                let c = [0, 1, 2].map(|k| f32::from_bits(rgb[k][i]));
+                seethru::util::color::encode_srgb8_table(glam::Vec3::from_array(c))
+            })
+            .collect();
+        let png = image::open(one.join(format!("{view}.png")))
+            .unwrap()
+            .to_rgb8();
+        assert!(
+            srgb == png.into_raw(),
+            "{view}.exr does not hold {view}.png's colour"
+        );
+        let (width, height) = seethru::io::frame_files::exr_size(&path).unwrap();
+        let list = channels(&path)
+            .into_iter()
+            .map(|(name, samples)| AnyChannel::new(name.as_str(), samples))
+            .collect();
+        let alone = dir.path().join(format!("{view}_alone.exr"));
+        write_exr_channels(&alone, width, height, list).unwrap();
+        assert!(
+            std::fs::read(&path).unwrap() == std::fs::read(&alone).unwrap(),
+            "{view}.exr is not the file its channels make"
+        );
+    }
+}

@@ -2,17 +2,19 @@
 //! the metrics written to a directory.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU8, Ordering};
+use std::sync::{Mutex, OnceLock};
 
 use anyhow::Result;
-use rayon::prelude::*;
 use seethru::io::atomic::write_text;
-use seethru::io::frame_files::{ExrContent, write_frame};
+use seethru::io::frame_files::{ExrContent, write_frame, write_frame_like};
 use seethru::io::staged::StagedDir;
 use seethru::measure::hazard::{DEFAULT_BOUND_ARCMIN, run_hazards_json};
 use seethru::measure::headline::{read_results, summary_text};
-use seethru::measure::holes::{attach_holes, write_hole_mask};
+use seethru::measure::holes::{attach_view_holes, write_hole_mask};
 use seethru::measure::maps::write_metrics_scaled;
 use seethru::measure::metrics::measure;
+use seethru::render::frame::Frame;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::scene::lens_keys::read_calibration_file;
@@ -20,7 +22,9 @@ use seethru::system::display::{DisplayModel, Filter};
 use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
 use seethru::system::memory::{both_eyes_estimate, check_memory, run_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
-use seethru::system::pipeline::{RunResult, driver_camera, run};
+use seethru::system::pipeline::{
+    Given, RunResult, RunViews, check_display_seen, driver_camera, run_staged,
+};
 
 use crate::cli::args::{
     EYE_METHODS, HeadErrorArgs, ReadWhen, RenderArgs, band, choice, pixels, positive,
@@ -235,6 +239,29 @@ fn run_command(
     Ok(())
 }
 
+/// `f`, typed as taking one scope's handle (a closure's own would take any scope's).
+fn in_scope<'s, F: Fn(&rayon::Scope<'s>) + Sync + Send + Copy>(f: F) -> F {
+    f
+}
+
+/// Writes view `name` of `views` (set) into `out`.
+fn write_view(views: &RunViews, out: &Path, name: &str, exr: ExrContent) -> Result<()> {
+    let slot = match name {
+        "truth" => &views.truth,
+        "occluded" => &views.occluded,
+        "frontal" => &views.frontal,
+        "back" => &views.back,
+        "display" => &views.display,
+        _ => &views.seethru,
+    };
+    write_frame(
+        slot.get().expect("a view is written once set"),
+        out,
+        name,
+        exr,
+    )
+}
+
 /// One run into `out` (inside the staging folder): every view, the metrics and run.json;
 /// `band`: the border band's width and the heatmap's fixed top, if any.
 fn write_run(
@@ -249,45 +276,93 @@ fn write_run(
         hazard_bound_arcmin: hazard_bound,
         heatmap_max_arcmin: heatmap_max,
     } = writes;
-    let result = run(ctx, options)?;
+    let views = RunViews::default();
+    // The first error of the writes running beside the run.
+    let failed: Mutex<Option<anyhow::Error>> = Mutex::new(None);
+    let note = |written: Result<()>| {
+        if let Err(e) = written {
+            failed
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .get_or_insert(e);
+        }
+    };
+    // Each view is written (PNGs and EXR, mostly single-threaded work) as soon as it is made,
+    // beside the renders that follow and the metrics, so that both threads stay busy to the
+    // end; the files are the same whatever the order. `out` and its folders are created by
+    // the writes (io::atomic), under the lock the interrupt handler takes: never after its
+    // clean-up.
+    let (views_ref, note) = (&views, &note);
+    // `occluded` and `seethru` are `truth` outside the obstacle's footprint: their EXRs take
+    // truth's compressed blocks there, so they are written after truth's file, by whichever
+    // comes last of that file and the `seethru` view.
+    let truth_zipped = OnceLock::new();
+    let waiting = AtomicU8::new(2);
+    let (truth_zipped, waiting) = (&truth_zipped, &waiting);
+    let driver_views = in_scope(move |s| {
+        if waiting.fetch_sub(1, Ordering::AcqRel) == 1 {
+            let like = truth_zipped.get().and_then(Option::as_ref);
+            for (name, slot) in [
+                ("occluded", &views_ref.occluded),
+                ("seethru", &views_ref.seethru),
+            ] {
+                let frame = slot.get().expect("set before its file is written");
+                s.spawn(move |_| {
+                    note(write_frame_like(frame, out, name, exr, like, false).map(|_| ()))
+                });
+            }
+        }
+    });
+    let measured = rayon::scope(|s| -> Result<_> {
+        let ready = |name: &'static str, frame: &Frame| match name {
+            "truth" => {
+                let frame = views_ref.truth.get().expect("just set");
+                s.spawn(move |s| {
+                    match write_frame_like(frame, out, name, exr, None, true) {
+                        Ok(zipped) => {
+                            let _ = truth_zipped.set(zipped);
+                        }
+                        Err(e) => note(Err(e)),
+                    }
+                    driver_views(s);
+                });
+            }
+            "occluded" => {}
+            "seethru" => driver_views(s),
+            _ => {
+                let _ = frame;
+                s.spawn(move |_| note(write_view(views_ref, out, name, exr)));
+            }
+        };
+        let rest = run_staged(ctx, options, Given::default(), views_ref, &ready)?;
+        let [truth, occluded, seethru] =
+            [&views_ref.truth, &views_ref.occluded, &views_ref.seethru]
+                .map(|v| v.get().expect("a finished run set every view"));
+        check_display_seen(ctx, occluded)?;
+        // The eye the views were rendered from.
+        let eye = options.eyes.view_camera(&ctx.scene.driver).position();
+        let (maps, mut metrics) = measure(ctx, &ctx.scene, eye, [truth, seethru, occluded], band);
+        let holes = attach_view_holes(
+            &mut metrics,
+            &maps,
+            rest.holes.as_deref(),
+            [truth, occluded, seethru],
+            &ctx.scene.obstacle,
+            options.scene_model.fill,
+        );
+        if let Some(holes) = &holes {
+            write_hole_mask(&out.join("holes.png"), &maps, holes)?;
+        }
+        write_metrics_scaled(out, &maps, truth, &metrics, heatmap_max)?;
+        Ok((rest, maps))
+    });
+    if let Some(e) = failed.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        return Err(e);
+    }
+    let (rest, maps) = measured?;
+    let result = rest.with_views(views);
     if let Some(d) = result.detection.filter(|d| !d.confidence.is_confident()) {
         eprintln!("warning: {}", d.confidence.warning(""));
-    }
-    // `out` and its folders are created by the writes (io::atomic), under the lock the
-    // interrupt handler takes: never after its clean-up.
-    let views = [
-        ("truth", &result.truth),
-        ("occluded", &result.occluded),
-        ("frontal", &result.frontal),
-        ("back", &result.back),
-        ("display", &result.display),
-        ("seethru", &result.seethru),
-    ];
-    // Encoding PNGs and EXRs is mostly single-threaded work: the six views are written side
-    // by side, and beside the metrics. The files are the same whatever the order.
-    let (written, (maps, mut metrics)) = rayon::join(
-        || {
-            views
-                .par_iter()
-                .try_for_each(|(name, frame)| write_frame(frame, out, name, exr))
-        },
-        || {
-            let frames = [&result.truth, &result.seethru, &result.occluded];
-            // The eye the views were rendered from.
-            let eye = options.eyes.view_camera(&ctx.scene.driver).position();
-            measure(ctx, &ctx.scene, eye, frames, band)
-        },
-    );
-    written?;
-    let holes = attach_holes(
-        &mut metrics,
-        &maps,
-        &result,
-        &ctx.scene.obstacle,
-        options.scene_model.fill,
-    );
-    if let Some(holes) = &holes {
-        write_hole_mask(&out.join("holes.png"), &maps, holes)?;
     }
     let driver = driver_camera(&ctx.scene, options)?;
     let hazards = run_hazards_json(ctx, &driver, &result, &maps, hazard_bound);
@@ -296,7 +371,6 @@ fn write_run(
         &out.join("hazards.json"),
         &serde_json::to_string_pretty(&hazards)?,
     )?;
-    write_metrics_scaled(out, &maps, &result.truth, &metrics, heatmap_max)?;
     // Last: a directory with run.json holds a finished run.
     write_text(
         &out.join("run.json"),

@@ -13,13 +13,16 @@
 //! blocks are written in order. On a big-endian machine the exr crate's own ZIP writer is used
 //! (the layout above is little-endian); the tests compare the two (`tests/exr.rs`).
 
+use exr::block::BlockIndex;
 use exr::block::chunk::{Chunk, CompressedBlock, CompressedScanLineBlock};
 use exr::block::writer::ChunksWriter;
-use exr::block::{BlockIndex, UncompressedBlock};
 use exr::image::write::layers::{LayersWriter, WritableLayers};
 use exr::meta::header::Header;
 use exr::prelude::*;
 use glam::Vec3;
+use miniz_oxide::deflate::core::{
+    CompressorOxide, TDEFLFlush, TDEFLStatus, compress, create_comp_flags_from_zip_params,
+};
 use rayon::prelude::*;
 
 /// The compression written in the header: ZIP over blocks of 16 scan lines.
@@ -39,40 +42,39 @@ pub fn write(
     }
     let headers = image.layer_data.infer_headers(&image.attributes);
     let layers = image.layer_data.create_writer(&headers);
-    write_blocks(write, headers, |meta, index| {
-        layers.extract_uncompressed_block(meta, index)
-    })
+    let block = |meta: &[Header], index| zipped(layers.extract_uncompressed_block(meta, index));
+    write_blocks(write, headers, block, false).map(|_| ())
 }
 
-/// Writes the file's blocks in order, each one's samples from `samples` (little-endian, line
-/// by line, channel by channel) zipped on rayon's threads.
+/// Writes the file's blocks in order, each one's compressed bytes from `block` (called on
+/// rayon's threads); with `keep`, also returns those bytes, in file order.
 fn write_blocks(
     write: impl std::io::Write + std::io::Seek,
     headers: exr::meta::Headers,
-    samples: impl Fn(&[Header], BlockIndex) -> Vec<u8> + Sync,
-) -> exr::error::Result<()> {
+    block: impl Fn(&[Header], BlockIndex) -> Vec<u8> + Sync,
+    keep: bool,
+) -> exr::error::Result<Vec<Vec<u8>>> {
+    let mut kept = Vec::new();
     exr::block::write(write, headers, true, |meta, chunk_writer| {
         let blocks: Vec<_> = meta.enumerate_ordered_header_block_indices().collect();
         // A few blocks per thread at a time: the compressed chunks wait for their turn in
         // memory, not the whole image's.
         let group = 4 * rayon::current_num_threads();
         for blocks in blocks.chunks(group) {
-            let chunks: Vec<(usize, Chunk)> = blocks
+            let chunks: Vec<(usize, BlockIndex, Vec<u8>)> = blocks
                 .par_iter()
-                .map(|&(at, index)| {
-                    let data = samples(&meta.headers, index);
-                    (
-                        at,
-                        zip_chunk(UncompressedBlock { index, data }, &meta.headers),
-                    )
-                })
+                .map(|&(at, index)| (at, index, block(&meta.headers, index)))
                 .collect();
-            for (at, chunk) in chunks {
-                chunk_writer.write_chunk(at, chunk)?;
+            for (at, index, bytes) in chunks {
+                if keep {
+                    kept.push(bytes.clone());
+                }
+                chunk_writer.write_chunk(at, chunk(index, &meta.headers, bytes))?;
             }
         }
         Ok(())
-    })
+    })?;
+    Ok(kept)
 }
 
 /// One channel's samples, borrowed from where they live (a frame's buffers): what
@@ -113,6 +115,10 @@ impl Plane<'_> {
         }
     }
 
+    fn is_u32(&self) -> bool {
+        matches!(self, Plane::U32(_))
+    }
+
     fn len(&self) -> Option<usize> {
         match self {
             Plane::F32(v) => Some(v.len()),
@@ -133,6 +139,32 @@ pub fn write_planes(
     planes: &[(&str, Plane<'_>)],
     write: impl std::io::Write + std::io::Seek,
 ) -> exr::error::Result<()> {
+    write_planes_like(width, height, planes, None, false, write).map(|_| ())
+}
+
+/// The compressed blocks of a file [`write_planes_like`] wrote, with the planes they came
+/// from: a file of another frame that shares rows with it reuses them.
+pub struct Zipped<'a> {
+    width: usize,
+    /// The planes in the file's channel order.
+    planes: Vec<(String, Plane<'a>)>,
+    /// Each block's bytes as the file holds them, in file order.
+    blocks: Vec<Vec<u8>>,
+}
+
+/// [`write_planes`], where each block whose samples are the same bytes as the block at the
+/// same place in `like` (same size and channels) takes `like`'s compressed bytes instead of
+/// being deflated again; with `keep`, returns this file's blocks for the next file. Deflate being a function of its
+/// input, the file is byte for byte what [`write_planes`] writes (`occluded` and `seethru`
+/// are `truth` outside the obstacle's footprint: a third of their blocks on das).
+pub fn write_planes_like<'a>(
+    width: usize,
+    height: usize,
+    planes: &[(&str, Plane<'a>)],
+    like: Option<&Zipped>,
+    keep: bool,
+    write: impl std::io::Write + std::io::Seek,
+) -> exr::error::Result<Option<Zipped<'a>>> {
     let pixels = width * height;
     if let Some((name, plane)) = planes
         .iter()
@@ -161,60 +193,128 @@ pub fn write_planes(
         AnyChannels::sort(channels),
     );
     let image = Image::from_layer(layer);
+    let names = &image.layer_data.channel_data.list;
+    if names.windows(2).any(|pair| pair[0].name == pair[1].name) {
+        return Err(exr::error::Error::Invalid("duplicate channel name".into()));
+    }
     // The planes in the file's channel order (sorted by name).
-    let sorted: Vec<Plane> = image
-        .layer_data
-        .channel_data
-        .list
+    let sorted: Vec<(String, Plane)> = names
         .iter()
         .map(|c| {
             planes
                 .iter()
                 .find(|(name, _)| c.name.eq(name))
-                .map(|(_, p)| *p)
+                .map(|(name, p)| (name.to_string(), *p))
                 .expect("every sorted channel is one of the planes")
         })
         .collect();
-    let names = &image.layer_data.channel_data.list;
-    if names.windows(2).any(|pair| pair[0].name == pair[1].name) {
-        return Err(exr::error::Error::Invalid("duplicate channel name".into()));
-    }
+    // `like` serves when its blocks are laid out as these: same width (and so the same
+    // blocks, its planes holding as many pixels), same channels and sample types.
+    let like =
+        like.filter(|like| {
+            like.width == width
+                && like.planes.len() == sorted.len()
+                && like.planes.iter().zip(&sorted).all(|((a, p), (b, q))| {
+                    a == b && p.len() == q.len() && p.is_u32() == q.is_u32()
+                })
+        });
     let headers = image.layer_data.infer_headers(&image.attributes);
-    write_blocks(write, headers, |_, index| {
+    let samples = |planes: &[(String, Plane)], index: BlockIndex| {
         let (x0, y0) = (index.pixel_position.x(), index.pixel_position.y());
         let (w, h) = (index.pixel_size.width(), index.pixel_size.height());
-        let mut data = Vec::with_capacity(w * h * 4 * sorted.len());
+        let mut data = Vec::with_capacity(w * h * 4 * planes.len());
         for y in y0..y0 + h {
-            for plane in &sorted {
+            for (_, plane) in planes {
                 plane.append_le(y * width + x0, w, &mut data);
             }
         }
         data
-    })
+    };
+    let block = |_: &[Header], index: BlockIndex| {
+        let raw = samples(&sorted, index);
+        if let Some(like) = like {
+            // Blocks of 16 lines, in order (line order increasing).
+            let at = index.pixel_position.y() / COMPRESSION.scan_lines_per_block();
+            if samples(&like.planes, index) == raw {
+                return like.blocks[at].clone();
+            }
+        }
+        zipped(raw)
+    };
+    let blocks = write_blocks(write, headers, block, keep)?;
+    Ok(keep.then_some(Zipped {
+        width,
+        planes: sorted,
+        blocks,
+    }))
 }
 
-/// One scan-line block as a ZIP chunk (raw when deflating does not shrink it).
-fn zip_chunk(block: UncompressedBlock, headers: &[Header]) -> Chunk {
-    let header = &headers[block.index.layer];
-    // Within i32: the exr crate checked the layer's bounds when it inferred the header.
-    let y_coordinate =
-        block.index.pixel_position.y() as i32 + header.own_attributes.layer_position.y();
-    // Little-endian already (the caller checked): the samples as the file stores them.
-    let raw = block.data;
-    let packed = predicted(&raw);
-    let deflated = miniz_oxide::deflate::compress_to_vec_zlib(&packed, DEFLATE_LEVEL);
-    let compressed_pixels_le = if deflated.len() < raw.len() {
+/// A block's samples (little-endian, line by line, channel by channel) as the file stores
+/// them: predicted and deflated, or raw when deflating does not shrink them.
+fn zipped(raw: Vec<u8>) -> Vec<u8> {
+    let deflated = deflate_zlib(&predicted(&raw));
+    if deflated.len() < raw.len() {
         deflated
     } else {
         raw
-    };
+    }
+}
+
+/// A block's stored bytes as the chunk of block `index`.
+fn chunk(index: BlockIndex, headers: &[Header], compressed_pixels_le: Vec<u8>) -> Chunk {
+    let header = &headers[index.layer];
+    // Within i32: the exr crate checked the layer's bounds when it inferred the header.
+    let y_coordinate = index.pixel_position.y() as i32 + header.own_attributes.layer_position.y();
     Chunk {
-        layer_index: block.index.layer,
+        layer_index: index.layer,
         compressed_block: CompressedBlock::ScanLine(CompressedScanLineBlock {
             y_coordinate,
             compressed_pixels_le,
         }),
     }
+}
+
+thread_local! {
+    /// Each thread's compressor and output buffer, kept from block to block: a fresh
+    /// compressor and a zeroed output of half the input per block were a tenth of a run's
+    /// page faults.
+    static DEFLATE: std::cell::RefCell<Option<(CompressorOxide, Vec<u8>)>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// `miniz_oxide::deflate::compress_to_vec_zlib(data, DEFLATE_LEVEL)`, the same bytes (the
+/// tests' twin), on the thread's compressor, reset. miniz_oxide's output depends on the room
+/// it is given (a third of das's blocks come out otherwise with more), so the room grows as
+/// in `compress_to_vec_zlib`: half the input (2 bytes at least), doubled whenever under 30
+/// bytes are left.
+pub fn deflate_zlib(mut data: &[u8]) -> Vec<u8> {
+    DEFLATE.with_borrow_mut(|kept| {
+        let (compressor, out) = kept.get_or_insert_with(|| {
+            let flags = create_comp_flags_from_zip_params(DEFLATE_LEVEL.into(), 1, 0);
+            (CompressorOxide::new(flags), Vec::new())
+        });
+        compressor.reset();
+        let mut room = (data.len() / 2).max(2);
+        let mut at = 0;
+        loop {
+            if out.len() < room {
+                out.resize(room, 0);
+            }
+            let (status, read, written) =
+                compress(compressor, data, &mut out[at..room], TDEFLFlush::Finish);
+            at += written;
+            match status {
+                TDEFLStatus::Done => return out[..at].to_vec(),
+                TDEFLStatus::Okay if read <= data.len() => {
+                    data = &data[read..];
+                    if room - at < 30 {
+                        room *= 2;
+                    }
+                }
+                status => unreachable!("miniz_oxide failed to deflate: {status:?}"),
+            }
+        }
+    })
 }
 
 /// OpenEXR's ZIP predictor: the even bytes then the odd ones, each byte replaced by its
@@ -252,6 +352,94 @@ mod tests {
             out[i] = out[i].wrapping_sub(out[i - 1]).wrapping_add(128);
         }
         out
+    }
+
+    /// `n` bytes of noise over `values` values: incompressible at 256 (deflate's output
+    /// outgrows half the input), compressed 2:1 to 3:2 at 16 to 40 as the views' blocks are.
+    fn bytes(n: usize, seed: u32, values: u32) -> Vec<u8> {
+        let h = |i: usize| crate::util::sampling::hash_u32(seed.wrapping_add(i as u32));
+        (0..n).map(|i| (h(i) % values) as u8).collect()
+    }
+
+    #[test]
+    fn the_kept_compressor_deflates_as_a_fresh_one() {
+        // Sizes that need no room, some, and several doublings of it; big and small in turn
+        // on one thread's compressor and buffer.
+        // (With a fixed 64 KiB of room, the 300 000 bytes of 16 or 40 values come out
+        // otherwise.)
+        let inputs = [
+            (0, 3),
+            (1, 256),
+            (2, 256),
+            (3, 3),
+            (300_000, 16),
+            (200_000, 256),
+            (100, 256),
+            (300_000, 40),
+            (300_000, 3),
+            (70_000, 256),
+            (5, 3),
+        ];
+        for (k, &(n, values)) in inputs.iter().enumerate() {
+            let data = bytes(n, k as u32, values);
+            assert!(
+                deflate_zlib(&data)
+                    == miniz_oxide::deflate::compress_to_vec_zlib(&data, DEFLATE_LEVEL),
+                "{n} bytes of {values} values"
+            );
+        }
+    }
+
+    #[test]
+    fn a_file_like_another_takes_its_blocks_where_the_samples_are_the_same() {
+        let (width, height) = (37usize, 70usize);
+        let a: Vec<f32> = bytes(width * height, 1, 256)
+            .iter()
+            .map(|&b| f32::from(b) * 0.37)
+            .collect();
+        let ids: Vec<u32> = (0..width * height).map(|i| (i / 50) as u32).collect();
+        // Lines 20 and 21 differ (block 1 of 16 lines); the other blocks are the same.
+        let mut b = a.clone();
+        b[20 * width + 3] += 1.0;
+        b[21 * width] = f32::NAN;
+        let pa: Vec<(&str, Plane)> = vec![("Y", Plane::F32(&a)), ("id", Plane::U32(&ids))];
+        let pb: Vec<(&str, Plane)> = vec![("Y", Plane::F32(&b)), ("id", Plane::U32(&ids))];
+        fn write<'a>(
+            size: (usize, usize),
+            planes: &[(&str, Plane<'a>)],
+            like: Option<&Zipped>,
+        ) -> (Vec<u8>, Zipped<'a>) {
+            let mut file = std::io::Cursor::new(Vec::new());
+            let zipped = write_planes_like(size.0, size.1, planes, like, true, &mut file);
+            (file.into_inner(), zipped.unwrap().unwrap())
+        }
+        let size = (width, height);
+        let (_, mut zipped_a) = write(size, &pa, None);
+        let (alone, _) = write(size, &pb, None);
+        let (like_a, _) = write(size, &pb, Some(&zipped_a));
+        assert!(like_a == alone, "written like a, b is another file");
+        // The blocks taken from `a` are a's bytes as kept: marked, they show where they went.
+        for block in &mut zipped_a.blocks {
+            *block = vec![0xee; 3];
+        }
+        let (_, zipped_b) = write(size, &pb, Some(&zipped_a));
+        let taken: Vec<bool> = zipped_b.blocks.iter().map(|b| b == &[0xee; 3]).collect();
+        assert_eq!(taken, [true, false, true, true, true]);
+        // Other channels, or another width: nothing taken.
+        let renamed: Vec<(&str, Plane)> = vec![("Z", Plane::F32(&b)), ("id", Plane::U32(&ids))];
+        let (_, other) = write(size, &renamed, Some(&zipped_a));
+        assert!(other.blocks.iter().all(|b| b != &[0xee; 3]));
+        let (mut narrow, mut file) = (zipped_a, std::io::Cursor::new(Vec::new()));
+        narrow.width = width - 1;
+        let zipped = write_planes_like(width, height, &pb, Some(&narrow), true, &mut file);
+        assert!(
+            zipped
+                .unwrap()
+                .unwrap()
+                .blocks
+                .iter()
+                .all(|b| b != &[0xee; 3])
+        );
     }
 
     #[test]

@@ -124,13 +124,18 @@ pub fn write_exr(frame: &Frame, path: &Path) -> Result<()> {
 /// The channels of `content` in one EXR at `path`; nothing for [`ExrContent::None`]. The
 /// samples are read block by block from the frame's buffers ([`exr_zip::write_planes`]).
 pub fn write_view_exr(frame: &Frame, path: &Path, content: ExrContent) -> Result<()> {
+    write_view_exr_like(frame, path, content, None, false).map(|_| ())
+}
+
+/// The channels of `content` of `frame` as the file's planes ([`exr_zip::Plane`]).
+fn view_planes(frame: &Frame, content: ExrContent) -> Vec<(&'static str, exr_zip::Plane<'_>)> {
     use exr_zip::Plane;
     fn vec<'a>(names: [&'static str; 3], values: &'a [Vec3]) -> [(&'static str, Plane<'a>); 3] {
         [0, 1, 2].map(|i| (names[i], Plane::Component(values, i)))
     }
     let [r, g, b, a] = channel::RGBA;
     let mut planes: Vec<(&str, Plane)> = match content {
-        ExrContent::None => return Ok(()),
+        ExrContent::None => return Vec::new(),
         ExrContent::Lean => vec([r, g, b], &frame.color).into(),
         ExrContent::Colour | ExrContent::All => {
             let mut planes: Vec<_> = vec([r, g, b], &frame.color).into();
@@ -148,10 +153,30 @@ pub fn write_view_exr(frame: &Frame, path: &Path, content: ExrContent) -> Result
         planes.push((channel::CAMERA_Z, Plane::F32(&frame.camera_z)));
         planes.extend(vec(channel::P, &frame.position));
     }
+    planes
+}
+
+/// [`write_view_exr`], reusing the compressed blocks of `like` (another frame's file) where
+/// this frame's samples are the same ([`exr_zip::write_planes_like`]: the same bytes); with
+/// `keep`, returns this file's blocks for the next (`None` for [`ExrContent::None`]).
+pub fn write_view_exr_like<'a>(
+    frame: &'a Frame,
+    path: &Path,
+    content: ExrContent,
+    like: Option<&exr_zip::Zipped>,
+    keep: bool,
+) -> Result<Option<exr_zip::Zipped<'a>>> {
+    if content == ExrContent::None {
+        return Ok(None);
+    }
+    let planes = view_planes(frame, content);
     let (width, height) = (frame.width as usize, frame.height as usize);
+    let mut zipped = None;
     write_atomically(path, |file| {
-        Ok(exr_zip::write_planes(width, height, &planes, file)?)
-    })
+        zipped = exr_zip::write_planes_like(width, height, &planes, like, keep, file)?;
+        Ok(())
+    })?;
+    Ok(zipped)
 }
 
 /// [`write_view_exr`]'s twin through the exr crate's own block extraction: every channel
@@ -445,7 +470,30 @@ fn sample_type(samples: &FlatSamples) -> &'static str {
 
 /// Writes `<name>.png`, `<name>_ids.png` and `<name>.exr` (holding `exr`) into `dir`.
 pub fn write_frame(frame: &Frame, dir: &Path, name: &str, exr: ExrContent) -> Result<()> {
-    write_color_png(frame, &dir.join(format!("{name}.png")))?;
-    write_id_png(frame, &dir.join(format!("{name}_ids.png")))?;
-    write_view_exr(frame, &dir.join(format!("{name}.exr")), exr)
+    write_frame_like(frame, dir, name, exr, None, false).map(|_| ())
+}
+
+/// [`write_frame`], the EXR's blocks reused from `like` where they are the same
+/// ([`write_view_exr_like`]); with `keep`, returns the EXR's blocks. The three files are
+/// encoded side by side.
+pub fn write_frame_like<'a>(
+    frame: &'a Frame,
+    dir: &Path,
+    name: &str,
+    exr: ExrContent,
+    like: Option<&exr_zip::Zipped>,
+    keep: bool,
+) -> Result<Option<exr_zip::Zipped<'a>>> {
+    let (pngs, zipped) = rayon::join(
+        || -> Result<()> {
+            let (colour, ids) = rayon::join(
+                || write_color_png(frame, &dir.join(format!("{name}.png"))),
+                || write_id_png(frame, &dir.join(format!("{name}_ids.png"))),
+            );
+            colour.and(ids)
+        },
+        || write_view_exr_like(frame, &dir.join(format!("{name}.exr")), exr, like, keep),
+    );
+    pngs?;
+    zipped
 }

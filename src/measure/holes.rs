@@ -107,9 +107,29 @@ pub fn attach_holes(
     obstacle: &Obstacle,
     fill: impl serde::Serialize,
 ) -> Option<Vec<bool>> {
-    let display_holes = result.holes.as_ref()?;
-    let mask = driver_hole_mask(obstacle, &result.occluded, maps, display_holes);
-    metrics["holes"] = hole_metrics(&mask, maps, &result.truth, &result.seethru, fill);
+    let driver_views = [&result.truth, &result.occluded, &result.seethru];
+    attach_view_holes(
+        metrics,
+        maps,
+        result.holes.as_deref(),
+        driver_views,
+        obstacle,
+        fill,
+    )
+}
+
+/// [`attach_holes`] given a run's display holes and its `truth`, `occluded` and `seethru`
+/// views, while the run's other views are still being written (`seethru run`).
+pub fn attach_view_holes(
+    metrics: &mut serde_json::Value,
+    maps: &MetricMaps,
+    display_holes: Option<&[bool]>,
+    [truth, occluded, seethru]: [&Frame; 3],
+    obstacle: &Obstacle,
+    fill: impl serde::Serialize,
+) -> Option<Vec<bool>> {
+    let mask = driver_hole_mask(obstacle, occluded, maps, display_holes?);
+    metrics["holes"] = hole_metrics(&mask, maps, truth, seethru, fill);
     Some(mask)
 }
 

@@ -105,9 +105,16 @@ struct PixelJob<'a> {
 
 impl RenderContext {
     pub fn new(scene: Scene) -> Result<Self> {
-        let world = World::build(&scene)?;
-        let accel = Accel::build(&world)?;
-        let sky = SkyModel::new(&scene.sky, &scene.sun);
+        // The sky's cloud table is made while the meshes are read.
+        let (built, sky) = rayon::join(
+            || -> Result<_> {
+                let world = World::build(&scene)?;
+                let accel = Accel::build(&world)?;
+                Ok((world, accel))
+            },
+            || SkyModel::new(&scene.sky, &scene.sun),
+        );
+        let (world, accel) = built?;
         Ok(Self {
             scene,
             world: Arc::new(world),

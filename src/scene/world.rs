@@ -9,6 +9,7 @@ use glam::{Affine3A, DAffine3, DVec3, Mat3A, Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::ray::Ray;
 use obvhs::rt_triangle::RtTriangle;
+use rayon::prelude::*;
 
 use crate::scene::limits::check_placed_mesh;
 use crate::scene::mesh_io::{LoadedMesh, shape_mesh};
@@ -165,7 +166,31 @@ impl World {
                 uv_repeat: Vec2::new(m.uv_repeat[0] as f32, m.uv_repeat[1] as f32),
             });
         }
-        let mut meshes: HashMap<PathBuf, LoadedMesh> = HashMap::new();
+        // Each mesh file is read once, however many objects place it, and the files are read
+        // side by side (parsing is most of a big scene's start); a file's error is reported
+        // when its first object is reached, as if read in turn.
+        let mesh_path = |shape: &Shape| match shape {
+            Shape::Mesh { path } => Some(path.clone()),
+            Shape::HeadMesh => Some(PathBuf::from("(built-in head mesh)")),
+            _ => None,
+        };
+        let mut firsts: Vec<(PathBuf, &Shape)> = Vec::new();
+        for (index, object) in scene.objects.iter().enumerate() {
+            if let Some(path) = mesh_path(&object.shape).filter(|_| keep(index))
+                && !firsts.iter().any(|(p, _)| *p == path)
+            {
+                firsts.push((path, &object.shape));
+            }
+        }
+        let loaded: Vec<Result<LoadedMesh>> = firsts
+            .par_iter()
+            .map(|(_, shape)| shape_mesh(shape).expect("a mesh shape"))
+            .collect();
+        let mut meshes: HashMap<PathBuf, Result<LoadedMesh>> = firsts
+            .into_iter()
+            .map(|(path, _)| path)
+            .zip(loaded)
+            .collect();
         for (index, object) in scene.objects.iter().enumerate() {
             world.objects.push(ObjectInfo {
                 name: object.name.clone(),
@@ -202,17 +227,13 @@ impl World {
                 } => frustum(*radius as f32, 0.0, *height as f32, *segments),
                 Shape::Quad { size } => quad_xy(size2(*size), 0),
                 Shape::Mesh { .. } | Shape::HeadMesh => {
-                    let path = match &object.shape {
-                        Shape::Mesh { path } => path.clone(),
-                        _ => PathBuf::from("(built-in head mesh)"),
+                    let path = &mesh_path(&object.shape).expect("a mesh shape");
+                    let mesh = match meshes.get(path).expect("read above") {
+                        Ok(mesh) => mesh,
+                        Err(_) => {
+                            return Err(meshes.remove(path).expect("read above").unwrap_err());
+                        }
                     };
-                    let path = &path;
-                    // Each file is read once, however many objects place it.
-                    if !meshes.contains_key(path) {
-                        let mesh = shape_mesh(&object.shape).expect("a mesh shape")?;
-                        meshes.insert(path.clone(), mesh);
-                    }
-                    let mesh = &meshes[path];
                     check_placed_mesh(
                         path,
                         &object.name,

@@ -12,6 +12,7 @@
 //! neither eye sees).
 
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 use serde_json::json;
 
 use crate::geometry::camera::Camera;
@@ -37,6 +38,7 @@ pub struct Obstruction {
 fn sweep(ctx: &RenderContext, eye: DVec3, forward: DVec3, across: DVec3) -> Vec<(bool, bool)> {
     let n = (2.0 * SPAN_DEG / STEP_DEG).round() as i64;
     (0..=n)
+        .into_par_iter()
         .map(|i| {
             let phi = (-SPAN_DEG + i as f64 * STEP_DEG).to_radians();
             let dir = forward * phi.cos() + across * phi.sin();
@@ -84,7 +86,7 @@ pub fn obstruction(ctx: &RenderContext, eye: DVec3, ipd: f64) -> Obstruction {
 pub fn display_pixels_seen(ctx: &RenderContext, driver: &Camera) -> usize {
     let eye = driver.position();
     display_points(&ctx.scene.obstacle)
-        .iter()
+        .par_iter()
         .flatten()
         .filter(|&&p| {
             let Some(px) = driver.project_point(p) else {

@@ -2,6 +2,7 @@
 //! model crops the frontal render, the display shows it, and the driver's view with the
 //! display in it is rendered beside the ground truth.
 
+use std::sync::OnceLock;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
@@ -340,6 +341,87 @@ pub struct Given<'a> {
 
 /// [`run_with_truth`] with whatever [`Given`] holds.
 pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Result<RunResult> {
+    let views = RunViews::default();
+    let rest = run_staged(ctx, options, given, &views, &|_, _| {})?;
+    Ok(rest.with_views(views))
+}
+
+/// The six views of a run, each set once, as [`run_staged`] makes it.
+#[derive(Default)]
+pub struct RunViews {
+    pub truth: OnceLock<Frame>,
+    pub occluded: OnceLock<Frame>,
+    pub frontal: OnceLock<Frame>,
+    pub back: OnceLock<Frame>,
+    pub display: OnceLock<Frame>,
+    pub seethru: OnceLock<Frame>,
+}
+
+impl RunViews {
+    /// Sets view `name`'s frame and hands it to `ready`.
+    fn set<'v>(
+        &'v self,
+        name: &'static str,
+        frame: Frame,
+        ready: &(dyn Fn(&'static str, &'v Frame) + Sync),
+    ) -> &'v Frame {
+        let slot = match name {
+            "truth" => &self.truth,
+            "occluded" => &self.occluded,
+            "frontal" => &self.frontal,
+            "back" => &self.back,
+            "display" => &self.display,
+            _ => &self.seethru,
+        };
+        assert!(slot.set(frame).is_ok(), "the {name} view is made once");
+        let frame = slot.get().expect("just set");
+        ready(name, frame);
+        frame
+    }
+}
+
+/// A run's results but its views: what [`run_staged`] returns beside the [`RunViews`] it fills.
+pub struct RunRest {
+    pub crop: Crop,
+    pub eye_used: DVec3,
+    pub detection: Option<FaceDetection>,
+    pub head_pose: Option<HeadPose>,
+    pub holes: Option<Vec<bool>>,
+    pub report: serde_json::Value,
+}
+
+impl RunRest {
+    /// The whole [`RunResult`], with the views [`run_staged`] filled.
+    pub fn with_views(self, views: RunViews) -> RunResult {
+        let take =
+            |slot: OnceLock<Frame>| slot.into_inner().expect("a finished run set every view");
+        RunResult {
+            truth: take(views.truth),
+            occluded: take(views.occluded),
+            frontal: take(views.frontal),
+            back: take(views.back),
+            display: take(views.display),
+            seethru: take(views.seethru),
+            crop: self.crop,
+            eye_used: self.eye_used,
+            detection: self.detection,
+            head_pose: self.head_pose,
+            holes: self.holes,
+            report: self.report,
+        }
+    }
+}
+
+/// [`run_given`], setting each view in `views` as soon as it is made and handing it to
+/// `ready` (with its file name: `truth`, `occluded`, `frontal`, `back`, `display`, `seethru`),
+/// so that a caller can write it while the next one renders. On success every view is set.
+pub fn run_staged<'v>(
+    ctx: &RenderContext,
+    options: &RunOptions,
+    given: Given,
+    views: &'v RunViews,
+    ready: &(dyn Fn(&'static str, &'v Frame) + Sync),
+) -> Result<RunRest> {
     let truth = given.truth;
     let mut scene = ctx.scene.clone();
     scene.frontal = options.sized_frontal(scene.frontal)?;
@@ -384,12 +466,14 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
         Some(b) => b.clone(),
         None => timed(&mut timings, &scene.back, View::Back),
     };
+    let back = views.set("back", back, ready);
     let frontal = match given.frontal {
         Some(f) => f.clone(),
         None => timed(&mut timings, &scene.frontal, View::Frontal),
     };
-    let (eye_used, head_fix) = eye_for_compensation(scene, &back, options)?;
-    let (crop, d2_used) = crop_for(scene, eye_used, &frontal, options)?;
+    let frontal = views.set("frontal", frontal, ready);
+    let (eye_used, head_fix) = eye_for_compensation(scene, back, options)?;
+    let (crop, d2_used) = crop_for(scene, eye_used, frontal, options)?;
     let map = frontal_map(scene, crop, options)?;
 
     let out = overflow(&map);
@@ -436,15 +520,15 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
     let (display, scene_model) = if let Some(d) = given.display {
         (d, None)
     } else if options.method.models_the_scene() {
-        let m = scene_model_display(ctx, scene, eye_used, &frontal, &crop, options)?;
+        let m = scene_model_display(ctx, scene, eye_used, frontal, &crop, options)?;
         (m.display.clone(), Some(m))
     } else if curved {
         (
-            curved_planar_display(scene, eye_used, d2_used, &frontal, options)?,
+            curved_planar_display(scene, eye_used, d2_used, frontal, options)?,
             None,
         )
     } else {
-        (resample_through(&frontal, &map, options.filter), None)
+        (resample_through(frontal, &map, options.filter), None)
     };
     timings.insert("display".into(), json!(start.elapsed().as_secs_f64()));
     let missing = display
@@ -453,6 +537,7 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
         .filter(|&&i| i == MISSING_ID)
         .count() as f64
         / display.object_id.len() as f64;
+    let display = views.set("display", display, ready);
     // `occluded` and `seethru` differ from `truth` only where the obstacle can be seen:
     // only those pixels are traced again.
     let truth = match truth {
@@ -462,9 +547,10 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
         }
         None => timed(&mut timings, &driver, View::Truth),
     };
+    let truth = views.set("truth", truth, ready);
     let (occluded, stats) = ctx.render_over(
         &driver,
-        &truth,
+        truth,
         view_bit::TRUTH,
         view_bit::OCCLUDED,
         None,
@@ -472,6 +558,7 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
         "occluded",
     );
     timings.insert("occluded".into(), json!(stats.seconds));
+    views.set("occluded", occluded, ready);
     let placement = DisplayPlacement::new(&scene.obstacle);
     let surface = match options.display {
         _ if given_display => DisplaySurface::Pixels {
@@ -490,7 +577,7 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
     };
     let (seethru, stats) = ctx.render_over(
         &driver,
-        &truth,
+        truth,
         view_bit::TRUTH,
         view_bit::SEETHRU,
         Some(&surface),
@@ -498,6 +585,7 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
         "seethru",
     );
     timings.insert("seethru".into(), json!(stats.seconds));
+    views.set("seethru", seethru, ready);
 
     let mut report = report(
         scene,
@@ -521,13 +609,7 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
     let seen = crate::system::obstruction::obstruction_json(ctx, &driver, options.eyes.ipd);
     report["obstruction_deg"] = seen["obstruction_deg"].clone();
     report["display_seen"] = seen["display_seen"].clone();
-    Ok(RunResult {
-        truth,
-        occluded,
-        frontal,
-        back,
-        display,
-        seethru,
+    Ok(RunRest {
         crop,
         eye_used,
         detection: head_fix.map(|f| f.detection),
