@@ -209,3 +209,41 @@ fn scenes_echoing_a_line_break_are_refused_in_one_line() {
         );
     }
 }
+
+#[test]
+fn sweep_merge_shows_a_setting_cell_holding_a_line_break_in_one_line() {
+    // The class of tests/fuzz/sweep_csv/setting_with_a_line_break.csv in the merge's own
+    // message: two parts whose rows differ in a setting, one written as a quoted cell with a
+    // line break and 60 more characters. The message shows it escaped and cut.
+    let kept = inputs("sweep_csv");
+    let text = std::str::from_utf8(
+        &kept
+            .iter()
+            .find(|(p, _)| p.ends_with("setting_with_a_line_break.csv"))
+            .unwrap()
+            .1,
+    )
+    .unwrap()
+    .to_string();
+    let header = text.lines().next().unwrap();
+    let row = |index: usize, theta: &str, version: &str| {
+        format!(
+            "{index},{theta},inf,28,0.033,4,2,11,5.9,0.5,0.32,0,0,0.9,0.6,4,32,1,oracle,5,0123456789abcdef,{version}\n"
+        )
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("p0.csv"), dir.path().join("p1.csv"));
+    std::fs::write(&a, format!("{header}\n{}", row(0, "20", "0.1.0"))).unwrap();
+    let long = format!("\"0.1.0\n{}\"", "x".repeat(60));
+    std::fs::write(&b, format!("{header}\n{}", row(1, "40", &long))).unwrap();
+    let err = seethru::measure::sweep_shard::merge(&[&a, &b], &dir.path().join("m.csv"))
+        .err()
+        .expect("parts computed with other settings are refused");
+    let shown = format!("{err:#}");
+    assert!(!shown.contains('\n'), "{shown}");
+    assert!(
+        shown.contains("computed with seethru 0.1.0\\nxxx") && shown.contains("x…,"),
+        "{shown}"
+    );
+    assert!(shown.len() < 400, "{shown}");
+}

@@ -148,12 +148,16 @@ pub fn params_of(header: &[String]) -> Option<Vec<String>> {
 fn cell_text(cell: &str) -> String {
     match cell.trim().parse::<f64>() {
         Ok(x) => short(x),
-        Err(_) => {
-            let start: String = cell.chars().take(40).collect();
-            let more = if cell.chars().count() > 40 { "…" } else { "" };
-            format!("`{}{more}`", start.escape_debug())
-        }
+        Err(_) => format!("`{}`", text_shown(cell)),
     }
+}
+
+/// Text from the file for a message, as written but escaped (a quoted cell may hold line
+/// breaks and control characters) and cut to 40 characters.
+fn text_shown(cell: &str) -> String {
+    let start: String = cell.chars().take(40).collect();
+    let more = if cell.chars().count() > 40 { "…" } else { "" };
+    format!("{}{more}", start.escape_debug())
 }
 
 /// `columns` up to and including the `upto`-th, joined, `…` for the rest, and their count.
@@ -262,16 +266,14 @@ pub fn settings_of(fields: &[String]) -> &[String] {
     &fields[fields.len() - SETTING_COLUMNS.len()..]
 }
 
-/// The first setting in which `a` and `b` differ: its name for messages and both values.
-pub fn first_difference<'a>(
-    a: &'a [String],
-    b: &'a [String],
-) -> Option<(&'static str, &'a str, &'a str)> {
+/// The first setting in which `a` and `b` differ: its name for messages and both values as a
+/// message shows them (escaped and cut: a file's cell may hold line breaks).
+pub fn first_difference(a: &[String], b: &[String]) -> Option<(&'static str, String, String)> {
     a.iter()
         .zip(b)
         .zip(SETTING_COLUMNS)
         .find(|((x, y), _)| x != y)
-        .map(|((x, y), (_, shown))| (shown, x.as_str(), y.as_str()))
+        .map(|((x, y), (_, shown))| (shown, text_shown(x), text_shown(y)))
 }
 
 /// The rows of an earlier run of the same sweep (`text`, the file `csv`) to keep. The header

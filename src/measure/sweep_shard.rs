@@ -115,7 +115,8 @@ pub fn merge(parts: &[&Path], out: &Path) -> Result<Merged> {
                 None => first_tail = Some((tail.to_vec(), part, number)),
                 Some((earlier, from, at)) if earlier.as_slice() != tail => {
                     let (shown, a, b) = if earlier[0] != tail[0] {
-                        (GRID_COLUMN, tail[0].as_str(), earlier[0].as_str())
+                        // check_row admitted both: integers, shown as written.
+                        (GRID_COLUMN, tail[0].clone(), earlier[0].clone())
                     } else {
                         first_difference(&tail[1..], &earlier[1..]).unwrap_or_default()
                     };
