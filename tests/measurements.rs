@@ -762,6 +762,63 @@ fn missing_counts_sky_the_frontal_camera_cannot_see() {
 }
 
 #[test]
+fn missing_counts_wall_points_hidden_from_a_camera_off_the_origin() {
+    // The wall at 12 m fills the view; a panel 1 m out that only the frontal camera sees
+    // (x ∈ [−0.3, 0.1], y ∈ [−0.3, 0.1]) stands between it and part of the wall. The camera is
+    // mounted off the obstacle's centre, so the ray to a wall point starts at its offset: a
+    // pixel is hidden when the segment from the camera to its true wall point meets the panel,
+    // found here by ray casting.
+    let camera = DVec3::new(0.15, -0.1, -0.1);
+    let text = common::WallScene {
+        wall: 12.0,
+        eye: [0.0, 0.0, 0.7],
+        ..common::WallScene::default()
+    }
+    .text()
+    .replace(
+        "[camera.frontal]\n",
+        &format!("[camera.frontal]\noffset = [{}, {}, {}]\n", camera.x, camera.y, camera.z),
+    )
+    .replace(
+        "translate = [0.0, 0.0, -12]",
+        "translate = [0.0, 0.0, -12]\n\n[[object]]\nname = \"panel\"\nkind = \"quad\"\nmaterial = \"wall\"\nsize = [0.4, 0.4]\ntranslate = [-0.1, -0.1, -1.0]\nhidden_from = [\"driver\"]",
+    );
+    assert!(text.contains("panel") && text.contains("offset"));
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let ctx = RenderContext::new(scene).unwrap();
+    let options = RunOptions {
+        d2: WorkingDistance::Infinity,
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options).unwrap();
+    let (maps, json) = measured(&ctx, &r);
+    let eye = ctx.scene.eye();
+    let (mut hidden, mut ambiguous) = (0usize, 0usize);
+    for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
+        let dir = r.occluded.position[i].as_dvec3() - eye;
+        let on_wall = eye + dir * ((-12.0 - eye.z) / dir.z);
+        let to = on_wall - camera;
+        let at_panel = camera + to * ((-1.0 - camera.z) / to.z);
+        let inside = |v: f64, lo: f64, hi: f64| (v - lo).min(hi - v);
+        let margin = inside(at_panel.x, -0.3, 0.1).min(inside(at_panel.y, -0.3, 0.1));
+        if margin.abs() < 1e-4 {
+            ambiguous += 1;
+        } else if margin > 0.0 {
+            hidden += 1;
+            assert!(maps.missing[i], "pixel {i}");
+        }
+    }
+    let reported = json["missing"]["hidden_from_frontal"].as_u64().unwrap() as usize;
+    assert_eq!(json["missing"]["outside_frontal_view"], 0);
+    assert!(hidden > 500, "{hidden}");
+    assert!(
+        reported.abs_diff(hidden) <= ambiguous,
+        "{reported} vs {hidden} (±{ambiguous})"
+    );
+}
+
+#[test]
 fn ssim_windows_are_seven_pixels_wide() {
     // Flat frames that differ in one pixel well inside the display (6 pixels from its edge):
     // exactly the 49 windows around it see the difference, each with the same statistics (48 pixels at l, one at
