@@ -819,6 +819,42 @@ fn missing_counts_wall_points_hidden_from_a_camera_off_the_origin() {
 }
 
 #[test]
+fn a_far_wall_is_not_hidden_by_itself() {
+    // A wall 2 km away that fills the view, nothing in front of it: no pixel is hidden from
+    // the frontal camera. Positions are f32 (a step of 1.2e-4 m at 2 km), so the ray towards a
+    // wall point meets the wall up to that far from the point; the test for a surface short of
+    // it must leave a margin that grows with the distance.
+    let text = common::WallScene {
+        wall: 2000.0,
+        eye: [0.0, 0.0, 0.7],
+        ..common::WallScene::default()
+    }
+    .text()
+    .replace("size = [80.0, 60.0]", "size = [30000.0, 20000.0]");
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let ctx = RenderContext::new(scene).unwrap();
+    let options = RunOptions {
+        d2: WorkingDistance::Infinity,
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options).unwrap();
+    let (maps, json) = measured(&ctx, &r);
+    let display = maps.display.iter().filter(|&&d| d).count();
+    assert!(display > 1000, "{display}");
+    assert!(
+        (0..maps.display.len()).all(|i| !maps.display[i] || r.truth.position[i].is_finite()),
+        "the wall fills the display"
+    );
+    assert_eq!(
+        json["missing"]["hidden_from_frontal"], 0,
+        "{}",
+        json["missing"]
+    );
+    assert_eq!(json["missing"]["outside_frontal_view"], 0);
+}
+
+#[test]
 fn ssim_windows_are_seven_pixels_wide() {
     // Flat frames that differ in one pixel well inside the display (6 pixels from its edge):
     // exactly the 49 windows around it see the difference, each with the same statistics (48 pixels at l, one at
