@@ -855,6 +855,55 @@ fn a_far_wall_is_not_hidden_by_itself() {
 }
 
 #[test]
+fn the_border_is_the_display_area_within_the_band_and_a_pixel_is_its_angle() {
+    // The eye on the display's axis, the driver camera looking along it: the display is
+    // sampled evenly, and a 5-pixel band around a 150 × 100 display holds
+    // 1 − 140·90 / (150·100) = 16 % of its area. One driver pixel at the image's centre spans
+    // atan(2·tan 20° / 200) (the camera's 40° over 200 pixels).
+    let ctx = common::WallScene {
+        eye: [0.0, 0.0, 0.7],
+        ..common::WallScene::default()
+    }
+    .context();
+    let options = RunOptions {
+        d2: WorkingDistance::Metres(6.0),
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options).unwrap();
+    let (_, json) = measured(&ctx, &r);
+    let pixels = |region: &serde_json::Value| region["pixels"].as_f64().unwrap();
+    let (display, border) = (pixels(&json["display"]), pixels(&json["border"]));
+    assert!(display > 5000.0, "{display}");
+    let share = border / display;
+    assert!((share - 0.16).abs() < 0.02, "border share {share}");
+    let sides: Vec<f64> = ["left", "right", "top", "bottom"]
+        .iter()
+        .map(|side| pixels(&json["border_per_side"][side]))
+        .collect();
+    // The corners lie in two bands: the border is at most their sum, at least the largest.
+    assert!(
+        border <= sides.iter().sum::<f64>() && border >= sides.iter().cloned().fold(0.0, f64::max)
+    );
+    let expected = (2.0 * 20f64.to_radians().tan() / 200.0).atan().to_degrees() * 60.0;
+    let got = json["driver_pixel_arcmin"].as_f64().unwrap();
+    assert!(
+        (got - expected).abs() < 1e-9 * expected,
+        "{got} vs {expected}"
+    );
+    let mean = json["display"]["misregistration_arcmin"]["mean"]
+        .as_f64()
+        .unwrap();
+    let mean_px = json["misregistration_mean_driver_px"].as_f64().unwrap();
+    assert!(mean > 1.0, "{mean}");
+    assert!(
+        (mean_px - mean / expected).abs() < 1e-6 * mean_px,
+        "{mean_px} vs {}",
+        mean / expected
+    );
+}
+
+#[test]
 fn ssim_windows_are_seven_pixels_wide() {
     // Flat frames that differ in one pixel well inside the display (6 pixels from its edge):
     // exactly the 49 windows around it see the difference, each with the same statistics (48 pixels at l, one at
