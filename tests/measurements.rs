@@ -762,6 +762,148 @@ fn missing_counts_sky_the_frontal_camera_cannot_see() {
 }
 
 #[test]
+fn missing_counts_wall_points_hidden_from_a_camera_off_the_origin() {
+    // The wall at 12 m fills the view; a panel 1 m out that only the frontal camera sees
+    // (x ∈ [−0.3, 0.1], y ∈ [−0.3, 0.1]) stands between it and part of the wall. The camera is
+    // mounted off the obstacle's centre, so the ray to a wall point starts at its offset: a
+    // pixel is hidden when the segment from the camera to its true wall point meets the panel,
+    // found here by ray casting.
+    let camera = DVec3::new(0.15, -0.1, -0.1);
+    let text = common::WallScene {
+        wall: 12.0,
+        eye: [0.0, 0.0, 0.7],
+        ..common::WallScene::default()
+    }
+    .text()
+    .replace(
+        "[camera.frontal]\n",
+        &format!("[camera.frontal]\noffset = [{}, {}, {}]\n", camera.x, camera.y, camera.z),
+    )
+    .replace(
+        "translate = [0.0, 0.0, -12]",
+        "translate = [0.0, 0.0, -12]\n\n[[object]]\nname = \"panel\"\nkind = \"quad\"\nmaterial = \"wall\"\nsize = [0.4, 0.4]\ntranslate = [-0.1, -0.1, -1.0]\nhidden_from = [\"driver\"]",
+    );
+    assert!(text.contains("panel") && text.contains("offset"));
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let ctx = RenderContext::new(scene).unwrap();
+    let options = RunOptions {
+        d2: WorkingDistance::Infinity,
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options).unwrap();
+    let (maps, json) = measured(&ctx, &r);
+    let eye = ctx.scene.eye();
+    let (mut hidden, mut ambiguous) = (0usize, 0usize);
+    for i in (0..maps.display.len()).filter(|&i| maps.display[i]) {
+        let dir = r.occluded.position[i].as_dvec3() - eye;
+        let on_wall = eye + dir * ((-12.0 - eye.z) / dir.z);
+        let to = on_wall - camera;
+        let at_panel = camera + to * ((-1.0 - camera.z) / to.z);
+        let inside = |v: f64, lo: f64, hi: f64| (v - lo).min(hi - v);
+        let margin = inside(at_panel.x, -0.3, 0.1).min(inside(at_panel.y, -0.3, 0.1));
+        if margin.abs() < 1e-4 {
+            ambiguous += 1;
+        } else if margin > 0.0 {
+            hidden += 1;
+            assert!(maps.missing[i], "pixel {i}");
+        }
+    }
+    let reported = json["missing"]["hidden_from_frontal"].as_u64().unwrap() as usize;
+    assert_eq!(json["missing"]["outside_frontal_view"], 0);
+    assert!(hidden > 500, "{hidden}");
+    assert!(
+        reported.abs_diff(hidden) <= ambiguous,
+        "{reported} vs {hidden} (±{ambiguous})"
+    );
+}
+
+#[test]
+fn a_far_wall_is_not_hidden_by_itself() {
+    // A wall 2 km away that fills the view, nothing in front of it: no pixel is hidden from
+    // the frontal camera. Positions are f32 (a step of 1.2e-4 m at 2 km), so the ray towards a
+    // wall point meets the wall up to that far from the point; the test for a surface short of
+    // it must leave a margin that grows with the distance.
+    let text = common::WallScene {
+        wall: 2000.0,
+        eye: [0.0, 0.0, 0.7],
+        ..common::WallScene::default()
+    }
+    .text()
+    .replace("size = [80.0, 60.0]", "size = [30000.0, 20000.0]");
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let ctx = RenderContext::new(scene).unwrap();
+    let options = RunOptions {
+        d2: WorkingDistance::Infinity,
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options).unwrap();
+    let (maps, json) = measured(&ctx, &r);
+    let display = maps.display.iter().filter(|&&d| d).count();
+    assert!(display > 1000, "{display}");
+    assert!(
+        (0..maps.display.len()).all(|i| !maps.display[i] || r.truth.position[i].is_finite()),
+        "the wall fills the display"
+    );
+    assert_eq!(
+        json["missing"]["hidden_from_frontal"], 0,
+        "{}",
+        json["missing"]
+    );
+    assert_eq!(json["missing"]["outside_frontal_view"], 0);
+}
+
+#[test]
+fn the_border_is_the_display_area_within_the_band_and_a_pixel_is_its_angle() {
+    // The eye on the display's axis, the driver camera looking along it: the display is
+    // sampled evenly, and a 5-pixel band around a 150 × 100 display holds
+    // 1 − 140·90 / (150·100) = 16 % of its area. One driver pixel at the image's centre spans
+    // atan(2·tan 20° / 200) (the camera's 40° over 200 pixels).
+    let ctx = common::WallScene {
+        eye: [0.0, 0.0, 0.7],
+        ..common::WallScene::default()
+    }
+    .context();
+    let options = RunOptions {
+        d2: WorkingDistance::Metres(6.0),
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options).unwrap();
+    let (_, json) = measured(&ctx, &r);
+    let pixels = |region: &serde_json::Value| region["pixels"].as_f64().unwrap();
+    let (display, border) = (pixels(&json["display"]), pixels(&json["border"]));
+    assert!(display > 5000.0, "{display}");
+    let share = border / display;
+    assert!((share - 0.16).abs() < 0.02, "border share {share}");
+    let sides: Vec<f64> = ["left", "right", "top", "bottom"]
+        .iter()
+        .map(|side| pixels(&json["border_per_side"][side]))
+        .collect();
+    // The corners lie in two bands: the border is at most their sum, at least the largest.
+    assert!(
+        border <= sides.iter().sum::<f64>() && border >= sides.iter().cloned().fold(0.0, f64::max)
+    );
+    let expected = (2.0 * 20f64.to_radians().tan() / 200.0).atan().to_degrees() * 60.0;
+    let got = json["driver_pixel_arcmin"].as_f64().unwrap();
+    assert!(
+        (got - expected).abs() < 1e-9 * expected,
+        "{got} vs {expected}"
+    );
+    let mean = json["display"]["misregistration_arcmin"]["mean"]
+        .as_f64()
+        .unwrap();
+    let mean_px = json["misregistration_mean_driver_px"].as_f64().unwrap();
+    assert!(mean > 1.0, "{mean}");
+    assert!(
+        (mean_px - mean / expected).abs() < 1e-6 * mean_px,
+        "{mean_px} vs {}",
+        mean / expected
+    );
+}
+
+#[test]
 fn ssim_windows_are_seven_pixels_wide() {
     // Flat frames that differ in one pixel well inside the display (6 pixels from its edge):
     // exactly the 49 windows around it see the difference, each with the same statistics (48 pixels at l, one at

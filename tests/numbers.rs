@@ -238,6 +238,96 @@ fn the_display_ssim_of_a_run_equals_wang_et_al_over_the_display() {
     );
 }
 
+#[test]
+fn the_display_flip_of_a_run_is_nv_flip_of_the_display_on_grey() {
+    // FLIP as the metrics' notes define it, computed here: both images cut to the display's
+    // bounding box, every pixel outside the display the same grey 128, NVIDIA's FLIP at the
+    // driver camera's pixels per degree; each display pixel's value and the display's mean.
+    // The driver camera turned off the display's axis: the display is a trapezoid whose
+    // bounding box holds pixels outside it.
+    let text = common::WallScene {
+        wall: 12.0,
+        eye: [0.0, 0.0, 0.7],
+        driver_resolution: [120, 90],
+        ..common::WallScene::default()
+    }
+    .text()
+    .replace("look_at = [0.0, 0.0, -6.0]", "look_at = [0.6, 0.4, -6.0]");
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let ctx = RenderContext::new(scene).unwrap();
+    let r = run(
+        &ctx,
+        &RunOptions {
+            d2: WorkingDistance::Metres(6.0),
+            spp: 1,
+            ..RunOptions::default()
+        },
+    )
+    .unwrap();
+    let (maps, json) = measured(&ctx, &r);
+    let (w, h) = (maps.width as usize, maps.height as usize);
+    let display: Vec<usize> = (0..w * h).filter(|&i| maps.display[i]).collect();
+    let (xs, ys) = (
+        display.iter().map(|&i| i % w),
+        display.iter().map(|&i| i / w),
+    );
+    let (x0, x1) = (xs.clone().min().unwrap(), xs.max().unwrap() + 1);
+    let (y0, y1) = (ys.clone().min().unwrap(), ys.max().unwrap() + 1);
+    // A box away from every edge of the frame, not square, and a display that does not fill
+    // it: an offset, a stride or a mask read at the wrong pixel changes what FLIP sees.
+    assert!(
+        x0 > 0 && y0 > 0 && x1 < w && y1 < h,
+        "box {x0}..{x1} × {y0}..{y1}"
+    );
+    assert_ne!(x1 - x0, y1 - y0);
+    assert!(display.len() < (x1 - x0) * (y1 - y0));
+    let cut = |f: &Frame| -> Vec<u8> {
+        let mut out = Vec::new();
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let i = y * w + x;
+                out.extend(if maps.display[i] {
+                    encode_srgb8(f.color[i])
+                } else {
+                    [128; 3]
+                });
+            }
+        }
+        out
+    };
+    let (bw, bh) = ((x1 - x0) as u32, (y1 - y0) as u32);
+    let fov_deg = 2.0 * ctx.scene.driver.tan_half_x().atan().to_degrees();
+    let flip = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(bw, bh, &cut(&r.truth)),
+        nv_flip::FlipImageRgb8::with_data(bw, bh, &cut(&r.seethru)),
+        (w as f64 / fov_deg) as f32,
+    )
+    .to_vec();
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            let got = maps.flip[i];
+            if maps.display[i] {
+                let expected = flip[(y - y0) * (x1 - x0) + x - x0] as f64;
+                assert!(
+                    (got - expected).abs() <= 1e-6 * expected.max(1e-3),
+                    "({x},{y}): {got} vs {expected}"
+                );
+            } else {
+                assert!(got.is_nan(), "({x},{y}) is outside the display: {got}");
+            }
+        }
+    }
+    let mean = display
+        .iter()
+        .map(|&i| flip[(i / w - y0) * (x1 - x0) + i % w - x0] as f64)
+        .sum::<f64>()
+        / display.len() as f64;
+    let got = json["display"]["flip_mean"].as_f64().unwrap();
+    assert!((got - mean).abs() <= 1e-9 * mean, "{got} vs {mean}");
+    assert!(mean > 0.01, "the shifted wall should differ: {mean}");
+}
+
 // ---------------------------------------------------------------------------------------------
 // The d2 → ∞ closed form and the error budget, rendered
 

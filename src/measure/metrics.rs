@@ -491,5 +491,14 @@ mod tests {
         mask[5 + 1] = true;
         mask[2 * 5 + 3] = true;
         assert_eq!(bounding_box(&mask, 5), Some((1, 1, 4, 3)));
+        // The first pixel in index order is the rightmost and the bottom row's only one: its
+        // own box must end one past it.
+        let mut mask = vec![false; 5 * 4];
+        mask[5 + 3] = true;
+        mask[2 * 5 + 1] = true;
+        assert_eq!(bounding_box(&mask, 5), Some((1, 1, 4, 3)));
+        let mut one = vec![false; 5 * 4];
+        one[2 * 5 + 2] = true;
+        assert_eq!(bounding_box(&one, 5), Some((2, 2, 3, 3)));
     }
 }
