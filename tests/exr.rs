@@ -199,17 +199,25 @@ fn measuring_a_run_without_aovs_names_the_flag() {
 #[test]
 fn seethru_zip_matches_the_exr_crates_zip_and_ignores_the_thread_count() {
     use seethru::io::exr_zip;
-    // A rendered frame's every AOV, at a height that leaves a partial block of 16 lines.
+    // A rendered frame's every AOV, at a size that leaves partial tiles across and down.
     let frame = rendered();
-    assert_ne!(frame.height % 16, 0);
+    assert!(
+        !frame.width.is_multiple_of(64) && !frame.height.is_multiple_of(64) && frame.width > 64
+    );
     let dir = tempfile::tempdir().unwrap();
     let ours = dir.path().join("ours.exr");
     write_frame(&frame, dir.path(), "ours", ExrContent::All).unwrap();
     let meta = exr::meta::MetaData::read_from_file(&ours, false).unwrap();
     assert_eq!(meta.headers[0].compression, Compression::ZIP16);
     assert_eq!(exr_zip::COMPRESSION, Compression::ZIP16);
+    assert!(
+        matches!(meta.headers[0].blocks, exr::meta::BlockDescription::Tiles(t)
+            if t.tile_size == Vec2(64, 64) && t.level_mode == exr::meta::attribute::LevelMode::Singular),
+        "{:?}",
+        meta.headers[0].blocks
+    );
     assert!(frame.bit_identical(&read_exr(&ours).unwrap()));
-    // The twin: the frame's channels through the exr crate's own ZIP16 writer.
+    // The twin: the frame's channels through the exr crate's own writer of ZIP tiles.
     let theirs = dir.path().join("theirs.exr");
     let f32s = |name: &'static str, v: Vec<f32>| AnyChannel::new(name, FlatSamples::F32(v));
     let axis = |v: &[glam::Vec3], k: usize| v.iter().map(|p| p[k]).collect::<Vec<f32>>();
@@ -237,7 +245,8 @@ fn seethru_zip_matches_the_exr_crates_zip_and_ignores_the_thread_count() {
         LayerAttributes::default(),
         Encoding {
             compression: Compression::ZIP16,
-            ..Encoding::UNCOMPRESSED
+            blocks: Blocks::Tiles(Vec2(64, 64)),
+            line_order: LineOrder::Increasing,
         },
         AnyChannels::sort(SmallVec::from_vec(list)),
     );
@@ -272,7 +281,7 @@ fn seethru_zip_matches_the_exr_crates_zip_and_ignores_the_thread_count() {
     let one = bytes_on(1);
     assert!(one == std::fs::read(&ours).unwrap(), "bytes differ");
     assert!(one == bytes_on(3), "bytes differ on 3 threads");
-    // Many blocks (38 of 16 lines), more than one thread's share of them at a time.
+    // Many blocks (30 tiles), more than one thread's share of them at a time.
     let (width, height) = (131usize, 600usize);
     let noise: Vec<f32> = (0..width * height)
         .map(|i| (hash_u32(i as u32) % 1000) as f32 * 0.01)

@@ -234,7 +234,7 @@ pub fn write_colour_exr(frame: &Frame, path: &Path) -> Result<()> {
     write_view_exr(frame, path, ExrContent::Colour)
 }
 
-/// The lossless compression of every EXR seethru writes: ZIP over blocks of 16 scan lines
+/// The lossless compression of every EXR seethru writes: ZIP over tiles of 64×64 pixels
 /// (exact for f32 and u32 samples), deflated fast and in parallel by [`exr_zip`]. On das's
 /// `run` it took about a third of PIZ's CPU for a folder 14 % larger (docs/guide/performance.md
 /// has the figures). Every OpenEXR reader (OpenCV, imageio, Blender, Nuke) reads it.
@@ -248,14 +248,10 @@ pub fn write_exr_channels(
     height: u32,
     channels: Vec<AnyChannel<FlatSamples>>,
 ) -> Result<()> {
-    let encoding = Encoding {
-        compression: EXR_COMPRESSION,
-        ..Encoding::UNCOMPRESSED
-    };
     let layer = Layer::new(
         (width as usize, height as usize),
         LayerAttributes::default(),
-        encoding,
+        exr_zip::ENCODING,
         AnyChannels::sort(SmallVec::from_vec(channels)),
     );
     let image = Image::from_layer(layer);
