@@ -2,12 +2,13 @@
 //! crate's and the blocks compressed on rayon's threads.
 //!
 //! The file is a standard tiled, ZIP-compressed EXR: each tile's samples are laid out
-//! little-endian line by line and channel by channel, split into even and odd bytes, delta-coded (+128) and
-//! deflated into a zlib stream, exactly as OpenEXR's `ImfZip` and the exr crate do; a block
-//! that would not shrink is stored raw, as the format requires. Only the deflate differs: the
-//! exr crate runs miniz_oxide at level 4; seethru runs level 1 (greedy matching), which took
-//! a quarter of the CPU for 6 % more bytes on das's views (docs/guide/performance.md). Every
-//! zlib reader inflates it: the exr crate, OpenEXR (OpenCV, imageio, Blender, Nuke).
+//! little-endian line by line and channel by channel, split into even and odd bytes,
+//! delta-coded (+128) and deflated into a zlib stream, exactly as OpenEXR's `ImfZip` and the
+//! exr crate do; a block that would not shrink is stored raw, as the format requires. Only
+//! the deflate differs: the exr crate runs miniz_oxide at level 4; seethru runs level 1
+//! (greedy matching), which took a quarter of the CPU for 6 % more bytes on das's views
+//! (docs/guide/performance.md). Every zlib reader inflates it: the exr crate, OpenEXR
+//! (OpenCV, imageio, Blender, Nuke).
 //!
 //! The bytes do not depend on the thread count: each block is compressed on its own and the
 //! blocks are written in order. On a big-endian machine the exr crate's own ZIP writer is used
