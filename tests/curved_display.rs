@@ -518,6 +518,7 @@ fn the_binocular_map_of_a_curved_display_uses_the_surface_points() {
 /// curved surface's own points through the model), as `run` does.
 #[test]
 fn a_sequence_shows_the_ideal_curved_display_exactly() {
+    use seethru::measure::metrics::Flip;
     use seethru::measure::sequence::{Measuring, run_sequence};
     use seethru::system::sequence::head_motion::HeadMotion;
     use seethru::system::sequence::predict::Prediction;
@@ -553,6 +554,7 @@ fn a_sequence_shows_the_ideal_curved_display_exactly() {
             full_frames: false,
             band: 5,
             progress: false,
+            flip: Flip::Skipped,
         };
         let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
         assert!(run.records.len() >= 3);

@@ -13,6 +13,7 @@ use seethru::analysis::examples::das_geometry;
 use seethru::analysis::physical::{self, ARCMIN_PER_RAD};
 use seethru::measure::binocular::binocular_map;
 use seethru::measure::image_diff::{Layer, LayerKind, STANDARD_PPD, diff_layer};
+use seethru::measure::metrics::Flip;
 use seethru::measure::metrics::{masked_ssim_map, measure};
 use seethru::measure::ratio::measure_ratio;
 use seethru::measure::ratio_setup::{Compensation, Setup, build_scene};
@@ -886,6 +887,7 @@ fn the_head_jitter_has_the_spread_its_flag_states() {
         full_frames: false,
         band: 5,
         progress: false,
+        flip: Flip::Skipped,
     };
     let run = run_sequence(&scene, options, how, &mut |_| Ok(())).unwrap();
     let errors: Vec<DVec3> = run

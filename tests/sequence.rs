@@ -7,6 +7,7 @@ use std::path::Path;
 
 use seethru::analysis::dynamic::{Motion, dynamic_misregistration};
 use seethru::analysis::physical::ARCMIN_PER_RAD;
+use seethru::measure::metrics::Flip;
 use seethru::measure::sequence::{Measuring, run_sequence};
 use seethru::render::integrator::RenderContext;
 use seethru::render::settings::RenderSettings;
@@ -57,6 +58,7 @@ fn the_measured_dynamic_misregistration_follows_the_formula() {
             full_frames: false,
             band: 5,
             progress: false,
+            flip: Flip::Skipped,
         };
         let run = run_sequence(
             &scene,
@@ -256,6 +258,21 @@ fn frames_and_csv_are_bit_identical_for_any_thread_count() {
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
         .collect();
     assert_eq!(rows.len(), 2);
+    // Without --flip, frames.csv's FLIP column is NaN in every row.
+    let frames = String::from_utf8(
+        outputs[0]
+            .iter()
+            .find(|f| f.0 == "latency_0ms/frames.csv")
+            .unwrap()
+            .1
+            .clone(),
+    )
+    .unwrap();
+    let header: Vec<&str> = frames.lines().next().unwrap().split(',').collect();
+    let flip = header.iter().position(|c| *c == "flip").unwrap();
+    for row in frames.lines().skip(1) {
+        assert_eq!(row.split(',').nth(flip), Some("NaN"), "{row}");
+    }
     assert!(rows[1][1] > rows[0][1] + 10.0, "{rows:?}");
 }
 
@@ -391,6 +408,52 @@ fn the_budget_geometry_is_the_das_scene() {
     assert!((d2 - g.scene_depth).abs() < 0.1, "d2 auto = {d2} m");
 }
 
+/// FLIP is a sequence's costliest image metric and is computed only when asked: without it
+/// every frame's `flip` is NaN and every other metric is the same, bit for bit; with it each
+/// frame has a FLIP in (0, 1] (the yawing wall is shown late, so the images differ).
+#[test]
+fn a_sequence_computes_flip_only_when_asked() {
+    let wall = common::WallScene::default();
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let records = |flip: Flip| {
+        let how = Measuring {
+            metrics: true,
+            full_frames: false,
+            band: 5,
+            progress: false,
+            flip,
+        };
+        let o = options(0.1, 30.0, 30.0, 20f64.to_radians());
+        let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
+        run.records
+            .iter()
+            .map(|r| r.metrics.unwrap())
+            .collect::<Vec<_>>()
+    };
+    let (with, without) = (records(Flip::Computed), records(Flip::Skipped));
+    assert_eq!(with.len(), without.len());
+    assert!(with.len() >= 3);
+    for (a, b) in with.iter().zip(&without) {
+        assert!(a.flip > 0.0 && a.flip <= 1.0, "{}", a.flip);
+        assert!(b.flip.is_nan(), "{}", b.flip);
+        let others = |m: &seethru::measure::sequence::FrameMetrics| {
+            [
+                m.coverage,
+                m.mean_arcmin,
+                m.p95_arcmin,
+                m.max_arcmin,
+                m.border_mean_arcmin,
+                m.psnr_db,
+                m.ssim,
+                m.missing_fraction,
+            ]
+            .map(f64::to_bits)
+        };
+        assert_eq!(others(a), others(b));
+        assert_eq!(a.display_pixels, b.display_pixels);
+    }
+}
+
 /// Re-projecting the late frontal image by the known vehicle motion takes the yaw's error
 /// away: on the wall with the model plane on it only the static error (the resampling
 /// quantum) of a sequence without latency is left.
@@ -403,6 +466,7 @@ fn reprojection_by_the_known_yaw_removes_the_dynamic_error() {
         full_frames: false,
         band: 5,
         progress: false,
+        flip: Flip::Skipped,
     };
     let mut means = Vec::new();
     for (latency, reproject) in [(0.1, false), (0.1, true), (0.0, false)] {
@@ -448,6 +512,7 @@ fn a_late_head_estimate_costs_what_the_formula_says() {
         full_frames: false,
         band: 5,
         progress: false,
+        flip: Flip::Skipped,
     };
     let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
     let mut checked = 0;
@@ -502,6 +567,7 @@ fn the_yaw_and_head_terms_add_with_their_signs() {
         full_frames: false,
         band: 5,
         progress: false,
+        flip: Flip::Skipped,
     };
     let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
     let (mut adding, mut opposing) = (0, 0);
@@ -573,7 +639,15 @@ fn a_lens_goes_through_the_sequence_as_through_run() {
                 "--out",
                 seq.to_str().unwrap(),
             ][..],
-            &["--duration", "0.05", "--fps", "20", "--head", "still"],
+            &[
+                "--duration",
+                "0.05",
+                "--fps",
+                "20",
+                "--head",
+                "still",
+                "--flip",
+            ],
             // The oracle sequence renders no back view: --back-width would be refused.
             &small[..4],
             &small[6..],
@@ -612,6 +686,14 @@ fn a_lens_goes_through_the_sequence_as_through_run() {
     assert!(
         (sequence - single).abs() <= 0.05 * single,
         "sequence {sequence}′ against run {single}′"
+    );
+    // --flip: the frame's FLIP, as the run's of the same instant.
+    let flip_column = header.iter().position(|c| *c == "flip").unwrap();
+    let flip: f64 = first[flip_column].parse().unwrap();
+    let run_flip = metrics["display"]["flip_mean"].as_f64().unwrap();
+    assert!(
+        (flip - run_flip).abs() <= 0.1 * run_flip,
+        "sequence FLIP {flip} against run {run_flip}"
     );
 }
 

@@ -250,6 +250,7 @@ def sequence(
     back_width: int | None = None,
     spp: int = 1,
     band: int = 5,
+    flip: bool = False,
     hazard_bound_arcmin: float = ...,
     max_memory: float = ...,
 ) -> Sequence:

@@ -18,6 +18,7 @@ use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
+use seethru::measure::metrics::Flip;
 use seethru::measure::sequence::{FrameRecord, Measuring, SequenceStepper};
 use seethru::render::frame::Frame;
 use seethru::render::settings::MAX_SPP;
@@ -285,7 +286,7 @@ fn step(stepper: &mut SequenceStepper) -> anyhow::Result<Stepped> {
 }
 
 /// The keywords of [`sequence`], in `seethru sequence --help`'s order.
-pub const SEQUENCE_KEYS: [&str; 35] = [
+pub const SEQUENCE_KEYS: [&str; 36] = [
     "duration",
     "fps",
     "display_hz",
@@ -319,6 +320,7 @@ pub const SEQUENCE_KEYS: [&str; 35] = [
     "back_width",
     "spp",
     "band",
+    "flip",
     "hazard_bound_arcmin",
     "max_memory",
 ];
@@ -411,6 +413,10 @@ pub fn sequence(
     let back_width = k.side("back_width")?;
     let spp = k.int("spp", 1, 1, MAX_SPP as i64)? as u32;
     let band = k.int("band", 5, 1, 1000)? as u32;
+    let flip = match k.flag("flip")? {
+        true => Flip::Computed,
+        false => Flip::Skipped,
+    };
     let bound = k.real("hazard_bound_arcmin", DEFAULT_BOUND_ARCMIN, 1e-6, 10800.0)?;
     let max_memory = k.real("max_memory", DEFAULT_MAX_MEMORY_GIB, 1e-6, 4096.0)?;
     let given: Vec<String> = SEQUENCE_KEYS
@@ -527,6 +533,7 @@ pub fn sequence(
         full_frames: true,
         band,
         progress: false,
+        flip,
     };
     let mut sequence = PySequence {
         current: None,

@@ -86,3 +86,22 @@ def test_bad_sequence_input_raises():
         seethru.sequence(scene, colour="red")
     with pytest.raises(ValueError, match="three numbers"):
         next(iter(seethru.sequence(scene, predictor=lambda info: "left", **OPTIONS)))
+
+
+def test_flip_is_computed_only_when_asked(tmp_path):
+    # As the command line's --flip: FLIP in every frame's metrics with flip=True, None (and
+    # a note saying why) without it.
+    out = tmp_path / "flip"
+    done = seethru_cli("sequence", str(SCENE), *CLI, "--flip", "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    with open(out / "latency_0ms" / "frames.csv") as f:
+        rows = list(csv.DictReader(f))
+    scene = seethru.Scene.load(str(SCENE))
+    with_flip = list(seethru.sequence(scene, predictor=oracle, flip=True, **OPTIONS))
+    without = list(seethru.sequence(scene, predictor=oracle, **OPTIONS))
+    assert len(with_flip) == len(without) == len(rows) > 1
+    for a, b, row in zip(with_flip, without, rows):
+        assert a.metrics["display"]["flip_mean"] == float(row["flip"]) > 0
+        assert b.metrics["display"]["flip_mean"] is None
+        assert "flip_not_computed" in b.metrics and "flip_not_computed" not in a.metrics
+        assert b.metrics["display"]["ssim"] == a.metrics["display"]["ssim"]

@@ -3,6 +3,7 @@
 //! loop with the truth and the metrics, at 640×360, 1 spp, on the bench's threads.
 
 use anyhow::Result;
+use seethru::measure::metrics::Flip;
 use seethru::measure::sequence::{Measuring, SequenceRun, run_sequence};
 use seethru::scene::Scene;
 use seethru::system::options::{HeadSource, Outside, RunOptions};
@@ -50,6 +51,7 @@ fn sequence(scene: &Scene, head: HeadSource, metrics: bool) -> Result<SequenceRu
         full_frames: false,
         band: 5,
         progress: false,
+        flip: Flip::Skipped,
     };
     run_sequence(scene, options, how, &mut |_| Ok(()))
 }

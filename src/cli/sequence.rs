@@ -9,6 +9,7 @@ use seethru::io::frame_files::{ExrContent, write_color_png, write_view_exr};
 use seethru::io::staged::StagedDir;
 use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
 use seethru::measure::headline::{RunKind, summary_text};
+use seethru::measure::metrics::Flip;
 use seethru::measure::sequence::{Measuring, SequenceRun, head_warning, run_sequence_hazards};
 use seethru::measure::sequence_files::{
     Preview, frames_csv, hazard_figure, latency_figure, over_time_figure, summary,
@@ -142,6 +143,10 @@ pub struct Sequence {
     /// Write every frame's truth and seethru views (whole driver views) as PNG or EXR.
     #[arg(long, value_enum, value_parser = choice::<FramesFormat>(), default_value_t = FramesFormat::None)]
     frames: FramesFormat,
+    /// Compute FLIP for every frame (frames.csv's `flip` column; NaN without it): about a
+    /// third of the per-frame metrics' time.
+    #[arg(long)]
+    flip: bool,
     /// What the EXRs of --frames exr and of --capture's folders hold, as `capture --exr`:
     /// all (every AOV), lean (R, G, B, Z, N and the ids), colour (R, G, B, A only) or none
     /// (--capture: PNGs and JSON only).
@@ -367,6 +372,10 @@ impl Sequence {
                 full_frames: frames != FramesFormat::None,
                 band: self.band,
                 progress: true,
+                flip: match self.flip {
+                    true => Flip::Computed,
+                    false => Flip::Skipped,
+                },
             };
             let bound = self.hazard_bound_arcmin;
             let run = run_sequence_hazards(&scene, options, how, bound, &label, &mut |f| {

@@ -252,6 +252,27 @@ pub fn measure(
     frames: [&Frame; 3],
     band: u32,
 ) -> (MetricMaps, serde_json::Value) {
+    measure_with(ctx, scene, driver_eye, frames, band, Flip::Computed)
+}
+
+/// Whether [`measure_with`] computes FLIP, the costliest of its image metrics.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Flip {
+    Computed,
+    /// Every FLIP figure NaN (null in the JSON, which says so): a sequence's frames without
+    /// `--flip`, where FLIP was a third of the metrics' time.
+    Skipped,
+}
+
+/// [`measure`], with FLIP computed or not.
+pub fn measure_with(
+    ctx: &RenderContext,
+    scene: &Scene,
+    driver_eye: DVec3,
+    frames: [&Frame; 3],
+    band: u32,
+    flip: Flip,
+) -> (MetricMaps, serde_json::Value) {
     let [truth, seethru, occluded] = frames;
     let (w, h) = (truth.width as usize, truth.height as usize);
     let obstacle = &scene.obstacle;
@@ -372,7 +393,11 @@ pub fn measure(
     let ssim = masked_ssim_map(&lum_t, &lum_s, &display, w, h);
     // FLIP with the driver's eye as the observer: pixels per degree of the driver's camera.
     let ppd = w as f32 / (2.0 * scene.driver.half_angle_x.to_degrees() as f32);
-    let flip = masked_flip_map(&srgb_t, &srgb_s, &display, w, ppd);
+    let flip_skipped = flip == Flip::Skipped;
+    let flip = match flip {
+        Flip::Computed => masked_flip_map(&srgb_t, &srgb_s, &display, w, ppd),
+        Flip::Skipped => vec![f64::NAN; w * h],
+    };
     let region = |keep: &dyn Fn(usize) -> bool| {
         let pixels_in: Vec<usize> = on_display.iter().copied().filter(|&i| keep(i)).collect();
         let pixels = pixels_in.len();
@@ -427,7 +452,7 @@ pub fn measure(
                 && class[i].shown_sky == shown_sky
         })
     };
-    let json = json!({
+    let mut json = json!({
         "display_pixels": count,
         "coverage": if count == 0 { f64::NAN } else { 1.0 - blank as f64 / count as f64 },
         "blank_pixels": blank,
@@ -451,6 +476,10 @@ pub fn measure(
         "flip_pixels_per_degree": ppd,
         "notes": "every display pixel counts. misregistration: angle at the eye between the direction seethru shows and the truth's (towards a world point, or a sky direction), over the covered pixels; coverage: fraction of the region's pixels that show the scene (blank pixels, outside the frontal view, have no misregistration and count in the image metrics as the black they show); undefined_pixels: neither a point nor a direction (0 for frames of this version). Colour metrics on 8-bit sRGB; SSIM on luminance with 7×7 windows inside the display mask; FLIP (NVIDIA, via nv-flip) with the driver's camera as observer, on the display's bounding box with everything outside the display mask set to the same grey in both images",
     });
+    if flip_skipped {
+        json["flip_not_computed"] =
+            json!("FLIP was not computed (a sequence without --flip): every flip_mean is null");
+    }
     let blank = (0..w * h).map(|i| class[i].blank).collect();
     (
         MetricMaps {

@@ -11,7 +11,7 @@ use obvhs::aabb::Aabb;
 
 use crate::geometry::opencv::camera_json;
 use crate::measure::hazard::{DEFAULT_BOUND_ARCMIN, HazardSeen, hazard_seen};
-use crate::measure::metrics::{MetricMaps, measure};
+use crate::measure::metrics::{Flip, MetricMaps, measure_with};
 use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
@@ -156,6 +156,8 @@ pub struct Measuring {
     /// Border band, display pixels.
     pub band: u32,
     pub progress: bool,
+    /// FLIP for every frame (else its column is NaN): a third of the metrics' time.
+    pub flip: Flip,
 }
 
 /// The world box of the obstacle's body.
@@ -430,12 +432,13 @@ impl SequenceStepper {
         let mut measured = ctx.scene.clone();
         measured.frontal = shown.frontal;
         let (truth, seethru) = (&self.truth, &self.seethru);
-        let (maps, json) = measure(
+        let (maps, json) = measure_with(
             &ctx,
             &measured,
             driver.position(),
             [truth, seethru, occluded],
             self.how.band,
+            self.how.flip,
         );
         let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
             .atan()
