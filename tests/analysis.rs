@@ -614,6 +614,16 @@ fn head_error_angles_equal_the_ray_geometry() {
         close(per_cm, 0.01 / 0.8 * physical::ARCMIN_PER_RAD, 1e-3),
         "{per_cm}"
     );
+    // An eye beyond the display's right edge (x = 0.3 m, the display spanning ±0.25 m):
+    // the worst point is that edge, 5 cm short of the eye, where the directions through
+    // it from the true eye and from the eye 1 cm further out differ by
+    // atan(6 cm / d1) − atan(5 cm / d1); nowhere on the display is it larger.
+    let edge = physical::head_error_arcmin_per_cm(0.3, 0.8, 0.5, f64::INFINITY, true);
+    let expected = ((0.06f64 / 0.8).atan() - (0.05f64 / 0.8).atan()) * physical::ARCMIN_PER_RAD;
+    assert!(
+        (edge - expected).abs() <= 1e-9 * expected,
+        "{edge} vs {expected} arcmin"
+    );
 }
 
 /// Which display point shows the scene-plane edge, found by bisection on what the frontal

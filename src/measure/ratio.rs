@@ -323,5 +323,21 @@ mod tests {
         // Pixels off the display (None) are not brackets; an edge with nothing beyond is none.
         let q: Vec<Option<f64>> = (0..6).map(|i| (i < 4).then_some(i as f64)).collect();
         assert_eq!(bracket_edge(&frame, &q, is_object, true), None);
+        // A second row, off the object, at the same plane coordinates (a column of the view
+        // above the object sees the same line of the plane): a pixel level with the object's
+        // edge is not beyond it.
+        let two_rows = Frame::from_pixels(
+            6,
+            2,
+            &(0..12)
+                .map(|i| crate::render::frame::Pixel {
+                    object_id: if (1..4).contains(&i) { 7 } else { 1 },
+                    ..crate::render::frame::Pixel::SKY
+                })
+                .collect::<Vec<_>>(),
+        );
+        let q: Vec<Option<f64>> = (0..12).map(|i| Some((i % 6) as f64)).collect();
+        assert_eq!(bracket_edge(&two_rows, &q, is_object, true), Some((3.0, 4.0)));
+        assert_eq!(bracket_edge(&two_rows, &q, is_object, false), Some((1.0, 0.0)));
     }
 }
