@@ -337,7 +337,13 @@ mod tests {
                 .collect::<Vec<_>>(),
         );
         let q: Vec<Option<f64>> = (0..12).map(|i| Some((i % 6) as f64)).collect();
-        assert_eq!(bracket_edge(&two_rows, &q, is_object, true), Some((3.0, 4.0)));
-        assert_eq!(bracket_edge(&two_rows, &q, is_object, false), Some((1.0, 0.0)));
+        assert_eq!(
+            bracket_edge(&two_rows, &q, is_object, true),
+            Some((3.0, 4.0))
+        );
+        assert_eq!(
+            bracket_edge(&two_rows, &q, is_object, false),
+            Some((1.0, 0.0))
+        );
     }
 }
