@@ -242,16 +242,12 @@ fn frames_and_csv_are_bit_identical_for_any_thread_count() {
     for (a, b) in outputs[0].iter().zip(&outputs[1]) {
         assert!(a == b, "{} differs between 1 and 3 threads", a.0);
     }
+    let text = |name: &str| {
+        let file = outputs[0].iter().find(|f| f.0 == name).unwrap();
+        String::from_utf8(file.1.clone()).unwrap()
+    };
     // Three frames per latency, and more misregistration with 100 ms of latency.
-    let csv = String::from_utf8(
-        outputs[0]
-            .iter()
-            .find(|f| f.0 == "latency.csv")
-            .unwrap()
-            .1
-            .clone(),
-    )
-    .unwrap();
+    let csv = text("latency.csv");
     let rows: Vec<Vec<f64>> = csv
         .lines()
         .skip(1)
@@ -259,15 +255,7 @@ fn frames_and_csv_are_bit_identical_for_any_thread_count() {
         .collect();
     assert_eq!(rows.len(), 2);
     // Without --flip, frames.csv's FLIP column is NaN in every row.
-    let frames = String::from_utf8(
-        outputs[0]
-            .iter()
-            .find(|f| f.0 == "latency_0ms/frames.csv")
-            .unwrap()
-            .1
-            .clone(),
-    )
-    .unwrap();
+    let frames = text("latency_0ms/frames.csv");
     let header: Vec<&str> = frames.lines().next().unwrap().split(',').collect();
     let flip = header.iter().position(|c| *c == "flip").unwrap();
     for row in frames.lines().skip(1) {

@@ -303,19 +303,21 @@ mod tests {
         assert_eq!(ratio_uncertainty(m(1.0, 0.0), m(2.0, 0.0)), 0.0);
     }
 
+    /// `rows` rows of six pixels, the object (id 7) on the first row's pixels 1..3.
+    fn rows_of_six(rows: u32) -> Frame {
+        let pixels: Vec<_> = (0..6 * rows)
+            .map(|i| crate::render::frame::Pixel {
+                object_id: if (1..4).contains(&i) { 7 } else { 1 },
+                ..crate::render::frame::Pixel::SKY
+            })
+            .collect();
+        Frame::from_pixels(6, rows, &pixels)
+    }
+
     #[test]
     fn edges_are_bracketed_from_the_side_asked_for() {
         // Six display pixels along a row at plane coordinates 0..6; the object (id 7) on 1..3.
-        let frame = Frame::from_pixels(
-            6,
-            1,
-            &(0..6)
-                .map(|i| crate::render::frame::Pixel {
-                    object_id: if (1..4).contains(&i) { 7 } else { 1 },
-                    ..crate::render::frame::Pixel::SKY
-                })
-                .collect::<Vec<_>>(),
-        );
+        let frame = rows_of_six(1);
         let q: Vec<Option<f64>> = (0..6).map(|i| Some(i as f64)).collect();
         let is_object = |id: u32, _: u32| id == 7;
         assert_eq!(bracket_edge(&frame, &q, is_object, true), Some((3.0, 4.0)));
@@ -326,16 +328,7 @@ mod tests {
         // A second row, off the object, at the same plane coordinates (a column of the view
         // above the object sees the same line of the plane): a pixel level with the object's
         // edge is not beyond it.
-        let two_rows = Frame::from_pixels(
-            6,
-            2,
-            &(0..12)
-                .map(|i| crate::render::frame::Pixel {
-                    object_id: if (1..4).contains(&i) { 7 } else { 1 },
-                    ..crate::render::frame::Pixel::SKY
-                })
-                .collect::<Vec<_>>(),
-        );
+        let two_rows = rows_of_six(2);
         let q: Vec<Option<f64>> = (0..12).map(|i| Some((i % 6) as f64)).collect();
         assert_eq!(
             bracket_edge(&two_rows, &q, is_object, true),
