@@ -392,3 +392,31 @@ fn a_bad_calibration_file_is_one_line_naming_its_file_line_and_key() {
         assert!(!out.exists(), "nothing written");
     }
 }
+
+/// The model point of a display point at a finite d2 is where the eye's ray through it meets
+/// the plane z = −d2: the point the returned normalised coordinates name on that plane (the
+/// frontal camera at the origin looking down −z, y down) is on the line from the eye through
+/// the display point.
+#[test]
+fn the_model_point_at_a_finite_d2_is_on_the_eyes_ray() {
+    for eye in [
+        DVec3::new(0.0, 0.0, 0.8),
+        DVec3::new(-0.35, 0.12, 0.6),
+        DVec3::new(0.2, -0.05, 1.1),
+    ] {
+        for on_display in [DVec3::new(0.1, 0.2, 0.0), DVec3::new(-0.125, -0.225, 0.0)] {
+            for d2 in [0.5, 3.0, 20.0] {
+                let n = model_point_normalised(eye, on_display, Some(d2));
+                let on_plane = DVec3::new(n.x * d2, -n.y * d2, -d2);
+                let (ray, to_point) = (on_display - eye, on_plane - eye);
+                let off_ray = ray.cross(to_point).length() / ray.length();
+                assert!(
+                    off_ray < 1e-12 * to_point.length(),
+                    "eye {eye} display {on_display} d2 {d2}: {off_ray} m off the ray"
+                );
+                // Beyond the display, not behind the eye.
+                assert!(to_point.dot(ray) > ray.length_squared());
+            }
+        }
+    }
+}
