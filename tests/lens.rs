@@ -420,3 +420,50 @@ fn the_model_point_at_a_finite_d2_is_on_the_eyes_ray() {
         }
     }
 }
+
+/// `radial_error_px` is the distance, in pixels, between where the true lens and the believed
+/// one put a ray of undistorted radius r: f·|r·(1 + k1 r² + k2 r⁴ + k3 r⁶) − the same with the
+/// believed k| (Brown–Conrady, radial terms), here with every coefficient differing.
+#[test]
+fn the_radial_error_is_the_distance_between_two_distortions() {
+    let distorted = |k: [f64; 3], r: f64| {
+        let r2 = r * r;
+        r * (1.0 + k[0] * r2 + k[1] * r2 * r2 + k[2] * r2 * r2 * r2)
+    };
+    let f = 900.0;
+    for (truth, believed) in [
+        ([-0.28, 0.09, -0.012], [-0.2, 0.02, 0.004]),
+        ([0.05, -0.3, 0.2], [0.0, 0.1, -0.05]),
+    ] {
+        for r in [0.1, 0.45, 0.9] {
+            let expected = f * (distorted(truth, r) - distorted(believed, r)).abs();
+            let got = radial_error_px(f, truth, believed, r);
+            assert!(
+                (got - expected).abs() <= 1e-9 * expected,
+                "{truth:?} vs {believed:?} at r {r}: {got} px, expected {expected}"
+            );
+        }
+    }
+}
+
+/// The display's corners, top-left, top-right, bottom-right, bottom-left, are where the
+/// display's own pixel coordinates (the renderer's mapping of a point on it) are the image's
+/// corners.
+#[test]
+fn the_display_corners_are_where_its_pixel_coordinates_are_the_image_corners() {
+    use seethru::analysis::binocular::display_corners;
+    use seethru::system::display::DisplayPlacement;
+    let scene = common::das();
+    let o = &scene.obstacle;
+    let placement = DisplayPlacement::new(o);
+    let [w, h] = o.display_resolution.map(|v| v as f64);
+    let expected = [(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)];
+    for (corner, (x, y)) in display_corners(o.width, o.height).iter().zip(expected) {
+        let world = o.world_from_obstacle.transform_point3(*corner).as_vec3();
+        let at = placement.pixel_coords(world);
+        assert!(
+            (at - DVec2::new(x, y)).length() < 1e-3,
+            "corner {corner} is at display pixel {at}, expected ({x}, {y})"
+        );
+    }
+}
