@@ -519,7 +519,7 @@ fn the_binocular_map_of_a_curved_display_uses_the_surface_points() {
 #[test]
 fn a_sequence_shows_the_ideal_curved_display_exactly() {
     use seethru::measure::metrics::Flip;
-    use seethru::measure::sequence::{Measuring, run_sequence};
+    use seethru::measure::sequence::run_sequence;
     use seethru::system::sequence::head_motion::HeadMotion;
     use seethru::system::sequence::predict::Prediction;
     use seethru::system::sequence::system_loop::SequenceOptions;
@@ -549,13 +549,7 @@ fn a_sequence_shows_the_ideal_curved_display_exactly() {
             reproject: false,
             byo: Default::default(),
         };
-        let how = Measuring {
-            metrics: true,
-            full_frames: false,
-            band: 5,
-            progress: false,
-            flip: Flip::Skipped,
-        };
+        let how = common::measuring(Flip::Skipped);
         let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
         assert!(run.records.len() >= 3);
         run.records

@@ -193,26 +193,34 @@ fn measured(
     )
 }
 
-#[test]
-fn the_display_ssim_of_a_run_equals_wang_et_al_over_the_display() {
-    // The textured wall at 12 m with the model plane at 6 m: seethru is the truth shifted,
-    // by an amount that grows across the display.
-    let ctx = common::WallScene {
+/// A run of the textured wall at 12 m, the driver's camera at 120×90 looking as `look_at`
+/// (a line of the scene file) and the model plane at 6 m: seethru is the truth shifted, by an
+/// amount that grows across the display.
+fn wall_run_with_the_model_plane_short(look_at: &str) -> (RenderContext, RunResult) {
+    let text = common::WallScene {
         wall: 12.0,
         eye: [0.0, 0.0, 0.7],
         driver_resolution: [120, 90],
         ..common::WallScene::default()
     }
-    .context();
-    let r = run(
-        &ctx,
-        &RunOptions {
-            d2: WorkingDistance::Metres(6.0),
-            spp: 1,
-            ..RunOptions::default()
-        },
-    )
-    .unwrap();
+    .text()
+    .replace("look_at = [0.0, 0.0, -6.0]", look_at);
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let ctx = RenderContext::new(scene).unwrap();
+    let options = RunOptions {
+        d2: WorkingDistance::Metres(6.0),
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let r = run(&ctx, &options).unwrap();
+    (ctx, r)
+}
+
+#[test]
+fn the_display_ssim_of_a_run_equals_wang_et_al_over_the_display() {
+    // The textured wall at 12 m with the model plane at 6 m: seethru is the truth shifted,
+    // by an amount that grows across the display.
+    let (ctx, r) = wall_run_with_the_model_plane_short("look_at = [0.0, 0.0, -6.0]");
     let (maps, json) = measured(&ctx, &r);
     let (w, h) = (maps.width as usize, maps.height as usize);
     let lum = |f: &Frame| -> Vec<f64> {
@@ -246,25 +254,7 @@ fn the_display_flip_of_a_run_is_nv_flip_of_the_display_on_grey() {
     // driver camera's pixels per degree; each display pixel's value and the display's mean.
     // The driver camera turned off the display's axis: the display is a trapezoid whose
     // bounding box holds pixels outside it.
-    let text = common::WallScene {
-        wall: 12.0,
-        eye: [0.0, 0.0, 0.7],
-        driver_resolution: [120, 90],
-        ..common::WallScene::default()
-    }
-    .text()
-    .replace("look_at = [0.0, 0.0, -6.0]", "look_at = [0.6, 0.4, -6.0]");
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
-    let ctx = RenderContext::new(scene).unwrap();
-    let r = run(
-        &ctx,
-        &RunOptions {
-            d2: WorkingDistance::Metres(6.0),
-            spp: 1,
-            ..RunOptions::default()
-        },
-    )
-    .unwrap();
+    let (ctx, r) = wall_run_with_the_model_plane_short("look_at = [0.6, 0.4, -6.0]");
     let (maps, json) = measured(&ctx, &r);
     let (w, h) = (maps.width as usize, maps.height as usize);
     let display: Vec<usize> = (0..w * h).filter(|&i| maps.display[i]).collect();

@@ -8,7 +8,7 @@ use std::path::Path;
 use seethru::analysis::dynamic::{Motion, dynamic_misregistration};
 use seethru::analysis::physical::ARCMIN_PER_RAD;
 use seethru::measure::metrics::Flip;
-use seethru::measure::sequence::{Measuring, run_sequence};
+use seethru::measure::sequence::run_sequence;
 use seethru::render::integrator::RenderContext;
 use seethru::render::settings::RenderSettings;
 use seethru::scene::world::view_bit;
@@ -53,13 +53,7 @@ fn the_measured_dynamic_misregistration_follows_the_formula() {
     let eye = scene.obstacle.in_obstacle_frame(scene.eye());
     let yaw_rate = 20f64.to_radians();
     for (latency, display_hz) in [(0.05, 60.0), (0.1, 60.0), (0.033, 30.0)] {
-        let how = Measuring {
-            metrics: true,
-            full_frames: false,
-            band: 5,
-            progress: false,
-            flip: Flip::Skipped,
-        };
+        let how = common::measuring(Flip::Skipped);
         let run = run_sequence(
             &scene,
             options(latency, 60.0, display_hz, yaw_rate),
@@ -404,13 +398,7 @@ fn a_sequence_computes_flip_only_when_asked() {
     let wall = common::WallScene::default();
     let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
     let records = |flip: Flip| {
-        let how = Measuring {
-            metrics: true,
-            full_frames: false,
-            band: 5,
-            progress: false,
-            flip,
-        };
+        let how = common::measuring(flip);
         let o = options(0.1, 30.0, 30.0, 20f64.to_radians());
         let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
         run.records
@@ -449,13 +437,7 @@ fn a_sequence_computes_flip_only_when_asked() {
 fn reprojection_by_the_known_yaw_removes_the_dynamic_error() {
     let wall = common::WallScene::default();
     let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
-    let how = Measuring {
-        metrics: true,
-        full_frames: false,
-        band: 5,
-        progress: false,
-        flip: Flip::Skipped,
-    };
+    let how = common::measuring(Flip::Skipped);
     let mut means = Vec::new();
     for (latency, reproject) in [(0.1, false), (0.1, true), (0.0, false)] {
         let mut o = options(latency, 30.0, 30.0, 20f64.to_radians());
@@ -495,13 +477,7 @@ fn a_late_head_estimate_costs_what_the_formula_says() {
         amplitude,
         frequency,
     };
-    let how = Measuring {
-        metrics: true,
-        full_frames: false,
-        band: 5,
-        progress: false,
-        flip: Flip::Skipped,
-    };
+    let how = common::measuring(Flip::Skipped);
     let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
     let mut checked = 0;
     for r in &run.records {
@@ -550,13 +526,7 @@ fn the_yaw_and_head_terms_add_with_their_signs() {
         frequency,
     };
     let sway = o.head.clone();
-    let how = Measuring {
-        metrics: true,
-        full_frames: false,
-        band: 5,
-        progress: false,
-        flip: Flip::Skipped,
-    };
+    let how = common::measuring(Flip::Skipped);
     let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
     let (mut adding, mut opposing) = (0, 0);
     for r in &run.records {

@@ -413,10 +413,7 @@ pub fn sequence(
     let back_width = k.side("back_width")?;
     let spp = k.int("spp", 1, 1, MAX_SPP as i64)? as u32;
     let band = k.int("band", 5, 1, 1000)? as u32;
-    let flip = match k.flag("flip")? {
-        true => Flip::Computed,
-        false => Flip::Skipped,
-    };
+    let flip = Flip::asked(k.flag("flip")?);
     let bound = k.real("hazard_bound_arcmin", DEFAULT_BOUND_ARCMIN, 1e-6, 10800.0)?;
     let max_memory = k.real("max_memory", DEFAULT_MAX_MEMORY_GIB, 1e-6, 4096.0)?;
     let given: Vec<String> = SEQUENCE_KEYS

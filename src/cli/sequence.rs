@@ -372,10 +372,7 @@ impl Sequence {
                 full_frames: frames != FramesFormat::None,
                 band: self.band,
                 progress: true,
-                flip: match self.flip {
-                    true => Flip::Computed,
-                    false => Flip::Skipped,
-                },
+                flip: Flip::asked(self.flip),
             };
             let bound = self.hazard_bound_arcmin;
             let run = run_sequence_hazards(&scene, options, how, bound, &label, &mut |f| {

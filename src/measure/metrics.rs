@@ -264,6 +264,13 @@ pub enum Flip {
     Skipped,
 }
 
+impl Flip {
+    /// FLIP computed when `asked` (a command's `--flip`), else skipped.
+    pub fn asked(asked: bool) -> Flip {
+        if asked { Flip::Computed } else { Flip::Skipped }
+    }
+}
+
 /// [`measure`], with FLIP computed or not.
 pub fn measure_with(
     ctx: &RenderContext,
