@@ -5,7 +5,7 @@
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use crate::scene::texture::Texture;
+use crate::scene::texture::Texels;
 
 use crate::scene::{Sky, Sun};
 use crate::util::color::srgb_to_linear3;
@@ -23,7 +23,8 @@ pub struct SkyModel {
     cloud_size: f32,
     /// Cloud noise over one period of the cloud layer, precomputed: evaluating five octaves
     /// of noise per sky pixel cost more than tracing its ray.
-    clouds: Texture,
+    /// Cloud noise in [0, 1): a scalar table, a third of an RGB one's cache footprint.
+    clouds: Texels<f32>,
     /// Unit direction towards the sun, world frame.
     pub sun_direction: Vec3,
     /// Sun irradiance on a surface facing it, linear RGB.
@@ -65,7 +66,7 @@ impl SkyModel {
         }
         // Where the ray meets the cloud layer, in units of cloud size.
         let p = Vec2::new(dir.x, dir.z) * (self.cloud_height / dir.y) / self.cloud_size;
-        let n = self.clouds.sample(p / CLOUD_PERIOD as f32).x;
+        let n = self.clouds.sample(p / CLOUD_PERIOD as f32);
         let threshold = 0.72 - 0.45 * self.cloud_cover;
         let density = ((n - threshold) / 0.12).clamp(0.0, 1.0);
         // Far clouds dissolve into the haze at the horizon.
@@ -102,7 +103,7 @@ const CLOUD_PERIOD: u32 = 8;
 /// Texels of the cloud table per side.
 const CLOUD_TABLE: u32 = 512;
 
-fn cloud_table(seed: u32) -> Texture {
+fn cloud_table(seed: u32) -> Texels<f32> {
     let n = CLOUD_TABLE;
     let octaves = Octaves::new(seed);
     let texels = (0..n * n)
@@ -110,10 +111,10 @@ fn cloud_table(seed: u32) -> Texture {
         .map(|i| {
             let p = Vec2::new((i % n) as f32 + 0.5, (i / n) as f32 + 0.5)
                 * (CLOUD_PERIOD as f32 / n as f32);
-            Vec3::splat(octaves.fbm(p))
+            octaves.fbm(p)
         })
         .collect();
-    Texture {
+    Texels {
         width: n,
         height: n,
         texels,

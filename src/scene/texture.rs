@@ -1,4 +1,5 @@
-//! Image textures: linear RGB texels, bilinear lookup, repeating.
+//! Image textures: linear RGB texels, bilinear lookup, repeating; and the same lookup over
+//! scalar tables (the sky's clouds).
 
 use std::path::Path;
 
@@ -8,12 +9,38 @@ use glam::{Vec2, Vec3};
 use crate::scene::limits::{MAX_PIXELS, MAX_RESOLUTION};
 use crate::util::color::srgb_to_linear;
 
+/// A repeating grid of texels with bilinear lookup.
 #[derive(Clone, Debug)]
-pub struct Texture {
+pub struct Texels<T> {
+    /// Texels per row, in [1, MAX_RESOLUTION].
     pub width: u32,
+    /// Rows, in [1, MAX_RESOLUTION].
     pub height: u32,
-    /// Row-major, row 0 at the top, linear RGB.
-    pub texels: Vec<Vec3>,
+    /// Row-major, row 0 at the top.
+    pub texels: Vec<T>,
+}
+
+/// An image texture: linear RGB texels.
+pub type Texture = Texels<Vec3>;
+
+/// What a texel can be: a value with linear interpolation.
+pub trait Texel: Copy {
+    /// `self` at `t` = 0 to `other` at `t` = 1.
+    fn lerp(self, other: Self, t: f32) -> Self;
+}
+
+impl Texel for Vec3 {
+    fn lerp(self, other: Vec3, t: f32) -> Vec3 {
+        Vec3::lerp(self, other, t)
+    }
+}
+
+/// Glam's `Vec3::lerp` on one channel, operation for operation: a scalar table samples to
+/// the bits an RGB texture of equal channels gives.
+impl Texel for f32 {
+    fn lerp(self, other: f32, t: f32) -> f32 {
+        self * (1.0 - t) + other * t
+    }
 }
 
 impl Texture {
@@ -63,9 +90,11 @@ impl Texture {
                 .collect(),
         })
     }
+}
 
+impl<T: Texel> Texels<T> {
     /// Bilinear lookup at `uv` (u right, v down, repeating with period 1).
-    pub fn sample(&self, uv: Vec2) -> Vec3 {
+    pub fn sample(&self, uv: Vec2) -> T {
         let x = uv.x * self.width as f32 - 0.5;
         let y = uv.y * self.height as f32 - 0.5;
         if !x.is_finite() || !y.is_finite() {
@@ -115,5 +144,35 @@ mod tests {
                 .abs_diff_eq(Vec3::splat(0.5), 1e-6)
         );
         assert!(t.sample(Vec2::new(1.75, 3.5)).abs_diff_eq(Vec3::ONE, 1e-6));
+    }
+
+    /// The sky's scalar cloud table must sample to the bits the RGB texture it replaced gave.
+    #[test]
+    fn scalar_table_samples_as_its_rgb_twin() {
+        let (width, height) = (7, 5);
+        let values: Vec<f32> = (0..width * height)
+            .map(|i| ((i * 37 % 23) as f32 / 23.0).powf(1.7))
+            .collect();
+        let scalar = Texels {
+            width,
+            height,
+            texels: values.clone(),
+        };
+        let rgb = Texture {
+            width,
+            height,
+            texels: values.iter().map(|&v| Vec3::splat(v)).collect(),
+        };
+        let mut between = 0;
+        for i in 0..2000 {
+            let uv = Vec2::new(
+                (i as f32 * 0.618_034).fract() * 9.0 - 4.0,
+                (i as f32 * 0.414_213_6).fract() * 300.0 - 150.0,
+            );
+            let s = scalar.sample(uv);
+            assert_eq!(s.to_bits(), rgb.sample(uv).x.to_bits(), "uv {uv}");
+            between += usize::from(!values.contains(&s));
+        }
+        assert!(between > 1900, "only {between} lookups fell between texels");
     }
 }
