@@ -152,3 +152,71 @@ pub fn read_hole_mask(path: &Path, width: u32, height: u32) -> Result<Option<Vec
     }
     Ok(Some(image.pixels().map(|p| p.0 == [255, 0, 255]).collect()))
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::{DAffine3, DVec3};
+
+    use super::*;
+    use crate::scene::display_surface::DisplayShape;
+
+    /// A driver-view pixel that sees the display's edge (a float's rounding from outside it)
+    /// belongs to the edge column or row, not to the next row's first pixel or past the end.
+    #[test]
+    fn hole_mask_maps_edge_points_to_the_edge_pixels() {
+        let (dw, dh) = (4, 3);
+        let obstacle = Obstacle {
+            world_from_obstacle: DAffine3::from_translation(DVec3::new(1.0, 2.0, -3.0)),
+            width: 0.4,
+            height: 0.3,
+            thickness: 0.01,
+            display_resolution: [dw, dh],
+            display_off_color: [0.0; 3],
+            body_color: [0.2; 3],
+            display_shape: DisplayShape::Flat,
+        };
+        // Driver-view pixels at the display's top-right, bottom-right and top-left corners,
+        // a hair outside (as float rounding puts them), in world coordinates.
+        let at = |x: f64, y: f64| {
+            let p = obstacle
+                .world_from_obstacle
+                .transform_point3(DVec3::new(x, y, 0.0));
+            p.as_vec3()
+        };
+        let e = 1e-5;
+        let positions = [
+            at(0.2 + e, 0.15 + e),
+            at(0.2 + e, -0.15 - e),
+            at(-0.2 - e, 0.15 + e),
+        ];
+        let mut occluded = Frame::new(positions.len() as u32, 1);
+        occluded.position = positions.to_vec();
+        let n = positions.len();
+        let maps = MetricMaps {
+            width: n as u32,
+            height: 1,
+            misregistration: vec![0.0; n],
+            missing: vec![false; n],
+            display: vec![true; n],
+            blank: vec![false; n],
+            ssim: vec![1.0; n],
+            flip: vec![0.0; n],
+        };
+        let pixel = |u: u32, v: u32| (v * dw + u) as usize;
+        // Only the right column's top and bottom pixels are holes.
+        let mut holes = vec![false; (dw * dh) as usize];
+        holes[pixel(dw - 1, 0)] = true;
+        holes[pixel(dw - 1, dh - 1)] = true;
+        assert_eq!(
+            driver_hole_mask(&obstacle, &occluded, &maps, &holes),
+            [true, true, false]
+        );
+        // The top-left corner's pixel, alone a hole.
+        let mut holes = vec![false; (dw * dh) as usize];
+        holes[pixel(0, 0)] = true;
+        assert_eq!(
+            driver_hole_mask(&obstacle, &occluded, &maps, &holes),
+            [false, false, true]
+        );
+    }
+}
