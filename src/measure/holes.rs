@@ -155,7 +155,7 @@ pub fn read_hole_mask(path: &Path, width: u32, height: u32) -> Result<Option<Vec
 
 #[cfg(test)]
 mod tests {
-    use glam::{DAffine3, DVec3};
+    use glam::{DAffine3, DVec3, Vec3};
 
     use super::*;
     use crate::scene::display_surface::DisplayShape;
@@ -218,5 +218,59 @@ mod tests {
             driver_hole_mask(&obstacle, &occluded, &maps, &holes),
             [false, false, true]
         );
+    }
+
+    /// `holes` in metrics.json: each figure of the seen and filled parts against sums done
+    /// by hand on six pixels (one outside the display, one filled hole left blank).
+    #[test]
+    fn hole_metrics_split_the_display_into_seen_and_filled() {
+        let n = 6;
+        let display = [true, true, true, true, true, false];
+        let holes = [false, false, true, true, false, false];
+        let maps = MetricMaps {
+            width: n as u32,
+            height: 1,
+            misregistration: vec![1.0, 3.0, 7.0, f32::NAN, 5.0, f32::NAN],
+            missing: vec![false; n],
+            display: display.to_vec(),
+            blank: vec![false, false, false, true, false, false],
+            ssim: vec![0.9, 0.7, 0.5, 0.1, 0.8, f64::NAN],
+            flip: vec![0.1, 0.3, 0.2, 0.6, 0.5, f64::NAN],
+        };
+        let mut truth = Frame::new(n as u32, 1);
+        truth.color = vec![Vec3::ONE; n];
+        let mut seethru = truth.clone();
+        // One seen pixel and one filled one black where the truth is white.
+        seethru.color[4] = Vec3::ZERO;
+        seethru.color[2] = Vec3::ZERO;
+        seethru.object_id[3] = MISSING_ID;
+        let m = hole_metrics(&holes, &maps, &truth, &seethru, "none");
+        let close = |v: &serde_json::Value, expected: f64| {
+            let v = v.as_f64().expect("a number");
+            assert!(
+                (v - expected).abs() <= 1e-12 * expected.abs(),
+                "{v} against {expected}"
+            );
+        };
+        close(&m["fraction"], 2.0 / 5.0);
+        assert_eq!(m["pixels"], 2);
+        let (seen, filled) = (&m["seen"], &m["filled"]);
+        assert_eq!(seen["pixels"], 3);
+        close(&seen["coverage"], 1.0);
+        assert_eq!(seen["misregistration_arcmin"]["count"], 3);
+        close(&seen["misregistration_arcmin"]["mean"], 3.0);
+        close(&seen["misregistration_arcmin"]["max"], 5.0);
+        // One of three pixels off by 255 in each channel: MSE 255²/3.
+        close(&seen["psnr_db"], 10.0 * 3f64.log10());
+        close(&seen["ssim"], (0.9 + 0.7 + 0.8) / 3.0);
+        close(&seen["flip_mean"], (0.1 + 0.3 + 0.5) / 3.0);
+        assert_eq!(filled["pixels"], 2);
+        close(&filled["coverage"], 0.5);
+        assert_eq!(filled["misregistration_arcmin"]["count"], 1);
+        close(&filled["misregistration_arcmin"]["mean"], 7.0);
+        close(&filled["psnr_db"], 10.0 * 2f64.log10());
+        close(&filled["ssim"], (0.5 + 0.1) / 2.0);
+        close(&filled["flip_mean"], (0.2 + 0.6) / 2.0);
+        assert_eq!(m["fill"], "none");
     }
 }
