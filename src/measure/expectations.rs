@@ -381,6 +381,7 @@ mod tests {
             ("coverage == 0.9", "needs its tolerance"),
             ("coverage <= 1 and more", "goes on after"),
             ("coverage == 1 +- -1", "[0, inf)"),
+            ("coverage == 1 +- -0.0001", "[0, inf)"),
             ("flip_mean_vs_golden <= 1", "unknown metric"),
         ] {
             let command = if text.starts_with("flip") {
@@ -390,6 +391,56 @@ mod tests {
             };
             let e = parse_bound(text, command).unwrap_err();
             assert!(e.contains(says), "{text}: {e}");
+        }
+        // A recorded value may be held exactly.
+        let b = parse_bound("coverage == 1 +- 0", CaseCommand::Run).unwrap();
+        assert!(b.holds(1.0) && !b.holds(1.0 + 1e-12));
+        // The golden metrics are a run case's alone, in its list and not a sequence's.
+        let run = parse_bound("misregistration.avg <= 1", CaseCommand::Run).unwrap_err();
+        let sequence = parse_bound("misregistration.avg <= 1", CaseCommand::Sequence).unwrap_err();
+        for (metric, _) in GOLDEN_METRICS {
+            assert!(run.contains(metric), "{run}");
+            assert!(!sequence.contains(metric), "{sequence}");
+        }
+        assert!(run.contains("misregistration.mean") && sequence.contains("coverage.min"));
+    }
+
+    /// A case's name must be a folder name and its options must leave `--out` to `check`;
+    /// each rule alone refuses its case, and a case that keeps them all is read.
+    #[test]
+    fn case_names_and_options_are_checked() {
+        let read = |name: &str, options: &str| {
+            let text = format!(
+                "[[case]]\nname = \"{name}\"\nscene = \"das.toml\"\noptions = {options}\nexpect = [\"coverage >= 0.9\"]\n"
+            );
+            let file = SourceFile::from_text(Path::new("cases.toml"), text);
+            expectations_from_source(&file, &|_, _| None).map_err(|e| e.to_string())
+        };
+        let read = |name: &str, options: &str| {
+            let got = read(name, options);
+            (
+                got.as_ref().map(|e| e.cases.len()).ok(),
+                got.err().unwrap_or_default(),
+            )
+        };
+        assert_eq!(read("lean", r#"["--width", "64"]"#).0, Some(1));
+        for name in ["", "  ", "a/b", "/", "a\\tb"] {
+            let (cases, e) = read(name, "[]");
+            assert!(
+                cases.is_none() && e.contains("is not a case name"),
+                "{name:?}: {e}"
+            );
+        }
+        for options in [
+            r#"["--out", "x"]"#,
+            r#"["--out=x"]"#,
+            r#"["--width", "64", "--out", "x"]"#,
+        ] {
+            let (cases, e) = read("lean", options);
+            assert!(
+                cases.is_none() && e.contains("--out is set by seethru check"),
+                "{options}: {e}"
+            );
         }
     }
 
