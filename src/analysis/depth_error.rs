@@ -68,4 +68,30 @@ mod tests {
             );
         }
     }
+
+    /// Against a twin that integrates each side of the kink at δ = 0 apart (a smooth
+    /// integrand on each, so its Simpson sums converge to 1e-12): within the rule's own error
+    /// at the kink, for a small noise and for one whose lower limit is cut at Z + δ > 0.
+    #[test]
+    fn the_mean_relative_shift_equals_a_finer_integration() {
+        let density = |g: f64| (-0.5 * g * g).exp() / (2.0 * std::f64::consts::PI).sqrt();
+        let simpson = |f: &dyn Fn(f64) -> f64, a: f64, b: f64| {
+            let n = 40_000;
+            let h = (b - a) / n as f64;
+            let inner: f64 = (1..n)
+                .map(|k| f(a + k as f64 * h) * if k % 2 == 1 { 4.0 } else { 2.0 })
+                .sum();
+            (f(a) + f(b) + inner) * h / 3.0
+        };
+        for s in [0.05, 0.2] {
+            let shift = |g: f64| (g * s / (1.0 + g * s)).abs() * density(g);
+            let lo = -(0.999 / s).min(8.0);
+            let twin = simpson(&shift, lo, 0.0) + simpson(&shift, 0.0, 8.0);
+            let got = mean_abs_relative_shift(s);
+            assert!(
+                (got - twin).abs() < 1.5e-6 * twin,
+                "{s}: {got} against {twin}"
+            );
+        }
+    }
 }
