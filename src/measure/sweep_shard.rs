@@ -197,3 +197,51 @@ pub fn merge(parts: &[&Path], out: &Path) -> Result<Merged> {
         body,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shard_is_k_of_n_with_k_below_n() {
+        for (text, shard) in [("0/1", (0, 1)), ("2/3", (2, 3)), (" 1 / 3 ", (1, 3))] {
+            let got: Shard = text.parse().unwrap();
+            assert_eq!((got.index, got.count), shard, "{text}");
+        }
+        let top = format!("{}/{}", MAX_SHARDS - 1, MAX_SHARDS);
+        assert!(top.parse::<Shard>().is_ok());
+        for text in [
+            "3/3",
+            "4/3",
+            "0/0",
+            "1/0",
+            &format!("0/{}", MAX_SHARDS + 1),
+            "1",
+            "a/2",
+        ] {
+            let e = text.parse::<Shard>().unwrap_err();
+            assert!(e.contains("K/N with N in [1, "), "{text}: {e}");
+        }
+    }
+
+    /// Parts of two sweeps are refused by their headers, before any row is read.
+    #[test]
+    fn parts_with_different_headers_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let part = |name: &str, param: &str| {
+            let path = dir.path().join(name);
+            std::fs::write(&path, encode(&sweep_header(&[param.to_string()])) + "\n").unwrap();
+            path
+        };
+        let (a, b) = (part("a.csv", "d2"), part("b.csv", "ipd"));
+        let e = merge(&[&a, &b], &dir.path().join("out.csv"))
+            .err()
+            .map(|e| format!("{e:#}"))
+            .unwrap_or_default();
+        assert!(
+            e.contains("b.csv: its header differs from") && e.contains("a.csv"),
+            "{e}"
+        );
+        assert!(!dir.path().join("out.csv").exists());
+    }
+}
