@@ -208,6 +208,53 @@ fn merging_counts_the_grid_the_parts_were_cut_from_and_refuses_mixed_settings() 
         &["sweep-merge", "p0.csv", "p1.csv", "--out", "m.csv"],
     );
     assert_eq!(code, 0, "{err}");
+    // The merge is the unsharded sweep: its CSV and its plot (drawn from the parameters'
+    // values the merge collects), byte for byte.
+    sweep_in(dir.path(), &[&grid[..], &["--out", "whole.csv"]].concat());
+    for (merged, whole) in [
+        ("m.csv", "whole.csv"),
+        ("m_plot.svg", "whole_plot.svg"),
+        ("m_plot.csv", "whole_plot.csv"),
+    ] {
+        let read = |name: &str| std::fs::read(dir.path().join(name)).unwrap();
+        assert!(read(merged) == read(whole), "{merged} differs from {whole}");
+    }
+    // A part given twice merges as once; a row of it changed is refused.
+    let (code, err) = run_in(
+        dir.path(),
+        &[
+            "sweep-merge",
+            "p0.csv",
+            "p1.csv",
+            "p1.csv",
+            "--out",
+            "m3.csv",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let p1 = std::fs::read_to_string(dir.path().join("p1.csv")).unwrap();
+    let mut lines = p1.lines();
+    let header = lines.next().unwrap();
+    let mut fields: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let index = fields[0].to_string();
+    fields[3] = "999";
+    let changed = format!("{header}\n{}\n", fields.join(","));
+    std::fs::write(dir.path().join("d.csv"), changed).unwrap();
+    refused(
+        dir.path(),
+        &[
+            "sweep-merge",
+            "p0.csv",
+            "p1.csv",
+            "d.csv",
+            "--out",
+            "m4.csv",
+        ],
+        1,
+        &[&format!(
+            "d.csv:2: configuration {index} differs from p1.csv:2"
+        )],
+    );
     // A part computed at another width is not a part of this sweep.
     sweep_in(
         dir.path(),
