@@ -157,7 +157,61 @@ pub fn write_mask_png(path: &Path, maps: &MetricMaps, marked: &[bool]) -> Result
 
 #[cfg(test)]
 mod tests {
-    use super::p99_top;
+    use glam::Vec3;
+
+    use super::*;
+
+    /// A 4×1 driver view: two display pixels (5′ and 20′), one blank, one outside the
+    /// display (truth white); values 0..199 elsewhere set the p99.
+    fn maps_of(misregistration: Vec<f32>) -> MetricMaps {
+        let n = misregistration.len();
+        let mut display = vec![true; n];
+        display[3] = false;
+        let mut blank = vec![false; n];
+        blank[2] = true;
+        MetricMaps {
+            width: n as u32,
+            height: 1,
+            misregistration,
+            missing: vec![false; n],
+            display,
+            blank,
+            ssim: vec![f64::NAN; n],
+            flip: vec![f64::NAN; n],
+        }
+    }
+
+    #[test]
+    fn the_heatmap_scale_is_the_p99_or_the_fixed_top_and_says_which() {
+        let maps = maps_of((0..200).map(|k| ((k * 67) % 200) as f32).collect());
+        assert_eq!(
+            heat_top(&maps, None),
+            (198.0, "arcmin, clipped at p99".to_string())
+        );
+        assert_eq!(
+            heat_top(&maps, Some(12.5)),
+            (12.5, "arcmin, fixed (--heatmap-max)".to_string())
+        );
+    }
+
+    /// Each pixel's colour: the display's by its value over the top, blank black, outside
+    /// the truth's grey (a sixth of its sRGB sum).
+    #[test]
+    fn heatmap_pixels_are_coloured_by_value_over_the_top() {
+        let maps = maps_of(vec![5.0, 20.0, f32::NAN, f32::NAN]);
+        let mut truth = Frame::new(4, 1);
+        truth.color = vec![Vec3::ONE; 4];
+        for (fixed, top) in [(None, 20.0), (Some(40.0), 40.0)] {
+            let (w, h, rgb) = heatmap_rgb_scaled(&maps, &truth, fixed).unwrap();
+            assert!(w > 4 && h >= 1);
+            let pixel = |x: usize| [rgb[3 * x], rgb[3 * x + 1], rgb[3 * x + 2]];
+            assert_eq!(pixel(0), heat_color(5.0 / top), "{fixed:?}");
+            assert_eq!(pixel(1), heat_color(20.0 / top), "{fixed:?}");
+            assert_eq!(pixel(2), [0, 0, 0]);
+            assert_eq!(pixel(3), [127, 127, 127]);
+        }
+        assert_ne!(heat_color(0.25), heat_color(0.5));
+    }
 
     #[test]
     fn the_p99_top_skips_non_finite_values_and_is_at_least_one() {
