@@ -44,15 +44,10 @@ pub fn p99_top(values: impl Iterator<Item = f32>) -> f32 {
         .max(1.0)
 }
 
-/// The misregistration heatmap beside a colour bar in arc-minutes, clipped at the 99th
-/// percentile of the display's values (labelled on the bar); outside the display, the truth
-/// in dimmed grey for context.
-pub fn heatmap_rgb(maps: &MetricMaps, truth: &Frame) -> Result<(u32, u32, Vec<u8>)> {
-    heatmap_rgb_scaled(maps, truth, None)
-}
-
-/// [`heatmap_rgb`] with the top of the scale fixed at `fixed` arc-minutes when given.
-pub fn heatmap_rgb_scaled(
+/// The misregistration heatmap beside a colour bar in arc-minutes, its top `fixed` when
+/// given (`--heatmap-max`), else the 99th percentile of the display's values (labelled on the
+/// bar); outside the display, the truth in dimmed grey for context.
+pub fn heatmap_rgb(
     maps: &MetricMaps,
     truth: &Frame,
     fixed: Option<f32>,
@@ -131,7 +126,7 @@ pub fn write_metrics_scaled(
         maps.height,
         channels,
     )?;
-    let (w, h, rgb) = heatmap_rgb_scaled(maps, truth, heat_max)?;
+    let (w, h, rgb) = heatmap_rgb(maps, truth, heat_max)?;
     write_png(&dir.join("misregistration.png"), w, h, rgb)?;
     write_mask_png(&dir.join("missing.png"), maps, &maps.missing)
 }
@@ -202,7 +197,7 @@ mod tests {
         let mut truth = Frame::new(4, 1);
         truth.color = vec![Vec3::ONE; 4];
         for (fixed, top) in [(None, 20.0), (Some(40.0), 40.0)] {
-            let (w, h, rgb) = heatmap_rgb_scaled(&maps, &truth, fixed).unwrap();
+            let (w, h, rgb) = heatmap_rgb(&maps, &truth, fixed).unwrap();
             assert!(w > 4 && h >= 1);
             let pixel = |x: usize| [rgb[3 * x], rgb[3 * x + 1], rgb[3 * x + 2]];
             assert_eq!(pixel(0), heat_color(5.0 / top), "{fixed:?}");

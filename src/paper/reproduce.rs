@@ -176,7 +176,7 @@ pub fn reproduce_named(
             );
             frame_png(&result.truth, &out.join(&dir).join("truth.png"))?;
             frame_png(&result.seethru, &out.join(&dir).join("seethru.png"))?;
-            let (w, h, rgb) = heatmap_rgb(&maps, &result.truth)?;
+            let (w, h, rgb) = heatmap_rgb(&maps, &result.truth, None)?;
             write_png(&out.join(&dir).join("misregistration.png"), w, h, rgb)?;
             compared.push((format!("θ_F = {theta}°"), maps));
             progress.advance(1);
