@@ -22,8 +22,8 @@ pub struct SkyModel {
     cloud_height: f32,
     cloud_size: f32,
     /// Cloud noise over one period of the cloud layer, precomputed: evaluating five octaves
-    /// of noise per sky pixel cost more than tracing its ray.
-    /// Cloud noise in [0, 1): a scalar table, a third of an RGB one's cache footprint.
+    /// of noise per sky pixel cost more than tracing its ray. Values in [0, 1), scalars: an
+    /// RGB table of them took three times the cache.
     clouds: Texels<f32>,
     /// Unit direction towards the sun, world frame.
     pub sun_direction: Vec3,
