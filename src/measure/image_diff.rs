@@ -626,6 +626,21 @@ pub fn check_thresholds(diffs: &[LayerDiff], thresholds: &[Threshold]) -> Result
 mod tests {
     use super::*;
 
+    /// Each side in [1, MAX_RESOLUTION] and the area at most MAX_PIXELS, every bound
+    /// inclusive, each rule refusing alone.
+    #[test]
+    fn picture_sizes_are_checked_at_their_bounds() {
+        let max = MAX_RESOLUTION as usize;
+        let tall = (MAX_PIXELS / u64::from(MAX_RESOLUTION)) as usize;
+        for (w, h) in [(1, 1), (max, 1), (1, max), (max, tall), (tall, max)] {
+            assert!(check_size(w, h).is_ok(), "{w}×{h}");
+        }
+        for (w, h) in [(0, 1), (1, 0), (max + 1, 1), (1, max + 1), (max, tall + 1)] {
+            let e = check_size(w, h).unwrap_err().to_string();
+            assert!(e.contains(&format!("{w}×{h}")), "{e}");
+        }
+    }
+
     #[test]
     fn channels_group_into_layers() {
         assert_eq!(layer_of("R"), "colour");
