@@ -641,6 +641,21 @@ mod tests {
         }
     }
 
+    /// EXR stores channels sorted by name (B, G, R); the colour layer reads back as R, G, B.
+    #[test]
+    fn an_exr_colour_layer_reads_as_r_g_b() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.exr");
+        let channel =
+            |name: &str, v: f32| exr::prelude::AnyChannel::new(name, FlatSamples::F32(vec![v; 2]));
+        let channels = vec![channel("R", 1.0), channel("G", 2.0), channel("B", 3.0)];
+        crate::io::frame_files::write_exr_channels(&path, 2, 1, channels).unwrap();
+        let picture = read_picture(&path).unwrap();
+        let colour = picture.layers.iter().find(|l| l.name == "colour").unwrap();
+        assert_eq!(colour.channels, ["R", "G", "B"]);
+        assert_eq!(colour.values, [vec![1.0; 2], vec![2.0; 2], vec![3.0; 2]]);
+    }
+
     #[test]
     fn channels_group_into_layers() {
         assert_eq!(layer_of("R"), "colour");
