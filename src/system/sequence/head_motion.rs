@@ -99,4 +99,26 @@ mod tests {
         };
         assert!((sway.eye(eye0, 0.5).x - 0.38).abs() < 1e-12);
     }
+
+    #[test]
+    fn a_motion_is_reported_by_its_flag_value() {
+        // sequence.json's "head" is what the user typed after --head (a recorded path:
+        // "path"), so that a report reads back as the command that made it.
+        use clap::ValueEnum;
+        let flag = |p: HeadPreset| p.to_possible_value().unwrap().get_name().to_string();
+        let sway = HeadMotion::Sway {
+            amplitude: 0.03,
+            frequency: 0.5,
+        };
+        let lean = HeadMotion::Lean {
+            distance: 0.1,
+            duration: 0.3,
+            start: 0.5,
+        };
+        assert_eq!(HeadMotion::Still.name(), flag(HeadPreset::Still));
+        assert_eq!(sway.name(), flag(HeadPreset::Sway));
+        assert_eq!(lean.name(), flag(HeadPreset::Lean));
+        let path = HeadPath::parse(b"0,0.3,0,0.7", "path.csv").unwrap();
+        assert_eq!(HeadMotion::Path(path).name(), "path");
+    }
 }
