@@ -437,3 +437,104 @@ fn rows_that_share_an_eye_or_a_world_equal_rows_computed_alone() {
         .to_string();
     assert!(err.contains("of the grid's 8 configurations"), "{err}");
 }
+
+#[test]
+fn a_row_holds_the_metrics_of_run_with_the_same_settings() {
+    // The sweep's own settings (--width, --spp, --head, --band; --outside black) reach every
+    // row: a row equals what `seethru run` reports for its configuration, bit for bit.
+    // The estimated head makes the back camera's size matter too.
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("s.csv");
+    let options = SweepOptions {
+        width: 96,
+        spp: 2,
+        head: HeadSource::Estimated,
+        band: 2,
+        shard: None,
+        bound_arcmin: 1.0,
+    };
+    let scene = common::repo_path("scenes/das.toml");
+    let params = [parse_param("d2=6").unwrap()];
+    assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 1);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let row: std::collections::HashMap<&str, &str> =
+        lines[0].split(',').zip(lines[1].split(',')).collect();
+    let out = dir.path().join("run");
+    let (ok, _, err) = common::seethru(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--width",
+        "96",
+        "--spp",
+        "2",
+        "--head",
+        "estimated",
+        "--band",
+        "2",
+        "--outside",
+        "black",
+        "--d2",
+        "6",
+        "--exr",
+        "none",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let json = |name: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(out.join(name)).unwrap()).unwrap()
+    };
+    let (metrics, report) = (json("metrics.json"), json("run.json"));
+    let display = &metrics["display"];
+    let border = &metrics["border"];
+    for (column, value) in [
+        (
+            "misregistration_mean_arcmin",
+            &display["misregistration_arcmin"]["mean"],
+        ),
+        (
+            "misregistration_p95_arcmin",
+            &display["misregistration_arcmin"]["p95"],
+        ),
+        (
+            "misregistration_max_arcmin",
+            &display["misregistration_arcmin"]["max"],
+        ),
+        (
+            "border_mean_arcmin",
+            &border["misregistration_arcmin"]["mean"],
+        ),
+        (
+            "border_p95_arcmin",
+            &border["misregistration_arcmin"]["p95"],
+        ),
+        ("psnr_db", &display["psnr_db"]),
+        ("ssim", &display["ssim"]),
+        ("missing_fraction", &metrics["missing"]["fraction"]),
+        (
+            "display_outside_frontal_fraction",
+            &report["missing_fraction"],
+        ),
+        ("R1", &report["crop"]["R1_left"]),
+        ("R2", &report["crop"]["R2_right"]),
+        ("coverage", &metrics["coverage"]),
+    ] {
+        // serde_json's reader may miss the last bit of a number: a few ulp of room.
+        let want = value
+            .as_f64()
+            .unwrap_or_else(|| panic!("{column}: {value}"));
+        let got: f64 = row[column].parse().unwrap();
+        assert!(
+            (got - want).abs() <= 4.0 * f64::EPSILON * want.abs(),
+            "{column}: sweep {got}, run {want}"
+        );
+    }
+    // The head was estimated, as asked: the eye used is not the scene's, so the rows of an
+    // oracle head would differ.
+    assert!(
+        report["eye_used"]["error_m"].as_f64().unwrap() > 1e-4,
+        "{}",
+        report["eye_used"]
+    );
+}

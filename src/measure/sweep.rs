@@ -306,9 +306,25 @@ fn write_driver_shares(
 /// configurations whose display is not fully covered (coverage < 1) are marked with a dot,
 /// since their mean is over fewer pixels.
 fn plot(csv: &Path, params: &[Param], rows: &[(usize, String)]) -> Result<()> {
+    let Some(figure) = figure_of(params, rows) else {
+        return Ok(());
+    };
+    let stem = csv
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| "sweep".into());
+    figure.write(
+        csv.parent().unwrap_or(Path::new(".")),
+        &format!("{stem}_plot"),
+    )
+}
+
+/// The figure of [`plot`] for the CSV rows `rows`; `None` when there is nothing to draw: a
+/// non-numeric first axis (d2 = inf, auto: the CSV is the result) or no finite mean.
+fn figure_of(params: &[Param], rows: &[(usize, String)]) -> Option<Figure> {
     let x_of = |s: &str| s.parse::<f64>().ok().filter(|x| x.is_finite());
     if params[0].values.iter().any(|v| x_of(v).is_none()) {
-        return Ok(()); // A non-numeric axis (d2 = inf, auto): the CSV is the result.
+        return None;
     }
     let column = 1 + params.len();
     let coverage_column = column + METRIC_COLUMNS.len() - 1;
@@ -348,7 +364,7 @@ fn plot(csv: &Path, params: &[Param], rows: &[(usize, String)]) -> Result<()> {
         .filter(|y| y.is_finite())
         .collect();
     if xs.is_empty() || ys.is_empty() {
-        return Ok(());
+        return None;
     }
     let (x0, x1) = xs
         .iter()
@@ -380,14 +396,7 @@ fn plot(csv: &Path, params: &[Param], rows: &[(usize, String)]) -> Result<()> {
         legend: plotters::prelude::SeriesLabelPosition::UpperRight,
     }
     .with_legend_clear_of_data();
-    let stem = csv
-        .file_stem()
-        .map(|s| s.to_string_lossy().to_string())
-        .unwrap_or_else(|| "sweep".into());
-    figure.write(
-        csv.parent().unwrap_or(Path::new(".")),
-        &format!("{stem}_plot"),
-    )
+    Some(figure)
 }
 
 #[cfg(test)]
@@ -406,5 +415,95 @@ mod tests {
             assert!(err.contains(words), "{err}");
         }
         assert!(check_out(&dir.path().join("new.csv")).is_ok());
+    }
+
+    /// A CSV row as `sweep` writes it: index, the values, the metric columns (mean
+    /// misregistration `mean`, coverage `coverage`, the others 0), then what closes a row.
+    fn row(index: usize, values: &[&str], mean: f64, coverage: f64) -> (usize, String) {
+        let mut fields = vec![index.to_string()];
+        fields.extend(values.iter().map(|v| v.to_string()));
+        for (column, _, _) in METRIC_COLUMNS {
+            fields.push(match column {
+                "misregistration_mean_arcmin" => mean.to_string(),
+                "coverage" => coverage.to_string(),
+                _ => "0".into(),
+            });
+        }
+        fields.extend(["4", "64", "1", "oracle", "3", "hash", "0.1.0"].map(String::from));
+        (index, crate::measure::sweep_csv::encode(&fields))
+    }
+
+    fn param(name: &str, values: &[&str]) -> Param {
+        Param {
+            name: name.into(),
+            values: values.iter().map(|v| v.to_string()).collect(),
+        }
+    }
+
+    #[test]
+    fn the_plot_draws_each_rows_mean_and_marks_the_rows_not_fully_covered() {
+        let params = [param("theta_f", &["30", "60"]), param("d2", &["inf", "6"])];
+        let rows = [
+            row(0, &["30", "inf"], 20.0, 0.75),
+            row(1, &["30", "6"], 50.0, 1.0),
+            row(2, &["60", "inf"], 10.0, 1.0),
+            row(3, &["60", "6"], 80.0, 0.5),
+        ];
+        let figure = figure_of(&params, &rows).unwrap();
+        let curves: Vec<(&str, &[(f64, f64)])> = figure
+            .series
+            .iter()
+            .map(|s| (s.label.as_str(), s.points.as_slice()))
+            .collect();
+        assert_eq!(
+            curves,
+            [
+                ("d2 = inf", &[(30.0, 20.0), (60.0, 10.0)][..]),
+                ("d2 = 6", &[(30.0, 50.0), (60.0, 80.0)][..])
+            ]
+        );
+        // The rows whose display is not fully covered, on their curve, and said so.
+        assert_eq!(figure.marks, [(30.0, 20.0, 0), (60.0, 80.0, 1)]);
+        assert!(figure.title.contains("coverage < 1"), "{}", figure.title);
+        // The axes hold every point, the y axis from 0 with a tenth of room above.
+        assert_eq!(figure.x_range, (30.0, 60.0));
+        assert_eq!(figure.y_range.0, 0.0);
+        let top = figure.y_range.1;
+        assert!(
+            top > 80.0 * 1.05 && top < 80.0 * 1.2,
+            "{:?}",
+            figure.y_range
+        );
+        // Fully covered rows: no marks, no note.
+        let covered = [
+            row(0, &["30", "inf"], 20.0, 1.0),
+            row(1, &["30", "6"], 50.0, 1.0),
+            row(2, &["60", "inf"], 10.0, 1.0),
+            row(3, &["60", "6"], 80.0, 1.0),
+        ];
+        let figure = figure_of(&params, &covered).unwrap();
+        assert!(figure.marks.is_empty() && !figure.title.contains("coverage"));
+    }
+
+    #[test]
+    fn a_plot_of_one_parameter_or_one_value_has_one_curve_and_an_axis_of_some_width() {
+        let params = [param("theta_f", &["40"])];
+        let rows = [row(0, &["40"], 3.0, 1.0)];
+        let figure = figure_of(&params, &rows).unwrap();
+        assert_eq!(figure.series.len(), 1);
+        // All means 0 still give the y axis some height.
+        let zero = figure_of(&params, &[row(0, &["40"], 0.0, 1.0)]).unwrap();
+        assert!(zero.y_range.1 > zero.y_range.0, "{:?}", zero.y_range);
+        assert_eq!(figure.series[0].points, [(40.0, 3.0)]);
+        let (x0, x1) = figure.x_range;
+        assert!(x0 <= 40.0 && 40.0 <= x1 && x1 > x0, "{x0}..{x1}");
+    }
+
+    #[test]
+    fn nothing_is_plotted_without_a_numeric_axis_or_a_finite_mean() {
+        let rows = [row(0, &["inf"], 3.0, 1.0)];
+        assert!(figure_of(&[param("d2", &["inf"])], &rows).is_none());
+        let rows = [row(0, &["40"], f64::NAN, 1.0)];
+        assert!(figure_of(&[param("theta_f", &["40"])], &rows).is_none());
     }
 }
