@@ -233,4 +233,52 @@ mod tests {
         );
         assert!(Timeline { fps: 0.0, ..tl }.validate().is_err());
     }
+
+    #[test]
+    fn a_timeline_is_valid_up_to_each_bound_and_not_beyond() {
+        // The library's own check (Python and byo steps build timelines without the CLI's
+        // parsers): every bound is inclusive where documented, exclusive where not.
+        let tl = Timeline {
+            duration: 1.0,
+            fps: 60.0,
+            display_hz: 60.0,
+            latency_camera: 0.0,
+            latency_tracking: 0.0,
+        };
+        let valid = |t: Timeline| t.validate().is_ok();
+        assert!(valid(tl));
+        for duration in [0.0, -1.0, f64::NAN, MAX_DURATION_S * (1.0 + 1e-12)] {
+            let err = Timeline { duration, ..tl }
+                .validate()
+                .unwrap_err()
+                .to_string();
+            assert!(err.starts_with("--duration must be in (0, 3600]"), "{err}");
+        }
+        // The longest sequence, at a rate that keeps it within the frame limit.
+        let longest = Timeline {
+            duration: MAX_DURATION_S,
+            fps: 1.0,
+            display_hz: 1.0,
+            ..tl
+        };
+        assert!(valid(longest));
+        // Exactly the most frames (at 1000 Hz for 100 s), then one more.
+        let most = Timeline {
+            duration: 100.0,
+            fps: 1000.0,
+            ..tl
+        };
+        assert_eq!(most.frames(), MAX_FRAMES);
+        assert!(valid(most));
+        let over = Timeline {
+            duration: 100.001,
+            ..most
+        };
+        assert_eq!(over.frames(), MAX_FRAMES + 1);
+        let err = over.validate().unwrap_err().to_string();
+        assert!(
+            err.contains("100001 frames, more than the limit of 100000"),
+            "{err}"
+        );
+    }
 }
