@@ -235,3 +235,159 @@ pub fn pose_table(results: &[PoseResult]) -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(name: &str) -> Scene {
+        Scene::load(std::path::Path::new(&format!("scenes/{name}"))).unwrap()
+    }
+
+    /// A pose result with only what the table and the time line read.
+    fn result(frontal: Option<f64>, fitted: Option<f64>, confidence: Option<f64>) -> PoseResult {
+        PoseResult {
+            yaw_deg: 0.0,
+            pitch_deg: 0.0,
+            distance_m: 1.0,
+            frontal_error_m: frontal,
+            fitted_error_m: fitted,
+            confidence,
+            frontal_confidence: confidence,
+            fitted_yaw_deg: None,
+            yaw_error_deg: None,
+            eye_m: [0.0; 3],
+            fitted_eye_m: None,
+            fit_s: 0.0,
+        }
+    }
+
+    #[test]
+    fn the_grid_camera_keeps_the_back_cameras_aspect() {
+        let das = scene("das.toml");
+        assert_eq!((das.back.width, das.back.height), (640, 480));
+        let size = |w| {
+            let c = grid_camera(&das, w);
+            (c.width, c.height)
+        };
+        assert_eq!(size(None), (640, 480));
+        assert_eq!(size(Some(320)), (320, 240));
+        // 101 × 3/4 = 75.75: rounded.
+        assert_eq!(size(Some(101)), (101, 76));
+        assert_eq!(size(Some(1)), (1, 1));
+    }
+
+    #[test]
+    fn the_spread_is_the_nearest_rank_median_p95_and_max() {
+        assert_eq!(spread(&[]), None);
+        assert_eq!(spread(&[4.0]), Some([4.0; 3]));
+        // 1…20 shuffled: ranks ⌈0.5·20⌉ = 10 and ⌈0.95·20⌉ = 19.
+        let values: Vec<f64> = (0..20).map(|i| ((i * 7) % 20 + 1) as f64).collect();
+        assert_eq!(spread(&values), Some([10.0, 19.0, 20.0]));
+        // Three values: ranks 2 and 3.
+        assert_eq!(spread(&[0.3, -1.0, 0.1]), Some([0.1, 0.3, 0.3]));
+    }
+
+    #[test]
+    fn the_fit_time_line_gives_the_spread_in_milliseconds_and_the_set_up_apart() {
+        assert_eq!(fit_time_line(&[], 1.0), None);
+        let results: Vec<PoseResult> = (1..=20)
+            .map(|i| PoseResult {
+                fit_s: i as f64 * 1e-3,
+                ..result(None, None, None)
+            })
+            .collect();
+        let line = fit_time_line(&results, 0.25).unwrap();
+        assert!(
+            line.contains(
+                "20 frames): median 10.0 ms, p95 19.0 ms, max 20.0 ms; one-time set-up 250.0 ms"
+            ),
+            "{line}"
+        );
+    }
+
+    #[test]
+    fn the_pose_table_counts_every_class_and_spreads_each_estimators_errors() {
+        let c = crate::system::head::CONFIDENT_HEAD;
+        let results = [
+            result(Some(0.10), Some(0.01), Some(c)),
+            result(Some(0.20), Some(0.02), Some(1.0)),
+            result(Some(0.30), Some(0.05), Some(c - 0.01)),
+            result(None, None, None),
+        ];
+        let table = pose_table(&results);
+        assert!(
+            table.starts_with(&format!(
+                "4 poses: 2 confident, 1 unconfident (confidence < {c}), 1 without a detection"
+            )),
+            "{table}"
+        );
+        for row in [
+            "| frontal equations (d1, b_h) | 3 | 20.00 | 30.00 | 30.00 |",
+            "| yaw fit | 3 | 2.00 | 5.00 | 5.00 |",
+            "| yaw fit, confident | 2 | 1.00 | 2.00 | 2.00 |",
+            "| yaw fit, unconfident | 1 | 5.00 | 5.00 | 5.00 |",
+        ] {
+            assert!(table.contains(row), "{row} not in\n{table}");
+        }
+        // No pose of a class: its row says so.
+        let table = pose_table(&results[..2]);
+        assert!(
+            table.contains("| yaw fit, unconfident | 0 | — | — | — |"),
+            "{table}"
+        );
+    }
+
+    #[test]
+    fn a_scene_without_a_head_has_no_pose_to_turn() {
+        let mut headless = scene("das.toml");
+        for o in &mut headless.objects {
+            o.motion.moves_with = MovesWith::Vehicle;
+        }
+        let back = grid_camera(&headless, Some(16));
+        let err = posed_view(&headless, &back, 0.0, 0.0, 1.0).unwrap_err();
+        assert!(
+            err.to_string().contains("no object with moves_with"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_grid_moves_the_eye_along_the_line_of_sight_and_measures_the_tracker_there() {
+        // The mesh head at 0.8 and 1.25 of its distance, facing the back camera: the eye
+        // (turned about the neck to face it) within a few cm of that distance, the tracker
+        // detecting it, and its yaw error wrapped into (−180°, 180°].
+        let das = scene("das_mesh_head.toml");
+        let camera = das.back.position();
+        let d0 = (das.eye() - camera).length();
+        let results = pose_grid(&das, &[0.0], &[0.0], &[0.8, 1.25], None).unwrap();
+        assert_eq!(results.len(), 2);
+        for (r, scale) in results.iter().zip([0.8, 1.25]) {
+            let eye = DVec3::from(r.eye_m);
+            assert_eq!(r.distance_m, (eye - camera).length());
+            assert!((r.distance_m - scale * d0).abs() < 0.05, "{scale}: {r:?}");
+            let error = r.yaw_error_deg.unwrap();
+            assert!(error.abs() < 10.0, "{r:?}");
+            assert!(r.fitted_error_m.unwrap() < 0.1, "{r:?}");
+        }
+        // The same frame against a true yaw 360° or 720° away: the same error; 180° away:
+        // the error wrapped to the other side.
+        let back = grid_camera(&das, None);
+        let (frame, eye, world_yaw) = posed_view(&das, &back, 0.0, 0.0, 1.0).unwrap();
+        let error = |w: f64| {
+            estimate_pose(&frame, &back, eye, [0.0, 0.0, w])
+                .yaw_error_deg
+                .unwrap()
+        };
+        let e = error(world_yaw);
+        assert!((error(world_yaw + 360.0) - e).abs() < 1e-9);
+        assert!((error(world_yaw - 720.0) - e).abs() < 1e-9);
+        let turned = error(world_yaw + 180.0);
+        assert!(
+            turned > -180.0 && turned <= 180.0 && turned.abs() > 170.0,
+            "{turned}"
+        );
+        let apart = (turned - e - 180.0).rem_euclid(360.0);
+        assert!(apart < 1e-9 || apart > 360.0 - 1e-9, "{turned} vs {e}");
+    }
+}
