@@ -182,6 +182,71 @@ mod tests {
     }
 
     #[test]
+    fn drivers_are_grouped_by_the_other_parameters_and_summed_up_per_group() {
+        // `eye` first, d2 second: each row's group is its d2, read from its own column.
+        let param = |name: &str, values: &[&str]| Param {
+            name: name.into(),
+            values: values.iter().map(|v| v.to_string()).collect(),
+        };
+        let eyes = ["eyellipse:7:0", "eyellipse:7:1", "eyellipse:7:2"];
+        let params = [param("eye", &eyes), param("d2", &["inf", "6"])];
+        let means = [
+            ("inf", [(0.5, 1.0), (2.0, 3.0), (f64::NAN, f64::NAN)]),
+            ("6", [(0.2, 0.9), (0.3, 1.5), (0.4, 2.5)]),
+        ];
+        let mut rows = Vec::new();
+        for (d2, drivers) in means {
+            for (eye, (mean, p95)) in eyes.iter().zip(drivers) {
+                let index = rows.len();
+                let fields = [index.to_string(), eye.to_string(), d2.into()]
+                    .into_iter()
+                    .chain([mean, p95].map(|v| v.to_string()))
+                    .collect::<Vec<_>>();
+                rows.push((index, crate::measure::sweep_csv::encode(&fields)));
+            }
+        }
+        let shares = driver_shares(&params, &rows, 1.0).unwrap();
+        assert_eq!(
+            (shares["samples"].as_u64(), shares["seed"].as_str()),
+            (Some(3), Some("7"))
+        );
+        let groups = shares["groups"].as_array().unwrap();
+        let counts = |g: &Value, which: &str| {
+            let s = &g[which];
+            (
+                s["under_bound"].as_u64().unwrap(),
+                s["drivers_counted"].as_u64().unwrap(),
+            )
+        };
+        assert_eq!(groups.len(), 2);
+        assert_eq!(groups[0]["configuration"], json!([{"d2": "inf"}]));
+        assert_eq!(counts(&groups[0], "mean_misregistration"), (1, 2));
+        assert_eq!(counts(&groups[0], "p95_misregistration"), (1, 2));
+        assert_eq!(groups[1]["configuration"], json!([{"d2": "6"}]));
+        assert_eq!(counts(&groups[1], "mean_misregistration"), (3, 3));
+        assert_eq!(counts(&groups[1], "p95_misregistration"), (1, 3));
+        // The terminal's lines: per group, the mean's then the p95's, in percent.
+        let lines = summary_lines(&shares);
+        let (lo, hi) = wilson_interval(1, 2, Z_975);
+        assert_eq!(lines.len(), 4);
+        assert_eq!(
+            lines[0],
+            format!(
+                "[{{\"d2\":\"inf\"}}]: mean misregistration ≤ 1′ for 1 of 2 drivers (50.0 %, 95 % Wilson interval {:.1}–{:.1} %; 1 without a metric left out)",
+                100.0 * lo,
+                100.0 * hi
+            )
+        );
+        assert!(
+            lines[3].starts_with(
+                "[{\"d2\":\"6\"}]: p95 misregistration ≤ 1′ for 1 of 3 drivers (33.3 %"
+            ),
+            "{}",
+            lines[3]
+        );
+    }
+
+    #[test]
     fn nan_rows_are_excluded_and_counted() {
         let s = Share::of(&[0.5, 2.0, f64::NAN, 1.0], 1.0);
         assert_eq!(
