@@ -387,7 +387,8 @@ mod tests {
             turned > -180.0 && turned <= 180.0 && turned.abs() > 170.0,
             "{turned}"
         );
-        let apart = (turned - e - 180.0).rem_euclid(360.0);
-        assert!(apart < 1e-9 || apart > 360.0 - 1e-9, "{turned} vs {e}");
+        // 180° apart, on the circle.
+        let apart = (turned - e).rem_euclid(360.0);
+        assert!((apart - 180.0).abs() < 1e-9, "{turned} vs {e}");
     }
 }
