@@ -443,13 +443,21 @@ mod tests {
     #[test]
     fn the_plot_draws_each_rows_mean_and_marks_the_rows_not_fully_covered() {
         let params = [param("theta_f", &["30", "60"]), param("d2", &["inf", "6"])];
-        let rows = [
-            row(0, &["30", "inf"], 20.0, 0.75),
-            row(1, &["30", "6"], 50.0, 1.0),
-            row(2, &["60", "inf"], 10.0, 1.0),
-            row(3, &["60", "6"], 80.0, 0.5),
-        ];
-        let figure = figure_of(&params, &rows).unwrap();
+        // The 2 × 2 grid's means, with row 0's and row 3's displays partly covered.
+        let rows_covered = |coverage: [f64; 4]| {
+            [
+                ("30", "inf", 20.0),
+                ("30", "6", 50.0),
+                ("60", "inf", 10.0),
+                ("60", "6", 80.0),
+            ]
+            .iter()
+            .zip(coverage)
+            .enumerate()
+            .map(|(i, (&(theta, d2, mean), c))| row(i, &[theta, d2], mean, c))
+            .collect::<Vec<_>>()
+        };
+        let figure = figure_of(&params, &rows_covered([0.75, 1.0, 1.0, 0.5])).unwrap();
         let curves: Vec<(&str, &[(f64, f64)])> = figure
             .series
             .iter()
@@ -475,13 +483,7 @@ mod tests {
             figure.y_range
         );
         // Fully covered rows: no marks, no note.
-        let covered = [
-            row(0, &["30", "inf"], 20.0, 1.0),
-            row(1, &["30", "6"], 50.0, 1.0),
-            row(2, &["60", "inf"], 10.0, 1.0),
-            row(3, &["60", "6"], 80.0, 1.0),
-        ];
-        let figure = figure_of(&params, &covered).unwrap();
+        let figure = figure_of(&params, &rows_covered([1.0; 4])).unwrap();
         assert!(figure.marks.is_empty() && !figure.title.contains("coverage"));
     }
 
