@@ -582,3 +582,62 @@ fn clip(rect: PixelRect, frame: &Frame) -> PixelRect {
         y1: rect.y1.min(frame.height),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A frame whose head was sampled at `head_s` with confidence `confidence`.
+    fn record(frame: usize, head_s: f64, confidence: Option<f64>) -> FrameRecord {
+        FrameRecord {
+            frame,
+            times: FrameTimes {
+                display: head_s,
+                refresh: 0,
+                refresh_time: head_s,
+                capture: head_s,
+                head: head_s,
+            },
+            eye_true: DVec3::ZERO,
+            eye_estimated: DVec3::ZERO,
+            eye_used: DVec3::ZERO,
+            head_confidence: confidence,
+            head_pose: None,
+            head_yaw_true_deg: None,
+            vehicle_position: DVec3::ZERO,
+            vehicle_yaw_deg: 0.0,
+            d2_used: None,
+            metrics: None,
+            hazards: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_head_warning_counts_the_doubtful_frames_and_names_the_worst() {
+        let c = CONFIDENT_HEAD;
+        // Oracle frames (no confidence) are not scored; a confidence at the threshold is
+        // confident.
+        let records = [
+            record(0, 0.0, None),
+            record(1, 0.1, Some(c)),
+            record(2, 0.2, Some(c - 0.2)),
+            record(3, 0.3, Some(c - 0.1)),
+            record(4, 0.4, Some(1.0)),
+        ];
+        let warning = head_warning(&records).unwrap();
+        assert!(
+            warning.starts_with(&format!(
+                "head estimate unreliable in 2 of 4 frames (confidence < {c}; lowest {:.2}, head sampled at t = 0.2 s)",
+                c - 0.2
+            )),
+            "{warning}"
+        );
+        // Every frame confident, or none scored: no warning.
+        assert_eq!(head_warning(&records[..2]), None);
+        assert_eq!(
+            head_warning(&[records[4].clone(), records[1].clone()]),
+            None
+        );
+        assert_eq!(head_warning(&records[..1]), None);
+    }
+}
