@@ -184,12 +184,11 @@ mod tests {
     #[test]
     fn drivers_are_grouped_by_the_other_parameters_and_summed_up_per_group() {
         // `eye` first, d2 second: each row's group is its d2, read from its own column.
-        let param = |name: &str, values: &[&str]| Param {
-            name: name.into(),
-            values: values.iter().map(|v| v.to_string()).collect(),
-        };
-        let eyes = ["eyellipse:7:0", "eyellipse:7:1", "eyellipse:7:2"];
-        let params = [param("eye", &eyes), param("d2", &["inf", "6"])];
+        let params = [
+            crate::measure::sweep_grid::eyellipse_param(3, 7),
+            crate::measure::sweep_grid::parse_param("d2=inf,6").unwrap(),
+        ];
+        let eyes = &params[0].values;
         let means = [
             ("inf", [(0.5, 1.0), (2.0, 3.0), (f64::NAN, f64::NAN)]),
             ("6", [(0.2, 0.9), (0.3, 1.5), (0.4, 2.5)]),

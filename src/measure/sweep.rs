@@ -417,6 +417,10 @@ mod tests {
         assert!(check_out(&dir.path().join("new.csv")).is_ok());
     }
 
+    fn param(spec: &str) -> Param {
+        crate::measure::sweep_grid::parse_param(spec).unwrap()
+    }
+
     /// A CSV row as `sweep` writes it: index, the values, the metric columns (mean
     /// misregistration `mean`, coverage `coverage`, the others 0), then what closes a row.
     fn row(index: usize, values: &[&str], mean: f64, coverage: f64) -> (usize, String) {
@@ -433,16 +437,9 @@ mod tests {
         (index, crate::measure::sweep_csv::encode(&fields))
     }
 
-    fn param(name: &str, values: &[&str]) -> Param {
-        Param {
-            name: name.into(),
-            values: values.iter().map(|v| v.to_string()).collect(),
-        }
-    }
-
     #[test]
     fn the_plot_draws_each_rows_mean_and_marks_the_rows_not_fully_covered() {
-        let params = [param("theta_f", &["30", "60"]), param("d2", &["inf", "6"])];
+        let params = [param("theta_f=30,60"), param("d2=inf,6")];
         // The 2 × 2 grid's means, with row 0's and row 3's displays partly covered.
         let rows_covered = |coverage: [f64; 4]| {
             [
@@ -489,7 +486,7 @@ mod tests {
 
     #[test]
     fn a_plot_of_one_parameter_or_one_value_has_one_curve_and_an_axis_of_some_width() {
-        let params = [param("theta_f", &["40"])];
+        let params = [param("theta_f=40")];
         let rows = [row(0, &["40"], 3.0, 1.0)];
         let figure = figure_of(&params, &rows).unwrap();
         assert_eq!(figure.series.len(), 1);
@@ -504,8 +501,8 @@ mod tests {
     #[test]
     fn nothing_is_plotted_without_a_numeric_axis_or_a_finite_mean() {
         let rows = [row(0, &["inf"], 3.0, 1.0)];
-        assert!(figure_of(&[param("d2", &["inf"])], &rows).is_none());
+        assert!(figure_of(&[param("d2=inf")], &rows).is_none());
         let rows = [row(0, &["40"], f64::NAN, 1.0)];
-        assert!(figure_of(&[param("theta_f", &["40"])], &rows).is_none());
+        assert!(figure_of(&[param("theta_f=40")], &rows).is_none());
     }
 }
