@@ -8,11 +8,11 @@ use std::path::Path;
 use seethru::analysis::dynamic::{Motion, dynamic_misregistration};
 use seethru::analysis::physical::ARCMIN_PER_RAD;
 use seethru::measure::metrics::Flip;
-use seethru::measure::sequence::run_sequence;
+use seethru::measure::sequence::{SequenceStepper, run_sequence};
 use seethru::render::integrator::RenderContext;
 use seethru::render::settings::RenderSettings;
 use seethru::scene::world::view_bit;
-use seethru::system::options::{RunOptions, WorkingDistance};
+use seethru::system::options::{Method, RunOptions, WorkingDistance};
 use seethru::system::sequence::head_motion::HeadMotion;
 use seethru::system::sequence::predict::Prediction;
 use seethru::system::sequence::system_loop::{SequenceOptions, SystemLoop};
@@ -92,6 +92,58 @@ fn the_measured_dynamic_misregistration_follows_the_formula() {
             "{ages:?}"
         );
     }
+}
+
+/// What a stepped run reports beside its metrics: the frames made so far; each frame's
+/// vehicle heading, against the turn of the driver's view the rig renders at that time; the
+/// stages' seconds, each within the frames' time; and the frontal pixels rendered per
+/// camera refresh, the whole frontal image when the method has no crop to render alone.
+#[test]
+fn a_run_reports_its_frames_headings_stage_times_and_frontal_pixels() {
+    let wall = common::WallScene::default();
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let mut o = options(0.05, 60.0, 20.0, 20f64.to_radians());
+    o.run.method = Method::None;
+    let how = common::measuring(Flip::Skipped);
+    let mut stepper = SequenceStepper::new(&scene, o, how, 10.0).unwrap();
+    // Headings in the ground plane (the driver looks a little down).
+    let level = |v: glam::DVec3| glam::DVec3::new(v.x, 0.0, v.z);
+    let base = level(stepper.system.rig.scene_at(0.0).driver.forward());
+    let mut made = 0;
+    while stepper.step().unwrap().is_some() {
+        made += 1;
+        let records = stepper.records();
+        assert_eq!(records.len(), made);
+        let r = records.last().unwrap();
+        assert_eq!(r.frame, made - 1);
+        let forward = stepper
+            .system
+            .rig
+            .scene_at(r.times.display)
+            .driver
+            .forward();
+        let turned = base.cross(forward).y.atan2(base.dot(forward)).to_degrees();
+        assert!(
+            (r.vehicle_yaw_deg - turned).abs() < 1e-9,
+            "frame {}: heading {}°, the view turned {turned}°",
+            r.frame,
+            r.vehicle_yaw_deg
+        );
+    }
+    assert_eq!(made, 9);
+    let refreshes: std::collections::BTreeSet<i64> =
+        stepper.records().iter().map(|r| r.times.refresh).collect();
+    assert!(refreshes.len() >= 3, "{refreshes:?}");
+    let frontal = stepper.system.rig.base.frontal;
+    let run = stepper.finish();
+    assert!(run.records[8].vehicle_yaw_deg > 2.0);
+    assert_eq!(
+        run.frontal_pixels_per_refresh,
+        f64::from(frontal.width) * f64::from(frontal.height)
+    );
+    assert!(run.truth_seconds > 0.0 && run.metrics_seconds > 0.0);
+    assert!(run.truth_seconds + run.metrics_seconds <= run.stepping_seconds);
+    assert!(run.stepping_seconds <= run.total_seconds);
 }
 
 /// The moving part traced beside the static hierarchy gives the images of a world rebuilt

@@ -180,6 +180,15 @@ impl Camera {
         self.half_angle_x.tan()
     }
 
+    /// The angle the central pixel's width subtends at the eye, arc-minutes (the pinhole's
+    /// widest pixel: pixels off the axis subtend less).
+    pub fn central_pixel_arcmin(&self) -> f64 {
+        (2.0 * self.tan_half_x() / self.width as f64)
+            .atan()
+            .to_degrees()
+            * 60.0
+    }
+
     /// Tangent of the vertical half angle (square pixels).
     pub fn tan_half_y(&self) -> f64 {
         self.tan_half_x() * self.height as f64 / self.width as f64
@@ -254,6 +263,22 @@ mod tests {
             200,
         )
         .unwrap()
+    }
+
+    /// Against the angle between two traced rays a pixel apart at the centre, and more than
+    /// that of any pixel nearer the edge.
+    #[test]
+    fn the_central_pixel_subtends_the_angle_between_its_edge_rays() {
+        let cam = test_camera();
+        let angle = |x: f64| {
+            let y = cam.height as f64 / 2.0;
+            let (_, a) = cam.world_ray(DVec2::new(x, y));
+            let (_, b) = cam.world_ray(DVec2::new(x + 1.0, y));
+            a.angle_between(b).to_degrees() * 60.0
+        };
+        let centre = angle(cam.width as f64 / 2.0);
+        assert!((cam.central_pixel_arcmin() - centre).abs() < 1e-9 * centre);
+        assert!(angle(10.0) < 0.9 * centre);
     }
 
     #[test]

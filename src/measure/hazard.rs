@@ -263,17 +263,13 @@ pub fn run_hazards_json(
     maps: &MetricMaps,
     bound_arcmin: f64,
 ) -> serde_json::Value {
-    let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
-        .atan()
-        .to_degrees()
-        * 60.0;
     let hazards = hazard_frame(
         &ctx.scene,
         &result.truth,
         &result.seethru,
         maps,
         bound_arcmin,
-        arcmin_per_px,
+        driver.central_pixel_arcmin(),
     );
     hazards_json(&hazards, bound_arcmin)
 }

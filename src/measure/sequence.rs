@@ -162,12 +162,14 @@ pub struct Measuring {
 
 /// The world box of the obstacle's body.
 fn obstacle_box(o: &Obstacle) -> Aabb {
+    let (lo, hi) = o.body_bounds();
     let mut b = Aabb::empty();
     for k in 0..8 {
+        let pick = |bit: usize, l: f64, h: f64| if k & bit == 0 { l } else { h };
         let p = DVec3::new(
-            if k & 1 == 0 { -0.5 } else { 0.5 } * o.width,
-            if k & 2 == 0 { -0.5 } else { 0.5 } * o.height,
-            if k & 4 == 0 { 0.0 } else { -o.thickness },
+            pick(1, lo.x, hi.x),
+            pick(2, lo.y, hi.y),
+            pick(4, lo.z, hi.z),
         );
         b.extend(o.world_from_obstacle.transform_point3(p).as_vec3().into());
     }
@@ -440,16 +442,12 @@ impl SequenceStepper {
             self.how.band,
             self.how.flip,
         );
-        let arcmin_per_px = (2.0 * driver.half_angle_x.tan() / driver.width as f64)
-            .atan()
-            .to_degrees()
-            * 60.0;
         record.hazards = hazard_seen(
             &self.scene,
             [truth, seethru, occluded],
             &maps,
             self.hazard_bound_arcmin,
-            arcmin_per_px,
+            driver.central_pixel_arcmin(),
         );
         self.metrics_seconds += t1.elapsed().as_secs_f64();
         record.metrics = Some(FrameMetrics::from_json(&json));
@@ -586,6 +584,7 @@ fn clip(rect: PixelRect, frame: &Frame) -> PixelRect {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::frame::Pixel;
 
     /// A frame whose head was sampled at `head_s` with confidence `confidence`.
     fn record(frame: usize, head_s: f64, confidence: Option<f64>) -> FrameRecord {
@@ -639,5 +638,129 @@ mod tests {
             None
         );
         assert_eq!(head_warning(&records[..1]), None);
+    }
+
+    /// The obstacle's body bounds are those of its triangles in the world the renderer
+    /// traces (in the obstacle frame, where they are tight), for a flat display and for the
+    /// cabin's curved one, whose surface bulges out of the flat box; and its world box holds
+    /// every traced triangle (the cabin's pillar is turned about all three axes).
+    #[test]
+    fn the_obstacle_box_holds_the_traced_obstacle() {
+        for name in ["das.toml", "cabin.toml"] {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("scenes")
+                .join(name);
+            let scene = Scene::load(&path).unwrap();
+            let world = crate::scene::world::World::build(&scene).unwrap();
+            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+            let mut traced = Aabb::empty();
+            for (prim, t) in world.triangles.iter().enumerate() {
+                if world.object_of(prim) != world.obstacle_id {
+                    continue;
+                }
+                traced = traced.union(&t.aabb());
+                let v0 = t.v0.as_dvec3();
+                for v in [v0, v0 - t.e1.as_dvec3(), v0 + t.e2.as_dvec3()] {
+                    let p = scene.obstacle.in_obstacle_frame(v);
+                    (lo, hi) = (lo.min(p), hi.max(p));
+                }
+            }
+            let (body_lo, body_hi) = scene.obstacle.body_bounds();
+            let gap = (body_lo - lo).abs().max((body_hi - hi).abs());
+            assert!(
+                gap.max_element() < 1e-5,
+                "{name}: {body_lo}..{body_hi} against {lo}..{hi}"
+            );
+            let b = obstacle_box(&scene.obstacle);
+            let outside = (b.min - traced.min).max(traced.max - b.max);
+            assert!(
+                outside.max_element() < 1e-5,
+                "{name}: {b:?} against {traced:?}"
+            );
+        }
+    }
+
+    /// The union of two rectangles, and of one with nothing.
+    #[test]
+    fn union_holds_both_rectangles_and_nothing_adds_nothing() {
+        let a = PixelRect {
+            x0: 4,
+            y0: 5,
+            x1: 9,
+            y1: 7,
+        };
+        let b = PixelRect {
+            x0: 2,
+            y0: 6,
+            x1: 6,
+            y1: 11,
+        };
+        assert_eq!(
+            union(a, b),
+            PixelRect {
+                x0: 2,
+                y0: 5,
+                x1: 9,
+                y1: 11
+            }
+        );
+        assert_eq!(union(NOTHING, a), a);
+        assert_eq!(union(a, NOTHING), a);
+        let empty_elsewhere = PixelRect {
+            x0: 20,
+            y0: 20,
+            x1: 20,
+            y1: 30,
+        };
+        assert_eq!(union(empty_elsewhere, b), b);
+        assert_eq!(union(b, empty_elsewhere), b);
+    }
+
+    /// Every AOV of the rectangle's pixels is copied, and no other pixel, also when the
+    /// rectangle runs past the frame.
+    #[test]
+    fn copy_rect_copies_the_rectangle_and_nothing_else() {
+        let (w, h) = (7u32, 5u32);
+        let pixels: Vec<Pixel> = (0..w * h)
+            .map(|i| {
+                let v = i as f32 + 1.0;
+                Pixel {
+                    color: glam::Vec3::splat(v),
+                    depth: v,
+                    camera_z: -v,
+                    position: glam::Vec3::new(v, 0.0, 0.0),
+                    normal: glam::Vec3::new(0.0, v, 0.0),
+                    object_id: i + 1,
+                    part_id: i + 2,
+                }
+            })
+            .collect();
+        let from = Frame::from_pixels(w, h, &pixels);
+        for rect in [
+            PixelRect {
+                x0: 2,
+                y0: 1,
+                x1: 5,
+                y1: 4,
+            },
+            PixelRect {
+                x0: 5,
+                y0: 3,
+                x1: 100,
+                y1: 100,
+            },
+        ] {
+            let mut to = Frame::new(w, h);
+            copy_rect(&from, &mut to, rect);
+            for y in 0..h {
+                for x in 0..w {
+                    let inside = (rect.x0..rect.x1).contains(&x) && (rect.y0..rect.y1).contains(&y);
+                    let want = if inside { from.pixel(x, y) } else { Pixel::SKY };
+                    // Debug strings, since the sky's position is NaN.
+                    let (got, want) = (format!("{:?}", to.pixel(x, y)), format!("{want:?}"));
+                    assert_eq!(got, want, "({x}, {y}) of {rect:?}");
+                }
+            }
+        }
     }
 }

@@ -204,6 +204,23 @@ impl Obstacle {
         })
     }
 
+    /// Obstacle-frame bounding box (min, max) of the body with its display: the
+    /// `width` × `height` × `thickness` box behind a flat display, or a curved display's
+    /// surface and its copy `thickness` behind (a curved surface can bulge beyond the box).
+    pub fn body_bounds(&self) -> (DVec3, DVec3) {
+        let back = DVec3::new(0.0, 0.0, -self.thickness);
+        match self.display_shape.curved() {
+            Some(surface) => {
+                let (lo, hi) = surface.bounds();
+                (lo + back, hi)
+            }
+            None => {
+                let half = DVec3::new(self.width / 2.0, self.height / 2.0, 0.0);
+                (back - half, half)
+            }
+        }
+    }
+
     /// Obstacle-frame coordinates of a world point.
     pub fn in_obstacle_frame(&self, world: DVec3) -> DVec3 {
         self.world_from_obstacle.inverse().transform_point3(world)
