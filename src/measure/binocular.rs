@@ -13,6 +13,7 @@ use glam::DVec3;
 use serde_json::json;
 
 use crate::analysis::binocular::{disparity_mismatch, disparity_mismatch_along, vergence};
+use crate::analysis::physical::ARCMIN_PER_RAD;
 use crate::io::atomic::write_text;
 use crate::io::frame_files::{write_exr_channels, write_png};
 use crate::measure::maps::heat_color;
@@ -21,8 +22,6 @@ use crate::scene::Obstacle;
 use crate::system::display::MISSING_ID;
 use crate::system::surface_map::display_points;
 use crate::util::color::encode_srgb8;
-
-const ARCMIN_PER_RAD: f64 = 60.0 * 180.0 / std::f64::consts::PI;
 
 /// The mismatch per display pixel, arc-minutes; NaN where the pixel shows nothing.
 pub struct BinocularMap {
@@ -146,23 +145,9 @@ pub fn anaglyph_rgb(left: &Frame, right: &Frame) -> Vec<u8> {
         .collect()
 }
 
-/// Writes `binocular.json`, `binocular.exr` (`Y`: mismatch, arcmin, NaN where missing),
-/// `binocular.png` (heatmap, blue = smallest, red = largest of the map) and `anaglyph.png`.
-pub fn write_binocular(
-    dir: &Path,
-    map: &BinocularMap,
-    stats: &serde_json::Value,
-    seethru: [&Frame; 2],
-) -> Result<()> {
-    write_text(
-        &dir.join("binocular.json"),
-        &serde_json::to_string_pretty(stats)?,
-    )?;
-    let channels = vec![
-        AnyChannel::new("Y", FlatSamples::F32(map.mismatch_arcmin.clone())),
-        AnyChannel::new("scene_depth.Z", FlatSamples::F32(map.scene_depth.clone())),
-    ];
-    write_exr_channels(&dir.join("binocular.exr"), map.width, map.height, channels)?;
+/// The mismatch heatmap beside its colour bar: blue at the map's smallest value, red at its
+/// largest, black where the pixel has no value.
+fn mismatch_heatmap_rgb(map: &BinocularMap) -> Result<(u32, u32, Vec<u8>)> {
     let finite = map
         .mismatch_arcmin
         .iter()
@@ -193,7 +178,27 @@ pub fn write_binocular(
         legend: vec![([0, 0, 0], "no value".into())],
         clipped: false,
     };
-    let (w, h, rgb) = crate::io::colour_bar::with_colour_bar(map.width, map.height, &rgb, &bar)?;
+    crate::io::colour_bar::with_colour_bar(map.width, map.height, &rgb, &bar)
+}
+
+/// Writes `binocular.json`, `binocular.exr` (`Y`: mismatch, arcmin, NaN where missing),
+/// `binocular.png` (heatmap, blue = smallest, red = largest of the map) and `anaglyph.png`.
+pub fn write_binocular(
+    dir: &Path,
+    map: &BinocularMap,
+    stats: &serde_json::Value,
+    seethru: [&Frame; 2],
+) -> Result<()> {
+    write_text(
+        &dir.join("binocular.json"),
+        &serde_json::to_string_pretty(stats)?,
+    )?;
+    let channels = vec![
+        AnyChannel::new("Y", FlatSamples::F32(map.mismatch_arcmin.clone())),
+        AnyChannel::new("scene_depth.Z", FlatSamples::F32(map.scene_depth.clone())),
+    ];
+    write_exr_channels(&dir.join("binocular.exr"), map.width, map.height, channels)?;
+    let (w, h, rgb) = mismatch_heatmap_rgb(map)?;
     write_png(&dir.join("binocular.png"), w, h, rgb)?;
     let [l, r] = seethru;
     write_png(
@@ -217,5 +222,73 @@ mod tests {
         r.color[0] = Vec3::new(0.0, 1.0, 1.0);
         assert_eq!(anaglyph_rgb(&l, &r), vec![255, 255, 255]);
         assert_eq!(anaglyph_rgb(&r, &l), vec![0, 0, 0]);
+    }
+
+    /// Five display pixels, one missing: mismatch 4, –, 1, 3, 2 arcmin over scene depths 2,
+    /// –, 6, 4 m and sky.
+    fn five_pixels() -> BinocularMap {
+        BinocularMap {
+            width: 5,
+            height: 1,
+            mismatch_arcmin: vec![4.0, f32::NAN, 1.0, 3.0, 2.0],
+            scene_depth: vec![2.0, f32::NAN, 6.0, 4.0, f32::INFINITY],
+        }
+    }
+
+    /// The statistics by hand: the missing pixel counted, the percentiles at the rounded
+    /// rank (n − 1) q of the sorted values, the median depth, and the geometry of a cyclopean
+    /// eye 0.6 m from a display centre at 30° off its normal.
+    #[test]
+    fn the_stats_count_rank_and_place_the_eyes() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/das.toml");
+        let mut obstacle = crate::scene::Scene::load(&path).unwrap().obstacle;
+        let centre = DVec3::new(1.0, 2.0, 3.0);
+        obstacle.world_from_obstacle = glam::DAffine3::from_translation(centre);
+        let (sin, cos) = 30f64.to_radians().sin_cos();
+        let cyclopean = centre + 0.6 * DVec3::new(sin, 0.0, cos);
+        let half_ipd = DVec3::new(0.032, 0.0, 0.0);
+        let stats = binocular_stats(
+            &five_pixels(),
+            &obstacle,
+            cyclopean - half_ipd,
+            cyclopean + half_ipd,
+        );
+        let number = |key: &str| stats.pointer(key).and_then(|v| v.as_f64()).unwrap();
+        assert_eq!(number("/display_pixels"), 5.0);
+        assert_eq!(number("/measured_pixels"), 4.0);
+        assert_eq!(number("/missing_pixels"), 1.0);
+        let m = "/mismatch_arcmin";
+        assert_eq!(number(&format!("{m}/mean")), 2.5);
+        // Ranks 0.15, 1.5 and 2.85 of [1, 2, 3, 4] round to 0, 2 and 3.
+        for (key, want) in [
+            ("min", 1.0),
+            ("p5", 1.0),
+            ("median", 3.0),
+            ("p95", 4.0),
+            ("max", 4.0),
+        ] {
+            assert_eq!(number(&format!("{m}/{key}")), want, "{key}");
+        }
+        // Depths [2, 4, 6, ∞]: rank 1.5 rounds to 2.
+        assert_eq!(number("/scene_depth_median_m"), 6.0);
+        assert!((number("/d1_m") - 0.6 * cos).abs() < 1e-12);
+        assert!((number("/ipd_m") - 0.064).abs() < 1e-12);
+        assert!((number("/display_centre_off_axis_deg") - 30.0).abs() < 1e-9);
+    }
+
+    /// Each pixel's colour: blue at the smallest value, red at the largest, the rest at
+    /// their place between; black where missing.
+    #[test]
+    fn the_heatmap_spans_the_maps_smallest_to_largest_value() {
+        let (w, h, rgb) = mismatch_heatmap_rgb(&five_pixels()).unwrap();
+        assert!(w > 5 && h >= 1);
+        let pixel = |x: usize| [rgb[3 * x], rgb[3 * x + 1], rgb[3 * x + 2]];
+        let want = [heat_color(1.0), [0, 0, 0], heat_color(0.0)];
+        assert_eq!([pixel(0), pixel(1), pixel(2)], want);
+        assert_eq!(
+            [pixel(3), pixel(4)],
+            [heat_color(2.0 / 3.0), heat_color(1.0 / 3.0)]
+        );
+        assert_ne!(heat_color(1.0 / 3.0), heat_color(0.5));
     }
 }
