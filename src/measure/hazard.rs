@@ -58,7 +58,8 @@ pub fn hazard_frame(
         let (mut truth_pixels, mut hidden, mut shown) = (0u64, 0u64, 0u64);
         let (mut hidden_sum, mut shown_sum, mut shown_any) = ([0.0f64; 2], [0.0f64; 2], 0u64);
         for i in 0..truth.object_id.len() {
-            let at = [(i % w) as f64 + 0.5, (i / w) as f64 + 0.5];
+            // Pixel corners: the half pixel to their centres cancels in the centroids' gap.
+            let at = [(i % w) as f64, (i / w) as f64];
             if maps.display[i] && seethru.object_id[i] == id {
                 shown_any += 1;
                 shown_sum = [shown_sum[0] + at[0], shown_sum[1] + at[1]];
@@ -272,4 +273,89 @@ pub fn run_hazards_json(
         driver.central_pixel_arcmin(),
     );
     hazards_json(&hazards, bound_arcmin)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 4 × 3 frame of left_turn's pedestrian (P) and cyclist (C, nowhere in the truth),
+    /// by hand. Display columns x ≥ 1. Truth P at (0,0), (1,0), (1,1), (2,1): 4 pixels, the
+    /// last three hidden. The see-through view shows P at (0,0), (1,1) (1′ off), (2,1) (100′
+    /// off) and (3,1); the occluded view at (0,0).
+    #[test]
+    fn hazards_count_hidden_and_shown_pixels_and_their_centroids_by_hand() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/left_turn.toml");
+        let scene = Scene::load(&path).unwrap();
+        let id_of =
+            |name: &str| scene.objects.iter().position(|o| o.name == name).unwrap() as u32 + 1;
+        let (p, cyclist) = (id_of("pedestrian"), id_of("cyclist"));
+        let (w, h) = (4u32, 3u32);
+        let at = |x: u32, y: u32| (y * w + x) as usize;
+        let mut truth = Frame::new(w, h);
+        let mut seethru = Frame::new(w, h);
+        let mut occluded = Frame::new(w, h);
+        for (x, y) in [(0, 0), (1, 0), (1, 1), (2, 1)] {
+            truth.object_id[at(x, y)] = p;
+        }
+        for (x, y) in [(0, 0), (1, 1), (2, 1), (3, 1)] {
+            seethru.object_id[at(x, y)] = p;
+        }
+        occluded.object_id[at(0, 0)] = p;
+        let n = (w * h) as usize;
+        let mut maps = MetricMaps {
+            width: w,
+            height: h,
+            misregistration: vec![f32::NAN; n],
+            missing: vec![false; n],
+            display: (0..n).map(|i| i % w as usize >= 1).collect(),
+            blank: vec![false; n],
+            ssim: vec![f64::NAN; n],
+            flip: vec![f64::NAN; n],
+        };
+        for i in 0..n {
+            if maps.display[i] {
+                maps.misregistration[i] = 0.5;
+            }
+        }
+        maps.misregistration[at(1, 1)] = 1.0;
+        maps.misregistration[at(2, 1)] = 100.0;
+        let (bound, arcmin_per_px) = (10.0, 2.0);
+        let seen = hazard_seen(
+            &scene,
+            [&truth, &seethru, &occluded],
+            &maps,
+            bound,
+            arcmin_per_px,
+        );
+        let names: Vec<&str> = seen.iter().map(|s| s.frame.name.as_str()).collect();
+        assert_eq!(names, ["pedestrian", "cyclist"]);
+        let ped = &seen[0];
+        assert_eq!(ped.frame.id, p);
+        assert_eq!(
+            [
+                ped.frame.truth_pixels,
+                ped.frame.hidden_pixels,
+                ped.frame.shown_pixels
+            ],
+            [4, 3, 1]
+        );
+        assert_eq!(ped.frame.visibility, 1.0 / 3.0);
+        // Pixel centres: hidden (1.5, 0.5), (1.5, 1.5), (2.5, 1.5); shown anywhere on the
+        // display (1.5, 1.5), (2.5, 1.5), (3.5, 1.5).
+        let hidden: [f64; 2] = [5.5 / 3.0, 3.5 / 3.0];
+        let shown = [7.5 / 3.0, 1.5];
+        let px = (hidden[0] - shown[0]).hypot(hidden[1] - shown[1]);
+        assert!((ped.frame.centroid_error_arcmin - px * arcmin_per_px).abs() < 1e-12);
+        // Seen with the display off: (0,0); on: (0,0) beside the display, and (1,1) within
+        // the bound.
+        assert_eq!([ped.seen_off_pixels, ped.seen_on_pixels], [1, 2]);
+        assert_eq!([ped.seen_off(), ped.seen_on()], [0.25, 0.5]);
+        assert!(ped.hidden_off() && !ped.hidden_on() && !ped.visible_on_display());
+        let c = &seen[1];
+        assert_eq!(c.frame.id, cyclist);
+        assert_eq!([c.frame.truth_pixels, c.seen_on_pixels], [0, 0]);
+        assert!(c.frame.visibility.is_nan() && c.frame.centroid_error_arcmin.is_nan());
+        assert!(c.seen_on().is_nan() && !c.hidden_on() && !c.hidden_off());
+    }
 }
