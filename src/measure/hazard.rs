@@ -282,7 +282,7 @@ mod tests {
     /// A 4 × 3 frame of left_turn's pedestrian (P) and cyclist (C, nowhere in the truth),
     /// by hand. Display columns x ≥ 1. Truth P at (0,0), (1,0), (1,1), (2,1): 4 pixels, the
     /// last three hidden. The see-through view shows P at (0,0), (1,1) (1′ off), (2,1) (100′
-    /// off) and (3,1); the occluded view at (0,0).
+    /// off) and (3,1); the occluded view at (0,0) and (1,0).
     #[test]
     fn hazards_count_hidden_and_shown_pixels_and_their_centroids_by_hand() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/left_turn.toml");
@@ -302,6 +302,7 @@ mod tests {
             seethru.object_id[at(x, y)] = p;
         }
         occluded.object_id[at(0, 0)] = p;
+        occluded.object_id[at(1, 0)] = p;
         let n = (w * h) as usize;
         let mut maps = MetricMaps {
             width: w,
@@ -347,11 +348,11 @@ mod tests {
         let shown = [7.5 / 3.0, 1.5];
         let px = (hidden[0] - shown[0]).hypot(hidden[1] - shown[1]);
         assert!((ped.frame.centroid_error_arcmin - px * arcmin_per_px).abs() < 1e-12);
-        // Seen with the display off: (0,0); on: (0,0) beside the display, and (1,1) within
-        // the bound.
-        assert_eq!([ped.seen_off_pixels, ped.seen_on_pixels], [1, 2]);
-        assert_eq!([ped.seen_off(), ped.seen_on()], [0.25, 0.5]);
-        assert!(ped.hidden_off() && !ped.hidden_on() && !ped.visible_on_display());
+        // Seen with the display off: (0,0) and (1,0); on: (0,0) beside the display, and
+        // (1,1) within the bound. Half of it seen is not hidden.
+        assert_eq!([ped.seen_off_pixels, ped.seen_on_pixels], [2, 2]);
+        assert_eq!([ped.seen_off(), ped.seen_on()], [0.5, 0.5]);
+        assert!(!ped.hidden_off() && !ped.hidden_on() && !ped.visible_on_display());
         let c = &seen[1];
         assert_eq!(c.frame.id, cyclist);
         assert_eq!([c.frame.truth_pixels, c.seen_on_pixels], [0, 0]);
