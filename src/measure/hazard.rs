@@ -280,9 +280,10 @@ mod tests {
     use super::*;
 
     /// A 4 × 3 frame of left_turn's pedestrian (P) and cyclist (C, nowhere in the truth),
-    /// by hand. Display columns x ≥ 1. Truth P at (0,0), (1,0), (1,1), (2,1): 4 pixels, the
-    /// last three hidden. The see-through view shows P at (0,0), (1,1) (1′ off), (2,1) (100′
-    /// off) and (3,1); the occluded view at (0,0) and (1,0).
+    /// by hand. Display columns x ≥ 1, misregistration 0.5′ but at (1,1) 1′ and (2,1) 100′.
+    /// Truth P at (0,0), (1,0), (1,1), (2,1), (3,1), (0,2): 6 pixels, 4 hidden. The
+    /// see-through view shows P at (0,0), (1,1), (2,1), (3,1) and (2,2); the occluded view
+    /// at (0,0), (1,0) and (0,2).
     #[test]
     fn hazards_count_hidden_and_shown_pixels_and_their_centroids_by_hand() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/left_turn.toml");
@@ -295,14 +296,15 @@ mod tests {
         let mut truth = Frame::new(w, h);
         let mut seethru = Frame::new(w, h);
         let mut occluded = Frame::new(w, h);
-        for (x, y) in [(0, 0), (1, 0), (1, 1), (2, 1)] {
+        for (x, y) in [(0, 0), (1, 0), (1, 1), (2, 1), (3, 1), (0, 2)] {
             truth.object_id[at(x, y)] = p;
         }
-        for (x, y) in [(0, 0), (1, 1), (2, 1), (3, 1)] {
+        for (x, y) in [(0, 0), (1, 1), (2, 1), (3, 1), (2, 2)] {
             seethru.object_id[at(x, y)] = p;
         }
-        occluded.object_id[at(0, 0)] = p;
-        occluded.object_id[at(1, 0)] = p;
+        for (x, y) in [(0, 0), (1, 0), (0, 2)] {
+            occluded.object_id[at(x, y)] = p;
+        }
         let n = (w * h) as usize;
         let mut maps = MetricMaps {
             width: w,
@@ -333,26 +335,28 @@ mod tests {
         assert_eq!(names, ["pedestrian", "cyclist"]);
         let ped = &seen[0];
         assert_eq!(ped.frame.id, p);
+        // Shown within the bound: (1,1) and (3,1), half the hidden pixels.
         assert_eq!(
             [
                 ped.frame.truth_pixels,
                 ped.frame.hidden_pixels,
                 ped.frame.shown_pixels
             ],
-            [4, 3, 1]
+            [6, 4, 2]
         );
-        assert_eq!(ped.frame.visibility, 1.0 / 3.0);
-        // Pixel centres: hidden (1.5, 0.5), (1.5, 1.5), (2.5, 1.5); shown anywhere on the
-        // display (1.5, 1.5), (2.5, 1.5), (3.5, 1.5).
-        let hidden: [f64; 2] = [5.5 / 3.0, 3.5 / 3.0];
-        let shown = [7.5 / 3.0, 1.5];
+        assert_eq!(ped.frame.visibility, 0.5);
+        // Pixel corners: hidden (1,0), (1,1), (2,1), (3,1); shown anywhere on the display
+        // (1,1), (2,1), (3,1), (2,2).
+        let hidden: [f64; 2] = [7.0 / 4.0, 3.0 / 4.0];
+        let shown = [2.0, 5.0 / 4.0];
         let px = (hidden[0] - shown[0]).hypot(hidden[1] - shown[1]);
         assert!((ped.frame.centroid_error_arcmin - px * arcmin_per_px).abs() < 1e-12);
-        // Seen with the display off: (0,0) and (1,0); on: (0,0) beside the display, and
-        // (1,1) within the bound. Half of it seen is not hidden.
-        assert_eq!([ped.seen_off_pixels, ped.seen_on_pixels], [2, 2]);
+        // Seen with the display off: (0,0), (1,0), (0,2); on: (0,0) beside the display, and
+        // (1,1), (3,1) within the bound. Half of it seen is not hidden, and half of its
+        // hidden pixels shown is visible on the display.
+        assert_eq!([ped.seen_off_pixels, ped.seen_on_pixels], [3, 3]);
         assert_eq!([ped.seen_off(), ped.seen_on()], [0.5, 0.5]);
-        assert!(!ped.hidden_off() && !ped.hidden_on() && !ped.visible_on_display());
+        assert!(!ped.hidden_off() && !ped.hidden_on() && ped.visible_on_display());
         let c = &seen[1];
         assert_eq!(c.frame.id, cyclist);
         assert_eq!([c.frame.truth_pixels, c.seen_on_pixels], [0, 0]);
