@@ -363,4 +363,47 @@ mod tests {
         assert!(c.frame.visibility.is_nan() && c.frame.centroid_error_arcmin.is_nan());
         assert!(c.seen_on().is_nan() && !c.hidden_on() && !c.hidden_off());
     }
+
+    /// Six frames 0.1 s apart by hand: out of view, then hidden with the display off for
+    /// three frames (two of them also with it on), seen again, out of view.
+    #[test]
+    fn hazard_times_follow_the_frames_by_hand() {
+        let seen = |truth: u64, off: u64, on: u64, visibility: f64| HazardSeen {
+            frame: HazardFrame {
+                name: "pedestrian".into(),
+                id: 3,
+                truth_pixels: truth,
+                hidden_pixels: 0,
+                shown_pixels: 0,
+                visibility,
+                centroid_error_arcmin: f64::NAN,
+            },
+            seen_off_pixels: off,
+            seen_on_pixels: on,
+        };
+        let frames = [
+            seen(0, 0, 0, f64::NAN),
+            seen(10, 2, 8, 0.8),
+            seen(10, 2, 2, 0.2),
+            seen(10, 2, 3, 0.4),
+            seen(10, 9, 9, f64::NAN),
+            seen(0, 0, 0, f64::NAN),
+        ];
+        let t: Vec<f64> = (0..6).map(|k| 1.0 + 0.1 * k as f64).collect();
+        let per_frame: Vec<Vec<HazardSeen>> = frames.iter().map(|f| vec![f.clone()]).collect();
+        let times = hazard_times(&t, &per_frame, 0.1);
+        assert_eq!(
+            times,
+            [HazardTimes {
+                name: "pedestrian".into(),
+                first_hidden_s: Some(t[1]),
+                first_visible_on_display_s: Some(t[1]),
+                longest_hidden_display_on_s: 2.0 * 0.1,
+                longest_hidden_display_off_s: 3.0 * 0.1,
+                frames_hidden_on: 2,
+                frames_hidden_off: 3,
+                frames_out_of_view: 2,
+            }]
+        );
+    }
 }
