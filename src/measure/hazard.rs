@@ -364,8 +364,9 @@ mod tests {
         assert!(c.seen_on().is_nan() && !c.hidden_on() && !c.hidden_off());
     }
 
-    /// Six frames 0.1 s apart by hand: out of view, then hidden with the display off for
-    /// three frames (two of them also with it on), seen again, out of view.
+    /// Seven frames 0.1 s apart by hand: out of view, then hidden with the display off for
+    /// three frames (two of them also with it on), seen again, out of view, and hidden once
+    /// more with the display on.
     #[test]
     fn hazard_times_follow_the_frames_by_hand() {
         let seen = |truth: u64, off: u64, on: u64, visibility: f64| HazardSeen {
@@ -388,8 +389,9 @@ mod tests {
             seen(10, 2, 3, 0.4),
             seen(10, 9, 9, f64::NAN),
             seen(0, 0, 0, f64::NAN),
+            seen(10, 9, 1, 0.6),
         ];
-        let t: Vec<f64> = (0..6).map(|k| 1.0 + 0.1 * k as f64).collect();
+        let t: Vec<f64> = (0..7).map(|k| 1.0 + 0.1 * k as f64).collect();
         let per_frame: Vec<Vec<HazardSeen>> = frames.iter().map(|f| vec![f.clone()]).collect();
         let times = hazard_times(&t, &per_frame, 0.1);
         assert_eq!(
@@ -400,7 +402,7 @@ mod tests {
                 first_visible_on_display_s: Some(t[1]),
                 longest_hidden_display_on_s: 2.0 * 0.1,
                 longest_hidden_display_off_s: 3.0 * 0.1,
-                frames_hidden_on: 2,
+                frames_hidden_on: 3,
                 frames_hidden_off: 3,
                 frames_out_of_view: 2,
             }]
