@@ -21,6 +21,7 @@ use crate::scene::motion::MovesWith;
 use crate::system::head::eye_from_detection;
 use crate::system::head_pose::locate;
 use crate::system::head_side::detect_turned;
+use crate::util::quantile::nearest_rank;
 
 /// One pose of the grid and what the tracker made of it.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -171,8 +172,11 @@ pub fn spread(values: &[f64]) -> Option<[f64; 3]> {
     }
     let mut v = values.to_vec();
     v.sort_by(f64::total_cmp);
-    let rank = |q: f64| v[((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
-    Some([rank(0.5), rank(0.95), v[v.len() - 1]])
+    Some([
+        nearest_rank(&v, 0.5),
+        nearest_rank(&v, 0.95),
+        v[v.len() - 1],
+    ])
 }
 
 /// The fit's wall time per frame (`detect_turned` and `locate`, one thread) over a grid, one

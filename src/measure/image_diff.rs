@@ -17,6 +17,7 @@ use crate::measure::metrics::{masked_ssim_map, psnr};
 use crate::scene::limits::{MAX_PIXELS, MAX_RESOLUTION};
 use crate::util::color::encode_srgb8;
 use crate::util::input_file::not_a_file;
+use crate::util::quantile::nearest_rank;
 
 /// Pixels per degree of FLIP's standard observer (0.7 m from a 0.7 m wide 4K monitor), used
 /// where the run does not give the driver camera's.
@@ -293,11 +294,6 @@ pub fn known_metric_names() -> String {
     KNOWN_METRICS.map(|m| m.0).join(", ")
 }
 
-fn percentile(sorted: &[f32], q: f64) -> f64 {
-    let n = sorted.len();
-    sorted[((q * n as f64).ceil() as usize).clamp(1, n) - 1] as f64
-}
-
 /// The difference of layer `a` and `b` (same name, size and channels), FLIP at `ppd`.
 pub fn diff_layer(
     a: &Layer,
@@ -375,7 +371,7 @@ pub fn diff_layer(
                     "flip_mean",
                     map.iter().map(|&v| v as f64).sum::<f64>() / pixels as f64,
                 ),
-                ("flip_p95", percentile(&sorted, 0.95)),
+                ("flip_p95", nearest_rank(&sorted, 0.95) as f64),
                 ("flip_max", sorted[pixels - 1] as f64),
                 ("psnr_db", psnr(&sa, &sb, &everywhere)),
                 ("ssim", ssim.iter().sum::<f64>() / pixels as f64),

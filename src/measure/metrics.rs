@@ -20,6 +20,7 @@ use crate::scene::Scene;
 use crate::scene::world::view_bit;
 use crate::system::display::{DisplayPlacement, MISSING_ID};
 use crate::util::color::encode_srgb8;
+use crate::util::quantile::nearest_rank;
 
 /// Per-pixel results over the driver's view (NaN / false outside the display region).
 pub struct MetricMaps {
@@ -47,7 +48,7 @@ pub fn stats(values: &mut [f64]) -> serde_json::Value {
     values.sort_by(f64::total_cmp);
     let n = values.len();
     let mean = values.iter().sum::<f64>() / n as f64;
-    let p95 = values[((0.95 * n as f64).ceil() as usize).clamp(1, n) - 1];
+    let p95 = nearest_rank(values, 0.95);
     json!({"count": n, "mean": mean, "p95": p95, "max": values[n - 1]})
 }
 

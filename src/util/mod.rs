@@ -1,6 +1,6 @@
 //! Small pieces every layer uses: sRGB transfer functions, deterministic hashing for
 //! sampling and FNV-1a for fingerprints, short numbers for messages, the progress line,
-//! JSON for infinite distances, the process's peak memory, input files read within limits,
+//! JSON for infinite distances, nearest-rank quantiles, the process's peak memory, input files read within limits,
 //! and errors as one inert line.
 
 pub mod color;
@@ -11,4 +11,5 @@ pub mod memory;
 pub mod message;
 pub mod number;
 pub mod progress;
+pub mod quantile;
 pub mod sampling;
