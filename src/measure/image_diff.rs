@@ -669,16 +669,20 @@ mod tests {
         }
     }
 
+    /// Equal non-finite values (∞ and ∞, NaN and NaN) are the same; a non-finite value
+    /// against anything else differs and is a mismatch, left out of the errors.
     #[test]
     fn absolute_errors_count_nonfinite_mismatches_apart() {
-        let a = data_layer(vec![1.0, f64::INFINITY, 3.0, f64::INFINITY]);
-        let b = data_layer(vec![1.5, f64::INFINITY, 5.0, 7.0]);
-        let d = diff_layer(&a, &b, 2, 2, (STANDARD_PPD, "x".into())).unwrap();
+        let (inf, nan) = (f64::INFINITY, f64::NAN);
+        let a = data_layer(vec![1.0, inf, 3.0, inf, nan, nan, inf, -inf]);
+        let b = data_layer(vec![1.5, inf, 5.0, 7.0, 2.0, nan, nan, inf]);
+        let d = diff_layer(&a, &b, 4, 2, (STANDARD_PPD, "x".into())).unwrap();
         assert_eq!(d.metric("max_abs_error"), Some(2.0));
         // (0.5 + 2) over the two pixels both finite.
         assert_eq!(d.metric("mean_abs_error"), Some(1.25));
-        assert_eq!(d.metric("differing_pixels"), Some(3.0));
-        assert_eq!(d.metric("nonfinite_mismatch_pixels"), Some(1.0));
+        assert_eq!(d.metric("differing_pixels"), Some(6.0));
+        assert_eq!(d.metric("differing_fraction"), Some(0.75));
+        assert_eq!(d.metric("nonfinite_mismatch_pixels"), Some(4.0));
         assert_eq!(d.metric("flip_mean"), None);
     }
 
