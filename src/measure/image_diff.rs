@@ -15,7 +15,7 @@ use serde_json::{Value, json};
 
 use crate::measure::metrics::{masked_ssim_map, psnr};
 use crate::scene::limits::{MAX_PIXELS, MAX_RESOLUTION};
-use crate::util::color::encode_srgb8;
+use crate::util::color::{encode_srgb8, luma};
 use crate::util::input_file::not_a_file;
 use crate::util::quantile::nearest_rank;
 
@@ -352,11 +352,7 @@ pub fn diff_layer(
         let mut sorted = map.clone();
         sorted.sort_by(f32::total_cmp);
         let everywhere = vec![true; pixels];
-        let lum = |s: &[[u8; 3]]| -> Vec<f64> {
-            s.iter()
-                .map(|c| 0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64)
-                .collect()
-        };
+        let lum = |s: &[[u8; 3]]| -> Vec<f64> { s.iter().map(|&c| luma(c)).collect() };
         let ssim = masked_ssim_map(
             &lum(&sa),
             &lum(&sb),

@@ -19,7 +19,7 @@ use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
 use crate::scene::world::view_bit;
 use crate::system::display::{DisplayPlacement, MISSING_ID};
-use crate::util::color::encode_srgb8;
+use crate::util::color::{encode_srgb8, luma};
 use crate::util::quantile::nearest_rank;
 
 /// Per-pixel results over the driver's view (NaN / false outside the display region).
@@ -55,10 +55,6 @@ pub fn stats(values: &mut [f64]) -> serde_json::Value {
 fn mean(values: impl Iterator<Item = f64>) -> f64 {
     let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
     if n == 0 { f64::NAN } else { sum / n as f64 }
-}
-
-fn luminance(c: [u8; 3]) -> f64 {
-    0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64
 }
 
 /// The direction from `eye` that a pixel shows: towards its world point, or its sky
@@ -395,8 +391,8 @@ pub fn measure_with(
     for &i in &on_display {
         srgb_t[i] = encode_srgb8(truth.color[i]);
         srgb_s[i] = encode_srgb8(seethru.color[i]);
-        lum_t[i] = luminance(srgb_t[i]);
-        lum_s[i] = luminance(srgb_s[i]);
+        lum_t[i] = luma(srgb_t[i]);
+        lum_s[i] = luma(srgb_s[i]);
     }
     let ssim = masked_ssim_map(&lum_t, &lum_s, &display, w, h);
     // FLIP with the driver's eye as the observer: pixels per degree of the driver's camera.

@@ -86,6 +86,11 @@ pub fn encode_srgb8_table(c: Vec3) -> [u8; 3] {
     [q(c.x), q(c.y), q(c.z)]
 }
 
+/// Rec. 709 luma of 8-bit sRGB code values, [0, 255]: what SSIM compares.
+pub fn luma(c: [u8; 3]) -> f64 {
+    0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -123,5 +128,19 @@ mod tests {
             assert_eq!(encode_srgb8(Vec3::splat(linear)), [v; 3]);
         }
         assert_eq!(encode_srgb8(Vec3::new(-1.0, 2.0, f32::NAN)), [0, 255, 0]);
+    }
+
+    /// Rec. 709's weights: each primary's share of white, white itself 255.
+    #[test]
+    fn luma_weighs_the_primaries_as_rec_709() {
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
+        assert!(close(luma([255, 0, 0]), 0.2126 * 255.0));
+        assert!(close(luma([0, 255, 0]), 0.7152 * 255.0));
+        assert!(close(luma([0, 0, 255]), 0.0722 * 255.0));
+        assert!(close(luma([255, 255, 255]), 255.0));
+        assert!(close(
+            luma([10, 20, 30]),
+            0.2126 * 10.0 + 0.7152 * 20.0 + 0.0722 * 30.0
+        ));
     }
 }
