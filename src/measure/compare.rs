@@ -6,7 +6,7 @@ use serde_json::json;
 
 use crate::measure::hazard::run_hazards_json;
 use crate::measure::holes::attach_holes;
-use crate::measure::maps::heat_color;
+use crate::measure::maps::{heat_color, p99_top};
 use crate::measure::metrics::{MetricMaps, measure};
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
@@ -196,14 +196,10 @@ const HOLE: [u8; 3] = [255, 0, 255];
 /// The shared scale of the strips' heatmaps: the largest 99th percentile of any method's
 /// misregistration, rounded up to a multiple of 10 arc-minutes (at least 10).
 fn shared_heat_top(drafts: &[&StripDraft]) -> f32 {
-    let p99 = |d: &&StripDraft| {
-        let mut v: Vec<f32> = d.heat.iter().map(|h| h.1).collect();
-        v.sort_by(f32::total_cmp);
-        v.get((v.len() as f32 * 0.99) as usize)
-            .copied()
-            .unwrap_or(0.0)
-    };
-    let top = drafts.iter().map(p99).fold(0.0f32, f32::max);
+    let top = drafts
+        .iter()
+        .map(|d| p99_top(d.heat.iter().map(|h| h.1)))
+        .fold(0.0f32, f32::max);
     ((top / 10.0).ceil() * 10.0).max(10.0)
 }
 
@@ -364,4 +360,127 @@ pub fn html_page(title: &str, table_md: &str, strips: &[(&str, String)]) -> Stri
     }
     page += "</body></html>\n";
     page
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    const WHITE: [u8; 3] = [255, 255, 255];
+
+    /// A 5 × 4 view whose display is (1,1), (2,1), (3,1), (1,2) and (3,2) (bounding box
+    /// x 1..=3, y 1..=2): misregistration 5′ at (1,1), 20′ at (2,1) and 1′ at (3,2), (3,1)
+    /// blank, (1,2) without a direction; holes at (3,2) and at (0,0), outside the display.
+    fn view() -> (MetricMaps, Frame, Frame, Vec<bool>) {
+        let (w, n) = (5, 20);
+        let at = |x: usize, y: usize| y * w + x;
+        let mut display = vec![false; n];
+        for (x, y) in [(1, 1), (2, 1), (3, 1), (1, 2), (3, 2)] {
+            display[at(x, y)] = true;
+        }
+        let mut misregistration = vec![f32::NAN; n];
+        misregistration[at(1, 1)] = 5.0;
+        misregistration[at(2, 1)] = 20.0;
+        misregistration[at(3, 2)] = 1.0;
+        let mut blank = vec![false; n];
+        blank[at(3, 1)] = true;
+        let maps = MetricMaps {
+            width: 5,
+            height: 4,
+            misregistration,
+            missing: vec![false; n],
+            display,
+            blank,
+            ssim: vec![f64::NAN; n],
+            flip: vec![f64::NAN; n],
+        };
+        let (mut truth, mut seethru) = (Frame::new(5, 4), Frame::new(5, 4));
+        for i in 0..n {
+            let v = i as f32 / n as f32;
+            truth.color[i] = Vec3::splat(v);
+            seethru.color[i] = Vec3::new(0.0, v, 1.0);
+        }
+        let mut holes = vec![false; n];
+        holes[at(3, 2)] = true;
+        holes[at(0, 0)] = true;
+        (maps, truth, seethru, holes)
+    }
+
+    /// Four panels of the 3 × 2 bounding box, 4 white pixels apart (24 × 2): truth,
+    /// seethru, the heatmap (its values kept for later, at their pixels' bytes) and holes.
+    #[test]
+    fn the_strip_cuts_each_panel_to_the_displays_box() {
+        let (maps, truth, seethru, holes) = view();
+        let d = strip(&maps, &truth, &seethru, Some(&holes));
+        assert_eq!((d.width, d.height), (24, 2));
+        let pixel = |x: usize, y: usize| {
+            let o = (y * 24 + x) * 3;
+            [d.rgb[o], d.rgb[o + 1], d.rgb[o + 2]]
+        };
+        let srgb = |f: &Frame, x: usize, y: usize| encode_srgb8(f.color[y * 5 + x]);
+        assert_eq!(pixel(0, 0), srgb(&truth, 1, 1));
+        assert_eq!(pixel(2, 1), srgb(&truth, 3, 2));
+        assert_eq!(pixel(7, 0), srgb(&seethru, 1, 1));
+        assert_eq!(pixel(9, 1), srgb(&seethru, 3, 2));
+        // The heatmap: black until coloured, blank black, no direction dark grey.
+        assert_eq!([pixel(14, 0), pixel(16, 0)], [BLANK, BLANK]);
+        assert_eq!([pixel(14, 1), pixel(15, 1)], [NO_DIRECTION; 2]);
+        let heat = [((14, 0), 5.0), ((15, 0), 20.0), ((16, 1), 1.0)];
+        let want: Vec<(usize, f32)> = heat
+            .iter()
+            .map(|&((x, y), v)| ((y * 24 + x) * 3, v))
+            .collect();
+        assert_eq!(d.heat, want);
+        // Holes magenta, the display's other pixels grey, the rest black.
+        assert_eq!(
+            [pixel(21, 0), pixel(23, 1), pixel(22, 1)],
+            [[60; 3], HOLE, [0; 3]]
+        );
+        for (x, y) in [(3, 0), (6, 1), (13, 0), (17, 1), (20, 0)] {
+            assert_eq!(pixel(x, y), WHITE, "({x}, {y})");
+        }
+        // Without holes, the fourth panel is only the display.
+        let d = strip(&maps, &truth, &seethru, None);
+        assert_eq!(d.rgb[(24 + 23) * 3], 60);
+        // No display pixel: the whole view.
+        let mut none = maps;
+        none.display = vec![false; 20];
+        let d = strip(&none, &truth, &seethru, None);
+        assert_eq!((d.width, d.height), (4 * 5 + 3 * 4, 4));
+    }
+
+    /// The shared top is the largest p99 of any strip, rounded up to ten arc-minutes, ten at
+    /// least; each heatmap pixel is coloured by its value over it.
+    #[test]
+    fn strips_share_a_top_rounded_up_to_ten_arcmin() {
+        let draft = |heat: Vec<f32>| StripDraft {
+            width: 1,
+            height: 1,
+            rgb: vec![0; 3],
+            heat: heat.into_iter().map(|v| (0, v)).collect(),
+        };
+        // p99 of 100 values is the largest (rank ⌊0.99 · 100⌋ of 0…99).
+        let steep = draft((1..=100).map(|k| 0.23 * k as f32).collect());
+        let flat = draft(vec![3.0; 100]);
+        let (thirty, just_over) = (draft(vec![30.0]), draft(vec![30.5]));
+        assert_eq!(shared_heat_top(&[&steep, &flat]), 30.0);
+        assert_eq!(shared_heat_top(&[&flat]), 10.0);
+        assert_eq!(shared_heat_top(&[&draft(Vec::new())]), 10.0);
+        assert_eq!(shared_heat_top(&[&flat, &thirty]), 30.0);
+        assert_eq!(shared_heat_top(&[&just_over, &flat]), 40.0);
+
+        let (maps, truth, seethru, holes) = view();
+        let d = strip(&maps, &truth, &seethru, Some(&holes));
+        let (w, _, rgb) = finish_strip(&d, 40.0).unwrap();
+        assert!(w > 24);
+        let pixel = |x: usize, y: usize| {
+            let o = (y * w as usize + x) * 3;
+            [rgb[o], rgb[o + 1], rgb[o + 2]]
+        };
+        assert_eq!(pixel(14, 0), heat_color(5.0 / 40.0));
+        assert_eq!(pixel(15, 0), heat_color(20.0 / 40.0));
+        assert_eq!(pixel(16, 1), heat_color(1.0 / 40.0));
+        assert_eq!(pixel(0, 0), encode_srgb8(truth.color[6]));
+    }
 }
