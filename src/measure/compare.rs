@@ -385,16 +385,7 @@ mod tests {
         misregistration[at(3, 2)] = 1.0;
         let mut blank = vec![false; n];
         blank[at(3, 1)] = true;
-        let maps = MetricMaps {
-            width: 5,
-            height: 4,
-            misregistration,
-            missing: vec![false; n],
-            display,
-            blank,
-            ssim: vec![f64::NAN; n],
-            flip: vec![f64::NAN; n],
-        };
+        let maps = MetricMaps::of_masks([5, 4], misregistration, display, blank);
         let (mut truth, mut seethru) = (Frame::new(5, 4), Frame::new(5, 4));
         for i in 0..n {
             let v = i as f32 / n as f32;

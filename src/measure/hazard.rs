@@ -306,16 +306,8 @@ mod tests {
             occluded.object_id[at(x, y)] = p;
         }
         let n = (w * h) as usize;
-        let mut maps = MetricMaps {
-            width: w,
-            height: h,
-            misregistration: vec![f32::NAN; n],
-            missing: vec![false; n],
-            display: (0..n).map(|i| i % w as usize >= 1).collect(),
-            blank: vec![false; n],
-            ssim: vec![f64::NAN; n],
-            flip: vec![f64::NAN; n],
-        };
+        let display = (0..n).map(|i| i % w as usize >= 1).collect();
+        let mut maps = MetricMaps::of_masks([w, h], vec![f32::NAN; n], display, vec![false; n]);
         for i in 0..n {
             if maps.display[i] {
                 maps.misregistration[i] = 0.5;

@@ -164,16 +164,7 @@ mod tests {
         display[3] = false;
         let mut blank = vec![false; n];
         blank[2] = true;
-        MetricMaps {
-            width: n as u32,
-            height: 1,
-            misregistration,
-            missing: vec![false; n],
-            display,
-            blank,
-            ssim: vec![f64::NAN; n],
-            flip: vec![f64::NAN; n],
-        }
+        MetricMaps::of_masks([n as u32, 1], misregistration, display, blank)
     }
 
     #[test]

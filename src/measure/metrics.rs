@@ -40,6 +40,31 @@ pub struct MetricMaps {
     pub flip: Vec<f64>,
 }
 
+#[cfg(test)]
+impl MetricMaps {
+    /// Maps for the tests of what reads them: the given misregistration and masks, no pixel
+    /// missing, SSIM and FLIP not computed (NaN).
+    pub(crate) fn of_masks(
+        [width, height]: [u32; 2],
+        misregistration: Vec<f32>,
+        display: Vec<bool>,
+        blank: Vec<bool>,
+    ) -> MetricMaps {
+        let n = misregistration.len();
+        assert_eq!(n, width as usize * height as usize);
+        MetricMaps {
+            width,
+            height,
+            misregistration,
+            missing: vec![false; n],
+            display,
+            blank,
+            ssim: vec![f64::NAN; n],
+            flip: vec![f64::NAN; n],
+        }
+    }
+}
+
 /// Summary statistics of a set of values.
 pub fn stats(values: &mut [f64]) -> serde_json::Value {
     if values.is_empty() {
