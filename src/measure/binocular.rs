@@ -240,8 +240,7 @@ mod tests {
     /// eye 0.6 m from a display centre at 30° off its normal.
     #[test]
     fn the_stats_count_rank_and_place_the_eyes() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/das.toml");
-        let mut obstacle = crate::scene::Scene::load(&path).unwrap().obstacle;
+        let mut obstacle = crate::scene::Scene::bundled("das.toml").obstacle;
         let centre = DVec3::new(1.0, 2.0, 3.0);
         obstacle.world_from_obstacle = glam::DAffine3::from_translation(centre);
         let (sin, cos) = 30f64.to_radians().sin_cos();

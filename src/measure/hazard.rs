@@ -286,8 +286,7 @@ mod tests {
     /// at (0,0), (1,0) and (0,2).
     #[test]
     fn hazards_count_hidden_and_shown_pixels_and_their_centroids_by_hand() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/left_turn.toml");
-        let scene = Scene::load(&path).unwrap();
+        let scene = Scene::bundled("left_turn.toml");
         let id_of =
             |name: &str| scene.objects.iter().position(|o| o.name == name).unwrap() as u32 + 1;
         let (p, cyclist) = (id_of("pedestrian"), id_of("cyclist"));

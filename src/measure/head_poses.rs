@@ -244,10 +244,6 @@ pub fn pose_table(results: &[PoseResult]) -> String {
 mod tests {
     use super::*;
 
-    fn scene(name: &str) -> Scene {
-        Scene::load(std::path::Path::new(&format!("scenes/{name}"))).unwrap()
-    }
-
     /// A pose result with only what the table and the time line read.
     fn result(frontal: Option<f64>, fitted: Option<f64>, confidence: Option<f64>) -> PoseResult {
         PoseResult {
@@ -268,7 +264,7 @@ mod tests {
 
     #[test]
     fn the_grid_camera_keeps_the_back_cameras_aspect() {
-        let das = scene("das.toml");
+        let das = Scene::bundled("das.toml");
         assert_eq!((das.back.width, das.back.height), (640, 480));
         let size = |w| {
             let c = grid_camera(&das, w);
@@ -344,7 +340,7 @@ mod tests {
 
     #[test]
     fn a_scene_without_a_head_has_no_pose_to_turn() {
-        let mut headless = scene("das.toml");
+        let mut headless = Scene::bundled("das.toml");
         for o in &mut headless.objects {
             o.motion.moves_with = MovesWith::Vehicle;
         }
@@ -361,7 +357,7 @@ mod tests {
         // The mesh head at 0.8 and 1.25 of its distance, facing the back camera: the eye
         // (turned about the neck to face it) within a few cm of that distance, the tracker
         // detecting it, and its yaw error wrapped into (−180°, 180°].
-        let das = scene("das_mesh_head.toml");
+        let das = Scene::bundled("das_mesh_head.toml");
         let camera = das.back.position();
         let d0 = (das.eye() - camera).length();
         let results = pose_grid(&das, &[0.0], &[0.0], &[0.8, 1.25], None).unwrap();

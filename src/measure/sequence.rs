@@ -647,10 +647,7 @@ mod tests {
     #[test]
     fn the_obstacle_box_holds_the_traced_obstacle() {
         for name in ["das.toml", "cabin.toml"] {
-            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("scenes")
-                .join(name);
-            let scene = Scene::load(&path).unwrap();
+            let scene = Scene::bundled(name);
             let world = crate::scene::world::World::build(&scene).unwrap();
             let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
             let mut traced = Aabb::empty();

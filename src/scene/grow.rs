@@ -150,8 +150,7 @@ mod tests {
 
     #[test]
     fn growth_reaches_the_factor_and_is_deterministic() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/das.toml");
-        let base = Scene::load(&path).unwrap();
+        let base = Scene::bundled("das.toml");
         let n = |s: &Scene| World::build(s).unwrap().triangles.len() as f64;
         assert!(grow(&base, 1.0).unwrap() == base);
         let grown = grow(&base, 10.0).unwrap();

@@ -19,6 +19,15 @@ use crate::scene::{CameraKind, DriverFace, Material, Object, Obstacle, Scene, Sh
 const OBJECT_KINDS: [&str; 7] = ["plane", "box", "sphere", "cylinder", "cone", "quad", "mesh"];
 
 impl Scene {
+    /// A scene of the repository's `scenes/` folder, for unit tests.
+    #[cfg(test)]
+    pub(crate) fn bundled(name: &str) -> Scene {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(name);
+        Scene::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"))
+    }
+
     /// Reads and validates a scene file.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let file = SourceFile::read(path)?;
