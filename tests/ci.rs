@@ -186,6 +186,10 @@ fn exr_layers_are_compared_one_by_one_and_a_missing_layer_is_refused() {
     let (code, _, err) = run(dir.path(), &["diff", "a.exr", "c.exr"]);
     assert_eq!(code, 2);
     assert_one_error_line(&err, &["c.exr has no layer `Z`", "a.exr has it"]);
+    // The same the other way round: the second file's extra layer is missing in the first.
+    let (code, _, err) = run(dir.path(), &["diff", "c.exr", "a.exr"]);
+    assert_eq!(code, 2);
+    assert_one_error_line(&err, &["c.exr has no layer `Z`", "a.exr has it"]);
     let (code, _, err) = run(dir.path(), &["diff", "a.exr", "b.exr", "--layer", "P"]);
     assert_eq!(code, 2);
     assert_one_error_line(&err, &["no layer `P`", "colour, Z"]);

@@ -633,6 +633,63 @@ mod tests {
         }
     }
 
+    /// A driver view is seen at the driver camera's pixels per degree, read from the run's
+    /// metrics.json when it is a positive number; any other view, no file, or a value that
+    /// is not a positive number falls back to the standard observer.
+    #[test]
+    fn flip_sees_a_runs_driver_views_at_its_cameras_pixels_per_degree() {
+        let dir = tempfile::tempdir().unwrap();
+        let ppd = |view| pixels_per_degree(dir.path(), view);
+        let standard = (STANDARD_PPD, "the standard observer".to_string());
+        assert_eq!(ppd("truth"), standard);
+        let write = |value: &str| {
+            let json = format!("{{\"flip_pixels_per_degree\": {value}}}");
+            std::fs::write(dir.path().join("metrics.json"), json).unwrap();
+        };
+        write("41.5");
+        for view in DRIVER_VIEWS {
+            let (value, from) = ppd(view);
+            assert_eq!(value, 41.5, "{view}");
+            assert!(from.starts_with("the driver camera") && from.contains("metrics.json"));
+        }
+        for view in ["frontal", "back", "display", "misregistration"] {
+            assert_eq!(ppd(view), standard, "{view}");
+        }
+        for bad in ["0", "-0.0", "-3", "null", "\"41\""] {
+            write(bad);
+            assert_eq!(ppd("seethru"), standard, "{bad}");
+        }
+    }
+
+    /// The FLIP heatmap is magma, as NVIDIA's tool shows it: near black at 0, pale yellow
+    /// at 1 and beyond (clamped), brighter as the error grows; the colour bar to its right.
+    #[test]
+    fn the_flip_heatmap_runs_from_black_at_0_to_pale_yellow_at_1() {
+        let values = [0.0, 0.25, 0.5, 0.75, 1.0, 3.0];
+        let (w, _, rgb) = flip_heatmap(&values, 6, 1).unwrap();
+        assert_eq!(w, 6 + crate::io::colour_bar::BAR_COLUMN);
+        let px = |i: usize| [rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]];
+        let sum = |c: [u8; 3]| c.iter().map(|&v| u32::from(v)).sum::<u32>();
+        assert!(sum(px(0)) < 15, "{:?}", px(0));
+        let pale = px(4);
+        assert!(
+            pale[0] > 240 && pale[1] > 240 && pale[2] > 170 && pale[2] < 210,
+            "{pale:?}"
+        );
+        assert_eq!(px(5), pale);
+        for i in 1..5 {
+            assert!(
+                sum(px(i)) > sum(px(i - 1)),
+                "{i}: {:?} {:?}",
+                px(i - 1),
+                px(i)
+            );
+        }
+        // Magma's middle is red-purple: red well above green.
+        let mid = px(2);
+        assert!(mid[0] > 150 && mid[1] < 80, "{mid:?}");
+    }
+
     /// EXR stores channels sorted by name (B, G, R); the colour layer reads back as R, G, B.
     #[test]
     fn an_exr_colour_layer_reads_as_r_g_b() {
