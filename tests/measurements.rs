@@ -13,7 +13,7 @@ use seethru::analysis::{
 use seethru::measure::metrics::{MetricMaps, measure};
 use seethru::measure::{
     ratio::{RatioResult, measure_ratio},
-    ratio_setup::{Compensation, Setup},
+    ratio_setup::{Compensation, Setup, build_scene},
 };
 use seethru::render::frame::Frame;
 use seethru::render::integrator::RenderContext;
@@ -203,6 +203,83 @@ fn impossible_setups_are_rejected() {
             "{err}"
         );
     }
+}
+
+/// The paper's printed and Unity numbers are reported for its own two setups only, each
+/// with its sign; every result names its setup.
+#[test]
+fn the_papers_numbers_come_with_its_own_setups_only() {
+    let paper = [
+        (
+            occlusion(5.0, -0.35, 6.3, 2.5, 1.75),
+            "occlusion",
+            (-0.73, -0.71),
+        ),
+        (
+            foreshortening(5.0, -1.5, 1.3, 2.0, 0.7, 90.0),
+            "foreshortening",
+            (2.47, 2.64),
+        ),
+    ];
+    for (setup, kind, printed) in paper {
+        let r = measure_ratio(&setup, 160, &Compensation::default()).unwrap();
+        assert_eq!(r.setup, kind);
+        assert_eq!(
+            (r.paper_printed, r.paper_unity),
+            (Some(printed.0), Some(printed.1))
+        );
+    }
+    // One parameter off the paper's: no paper numbers.
+    for (setup, kind) in [
+        (occlusion(5.0, -0.35, 6.3, 2.5, 1.5), "occlusion"),
+        (
+            foreshortening(5.0, -1.5, 1.3, 2.0, 0.7, 80.0),
+            "foreshortening",
+        ),
+    ] {
+        let r = measure_ratio(&setup, 160, &Compensation::default()).unwrap();
+        assert_eq!(r.setup, kind);
+        assert_eq!((r.paper_printed, r.paper_unity), (None, None), "{setup:?}");
+    }
+}
+
+/// Every bound of a setup's parameters, each refusing alone, with its message; the bounds
+/// that are inclusive (γ = 90°, a predicted width of exactly 1e-6 m) accept.
+#[test]
+fn setup_parameters_are_checked_at_their_bounds() {
+    let none = Compensation::default();
+    let refused = |setup: Setup, words: &str| {
+        let e = build_scene(&setup, 64, &none).unwrap_err().to_string();
+        assert!(e.contains(words), "{setup:?}: {e}");
+    };
+    let positive = "d1 and d2 must be > 0";
+    refused(occlusion(1.0, 0.5, 4.0, 0.0, 0.2), positive);
+    refused(foreshortening(1.0, 0.5, 0.0, 1.0, 0.2, 45.0), positive);
+    refused(occlusion(1.0, f64::NAN, 4.0, 1.0, 0.2), positive);
+    refused(occlusion(1.0, 0.5, 4.0, 1.0, f64::INFINITY), positive);
+    refused(occlusion(0.0, 0.5, 4.0, 1.0, 0.2), "--L must be in (0, d2)");
+    refused(occlusion(4.0, 0.5, 4.0, 1.0, 0.2), "--L must be in (0, d2)");
+    refused(
+        foreshortening(0.0, 0.5, 3.0, 1.0, 0.2, 45.0),
+        "--l must be > 0",
+    );
+    refused(
+        foreshortening(1.0, 0.5, 3.0, 1.0, 0.2, 0.0),
+        "--gamma in (0, 90]",
+    );
+    build_scene(&foreshortening(1.0, 0.5, 3.0, 1.0, 0.2, 90.0), 64, &none).unwrap();
+    // p_cam = L b1 / (d2 − L) = b1 here: 1e-6 m is the smallest width measured.
+    let zero = "the predicted widths are zero or undefined";
+    build_scene(&occlusion(1.0, 1e-6, 2.0, 1.0, 0.2), 64, &none).unwrap();
+    refused(occlusion(1.0, 0.9e-6, 2.0, 1.0, 0.2), zero);
+    // p_user = L (b_h + b1) / (d1 + d2 − L): zero with b_h = −b1; exactly b1 = 1e-6 m here
+    // (p_cam twice that).
+    refused(occlusion(1.0, 0.5, 2.0, 1.0, -0.5), zero);
+    build_scene(&occlusion(1.0, 1e-6, 1.5, 0.5, 0.0), 64, &none).unwrap();
+    refused(occlusion(1.0, 0.9e-6, 1.5, 0.5, 0.0), zero);
+    // Finite parameters whose widths overflow: p_cam alone, then p_user alone.
+    refused(occlusion(0.5, 1e308, 0.6, 1.0, 0.0), zero);
+    refused(occlusion(1.0, 1e308, 2.0, 1.0, 1e308), zero);
 }
 
 /// The metrics of a run's own frames, as `run` computes them (border band 5 display pixels).
