@@ -280,6 +280,18 @@ fn setup_parameters_are_checked_at_their_bounds() {
     // Finite parameters whose widths overflow: p_cam alone, then p_user alone.
     refused(occlusion(0.5, 1e308, 0.6, 1.0, 0.0), zero);
     refused(occlusion(1.0, 1e308, 2.0, 1.0, 1e308), zero);
+    // A head bias moves the perceived edge by bx·d2/d1: with bx = −p_cam·d1/d2 (−25 cm
+    // here) the driver perceives the displayed edge on the corner, a width of zero.
+    let biased = |bx: f64| Compensation {
+        head_bias_cm: [bx, 0.0, 0.0],
+        ..Compensation::default()
+    };
+    let setup = occlusion(1.0, 0.5, 2.0, 1.0, 0.2);
+    let e = build_scene(&setup, 64, &biased(-25.0))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("the driver perceives no width"), "{e}");
+    build_scene(&setup, 64, &biased(-24.9)).unwrap();
 }
 
 /// The metrics of a run's own frames, as `run` computes them (border band 5 display pixels).
@@ -1111,5 +1123,204 @@ fn the_ratio_command_prints_a_table_and_refuses_bad_compensations() {
             err.starts_with("error: ") && err.contains(needle),
             "{extra:?}: {err}"
         );
+    }
+}
+
+/// The objects along a ray in one view, by name (`sky` when nothing is hit).
+fn hit_name(ctx: &RenderContext, origin: DVec3, dir: DVec3, view: u8) -> String {
+    match ctx.trace(origin.as_vec3(), dir.normalize().as_vec3(), view) {
+        Some(hit) => ctx.world.objects[hit.object as usize - 1].name.clone(),
+        None => "sky".into(),
+    }
+}
+
+/// How many times the object changes along a sequence of names.
+fn transitions(names: &[String]) -> usize {
+    names.windows(2).filter(|w| w[0] != w[1]).count()
+}
+
+/// A setup's scene is sized for its measurement, checked by casting rays into it, for the
+/// paper's setups, a narrow one (p_cam ≈ 1 cm), a deep one (a 6 m surface straight back from
+/// 1 m) and a slanted one, each under the paper's compensation, the `d2 → ∞` model and a
+/// nearer model with a head bias:
+/// - the display shows every edge point (the corner and the edges where the camera, the eye
+///   and the driver see them) with at least a quarter of the span of scene beside it, and
+///   is at most a span and 10 cm (on the plane) wider than that: the widths keep their pixels;
+/// - its pixels are square;
+/// - the frontal camera sees every model point the display asks for, and the outermost of them
+///   lies in the outer third of its image (no more than 1.5 times the field needed);
+/// - the driver's view holds the whole display, which fills at least 80 % of its width;
+/// - every ray the measurement uses hits the setup: the driver's through the display and the
+///   frontal camera's through every pixel never see the sky, and every display or image
+///   column sees one object from its top to its bottom row (the setup is a top view,
+///   extruded); along the display's middle row, the driver and the frontal camera's rays
+///   towards the model points cross one edge of the occluder or the two ends of the surface,
+///   never the occluder's far end.
+#[test]
+fn a_setups_scene_is_sized_for_its_measurement() {
+    use seethru::scene::world::view_bit;
+    let setups = [
+        occlusion(5.0, -0.35, 6.3, 2.5, 1.75),
+        foreshortening(5.0, -1.5, 1.3, 2.0, 0.7, 90.0),
+        occlusion(0.3, -0.1, 3.0, 0.7, 0.3),
+        foreshortening(6.0, -0.5, 1.0, 0.6, 0.3, 90.0),
+        foreshortening(2.0, 0.4, 2.0, 0.7, -0.3, 30.0),
+    ];
+    let compensations = [
+        Compensation::default(),
+        Compensation {
+            model_d2: Some(f64::INFINITY),
+            ..Compensation::default()
+        },
+        Compensation {
+            model_d2: Some(3.0),
+            head_bias_cm: [3.0, 1.0, -5.0],
+        },
+    ];
+    for setup in setups {
+        let (b1, d1, d2, b_h, edges_expected) = match setup {
+            Setup::Occlusion(p) => (p.b1, p.d1, p.d2, p.b_h, 1),
+            Setup::Foreshortening(p) => (p.b1, p.d1, p.d2, p.b_h, 2),
+        };
+        for c in compensations {
+            let at = format!("{setup:?} {c:?}");
+            let scene = build_scene(&setup, 160, &c).unwrap();
+            let eye = DVec3::new(-b_h, 0.0, d1);
+            assert!((scene.driver.position() - eye).length() < 1e-12, "{at}");
+            let (hw, h) = (scene.obstacle.width / 2.0, scene.obstacle.height);
+            // The display: edge points with their margin, and not much more.
+            let (pc, pu) = setup.predicted();
+            let (pc_perceived, _) = setup.predicted_perceived(&c);
+            let span = pc.abs().max(pu.abs()).max(pc_perceived.abs());
+            let k = d1 / (d1 + d2);
+            let display_x = |q: f64| eye.x + (q - eye.x) * k;
+            let perceived_corner = setup.geometry(&c).perceived(b1);
+            let reach = [b1, b1 + pc, b1 + pu, b1 + pc_perceived, perceived_corner]
+                .map(|q| display_x(q).abs())
+                .into_iter()
+                .fold(0.0, f64::max);
+            assert!(hw >= reach + 0.25 * span * k, "{at}: {hw} {reach} {span}");
+            assert!(
+                hw <= 1.05 * reach + (span + 0.1) * k,
+                "{at}: {hw} {reach} {span}"
+            );
+            let [columns, rows] = scene.obstacle.display_resolution;
+            let (pixel_w, pixel_h) = (2.0 * hw / columns as f64, h / rows as f64);
+            assert!((pixel_h / pixel_w - 1.0).abs() < 1.0 / rows as f64, "{at}");
+            // Display points: a grid over the display, its corners included.
+            let grid = |nx: usize, ny: usize| {
+                (0..nx)
+                    .map(|i| {
+                        let x = hw * (2.0 * i as f64 / (nx - 1) as f64 - 1.0) * 0.999;
+                        (0..ny)
+                            .map(|j| {
+                                let y = h / 2.0 * (2.0 * j as f64 / (ny - 1) as f64 - 1.0) * 0.999;
+                                DVec3::new(x, y, 0.0)
+                            })
+                            .collect::<Vec<_>>()
+                    })
+                    .collect::<Vec<_>>()
+            };
+            let points = grid(41, 5);
+            // The model point (or direction, for d2 → ∞) a display point asks the camera for.
+            let model_eye = eye + DVec3::from(c.head_bias_cm) / 100.0;
+            let model_d2 = c.model_d2.unwrap_or(d2);
+            let towards_model = |p: DVec3| {
+                let ray = p - model_eye;
+                if model_d2.is_infinite() {
+                    ray
+                } else {
+                    model_eye + ray * (model_d2 + model_eye.z) / -ray.z
+                }
+            };
+            let frontal = &scene.frontal;
+            let (fw, fh) = (frontal.width as f64, frontal.height as f64);
+            let mut outermost: f64 = 0.0;
+            for p in points.iter().flatten() {
+                let px = frontal.project_direction(towards_model(*p)).unwrap();
+                assert!(
+                    (0.0..=fw).contains(&px.x) && (0.0..=fh).contains(&px.y),
+                    "{at}: {p} asks for {px}"
+                );
+                outermost = outermost
+                    .max((px.x / fw - 0.5).abs() * 2.0)
+                    .max((px.y / fh - 0.5).abs() * 2.0);
+            }
+            assert!(outermost >= 1.0 / 1.5, "{at}: {outermost}");
+            let driver = &scene.driver;
+            let mut widest: f64 = 0.0;
+            for p in points.iter().flatten() {
+                let px = driver.project_point(*p).unwrap();
+                let (w, hh) = (driver.width as f64, driver.height as f64);
+                assert!(
+                    (0.0..=w).contains(&px.x) && (0.0..=hh).contains(&px.y),
+                    "{at}: {px}"
+                );
+                widest = widest.max((px.x / w - 0.5).abs() * 2.0);
+            }
+            assert!(widest >= 0.8, "{at}: {widest}");
+            // Rays: the driver's through the display, the frontal camera's through its pixels.
+            let ctx = RenderContext::new(scene.clone()).unwrap();
+            let expected_names = match setup {
+                Setup::Occlusion(_) => ["plane", "occluder"],
+                Setup::Foreshortening(_) => ["backdrop", "surface"],
+            };
+            let check_columns = |columns: Vec<Vec<String>>, what: &str| {
+                for column in &columns {
+                    assert!(
+                        column.iter().all(|n| expected_names.contains(&n.as_str())),
+                        "{at}: {what}: {column:?}"
+                    );
+                    assert_eq!(transitions(column), 0, "{at}: {what}: {column:?}");
+                }
+                columns
+                    .iter()
+                    .map(|c| c[c.len() / 2].clone())
+                    .collect::<Vec<_>>()
+            };
+            let through_display = check_columns(
+                points
+                    .iter()
+                    .map(|col| {
+                        col.iter()
+                            .map(|p| hit_name(&ctx, eye, *p - eye, view_bit::TRUTH))
+                            .collect()
+                    })
+                    .collect(),
+                "driver through the display",
+            );
+            assert_eq!(
+                transitions(&through_display),
+                edges_expected,
+                "{at}: {through_display:?}"
+            );
+            check_columns(
+                (0..frontal.width)
+                    .step_by(3)
+                    .map(|x| {
+                        [0.5, fh / 2.0, fh - 0.5]
+                            .map(|y| {
+                                let (o, d) = frontal.world_ray(glam::DVec2::new(x as f64 + 0.5, y));
+                                hit_name(&ctx, o, d, view_bit::FRONTAL)
+                            })
+                            .to_vec()
+                    })
+                    .collect(),
+                "frontal image",
+            );
+            let asked: Vec<String> = points
+                .iter()
+                .map(|col| {
+                    let d = towards_model(col[col.len() / 2]);
+                    let d = if model_d2.is_infinite() {
+                        d
+                    } else {
+                        d - frontal.position()
+                    };
+                    hit_name(&ctx, frontal.position(), d, view_bit::FRONTAL)
+                })
+                .collect();
+            assert_eq!(transitions(&asked), edges_expected, "{at}: {asked:?}");
+        }
     }
 }

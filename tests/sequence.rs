@@ -811,3 +811,197 @@ fn the_preview_has_a_colour_bar_whose_scale_heatmap_max_fixes() {
         "{auto_top} {auto_how}"
     );
 }
+
+/// Every column of frames.csv and every figure of summary.json against what the sequence
+/// was asked for: a swaying head (its path known in closed form), a display refreshing at
+/// 4 Hz under 10 Hz frames (so images are held), 50 ms camera and 30 ms tracking latency.
+/// The clock, the eye columns, the ages, the eye error and the eye's velocity come from the
+/// sway and the refresh grid computed here; the summary's figures from the CSV's columns.
+#[test]
+fn frames_csv_and_summary_hold_what_the_sequence_was_asked_for() {
+    use seethru::measure::sequence_files::{frames_csv, summary};
+    let wall = common::WallScene::default();
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let eye0 = scene.obstacle.in_obstacle_frame(scene.eye());
+    let (amplitude, frequency) = (0.03, 0.7);
+    let mut o = options(0.05, 10.0, 4.0, 0.0);
+    o.timeline.duration = 0.6;
+    o.timeline.latency_tracking = 0.03;
+    o.head = HeadMotion::Sway {
+        amplitude,
+        frequency,
+    };
+    let how = common::measuring(Flip::Skipped);
+    let run = run_sequence(&scene, o.clone(), how, &mut |_| Ok(())).unwrap();
+    let csv = frames_csv(&run.records, &o.timeline).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 6);
+    let col = |name: &str| -> Vec<f64> {
+        let i = header.iter().position(|c| *c == name).unwrap();
+        rows.iter().map(|r| r[i]).collect()
+    };
+    let sway_x = |t: f64| eye0.x + amplitude * (std::f64::consts::TAU * frequency * t).sin();
+    let close = |a: f64, b: f64, what: &str| assert!((a - b).abs() < 1e-9, "{what}: {a} vs {b}");
+    let mut errors = Vec::new();
+    for (k, row_t) in col("t_s").into_iter().enumerate() {
+        let t = k as f64 / 10.0;
+        let refresh = (t * 4.0 + 1e-9).floor() / 4.0;
+        let (capture, head) = (refresh - 0.05, refresh - 0.08);
+        close(row_t, t, "t_s");
+        close(col("frame")[k], k as f64, "frame");
+        close(col("refresh_s")[k], refresh, "refresh_s");
+        close(col("capture_s")[k], capture, "capture_s");
+        close(col("head_sample_s")[k], head, "head_sample_s");
+        close(col("latency_camera_ms")[k], 50.0, "latency_camera_ms");
+        close(col("latency_tracking_ms")[k], 30.0, "latency_tracking_ms");
+        close(col("hold_ms")[k], (t - refresh) * 1e3, "hold_ms");
+        close(col("image_age_ms")[k], (t - capture) * 1e3, "image_age_ms");
+        close(col("head_age_ms")[k], (t - head) * 1e3, "head_age_ms");
+        for (axis, true_m) in [("x", sway_x(t)), ("y", eye0.y), ("z", eye0.z)] {
+            close(col(&format!("eye_true_{axis}_m"))[k], true_m, "eye_true");
+        }
+        // The ellipsoid face's estimate sits within a few millimetres of the head sample's
+        // eye; the compensation uses it unpredicted.
+        let estimated = col("eye_estimated_x_m")[k];
+        assert!(
+            (estimated - sway_x(head)).abs() < 5e-3,
+            "frame {k}: {estimated}"
+        );
+        close(col("eye_used_x_m")[k], estimated, "eye_used_x_m");
+        let used = glam::DVec3::new(
+            col("eye_used_x_m")[k],
+            col("eye_used_y_m")[k],
+            col("eye_used_z_m")[k],
+        );
+        let error = (used - glam::DVec3::new(sway_x(t), eye0.y, eye0.z)).length() * 1e3;
+        close(col("eye_error_mm")[k], error, "eye_error_mm");
+        errors.push(error);
+        let velocity = if k == 0 {
+            0.0
+        } else {
+            (sway_x(t) - sway_x(t - 0.1)) / 0.1
+        };
+        close(col("eye_x_velocity_m_s")[k], velocity, "eye_x_velocity_m_s");
+        close(col("eye_z_velocity_m_s")[k], 0.0, "eye_z_velocity_m_s");
+        close(col("d2_m")[k], 6.0, "d2_m");
+        let coverage = col("coverage")[k];
+        assert!(coverage > 0.5 && coverage <= 1.0, "frame {k}: {coverage}");
+        close(col("blank_fraction")[k], 1.0 - coverage, "blank_fraction");
+    }
+    // The eye moves and the images are held: some frames' errors differ, none is zero.
+    assert!(errors.iter().all(|e| *e > 1.0), "{errors:?}");
+    let s = summary(&run, &o.timeline);
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let max = |v: &[f64]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let min = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+    let figure = |path: &str| s.pointer(path).and_then(|v| v.as_f64()).unwrap();
+    assert_eq!(s["frames"], 6);
+    close(
+        figure("/latency_camera_ms"),
+        50.0,
+        "summary latency_camera_ms",
+    );
+    close(
+        figure("/latency_tracking_ms"),
+        30.0,
+        "summary latency_tracking_ms",
+    );
+    for (path, expected) in [
+        (
+            "/misregistration_arcmin/mean_of_frame_means",
+            mean(&col("misregistration_mean_arcmin")),
+        ),
+        (
+            "/misregistration_arcmin/mean_of_frame_p95",
+            mean(&col("misregistration_p95_arcmin")),
+        ),
+        (
+            "/misregistration_arcmin/max_of_frame_p95",
+            max(&col("misregistration_p95_arcmin")),
+        ),
+        (
+            "/misregistration_arcmin/max",
+            max(&col("misregistration_max_arcmin")),
+        ),
+        ("/coverage/mean", mean(&col("coverage"))),
+        ("/coverage/min", min(&col("coverage"))),
+        ("/missing_fraction_mean", mean(&col("missing_fraction"))),
+        ("/eye_error_mm/mean", mean(&errors)),
+        ("/eye_error_mm/max", max(&errors)),
+        (
+            "/frames_per_second/system_loop",
+            6.0 / figure("/seconds/system_total"),
+        ),
+        (
+            "/frames_per_second/with_truth_and_metrics",
+            6.0 / figure("/seconds/total"),
+        ),
+    ] {
+        close(figure(path), expected, path);
+    }
+    // The means and maxima differ here, so a summary that swapped them would fail.
+    assert!(max(&errors) > mean(&errors) * 1.05, "{errors:?}");
+}
+
+/// The misregistration figures hold every point, with 5 to 10 % headroom above the highest
+/// (and 2 to 5 % right of the longest latency); a curve below 1′ gets the axis to 1.1′.
+#[test]
+fn the_misregistration_figures_hold_their_points_with_a_little_headroom() {
+    use seethru::measure::sequence::FrameMetrics;
+    use seethru::measure::sequence_files::{latency_figure, over_time_figure};
+    let wall = common::WallScene::default();
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let how = common::measuring(Flip::Skipped);
+    let run = run_sequence(&scene, options(0.1, 10.0, 10.0, 0.3), how, &mut |_| Ok(())).unwrap();
+    let mut low = run.records.clone();
+    for r in &mut low {
+        r.metrics = Some(FrameMetrics {
+            mean_arcmin: 0.5,
+            ..r.metrics.unwrap()
+        });
+    }
+    let highest = |points: &[(f64, f64)]| points.iter().map(|p| p.1).fold(0.0, f64::max);
+    let figure = over_time_figure(
+        &[
+            ("turning".into(), &run.records[..]),
+            ("low".into(), &low[..]),
+        ],
+        0.9,
+    );
+    let top = highest(&figure.series[0].points);
+    assert!(top > 5.0, "{top}");
+    assert_eq!(figure.y_range.0, 0.0);
+    assert!(
+        figure.y_range.1 >= 1.05 * top && figure.y_range.1 <= 1.1 * top + 1e-9,
+        "{:?} for {top}",
+        figure.y_range
+    );
+    assert_eq!(figure.x_range, (0.0, 0.9));
+    let figure = over_time_figure(&[("low".into(), &low[..])], 0.9);
+    assert!(
+        (figure.y_range.1 - 1.1).abs() < 1e-12,
+        "{:?}",
+        figure.y_range
+    );
+    // Latency (ms), mean, p95.
+    let points = [(0.0, 1.0, 3.0), (50.0, 8.0, 20.0), (120.0, 15.0, 30.0)];
+    let figure = latency_figure(&points);
+    assert!(
+        figure.y_range.1 >= 31.5 && figure.y_range.1 <= 33.0 + 1e-9,
+        "{:?}",
+        figure.y_range
+    );
+    assert!(
+        figure.x_range.1 >= 122.4 && figure.x_range.1 <= 126.0 + 1e-9,
+        "{:?}",
+        figure.x_range
+    );
+    let p95: Vec<(f64, f64)> = points.iter().map(|p| (p.0, p.2)).collect();
+    assert_eq!(figure.series[1].points, p95);
+    let figure = latency_figure(&[(0.0, 0.2, 0.5), (0.5, 0.3, 0.6)]);
+    assert!((figure.y_range.1 - 1.1).abs() < 1e-12 && (figure.x_range.1 - 1.05).abs() < 1e-12);
+}
