@@ -1005,3 +1005,54 @@ fn the_misregistration_figures_hold_their_points_with_a_little_headroom() {
     let figure = latency_figure(&[(0.0, 0.2, 0.5), (0.5, 0.3, 0.6)]);
     assert!((figure.y_range.1 - 1.1).abs() < 1e-12 && (figure.x_range.1 - 1.05).abs() < 1e-12);
 }
+
+/// A display that fills only part of the driver's view (the wall scene's 30 × 20 cm display
+/// under a 40° view): the window starts below the view's top row, and the preview holds the
+/// whole window (under 320 pixels, so at full size) — three panels as wide as it, and at
+/// least as tall — beside the colour bar.
+#[test]
+fn the_preview_holds_a_window_below_the_views_top() {
+    let dir = tempfile::tempdir().unwrap();
+    let street = common::repo_path("assets/street.png");
+    let text = common::WallScene::default()
+        .text()
+        .replace("../assets/street.png", street.to_str().unwrap());
+    let scene = dir.path().join("wall.toml");
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.path().join("out");
+    let (ok, _, err) = common::seethru(&[
+        "sequence",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--duration",
+        "0.2",
+        "--fps",
+        "10",
+        "--yaw-rate",
+        "10",
+        "--width",
+        "96",
+    ]);
+    assert!(ok, "{err}");
+    let run = out.join("latency_0ms");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("summary.json")).unwrap()).unwrap();
+    let window: Vec<u32> = summary["window_px"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap() as u32)
+        .collect();
+    let (ww, wh) = (window[2] - window[0], window[3] - window[1]);
+    assert!(window[1] > 0 && ww.max(wh) <= 320, "{window:?}");
+    let png = std::fs::read(run.join("preview.png")).unwrap();
+    let preview = image::load_from_memory(&png).unwrap().to_rgb8();
+    let bar_column = seethru::io::colour_bar::BAR_COLUMN;
+    assert_eq!(preview.width(), 3 * ww + 8 + bar_column, "{window:?}");
+    assert!(
+        preview.height() >= wh,
+        "{} for {window:?}",
+        preview.height()
+    );
+}
