@@ -1140,8 +1140,9 @@ fn transitions(names: &[String]) -> usize {
 }
 
 /// A setup's scene is sized for its measurement, checked by casting rays into it, for the
-/// paper's setups, a narrow one (p_cam ≈ 1 cm), a deep one (a 6 m surface straight back from
-/// 1 m) and a slanted one, each under the paper's compensation, the `d2 → ∞` model and a
+/// paper's setups, a narrow one (p_cam ≈ 1 cm), two deep ones (6 and 15 m surfaces straight
+/// back from 1 m: the frontal camera's top rows reach far above the scene plane there) and a
+/// slanted one, each under the paper's compensation, the `d2 → ∞` model and a
 /// nearer model with a head bias:
 /// - the display shows every edge point (the corner and the edges where the camera, the eye
 ///   and the driver see them) with at least a quarter of the span of scene beside it, and
@@ -1164,6 +1165,7 @@ fn a_setups_scene_is_sized_for_its_measurement() {
         foreshortening(5.0, -1.5, 1.3, 2.0, 0.7, 90.0),
         occlusion(0.3, -0.1, 3.0, 0.7, 0.3),
         foreshortening(6.0, -0.5, 1.0, 0.6, 0.3, 90.0),
+        foreshortening(15.0, -0.5, 1.0, 0.6, 0.3, 90.0),
         foreshortening(2.0, 0.4, 2.0, 0.7, -0.3, 30.0),
     ];
     let compensations = [
