@@ -246,28 +246,34 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
         };
         m.x.abs().max(2.0 * m.y.abs())
     };
-    let tan_needed = [-1.0, 1.0]
-        .into_iter()
-        .flat_map(|sx| [-1.0, 1.0].map(|sy| DVec3::new(sx * half_width, sy * height / 2.0, 0.0)))
+    let display_corners = [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)]
+        .map(|(sx, sy)| DVec3::new(sx * half_width, sy * height / 2.0, 0.0));
+    let tan_needed = display_corners
         .map(tangents)
+        .into_iter()
         .fold(0.0, f64::max);
     let theta_f = (tan_needed * 1.05).atan().min(85f64.to_radians());
     let frontal = Camera::new(DAffine3::IDENTITY, theta_f, width, (width / 2).max(8))?;
-    // The driver looks at the display centre, wide enough to see the whole display.
+    // The driver looks at the display centre, wide enough to see the whole display, and tall
+    // enough: an eye near one edge of a wide display sees that edge's corners steeply.
     let look = -eye.normalize();
-    let half_x = [-half_width, half_width]
+    let half_x = ([-half_width, half_width]
         .map(|x| (DVec3::new(x, 0.0, 0.0) - eye).normalize().dot(look).acos())
         .into_iter()
         .fold(0.0, f64::max)
-        + 1f64.to_radians();
-    let driver = Camera::look_at(
-        eye,
-        DVec3::ZERO,
-        DVec3::Y,
-        half_x.min(85f64.to_radians()),
-        width,
-        (width / 4).max(8),
-    )?;
+        + 1f64.to_radians())
+    .min(85f64.to_radians());
+    let aim = Camera::look_at(eye, DVec3::ZERO, DVec3::Y, half_x, width, width)?;
+    let camera_from_world = aim.world_from_camera.inverse();
+    let tan_y_needed = display_corners
+        .map(|c| {
+            let p = camera_from_world.transform_point3(c);
+            (p.y / -p.z).abs()
+        })
+        .into_iter()
+        .fold(0.0, f64::max);
+    let rows = (width as f64 * tan_y_needed * 1.05 / half_x.tan()).ceil() as u32;
+    let driver = aim.with_resolution(width, rows.min(4 * width).max((width / 4).max(8)));
     let back = Camera::new(DAffine3::from_rotation_y(std::f64::consts::PI), 0.6, 8, 6)?;
     let materials = vec![
         material("background", [0.6, 0.6, 0.6]),
@@ -276,6 +282,18 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
     // Tall enough that every display row sees the setup, from the eye and from the camera.
     let tall = 4.0 * height * (d1 + d2) / d1 + 2.0 * tan_needed * (d2 + p_depth(setup)) + 2.0;
     let far = d2 + 50.0;
+    // Half the size a background at `depth` behind the display needs: every ray the views
+    // cast hits it, the driver's through the display and the frontal camera's anywhere.
+    let reach_at = |depth: f64| {
+        let from_eye = display_corners
+            .map(|c| {
+                let p = eye + (c - eye) * (d1 + depth) / d1;
+                p.x.abs().max(p.y.abs())
+            })
+            .into_iter()
+            .fold(0.0, f64::max);
+        from_eye.max(frontal.tan_half_x().max(frontal.tan_half_y()) * depth) * 1.1 + 1.0
+    };
     let mut objects = Vec::new();
     match *setup {
         Setup::Occlusion(p) => {
@@ -283,7 +301,7 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
             objects.push(object(
                 "plane",
                 Shape::Quad {
-                    size: [4.0 * far, 4.0 * far],
+                    size: [(4.0 * far).max(2.0 * reach_at(d2)); 2],
                 },
                 0,
                 DAffine3::from_translation(DVec3::new(0.0, 0.0, -d2)),
@@ -312,7 +330,7 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
             objects.push(object(
                 "backdrop",
                 Shape::Quad {
-                    size: [8.0 * far, 8.0 * far],
+                    size: [(8.0 * far).max(2.0 * reach_at(far)); 2],
                 },
                 0,
                 DAffine3::from_translation(DVec3::new(0.0, 0.0, -far)),
