@@ -1197,17 +1197,17 @@ fn a_setups_scene_is_sized_for_its_measurement() {
         };
         for c in &compensations[..measured_under] {
             let at = format!("{setup:?} {c:?}");
-            let scene = build_scene(&setup, 160, &c).unwrap();
+            let scene = build_scene(&setup, 160, c).unwrap();
             let eye = DVec3::new(-b_h, 0.0, d1);
             assert!((scene.driver.position() - eye).length() < 1e-12, "{at}");
             let (hw, h) = (scene.obstacle.width / 2.0, scene.obstacle.height);
             // The display: edge points with their margin, and not much more.
             let (pc, pu) = setup.predicted();
-            let (pc_perceived, _) = setup.predicted_perceived(&c);
+            let (pc_perceived, _) = setup.predicted_perceived(c);
             let span = pc.abs().max(pu.abs()).max(pc_perceived.abs());
             let k = d1 / (d1 + d2);
             let display_x = |q: f64| eye.x + (q - eye.x) * k;
-            let perceived_corner = setup.geometry(&c).perceived(b1);
+            let perceived_corner = setup.geometry(c).perceived(b1);
             let reach = [b1, b1 + pc, b1 + pu, b1 + pc_perceived, perceived_corner]
                 .map(|q| display_x(q).abs())
                 .into_iter()
