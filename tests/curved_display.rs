@@ -278,9 +278,7 @@ fn the_obstruction_angle_of_a_plate_is_2_atan_w_over_2d() {
 
 fn scratch_wall(text: &str) -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
-    let street = common::repo_path("assets/street.png");
-    let text = text.replace("../assets/street.png", &street.display().to_string());
-    std::fs::write(dir.path().join("scene.toml"), text).unwrap();
+    common::scene_file_in(dir.path(), "scene.toml", text);
     dir
 }
 

@@ -683,17 +683,6 @@ fn the_binocular_map_is_the_exact_vergence_for_an_off_axis_eye_at_every_pixel() 
 // ---------------------------------------------------------------------------------------------
 // --latency-tracking and --head-jitter-cm
 
-/// The wall scene written into `dir` (its texture by absolute path), for the command line.
-fn wall_file(dir: &std::path::Path, setup: &common::WallScene) -> std::path::PathBuf {
-    let texture = common::repo_path("assets/street.png");
-    let text = setup
-        .text()
-        .replace("../assets/street.png", texture.to_str().unwrap());
-    let path = dir.join("wall.toml");
-    std::fs::write(&path, text).unwrap();
-    path
-}
-
 /// `frames.csv` of a sequence folder as rows of named values.
 fn frames_csv(dir: &std::path::Path) -> Vec<std::collections::HashMap<String, f64>> {
     let mut reader = csv::Reader::from_path(dir.join("frames.csv")).unwrap();
@@ -719,7 +708,7 @@ fn the_tracking_latency_costs_what_the_dynamic_formula_says() {
     // the band tests/sequence.rs justifies for camera latency (first order, paraxial).
     let dir = tempfile::tempdir().unwrap();
     let setup = common::WallScene::default();
-    let scene = wall_file(dir.path(), &setup);
+    let scene = setup.file_in(dir.path());
     let out = dir.path().join("seq");
     let (amplitude, frequency, latency, tracking) = (0.03, 0.5, 0.02, 0.03);
     let (ok, _, err) = common::seethru(&[

@@ -1013,12 +1013,7 @@ fn the_misregistration_figures_hold_their_points_with_a_little_headroom() {
 #[test]
 fn the_preview_holds_a_window_below_the_views_top() {
     let dir = tempfile::tempdir().unwrap();
-    let street = common::repo_path("assets/street.png");
-    let text = common::WallScene::default()
-        .text()
-        .replace("../assets/street.png", street.to_str().unwrap());
-    let scene = dir.path().join("wall.toml");
-    std::fs::write(&scene, text).unwrap();
+    let scene = common::WallScene::default().file_in(dir.path());
     let out = dir.path().join("out");
     let (ok, _, err) = common::seethru(&[
         "sequence",

@@ -218,10 +218,25 @@ translate = [0.0, 0.0, -{wall}]
         )
     }
 
+    /// The scene written into `dir` as `wall.toml`, for the command line.
+    pub fn file_in(&self, dir: &Path) -> PathBuf {
+        scene_file_in(dir, "wall.toml", &self.text())
+    }
+
     pub fn context(&self) -> seethru::render::integrator::RenderContext {
         let scene = parse_in(&repo_path("scenes"), "wall.toml", &self.text()).unwrap();
         seethru::render::integrator::RenderContext::new(scene).unwrap()
     }
+}
+
+/// A scene text of `scenes/` written into `dir` as `name`, its `../assets/street.png` by
+/// absolute path, so that the command line can read it from there.
+pub fn scene_file_in(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let street = repo_path("assets/street.png");
+    let text = text.replace("../assets/street.png", street.to_str().unwrap());
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
 }
 
 /// The coverage the planar model predicts for the driver's view of the display, by ray
