@@ -1009,11 +1009,17 @@ fn the_misregistration_figures_hold_their_points_with_a_little_headroom() {
 /// A display that fills only part of the driver's view (the wall scene's 30 × 20 cm display
 /// under a 40° view): the window starts below the view's top row, and the preview holds the
 /// whole window (under 320 pixels, so at full size) — three panels as wide as it, and at
-/// least as tall — beside the colour bar.
+/// least as tall — beside the colour bar; its heat panel dims the truth outside the display and
+/// shows blank display pixels black.
 #[test]
 fn the_preview_holds_a_window_below_the_views_top() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = common::WallScene::default().file_in(dir.path());
+    // A frontal camera of ±10° sees less than the display asks for (±13.5°): blank pixels.
+    let wall = common::WallScene {
+        frontal_half_angle: 10.0,
+        ..Default::default()
+    };
+    let scene = wall.file_in(dir.path());
     let out = dir.path().join("out");
     let (ok, _, err) = common::seethru(&[
         "sequence",
@@ -1049,5 +1055,36 @@ fn the_preview_holds_a_window_below_the_views_top() {
         preview.height() >= wh,
         "{} for {window:?}",
         preview.height()
+    );
+    // The heat panel: outside the display (the window's margin and the obstacle's body), the
+    // truth dimmed to grey, a sixth of its channels' sum; on it, the heat colours (never
+    // grey). The panels' rows end at the last row whose truth is not the white padding.
+    let pixel = |x: u32, y: u32| preview.get_pixel(x, y).0;
+    let last = (0..preview.height())
+        .rev()
+        .find(|&y| pixel(0, y) != [255; 3])
+        .unwrap();
+    let (mut dimmed, mut blank, mut heat) = (0, 0, 0);
+    for y in last + 1 - wh..=last {
+        for x in 0..ww {
+            let truth = pixel(x, y);
+            let shown = pixel(2 * (ww + 4) + x, y);
+            let grey = (truth.iter().map(|&c| c as u32).sum::<u32>() / 6) as u8;
+            if shown == [grey; 3] {
+                dimmed += 1;
+            } else if shown == [0; 3] {
+                blank += 1;
+            } else {
+                assert!(
+                    shown[0] != shown[1] || shown[1] != shown[2],
+                    "({x}, {y}): {shown:?}"
+                );
+                heat += 1;
+            }
+        }
+    }
+    assert!(
+        dimmed > 200 && blank > 50 && heat > 200,
+        "{dimmed} dimmed, {blank} blank, {heat} heat"
     );
 }
