@@ -1010,7 +1010,7 @@ fn the_misregistration_figures_hold_their_points_with_a_little_headroom() {
 /// under a 40° view): the window starts below the view's top row, and the preview holds the
 /// whole window (under 320 pixels, so at full size) — three panels as wide as it, and at
 /// least as tall — beside the colour bar; its heat panel dims the truth outside the display and
-/// shows blank display pixels black.
+/// shows blank display pixels black; a caption is above them.
 #[test]
 fn the_preview_holds_a_window_below_the_views_top() {
     let dir = tempfile::tempdir().unwrap();
@@ -1087,4 +1087,12 @@ fn the_preview_holds_a_window_below_the_views_top() {
         dimmed > 200 && blank > 50 && heat > 200,
         "{dimmed} dimmed, {blank} blank, {heat} heat"
     );
+    // Above the panels, the caption: at least a line's strip, with dark text on it.
+    let top = last + 1 - wh;
+    assert!(top >= seethru::io::caption::strip_height(1), "{top}");
+    let text = (0..top)
+        .flat_map(|y| (0..preview.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| pixel(x, y).iter().all(|&c| c < 100))
+        .count();
+    assert!(text > 20, "{text} dark pixels in the caption");
 }
