@@ -136,4 +136,55 @@ mod tests {
         none.observe(1.0, eye(1.0));
         assert_eq!(none.predict(2.0), eye(1.0));
     }
+
+    /// The filter's step against the textbook recursion written with 2 × 2 matrices:
+    /// predict x = F x, P = F P Fᵀ + Q; update with H = [1, 0] and P = (I − K H) P. Uneven
+    /// steps and noisy positions, so that every term of the covariance matters.
+    #[test]
+    fn a_kalman_step_is_the_textbook_recursion() {
+        type M = [[f64; 2]; 2];
+        let mul = |a: M, b: M| -> M {
+            std::array::from_fn(|i| std::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j]))
+        };
+        let transpose = |a: M| -> M { [[a[0][0], a[1][0]], [a[0][1], a[1][1]]] };
+        let r = 0.003f64.powi(2);
+        let mut axis = Axis::new(0.5, r);
+        let (mut x, mut p): ([f64; 2], M) = ([0.5, 0.0], [[r, 0.0], [0.0, 1.0]]);
+        let mut t = 0.0;
+        for k in 1..40 {
+            let dt = 0.01 + 0.02 * ((k * 7) % 5) as f64;
+            t += dt;
+            let z = 0.5 + 0.1 * (3.0 * t).sin() + 0.002 * ((k * 13 % 7) as f64 - 3.0);
+            axis.step(dt, z, r);
+            let f: M = [[1.0, dt], [0.0, 1.0]];
+            let q = KALMAN_ACCELERATION_DENSITY;
+            let noise: M = [
+                [q * dt.powi(3) / 3.0, q * dt * dt / 2.0],
+                [q * dt * dt / 2.0, q * dt],
+            ];
+            let spread = mul(mul(f, p), transpose(f));
+            let predicted: M =
+                std::array::from_fn(|i| std::array::from_fn(|j| spread[i][j] + noise[i][j]));
+            let ahead = [x[0] + dt * x[1], x[1]];
+            let s = predicted[0][0] + r;
+            let gain = [predicted[0][0] / s, predicted[1][0] / s];
+            let innovation = z - ahead[0];
+            x = [
+                ahead[0] + gain[0] * innovation,
+                ahead[1] + gain[1] * innovation,
+            ];
+            p = mul([[1.0 - gain[0], 0.0], [-gain[1], 1.0]], predicted);
+            let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + b.abs());
+            for i in 0..2 {
+                assert!(close(axis.x[i], x[i]), "step {k}: x {:?} vs {x:?}", axis.x);
+                for j in 0..2 {
+                    assert!(
+                        close(axis.p[i][j], p[i][j]),
+                        "step {k}: P {:?} vs {p:?}",
+                        axis.p
+                    );
+                }
+            }
+        }
+    }
 }
