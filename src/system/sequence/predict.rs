@@ -137,44 +137,58 @@ mod tests {
         assert_eq!(none.predict(2.0), eye(1.0));
     }
 
-    /// The filter's step against the textbook recursion written with 2 × 2 matrices:
-    /// predict x = F x, P = F P Fᵀ + Q; update with H = [1, 0] and P = (I − K H) P. Uneven
-    /// steps and noisy positions, so that every term of the covariance matters.
-    #[test]
-    fn a_kalman_step_is_the_textbook_recursion() {
-        type M = [[f64; 2]; 2];
+    type M = [[f64; 2]; 2];
+
+    /// One step of the textbook Kalman recursion in 2 × 2 matrices: predict x = F x,
+    /// P = F P Fᵀ + Q; update with H = [1, 0], K = P Hᵀ / (H P Hᵀ + r), P = (I − K H) P.
+    fn textbook_step(x: [f64; 2], p: M, dt: f64, z: f64, r: f64) -> ([f64; 2], M) {
         let mul = |a: M, b: M| -> M {
             std::array::from_fn(|i| std::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j]))
         };
         let transpose = |a: M| -> M { [[a[0][0], a[1][0]], [a[0][1], a[1][1]]] };
+        let f: M = [[1.0, dt], [0.0, 1.0]];
+        let q = KALMAN_ACCELERATION_DENSITY;
+        let noise: M = [
+            [q * dt.powi(3) / 3.0, q * dt * dt / 2.0],
+            [q * dt * dt / 2.0, q * dt],
+        ];
+        let spread = mul(mul(f, p), transpose(f));
+        let predicted: M =
+            std::array::from_fn(|i| std::array::from_fn(|j| spread[i][j] + noise[i][j]));
+        let ahead = [x[0] + dt * x[1], x[1]];
+        let s = predicted[0][0] + r;
+        let gain = [predicted[0][0] / s, predicted[1][0] / s];
+        let innovation = z - ahead[0];
+        (
+            [
+                ahead[0] + gain[0] * innovation,
+                ahead[1] + gain[1] * innovation,
+            ],
+            mul([[1.0 - gain[0], 0.0], [-gain[1], 1.0]], predicted),
+        )
+    }
+
+    /// Uneven steps (10–90 ms) and noisy positions, so that every term matters.
+    fn noisy_track(k: usize) -> (f64, f64) {
+        let t: f64 = (1..=k).map(|i| 0.01 + 0.02 * ((i * 7) % 5) as f64).sum();
+        let z = 0.5 + 0.1 * (3.0 * t).sin() + 0.002 * ((k * 13 % 7) as f64 - 3.0);
+        (t, z)
+    }
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= 1e-12 * (1.0 + b.abs())
+    }
+
+    /// The filter's step against the textbook recursion: state and covariance, every step.
+    #[test]
+    fn a_kalman_step_is_the_textbook_recursion() {
         let r = 0.003f64.powi(2);
         let mut axis = Axis::new(0.5, r);
         let (mut x, mut p): ([f64; 2], M) = ([0.5, 0.0], [[r, 0.0], [0.0, 1.0]]);
-        let mut t = 0.0;
         for k in 1..40 {
-            let dt = 0.01 + 0.02 * ((k * 7) % 5) as f64;
-            t += dt;
-            let z = 0.5 + 0.1 * (3.0 * t).sin() + 0.002 * ((k * 13 % 7) as f64 - 3.0);
+            let (dt, z) = (noisy_track(k).0 - noisy_track(k - 1).0, noisy_track(k).1);
             axis.step(dt, z, r);
-            let f: M = [[1.0, dt], [0.0, 1.0]];
-            let q = KALMAN_ACCELERATION_DENSITY;
-            let noise: M = [
-                [q * dt.powi(3) / 3.0, q * dt * dt / 2.0],
-                [q * dt * dt / 2.0, q * dt],
-            ];
-            let spread = mul(mul(f, p), transpose(f));
-            let predicted: M =
-                std::array::from_fn(|i| std::array::from_fn(|j| spread[i][j] + noise[i][j]));
-            let ahead = [x[0] + dt * x[1], x[1]];
-            let s = predicted[0][0] + r;
-            let gain = [predicted[0][0] / s, predicted[1][0] / s];
-            let innovation = z - ahead[0];
-            x = [
-                ahead[0] + gain[0] * innovation,
-                ahead[1] + gain[1] * innovation,
-            ];
-            p = mul([[1.0 - gain[0], 0.0], [-gain[1], 1.0]], predicted);
-            let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + b.abs());
+            (x, p) = textbook_step(x, p, dt, z, r);
             for i in 0..2 {
                 assert!(close(axis.x[i], x[i]), "step {k}: x {:?} vs {x:?}", axis.x);
                 for j in 0..2 {
@@ -185,6 +199,32 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    /// The Kalman predictor is the textbook filter on each axis with the measurement variance
+    /// σ², extrapolated by its velocity; a repeated or older estimate is ignored.
+    #[test]
+    fn the_kalman_predictor_filters_each_axis_with_variance_sigma_squared() {
+        let sigma = 0.004;
+        let mut predictor = Predictor::new(Prediction::Kalman, sigma);
+        let (t0, z0) = noisy_track(0);
+        let (mut x, mut p): ([f64; 2], M) = ([z0, 0.0], [[sigma * sigma, 0.0], [0.0, 1.0]]);
+        predictor.observe(t0, DVec3::new(z0, 0.7, -z0));
+        for k in 1..30 {
+            let (t, z) = noisy_track(k);
+            predictor.observe(t, DVec3::new(z, 0.7, -z));
+            predictor.observe(t, DVec3::new(9.0, 9.0, 9.0));
+            predictor.observe(t - 1e-3, DVec3::new(9.0, 9.0, 9.0));
+            (x, p) = textbook_step(x, p, t - noisy_track(k - 1).0, z, sigma * sigma);
+            let ahead = t + 0.05;
+            let predicted = predictor.predict(ahead);
+            let expected = x[0] + x[1] * 0.05;
+            assert!(
+                close(predicted.x, expected),
+                "step {k}: {predicted} vs {expected}"
+            );
+            assert!(close(predicted.z, -expected), "step {k}: {predicted}");
         }
     }
 }
