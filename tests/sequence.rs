@@ -814,7 +814,8 @@ fn the_preview_has_a_colour_bar_whose_scale_heatmap_max_fixes() {
 
 /// Every column of frames.csv and every figure of summary.json against what the sequence
 /// was asked for: a swaying head (its path known in closed form), a display refreshing at
-/// 4 Hz under 10 Hz frames (so images are held), 50 ms camera and 30 ms tracking latency.
+/// 4 Hz under 10 Hz frames (so images are held), 50 ms camera and 30 ms tracking latency,
+/// a head-tracking bias of (2, −1, 0.5) cm.
 /// The clock, the eye columns, the ages, the eye error and the eye's velocity come from the
 /// sway and the refresh grid computed here; the summary's figures from the CSV's columns.
 #[test]
@@ -827,6 +828,8 @@ fn frames_csv_and_summary_hold_what_the_sequence_was_asked_for() {
     let mut o = options(0.05, 10.0, 4.0, 0.0);
     o.timeline.duration = 0.6;
     o.timeline.latency_tracking = 0.03;
+    // A head-tracking bias, cm, obstacle frame: the estimate is off by it.
+    o.run.head_bias_cm = [2.0, -1.0, 0.5];
     o.head = HeadMotion::Sway {
         amplitude,
         frequency,
@@ -864,10 +867,27 @@ fn frames_csv_and_summary_hold_what_the_sequence_was_asked_for() {
         for (axis, true_m) in [("x", sway_x(t)), ("y", eye0.y), ("z", eye0.z)] {
             close(col(&format!("eye_true_{axis}_m"))[k], true_m, "eye_true");
         }
-        // The oracle head source: the true eye at the head sample's time, used unpredicted.
+        // The oracle head source: the true eye at the head sample's time plus the bias,
+        // used unpredicted.
         let estimated = col("eye_estimated_x_m")[k];
-        close(estimated, sway_x(head), "eye_estimated_x_m");
-        close(col("eye_used_x_m")[k], estimated, "eye_used_x_m");
+        close(estimated, sway_x(head) + 0.02, "eye_estimated_x_m");
+        close(
+            col("eye_estimated_y_m")[k],
+            eye0.y - 0.01,
+            "eye_estimated_y_m",
+        );
+        close(
+            col("eye_estimated_z_m")[k],
+            eye0.z + 0.005,
+            "eye_estimated_z_m",
+        );
+        for axis in ["x", "y", "z"] {
+            let (used, estimated) = (
+                format!("eye_used_{axis}_m"),
+                format!("eye_estimated_{axis}_m"),
+            );
+            close(col(&used)[k], col(&estimated)[k], &used);
+        }
         let used = glam::DVec3::new(
             col("eye_used_x_m")[k],
             col("eye_used_y_m")[k],
