@@ -1142,8 +1142,8 @@ fn transitions(names: &[String]) -> usize {
 /// A setup's scene is sized for its measurement, checked by casting rays into it, for the
 /// paper's setups, a narrow one (p_cam ≈ 1 cm), two deep ones (6 and 15 m surfaces straight
 /// back from 1 m: the frontal camera's top rows reach far above the scene plane there), a
-/// slanted one and two right of the display's centre, each under the paper's compensation, the `d2 → ∞` model and a
-/// nearer model with a head bias:
+/// slanted one, two right of the display's centre and two far ones, each under the paper's
+/// compensation, the `d2 → ∞` model and a nearer model with a head bias:
 /// - the display shows every edge point (the corner and the edges where the camera, the eye
 ///   and the driver see them) with at least a quarter of the span of scene beside it, and
 ///   is at most a span and 10 cm (on the plane) wider than that: the widths keep their pixels;
@@ -1174,8 +1174,8 @@ fn a_setups_scene_is_sized_for_its_measurement() {
         (foreshortening(3.0, 0.6, 4.0, 1.0, -1.0, 75.0), 3),
         // A far plane seen from an eye near the display's left edge: the driver's rays through
         // the display reach 200 m across the plane (600 m across the backdrop), and the
-        // corners are steep. (With the
-        // biased compensation the display reaches past the eye, out of any pinhole's view.)
+        // corners are steep. (With the biased compensation the display reaches past the eye,
+        // out of any pinhole's view.)
         (occlusion(5.0, -0.35, 30.0, 0.5, 1.75), 2),
         (foreshortening(5.0, -0.35, 30.0, 0.5, 1.75, 60.0), 2),
     ];

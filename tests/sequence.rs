@@ -843,14 +843,16 @@ fn frames_csv_and_summary_hold_what_the_sequence_was_asked_for() {
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
         .collect();
     assert_eq!(rows.len(), 6);
-    let col = |name: &str| -> Vec<f64> {
-        let i = header.iter().position(|c| *c == name).unwrap();
-        rows.iter().map(|r| r[i]).collect()
-    };
+    let columns: std::collections::HashMap<&str, Vec<f64>> = header
+        .iter()
+        .enumerate()
+        .map(|(i, name)| (*name, rows.iter().map(|r| r[i]).collect()))
+        .collect();
+    let col = |name: &str| -> &[f64] { &columns[name] };
     let sway_x = |t: f64| eye0.x + amplitude * (std::f64::consts::TAU * frequency * t).sin();
     let close = |a: f64, b: f64, what: &str| assert!((a - b).abs() < 1e-9, "{what}: {a} vs {b}");
     let mut errors = Vec::new();
-    for (k, row_t) in col("t_s").into_iter().enumerate() {
+    for (k, row_t) in col("t_s").iter().copied().enumerate() {
         let t = k as f64 / 10.0;
         let refresh = (t * 4.0 + 1e-9).floor() / 4.0;
         let (capture, head) = (refresh - 0.05, refresh - 0.08);
@@ -929,23 +931,23 @@ fn frames_csv_and_summary_hold_what_the_sequence_was_asked_for() {
     for (path, expected) in [
         (
             "/misregistration_arcmin/mean_of_frame_means",
-            mean(&col("misregistration_mean_arcmin")),
+            mean(col("misregistration_mean_arcmin")),
         ),
         (
             "/misregistration_arcmin/mean_of_frame_p95",
-            mean(&col("misregistration_p95_arcmin")),
+            mean(col("misregistration_p95_arcmin")),
         ),
         (
             "/misregistration_arcmin/max_of_frame_p95",
-            max(&col("misregistration_p95_arcmin")),
+            max(col("misregistration_p95_arcmin")),
         ),
         (
             "/misregistration_arcmin/max",
-            max(&col("misregistration_max_arcmin")),
+            max(col("misregistration_max_arcmin")),
         ),
-        ("/coverage/mean", mean(&col("coverage"))),
-        ("/coverage/min", min(&col("coverage"))),
-        ("/missing_fraction_mean", mean(&col("missing_fraction"))),
+        ("/coverage/mean", mean(col("coverage"))),
+        ("/coverage/min", min(col("coverage"))),
+        ("/missing_fraction_mean", mean(col("missing_fraction"))),
         ("/eye_error_mm/mean", mean(&errors)),
         ("/eye_error_mm/max", max(&errors)),
         (

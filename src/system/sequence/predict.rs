@@ -186,7 +186,8 @@ mod tests {
         let mut axis = Axis::new(0.5, r);
         let (mut x, mut p): ([f64; 2], M) = ([0.5, 0.0], [[r, 0.0], [0.0, 1.0]]);
         for k in 1..40 {
-            let (dt, z) = (noisy_track(k).0 - noisy_track(k - 1).0, noisy_track(k).1);
+            let ((t, z), (t_before, _)) = (noisy_track(k), noisy_track(k - 1));
+            let dt = t - t_before;
             axis.step(dt, z, r);
             (x, p) = textbook_step(x, p, dt, z, r);
             for i in 0..2 {
