@@ -513,7 +513,8 @@ fn the_binocular_map_of_a_curved_display_uses_the_surface_points() {
 
 /// `sequence --display ideal` on a curved display: a still head and vehicle with the model
 /// plane on the wall show the wall exactly in every frame (no resampling quantum, and the
-/// curved surface's own points through the model), as `run` does.
+/// curved surface's own points through the model), as `run` does. With 2 samples a pixel,
+/// the display's pixels show what `run`'s do: the same misregistration and PSNR.
 #[test]
 fn a_sequence_shows_the_ideal_curved_display_exactly() {
     use seethru::measure::metrics::Flip;
@@ -527,10 +528,12 @@ fn a_sequence_shows_the_ideal_curved_display_exactly() {
         6.0,
     );
     let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
-    let mean = |display| {
+    let spp = 2;
+    let largest_over_frames = |display| {
         let o = SequenceOptions {
             run: RunOptions {
                 display,
+                spp,
                 ..options(WorkingDistance::Metres(6.0))
             },
             timeline: Timeline {
@@ -550,19 +553,23 @@ fn a_sequence_shows_the_ideal_curved_display_exactly() {
         let how = common::measuring(Flip::Skipped);
         let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
         assert!(run.records.len() >= 3);
-        run.records
-            .iter()
-            .map(|r| r.metrics.unwrap().mean_arcmin)
-            .fold(0.0, f64::max)
+        let metrics: Vec<_> = run.records.iter().map(|r| r.metrics.unwrap()).collect();
+        let largest = |f: fn(&FrameMetrics) -> f64| metrics.iter().map(f).fold(0.0, f64::max);
+        (largest(|m| m.mean_arcmin), largest(|m| m.psnr_db))
     };
+    use seethru::measure::sequence::FrameMetrics;
     use seethru::system::display::DisplayModel;
-    let ideal = mean(DisplayModel::Ideal);
-    let pixels = mean(DisplayModel::Pixels);
+    let (ideal, _) = largest_over_frames(DisplayModel::Ideal);
+    let (pixels, pixels_psnr) = largest_over_frames(DisplayModel::Pixels);
     assert!(ideal < 0.01, "ideal: {ideal}′");
     // The sequence renders only the frontal pixels the curved display reads; its still
     // frames are `run`'s, which renders the whole frontal image.
     let ctx = RenderContext::new(scene.clone()).unwrap();
-    let r = run(&ctx, &options(WorkingDistance::Metres(6.0))).unwrap();
+    let once = RunOptions {
+        spp,
+        ..options(WorkingDistance::Metres(6.0))
+    };
+    let r = run(&ctx, &once).unwrap();
     let (_, metrics) = seethru::measure::metrics::measure(
         &ctx,
         &ctx.scene,
@@ -576,6 +583,13 @@ fn a_sequence_shows_the_ideal_curved_display_exactly() {
     assert!(
         (pixels - single).abs() < 1e-9 * single,
         "sequence {pixels}′, run {single}′"
+    );
+    // The colours too: a frontal or see-through view rendered with another sample count
+    // would change the PSNR.
+    let single_psnr = metrics["display"]["psnr_db"].as_f64().unwrap();
+    assert!(
+        (pixels_psnr - single_psnr).abs() < 1e-9 * single_psnr,
+        "sequence PSNR {pixels_psnr} dB, run {single_psnr} dB"
     );
     // The physical display's pixels leave their quantum: the check above can tell.
     assert!(pixels > 20.0 * ideal && pixels > 0.1, "pixels: {pixels}′");

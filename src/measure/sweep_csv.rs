@@ -513,8 +513,15 @@ mod tests {
             assert!(err.starts_with("s.csv:3: ") && err.contains(words), "{err}");
             assert!(err.contains("delete the row"), "{err}");
         }
-        // Rounding past a bound is not a bad cell; NaN is the undefined metric a sweep writes.
-        let rows = resume(&file(&[row(0, "20", &["NaN", "10800.000000000002"], 2)])).unwrap();
+        // Rounding past a bound, either way, is not a bad cell; NaN is the undefined metric a
+        // sweep writes.
+        let rows = resume(&file(&[row(
+            0,
+            "20",
+            &["NaN", "10800.000000000002", "-1e-9"],
+            2,
+        )]))
+        .unwrap();
         assert_eq!(rows.len(), 1);
         let err = resume(&file(&[row(0, "20", &[], 0)]))
             .unwrap_err()
@@ -573,6 +580,48 @@ mod tests {
             assert!(err.contains(&words), "{err}\nlacks {words}");
             assert!(!err.contains('\n'));
         }
+    }
+
+    /// A sweep's header gives back its parameters, however many; a header with a column
+    /// missing, added, renamed or moved, or without `index` first, is not a sweep's.
+    #[test]
+    fn a_sweep_header_gives_back_its_parameters_and_nothing_else_does() {
+        let names = |n: &[&str]| n.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        for params in [
+            names(&["theta_f"]),
+            names(&["d2", "eye_x", "head_bias_x_cm"]),
+        ] {
+            let full = header(&params);
+            assert_eq!(params_of(&full), Some(params.clone()));
+            let mut extra = full.clone();
+            extra.push("note".into());
+            let mut swapped = full.clone();
+            swapped.swap(params.len() + 1, params.len() + 2);
+            let mut renamed = full.clone();
+            renamed[0] = "row".into();
+            for other in [
+                full[1..].to_vec(),
+                full[..full.len() - 1].to_vec(),
+                extra,
+                swapped,
+                renamed,
+            ] {
+                assert_eq!(params_of(&other), None, "{other:?}");
+            }
+        }
+        // No parameter column: the metrics and settings alone are not a sweep.
+        assert_eq!(params_of(&header(&[])), None);
+        assert_eq!(params_of(&[]), None);
+    }
+
+    /// A cell in a message: 40 characters as written, then `…` when there are more.
+    #[test]
+    fn a_long_cell_is_cut_at_40_characters_with_an_ellipsis() {
+        let forty = "é".repeat(40);
+        assert_eq!(text_shown(&forty), forty);
+        assert_eq!(text_shown(&format!("{forty}x")), format!("{forty}…"));
+        assert_eq!(text_shown("a\nb"), "a\\nb");
+        assert_eq!(cell_text(" 2.50 "), "2.5");
     }
 
     #[test]

@@ -372,6 +372,80 @@ mod tests {
         }
     }
 
+    fn refused(spec: &str) -> String {
+        match parse_param(spec) {
+            Ok(p) => panic!("{spec} gave {:?}", p.values),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn an_eyellipse_value_names_its_seed_and_sample() {
+        assert_eq!(eyellipse_sample("eyellipse:7:3").unwrap(), (7, 3));
+        assert_eq!(
+            eyellipse_param(2, 9).values,
+            ["eyellipse:9:0", "eyellipse:9:1"]
+        );
+        for bad in [
+            "eyellipse:x:3",
+            "eyellipse:7:-1",
+            "eyellipse:7",
+            "ellipse:7:3",
+        ] {
+            assert!(eyellipse_sample(bad).is_err(), "{bad}");
+        }
+        assert_eq!(
+            parse_param(" eye = eyellipse ").unwrap().values,
+            [EYELLIPSE]
+        );
+        assert!(refused("eye=0.1").contains("the only value is eyellipse"));
+    }
+
+    /// The limits of a parameter's values, at their edges: a step of −0 is no step, at most
+    /// [`MAX_VALUES`] values however given, an empty value named as such.
+    #[test]
+    fn the_value_limits_hold_at_their_edges() {
+        let steps = "need step > 0, stop ≥ start and at most 10000 values";
+        for spec in [
+            "theta_f=20:80:-0",
+            "theta_f=20:80:0",
+            "theta_f=20:80:-5",
+            "theta_f=80:20:5",
+            // 10001 values: one too many, said before any is made.
+            "frontal_width=1:10001:1",
+            "theta_f=0.01:89:0.001",
+            "eye_x=0:1e9:1",
+        ] {
+            assert!(refused(spec).contains(steps), "{spec}");
+        }
+        let range = parse_param("frontal_width=1:10000:1").unwrap();
+        assert_eq!(range.values.len(), MAX_VALUES);
+        assert_eq!(range.values[MAX_VALUES - 1], "10000");
+        let even = parse_param("theta_f=1:79.1171875:0.0078125").unwrap();
+        assert_eq!(
+            (even.values.len(), even.values[1].as_str()),
+            (MAX_VALUES, "1.0078125")
+        );
+        let list = |n: usize| {
+            let values: Vec<String> = (0..n).map(|i| format!("{}", 1 + i)).collect();
+            format!("frontal_width={}", values.join(","))
+        };
+        assert_eq!(
+            parse_param(&list(MAX_VALUES)).unwrap().values.len(),
+            MAX_VALUES
+        );
+        assert!(
+            refused(&list(MAX_VALUES + 1)).contains("10001 values, more than the limit of 10000")
+        );
+        assert!(refused("theta_f=").contains("no values"));
+        assert!(refused("theta_f= , ").contains("an empty value between commas"));
+        assert!(refused("theta_f=20,,40").contains("an empty value between commas"));
+        assert!(refused("theta_f=20,").contains("an empty value between commas"));
+        assert!(refused("d2=5,5").contains("the value 5 is given twice"));
+        assert!(refused("d2=5,5.0").contains("5.0 is the value 5 again"));
+        assert!(refused("d2=inf,infinity").contains("infinity is the value inf again"));
+    }
+
     #[test]
     fn ranges_lists_and_errors() {
         assert_eq!(

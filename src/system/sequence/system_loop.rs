@@ -656,3 +656,22 @@ fn blank_outside(frame: &mut Frame, region: PixelRect) {
 fn contains(outer: PixelRect, inner: PixelRect) -> bool {
     inner.x0 >= outer.x0 && inner.y0 >= outer.y0 && inner.x1 <= outer.x1 && inner.y1 <= outer.y1
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each stage counts once: distinct powers of two, so a stage left out, counted twice or
+    /// subtracted gives another sum.
+    #[test]
+    fn the_total_is_the_sum_of_every_stage() {
+        let seconds = StageSeconds {
+            moving: 1.0,
+            frontal: 2.0,
+            head: 4.0,
+            compensation: 8.0,
+            seethru: 16.0,
+        };
+        assert_eq!(seconds.total(), 31.0);
+    }
+}
