@@ -90,7 +90,9 @@ fn a_detection_in_the_pixels_it_used_is_the_whole_images() {
 
 /// A leaning, estimated-head sequence (das, 320×240 back camera, 30 refreshes): tracking
 /// the face gives every frame's eye estimate and confidence bit for bit as rendering and
-/// searching the whole back image each time, and renders under half its back pixels.
+/// searching the whole back image each time, and renders under half its back pixels. Every
+/// estimate is confident, so `--require-confident-head` refuses none; the head stage's time
+/// is counted.
 #[test]
 fn the_tracked_head_estimates_are_the_whole_images() {
     let options = SequenceOptions {
@@ -102,6 +104,7 @@ fn the_tracked_head_estimates_are_the_whole_images() {
             back_width: Some(320),
             spp: 1,
             outside: Outside::Black,
+            require_confident_head: true,
             ..RunOptions::default()
         },
         timeline: Timeline {
@@ -126,12 +129,18 @@ fn the_tracked_head_estimates_are_the_whole_images() {
     let estimates = |track: bool| {
         let mut system = SystemLoop::new(&scene, options.clone()).unwrap();
         system.track_face = track;
+        let start = std::time::Instant::now();
         let shown: Vec<_> = (0..system.options.timeline.frames())
             .map(|k| {
                 let s = system.show(k).unwrap();
                 (s.eye_estimated.to_array(), s.head_confidence)
             })
             .collect();
+        let head = system.seconds.head;
+        assert!(
+            head > 0.0 && head < start.elapsed().as_secs_f64(),
+            "head stage {head} s"
+        );
         (shown, system.back_pixels)
     };
     let (tracked, tracked_pixels) = estimates(true);
