@@ -538,3 +538,64 @@ fn a_row_holds_the_metrics_of_run_with_the_same_settings() {
         report["eye_used"]
     );
 }
+
+/// Each sweep parameter sets its scene key or run option, and nothing else: θ_F in radians,
+/// the model distance, the display's width with its pixel columns in proportion, the eye
+/// (with the head) along the display's x or normal, the head bias, the frontal width. A
+/// configuration that puts the eye behind the display is refused.
+#[test]
+fn every_parameter_sets_its_key_or_option() {
+    use seethru::measure::sweep_grid::configure;
+    use seethru::system::options::{RunOptions, WorkingDistance};
+    let das = common::das();
+    let base = RunOptions::default();
+    let one = |name: &str, value: &str| {
+        configure(&das, &base, &[(name.to_string(), value.to_string())]).unwrap()
+    };
+    let (s, _) = one("theta_f", "30");
+    assert_eq!(s.frontal.half_angle_x, 30f64.to_radians());
+    let (_, o) = one("d2", "7.5");
+    assert_eq!(o.d2, WorkingDistance::Metres(7.5));
+    // das: 0.25 m wide at 250 × 450 pixels.
+    let (s, _) = one("display_width", "0.375");
+    assert_eq!(s.obstacle.width, 0.375);
+    assert_eq!(s.obstacle.display_resolution, [375, 450]);
+    let (s, _) = one("display_width", "0.1");
+    assert_eq!(s.obstacle.display_resolution, [100, 450]);
+    let world_from_obstacle = das.obstacle.world_from_obstacle;
+    for (name, axis) in [("eye_x", glam::DVec3::X), ("eye_z", glam::DVec3::Z)] {
+        let (s, _) = one(name, "0.05");
+        let moved = s.eye() - das.eye();
+        let expected = world_from_obstacle.transform_vector3(axis * 0.05);
+        assert!((moved - expected).length() < 1e-12, "{name}: {moved}");
+        let head = |scene: &seethru::scene::Scene| {
+            scene
+                .objects
+                .iter()
+                .find(|o| o.name == "head")
+                .unwrap()
+                .world_from_object
+                .translation
+        };
+        assert!(
+            (head(&s) - head(&das) - expected).length() < 1e-12,
+            "{name}: the head"
+        );
+    }
+    let (_, o) = one("head_bias_x_cm", "-3");
+    assert_eq!(o.head_bias_cm, [-3.0, 0.0, 0.0]);
+    let (s, o) = one("frontal_width", "640");
+    assert_eq!(o.frontal_width, Some(640));
+    assert_eq!(
+        s.frontal, das.frontal,
+        "frontal_width is a run option, not a scene key"
+    );
+    let d1 = world_from_obstacle.inverse().transform_point3(das.eye()).z;
+    let behind = format!("{}", -d1);
+    let err = configure(&das, &base, &[("eye_z".into(), behind)])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("puts the eye behind the display"), "{err}");
+    let (s, _) = one("eye_z", &format!("{}", 0.5 - d1));
+    assert!((world_from_obstacle.inverse().transform_point3(s.eye()).z - 0.5).abs() < 1e-12);
+}

@@ -446,6 +446,51 @@ mod tests {
         assert!(refused("d2=inf,infinity").contains("infinity is the value inf again"));
     }
 
+    /// A grid of exactly [`MAX_CONFIGURATIONS`] is made; one more is refused, naming each
+    /// parameter's count and the product.
+    #[test]
+    fn the_grid_size_limit_is_inclusive() {
+        let param = |name: &str, n: usize| Param {
+            name: name.into(),
+            values: (0..n).map(|i| i.to_string()).collect(),
+        };
+        let exact = [param("theta_f", 10), param("d2", 10_000)];
+        assert_eq!(check_grid_size(&exact).unwrap(), MAX_CONFIGURATIONS);
+        assert_eq!(
+            check_grid_size(&[param("eye_x", 7), param("eye_z", 3)]).unwrap(),
+            21
+        );
+        let over = [param("theta_f", 11), param("d2", 9091)];
+        let err = check_grid_size(&over).unwrap_err().to_string();
+        assert!(
+            err.contains(
+                "theta_f 11 × d2 9091 = 100001 configurations, more than the limit of 100000"
+            ),
+            "{err}"
+        );
+    }
+
+    /// A bad value's message gives its parameter's admissible values: the names only for d2.
+    #[test]
+    fn a_bad_value_names_the_admissible_ones() {
+        assert_eq!(
+            refused("d2=-1"),
+            "d2 = -1: must be inf, auto or a number in [1e-6, 1000000] m"
+        );
+        assert_eq!(
+            refused("theta_f=inf"),
+            "theta_f = `inf`: must be a number in [0.01, 89] degrees"
+        );
+        assert_eq!(
+            refused("frontal_width=2.5"),
+            "frontal_width = 2.5: must be an integer in [1, 16384] pixels"
+        );
+        assert_eq!(
+            refused("head_bias_x_cm=-501"),
+            "head_bias_x_cm = -501: must be a number in [-500, 500] cm"
+        );
+    }
+
     #[test]
     fn ranges_lists_and_errors() {
         assert_eq!(
