@@ -91,6 +91,14 @@ fn the_measured_dynamic_misregistration_follows_the_formula() {
             if display_hz < 60.0 { 2 } else { 1 },
             "{ages:?}"
         );
+        // The planar crop is rendered alone: a part of the frontal image, more than none.
+        let frontal = scene.frontal;
+        let whole = f64::from(frontal.width) * f64::from(frontal.height);
+        let rendered = run.frontal_pixels_per_refresh;
+        assert!(
+            rendered > 0.0 && rendered < 0.8 * whole,
+            "{rendered} of {whole} pixels"
+        );
     }
 }
 
@@ -1165,4 +1173,62 @@ fn the_model_head_source_estimates_the_eye_one_latency_back() {
     let (back, now) = (median(back), median(now));
     assert!(back < 0.003, "median residual one latency back {back} m");
     assert!(now > 0.008, "median residual at the sample time {now} m");
+}
+
+/// `d2 auto` in a sequence: every refresh renders the whole frontal image (the median depth
+/// is read from it) and finds the wall 6 m ahead of the display.
+#[test]
+fn a_sequence_with_d2_auto_finds_the_wall_each_refresh() {
+    let wall = common::WallScene::default();
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let mut o = options(0.05, 20.0, 20.0, 0.0);
+    o.run.d2 = WorkingDistance::Auto;
+    o.run.frontal_width = Some(128);
+    let mut system = SystemLoop::new(&scene, o).unwrap();
+    let frames = system.options.timeline.frames();
+    for k in 0..frames {
+        let d2 = system.show(k).unwrap().d2_used.unwrap();
+        assert!((d2 - 6.0).abs() < 0.06, "frame {k}: d2 auto = {d2} m");
+    }
+    let frontal = system.rig.base.frontal;
+    assert_eq!(
+        system.frontal_pixels,
+        frames as u64 * u64::from(frontal.width) * u64::from(frontal.height)
+    );
+}
+
+/// A crop that leaves the frontal camera's view stops a sequence as it stops `run`, with the
+/// same message (the side, how far, where the eye may be) and the refresh's time; with
+/// `--outside black` the frame shows black there and counts it.
+#[test]
+fn a_crop_outside_the_frontal_view_is_refused_as_run_refuses_it() {
+    let wall = common::WallScene {
+        frontal_half_angle: 14.0,
+        ..Default::default()
+    };
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let o = options(0.05, 20.0, 20.0, 0.0);
+    let err = SystemLoop::new(&scene, o.clone())
+        .unwrap()
+        .show(0)
+        .map(|_| ())
+        .unwrap_err();
+    let err = format!("{err:#}");
+    let ctx = RenderContext::new(scene.clone()).unwrap();
+    let single = seethru::system::pipeline::run(&ctx, &o.run)
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        single.starts_with("the crop leaves the frontal camera's view on the ")
+            && single.contains("the eye must stay within x ∈ ["),
+        "{single}"
+    );
+    assert_eq!(err, format!("at t = 0 s: {single}"));
+    let mut black = o;
+    black.run.outside = seethru::system::options::Outside::Black;
+    let how = common::measuring(Flip::Skipped);
+    let run = run_sequence(&scene, black, how, &mut |_| Ok(())).unwrap();
+    let coverage = run.records[0].metrics.unwrap().coverage;
+    assert!(coverage > 0.0 && coverage < 1.0, "coverage {coverage}");
 }

@@ -215,6 +215,53 @@ fn overflow(map: &FrontalMap) -> [(&'static str, f64); 4] {
     ]
 }
 
+/// With `--method planar` on a flat display and `--outside error`: an error when the crop
+/// (`map`, for the eye at `eye`, world, and the model plane at `d2_used`) leaves the frontal
+/// camera's view, naming the side, by how much, and where the eye may be instead.
+pub fn check_crop_in_view(
+    scene: &Scene,
+    eye: DVec3,
+    d2_used: Option<f64>,
+    map: &FrontalMap,
+    options: &RunOptions,
+) -> Result<()> {
+    // A curved display is compensated per pixel; its crop is only its reference rectangle's.
+    let curved = scene.obstacle.display_shape.curved().is_some();
+    if options.method != Method::Planar || curved || options.outside != Outside::Error {
+        return Ok(());
+    }
+    let Some((side, px)) = overflow(map).into_iter().find(|(_, px)| *px > 1e-9) else {
+        return Ok(());
+    };
+    let d1 = scene.obstacle.in_obstacle_frame(eye).z;
+    let (ax, ay) = admissible_offsets(&scene.frontal, &scene.obstacle, d1, d2_used);
+    let axis = scene.obstacle.in_obstacle_frame(scene.frontal.position());
+    let extent = if side == "left" || side == "right" {
+        map.crop.frontal_size[0]
+    } else {
+        map.crop.frontal_size[1]
+    };
+    let share = 100.0 * px / extent as f64;
+    let region = if ax < 0.0 || ay < 0.0 {
+        // The range would print high to low: no eye position is admissible.
+        "no eye position keeps the whole crop inside the frontal view there (its field of view is too narrow for the display at this d2)".to_string()
+    } else {
+        format!(
+            "the eye must stay within x ∈ [{}, {}] m, y ∈ [{}, {}] m of the obstacle frame",
+            short(axis.x - ax),
+            short(axis.x + ax),
+            short(axis.y - ay),
+            short(axis.y + ay)
+        )
+    };
+    bail!(
+        "the crop leaves the frontal camera's view on the {side} by {} px ({}% of the image); at d1 = {} m {region} (use --outside black to show the rest black)",
+        short(px),
+        short(share),
+        short(d1),
+    );
+}
+
 /// The admissible eye offsets across and up the display (obstacle frame, relative to the
 /// frontal camera's axis) at eye distance `d1`, for a frontal camera perpendicular to the
 /// display: |x| ≤ d1 (tan θx − D/(2 d2)) − D/2, and likewise vertically (from eq. RATIO1 ≥ 0).
@@ -480,39 +527,8 @@ pub fn run_staged<'v>(
     // A curved display is compensated per pixel; its crop is only its reference rectangle's.
     let curved =
         options.method == Method::Planar && scene.obstacle.display_shape.curved().is_some();
-    if options.method == Method::Planar
-        && given.display.is_none()
-        && !curved
-        && options.outside == Outside::Error
-        && let Some((side, px)) = out.iter().copied().find(|(_, px)| *px > 1e-9)
-    {
-        let d1 = scene.obstacle.in_obstacle_frame(eye_used).z;
-        let (ax, ay) = admissible_offsets(&scene.frontal, &scene.obstacle, d1, d2_used);
-        let axis = scene.obstacle.in_obstacle_frame(scene.frontal.position());
-        let extent = if side == "left" || side == "right" {
-            crop.frontal_size[0]
-        } else {
-            crop.frontal_size[1]
-        };
-        let share = 100.0 * px / extent as f64;
-        let region = if ax < 0.0 || ay < 0.0 {
-            // The range would print high to low: no eye position is admissible.
-            "no eye position keeps the whole crop inside the frontal view there (its field of view is too narrow for the display at this d2)".to_string()
-        } else {
-            format!(
-                "the eye must stay within x ∈ [{}, {}] m, y ∈ [{}, {}] m of the obstacle frame",
-                short(axis.x - ax),
-                short(axis.x + ax),
-                short(axis.y - ay),
-                short(axis.y + ay)
-            )
-        };
-        bail!(
-            "the crop leaves the frontal camera's view on the {side} by {} px ({}% of the image); at d1 = {} m {region} (use --outside black to show the rest black)",
-            short(px),
-            short(share),
-            short(d1),
-        );
+    if given.display.is_none() {
+        check_crop_in_view(scene, eye_used, d2_used, &map, options)?;
     }
 
     let start = Instant::now();

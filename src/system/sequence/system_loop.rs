@@ -34,8 +34,10 @@ use crate::system::frontal_map::FrontalMap;
 use crate::system::head::{DetectError, FaceDetection, detect_in, gaussian};
 use crate::system::head_estimate::{detect_face, fix_from, turned_reads};
 use crate::system::head_pose::HeadPose;
-use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
-use crate::system::pipeline::{crop_for, driver_camera, frontal_map, ideal_map};
+use crate::system::options::{HeadSource, Method, RunOptions, WorkingDistance};
+use crate::system::pipeline::{
+    check_crop_in_view, crop_for, driver_camera, frontal_map, ideal_map,
+};
 use crate::system::point_model::PointModel;
 use crate::system::sequence::byo::{Byo, RefreshInputs};
 use crate::system::sequence::head_motion::HeadMotion;
@@ -384,20 +386,7 @@ impl SystemLoop {
             crop
         };
         let map = frontal_map(&geometry, crop, run)?;
-        if run.method == Method::Planar && run.outside == Outside::Error && !curved {
-            let (min, max) = map.bounds();
-            let [w, h] = crop.frontal_size.map(f64::from);
-            if min.x < -1e-9 || min.y < -1e-9 || max.x > w + 1e-9 || max.y > h + 1e-9 {
-                bail!(
-                    "{}: the crop leaves the frontal camera's view (corners from ({:.1}, {:.1}) to ({:.1}, {:.1}) px in a {w}×{h} image); use --outside black to show the rest black and count it",
-                    at(),
-                    min.x,
-                    min.y,
-                    max.x,
-                    max.y
-                );
-            }
-        }
+        check_crop_in_view(&geometry, eye_world, d2_used, &map, run).with_context(at)?;
         let mut inputs = None;
         if byo.needs_inputs() {
             let b = self.context_at(times.head)?;
