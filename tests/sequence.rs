@@ -151,6 +151,16 @@ fn a_run_reports_its_frames_headings_stage_times_and_frontal_pixels() {
     );
     assert!(run.truth_seconds > 0.0 && run.metrics_seconds > 0.0);
     assert!(run.truth_seconds + run.metrics_seconds <= run.stepping_seconds);
+    // The system's stages are parts of the stepping too, none counted twice.
+    let parts = run.system.total() + run.truth_seconds + run.metrics_seconds;
+    assert!(
+        run.system.compensation > 0.0 && parts <= run.stepping_seconds,
+        "{:?}, truth {} s, metrics {} s, stepping {} s",
+        run.system,
+        run.truth_seconds,
+        run.metrics_seconds,
+        run.stepping_seconds
+    );
     assert!(run.stepping_seconds <= run.total_seconds);
 }
 
@@ -1138,7 +1148,7 @@ fn the_preview_holds_a_window_below_the_views_top() {
 /// tracker latency (1/30 s) earlier, with the tracker's 2 mm lateral noise. A 10 cm, 1 Hz
 /// sway moves the eye up to 21 mm in a latency: the median lateral residual against the
 /// sway's closed form one latency back stays within the noise, while the eye of the sample
-/// time itself is off by about 13 mm.
+/// time itself is off by about 15 mm.
 #[test]
 fn the_model_head_source_estimates_the_eye_one_latency_back() {
     let wall = common::WallScene::default();
