@@ -154,6 +154,12 @@ fn the_tracked_head_estimates_are_the_whole_images() {
     let moved = DVec3::from_array(tracked[29].0) - DVec3::from_array(tracked[0].0);
     assert!(moved.length() > 0.05, "{moved}");
     assert_eq!(whole_pixels, 30 * 320 * 240);
+    // The first refresh renders the whole image, each later one the face's region (about
+    // 90 × 90 pixels here): counted too.
+    assert!(
+        tracked_pixels > 320 * 240 + 29 * 50 * 50,
+        "tracked {tracked_pixels} back pixels"
+    );
     assert!(
         2 * tracked_pixels < whole_pixels,
         "tracked {tracked_pixels} of {whole_pixels} back pixels"

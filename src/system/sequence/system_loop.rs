@@ -663,4 +663,48 @@ mod tests {
         };
         assert_eq!(seconds.total(), 31.0);
     }
+
+    /// The pixels from `min` to `max` with the filters' 3 pixels on each side, whole pixels
+    /// outwards, clamped to the image.
+    #[test]
+    fn a_rect_around_points_holds_the_filters_margin_within_the_image() {
+        let camera = Camera::new(glam::DAffine3::IDENTITY, 0.5, 640, 480).unwrap();
+        let rect = rect_around(DVec2::new(10.2, 20.7), DVec2::new(30.1, 40.0), &camera);
+        assert_eq!((rect.x0, rect.y0, rect.x1, rect.y1), (7, 17, 34, 43));
+        let rect = rect_around(DVec2::new(-5.0, 2.5), DVec2::new(700.0, 477.5), &camera);
+        assert_eq!((rect.x0, rect.y0, rect.x1, rect.y1), (0, 0, 640, 480));
+    }
+
+    /// Every pixel outside the region is black, every pixel inside kept: each side's edge
+    /// pixels on both sides of it.
+    #[test]
+    fn blanking_outside_a_region_keeps_exactly_the_region() {
+        let mut frame = Frame::new(8, 6);
+        frame.color.fill(glam::Vec3::ONE);
+        let region = PixelRect {
+            x0: 2,
+            y0: 1,
+            x1: 5,
+            y1: 4,
+        };
+        blank_outside(&mut frame, region);
+        for y in 0..6 {
+            for x in 0..8 {
+                let inside = (2..5).contains(&x) && (1..4).contains(&y);
+                let expected = if inside {
+                    glam::Vec3::ONE
+                } else {
+                    glam::Vec3::ZERO
+                };
+                assert_eq!(frame.color[frame.index(x, y)], expected, "({x}, {y})");
+            }
+        }
+        assert!(contains(region, region));
+        for (x0, y0, x1, y1) in [(1, 1, 4, 4), (2, 0, 5, 4), (2, 1, 6, 4), (2, 1, 5, 5)] {
+            assert!(
+                !contains(region, PixelRect { x0, y0, x1, y1 }),
+                "{x0} {y0} {x1} {y1}"
+            );
+        }
+    }
 }
