@@ -825,3 +825,65 @@ fn the_border_bands_of_a_curved_display_follow_its_uvs() {
         "right {got_right} vs {right}"
     );
 }
+
+/// A curved display one pixel wide: all its points lie in one frontal column, and the
+/// sequence still renders the frontal pixels they read, so its display shows what `run`'s
+/// does (the same PSNR and misregistration).
+#[test]
+fn a_one_column_curved_display_shows_in_a_sequence_what_run_shows() {
+    use seethru::measure::metrics::Flip;
+    use seethru::measure::sequence::run_sequence;
+    use seethru::system::sequence::head_motion::HeadMotion;
+    use seethru::system::sequence::predict::Prediction;
+    use seethru::system::sequence::system_loop::SequenceOptions;
+    use seethru::system::sequence::timeline::Timeline;
+    let text = common::WallScene {
+        display_resolution: [1, 100],
+        ..common::WallScene::default()
+    }
+    .text()
+    .replace(
+        "display_resolution = [",
+        "display_shape = \"cylinder\"\ndisplay_radius = 0.2\ndisplay_segments = 48\ndisplay_resolution = [",
+    );
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let once = options(WorkingDistance::Metres(6.0));
+    let o = SequenceOptions {
+        run: once.clone(),
+        timeline: Timeline {
+            duration: 0.05,
+            fps: 20.0,
+            display_hz: 20.0,
+            latency_camera: 0.0,
+            latency_tracking: 0.0,
+        },
+        speed: 0.0,
+        yaw_rate: 0.0,
+        head: HeadMotion::Still,
+        predict: Prediction::None,
+        reproject: false,
+        byo: Default::default(),
+    };
+    let how = common::measuring(Flip::Skipped);
+    let sequence = run_sequence(&scene, o, how, &mut |_| Ok(()))
+        .unwrap()
+        .records[0]
+        .metrics
+        .unwrap();
+    let ctx = RenderContext::new(scene.clone()).unwrap();
+    let r = run(&ctx, &once).unwrap();
+    let (_, metrics) = seethru::measure::metrics::measure(
+        &ctx,
+        &ctx.scene,
+        ctx.scene.eye(),
+        [&r.truth, &r.seethru, &r.occluded],
+        5,
+    );
+    let display = &metrics["display"];
+    assert!(sequence.display_pixels > 0);
+    assert_eq!(sequence.psnr_db, display["psnr_db"].as_f64().unwrap());
+    assert_eq!(
+        sequence.mean_arcmin,
+        display["misregistration_arcmin"]["mean"].as_f64().unwrap()
+    );
+}
