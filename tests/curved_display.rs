@@ -511,6 +511,20 @@ fn the_binocular_map_of_a_curved_display_uses_the_surface_points() {
     assert!(flat_gap > 5.0, "{flat_gap}′");
 }
 
+/// The metrics of `run` on `scene` with `options`, as `seethru run` writes them.
+fn run_metrics(scene: &seethru::scene::Scene, options: &RunOptions) -> serde_json::Value {
+    let ctx = RenderContext::new(scene.clone()).unwrap();
+    let r = run(&ctx, options).unwrap();
+    let (_, metrics) = seethru::measure::metrics::measure(
+        &ctx,
+        &ctx.scene,
+        ctx.scene.eye(),
+        [&r.truth, &r.seethru, &r.occluded],
+        5,
+    );
+    metrics
+}
+
 /// `sequence --display ideal` on a curved display: a still head and vehicle with the model
 /// plane on the wall show the wall exactly in every frame (no resampling quantum, and the
 /// curved surface's own points through the model), as `run` does. With 2 samples a pixel,
@@ -519,10 +533,6 @@ fn the_binocular_map_of_a_curved_display_uses_the_surface_points() {
 fn a_sequence_shows_the_ideal_curved_display_exactly() {
     use seethru::measure::metrics::Flip;
     use seethru::measure::sequence::run_sequence;
-    use seethru::system::sequence::head_motion::HeadMotion;
-    use seethru::system::sequence::predict::Prediction;
-    use seethru::system::sequence::system_loop::SequenceOptions;
-    use seethru::system::sequence::timeline::Timeline;
     let text = wall(
         "display_shape = \"cylinder\"\ndisplay_radius = 0.2\ndisplay_segments = 48",
         6.0,
@@ -530,26 +540,12 @@ fn a_sequence_shows_the_ideal_curved_display_exactly() {
     let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
     let spp = 2;
     let largest_over_frames = |display| {
-        let o = SequenceOptions {
-            run: RunOptions {
-                display,
-                spp,
-                ..options(WorkingDistance::Metres(6.0))
-            },
-            timeline: Timeline {
-                duration: 0.1,
-                fps: 30.0,
-                display_hz: 30.0,
-                latency_camera: 0.05,
-                latency_tracking: 0.0,
-            },
-            speed: 0.0,
-            yaw_rate: 0.0,
-            head: HeadMotion::Still,
-            predict: Prediction::None,
-            reproject: false,
-            byo: Default::default(),
+        let run = RunOptions {
+            display,
+            spp,
+            ..options(WorkingDistance::Metres(6.0))
         };
+        let o = common::still_sequence(run, 0.1, 30.0, 0.05);
         let how = common::measuring(Flip::Skipped);
         let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
         assert!(run.records.len() >= 3);
@@ -564,19 +560,11 @@ fn a_sequence_shows_the_ideal_curved_display_exactly() {
     assert!(ideal < 0.01, "ideal: {ideal}′");
     // The sequence renders only the frontal pixels the curved display reads; its still
     // frames are `run`'s, which renders the whole frontal image.
-    let ctx = RenderContext::new(scene.clone()).unwrap();
     let once = RunOptions {
         spp,
         ..options(WorkingDistance::Metres(6.0))
     };
-    let r = run(&ctx, &once).unwrap();
-    let (_, metrics) = seethru::measure::metrics::measure(
-        &ctx,
-        &ctx.scene,
-        ctx.scene.eye(),
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let metrics = run_metrics(&scene, &once);
     let single = metrics["display"]["misregistration_arcmin"]["mean"]
         .as_f64()
         .unwrap();
@@ -833,10 +821,6 @@ fn the_border_bands_of_a_curved_display_follow_its_uvs() {
 fn a_one_column_curved_display_shows_in_a_sequence_what_run_shows() {
     use seethru::measure::metrics::Flip;
     use seethru::measure::sequence::run_sequence;
-    use seethru::system::sequence::head_motion::HeadMotion;
-    use seethru::system::sequence::predict::Prediction;
-    use seethru::system::sequence::system_loop::SequenceOptions;
-    use seethru::system::sequence::timeline::Timeline;
     let text = common::WallScene {
         display_resolution: [1, 100],
         ..common::WallScene::default()
@@ -848,37 +832,14 @@ fn a_one_column_curved_display_shows_in_a_sequence_what_run_shows() {
     );
     let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
     let once = options(WorkingDistance::Metres(6.0));
-    let o = SequenceOptions {
-        run: once.clone(),
-        timeline: Timeline {
-            duration: 0.05,
-            fps: 20.0,
-            display_hz: 20.0,
-            latency_camera: 0.0,
-            latency_tracking: 0.0,
-        },
-        speed: 0.0,
-        yaw_rate: 0.0,
-        head: HeadMotion::Still,
-        predict: Prediction::None,
-        reproject: false,
-        byo: Default::default(),
-    };
+    let o = common::still_sequence(once.clone(), 0.05, 20.0, 0.0);
     let how = common::measuring(Flip::Skipped);
     let sequence = run_sequence(&scene, o, how, &mut |_| Ok(()))
         .unwrap()
         .records[0]
         .metrics
         .unwrap();
-    let ctx = RenderContext::new(scene.clone()).unwrap();
-    let r = run(&ctx, &once).unwrap();
-    let (_, metrics) = seethru::measure::metrics::measure(
-        &ctx,
-        &ctx.scene,
-        ctx.scene.eye(),
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let metrics = run_metrics(&scene, &once);
     let display = &metrics["display"];
     assert!(sequence.display_pixels > 0);
     assert_eq!(sequence.psnr_db, display["psnr_db"].as_f64().unwrap());

@@ -24,10 +24,6 @@ use seethru::system::display::DisplayModel;
 use seethru::system::eyes::{Eye, Eyes};
 use seethru::system::options::{RunOptions, WorkingDistance};
 use seethru::system::pipeline::{RunResult, eye_for_compensation, run};
-use seethru::system::sequence::head_motion::HeadMotion;
-use seethru::system::sequence::predict::Prediction;
-use seethru::system::sequence::system_loop::SequenceOptions;
-use seethru::system::sequence::timeline::Timeline;
 use seethru::util::color::encode_srgb8;
 
 /// f32's relative rounding (half an ulp): frames store positions, the maps angles, in f32.
@@ -841,26 +837,12 @@ fn the_head_jitter_has_the_spread_its_flag_states() {
         ..common::WallScene::default()
     };
     let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &small.text()).unwrap();
-    let options = SequenceOptions {
-        run: RunOptions {
-            head_jitter_cm: sigma_cm,
-            spp: 1,
-            ..RunOptions::default()
-        },
-        timeline: Timeline {
-            duration: 1.5,
-            fps: 100.0,
-            display_hz: 100.0,
-            latency_camera: 0.0,
-            latency_tracking: 0.0,
-        },
-        speed: 0.0,
-        yaw_rate: 0.0,
-        head: HeadMotion::Still,
-        predict: Prediction::None,
-        reproject: false,
-        byo: Default::default(),
+    let run = RunOptions {
+        head_jitter_cm: sigma_cm,
+        spp: 1,
+        ..RunOptions::default()
     };
+    let options = common::still_sequence(run, 1.5, 100.0, 0.0);
     let how = Measuring {
         metrics: false,
         full_frames: false,

@@ -307,3 +307,29 @@ pub fn measuring(flip: seethru::measure::metrics::Flip) -> seethru::measure::seq
         flip,
     }
 }
+
+/// A sequence of `run` with the vehicle and the head still: `duration` seconds of frames at
+/// `hz` (the display refreshing with them), the frontal image `latency_camera` seconds old.
+pub fn still_sequence(
+    run: seethru::system::options::RunOptions,
+    duration: f64,
+    hz: f64,
+    latency_camera: f64,
+) -> seethru::system::sequence::system_loop::SequenceOptions {
+    seethru::system::sequence::system_loop::SequenceOptions {
+        run,
+        timeline: seethru::system::sequence::timeline::Timeline {
+            duration,
+            fps: hz,
+            display_hz: hz,
+            latency_camera,
+            latency_tracking: 0.0,
+        },
+        speed: 0.0,
+        yaw_rate: 0.0,
+        head: seethru::system::sequence::head_motion::HeadMotion::Still,
+        predict: seethru::system::sequence::predict::Prediction::None,
+        reproject: false,
+        byo: Default::default(),
+    }
+}
