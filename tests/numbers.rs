@@ -836,7 +836,7 @@ fn the_head_jitter_has_the_spread_its_flag_states() {
         frontal_resolution: [64, 48],
         ..common::WallScene::default()
     };
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &small.text()).unwrap();
+    let scene = small.scene();
     let run = RunOptions {
         head_jitter_cm: sigma_cm,
         spp: 1,

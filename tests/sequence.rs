@@ -49,7 +49,7 @@ fn options(latency: f64, fps: f64, display_hz: f64, yaw_rate: f64) -> SequenceOp
 #[test]
 fn the_measured_dynamic_misregistration_follows_the_formula() {
     let wall = common::WallScene::default();
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let scene = wall.scene();
     let eye = scene.obstacle.in_obstacle_frame(scene.eye());
     let yaw_rate = 20f64.to_radians();
     for (latency, display_hz) in [(0.05, 60.0), (0.1, 60.0), (0.033, 30.0)] {
@@ -109,7 +109,7 @@ fn the_measured_dynamic_misregistration_follows_the_formula() {
 #[test]
 fn a_run_reports_its_frames_headings_stage_times_and_frontal_pixels() {
     let wall = common::WallScene::default();
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let scene = wall.scene();
     let mut o = options(0.05, 60.0, 20.0, 20f64.to_radians());
     o.run.method = Method::None;
     let how = common::measuring(Flip::Skipped);
@@ -466,7 +466,7 @@ fn the_budget_geometry_is_the_das_scene() {
 #[test]
 fn a_sequence_computes_flip_only_when_asked() {
     let wall = common::WallScene::default();
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let scene = wall.scene();
     let records = |flip: Flip| {
         let how = common::measuring(flip);
         let o = options(0.1, 30.0, 30.0, 20f64.to_radians());
@@ -506,7 +506,7 @@ fn a_sequence_computes_flip_only_when_asked() {
 #[test]
 fn reprojection_by_the_known_yaw_removes_the_dynamic_error() {
     let wall = common::WallScene::default();
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let scene = wall.scene();
     let how = common::measuring(Flip::Skipped);
     let mut means = Vec::new();
     for (latency, reproject) in [(0.1, false), (0.1, true), (0.0, false)] {
@@ -536,7 +536,7 @@ fn reprojection_by_the_known_yaw_removes_the_dynamic_error() {
 #[test]
 fn a_late_head_estimate_costs_what_the_formula_says() {
     let wall = common::WallScene::default();
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let scene = wall.scene();
     let eye = scene.obstacle.in_obstacle_frame(scene.eye());
     let (amplitude, frequency, latency) = (0.03, 0.5, 0.02);
     let mut o = options(latency, 10.0, 10.0, 0.0);
@@ -583,7 +583,7 @@ fn a_late_head_estimate_costs_what_the_formula_says() {
 #[test]
 fn the_yaw_and_head_terms_add_with_their_signs() {
     let wall = common::WallScene::default();
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let scene = wall.scene();
     let eye = scene.obstacle.in_obstacle_frame(scene.eye());
     let (amplitude, frequency, latency, tracking) = (0.008, 1.0, 0.1, 0.03);
     let yaw_rate = 5f64.to_radians();
@@ -840,7 +840,7 @@ fn the_preview_has_a_colour_bar_whose_scale_heatmap_max_fixes() {
 fn frames_csv_and_summary_hold_what_the_sequence_was_asked_for() {
     use seethru::measure::sequence_files::{frames_csv, summary};
     let wall = common::WallScene::default();
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let scene = wall.scene();
     let eye0 = scene.obstacle.in_obstacle_frame(scene.eye());
     let (amplitude, frequency) = (0.03, 0.7);
     let mut o = options(0.05, 10.0, 4.0, 0.0);
@@ -1001,7 +1001,7 @@ fn the_misregistration_figures_hold_their_points_with_a_little_headroom() {
     use seethru::measure::sequence::FrameMetrics;
     use seethru::measure::sequence_files::{latency_figure, over_time_figure};
     let wall = common::WallScene::default();
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let scene = wall.scene();
     let how = common::measuring(Flip::Skipped);
     let run = run_sequence(&scene, options(0.1, 10.0, 10.0, 0.3), how, &mut |_| Ok(())).unwrap();
     let mut low = run.records.clone();
@@ -1152,7 +1152,7 @@ fn the_preview_holds_a_window_below_the_views_top() {
 #[test]
 fn the_model_head_source_estimates_the_eye_one_latency_back() {
     let wall = common::WallScene::default();
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let scene = wall.scene();
     let eye0 = scene.obstacle.in_obstacle_frame(scene.eye());
     let mut o = options(0.0, 30.0, 30.0, 0.0);
     o.timeline.duration = 1.0;
@@ -1190,7 +1190,7 @@ fn the_model_head_source_estimates_the_eye_one_latency_back() {
 #[test]
 fn a_sequence_with_d2_auto_finds_the_wall_each_refresh() {
     let wall = common::WallScene::default();
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let scene = wall.scene();
     let mut o = options(0.05, 20.0, 20.0, 0.0);
     o.run.d2 = WorkingDistance::Auto;
     o.run.frontal_width = Some(128);
@@ -1216,7 +1216,7 @@ fn a_crop_outside_the_frontal_view_is_refused_as_run_refuses_it() {
         frontal_half_angle: 14.0,
         ..Default::default()
     };
-    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &wall.text()).unwrap();
+    let scene = wall.scene();
     let o = options(0.05, 20.0, 20.0, 0.0);
     let err = SystemLoop::new(&scene, o.clone())
         .unwrap()

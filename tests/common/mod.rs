@@ -223,9 +223,13 @@ translate = [0.0, 0.0, -{wall}]
         scene_file_in(dir, "wall.toml", &self.text())
     }
 
+    /// The scene, read as `scenes/wall.toml` would be.
+    pub fn scene(&self) -> Scene {
+        parse_in(&repo_path("scenes"), "wall.toml", &self.text()).unwrap()
+    }
+
     pub fn context(&self) -> seethru::render::integrator::RenderContext {
-        let scene = parse_in(&repo_path("scenes"), "wall.toml", &self.text()).unwrap();
-        seethru::render::integrator::RenderContext::new(scene).unwrap()
+        seethru::render::integrator::RenderContext::new(self.scene()).unwrap()
     }
 }
 
