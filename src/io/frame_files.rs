@@ -12,7 +12,7 @@ use crate::io::atomic::write_atomically;
 use crate::io::exr_zip;
 use crate::render::frame::Frame;
 use crate::scene::limits::{MAX_COORDINATE, MAX_PIXELS, MAX_RESOLUTION};
-use crate::util::color::encode_srgb8_table;
+use crate::util::color::encode_srgb8;
 use crate::util::number::short;
 use crate::util::sampling::hash_u32;
 
@@ -26,12 +26,11 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<(
     )
 }
 
-/// The colour AOV as an 8-bit sRGB PNG (clamped to [0, 1]), encoded by table
-/// ([`encode_srgb8_table`]: the codes of [`crate::util::color::encode_srgb8`] without a `powf` per channel).
+/// The colour AOV as an 8-bit sRGB PNG (clamped to [0, 1]; [`encode_srgb8`]).
 pub fn write_color_png(frame: &Frame, path: &Path) -> Result<()> {
     let mut rgb = Vec::with_capacity(3 * frame.color.len());
     for &c in &frame.color {
-        rgb.extend_from_slice(&encode_srgb8_table(c));
+        rgb.extend_from_slice(&encode_srgb8(c));
     }
     write_png(path, frame.width, frame.height, rgb)
 }

@@ -101,7 +101,7 @@ impl Wireframe {
 /// encoding table of `detect_turned` (tens of ms; otherwise the first frame pays it).
 pub fn prepare_fit() {
     wireframes();
-    crate::util::color::encode_srgb8_table(glam::Vec3::ZERO);
+    crate::util::color::encode_srgb8(glam::Vec3::ZERO);
 }
 
 fn wireframes() -> &'static Wireframes {

@@ -16,7 +16,7 @@ use crate::system::head::{
     face_region, inner_blobs, is_skin, luminance, pupil_centroid,
 };
 use crate::system::head_confidence::IRIS_OVER_FACE;
-use crate::util::color::{encode_srgb8, encode_srgb8_table};
+use crate::util::color::{encode_srgb8, encode_srgb8_by_transfer};
 
 /// Sclera: bright and nearly grey (the skin is red over blue by ~2 in sRGB).
 fn is_white([r, g, b]: [u8; 3], face_lum: f32) -> bool {
@@ -42,8 +42,7 @@ struct Candidate {
 /// The face (the largest skin region, neck included), the two pupils and the outline's
 /// candidates of a colour frame (8-bit sRGB as a camera delivers it).
 ///
-/// Only the pixels the detection reads are encoded to sRGB (by table,
-/// [`encode_srgb8_table`]): those whose linear colour could be skin (red over green over
+/// Only the pixels the detection reads are encoded to sRGB ([`encode_srgb8`]): those whose linear colour could be skin (red over green over
 /// blue), the pupil search box and the samples of the outline's scan;
 /// [`detect_turned_reference`], which encodes every pixel, is its brute-force twin.
 pub fn detect_turned(frame: &Frame) -> Result<FaceDetection, DetectError> {
@@ -67,9 +66,9 @@ fn may_be_skin(c: Vec3) -> bool {
 fn detect_turned_from(frame: &Frame, encode_all: bool) -> Result<FaceDetection, DetectError> {
     let (w, h) = (frame.width as usize, frame.height as usize);
     let encode = if encode_all {
-        encode_srgb8
+        encode_srgb8_by_transfer
     } else {
-        encode_srgb8_table
+        encode_srgb8
     };
     let mut rgb: Vec<[u8; 3]> = vec![[0; 3]; w * h];
     let mut skin: Vec<bool> = vec![false; w * h];
