@@ -13,9 +13,14 @@ use glam::{DVec2, DVec3, Vec3};
 use serde_json::json;
 
 use crate::analysis::physical::ARCMIN_PER_RAD;
-use crate::render::accel::{Hit, make_ray};
+#[cfg(test)]
+use crate::render::accel::Hit;
+use crate::render::accel::make_ray;
+use crate::render::bvh_packet::{PACKET, PacketStack, RayPacket};
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
+use crate::render::ray::TraceRay;
+use crate::render::simd::Isa;
 use crate::scene::Scene;
 use crate::scene::world::view_bit;
 use crate::system::display::{DisplayPlacement, MISSING_ID};
@@ -99,17 +104,78 @@ fn angle_between(a: DVec3, b: DVec3) -> f64 {
     a.cross(b).length().atan2(a.dot(b))
 }
 
-/// The bounding box of `mask` as (x0, y0, x1, y1), exclusive ends; `None` when it is empty.
-fn bounding_box(mask: &[bool], w: usize) -> Option<(usize, usize, usize, usize)> {
-    mask.iter()
-        .enumerate()
-        .filter(|(_, m)| **m)
-        .fold(None, |b, (i, _)| {
-            let (x, y) = (i % w, i / w);
-            Some(b.map_or((x, y, x + 1, y + 1), |(x0, y0, x1, y1)| {
-                (x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1))
-            }))
-        })
+/// Pixels of a frame `frame_width` wide (indices in increasing order) and their bounding box,
+/// where SSIM's windows and FLIP's filters read them: every pixel a window or filter of theirs
+/// reads is inside it, so a map over the box is the frame's map there.
+struct DisplayBox<'a> {
+    pixels: &'a [usize],
+    frame_width: usize,
+    /// The box's first column and row in the frame, and its size, pixels (0 × 0 without pixels).
+    x0: usize,
+    y0: usize,
+    width: usize,
+    height: usize,
+}
+
+impl<'a> DisplayBox<'a> {
+    fn of(pixels: &'a [usize], frame_width: usize) -> DisplayBox<'a> {
+        let (Some(&first), Some(&last)) = (pixels.first(), pixels.last()) else {
+            return DisplayBox {
+                pixels,
+                frame_width,
+                x0: 0,
+                y0: 0,
+                width: 0,
+                height: 0,
+            };
+        };
+        let (x0, x1) = pixels.iter().fold((usize::MAX, 0), |(x0, x1), &i| {
+            (x0.min(i % frame_width), x1.max(i % frame_width + 1))
+        });
+        let (y0, y1) = (first / frame_width, last / frame_width + 1);
+        DisplayBox {
+            pixels,
+            frame_width,
+            x0,
+            y0,
+            width: x1 - x0,
+            height: y1 - y0,
+        }
+    }
+
+    /// The box's index of the frame's pixel `i` (one of the box's pixels).
+    fn in_box(&self, i: usize) -> usize {
+        (i / self.frame_width - self.y0) * self.width + i % self.frame_width - self.x0
+    }
+
+    /// A box-sized image: `values` (one per pixel, in order) at the pixels, `fill` elsewhere.
+    fn spread<T: Copy>(&self, values: impl Iterator<Item = T>, fill: T) -> Vec<T> {
+        let mut out = vec![fill; self.width * self.height];
+        for (&i, v) in self.pixels.iter().zip(values) {
+            out[self.in_box(i)] = v;
+        }
+        out
+    }
+
+    /// Which pixels of the box are the pixels.
+    fn mask(&self) -> Vec<bool> {
+        self.spread(std::iter::repeat(true), false)
+    }
+
+    /// A box-sized image's values at the pixels, in order.
+    fn gather<T: Copy>(&self, boxed: &[T]) -> Vec<T> {
+        self.pixels.iter().map(|&i| boxed[self.in_box(i)]).collect()
+    }
+
+    /// A frame of `len` pixels with `values` (one per pixel, in order) at the pixels, NaN
+    /// elsewhere.
+    fn scatter(&self, values: &[f64], len: usize) -> Vec<f64> {
+        let mut out = vec![f64::NAN; len];
+        for (&i, &v) in self.pixels.iter().zip(values) {
+            out[i] = v;
+        }
+        out
+    }
 }
 
 /// SSIM map on 8-bit luminance with 7×7 windows (Wang et al. 2004 constants) that see only
@@ -151,45 +217,24 @@ pub fn masked_ssim_map(a: &[f64], b: &[f64], mask: &[bool], w: usize, h: usize) 
     out
 }
 
-/// FLIP map (NVIDIA's ꟻLIP, via nv-flip) of the pixels of `mask` only, at `ppd` pixels per
-/// degree. FLIP filters each image spatially before comparing, so a whole-frame FLIP lets
-/// what lies outside the display leak into the display's border. Here both images are cut to
-/// the mask's bounding box and every pixel outside the mask is set to the same mid grey in
-/// both: the filters see the display's content and a shared, featureless surround, never
-/// anything outside the display. NaN outside the mask.
-fn masked_flip_map(
-    truth: &[[u8; 3]],
-    shown: &[[u8; 3]],
-    mask: &[bool],
-    w: usize,
-    ppd: f32,
-) -> Vec<f64> {
-    let mut out = vec![f64::NAN; mask.len()];
-    let Some((x0, y0, x1, y1)) = bounding_box(mask, w) else {
-        return out;
+/// FLIP map (NVIDIA's ꟻLIP, via nv-flip) over the box of `bounds`, of its pixels' colours
+/// `truth` and `shown` (one per pixel, in order), at `ppd` pixels per degree. FLIP filters each
+/// image spatially before comparing, so a whole-frame FLIP lets what lies outside the display
+/// leak into the display's border. Here both images are cut to the pixels' bounding box and
+/// every other pixel of it is set to the same mid grey in both: the filters see the display's
+/// content and a shared, featureless surround, never anything outside the display.
+fn boxed_flip_map(truth: &[[u8; 3]], shown: &[[u8; 3]], bounds: &DisplayBox, ppd: f32) -> Vec<f64> {
+    let cut = |colours: &[[u8; 3]]| -> Vec<u8> {
+        bounds.spread(colours.iter().copied(), [128; 3]).concat()
     };
-    let (bw, bh) = (x1 - x0, y1 - y0);
-    let cut = |image: &[[u8; 3]]| -> Vec<u8> {
-        (0..bw * bh)
-            .flat_map(|k| {
-                let i = (y0 + k / bw) * w + x0 + k % bw;
-                if mask[i] { image[i] } else { [128; 3] }
-            })
-            .collect()
+    let image = |colours| {
+        nv_flip::FlipImageRgb8::with_data(bounds.width as u32, bounds.height as u32, &cut(colours))
     };
-    let flip = nv_flip::flip(
-        nv_flip::FlipImageRgb8::with_data(bw as u32, bh as u32, &cut(truth)),
-        nv_flip::FlipImageRgb8::with_data(bw as u32, bh as u32, &cut(shown)),
-        ppd,
-    )
-    .to_vec();
-    for (k, v) in flip.iter().enumerate() {
-        let i = (y0 + k / bw) * w + x0 + k % bw;
-        if mask[i] {
-            out[i] = *v as f64;
-        }
-    }
-    out
+    nv_flip::flip(image(truth), image(shown), ppd)
+        .to_vec()
+        .into_iter()
+        .map(f64::from)
+        .collect()
 }
 
 /// PSNR (dB) of 8-bit sRGB colours over the pixels of `mask`.
@@ -219,23 +264,77 @@ fn psnr_over(a: &[[u8; 3]], b: &[[u8; 3]], pixels: &[usize]) -> f64 {
     }
 }
 
-/// Whether the closest surface the frontal camera sees along the ray from `origin` (unit
-/// `dir`) is nearer than `reach` m: exactly `ctx.trace(origin, dir, view_bit::FRONTAL)`'s
-/// hit at `t < reach`, but the traversal stops a little beyond `reach` and nothing is shaded.
-fn nearer_than(ctx: &RenderContext, origin: Vec3, dir: Vec3, reach: f64) -> bool {
-    // Every f32 below `reach` is at most `reach as f32`, below this bound.
+/// The ray from `origin` along unit `dir` of [`nearer_than`]: the traversal stops a little
+/// beyond `reach` (every f32 below `reach` is at most `reach as f32`, below this bound).
+fn reach_ray(origin: Vec3, dir: Vec3, reach: f64) -> TraceRay {
     let tmax = if reach.is_finite() {
         (reach as f32).max(0.0).next_up().next_up()
     } else {
         f32::INFINITY
     };
-    let ray = make_ray(origin, dir, 0.0, tmax);
+    make_ray(origin, dir, 0.0, tmax)
+}
+
+/// Whether the closest surface the frontal camera sees along the ray from `origin` (unit
+/// `dir`) is nearer than `reach` m: exactly `ctx.trace(origin, dir, view_bit::FRONTAL)`'s
+/// hit at `t < reach`, but the traversal stops a little beyond `reach` and nothing is shaded.
+/// One ray at a time: the twin of [`nearer_than_packet`].
+#[cfg(test)]
+fn nearer_than(ctx: &RenderContext, origin: Vec3, dir: Vec3, reach: f64) -> bool {
+    let ray = reach_ray(origin, dir, reach);
     let near = |hit: Option<Hit>| hit.is_some_and(|h| (h.t as f64) < reach);
     near(ctx.accel.closest(&ray, view_bit::FRONTAL))
         || ctx
             .moving
             .as_ref()
             .is_some_and(|m| near(m.accel.closest(&ray, view_bit::FRONTAL)))
+}
+
+/// [`nearer_than`] for the rays from `origin` of the lanes of `lanes` (bit i for lane i),
+/// lane i along `queries[i].0` to `queries[i].1` m, traced as one packet on `isa`'s kernels:
+/// bit i of the answer is lane i's. The rays of neighbouring display pixels from one camera
+/// are coherent, and the packet kernels give the per-ray hits bit for bit.
+fn nearer_than_packet(
+    ctx: &RenderContext,
+    origin: Vec3,
+    queries: &[(Vec3, f64); PACKET],
+    lanes: u32,
+    isa: Isa,
+    stack: &mut PacketStack,
+) -> u32 {
+    if lanes == 0 {
+        return 0;
+    }
+    let mut packet = RayPacket::new();
+    for (lane, &(dir, reach)) in queries.iter().enumerate() {
+        if lanes >> lane & 1 != 0 {
+            packet.set(lane, &reach_ray(origin, dir, reach));
+        }
+    }
+    let rays = packet;
+    let near_in = |packet: &RayPacket| {
+        (0..PACKET)
+            .filter(|&lane| {
+                packet.active >> lane & 1 != 0
+                    && packet
+                        .hit(lane)
+                        .is_some_and(|h| (h.t as f64) < queries[lane].1)
+            })
+            .fold(0u32, |bits, lane| bits | 1 << lane)
+    };
+    ctx.accel
+        .closest_packet(&mut packet, view_bit::FRONTAL, isa, stack);
+    let mut near = near_in(&packet);
+    if let Some(m) = &ctx.moving {
+        let mut rest = rays;
+        rest.active &= !near;
+        if rest.active != 0 {
+            m.accel
+                .closest_packet(&mut rest, view_bit::FRONTAL, isa, stack);
+            near |= near_in(&rest);
+        }
+    }
+    near
 }
 
 /// Why the frontal camera cannot see a display pixel's truth point.
@@ -314,13 +413,10 @@ pub fn measure_with(
         .map(|(&o, &p)| ctx.world.is_display(o, p))
         .collect();
     // Every statistic is over display pixels, taken in index order (row by row): the same
-    // sums as a pass over the whole frame, without visiting the rest of it.
+    // sums as a pass over the whole frame, without visiting the rest of it. What is kept per
+    // display pixel is kept in that order (index k of `on_display`), not over the frame.
     let on_display: Vec<usize> = (0..w * h).filter(|&i| display[i]).collect();
-    let mut misregistration = vec![f32::NAN; w * h];
-    let mut missing = vec![false; w * h];
-    let mut class = vec![PixelClass::default(); w * h];
-    // Which side bands each pixel is in: left, right, top, bottom.
-    let mut sides = vec![[false; 4]; w * h];
+    let count = on_display.len();
     let frontal = &scene.frontal;
     let in_frontal_image = |q: Option<DVec2>| {
         q.is_some_and(|q| {
@@ -328,14 +424,16 @@ pub fn measure_with(
         })
     };
     let frontal_origin = frontal.position();
-    // Each display pixel on its own (one ray towards the frontal camera each), in parallel.
-    let per_pixel = |i: usize| {
+    // One display pixel's measurements, and the ray towards the frontal camera that decides
+    // whether its truth point is hidden from it (direction, reach), where one is needed.
+    let per_pixel = |i: usize| -> (Measured, Option<(Vec3, f64)>) {
         let mut out = Measured {
             misregistration: f32::NAN,
             missing: None,
             class: PixelClass::default(),
             sides: [false; 4],
         };
+        let mut hidden_query = None;
         // The display pixel coordinates of the point: a curved display's from its UVs.
         let uv = placement.pixel_coords(occluded.position[i]);
         let (u, v) = (uv.x, uv.y);
@@ -372,15 +470,12 @@ pub fn measure_with(
                 } else {
                     f64::INFINITY
                 };
-                let origin = frontal_origin.as_vec3();
-                if nearer_than(ctx, origin, to.normalize().as_vec3(), reach) {
-                    out.missing = Some(Missing::Hidden);
-                }
+                hidden_query = Some((to.normalize().as_vec3(), reach));
             }
         }
         if seethru.object_id[i] == MISSING_ID {
             out.class.blank = true;
-            return out;
+            return (out, hidden_query);
         }
         let shown_dir = shown_direction(seethru.position[i], seethru.normal[i], driver_eye);
         match (shown_dir, true_dir) {
@@ -391,55 +486,100 @@ pub fn measure_with(
             }
             _ => out.class.undefined = true,
         }
-        out
+        (out, hidden_query)
     };
+    // Runs of PACKET display pixels in parallel, their rays to the frontal camera traced as
+    // one packet: the same answers for any number of threads.
+    let isa = Isa::best();
     let measured: Vec<Measured> = {
         use rayon::prelude::*;
-        on_display.par_iter().map(|&i| per_pixel(i)).collect()
+        on_display
+            .par_chunks(PACKET)
+            .map_init(PacketStack::new, |stack, run| {
+                let mut queries = [(Vec3::X, 0.0); PACKET];
+                let mut asked = 0u32;
+                let mut out: Vec<Measured> = Vec::with_capacity(run.len());
+                for (lane, &i) in run.iter().enumerate() {
+                    let (m, query) = per_pixel(i);
+                    if let Some(q) = query {
+                        queries[lane] = q;
+                        asked |= 1 << lane;
+                    }
+                    out.push(m);
+                }
+                let origin = frontal_origin.as_vec3();
+                let hidden = nearer_than_packet(ctx, origin, &queries, asked, isa, stack);
+                for (lane, m) in out.iter_mut().enumerate() {
+                    if hidden >> lane & 1 != 0 {
+                        m.missing = Some(Missing::Hidden);
+                    }
+                }
+                out
+            })
+            .flatten_iter()
+            .collect()
     };
+    let mut misregistration = vec![f32::NAN; w * h];
+    let mut missing = vec![false; w * h];
+    let mut blank = vec![false; w * h];
     let (mut out_of_view, mut hidden) = (0usize, 0usize);
     for (&i, m) in on_display.iter().zip(&measured) {
         misregistration[i] = m.misregistration;
         missing[i] = m.missing.is_some();
+        blank[i] = m.class.blank;
         out_of_view += usize::from(m.missing == Some(Missing::OutOfView));
         hidden += usize::from(m.missing == Some(Missing::Hidden));
-        class[i] = m.class;
-        sides[i] = m.sides;
     }
-    let count = on_display.len();
     let count_where =
-        |keep: &dyn Fn(usize) -> bool| on_display.iter().filter(|&&i| keep(i)).count();
+        |keep: &dyn Fn(&Measured) -> bool| measured.iter().filter(|m| keep(m)).count();
     let driver_pixel_arcmin = (2.0 * scene.driver.tan_half_x() / w as f64).atan() * ARCMIN_PER_RAD;
-    // Colours of the display's pixels only (nothing else is read; black elsewhere).
-    let (mut srgb_t, mut srgb_s) = (vec![[0u8; 3]; w * h], vec![[0u8; 3]; w * h]);
-    let (mut lum_t, mut lum_s) = (vec![0.0; w * h], vec![0.0; w * h]);
-    for &i in &on_display {
-        srgb_t[i] = encode_srgb8(truth.color[i]);
-        srgb_s[i] = encode_srgb8(seethru.color[i]);
-        lum_t[i] = luma(srgb_t[i]);
-        lum_s[i] = luma(srgb_s[i]);
-    }
-    let ssim = masked_ssim_map(&lum_t, &lum_s, &display, w, h);
+    // Colours of the display's pixels only.
+    let srgb_t: Vec<[u8; 3]> = on_display
+        .iter()
+        .map(|&i| encode_srgb8(truth.color[i]))
+        .collect();
+    let srgb_s: Vec<[u8; 3]> = on_display
+        .iter()
+        .map(|&i| encode_srgb8(seethru.color[i]))
+        .collect();
+    // SSIM's windows and FLIP's filters see the display pixels in their bounding box, which
+    // holds every pixel a window or filter of theirs would read.
+    let bounds = DisplayBox::of(&on_display, w);
+    let lum = |srgb: &[[u8; 3]]| bounds.spread(srgb.iter().map(|&c| luma(c)), 0.0);
+    let ssim_box = masked_ssim_map(
+        &lum(&srgb_t),
+        &lum(&srgb_s),
+        &bounds.mask(),
+        bounds.width,
+        bounds.height,
+    );
+    let ssim: Vec<f64> = bounds.gather(&ssim_box);
     // FLIP with the driver's eye as the observer: pixels per degree of the driver's camera.
     let ppd = w as f32 / (2.0 * scene.driver.half_angle_x.to_degrees() as f32);
     let flip_skipped = flip == Flip::Skipped;
-    let flip = match flip {
-        Flip::Computed => masked_flip_map(&srgb_t, &srgb_s, &display, w, ppd),
-        Flip::Skipped => vec![f64::NAN; w * h],
+    let flip: Vec<f64> = match flip {
+        Flip::Computed if count > 0 => {
+            bounds.gather(&boxed_flip_map(&srgb_t, &srgb_s, &bounds, ppd))
+        }
+        _ => vec![f64::NAN; count],
     };
-    let region = |keep: &dyn Fn(usize) -> bool| {
-        let pixels_in: Vec<usize> = on_display.iter().copied().filter(|&i| keep(i)).collect();
+    let region = |keep: &dyn Fn(&Measured) -> bool| {
+        let pixels_in: Vec<usize> = (0..count).filter(|&k| keep(&measured[k])).collect();
         let pixels = pixels_in.len();
-        let blank = pixels_in.iter().filter(|&&i| class[i].blank).count();
+        let blank = pixels_in
+            .iter()
+            .filter(|&&k| measured[k].class.blank)
+            .count();
         let mut values: Vec<f64> = pixels_in
             .iter()
-            .filter(|&&i| misregistration[i].is_finite())
-            .map(|&i| misregistration[i] as f64)
+            .map(|&k| measured[k].misregistration)
+            .filter(|v| v.is_finite())
+            .map(f64::from)
             .collect();
-        let over = |map: &[f64]| mean(pixels_in.iter().map(|&i| map[i]));
-        let colour_error = mean(pixels_in.iter().map(|&i| {
+        let over = |map: &[f64]| mean(pixels_in.iter().map(|&k| map[k]));
+        let colour_error = mean(pixels_in.iter().map(|&k| {
             (0..3)
-                .map(|c| (srgb_t[i][c] as f64 - srgb_s[i][c] as f64).abs())
+                .map(|c| (srgb_t[k][c] as f64 - srgb_s[k][c] as f64).abs())
                 .sum::<f64>()
                 / 3.0
         }));
@@ -454,48 +594,41 @@ pub fn measure_with(
             "flip_mean": over(&flip),
         })
     };
-    let in_band = |i: usize| display[i] && sides[i].iter().any(|&s| s);
     let per_side: serde_json::Map<String, serde_json::Value> = ["left", "right", "top", "bottom"]
         .iter()
         .enumerate()
-        .map(|(k, name)| {
-            (
-                name.to_string(),
-                region(&|i: usize| display[i] && sides[i][k]),
-            )
-        })
+        .map(|(k, name)| (name.to_string(), region(&|m| m.sides[k])))
         .collect();
-    let blank = count_where(&|i| display[i] && class[i].blank);
+    let blank_count = count_where(&|m| m.class.blank);
     let mean_px = mean(
-        on_display
+        measured
             .iter()
-            .map(|&i| misregistration[i])
+            .map(|m| m.misregistration)
             .filter(|v| v.is_finite())
-            .map(|v| v as f64),
+            .map(f64::from),
     ) / driver_pixel_arcmin;
     let sky = |truth_sky: bool, shown_sky: bool| {
-        count_where(&|i| {
-            display[i]
-                && misregistration[i].is_finite()
-                && class[i].truth_sky == truth_sky
-                && class[i].shown_sky == shown_sky
+        count_where(&|m| {
+            m.misregistration.is_finite()
+                && m.class.truth_sky == truth_sky
+                && m.class.shown_sky == shown_sky
         })
     };
     let mut json = json!({
         "display_pixels": count,
-        "coverage": if count == 0 { f64::NAN } else { 1.0 - blank as f64 / count as f64 },
-        "blank_pixels": blank,
+        "coverage": if count == 0 { f64::NAN } else { 1.0 - blank_count as f64 / count as f64 },
+        "blank_pixels": blank_count,
         "sky_pixels_included": {
             "truth_only": sky(true, false),
             "seethru_only": sky(false, true),
             "both": sky(true, true),
         },
-        "undefined_pixels": count_where(&|i| display[i] && class[i].undefined),
+        "undefined_pixels": count_where(&|m| m.class.undefined),
         "driver_pixel_arcmin": driver_pixel_arcmin,
-        "display": region(&|i| display[i]),
+        "display": region(&|_| true),
         "misregistration_mean_driver_px": mean_px,
         "border_band_display_px": band,
-        "border": region(&in_band),
+        "border": region(&|m| m.sides.iter().any(|&s| s)),
         "border_per_side": per_side,
         "missing": {
             "fraction": if count == 0 { 0.0 } else { (out_of_view + hidden) as f64 / count as f64 },
@@ -509,7 +642,6 @@ pub fn measure_with(
         json["flip_not_computed"] =
             json!("FLIP was not computed (a sequence without --flip): every flip_mean is null");
     }
-    let blank = (0..w * h).map(|i| class[i].blank).collect();
     (
         MetricMaps {
             width: w as u32,
@@ -518,8 +650,8 @@ pub fn measure_with(
             missing,
             display,
             blank,
-            ssim,
-            flip,
+            ssim: bounds.scatter(&ssim, w * h),
+            flip: bounds.scatter(&flip, w * h),
         },
         json,
     )
@@ -542,21 +674,100 @@ mod tests {
         assert_eq!(stats(&mut [])["count"], 0);
     }
 
+    /// The packet query against its per-ray twin, on das seen from the frontal camera, with
+    /// a moving layer (the car and the ball, carried 3 m towards the camera and 1 m left) that
+    /// alone decides some lanes: every reach from the camera's near field to infinity.
     #[test]
-    fn the_bounding_box_of_a_mask() {
-        let mut mask = vec![false; 5 * 4];
-        assert_eq!(bounding_box(&mask, 5), None);
-        mask[5 + 1] = true;
-        mask[2 * 5 + 3] = true;
-        assert_eq!(bounding_box(&mask, 5), Some((1, 1, 4, 3)));
-        // The first pixel in index order is the rightmost and the bottom row's only one: its
-        // own box must end one past it.
-        let mut mask = vec![false; 5 * 4];
-        mask[5 + 3] = true;
-        mask[2 * 5 + 1] = true;
-        assert_eq!(bounding_box(&mask, 5), Some((1, 1, 4, 3)));
-        let mut one = vec![false; 5 * 4];
-        one[2 * 5 + 2] = true;
-        assert_eq!(bounding_box(&one, 5), Some((2, 2, 3, 3)));
+    fn the_packet_query_answers_as_the_per_ray_one() {
+        use crate::render::moving::MovingParts;
+        use std::sync::Arc;
+        let scene = Scene::bundled("das.toml");
+        let mut ctx = RenderContext::new(scene.clone()).unwrap();
+        let movers = |i: usize| ["car", "ball"].contains(&scene.objects[i].name.as_str());
+        let moved = glam::DAffine3::from_translation(DVec3::new(-1.0, 0.0, 3.0));
+        let layer = MovingParts::new(&scene, &movers)
+            .unwrap()
+            .at(&|_| Some(moved))
+            .unwrap();
+        ctx.moving = Some(Arc::new(layer));
+        let camera = &scene.frontal;
+        let origin = camera.position().as_vec3();
+        let mut stack = PacketStack::new();
+        let (mut rays, mut near, mut by_moving) = (0, 0, 0);
+        for (k, isa) in Isa::ALL.into_iter().filter(|i| i.available()).enumerate() {
+            for y in (0..camera.height).step_by(9) {
+                for x0 in (0..camera.width).step_by(4 * PACKET) {
+                    let mut queries = [(Vec3::X, 0.0); PACKET];
+                    let mut lanes = 0u32;
+                    for (lane, query) in queries.iter_mut().enumerate() {
+                        let x = x0 + 3 * lane as u32;
+                        // Every third lane idle; reaches 0.5 m to 162 m and infinity.
+                        if x >= camera.width || lane % 3 == 2 {
+                            continue;
+                        }
+                        let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                        let (_, dir) = camera.world_ray(pixel);
+                        let reach = match (x + y) % 7 {
+                            0 => f64::INFINITY,
+                            r => 0.5 * 2.6f64.powi(r as i32),
+                        };
+                        *query = (dir.as_vec3(), reach);
+                        lanes |= 1 << lane;
+                    }
+                    let got = nearer_than_packet(&ctx, origin, &queries, lanes, isa, &mut stack);
+                    for (lane, &(dir, reach)) in queries.iter().enumerate() {
+                        let asked = lanes >> lane & 1 != 0;
+                        let want = asked && nearer_than(&ctx, origin, dir, reach);
+                        assert_eq!(got >> lane & 1 != 0, want, "{isa:?} ({x0}+3·{lane}, {y})");
+                        if k == 0 && asked {
+                            rays += 1;
+                            near += usize::from(want);
+                            let alone = ctx
+                                .accel
+                                .closest(&reach_ray(origin, dir, reach), view_bit::FRONTAL);
+                            let by_static = alone.is_some_and(|h| (h.t as f64) < reach);
+                            by_moving += usize::from(want && !by_static);
+                        }
+                    }
+                }
+            }
+        }
+        // Both answers, and the moving layer's, in numbers.
+        assert!(near > rays / 5 && near < rays * 4 / 5, "{near} of {rays}");
+        assert!(by_moving > 20, "{by_moving}");
+    }
+
+    #[test]
+    fn the_box_of_display_pixels() {
+        let corners = |b: DisplayBox| (b.x0, b.y0, b.x0 + b.width, b.y0 + b.height);
+        assert_eq!(corners(DisplayBox::of(&[], 5)), (0, 0, 0, 0));
+        assert_eq!(
+            corners(DisplayBox::of(&[5 + 1, 2 * 5 + 3], 5)),
+            (1, 1, 4, 3)
+        );
+        // The first pixel in index order is the rightmost and the bottom row's only one is the
+        // leftmost: the box spans both.
+        assert_eq!(
+            corners(DisplayBox::of(&[5 + 3, 2 * 5 + 1], 5)),
+            (1, 1, 4, 3)
+        );
+        assert_eq!(corners(DisplayBox::of(&[2 * 5 + 2], 5)), (2, 2, 3, 3));
+    }
+
+    #[test]
+    fn a_box_spreads_gathers_and_scatters_its_pixels_in_place() {
+        // Pixels (3, 1), (1, 2) and (2, 2) of a 5 × 4 frame: a box 3 wide and 2 high at (1, 1).
+        let pixels = [5 + 3, 2 * 5 + 1, 2 * 5 + 2];
+        let b = DisplayBox::of(&pixels, 5);
+        let boxed = b.spread([1.0, 2.0, 3.0].into_iter(), 0.0);
+        assert_eq!(boxed, vec![0.0, 0.0, 1.0, 2.0, 3.0, 0.0]);
+        assert_eq!(b.mask(), vec![false, false, true, true, true, false]);
+        assert_eq!(b.gather(&boxed), vec![1.0, 2.0, 3.0]);
+        let frame = b.scatter(&[1.0, 2.0, 3.0], 20);
+        let set: Vec<(usize, f64)> = (0..20)
+            .filter(|&i| !frame[i].is_nan())
+            .map(|i| (i, frame[i]))
+            .collect();
+        assert_eq!(set, vec![(8, 1.0), (11, 2.0), (12, 3.0)]);
     }
 }
