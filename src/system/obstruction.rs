@@ -12,7 +12,6 @@
 //! neither eye sees).
 
 use glam::{DVec3, Vec3};
-use rayon::prelude::*;
 use serde_json::json;
 
 use crate::geometry::camera::Camera;
@@ -37,17 +36,19 @@ pub struct Obstruction {
 /// Per ray of the sweep from `eye`: (blocked by the obstacle, blocked by its body).
 fn sweep(ctx: &RenderContext, eye: DVec3, forward: DVec3, across: DVec3) -> Vec<(bool, bool)> {
     let n = (2.0 * SPAN_DEG / STEP_DEG).round() as i64;
-    (0..=n)
-        .into_par_iter()
+    let dirs: Vec<Option<Vec3>> = (0..=n)
         .map(|i| {
             let phi = (-SPAN_DEG + i as f64 * STEP_DEG).to_radians();
-            let dir = forward * phi.cos() + across * phi.sin();
-            match ctx.trace(eye.as_vec3(), dir.as_vec3(), view_bit::OCCLUDED) {
-                Some(hit) if hit.object == ctx.world.obstacle_id => {
-                    (true, !ctx.world.is_display(hit.object, hit.part))
-                }
-                _ => (false, false),
+            Some((forward * phi.cos() + across * phi.sin()).as_vec3())
+        })
+        .collect();
+    ctx.trace_all(eye.as_vec3(), &dirs, view_bit::OCCLUDED)
+        .into_iter()
+        .map(|hit| match hit {
+            Some(hit) if hit.object == ctx.world.obstacle_id => {
+                (true, !ctx.world.is_display(hit.object, hit.part))
             }
+            _ => (false, false),
         })
         .collect()
 }
@@ -85,28 +86,32 @@ pub fn obstruction(ctx: &RenderContext, eye: DVec3, ipd: f64) -> Obstruction {
 /// thing the eye's ray to it meets.
 pub fn display_pixels_seen(ctx: &RenderContext, driver: &Camera) -> usize {
     let eye = driver.position();
-    display_points(&ctx.scene.obstacle)
-        .par_iter()
-        .flatten()
-        .filter(|&&p| {
-            let Some(px) = driver.project_point(p) else {
-                return false;
-            };
-            if !(px.x >= 0.0
+    let points = display_points(&ctx.scene.obstacle);
+    // The eye's ray to each point inside the driver's view, and the point's distance.
+    let rays: Vec<Option<(Vec3, f64)>> = points
+        .iter()
+        .map(|&p| {
+            let p = p?;
+            let px = driver.project_point(p)?;
+            let inside = px.x >= 0.0
                 && px.y >= 0.0
                 && px.x < driver.width as f64
-                && px.y < driver.height as f64)
-            {
-                return false;
-            }
+                && px.y < driver.height as f64;
             let to = p - eye;
             let dist = to.length();
-            let dir: Vec3 = (to / dist).as_vec3();
-            ctx.trace(eye.as_vec3(), dir, view_bit::OCCLUDED)
-                .is_some_and(|hit| {
-                    ctx.world.is_display(hit.object, hit.part)
-                        && (f64::from(hit.t) - dist).abs() < 1e-3 * dist.max(1.0)
-                })
+            inside.then(|| ((to / dist).as_vec3(), dist))
+        })
+        .collect();
+    let dirs: Vec<Option<Vec3>> = rays.iter().map(|r| r.map(|(dir, _)| dir)).collect();
+    ctx.trace_all(eye.as_vec3(), &dirs, view_bit::OCCLUDED)
+        .iter()
+        .zip(&rays)
+        .filter(|(hit, ray)| match (hit, ray) {
+            (Some(hit), Some((_, dist))) => {
+                ctx.world.is_display(hit.object, hit.part)
+                    && (f64::from(hit.t) - dist).abs() < 1e-3 * dist.max(1.0)
+            }
+            _ => false,
         })
         .count()
 }
