@@ -498,7 +498,9 @@ impl RenderContext {
     }
 
     /// [`RenderContext::trace_with`] for the rays of `packet` (directions `dirs`, from one
-    /// origin): the surface each lane's ray meets.
+    /// origin): the surface each lane's ray meets. Inlined into the tile loop, where a call
+    /// that returns sixteen surfaces cost renders 3 %.
+    #[inline(always)]
     fn trace_packet(
         &self,
         dirs: &[Vec3; PACKET],
