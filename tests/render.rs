@@ -367,36 +367,39 @@ fn packets_trace_a_sequences_moving_part_as_the_per_ray_path_does() {
     }
 }
 
-/// `trace_all`, 16 rays a packet on all threads, meets what `trace` meets ray by ray, with a
-/// sequence's moving part (the ball rolled, the rig driven) and rays left out; on 1 and 3
-/// threads, and from an origin where the moving ball decides some rays.
+/// `trace_fan`, up to 16 rays as one packet, meets what `trace` meets ray by ray, with a
+/// sequence's moving part (the ball rolled, the rig driven), rays left out and a short last
+/// fan.
 #[test]
-fn tracing_all_rays_at_once_meets_what_tracing_each_meets() {
+fn a_fan_of_rays_meets_what_each_ray_meets() {
+    use seethru::render::bvh_packet::{PACKET, PacketStack};
     use seethru::system::sequence::system_loop::SystemLoop;
     let mut options = common::still_sequence(Default::default(), 2.0, 10.0, 0.0);
     options.speed = 50.0 / 3.6;
     let mut system = SystemLoop::new(&common::das(), options).unwrap();
     let layered = system.context_at(1.5).unwrap();
     assert!(layered.moving.is_some(), "das's ball rolls");
-    let eye = layered.scene.driver.position();
+    let eye = layered.scene.driver.position().as_vec3();
     let driver = layered.scene.driver.with_resolution(97, 53);
-    // Every third ray left out.
+    // Every third ray left out; 97 × 53 rays end in a fan of 5.
     let dirs: Vec<Option<glam::Vec3>> = (0..97 * 53)
         .map(|i| {
             let pixel = DVec2::new((i % 97) as f64 + 0.5, (i / 97) as f64 + 0.5);
             (i % 3 != 1).then(|| driver.world_ray(pixel).1.as_vec3())
         })
         .collect();
+    let mut stack = PacketStack::new();
+    let mut got = Vec::new();
+    for fan in dirs.chunks(PACKET) {
+        let hits = layered.trace_fan(eye, fan, view_bit::OCCLUDED, &mut stack);
+        assert!(hits[fan.len()..].iter().all(Option::is_none));
+        got.extend_from_slice(&hits[..fan.len()]);
+    }
     let want: Vec<_> = dirs
         .iter()
-        .map(|d| d.and_then(|d| layered.trace(eye.as_vec3(), d, view_bit::OCCLUDED)))
+        .map(|d| d.and_then(|d| layered.trace(eye, d, view_bit::OCCLUDED)))
         .collect();
-    for threads in [1, 3] {
-        let got = on_threads(threads, || {
-            layered.trace_all(eye.as_vec3(), &dirs, view_bit::OCCLUDED)
-        });
-        assert_eq!(got, want, "{threads} threads");
-    }
+    assert_eq!(got, want);
     let moved = want
         .iter()
         .filter(|h| h.is_some_and(|h| h.material >= layered.world.materials.len() as u32))

@@ -104,9 +104,9 @@ fn angle_between(a: DVec3, b: DVec3) -> f64 {
     a.cross(b).length().atan2(a.dot(b))
 }
 
-/// Pixels of a frame `frame_width` wide (indices in increasing order) and their bounding box,
-/// where SSIM's windows and FLIP's filters read them: every pixel a window or filter of theirs
-/// reads is inside it, so a map over the box is the frame's map there.
+/// Pixels of a frame `frame_width` wide (indices in increasing order) and their bounding box:
+/// SSIM's masked windows read nothing outside it, so its map over the box is its map over the
+/// frame there; FLIP is taken over the box itself.
 struct DisplayBox<'a> {
     pixels: &'a [usize],
     frame_width: usize,
@@ -701,7 +701,7 @@ mod tests {
                     let mut lanes = 0u32;
                     for (lane, query) in queries.iter_mut().enumerate() {
                         let x = x0 + 3 * lane as u32;
-                        // Every third lane idle; reaches 0.5 m to 162 m and infinity.
+                        // Every third lane idle; reaches 0.5 m to 154 m and infinity.
                         if x >= camera.width || lane % 3 == 2 {
                             continue;
                         }

@@ -592,32 +592,28 @@ impl RenderContext {
         }
     }
 
-    /// [`RenderContext::trace`] of the rays from `origin` along each direction of `dirs`
-    /// (unit; `None`: no ray, no surface), in order: the same surfaces bit for bit, traced 16
-    /// at a time as packets on the CPU's widest kernels and on all threads. For coherent rays
-    /// of one origin: a fan across the obstacle, the display's pixels seen from the eye.
-    pub fn trace_all(
+    /// [`RenderContext::trace`] of the rays from `origin` along each direction of `dirs` (at
+    /// most [`PACKET`]; unit; `None`: no ray), lane by lane: the same surfaces bit for bit,
+    /// traced as one packet on the CPU's widest kernels; `None` in the lanes beyond. For
+    /// coherent rays of one origin: a fan across the obstacle, the display's pixels seen
+    /// from the eye.
+    pub fn trace_fan(
         &self,
         origin: Vec3,
         dirs: &[Option<Vec3>],
         view: u8,
-    ) -> Vec<Option<SurfaceHit>> {
-        let isa = Isa::best();
-        dirs.par_chunks(PACKET)
-            .map_init(PacketStack::new, |stack, run| {
-                let mut packet = RayPacket::new();
-                let mut lane_dirs = [Vec3::X; PACKET];
-                for (lane, dir) in run.iter().enumerate() {
-                    if let &Some(dir) = dir {
-                        lane_dirs[lane] = dir;
-                        packet.set(lane, &make_ray(origin, dir, 0.0, f32::INFINITY));
-                    }
-                }
-                let hits = self.trace_packet(&lane_dirs, &mut packet, view, isa, stack);
-                hits.into_iter().take(run.len()).collect::<Vec<_>>()
-            })
-            .flatten_iter()
-            .collect()
+        stack: &mut PacketStack,
+    ) -> [Option<SurfaceHit>; PACKET] {
+        assert!(dirs.len() <= PACKET, "{} rays in a packet", dirs.len());
+        let mut packet = RayPacket::new();
+        let mut lane_dirs = [Vec3::X; PACKET];
+        for (lane, dir) in dirs.iter().enumerate() {
+            if let &Some(dir) = dir {
+                lane_dirs[lane] = dir;
+                packet.set(lane, &make_ray(origin, dir, 0.0, f32::INFINITY));
+            }
+        }
+        self.trace_packet(&lane_dirs, &mut packet, view, Isa::best(), stack)
     }
 
     /// The closest surface visible in `view` along a ray from `origin` (unit `dir`).

@@ -12,9 +12,11 @@
 //! neither eye sees).
 
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 use serde_json::json;
 
 use crate::geometry::camera::Camera;
+use crate::render::bvh_packet::{PACKET, PacketStack};
 use crate::render::integrator::RenderContext;
 use crate::scene::world::view_bit;
 use crate::system::surface_map::display_points;
@@ -35,21 +37,30 @@ pub struct Obstruction {
 
 /// Per ray of the sweep from `eye`: (blocked by the obstacle, blocked by its body).
 fn sweep(ctx: &RenderContext, eye: DVec3, forward: DVec3, across: DVec3) -> Vec<(bool, bool)> {
-    let n = (2.0 * SPAN_DEG / STEP_DEG).round() as i64;
-    let dirs: Vec<Option<Vec3>> = (0..=n)
-        .map(|i| {
-            let phi = (-SPAN_DEG + i as f64 * STEP_DEG).to_radians();
-            Some((forward * phi.cos() + across * phi.sin()).as_vec3())
+    let n = (2.0 * SPAN_DEG / STEP_DEG).round() as usize;
+    let angles: Vec<usize> = (0..=n).collect();
+    angles
+        .par_chunks(PACKET)
+        .map_init(PacketStack::new, |stack, run| {
+            let dirs: Vec<Option<Vec3>> = run
+                .iter()
+                .map(|&i| {
+                    let phi = (-SPAN_DEG + i as f64 * STEP_DEG).to_radians();
+                    Some((forward * phi.cos() + across * phi.sin()).as_vec3())
+                })
+                .collect();
+            let hits = ctx.trace_fan(eye.as_vec3(), &dirs, view_bit::OCCLUDED, stack);
+            hits[..run.len()]
+                .iter()
+                .map(|hit| match hit {
+                    Some(hit) if hit.object == ctx.world.obstacle_id => {
+                        (true, !ctx.world.is_display(hit.object, hit.part))
+                    }
+                    _ => (false, false),
+                })
+                .collect::<Vec<_>>()
         })
-        .collect();
-    ctx.trace_all(eye.as_vec3(), &dirs, view_bit::OCCLUDED)
-        .into_iter()
-        .map(|hit| match hit {
-            Some(hit) if hit.object == ctx.world.obstacle_id => {
-                (true, !ctx.world.is_display(hit.object, hit.part))
-            }
-            _ => (false, false),
-        })
+        .flatten_iter()
         .collect()
 }
 
@@ -86,34 +97,34 @@ pub fn obstruction(ctx: &RenderContext, eye: DVec3, ipd: f64) -> Obstruction {
 /// thing the eye's ray to it meets.
 pub fn display_pixels_seen(ctx: &RenderContext, driver: &Camera) -> usize {
     let eye = driver.position();
-    let points = display_points(&ctx.scene.obstacle);
-    // The eye's ray to each point inside the driver's view, and the point's distance.
-    let rays: Vec<Option<(Vec3, f64)>> = points
-        .iter()
-        .map(|&p| {
-            let p = p?;
-            let px = driver.project_point(p)?;
-            let inside = px.x >= 0.0
-                && px.y >= 0.0
-                && px.x < driver.width as f64
-                && px.y < driver.height as f64;
-            let to = p - eye;
-            let dist = to.length();
-            inside.then(|| ((to / dist).as_vec3(), dist))
+    // The eye's ray to a point inside the driver's view, and the point's distance.
+    let ray_to = |p: Option<DVec3>| {
+        let p = p?;
+        let px = driver.project_point(p)?;
+        let inside =
+            px.x >= 0.0 && px.y >= 0.0 && px.x < driver.width as f64 && px.y < driver.height as f64;
+        let to = p - eye;
+        let dist = to.length();
+        inside.then(|| ((to / dist).as_vec3(), dist))
+    };
+    display_points(&ctx.scene.obstacle)
+        .par_chunks(PACKET)
+        .map_init(PacketStack::new, |stack, points| {
+            let rays: Vec<Option<(Vec3, f64)>> = points.iter().map(|&p| ray_to(p)).collect();
+            let dirs: Vec<Option<Vec3>> = rays.iter().map(|r| r.map(|(dir, _)| dir)).collect();
+            let hits = ctx.trace_fan(eye.as_vec3(), &dirs, view_bit::OCCLUDED, stack);
+            hits.iter()
+                .zip(&rays)
+                .filter(|(hit, ray)| match (hit, ray) {
+                    (Some(hit), Some((_, dist))) => {
+                        ctx.world.is_display(hit.object, hit.part)
+                            && (f64::from(hit.t) - dist).abs() < 1e-3 * dist.max(1.0)
+                    }
+                    _ => false,
+                })
+                .count()
         })
-        .collect();
-    let dirs: Vec<Option<Vec3>> = rays.iter().map(|r| r.map(|(dir, _)| dir)).collect();
-    ctx.trace_all(eye.as_vec3(), &dirs, view_bit::OCCLUDED)
-        .iter()
-        .zip(&rays)
-        .filter(|(hit, ray)| match (hit, ray) {
-            (Some(hit), Some((_, dist))) => {
-                ctx.world.is_display(hit.object, hit.part)
-                    && (f64::from(hit.t) - dist).abs() < 1e-3 * dist.max(1.0)
-            }
-            _ => false,
-        })
-        .count()
+        .sum()
 }
 
 /// The share of the display below which a run warns that the driver sees only a sliver of it.
