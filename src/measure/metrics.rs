@@ -312,13 +312,13 @@ fn nearer_than_packet(
         }
     }
     let rays = packet;
+    // A lane never set, or left out of `rest` (already near), holds no hit.
     let near_in = |packet: &RayPacket| {
         (0..PACKET)
             .filter(|&lane| {
-                packet.active >> lane & 1 != 0
-                    && packet
-                        .hit(lane)
-                        .is_some_and(|h| (h.t as f64) < queries[lane].1)
+                packet
+                    .hit(lane)
+                    .is_some_and(|h| (h.t as f64) < queries[lane].1)
             })
             .fold(0u32, |bits, lane| bits | 1 << lane)
     };
@@ -707,8 +707,16 @@ mod tests {
                         }
                         let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
                         let (_, dir) = camera.world_ray(pixel);
-                        let reach = match (x + y) % 7 {
+                        let reach = match (x + y) % 8 {
                             0 => f64::INFINITY,
+                            // Exactly the static surface's distance: it is not nearer.
+                            7 => ctx
+                                .accel
+                                .closest(
+                                    &reach_ray(origin, dir.as_vec3(), f64::INFINITY),
+                                    view_bit::FRONTAL,
+                                )
+                                .map_or(1.0, |h| f64::from(h.t)),
                             r => 0.5 * 2.6f64.powi(r as i32),
                         };
                         *query = (dir.as_vec3(), reach);
