@@ -157,6 +157,47 @@ fn compare_packets(accel: &Accel, expected: &[(TraceRay, Option<Hit>, bool)], vi
     }
 }
 
+#[test]
+fn a_packet_filled_axis_by_axis_equals_one_set_lane_by_lane() {
+    // Directions with zero, signed-zero, tiny (below and above the 1e-20 clamp) and ordinary
+    // components, from several origins; every count of rays from none to a full packet.
+    let mut rays = special_rays();
+    rays.extend(random_rays(Vec3::new(1.4, 1.2, 0.0), 40));
+    for d in [
+        Vec3::new(-0.0, 0.0, -1.0),
+        Vec3::new(1e-21, -1e-21, 1.0),
+        Vec3::new(-1e-20, 1e-20, -1.0),
+        Vec3::new(3e-20, -2e-19, 1.0),
+    ] {
+        rays.push((Vec3::new(-2.0, 0.5, -7.0), d));
+    }
+    let fields = |p: &RayPacket, lane: usize| {
+        let mut v: Vec<u32> = Vec::new();
+        for a in 0..3 {
+            v.extend([p.origin[a][lane], p.dir[a][lane], p.inv_dir[a][lane]].map(f32::to_bits));
+        }
+        v.extend([p.tmin[lane].to_bits(), p.tmax[lane].to_bits(), p.prim[lane]]);
+        v
+    };
+    for (start, n) in (0..rays.len()).step_by(7).zip((0..=PACKET).cycle()) {
+        let chunk: Vec<(Vec3, Vec3)> = rays.iter().cycle().skip(start).take(n).copied().collect();
+        let mut by_lane = RayPacket::new();
+        for (lane, &(o, d)) in chunk.iter().enumerate() {
+            by_lane.set(lane, &make_ray(o, d, 0.0, f32::INFINITY));
+        }
+        let mut by_axis = RayPacket::new();
+        by_axis.set_from_zero(n, |lane| chunk[lane]);
+        assert_eq!(by_axis.active, by_lane.active, "{n} rays from {start}");
+        for lane in 0..n {
+            assert_eq!(
+                fields(&by_axis, lane),
+                fields(&by_lane, lane),
+                "lane {lane} of {n}"
+            );
+        }
+    }
+}
+
 /// Camera rays in 4×4 tiles: packets as the integrator makes them.
 fn tiled_camera_rays(camera: &Camera) -> Vec<(Vec3, Vec3)> {
     let camera = camera.with_resolution(160, (160 * camera.height / camera.width).max(1));

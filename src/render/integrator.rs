@@ -447,13 +447,12 @@ impl RenderContext {
         let mut camera = RayPacket::new();
         let mut shadow = RayPacket::new();
         for sample in 0..job.spp {
-            camera.clear();
             for (lane, &(x, row)) in at[..n].iter().enumerate() {
                 let y = tile.y + row;
                 let (dx, dy) = pixel_offset(x, y, sample);
                 dirs[lane] = job.rays.direction(x as f32 + dx, y as f32 + dy);
-                camera.set(lane, &make_ray(origin, dirs[lane], 0.0, f32::INFINITY));
             }
+            camera.set_from_zero(n, |lane| (origin, dirs[lane]));
             let hits = self.trace_packet(&dirs, &mut camera, job.view, tile.isa, packet_stack);
             let mut shown = [None; PACKET];
             let mut shading: [Option<Shading>; PACKET] = std::array::from_fn(|_| None);

@@ -38,6 +38,17 @@ impl TraceRay {
     }
 }
 
+/// One component of [`TraceRay::inv_dir`] from that of the direction: [`TraceRay::new`]'s
+/// rule for one lane of a packet filled axis by axis.
+#[inline(always)]
+pub fn reciprocal(d: f32) -> f32 {
+    1.0 / if d.abs() < 1e-20 {
+        1e-20f32.copysign(d)
+    } else {
+        d
+    }
+}
+
 /// A closest-hit answer: which primitive of the world, at which distance (metres).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {

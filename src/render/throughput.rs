@@ -120,9 +120,7 @@ fn by_packets<T: Send>(
         .for_each_init(PacketStack::new, |stack, (rays, out)| {
             for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
                 let mut packet = RayPacket::new();
-                for (lane, ray) in rays.iter().enumerate() {
-                    packet.set(lane, &ray.ray());
-                }
+                packet.set_from_zero(rays.len(), |lane| (rays[lane].origin, rays[lane].dir));
                 trace(&mut packet, stack, out);
             }
         });
