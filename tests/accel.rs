@@ -198,6 +198,50 @@ fn a_packet_filled_axis_by_axis_equals_one_set_lane_by_lane() {
     }
 }
 
+#[test]
+fn bench_batches_traced_in_packets_equal_them_traced_ray_by_ray() {
+    // `bench`'s trace-only batches: camera rays in tiles, at a size whose last packet is
+    // short (61 × 37 = 2257 rays, 2257 mod 16 = 1), and the sun's shadow rays from their hits.
+    use seethru::render::throughput::{
+        camera_batch, shadow_batch, trace_any, trace_any_per_ray, trace_closest,
+        trace_closest_per_ray,
+    };
+    let scene = common::das();
+    let world = World::build(&scene).unwrap();
+    let accel = Accel::build(&world).unwrap();
+    let sun = seethru::render::sky::SkyModel::new(&scene.sky, &scene.sun).sun_direction;
+    let camera = View::Truth.camera(&scene).with_resolution(61, 37);
+    let primary = camera_batch(&camera, view_bit::TRUTH);
+    let mut per_ray = vec![None; primary.rays.len()];
+    trace_closest_per_ray(&accel, &primary, &mut per_ray);
+    for isa in Isa::ALL.into_iter().filter(|i| i.available()) {
+        let mut packets = vec![None; primary.rays.len()];
+        trace_closest(&accel, &primary, isa, &mut packets);
+        let bits = |h: &Option<Hit>| h.map(|h| (h.prim, h.t.to_bits()));
+        let first_difference = (0..per_ray.len()).find(|&i| bits(&packets[i]) != bits(&per_ray[i]));
+        assert_eq!(first_difference, None, "{isa:?}");
+    }
+    let hits = per_ray.iter().filter(|h| h.is_some()).count();
+    assert!(
+        hits > primary.rays.len() / 3 && hits < primary.rays.len(),
+        "{hits}"
+    );
+    let shadow = shadow_batch(&world, &primary, &per_ray, sun);
+    let mut per_ray = vec![false; shadow.rays.len()];
+    trace_any_per_ray(&accel, &shadow, &mut per_ray);
+    for isa in Isa::ALL.into_iter().filter(|i| i.available()) {
+        let mut packets = vec![true; shadow.rays.len()];
+        trace_any(&accel, &shadow, isa, &mut packets);
+        assert_eq!(packets, per_ray, "{isa:?}");
+    }
+    let blocked = per_ray.iter().filter(|&&b| b).count();
+    assert!(
+        blocked > 0 && blocked < per_ray.len(),
+        "{blocked} of {}",
+        per_ray.len()
+    );
+}
+
 /// Camera rays in 4×4 tiles: packets as the integrator makes them.
 fn tiled_camera_rays(camera: &Camera) -> Vec<(Vec3, Vec3)> {
     let camera = camera.with_resolution(160, (160 * camera.height / camera.width).max(1));
