@@ -242,6 +242,46 @@ fn bench_batches_traced_in_packets_equal_them_traced_ray_by_ray() {
     );
 }
 
+#[test]
+fn a_thread_stack_in_use_further_up_gives_way_to_a_fresh_one() {
+    // A query made while this thread's stack is borrowed (a trace inside a trace) gets a
+    // stack of its own, and the same answer, instead of a panic.
+    use seethru::render::bvh::Stack;
+    let scene = common::das();
+    let world = World::build(&scene).unwrap();
+    let accel = Accel::build(&world).unwrap();
+    let ray = make_ray(
+        scene.eye().as_vec3(),
+        Vec3::new(0.0, -0.3, -1.0).normalize(),
+        0.0,
+        f32::INFINITY,
+    );
+    let mut packet = RayPacket::new();
+    packet.set_from_zero(1, |_| (Vec3::from(ray.origin), Vec3::from(ray.dir)));
+    let trace = |stack: &mut PacketStack| {
+        let mut p = packet;
+        accel.closest_packet(&mut p, view_bit::TRUTH, Isa::best(), stack);
+        p.hit(0).map(|h| (h.prim, h.t.to_bits()))
+    };
+    let (outer, inner) = PacketStack::with_thread_stack(|outer| {
+        (
+            trace(outer),
+            PacketStack::with_thread_stack(|inner| trace(inner)),
+        )
+    });
+    assert!(outer.is_some());
+    assert_eq!(inner, outer);
+    let (outer, inner) = Stack::with_thread_stack(|outer| {
+        let hit = |s: &mut Stack| accel.closest_with(&ray, view_bit::TRUTH, s);
+        (hit(outer), Stack::with_thread_stack(|inner| hit(inner)))
+    });
+    assert_eq!(inner, outer);
+    assert_eq!(
+        outer.map(|h| (h.prim, h.t.to_bits())),
+        trace(&mut PacketStack::new())
+    );
+}
+
 /// Camera rays in 4×4 tiles: packets as the integrator makes them.
 fn tiled_camera_rays(camera: &Camera) -> Vec<(Vec3, Vec3)> {
     let camera = camera.with_resolution(160, (160 * camera.height / camera.width).max(1));

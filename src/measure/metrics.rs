@@ -495,26 +495,28 @@ pub fn measure_with(
         use rayon::prelude::*;
         on_display
             .par_chunks(PACKET)
-            .map_init(PacketStack::new, |stack, run| {
-                let mut queries = [(Vec3::X, 0.0); PACKET];
-                let mut asked = 0u32;
-                let mut out: Vec<Measured> = Vec::with_capacity(run.len());
-                for (lane, &i) in run.iter().enumerate() {
-                    let (m, query) = per_pixel(i);
-                    if let Some(q) = query {
-                        queries[lane] = q;
-                        asked |= 1 << lane;
+            .map(|run| {
+                PacketStack::with_thread_stack(|stack| {
+                    let mut queries = [(Vec3::X, 0.0); PACKET];
+                    let mut asked = 0u32;
+                    let mut out: Vec<Measured> = Vec::with_capacity(run.len());
+                    for (lane, &i) in run.iter().enumerate() {
+                        let (m, query) = per_pixel(i);
+                        if let Some(q) = query {
+                            queries[lane] = q;
+                            asked |= 1 << lane;
+                        }
+                        out.push(m);
                     }
-                    out.push(m);
-                }
-                let origin = frontal_origin.as_vec3();
-                let hidden = nearer_than_packet(ctx, origin, &queries, asked, isa, stack);
-                for (lane, m) in out.iter_mut().enumerate() {
-                    if hidden >> lane & 1 != 0 {
-                        m.missing = Some(Missing::Hidden);
+                    let origin = frontal_origin.as_vec3();
+                    let hidden = nearer_than_packet(ctx, origin, &queries, asked, isa, stack);
+                    for (lane, m) in out.iter_mut().enumerate() {
+                        if hidden >> lane & 1 != 0 {
+                            m.missing = Some(Missing::Hidden);
+                        }
                     }
-                }
-                out
+                    out
+                })
             })
             .flatten_iter()
             .collect()

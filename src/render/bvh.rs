@@ -142,6 +142,19 @@ impl Stack {
         }
     }
 
+    /// Runs `f` with this thread's stack, allocated once per thread (a fresh one where the
+    /// thread's is in use further up its call stack), as the packet stack's
+    /// `with_thread_stack`.
+    pub fn with_thread_stack<R>(f: impl FnOnce(&mut Stack) -> R) -> R {
+        thread_local! {
+            static STACK: std::cell::RefCell<Stack> = std::cell::RefCell::new(Stack::new());
+        }
+        STACK.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut stack) => f(&mut stack),
+            Err(_) => f(&mut Stack::new()),
+        })
+    }
+
     #[inline(always)]
     fn push(&mut self, key: u64) {
         self.entries[self.len] = key;

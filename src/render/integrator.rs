@@ -327,55 +327,56 @@ impl RenderContext {
         let progress = Progress::new(format!("rendering {label}"), bands.len(), settings.progress);
         let shadow_rays: u64 = bands
             .into_par_iter()
-            .map_init(
-                || (Stack::new(), PacketStack::new()),
-                |(stack, packet_stack), mut band| {
-                    let mut shadows = 0;
-                    // A cancelled render (render/cancel.rs) leaves its remaining bands as they are.
-                    if crate::render::cancel::requested() {
-                        return shadows;
-                    }
-                    // The band's rows inside the region.
-                    let rows =
-                        region.y0.max(band.y) - band.y..region.y1.min(band.y + band.len()) - band.y;
-                    match tracer {
-                        Tracer::PerRay => {
-                            for row in rows {
-                                for x in region.x0..region.x1 {
-                                    let pixel = self.render_pixel(
+            .map(|mut band| {
+                Stack::with_thread_stack(|stack| {
+                    PacketStack::with_thread_stack(|packet_stack| {
+                        let mut shadows = 0;
+                        // A cancelled render (render/cancel.rs) leaves its remaining bands as they are.
+                        if crate::render::cancel::requested() {
+                            return shadows;
+                        }
+                        // The band's rows inside the region.
+                        let rows = region.y0.max(band.y) - band.y
+                            ..region.y1.min(band.y + band.len()) - band.y;
+                        match tracer {
+                            Tracer::PerRay => {
+                                for row in rows {
+                                    for x in region.x0..region.x1 {
+                                        let pixel = self.render_pixel(
+                                            &job,
+                                            x,
+                                            band.y + row,
+                                            stack,
+                                            &mut shadows,
+                                        );
+                                        band.set(x, row, pixel);
+                                    }
+                                }
+                            }
+                            Tracer::Packets(isa) => {
+                                for x0 in (region.x0..region.x1).step_by(TILE_COLUMNS as usize) {
+                                    let tile = Tile {
+                                        isa,
+                                        y: band.y,
+                                        rows: rows.clone(),
+                                        columns: x0..(x0 + TILE_COLUMNS).min(region.x1),
+                                    };
+                                    self.render_tile(
                                         &job,
-                                        x,
-                                        band.y + row,
+                                        &tile,
+                                        &mut band,
                                         stack,
+                                        packet_stack,
                                         &mut shadows,
                                     );
-                                    band.set(x, row, pixel);
                                 }
                             }
                         }
-                        Tracer::Packets(isa) => {
-                            for x0 in (region.x0..region.x1).step_by(TILE_COLUMNS as usize) {
-                                let tile = Tile {
-                                    isa,
-                                    y: band.y,
-                                    rows: rows.clone(),
-                                    columns: x0..(x0 + TILE_COLUMNS).min(region.x1),
-                                };
-                                self.render_tile(
-                                    &job,
-                                    &tile,
-                                    &mut band,
-                                    stack,
-                                    packet_stack,
-                                    &mut shadows,
-                                );
-                            }
-                        }
-                    }
-                    progress.advance(1);
-                    shadows
-                },
-            )
+                        progress.advance(1);
+                        shadows
+                    })
+                })
+            })
             .sum();
         progress.finish();
         RenderStats {

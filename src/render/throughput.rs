@@ -117,12 +117,14 @@ fn by_packets<T: Send>(
         .rays
         .par_chunks(CHUNK)
         .zip(out.par_chunks_mut(CHUNK))
-        .for_each_init(PacketStack::new, |stack, (rays, out)| {
-            for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
-                let mut packet = RayPacket::new();
-                packet.set_from_zero(rays.len(), |lane| (rays[lane].origin, rays[lane].dir));
-                trace(&mut packet, stack, out);
-            }
+        .for_each(|(rays, out)| {
+            PacketStack::with_thread_stack(|stack| {
+                for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+                    let mut packet = RayPacket::new();
+                    packet.set_from_zero(rays.len(), |lane| (rays[lane].origin, rays[lane].dir));
+                    trace(&mut packet, stack, out);
+                }
+            })
         });
 }
 
@@ -132,10 +134,12 @@ pub fn trace_closest_per_ray(accel: &Accel, batch: &Batch, out: &mut [Option<Hit
         .rays
         .par_chunks(CHUNK)
         .zip(out.par_chunks_mut(CHUNK))
-        .for_each_init(Stack::new, |stack, (rays, out)| {
-            for (ray, out) in rays.iter().zip(out) {
-                *out = accel.closest_with(&ray.ray(), batch.view, stack);
-            }
+        .for_each(|(rays, out)| {
+            Stack::with_thread_stack(|stack| {
+                for (ray, out) in rays.iter().zip(out) {
+                    *out = accel.closest_with(&ray.ray(), batch.view, stack);
+                }
+            })
         });
 }
 
@@ -145,10 +149,12 @@ pub fn trace_any_per_ray(accel: &Accel, batch: &Batch, out: &mut [bool]) {
         .rays
         .par_chunks(CHUNK)
         .zip(out.par_chunks_mut(CHUNK))
-        .for_each_init(Stack::new, |stack, (rays, out)| {
-            for (ray, out) in rays.iter().zip(out) {
-                *out = accel.occluded_with(&ray.ray(), batch.view, stack);
-            }
+        .for_each(|(rays, out)| {
+            Stack::with_thread_stack(|stack| {
+                for (ray, out) in rays.iter().zip(out) {
+                    *out = accel.occluded_with(&ray.ray(), batch.view, stack);
+                }
+            })
         });
 }
 

@@ -41,24 +41,26 @@ fn sweep(ctx: &RenderContext, eye: DVec3, forward: DVec3, across: DVec3) -> Vec<
     let angles: Vec<usize> = (0..=n).collect();
     angles
         .par_chunks(PACKET)
-        .map_init(PacketStack::new, |stack, run| {
-            let dirs: Vec<Option<Vec3>> = run
-                .iter()
-                .map(|&i| {
-                    let phi = (-SPAN_DEG + i as f64 * STEP_DEG).to_radians();
-                    Some((forward * phi.cos() + across * phi.sin()).as_vec3())
-                })
-                .collect();
-            let hits = ctx.trace_fan(eye.as_vec3(), &dirs, view_bit::OCCLUDED, stack);
-            hits[..run.len()]
-                .iter()
-                .map(|hit| match hit {
-                    Some(hit) if hit.object == ctx.world.obstacle_id => {
-                        (true, !ctx.world.is_display(hit.object, hit.part))
-                    }
-                    _ => (false, false),
-                })
-                .collect::<Vec<_>>()
+        .map(|run| {
+            PacketStack::with_thread_stack(|stack| {
+                let dirs: Vec<Option<Vec3>> = run
+                    .iter()
+                    .map(|&i| {
+                        let phi = (-SPAN_DEG + i as f64 * STEP_DEG).to_radians();
+                        Some((forward * phi.cos() + across * phi.sin()).as_vec3())
+                    })
+                    .collect();
+                let hits = ctx.trace_fan(eye.as_vec3(), &dirs, view_bit::OCCLUDED, stack);
+                hits[..run.len()]
+                    .iter()
+                    .map(|hit| match hit {
+                        Some(hit) if hit.object == ctx.world.obstacle_id => {
+                            (true, !ctx.world.is_display(hit.object, hit.part))
+                        }
+                        _ => (false, false),
+                    })
+                    .collect::<Vec<_>>()
+            })
         })
         .flatten_iter()
         .collect()
@@ -109,20 +111,22 @@ pub fn display_pixels_seen(ctx: &RenderContext, driver: &Camera) -> usize {
     };
     display_points(&ctx.scene.obstacle)
         .par_chunks(PACKET)
-        .map_init(PacketStack::new, |stack, points| {
-            let rays: Vec<Option<(Vec3, f64)>> = points.iter().map(|&p| ray_to(p)).collect();
-            let dirs: Vec<Option<Vec3>> = rays.iter().map(|r| r.map(|(dir, _)| dir)).collect();
-            let hits = ctx.trace_fan(eye.as_vec3(), &dirs, view_bit::OCCLUDED, stack);
-            hits.iter()
-                .zip(&rays)
-                .filter(|(hit, ray)| match (hit, ray) {
-                    (Some(hit), Some((_, dist))) => {
-                        ctx.world.is_display(hit.object, hit.part)
-                            && (f64::from(hit.t) - dist).abs() < 1e-3 * dist.max(1.0)
-                    }
-                    _ => false,
-                })
-                .count()
+        .map(|points| {
+            PacketStack::with_thread_stack(|stack| {
+                let rays: Vec<Option<(Vec3, f64)>> = points.iter().map(|&p| ray_to(p)).collect();
+                let dirs: Vec<Option<Vec3>> = rays.iter().map(|r| r.map(|(dir, _)| dir)).collect();
+                let hits = ctx.trace_fan(eye.as_vec3(), &dirs, view_bit::OCCLUDED, stack);
+                hits.iter()
+                    .zip(&rays)
+                    .filter(|(hit, ray)| match (hit, ray) {
+                        (Some(hit), Some((_, dist))) => {
+                            ctx.world.is_display(hit.object, hit.part)
+                                && (f64::from(hit.t) - dist).abs() < 1e-3 * dist.max(1.0)
+                        }
+                        _ => false,
+                    })
+                    .count()
+            })
         })
         .sum()
 }
