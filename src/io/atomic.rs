@@ -6,8 +6,9 @@
 //! The rule that makes the interrupt clean-up complete: a temporary (a file, or a staging
 //! folder of `io::staged`) and the folders it needs are created and registered under one
 //! lock, and the interrupt handler takes that lock, removes what is registered and keeps the
-//! lock until the process exits. A thread that would create a temporary after the clean-up
-//! began waits for the exit instead; a writer only writes into the file it was handed open.
+//! lock until the process exits. A thread that would create a temporary, or move a finished
+//! one into place, after the clean-up began waits for the exit instead; a writer only writes
+//! into the file it was handed open.
 
 use std::collections::BTreeSet;
 use std::fs::File;
@@ -189,8 +190,15 @@ pub fn write_atomically(
         .with_context(|| format!("cannot write {}", shown(path).display()))
         .and_then(|()| {
             drop(writer);
+            // Under the lock, like the creation: an interrupt's clean-up (which keeps the
+            // lock until the exit) never runs while a finished file moves into a staging
+            // folder it is removing, which would leave the folder with that file in it.
+            let state = in_flight();
             std::fs::rename(&tmp, path).map_err(|e| {
-                anyhow::anyhow!("cannot move {} into place: {e}", shown(path).display())
+                anyhow::anyhow!(
+                    "cannot move {} into place: {e}",
+                    state.shown(path).display()
+                )
             })
         });
     if result.is_err() {
