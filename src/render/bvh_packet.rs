@@ -173,7 +173,7 @@ impl PacketStack {
 
     /// Runs `f` with this thread's stack, allocated once per thread (a fresh one where the
     /// thread's is in use further up its call stack). A stack per rayon split (`map_init`)
-    /// cost a fifth of `bench`'s shadow batch on two threads: its 86 kB were fresh pages,
+    /// cost about a seventh of `bench`'s shadow batch on two threads: its 86 kB were fresh pages,
     /// faulted in, at every split.
     pub fn with_thread_stack<R>(f: impl FnOnce(&mut PacketStack) -> R) -> R {
         thread_local! {
