@@ -119,9 +119,8 @@ fn by_packets<T: Send>(
         .zip(out.par_chunks_mut(CHUNK))
         .for_each(|(rays, out)| {
             PacketStack::with_thread_stack(|stack| {
-                // `set_from_zero` sets every field: one packet serves the whole chunk.
-                let mut packet = RayPacket::new();
                 for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+                    let mut packet = RayPacket::new();
                     packet.set_from_zero(rays.len(), |lane| (rays[lane].origin, rays[lane].dir));
                     trace(&mut packet, stack, out);
                 }
