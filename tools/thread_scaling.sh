@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Thread scaling of seethru's `bench` beside native Embree's packet anchor, and the per-pixel
 # CPU time against wall time of the shaded frame (examples/ray_cpu_time.rs), on a machine with
-# more cores. Writes seethru.txt, embree.txt and cpu.txt into OUT.
+# more cores, and how much a loop that shares nothing slows per copy with as many copies as the
+# most threads (alu.txt: user seconds per copy), which bounds any program's efficiency there.
+# Writes machine.txt, seethru.txt, cpu.txt, alu.txt and embree.txt into OUT.
 #
 #   SEETHRU=target/release/seethru CPU_TIME=target/release/examples/ray_cpu_time \
 #   EMBREE=../shared/peers/embree_native/embree_bench4 OBJ=/tmp/embree_das/das.obj \
@@ -33,4 +35,12 @@ for round in 1 2; do
     fi
   done
 done
-echo "wrote $out/seethru.txt, $out/cpu.txt${EMBREE:+ and $out/embree.txt}"
+# A cache-resident loop, alone and as many copies at once, three times each.
+most=$(printf '%s\n' $threads | sort -n | tail -1)
+loop() { (TIMEFORMAT=%U; time awk 'BEGIN{s=0; for(i=0;i<2e7;i++) s+=i*i; print s >"/dev/null"}') 2>&1; }
+for round in 1 2 3; do
+  echo "alone $(loop)" >>"$out/alu.txt"
+  for _ in $(seq "$most"); do loop | sed "s/^/$most at once /" >>"$out/alu.txt" & done
+  wait
+done
+echo "wrote $out/seethru.txt, $out/cpu.txt, $out/alu.txt${EMBREE:+ and $out/embree.txt}"
