@@ -25,22 +25,7 @@ use seethru::render::throughput::{
 use seethru::render::views::View;
 use seethru::scene::Scene;
 use seethru::scene::grow::grow;
-
-/// CPU nanoseconds of every thread of this process so far.
-fn cpu_ns() -> Result<u64> {
-    let mut total = 0;
-    for task in std::fs::read_dir("/proc/self/task")? {
-        let path = task?.path().join("schedstat");
-        // A thread that ended between the listing and the read is skipped.
-        if let Ok(text) = std::fs::read_to_string(&path) {
-            let on_cpu = text.split_whitespace().next().unwrap_or("");
-            total += on_cpu
-                .parse::<u64>()
-                .with_context(|| format!("{}: not a count of nanoseconds", path.display()))?;
-        }
-    }
-    Ok(total)
-}
+use seethru::util::cpu_time::threads_cpu_ns;
 
 fn number<T: std::str::FromStr>(
     arg: Option<&String>,
@@ -55,6 +40,11 @@ fn number<T: std::str::FromStr>(
             .ok()
             .with_context(|| format!("{name} '{s}' is not a number in {range}")),
     }
+}
+
+/// CPU nanoseconds of every thread of this process so far.
+fn cpu_ns() -> Result<u64> {
+    threads_cpu_ns().context("no per-thread CPU times here (/proc/self/task/*/schedstat)")
 }
 
 fn main() {

@@ -566,3 +566,34 @@ fn temporaries_of_killed_processes_are_removed_by_the_next_write() {
     assert!(!stale.exists());
     assert!(out.join("truth.png").exists());
 }
+
+#[test]
+fn bench_says_how_busy_the_frame_kept_its_workers() {
+    let (ok, out, err) = seethru(&[
+        "bench",
+        "scenes/das.toml",
+        "--width",
+        "160",
+        "--height",
+        "90",
+        "--repeat",
+        "3",
+        "--threads",
+        "2",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(out.lines().last().unwrap()).unwrap();
+    for view in ["truth", "frontal"] {
+        // CPU time over wall time × threads: about 1 where the workers never wait, lower on a
+        // busy machine; never twice as much (the threads left out) nor a thousandth (a unit
+        // slip). Linux says; other systems give null.
+        let busy = &v["frame"][view]["workers_busy"];
+        if cfg!(target_os = "linux") {
+            let busy = busy.as_f64().unwrap_or_else(|| panic!("{view}: {busy}"));
+            assert!((0.05..=1.1).contains(&busy), "{view}: {busy}");
+        } else {
+            assert!(busy.is_null(), "{view}: {busy}");
+        }
+    }
+}

@@ -17,6 +17,7 @@ use seethru::render::throughput::{
 use seethru::render::views::View;
 use seethru::scene::Scene;
 use seethru::scene::grow::grow;
+use seethru::util::cpu_time::threads_cpu_ns;
 use seethru::util::memory::peak_rss_bytes;
 use serde_json::json;
 
@@ -106,6 +107,11 @@ impl std::fmt::Display for Spread {
 /// Seconds of each of `repeat` runs of `job`, after one untimed warm-up run.
 fn timed(repeat: usize, mut job: impl FnMut()) -> Vec<f64> {
     job();
+    seconds_of_each(repeat, job)
+}
+
+/// Seconds of each of `repeat` runs of `job`.
+fn seconds_of_each(repeat: usize, mut job: impl FnMut()) -> Vec<f64> {
     (0..repeat)
         .map(|_| {
             let start = Instant::now();
@@ -113,6 +119,21 @@ fn timed(repeat: usize, mut job: impl FnMut()) -> Vec<f64> {
             start.elapsed().as_secs_f64()
         })
         .collect()
+}
+
+/// [`timed`], and how busy the repeats kept the `threads` workers: the process's CPU time over
+/// the wall time × `threads` (`None` where the system does not say). About 1 where they never
+/// wait (the thread that waits on them adds a per cent or so); one minus it is the share of
+/// their time they waited, out of work or for a core.
+fn timed_busy(repeat: usize, threads: usize, mut job: impl FnMut()) -> (Vec<f64>, Option<f64>) {
+    job();
+    let before = threads_cpu_ns();
+    let seconds = seconds_of_each(repeat, job);
+    let cpu_s = before
+        .zip(threads_cpu_ns())
+        .map(|(a, b)| b.saturating_sub(a) as f64 * 1e-9);
+    let wall_s: f64 = seconds.iter().sum::<f64>() * threads as f64;
+    (seconds, cpu_s.map(|cpu| cpu / wall_s))
 }
 
 /// Million rays per second of each run.
@@ -256,7 +277,7 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
             .into(),
     );
 
-    say("frame        shaded, 1 spp (primary + shadow + shading); ms min / median / max".into());
+    say("frame        shaded, 1 spp (primary + shadow + shading); ms min / median / max; workers' CPU time / (wall × threads)".into());
     let mut frames = serde_json::Map::new();
     for view in [View::Truth, View::Frontal] {
         let camera = view
@@ -265,7 +286,7 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         // One frame buffer for every repeat, as a sequence of renders keeps it: the first
         // touch of 50 MB of new pages is the kernel's work, not the renderer's.
         let mut frame = Frame::new(camera.width, camera.height);
-        let seconds = timed(options.repeat, || {
+        let (seconds, busy) = timed_busy(options.repeat, threads, || {
             ctx.render_into(
                 &camera,
                 view.bit(),
@@ -277,12 +298,16 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         let ms: Vec<f64> = seconds.iter().map(|s| s * 1e3).collect();
         let spread = Spread::of(&ms);
         say(format!(
-            "  {:<24} {}×{}  {spread}",
+            "  {:<24} {}×{}  {spread}   workers busy {}",
             view.name(),
             options.width,
-            options.height
+            options.height,
+            busy.map_or("unknown".into(), |b| format!("{:.0} %", b * 100.0))
         ));
-        frames.insert(view.name().into(), json!({"ms": spread.json()}));
+        frames.insert(
+            view.name().into(),
+            json!({"ms": spread.json(), "workers_busy": busy}),
+        );
     }
     let methods = crate::cli::bench_methods::method_costs(&ctx, options.repeat, options.json)?;
     let (lines, sequence) = crate::cli::bench_sequence::bench_sequence(&ctx.scene)?;

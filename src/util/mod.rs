@@ -1,9 +1,11 @@
 //! Small pieces every layer uses: sRGB transfer functions, deterministic hashing for
 //! sampling and FNV-1a for fingerprints, short numbers for messages, the progress line,
-//! JSON for infinite distances, nearest-rank quantiles, the process's peak memory, input files read within limits,
+//! JSON for infinite distances, nearest-rank quantiles, the process's peak memory and its threads'
+//! CPU time, input files read within limits,
 //! and errors as one inert line.
 
 pub mod color;
+pub mod cpu_time;
 pub mod hash;
 pub mod input_file;
 pub mod json;
