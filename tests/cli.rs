@@ -568,7 +568,7 @@ fn temporaries_of_killed_processes_are_removed_by_the_next_write() {
 }
 
 #[test]
-fn bench_says_how_busy_the_frame_kept_its_workers() {
+fn bench_measures_its_repeats_and_how_busy_the_frame_kept_its_workers() {
     let (ok, out, err) = seethru(&[
         "bench",
         "scenes/das.toml",
@@ -584,6 +584,23 @@ fn bench_says_how_busy_the_frame_kept_its_workers() {
     ]);
     assert!(ok, "{err}");
     let v: serde_json::Value = serde_json::from_str(out.lines().last().unwrap()).unwrap();
+    // Three repeats each: measured times that are positive, ordered, and not all the same (a
+    // clock that is not read, or one figure for all repeats, gives min = max).
+    let spreads = [
+        &v["rays"]["primary"]["mrays_per_s"],
+        &v["rays"]["shadow"]["mrays_per_s"],
+        &v["rays"]["primary_shadow_per_ray"]["mrays_per_s"],
+        &v["frame"]["truth"]["ms"],
+        &v["frame"]["frontal"]["ms"],
+    ];
+    for spread in spreads {
+        let [min, median, max] =
+            ["min", "median", "max"].map(|k| spread[k].as_f64().unwrap_or(-1.0));
+        assert!(
+            0.0 < min && min <= median && median <= max && min < max && max.is_finite(),
+            "{spread}"
+        );
+    }
     for view in ["truth", "frontal"] {
         // CPU time over wall time × threads: about 1 where the workers never wait, lower on a
         // busy machine; never twice as much (the threads left out) nor a thousandth (a unit
