@@ -7,21 +7,10 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Args, FromArgMatches};
+use seethru::util::cpu_time::process_cpu_seconds;
 use serde_json::json;
 
 use crate::cli::run::Run;
-
-/// CPU seconds (user + system) this process has used, from `/proc/self/stat`; `None` where
-/// the system does not say (not Linux). Under load, CPU time is a steadier figure than wall.
-fn process_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // Fields after the command name (which may hold spaces) start at state (field 3);
-    // utime and stime are fields 14 and 15, in clock ticks (100 per second on Linux).
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| fields.get(i)?.parse::<f64>().ok();
-    Some((ticks(11)? + ticks(12)?) / 100.0)
-}
 
 /// Bytes of the files under `dir`.
 fn folder_bytes(dir: &Path) -> Result<u64> {

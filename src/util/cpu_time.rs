@@ -1,8 +1,21 @@
-//! CPU time of this process's live threads, in nanoseconds, from Linux's per-thread scheduler
-//! statistics (`/proc/self/task/*/schedstat`): finer than `/proc/self/stat`'s clock ticks
-//! (10 ms), fine enough to tell a frame's work from its workers' waiting. Threads that end
-//! between two readings take their time with them, so compare readings across work done on
-//! threads that live through it (rayon's pool).
+//! CPU time of this process, two ways. [`process_cpu_seconds`] (`/proc/self/stat`) counts
+//! every thread, ended ones too, in clock ticks (10 ms): for whole commands. [`threads_cpu_ns`]
+//! (Linux's per-thread scheduler statistics, `/proc/self/task/*/schedstat`) counts in
+//! nanoseconds, fine enough to tell a frame's work from its workers' waiting, but only the
+//! live threads: threads that end between two readings take their time with them, so compare
+//! its readings across work done on threads that live through it (rayon's pool).
+
+/// CPU seconds (user + system) this process has used, from `/proc/self/stat`; `None` where
+/// the system does not say (not Linux). Under load, CPU time is a steadier figure than wall.
+pub fn process_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which may hold spaces) start at state (field 3);
+    // utime and stime are fields 14 and 15, in clock ticks (100 per second on Linux).
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i)?.parse::<f64>().ok();
+    Some((ticks(11)? + ticks(12)?) / 100.0)
+}
 
 /// On-CPU nanoseconds of every live thread of this process, or `None` where the system does
 /// not say (not Linux).
