@@ -440,6 +440,18 @@ fn textures_that_are_not_images_or_too_large_name_the_material_and_the_file() {
         );
         render_refused(dir.path(), words);
     }
+    // Textures and meshes are read side by side; a broken texture is still the error named
+    // when a mesh is broken too, as if read in turn.
+    let scene = format!(
+        "\n[[material]]\nname = \"t\"\ntexture = \"tex.png\"\n{}",
+        mesh_object("m.obj")
+    );
+    let obj = TRIANGLE.replacen("v 1 0 0", "v 1 nan 0", 1);
+    let dir = scratch(
+        &scene,
+        &[("tex.png", b"not an image at all"), ("m.obj", obj.as_bytes())],
+    );
+    render_refused(dir.path(), &["material `t`", "tex.png"]);
 }
 
 #[test]

@@ -28,9 +28,9 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<(
 
 /// The colour AOV as an 8-bit sRGB PNG (clamped to [0, 1]; [`encode_srgb8`]).
 pub fn write_color_png(frame: &Frame, path: &Path) -> Result<()> {
-    let mut rgb = Vec::with_capacity(3 * frame.color.len());
-    for &c in &frame.color {
-        rgb.extend_from_slice(&encode_srgb8(c));
+    let mut rgb = vec![0; 3 * frame.color.len()];
+    for (rgb, &c) in rgb.chunks_exact_mut(3).zip(&frame.color) {
+        rgb.copy_from_slice(&encode_srgb8(c));
     }
     write_png(path, frame.width, frame.height, rgb)
 }

@@ -361,7 +361,9 @@ pub(crate) fn obj_error_line(obj: &[u8]) -> Option<String> {
     if let Some(why) = text_error(obj, "OBJ") {
         return Some(why);
     }
-    let lines = || obj.split(|&b| b == b'\n').map(String::from_utf8_lossy);
+    // Text by the check above: each line UTF-8, so the whole.
+    let text = std::str::from_utf8(obj).ok()?;
+    let lines = || text.split('\n');
     let mut totals = [0usize; 3];
     for line in lines() {
         match line.split_whitespace().next() {
@@ -374,11 +376,14 @@ pub(crate) fn obj_error_line(obj: &[u8]) -> Option<String> {
     let mut so_far = [0usize; 3];
     // The first vertex line with a colour and the first without, if any.
     let mut coloured: [Option<usize>; 2] = [None, None];
+    // One buffer for every line's words after the key.
+    let mut rest: Vec<&str> = Vec::new();
     for (i, line) in lines().enumerate() {
         let mut words = line.split_whitespace();
         let at = |why: String| Some(format!("line {}: {why}", i + 1));
         let key = words.next();
-        let rest: Vec<&str> = words.collect();
+        rest.clear();
+        rest.extend(words);
         match key {
             Some(key @ ("v" | "vt" | "vn")) => {
                 let (slot, needed, what) = match key {
@@ -392,17 +397,21 @@ pub(crate) fn obj_error_line(obj: &[u8]) -> Option<String> {
                 };
                 so_far[slot] += 1;
                 let numbers = &rest[..needed.min(rest.len())];
-                if numbers.len() < needed || numbers.iter().any(|w| w.parse::<f32>().is_err()) {
-                    return at(format!(
-                        "`{key}` needs {needed} numbers, got `{}`",
-                        clipped(&numbers.join(" "))
-                    ));
-                }
-                if let Err(why) = finite_numbers(numbers) {
-                    return at(format!(
-                        "`{key}` {}: {why}: {what}",
-                        clipped(&numbers.join(" "))
-                    ));
+                let parsed = || numbers.iter().map(|w| w.parse::<f32>());
+                // Each number parsed once where all is well; the messages parse them again.
+                if numbers.len() < needed || !parsed().all(|x| x.is_ok_and(f32::is_finite)) {
+                    if numbers.len() < needed || parsed().any(|x| x.is_err()) {
+                        return at(format!(
+                            "`{key}` needs {needed} numbers, got `{}`",
+                            clipped(&numbers.join(" "))
+                        ));
+                    }
+                    if let Err(why) = finite_numbers(numbers) {
+                        return at(format!(
+                            "`{key}` {}: {why}: {what}",
+                            clipped(&numbers.join(" "))
+                        ));
+                    }
                 }
                 if key != "v" {
                     continue;
@@ -452,7 +461,7 @@ pub(crate) fn obj_error_line(obj: &[u8]) -> Option<String> {
                         if rest.len() == 1 { "index" } else { "indices" }
                     ));
                 }
-                for corner in rest {
+                for &corner in &rest {
                     for (slot, part) in corner.split('/').enumerate().filter(|(_, p)| !p.is_empty())
                     {
                         let kind = ["vertex", "texture coordinate", "normal"].get(slot);

@@ -150,25 +150,10 @@ impl World {
                 used[m] = true;
             }
         }
-        for (index, m) in scene.materials.iter().enumerate() {
-            let texture = match &m.texture {
-                Some(path) if used[index] => {
-                    let texture =
-                        Texture::load(path).with_context(|| format!("material `{}`", m.name))?;
-                    world.textures.push(texture);
-                    Some(world.textures.len() - 1)
-                }
-                _ => None,
-            };
-            world.materials.push(SurfaceMaterial {
-                albedo: srgb_to_linear3(m.color),
-                texture,
-                uv_repeat: Vec2::new(m.uv_repeat[0] as f32, m.uv_repeat[1] as f32),
-            });
-        }
         // Each mesh file is read once, however many objects place it, and the files are read
-        // side by side (parsing is most of a big scene's start); a file's error is reported
-        // when its first object is reached, as if read in turn.
+        // side by side, and beside the textures (parsing is most of a big scene's start); a
+        // texture's error comes first, then a file's when its first object is reached, as if
+        // read in turn.
         let mesh_path = |shape: &Shape| match shape {
             Shape::Mesh { path } => Some(path.clone()),
             Shape::HeadMesh => Some(PathBuf::from("(built-in head mesh)")),
@@ -182,10 +167,37 @@ impl World {
                 firsts.push((path, &object.shape));
             }
         }
-        let loaded: Vec<Result<LoadedMesh>> = firsts
-            .par_iter()
-            .map(|(_, shape)| shape_mesh(shape).expect("a mesh shape"))
-            .collect();
+        let (textures, loaded) = rayon::join(
+            || -> Vec<Option<Result<Texture>>> {
+                let load = |(index, m): (usize, &crate::scene::Material)| match &m.texture {
+                    Some(path) if used[index] => {
+                        Some(Texture::load(path).with_context(|| format!("material `{}`", m.name)))
+                    }
+                    _ => None,
+                };
+                scene.materials.iter().enumerate().map(load).collect()
+            },
+            || -> Vec<Result<LoadedMesh>> {
+                firsts
+                    .par_iter()
+                    .map(|(_, shape)| shape_mesh(shape).expect("a mesh shape"))
+                    .collect()
+            },
+        );
+        for (m, texture) in scene.materials.iter().zip(textures) {
+            let texture = match texture.transpose()? {
+                Some(texture) => {
+                    world.textures.push(texture);
+                    Some(world.textures.len() - 1)
+                }
+                None => None,
+            };
+            world.materials.push(SurfaceMaterial {
+                albedo: srgb_to_linear3(m.color),
+                texture,
+                uv_repeat: Vec2::new(m.uv_repeat[0] as f32, m.uv_repeat[1] as f32),
+            });
+        }
         let mut meshes: HashMap<PathBuf, Result<LoadedMesh>> = firsts
             .into_iter()
             .map(|(path, _)| path)

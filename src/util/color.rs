@@ -38,53 +38,66 @@ pub fn encode_srgb8_by_transfer(c: Vec3) -> [u8; 3] {
 
 /// Linear RGB to 8-bit sRGB, clamped to [0, 1]; NaN becomes 0 — the codes of
 /// [`encode_srgb8_by_transfer`] for every f32 (`tests` compares them all in [0, 1]; beyond it
-/// both clamp), by table: each channel is the count of the 255 code thresholds (the smallest
-/// linear value that the transfer function encodes to each code 1…255, found once by
-/// bisection over the f32 values) at or below it, counted from a second table indexed by the
-/// value's top 16 bits — a lookup and a comparison or two instead of a `powf`.
+/// both clamp), by table: a channel's code is the count of the 255 code thresholds (the
+/// smallest linear value that the transfer function encodes to each code 1…255, found once by
+/// bisection over the f32 values) at or below it, read from a second table indexed by the
+/// value's top 16 bits and one comparison — a bucket of 2^16 f32 values holds one threshold at
+/// most, the codes being ≥ 1/255 apart in sRGB — instead of a `powf`.
 pub fn encode_srgb8(c: Vec3) -> [u8; 3] {
-    static THRESHOLDS: std::sync::OnceLock<[f32; 255]> = std::sync::OnceLock::new();
-    let t = THRESHOLDS.get_or_init(|| {
-        let code = |v: f32| encode_srgb8_by_transfer(Vec3::splat(v))[0];
-        std::array::from_fn(|k| {
-            // Smallest v in (0, 1] with code(v) > k, bisected on the bit patterns (positive
-            // floats order as their bits).
-            let (mut lo, mut hi) = (0u32, 1f32.to_bits());
-            while hi - lo > 1 {
-                let m = lo + (hi - lo) / 2;
-                if usize::from(code(f32::from_bits(m))) > k {
-                    hi = m;
-                } else {
-                    lo = m;
+    let table = Srgb8Table::get();
+    [table.code(c.x), table.code(c.y), table.code(c.z)]
+}
+
+/// [`encode_srgb8`]'s tables.
+struct Srgb8Table {
+    /// The thresholds of codes 1…255, then +∞ (no code 256).
+    thresholds: [f32; 256],
+    /// For each bucket of 2^16 bit patterns in [0, 1]: the count of thresholds at or below its
+    /// first value.
+    starts: Vec<u8>,
+}
+
+impl Srgb8Table {
+    fn get() -> &'static Srgb8Table {
+        static TABLE: std::sync::OnceLock<Srgb8Table> = std::sync::OnceLock::new();
+        TABLE.get_or_init(|| {
+            let code = |v: f32| encode_srgb8_by_transfer(Vec3::splat(v))[0];
+            let mut thresholds = [f32::INFINITY; 256];
+            for (k, t) in thresholds[..255].iter_mut().enumerate() {
+                // Smallest v in (0, 1] with code(v) > k, bisected on the bit patterns
+                // (positive floats order as their bits).
+                let (mut lo, mut hi) = (0u32, 1f32.to_bits());
+                while hi - lo > 1 {
+                    let m = lo + (hi - lo) / 2;
+                    if usize::from(code(f32::from_bits(m))) > k {
+                        hi = m;
+                    } else {
+                        lo = m;
+                    }
                 }
+                *t = f32::from_bits(hi);
             }
-            f32::from_bits(hi)
+            let starts = (0..=1f32.to_bits() >> 16)
+                .map(|b| thresholds.partition_point(|&x| x <= f32::from_bits(b << 16)) as u8)
+                .collect();
+            Srgb8Table { thresholds, starts }
         })
-    });
-    // The count of thresholds at or below the first f32 of each bucket of 2^16 bit patterns
-    // in [0, 1]: where the count for a value in that bucket starts (one or two thresholds
-    // further at most, the codes being ≥ 1/255 apart in sRGB).
-    static STARTS: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
-    let starts = STARTS.get_or_init(|| {
-        (0..=1f32.to_bits() >> 16)
-            .map(|b| t.partition_point(|&x| x <= f32::from_bits(b << 16)) as u8)
-            .collect()
-    });
-    let q = |v: f32| {
-        // NaN and v ≤ 0: no threshold is ≤ it, code 0, as encode_srgb8; v ≥ 1: all 255.
-        if v.is_nan() || v <= 0.0 {
-            return 0;
+    }
+
+    fn code(&self, v: f32) -> u8 {
+        let bits = v.to_bits();
+        // v ≥ 1 (to +∞): 255; NaN and every v ≤ 0 (the negatives' bits being above +∞'s,
+        // and +0's 0): code 0, as the thresholds are all above 0.
+        if bits >= 1f32.to_bits() {
+            return if bits <= f32::INFINITY.to_bits() {
+                255
+            } else {
+                0
+            };
         }
-        if v >= 1.0 {
-            return 255;
-        }
-        let mut code = starts[(v.to_bits() >> 16) as usize] as usize;
-        while code < t.len() && t[code] <= v {
-            code += 1;
-        }
-        code as u8
-    };
-    [q(c.x), q(c.y), q(c.z)]
+        let start = usize::from(self.starts[(bits >> 16) as usize]);
+        (start + usize::from(self.thresholds[start] <= v)) as u8
+    }
 }
 
 /// Rec. 709 luma of 8-bit sRGB code values, [0, 255]: what SSIM compares.
