@@ -144,6 +144,11 @@ mod tests {
                 .abs_diff_eq(Vec3::splat(0.5), 1e-6)
         );
         assert!(t.sample(Vec2::new(1.75, 3.5)).abs_diff_eq(Vec3::ONE, 1e-6));
+        // Texel centres one period on and back, where the column wraps to the first exactly.
+        for u in [1.25, -0.75, 100.25, -99.75] {
+            assert_eq!(t.sample(Vec2::new(u, 0.5)), Vec3::ZERO, "u = {u}");
+            assert_eq!(t.sample(Vec2::new(u + 0.5, 0.5)), Vec3::ONE, "u = {u} + 0.5");
+        }
     }
 
     /// The sky's scalar cloud table must sample to the bits the RGB texture it replaced gave.
