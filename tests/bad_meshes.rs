@@ -449,7 +449,10 @@ fn textures_that_are_not_images_or_too_large_name_the_material_and_the_file() {
     let obj = TRIANGLE.replacen("v 1 0 0", "v 1 nan 0", 1);
     let dir = scratch(
         &scene,
-        &[("tex.png", b"not an image at all"), ("m.obj", obj.as_bytes())],
+        &[
+            ("tex.png", b"not an image at all"),
+            ("m.obj", obj.as_bytes()),
+        ],
     );
     render_refused(dir.path(), &["material `t`", "tex.png"]);
 }

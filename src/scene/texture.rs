@@ -147,7 +147,11 @@ mod tests {
         // Texel centres one period on and back, where the column wraps to the first exactly.
         for u in [1.25, -0.75, 100.25, -99.75] {
             assert_eq!(t.sample(Vec2::new(u, 0.5)), Vec3::ZERO, "u = {u}");
-            assert_eq!(t.sample(Vec2::new(u + 0.5, 0.5)), Vec3::ONE, "u = {u} + 0.5");
+            assert_eq!(
+                t.sample(Vec2::new(u + 0.5, 0.5)),
+                Vec3::ONE,
+                "u = {u} + 0.5"
+            );
         }
     }
 
