@@ -517,3 +517,30 @@ impl Ellipsoid {
         f32::INFINITY
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A part (a sequence's static or moving objects) reads only the textures its objects use;
+    /// the whole world reads them all.
+    #[test]
+    fn a_part_loads_only_the_textures_its_objects_use() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/das.toml");
+        let scene = Scene::load(&path).expect("das loads");
+        let textured = |m: &Option<usize>| m.is_some_and(|m| scene.materials[m].texture.is_some());
+        let uses = |i: usize| textured(&scene.objects[i].material);
+        let counts = |keep: &dyn Fn(usize) -> bool| {
+            let world = World::build_part(&scene, keep, false).expect("the part builds");
+            let indexed = world
+                .materials
+                .iter()
+                .filter(|m| m.texture.is_some())
+                .count();
+            (world.textures.len(), indexed)
+        };
+        assert_eq!(counts(&|_| true), (1, 1));
+        assert_eq!(counts(&uses), (1, 1));
+        assert_eq!(counts(&|i| !uses(i)), (0, 0));
+    }
+}
