@@ -113,22 +113,30 @@ pub fn write_metrics_scaled(
         &dir.join("metrics.json"),
         &serde_json::to_string_pretty(json)?,
     )?;
-    let channels = vec![
-        AnyChannel::new("Y", FlatSamples::F32(maps.misregistration.clone())),
-        AnyChannel::new(
-            "missing.mask",
-            FlatSamples::F32(maps.missing.iter().map(|&m| m as u8 as f32).collect()),
-        ),
-    ];
-    write_exr_channels(
-        &dir.join("misregistration.exr"),
-        maps.width,
-        maps.height,
-        channels,
-    )?;
-    let (w, h, rgb) = heatmap_rgb(maps, truth, heat_max)?;
-    write_png(&dir.join("misregistration.png"), w, h, rgb)?;
-    write_mask_png(&dir.join("missing.png"), maps, &maps.missing)
+    // The three images side by side (a run's last writes, while its other views may be
+    // written already); the first error in this order.
+    let exr = || {
+        let channels = vec![
+            AnyChannel::new("Y", FlatSamples::F32(maps.misregistration.clone())),
+            AnyChannel::new(
+                "missing.mask",
+                FlatSamples::F32(maps.missing.iter().map(|&m| m as u8 as f32).collect()),
+            ),
+        ];
+        write_exr_channels(
+            &dir.join("misregistration.exr"),
+            maps.width,
+            maps.height,
+            channels,
+        )
+    };
+    let heatmap = || {
+        let (w, h, rgb) = heatmap_rgb(maps, truth, heat_max)?;
+        write_png(&dir.join("misregistration.png"), w, h, rgb)
+    };
+    let mask = || write_mask_png(&dir.join("missing.png"), maps, &maps.missing);
+    let (exr, (heatmap, mask)) = rayon::join(exr, || rayon::join(heatmap, mask));
+    exr.and(heatmap).and(mask)
 }
 
 /// A mask of driver-view pixels as a PNG: `marked` pixels magenta, the rest of the display

@@ -167,7 +167,15 @@ impl World {
                 firsts.push((path, &object.shape));
             }
         }
-        let (textures, loaded) = rayon::join(
+        // The meshes first, on this thread: the longer task, while an idle thread (the
+        // sky's table done) takes the textures.
+        let (loaded, textures) = rayon::join(
+            || -> Vec<Result<LoadedMesh>> {
+                firsts
+                    .par_iter()
+                    .map(|(_, shape)| shape_mesh(shape).expect("a mesh shape"))
+                    .collect()
+            },
             || -> Vec<Option<Result<Texture>>> {
                 let load = |(index, m): (usize, &crate::scene::Material)| match &m.texture {
                     Some(path) if used[index] => {
@@ -176,12 +184,6 @@ impl World {
                     _ => None,
                 };
                 scene.materials.iter().enumerate().map(load).collect()
-            },
-            || -> Vec<Result<LoadedMesh>> {
-                firsts
-                    .par_iter()
-                    .map(|(_, shape)| shape_mesh(shape).expect("a mesh shape"))
-                    .collect()
             },
         );
         for (m, texture) in scene.materials.iter().zip(textures) {
