@@ -551,7 +551,7 @@ pub fn measure_with(
     // FLIP with the driver's eye as the observer: pixels per degree of the driver's camera.
     let ppd = w as f32 / (2.0 * scene.driver.half_angle_x.to_degrees() as f32);
     let flip_skipped = flip == Flip::Skipped;
-    // SSIM and FLIP side by side: FLIP (one thread's C++) was a fifth of the metrics' time.
+    // SSIM and FLIP side by side: FLIP (one thread's C++) was a third of the metrics' time.
     let (ssim, flip): (Vec<f64>, Vec<f64>) = rayon::join(
         || {
             let ssim_box = masked_ssim_map(
