@@ -354,9 +354,7 @@ pub fn read_display_image(path: &Path) -> Result<ImageFile> {
                 .to_rgb8();
             let color = image
                 .pixels()
-                .map(|p| {
-                    p.0.map(|c| crate::util::color::srgb_to_linear(c as f32 / 255.0))
-                })
+                .map(|p| p.0.map(crate::util::color::decode_srgb8))
                 .collect();
             Ok(ImageFile {
                 width: image.width(),

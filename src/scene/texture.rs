@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use glam::{Vec2, Vec3};
 
 use crate::scene::limits::{MAX_PIXELS, MAX_RESOLUTION};
-use crate::util::color::srgb_to_linear;
+use crate::util::color::decode_srgb8;
 
 /// A repeating grid of texels with bilinear lookup.
 #[derive(Clone, Debug)]
@@ -78,14 +78,11 @@ impl Texture {
         Ok(Texture {
             width: img.width(),
             height: img.height(),
-            texels: {
-                // The transfer function of each of the 256 codes once, not a `powf` per channel
-                // per texel (das's street: 4–9 ms of its start, then 1.5–3).
-                let linear: [f32; 256] =
-                    std::array::from_fn(|code| srgb_to_linear(code as f32 / 255.0));
-                let decode = |p: &image::Rgb<u8>| p.0.map(|code| linear[code as usize]);
-                img.pixels().map(|p| Vec3::from(decode(p))).collect()
-            },
+            // By table (das's street: 4–9 ms of its start with a `powf` per channel, then 1.5–3).
+            texels: img
+                .pixels()
+                .map(|p| Vec3::from(p.0.map(decode_srgb8)))
+                .collect(),
         })
     }
 }
@@ -188,6 +185,7 @@ mod tests {
     /// order that a table indexed by the wrong channel or off by one would not reproduce.
     #[test]
     fn loaded_texels_are_the_transfer_function_of_every_code() {
+        use crate::util::color::srgb_to_linear;
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("codes.png");
         let codes = |i: u32| [i as u8, (255 - i) as u8, (i * 7 % 256) as u8];

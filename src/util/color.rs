@@ -18,6 +18,15 @@ pub fn linear_to_srgb(c: f32) -> f32 {
     }
 }
 
+/// An 8-bit sRGB code in linear light: [`srgb_to_linear`] of `code / 255`, bit for bit, from a
+/// table of the 256 codes made once, not a `powf` per channel (a texture's texels, a display
+/// image's pixels).
+pub fn decode_srgb8(code: u8) -> f32 {
+    static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|code| srgb_to_linear(code as f32 / 255.0)))
+        [usize::from(code)]
+}
+
 pub fn srgb_to_linear3(c: [f64; 3]) -> Vec3 {
     Vec3::new(
         srgb_to_linear(c[0] as f32),
@@ -133,10 +142,12 @@ mod tests {
             let c = i as f32 / 100.0;
             assert!((linear_to_srgb(srgb_to_linear(c)) - c).abs() < 1e-5);
         }
-        // Every 8-bit value survives decoding and re-encoding.
+        // Every 8-bit value survives decoding and re-encoding; the table decodes as the
+        // function does.
         for v in 0..=255u8 {
             let linear = srgb_to_linear(v as f32 / 255.0);
             assert_eq!(encode_srgb8_by_transfer(Vec3::splat(linear)), [v; 3]);
+            assert_eq!(decode_srgb8(v).to_bits(), linear.to_bits(), "code {v}");
         }
         assert_eq!(
             encode_srgb8_by_transfer(Vec3::new(-1.0, 2.0, f32::NAN)),
