@@ -519,7 +519,7 @@ fn run_metrics(scene: &seethru::scene::Scene, options: &RunOptions) -> serde_jso
         &ctx,
         &ctx.scene,
         ctx.scene.eye(),
-        [&r.truth, &r.seethru, &r.occluded],
+        r.measured_views(),
         5,
     );
     metrics
@@ -778,7 +778,7 @@ fn the_border_bands_of_a_curved_display_follow_its_uvs() {
         &ctx,
         &ctx.scene,
         ctx.scene.eye(),
-        [&r.truth, &r.seethru, &r.occluded],
+        r.measured_views(),
         band,
     );
     let obstacle = &ctx.scene.obstacle;

@@ -210,13 +210,7 @@ fn small(display: DisplayModel) -> RunOptions {
 }
 
 fn misregistration_mean(ctx: &RenderContext, r: &RunResult) -> f64 {
-    let (_, m) = measure(
-        ctx,
-        &ctx.scene,
-        ctx.scene.eye(),
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (_, m) = measure(ctx, &ctx.scene, ctx.scene.eye(), r.measured_views(), 5);
     assert_eq!(m["coverage"], 1.0);
     m["display"]["misregistration_arcmin"]["mean"]
         .as_f64()

@@ -16,6 +16,7 @@ use seethru::measure::{
     ratio_setup::{Compensation, Setup, build_scene},
 };
 use seethru::render::frame::Frame;
+use seethru::render::frame_over::FrameView;
 use seethru::render::integrator::RenderContext;
 use seethru::system::display::{DisplayModel, MISSING_ID};
 use seethru::system::{
@@ -296,13 +297,7 @@ fn setup_parameters_are_checked_at_their_bounds() {
 
 /// The metrics of a run's own frames, as `run` computes them (border band 5 display pixels).
 fn measured(ctx: &RenderContext, r: &RunResult) -> (MetricMaps, serde_json::Value) {
-    measure(
-        ctx,
-        &ctx.scene,
-        ctx.scene.eye(),
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    )
+    measure(ctx, &ctx.scene, ctx.scene.eye(), r.measured_views(), 5)
 }
 
 /// A wall at `wall` metres behind a display at the origin; the model plane at `d2`.
@@ -335,14 +330,24 @@ fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
     // must read 10′ at every display pixel, whatever the point's distance or direction.
     let (ctx, r) = wall_run(6.0, 6.0);
     let eye = ctx.scene.eye();
-    let mut turned = r.truth.clone();
+    let mut turned = Frame::clone(&r.truth);
     for p in &mut turned.position {
         let v = p.as_dvec3() - eye;
         // About an axis perpendicular to the line of sight, so the sight line turns by 10′.
         let axis = v.cross(DVec3::new(0.3, 1.0, 0.2)).normalize();
         *p = (eye + DQuat::from_axis_angle(axis, (10.0f64 / 60.0).to_radians()) * v).as_vec3();
     }
-    let (maps, json) = measure(&ctx, &ctx.scene, eye, [&r.truth, &turned, &r.occluded], 5);
+    let (maps, json) = measure(
+        &ctx,
+        &ctx.scene,
+        eye,
+        [
+            FrameView::from(&r.truth),
+            FrameView::from(&turned),
+            FrameView::from(&r.occluded),
+        ],
+        5,
+    );
     let shown: Vec<f32> = maps
         .misregistration
         .iter()
@@ -372,7 +377,17 @@ fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
         blind.position[i] = Vec3::NAN;
         blind.normal[i] = Vec3::ZERO;
     }
-    let (_, json) = measure(&ctx, &ctx.scene, eye, [&r.truth, &blind, &r.occluded], 5);
+    let (_, json) = measure(
+        &ctx,
+        &ctx.scene,
+        eye,
+        [
+            FrameView::from(&r.truth),
+            FrameView::from(&blind),
+            FrameView::from(&r.occluded),
+        ],
+        5,
+    );
     assert_eq!(json["undefined_pixels"].as_u64(), Some(100));
     assert_eq!(
         json["display"]["misregistration_arcmin"]["count"]
@@ -695,7 +710,17 @@ fn masked_ssim_and_flip_see_only_the_display() {
     let eye = ctx.scene.eye();
     let (maps, before) = measured(&ctx, &r);
     let [truth, seethru] = scramble_outside([&r.truth, &r.seethru], &maps.display);
-    let (_, after) = measure(&ctx, &ctx.scene, eye, [&truth, &seethru, &r.occluded], 5);
+    let (_, after) = measure(
+        &ctx,
+        &ctx.scene,
+        eye,
+        [
+            FrameView::from(&truth),
+            FrameView::from(&seethru),
+            FrameView::from(&r.occluded),
+        ],
+        5,
+    );
     for region in ["display", "border"] {
         for metric in ["ssim", "flip_mean", "psnr_db"] {
             let (a, b) = (&before[region][metric], &after[region][metric]);
@@ -707,7 +732,17 @@ fn masked_ssim_and_flip_see_only_the_display() {
         }
     }
     // Changing the seethru frame outside the mask alone changes nothing either.
-    let (_, one_sided) = measure(&ctx, &ctx.scene, eye, [&r.truth, &seethru, &r.occluded], 5);
+    let (_, one_sided) = measure(
+        &ctx,
+        &ctx.scene,
+        eye,
+        [
+            FrameView::from(&r.truth),
+            FrameView::from(&seethru),
+            FrameView::from(&r.occluded),
+        ],
+        5,
+    );
     assert_eq!(
         before["border"]["flip_mean"],
         one_sided["border"]["flip_mean"]
@@ -721,7 +756,17 @@ fn masked_ssim_and_flip_see_only_the_display() {
         f
     };
     let (a, b) = (flat(&r.truth, 0.2), flat(&r.seethru, 0.3));
-    let (_, json) = measure(&ctx, &ctx.scene, eye, [&a, &b, &r.occluded], 5);
+    let (_, json) = measure(
+        &ctx,
+        &ctx.scene,
+        eye,
+        [
+            FrameView::from(&a),
+            FrameView::from(&b),
+            FrameView::from(&r.occluded),
+        ],
+        5,
+    );
     let lum = |v: f32| encode_srgb8(Vec3::splat(v))[0] as f64;
     let (la, lb) = (lum(0.2), lum(0.3));
     let c1 = (0.01f64 * 255.0).powi(2);
@@ -1010,13 +1055,23 @@ fn ssim_windows_are_seven_pixels_wide() {
         })
         .unwrap();
     let flat = |v: f32| {
-        let mut f = r.truth.clone();
+        let mut f = Frame::clone(&r.truth);
         f.color.iter_mut().for_each(|c| *c = Vec3::splat(v));
         f
     };
     let (a, mut b) = (flat(0.2), flat(0.2));
     b.color[inner] = Vec3::splat(0.5);
-    let (_, json) = measure(&ctx, &ctx.scene, ctx.scene.eye(), [&a, &b, &r.occluded], 5);
+    let (_, json) = measure(
+        &ctx,
+        &ctx.scene,
+        ctx.scene.eye(),
+        [
+            FrameView::from(&a),
+            FrameView::from(&b),
+            FrameView::from(&r.occluded),
+        ],
+        5,
+    );
     let lum = |v: f32| encode_srgb8(Vec3::splat(v))[0] as f64;
     let (l, delta) = (lum(0.2), lum(0.5) - lum(0.2));
     let (c1, c2) = ((0.01f64 * 255.0).powi(2), (0.03f64 * 255.0).powi(2));

@@ -19,6 +19,7 @@ use seethru::measure::ratio::measure_ratio;
 use seethru::measure::ratio_setup::{Compensation, Setup, build_scene};
 use seethru::measure::sequence::{Measuring, run_sequence};
 use seethru::render::frame::Frame;
+use seethru::render::frame_over::FrameView;
 use seethru::render::integrator::RenderContext;
 use seethru::system::display::DisplayModel;
 use seethru::system::eyes::{Eye, Eyes};
@@ -180,13 +181,7 @@ fn measured(
     ctx: &RenderContext,
     r: &RunResult,
 ) -> (seethru::measure::metrics::MetricMaps, serde_json::Value) {
-    measure(
-        ctx,
-        &ctx.scene,
-        ctx.scene.eye(),
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    )
+    measure(ctx, &ctx.scene, ctx.scene.eye(), r.measured_views(), 5)
 }
 
 /// A run of the textured wall at 12 m, the driver's camera at 120×90 looking as `look_at`
@@ -886,7 +881,7 @@ fn each_border_band_reads_its_own_side() {
     let turn = 10.0;
     let w = r.truth.width as usize;
     for (turned_side, opposite, axis) in [("left", "right", 0), ("top", "bottom", 1)] {
-        let mut shown = r.truth.clone();
+        let mut shown = Frame::clone(&r.truth);
         let mut columns = Vec::new();
         for (i, p) in shown.position.iter_mut().enumerate() {
             let on_display = o.in_obstacle_frame(r.occluded.position[i].as_dvec3());
@@ -901,7 +896,17 @@ fn each_border_band_reads_its_own_side() {
             *p = (eye + DQuat::from_axis_angle(about, (turn / 60.0f64).to_radians()) * v).as_vec3();
             columns.push(i % w);
         }
-        let (maps, json) = measure(&ctx, &ctx.scene, eye, [&r.truth, &shown, &r.occluded], 5);
+        let (maps, json) = measure(
+            &ctx,
+            &ctx.scene,
+            eye,
+            [
+                FrameView::Whole(&r.truth),
+                FrameView::Whole(&shown),
+                FrameView::Over(&r.occluded),
+            ],
+            5,
+        );
         assert!(maps.display.iter().filter(|&&d| d).count() > 1000);
         let band = |side: &str| json["border_per_side"][side]["misregistration_arcmin"].clone();
         let (on, off) = (band(turned_side), band(opposite));

@@ -508,9 +508,9 @@ fn driver_views_rendered_over_the_truth_equal_separate_renders() {
         assert!(r.seethru.bit_identical(&seethru), "{display:?} seethru");
         // The views do differ, and only inside the display's neighbourhood was traced again.
         assert!(!truth.bit_identical(&occluded) && !occluded.bit_identical(&seethru));
-        let (_, stats) = ctx.render_over(
+        let (over, stats) = ctx.render_over(
             &driver,
-            &truth,
+            &r.truth,
             View::Truth.bit(),
             View::Occluded.bit(),
             None,
@@ -518,6 +518,12 @@ fn driver_views_rendered_over_the_truth_equal_separate_renders() {
             "occluded",
         );
         assert!(stats.primary_rays < 160 * 90 * 2 / 4, "{stats:?}");
+        // Only the traced rectangle is the view's own; the rest is truth's, not a copy.
+        let rect = over.rect();
+        let traced = u64::from((rect.x1 - rect.x0) * (rect.y1 - rect.y0)) * 2;
+        assert_eq!(stats.primary_rays, traced);
+        assert!(std::sync::Arc::ptr_eq(over.base(), &r.truth));
+        assert!(over.whole().bit_identical(&occluded));
         // run.json's peak memory holds at least the three driver frames.
         let frame_bytes = (truth.color.len() * 52) as u64;
         let peak = r.report["peak_rss_bytes"].as_u64().unwrap();

@@ -80,13 +80,7 @@ fn options(method: Method) -> RunOptions {
 }
 
 fn display_mask(ctx: &RenderContext, r: &RunResult) -> Vec<bool> {
-    let (maps, _) = measure(
-        ctx,
-        &ctx.scene,
-        ctx.scene.eye(),
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (maps, _) = measure(ctx, &ctx.scene, ctx.scene.eye(), r.measured_views(), 5);
     maps.display
 }
 
@@ -334,7 +328,7 @@ fn holes_of_a_sideways_eye_are_the_disoccluded_area() {
         20.0,
     );
     let r = run(&ctx, &depth(SensorKind::Ideal)).unwrap();
-    let frames = [&r.truth, &r.seethru, &r.occluded];
+    let frames = r.measured_views();
     let (maps, mut metrics) = measure(&ctx, &ctx.scene, ctx.scene.eye(), frames, 5);
     let holes = attach_holes(&mut metrics, &maps, &r, &ctx.scene.obstacle, "none").unwrap();
     assert_eq!(metrics["missing"]["outside_frontal_view"], 0);
@@ -520,7 +514,7 @@ fn depth_noise_grows_the_misregistration_as_the_formula_predicts() {
         o.scene_model.sensor.quantum_1m = Some(0.0);
         o.scene_model.sensor.noise_1m = Some(sigma_1m);
         let r = run(&ctx, &o).unwrap();
-        let frames = [&r.truth, &r.seethru, &r.occluded];
+        let frames = r.measured_views();
         let (maps, mut metrics) = measure(&ctx, &ctx.scene, eye, frames, 5);
         let holes = attach_holes(&mut metrics, &maps, &r, &ctx.scene.obstacle, "none").unwrap();
         let (mut measured, mut predicted, mut n) = (0.0, 0.0, 0);

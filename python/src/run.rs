@@ -2,6 +2,8 @@
 //! views, the metrics (metrics.json's content), the misregistration map and run.json's
 //! content returned instead of written.
 
+use std::sync::Arc;
+
 use numpy::ndarray::Array2;
 use numpy::{PyArray, PyArray2};
 use pyo3::prelude::*;
@@ -89,7 +91,7 @@ pub fn measured(
     band: u32,
 ) -> (MetricMaps, serde_json::Value) {
     let eye = options.eyes.view_camera(&ctx.scene.driver).position();
-    let frames = [&result.truth, &result.seethru, &result.occluded];
+    let frames = result.measured_views();
     let (maps, mut metrics) = measure(ctx, &ctx.scene, eye, frames, band);
     attach_holes(
         &mut metrics,
@@ -123,13 +125,16 @@ impl PyRun {
         let report = json_to_py(py, &result.report)?;
         let metrics = json_to_py(py, metrics)?;
         let dict = PyDict::new(py);
+        // The views rendered over truth made whole first: then truth is theirs no longer, and
+        // is handed over without a copy.
+        let (occluded, seethru) = (result.occluded.into_whole(), result.seethru.into_whole());
         for (name, frame) in [
-            ("truth", result.truth),
-            ("occluded", result.occluded),
+            ("truth", Arc::unwrap_or_clone(result.truth)),
+            ("occluded", occluded),
             ("frontal", result.frontal),
             ("back", result.back),
             ("display", result.display),
-            ("seethru", result.seethru),
+            ("seethru", seethru),
         ] {
             dict.set_item(name, PyFrame::new(py, name, frame)?)?;
         }

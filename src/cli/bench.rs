@@ -125,16 +125,27 @@ fn seconds_of_each(repeat: usize, mut job: impl FnMut()) -> Vec<f64> {
 /// the wall time × `threads` (`None` where the system does not say). About 1 where they never
 /// wait (the thread that waits on them adds a per cent or so); one minus it is the share of
 /// their time they waited, out of work or for a core.
+///
+/// The threads' clocks move at the scheduler's ticks and switches (a few ms), and a small
+/// frame's repeats take under a millisecond: the share is taken over the repeats and, while
+/// they add up to less than [`BUSY_WALL_S`], more runs of the job (a busy machine read 0
+/// over three 160×90 frames).
 fn timed_busy(repeat: usize, threads: usize, mut job: impl FnMut()) -> (Vec<f64>, Option<f64>) {
     job();
     let before = threads_cpu_ns();
-    let seconds = seconds_of_each(repeat, job);
+    let seconds = seconds_of_each(repeat, &mut job);
+    let mut wall_s: f64 = seconds.iter().sum();
+    while wall_s < BUSY_WALL_S {
+        wall_s += seconds_of_each(1, &mut job)[0];
+    }
     let cpu_s = before
         .zip(threads_cpu_ns())
         .map(|(a, b)| b.saturating_sub(a) as f64 * 1e-9);
-    let wall_s: f64 = seconds.iter().sum::<f64>() * threads as f64;
-    (seconds, cpu_s.map(|cpu| cpu / wall_s))
+    (seconds, cpu_s.map(|cpu| cpu / (wall_s * threads as f64)))
 }
+
+/// The least wall time, seconds, over which [`timed_busy`] takes the workers' busy share.
+const BUSY_WALL_S: f64 = 0.1;
 
 /// Million rays per second of each run.
 fn mrays(rays: usize, seconds: &[f64]) -> Vec<f64> {

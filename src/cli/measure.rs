@@ -8,6 +8,7 @@ use seethru::io::staged::StagedDir;
 use seethru::measure::holes::{hole_metrics, read_hole_mask};
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
+use seethru::render::frame_over::FrameView;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 
@@ -66,7 +67,13 @@ fn measure_command(dir: &Path, band: u32) -> Result<serde_json::Value> {
     let eye = record
         .view_eye
         .map_or(ctx.scene.eye(), glam::DVec3::from_array);
-    let (maps, mut metrics) = measure(&ctx, &ctx.scene, eye, [&truth, &seethru, &occluded], band);
+    let (maps, mut metrics) = measure(
+        &ctx,
+        &ctx.scene,
+        eye,
+        [&truth, &seethru, &occluded].map(FrameView::from),
+        band,
+    );
     // A depth run's holes, as its holes.png has them.
     if let Some(holes) = read_hole_mask(&dir.join("holes.png"), truth.width, truth.height)? {
         let run: serde_json::Value =

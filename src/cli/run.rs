@@ -7,14 +7,14 @@ use std::sync::{Mutex, OnceLock};
 
 use anyhow::Result;
 use seethru::io::atomic::write_text;
-use seethru::io::frame_files::{ExrContent, write_frame, write_frame_like};
+use seethru::io::frame_files::{ExrContent, write_frame_keeping, write_frame_like};
 use seethru::io::staged::StagedDir;
 use seethru::measure::hazard::{DEFAULT_BOUND_ARCMIN, run_hazards_json};
 use seethru::measure::headline::{read_results, summary_text};
 use seethru::measure::holes::{attach_view_holes, write_hole_mask};
 use seethru::measure::maps::write_metrics_scaled;
 use seethru::measure::metrics::measure;
-use seethru::render::frame::Frame;
+use seethru::render::frame_over::FrameView;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::scene::lens_keys::read_calibration_file;
@@ -244,24 +244,6 @@ fn in_scope<'s, F: Fn(&rayon::Scope<'s>) + Sync + Send + Copy>(f: F) -> F {
     f
 }
 
-/// Writes view `name` of `views` (set) into `out`.
-fn write_view(views: &RunViews, out: &Path, name: &str, exr: ExrContent) -> Result<()> {
-    let slot = match name {
-        "truth" => &views.truth,
-        "occluded" => &views.occluded,
-        "frontal" => &views.frontal,
-        "back" => &views.back,
-        "display" => &views.display,
-        _ => &views.seethru,
-    };
-    write_frame(
-        slot.get().expect("a view is written once set"),
-        out,
-        name,
-        exr,
-    )
-}
-
 /// One run into `out` (inside the staging folder): every view, the metrics and run.json;
 /// `band`: the border band's width and the heatmap's fixed top, if any.
 fn write_run(
@@ -302,23 +284,20 @@ fn write_run(
     let driver_views = in_scope(move |s| {
         if waiting.fetch_sub(1, Ordering::AcqRel) == 1 {
             let like = truth_zipped.get().and_then(Option::as_ref);
-            for (name, slot) in [
-                ("occluded", &views_ref.occluded),
-                ("seethru", &views_ref.seethru),
-            ] {
-                let frame = slot.get().expect("set before its file is written");
-                s.spawn(move |_| {
-                    note(write_frame_like(frame, out, name, exr, like, false).map(|_| ()))
-                });
+            for name in ["occluded", "seethru"] {
+                let frame = views_ref.get(name).expect("set before its file is written");
+                s.spawn(move |_| note(write_frame_like(frame, out, name, exr, like)));
             }
         }
     });
     let measured = rayon::scope(|s| -> Result<_> {
-        let ready = |name: &'static str, frame: &Frame| match name {
+        // Each view is fetched again from `views`: the frame handed over lives as long as the
+        // run, not the scope.
+        let ready = |name: &'static str, _: FrameView<'_>| match name {
             "truth" => {
                 let frame = views_ref.truth.get().expect("just set");
                 s.spawn(move |s| {
-                    match write_frame_like(frame, out, name, exr, None, true) {
+                    match write_frame_keeping(frame, out, name, exr) {
                         Ok(zipped) => {
                             let _ = truth_zipped.set(zipped);
                         }
@@ -330,14 +309,13 @@ fn write_run(
             "occluded" => {}
             "seethru" => driver_views(s),
             _ => {
-                let _ = frame;
-                s.spawn(move |_| note(write_view(views_ref, out, name, exr)));
+                let frame = views_ref.get(name).expect("just set");
+                s.spawn(move |_| note(write_frame_like(frame, out, name, exr, None)));
             }
         };
         let rest = run_staged(ctx, options, Given::default(), views_ref, &ready)?;
-        let [truth, occluded, seethru] =
-            [&views_ref.truth, &views_ref.occluded, &views_ref.seethru]
-                .map(|v| v.get().expect("a finished run set every view"));
+        let [truth, occluded, seethru] = ["truth", "occluded", "seethru"]
+            .map(|name| views_ref.get(name).expect("a finished run set every view"));
         check_display_seen(ctx, occluded)?;
         // The eye the views were rendered from.
         let eye = options.eyes.view_camera(&ctx.scene.driver).position();
@@ -353,7 +331,7 @@ fn write_run(
         if let Some(holes) = &holes {
             write_hole_mask(&out.join("holes.png"), &maps, holes)?;
         }
-        write_metrics_scaled(out, &maps, truth, &metrics, heatmap_max)?;
+        write_metrics_scaled(out, &maps, truth.whole(), &metrics, heatmap_max)?;
         Ok((rest, maps))
     });
     if let Some(e) = failed.into_inner().unwrap_or_else(|e| e.into_inner()) {

@@ -9,10 +9,11 @@ use glam::Vec3;
 use rayon::prelude::*;
 use seethru::io::atomic::write_text;
 use seethru::io::display_map::{read_display_image, read_map};
-use seethru::io::frame_files::{ExrContent, write_frame};
+use seethru::io::frame_files::{ExrContent, write_frame_like};
 use seethru::io::staged::StagedDir;
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
+use seethru::render::frame_over::FrameView;
 use seethru::render::integrator::RenderContext;
 use seethru::system::capture::{Capture, DisplayImage, DisplayMap, capture, score};
 use seethru::system::display::Filter;
@@ -177,16 +178,16 @@ impl Score {
         let staged = StagedDir::new(&self.out)?;
         let out = staged.path();
         let views = [
-            ("truth", &result.truth),
-            ("occluded", &result.occluded),
-            ("display", &result.display),
-            ("seethru", &result.seethru),
+            ("truth", FrameView::Whole(&result.truth)),
+            ("occluded", FrameView::Over(&result.occluded)),
+            ("display", FrameView::Whole(&result.display)),
+            ("seethru", FrameView::Over(&result.seethru)),
         ];
         views
             .par_iter()
-            .try_for_each(|(name, frame)| write_frame(frame, out, name, self.exr))?;
+            .try_for_each(|&(name, frame)| write_frame_like(frame, out, name, self.exr, None))?;
         let eye = r.options.eyes.view_camera(&r.ctx.scene.driver).position();
-        let frames = [&result.truth, &result.seethru, &result.occluded];
+        let frames = result.measured_views();
         let (maps, mut metrics) = measure(&r.ctx, &r.ctx.scene, eye, frames, self.band);
         metrics["external_method"] = result.report["external_method"].clone();
         if !scored.has_map {

@@ -26,6 +26,8 @@ use miniz_oxide::deflate::core::{
 };
 use rayon::prelude::*;
 
+use crate::render::footprint::PixelRect;
+
 /// The compression written in the header: ZIP (OpenEXR's `ZIP_COMPRESSION`), each block
 /// deflated as one.
 pub const COMPRESSION: Compression = Compression::ZIP16;
@@ -105,17 +107,59 @@ pub enum Plane<'a> {
     Component(&'a [Vec3], usize),
     /// The same f32 at every pixel.
     Constant(f32),
+    /// `base`'s samples but inside `rect` (pixels of an image `width` wide), where they are
+    /// `patch`'s, a plane of the rectangle's size: a frame rendered over another
+    /// ([`crate::render::frame_over::FrameOver`]).
+    Over {
+        base: &'a Plane<'a>,
+        patch: &'a Plane<'a>,
+        rect: PixelRect,
+        width: usize,
+    },
 }
 
 impl Plane<'_> {
     fn sample_type(&self) -> FlatSamples {
         match self {
             Plane::U32(_) => FlatSamples::U32(Vec::new()),
+            Plane::Over { base, .. } => base.sample_type(),
             _ => FlatSamples::F32(Vec::new()),
         }
     }
 
-    /// Appends the samples of pixels `from..from + count` as little-endian bytes.
+    /// Pixels `from..from + count` of one row, as up to three runs of samples one after
+    /// another: (plane, its first sample, count); the runs of an [`Plane::Over`] that cross
+    /// its rectangle are the base's left of it, the patch's, and the base's right of it.
+    fn runs(&self, from: usize, count: usize) -> [(&Plane<'_>, usize, usize); 3] {
+        let Plane::Over {
+            base,
+            patch,
+            rect,
+            width,
+        } = self
+        else {
+            return [(self, from, count), (self, 0, 0), (self, 0, 0)];
+        };
+        let none = (*base, 0, 0);
+        let (y, xa) = (from / width, from % width);
+        let xb = xa + count;
+        debug_assert!(xb <= *width, "the pixels are in one row");
+        let (x0, x1) = (rect.x0 as usize, rect.x1 as usize);
+        let rows = rect.y0 as usize..rect.y1 as usize;
+        if !rows.contains(&y) || xb <= x0 || x1 <= xa {
+            return [(base, from, count), none, none];
+        }
+        let (a, b) = (xa.max(x0), xb.min(x1));
+        let in_patch = (y - rect.y0 as usize) * (x1 - x0) + (a - x0);
+        [
+            (base, from, a - xa),
+            (patch, in_patch, b - a),
+            (base, y * width + b, xb - b),
+        ]
+    }
+
+    /// Appends the samples of pixels `from..from + count` (of one row, for a
+    /// [`Plane::Over`]) as little-endian bytes.
     fn append_le(&self, from: usize, count: usize, out: &mut Vec<u8>) {
         let range = from..from + count;
         match *self {
@@ -128,34 +172,66 @@ impl Plane<'_> {
                 let bytes = c.to_le_bytes();
                 out.extend((0..count).flat_map(|_| bytes))
             }
+            Plane::Over { .. } => {
+                for (plane, from, count) in self.runs(from, count) {
+                    plane.append_le(from, count, out);
+                }
+            }
         }
     }
 
-    /// Whether pixels `from..from + count` have the same little-endian bytes in `self` and
-    /// `other`: bit for bit (two NaNs of one payload are the same; 0 and -0 are not).
-    fn same_samples(&self, other: &Plane, from: usize, count: usize) -> bool {
-        let range = from..from + count;
+    /// Whether `self`'s samples `from..from + count` have the same little-endian bytes as
+    /// `other`'s from `other_from` (of one row, for a [`Plane::Over`]): bit for bit (two NaNs
+    /// of one payload are the same; 0 and -0 are not). A plane's samples are its own without
+    /// a look: an [`Plane::Over`] against its base compares only its patch.
+    fn same_samples(&self, from: usize, other: &Plane, other_from: usize, count: usize) -> bool {
+        if let Plane::Over { .. } = self {
+            return other.same_as_runs(other_from, self.runs(from, count));
+        }
+        if let Plane::Over { .. } = other {
+            return self.same_as_runs(from, other.runs(other_from, count));
+        }
+        let (range, other_range) = (from..from + count, other_from..other_from + count);
         match (*self, *other) {
-            (Plane::U32(a), Plane::U32(b)) => a[range.clone()] == b[range],
-            (Plane::F32(a), Plane::F32(b)) => a[range.clone()]
+            (Plane::U32(a), Plane::U32(b)) if std::ptr::eq(a, b) && from == other_from => true,
+            (Plane::F32(a), Plane::F32(b)) if std::ptr::eq(a, b) && from == other_from => true,
+            (Plane::Component(a, i), Plane::Component(b, j))
+                if std::ptr::eq(a, b) && i == j && from == other_from =>
+            {
+                true
+            }
+            (Plane::U32(a), Plane::U32(b)) => a[range] == b[other_range],
+            (Plane::F32(a), Plane::F32(b)) => a[range]
                 .iter()
-                .zip(&b[range])
+                .zip(&b[other_range])
                 .all(|(x, y)| x.to_bits() == y.to_bits()),
-            (Plane::Component(a, i), Plane::Component(b, j)) => a[range.clone()]
+            (Plane::Component(a, i), Plane::Component(b, j)) => a[range]
                 .iter()
-                .zip(&b[range])
+                .zip(&b[other_range])
                 .all(|(x, y)| x[i].to_bits() == y[j].to_bits()),
             _ => {
                 let (mut a, mut b) = (Vec::new(), Vec::new());
                 self.append_le(from, count, &mut a);
-                other.append_le(from, count, &mut b);
+                other.append_le(other_from, count, &mut b);
                 a == b
             }
         }
     }
 
+    /// Whether `self`'s samples from `from` are those of `runs`, one after another.
+    fn same_as_runs(&self, mut from: usize, runs: [(&Plane, usize, usize); 3]) -> bool {
+        runs.into_iter().all(|(plane, at, count)| {
+            let same = self.same_samples(from, plane, at, count);
+            from += count;
+            same
+        })
+    }
+
     fn is_u32(&self) -> bool {
-        matches!(self, Plane::U32(_))
+        match self {
+            Plane::Over { base, .. } => base.is_u32(),
+            plane => matches!(plane, Plane::U32(_)),
+        }
     }
 
     fn len(&self) -> Option<usize> {
@@ -164,6 +240,7 @@ impl Plane<'_> {
             Plane::U32(v) => Some(v.len()),
             Plane::Component(v, _) => Some(v.len()),
             Plane::Constant(_) => None,
+            Plane::Over { base, .. } => base.len(),
         }
     }
 }
@@ -271,8 +348,10 @@ pub fn write_planes_like<'a>(
         let (x0, y0) = (index.pixel_position.x(), index.pixel_position.y());
         let (w, h) = (index.pixel_size.width(), index.pixel_size.height());
         (y0..y0 + h).all(|y| {
-            (planes.iter().zip(&sorted))
-                .all(|((_, a), (_, b))| a.same_samples(b, y * width + x0, w))
+            (planes.iter().zip(&sorted)).all(|((_, a), (_, b))| {
+                let from = y * width + x0;
+                a.same_samples(from, b, from, w)
+            })
         })
     };
     let block = |_: &[Header], index: BlockIndex| {
@@ -502,6 +581,85 @@ mod tests {
                 .iter()
                 .all(|b| b != &[0xee; 3])
         );
+    }
+
+    /// Planes of a frame rendered over another write the file of the whole frame's planes,
+    /// and take the other's blocks exactly where the whole frame's samples would.
+    #[test]
+    fn planes_over_a_base_write_the_whole_frames_file() {
+        let (width, height) = (150usize, 70usize);
+        let a: Vec<f32> = bytes(width * height, 3, 256)
+            .iter()
+            .map(|&b| f32::from(b) * 0.61)
+            .collect();
+        let n: Vec<Vec3> = a.iter().map(|&v| Vec3::new(v, -v, 0.5 * v)).collect();
+        // Columns 60..70 of rows 10..30 (tiles (0, 0) and (1, 0)): as `a` but for one sample
+        // in tile (1, 0); the normals differ there too.
+        let rect = PixelRect {
+            x0: 60,
+            y0: 10,
+            x1: 70,
+            y1: 30,
+        };
+        let inside = |i: usize| (60..70).contains(&(i % width)) && (10..30).contains(&(i / width));
+        let (patch, patch_n): (Vec<f32>, Vec<Vec3>) = (0..width * height)
+            .filter(|&i| inside(i))
+            .map(|i| match i == 20 * width + 66 {
+                true => (a[i] + 1.0, -n[i]),
+                false => (a[i], n[i]),
+            })
+            .unzip();
+        let mut whole = a.clone();
+        let mut whole_n = n.clone();
+        let changed = 20 * width + 66;
+        whole[changed] += 1.0;
+        whole_n[changed] = -whole_n[changed];
+        let (base, over_patch) = (Plane::F32(&a), Plane::F32(&patch));
+        let over = |base, patch| Plane::Over {
+            base,
+            patch,
+            rect,
+            width,
+        };
+        let base_n = [0, 1, 2].map(|k| Plane::Component(&n, k));
+        let patch_n = [0, 1, 2].map(|k| Plane::Component(&patch_n, k));
+        let mut planes = vec![("Y", over(&base, &over_patch))];
+        let names = ["N.X", "N.Y", "N.Z"];
+        planes.extend((0..3).map(|k| (names[k], over(&base_n[k], &patch_n[k]))));
+        let mut whole_planes = vec![("Y", Plane::F32(&whole))];
+        whole_planes.extend((0..3).map(|k| (names[k], Plane::Component(&whole_n, k))));
+        let mut base_planes = vec![("Y", base)];
+        base_planes.extend((0..3).map(|k| (names[k], base_n[k])));
+        let write = |planes: &[(&str, Plane)], like: Option<&Zipped>| {
+            let mut file = std::io::Cursor::new(Vec::new());
+            let zipped = write_planes_like(width, height, planes, like, true, &mut file);
+            (file.into_inner(), zipped.unwrap().unwrap().blocks)
+        };
+        let mut like = write_planes_like(
+            width,
+            height,
+            &base_planes,
+            None,
+            true,
+            std::io::Cursor::new(Vec::new()),
+        )
+        .unwrap()
+        .unwrap();
+        // Marked, the base's blocks show where they were taken.
+        for block in &mut like.blocks {
+            *block = vec![0xee; 3];
+        }
+        let taken =
+            |blocks: &[Vec<u8>]| -> Vec<bool> { blocks.iter().map(|b| b == &[0xee; 3]).collect() };
+        let (alone, _) = write(&planes, None);
+        assert!(
+            alone == write(&whole_planes, None).0,
+            "the whole frame's file"
+        );
+        let (_, over_blocks) = write(&planes, Some(&like));
+        let (_, whole_blocks) = write(&whole_planes, Some(&like));
+        assert_eq!(taken(&over_blocks), taken(&whole_blocks));
+        assert_eq!(taken(&over_blocks), [true, false, true, true, true, true]);
     }
 
     #[test]

@@ -11,6 +11,7 @@ use glam::Vec3;
 use crate::io::atomic::write_atomically;
 use crate::io::exr_zip;
 use crate::render::frame::Frame;
+use crate::render::frame_over::FrameView;
 use crate::scene::limits::{MAX_COORDINATE, MAX_PIXELS, MAX_RESOLUTION};
 use crate::util::color::encode_srgb8;
 use crate::util::number::short;
@@ -27,12 +28,19 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<(
 }
 
 /// The colour AOV as an 8-bit sRGB PNG (clamped to [0, 1]; [`encode_srgb8`]).
-pub fn write_color_png(frame: &Frame, path: &Path) -> Result<()> {
-    let mut rgb = vec![0; 3 * frame.color.len()];
-    for (rgb, &c) in rgb.chunks_exact_mut(3).zip(&frame.color) {
-        rgb.copy_from_slice(&encode_srgb8(c));
+pub fn write_color_png<'a>(frame: impl Into<FrameView<'a>>, path: &Path) -> Result<()> {
+    let frame = frame.into();
+    let (w, h) = (frame.width(), frame.height());
+    let mut rgb = vec![0; 3 * w as usize * h as usize];
+    let mut out = rgb.chunks_exact_mut(3);
+    for y in 0..h {
+        for run in frame.row(|f| &f.color, y) {
+            for (&c, rgb) in run.iter().zip(&mut out) {
+                rgb.copy_from_slice(&encode_srgb8(c));
+            }
+        }
     }
-    write_png(path, frame.width, frame.height, rgb)
+    write_png(path, w, h, rgb)
 }
 
 /// A stable, well-separated colour for an id; black for 0 (sky).
@@ -49,12 +57,19 @@ pub fn id_color(id: u32) -> [u8; 3] {
 }
 
 /// Object ids in false colour, for looking at; part ids modulate the brightness.
-pub fn write_id_png(frame: &Frame, path: &Path) -> Result<()> {
-    let mut rgb = Vec::with_capacity(3 * frame.object_id.len());
-    for (&o, &p) in frame.object_id.iter().zip(&frame.part_id) {
-        rgb.extend_from_slice(&id_color(o).map(|c| (c as u32 * (8 - p % 4) / 8) as u8));
+pub fn write_id_png<'a>(frame: impl Into<FrameView<'a>>, path: &Path) -> Result<()> {
+    let frame = frame.into();
+    let (w, h) = (frame.width(), frame.height());
+    let mut rgb = Vec::with_capacity(3 * w as usize * h as usize);
+    for y in 0..h {
+        let parts = frame.row(|f| &f.part_id, y);
+        for (objects, parts) in frame.row(|f| &f.object_id, y).iter().zip(parts) {
+            for (&o, &p) in objects.iter().zip(parts) {
+                rgb.extend_from_slice(&id_color(o).map(|c| (c as u32 * (8 - p % 4) / 8) as u8));
+            }
+        }
     }
-    write_png(path, frame.width, frame.height, rgb)
+    write_png(path, w, h, rgb)
 }
 
 /// The EXR channel names of a frame's AOVs, as renderers and compositors name them, so that
@@ -123,7 +138,7 @@ pub fn write_exr(frame: &Frame, path: &Path) -> Result<()> {
 /// The channels of `content` in one EXR at `path`; nothing for [`ExrContent::None`]. The
 /// samples are read block by block from the frame's buffers ([`exr_zip::write_planes`]).
 pub fn write_view_exr(frame: &Frame, path: &Path, content: ExrContent) -> Result<()> {
-    write_view_exr_like(frame, path, content, None, false).map(|_| ())
+    write_view_exr_like(frame, path, content, None)
 }
 
 /// The channels of `content` of `frame` as the file's planes ([`exr_zip::Plane`]).
@@ -155,24 +170,79 @@ fn view_planes(frame: &Frame, content: ExrContent) -> Vec<(&'static str, exr_zip
     planes
 }
 
-/// [`write_view_exr`], reusing the compressed blocks of `like` (another frame's file) where
-/// this frame's samples are the same ([`exr_zip::write_planes_like`]: the same bytes); with
-/// `keep`, returns this file's blocks for the next (`None` for [`ExrContent::None`]).
+/// [`write_view_exr`] of a frame whole or rendered over another, reusing the compressed
+/// blocks of `like` (another frame's file) where this frame's samples are the same
+/// ([`exr_zip::write_planes_like`]: the same bytes).
 pub fn write_view_exr_like<'a>(
+    frame: impl Into<FrameView<'a>>,
+    path: &Path,
+    content: ExrContent,
+    like: Option<&exr_zip::Zipped>,
+) -> Result<()> {
+    let over = match frame.into() {
+        FrameView::Whole(frame) => {
+            return write_planes(frame, path, content, like, false).map(|_| ());
+        }
+        FrameView::Over(over) => over,
+    };
+    let (base, patch) = (
+        view_planes(over.base(), content),
+        view_planes(over.patch(), content),
+    );
+    let (rect, width) = (over.rect(), over.base().width as usize);
+    let planes: Vec<_> = base
+        .iter()
+        .zip(&patch)
+        .map(|((name, base), (_, patch))| {
+            let plane = exr_zip::Plane::Over {
+                base,
+                patch,
+                rect,
+                width,
+            };
+            (*name, plane)
+        })
+        .collect();
+    write_exr_planes(over.base(), &planes, path, like, false).map(|_| ())
+}
+
+/// [`write_view_exr`], returning the file's blocks for the next file ([`write_view_exr_like`];
+/// `None` for [`ExrContent::None`]).
+pub fn write_view_exr_keeping<'a>(
+    frame: &'a Frame,
+    path: &Path,
+    content: ExrContent,
+) -> Result<Option<exr_zip::Zipped<'a>>> {
+    write_planes(frame, path, content, None, true)
+}
+
+/// The planes of `content` of `frame` into `path` ([`write_exr_planes`]).
+fn write_planes<'a>(
     frame: &'a Frame,
     path: &Path,
     content: ExrContent,
     like: Option<&exr_zip::Zipped>,
     keep: bool,
 ) -> Result<Option<exr_zip::Zipped<'a>>> {
-    if content == ExrContent::None {
+    write_exr_planes(frame, &view_planes(frame, content), path, like, keep)
+}
+
+/// `planes` of a frame of `size`'s size into `path` (nothing without planes:
+/// [`ExrContent::None`]), blocks reused from `like`; with `keep`, returns the file's blocks.
+fn write_exr_planes<'a>(
+    size: &Frame,
+    planes: &[(&str, exr_zip::Plane<'a>)],
+    path: &Path,
+    like: Option<&exr_zip::Zipped>,
+    keep: bool,
+) -> Result<Option<exr_zip::Zipped<'a>>> {
+    if planes.is_empty() {
         return Ok(None);
     }
-    let planes = view_planes(frame, content);
-    let (width, height) = (frame.width as usize, frame.height as usize);
+    let (width, height) = (size.width as usize, size.height as usize);
     let mut zipped = None;
     write_atomically(path, |file| {
-        zipped = exr_zip::write_planes_like(width, height, &planes, like, keep, file)?;
+        zipped = exr_zip::write_planes_like(width, height, planes, like, keep, file)?;
         Ok(())
     })?;
     Ok(zipped)
@@ -465,21 +535,48 @@ fn sample_type(samples: &FlatSamples) -> &'static str {
 
 /// Writes `<name>.png`, `<name>_ids.png` and `<name>.exr` (holding `exr`) into `dir`.
 pub fn write_frame(frame: &Frame, dir: &Path, name: &str, exr: ExrContent) -> Result<()> {
-    write_frame_like(frame, dir, name, exr, None, false).map(|_| ())
+    write_frame_like(frame, dir, name, exr, None)
 }
 
-/// [`write_frame`], the EXR's blocks reused from `like` where they are the same
-/// ([`write_view_exr_like`]); with `keep`, returns the EXR's blocks. The three files are
-/// encoded side by side.
+/// [`write_frame`] of a frame whole or rendered over another, the EXR's blocks reused from
+/// `like` where they are the same ([`write_view_exr_like`]). The three files are encoded
+/// side by side.
 pub fn write_frame_like<'a>(
-    frame: &'a Frame,
+    frame: impl Into<FrameView<'a>>,
     dir: &Path,
     name: &str,
     exr: ExrContent,
     like: Option<&exr_zip::Zipped>,
-    keep: bool,
+) -> Result<()> {
+    let frame = frame.into();
+    write_frame_files(frame, dir, name, || {
+        write_view_exr_like(frame, &dir.join(format!("{name}.exr")), exr, like)
+    })
+}
+
+/// [`write_frame`], returning the EXR's blocks for the next file ([`write_frame_like`]).
+pub fn write_frame_keeping<'a>(
+    frame: &'a Frame,
+    dir: &Path,
+    name: &str,
+    exr: ExrContent,
 ) -> Result<Option<exr_zip::Zipped<'a>>> {
-    let (pngs, zipped) = rayon::join(
+    let mut zipped = None;
+    write_frame_files(frame.into(), dir, name, || {
+        zipped = write_view_exr_keeping(frame, &dir.join(format!("{name}.exr")), exr)?;
+        Ok(())
+    })?;
+    Ok(zipped)
+}
+
+/// `<name>.png` and `<name>_ids.png` of `frame` into `dir`, beside `exr` (its EXR).
+fn write_frame_files(
+    frame: FrameView,
+    dir: &Path,
+    name: &str,
+    exr: impl FnOnce() -> Result<()> + Send,
+) -> Result<()> {
+    let (pngs, exr) = rayon::join(
         || -> Result<()> {
             let (colour, ids) = rayon::join(
                 || write_color_png(frame, &dir.join(format!("{name}.png"))),
@@ -487,8 +584,7 @@ pub fn write_frame_like<'a>(
             );
             colour.and(ids)
         },
-        || write_view_exr_like(frame, &dir.join(format!("{name}.exr")), exr, like, keep),
+        exr,
     );
-    pngs?;
-    zipped
+    pngs.and(exr)
 }

@@ -130,7 +130,7 @@ pub fn compare(
         let result = run_with_truth(ctx, &options, Some(&truth))
             .and_then(|r| check_display_seen(ctx, &r.occluded).map(|()| r))
             .map_err(|e| anyhow::anyhow!("{}: {e:#}", candidate.name()))?;
-        let frames = [&result.truth, &result.seethru, &result.occluded];
+        let frames = result.measured_views();
         let (maps, mut metrics) = measure(ctx, scene, scene.eye(), frames, band);
         let holes = attach_holes(
             &mut metrics,

@@ -37,7 +37,7 @@ pub fn compare_maps(
             )
         })?;
         let result = &scored.run;
-        let frames = [&result.truth, &result.seethru, &result.occluded];
+        let frames = result.measured_views();
         let eye = options.eyes.view_camera(&scene.driver).position();
         let (maps, metrics) = measure(ctx, scene, eye, frames, band);
         let display = &metrics["display"];

@@ -9,6 +9,7 @@ use serde_json::json;
 use crate::geometry::camera::Camera;
 use crate::measure::metrics::MetricMaps;
 use crate::render::frame::Frame;
+use crate::render::frame_over::FrameView;
 use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
 use crate::system::pipeline::RunResult;
@@ -43,7 +44,7 @@ pub struct HazardFrame {
 pub fn hazard_frame(
     scene: &Scene,
     truth: &Frame,
-    seethru: &Frame,
+    seethru: FrameView<'_>,
     maps: &MetricMaps,
     bound_arcmin: f64,
     arcmin_per_px: f64,
@@ -60,7 +61,8 @@ pub fn hazard_frame(
         for i in 0..truth.object_id.len() {
             // Pixel corners: the half pixel to their centres cancels in the centroids' gap.
             let at = [(i % w) as f64, (i / w) as f64];
-            if maps.display[i] && seethru.object_id[i] == id {
+            let shows_it = |i| seethru.get(|f| &f.object_id, i) == id;
+            if maps.display[i] && shows_it(i) {
                 shown_any += 1;
                 shown_sum = [shown_sum[0] + at[0], shown_sum[1] + at[1]];
             }
@@ -74,7 +76,7 @@ pub fn hazard_frame(
             hidden += 1;
             hidden_sum = [hidden_sum[0] + at[0], hidden_sum[1] + at[1]];
             let error = maps.misregistration[i] as f64;
-            if seethru.object_id[i] == id && error <= bound_arcmin {
+            if shows_it(i) && error <= bound_arcmin {
                 shown += 1;
             }
         }
@@ -181,26 +183,33 @@ pub fn hazard_seen(
     bound_arcmin: f64,
     arcmin_per_px: f64,
 ) -> Vec<HazardSeen> {
-    hazard_frame(scene, truth, seethru, maps, bound_arcmin, arcmin_per_px)
-        .into_iter()
-        .map(|frame| {
-            let id = frame.id;
-            let (mut off, mut on) = (0u64, 0u64);
-            for i in 0..truth.object_id.len() {
-                if truth.object_id[i] != id {
-                    continue;
-                }
-                off += u64::from(occluded.object_id[i] == id);
-                let within = !maps.display[i] || maps.misregistration[i] as f64 <= bound_arcmin;
-                on += u64::from(seethru.object_id[i] == id && within);
+    hazard_frame(
+        scene,
+        truth,
+        seethru.into(),
+        maps,
+        bound_arcmin,
+        arcmin_per_px,
+    )
+    .into_iter()
+    .map(|frame| {
+        let id = frame.id;
+        let (mut off, mut on) = (0u64, 0u64);
+        for i in 0..truth.object_id.len() {
+            if truth.object_id[i] != id {
+                continue;
             }
-            HazardSeen {
-                frame,
-                seen_off_pixels: off,
-                seen_on_pixels: on,
-            }
-        })
-        .collect()
+            off += u64::from(occluded.object_id[i] == id);
+            let within = !maps.display[i] || maps.misregistration[i] as f64 <= bound_arcmin;
+            on += u64::from(seethru.object_id[i] == id && within);
+        }
+        HazardSeen {
+            frame,
+            seen_off_pixels: off,
+            seen_on_pixels: on,
+        }
+    })
+    .collect()
 }
 
 /// One hazard over a sequence: when it was first hidden and first shown, and its longest
@@ -267,7 +276,7 @@ pub fn run_hazards_json(
     let hazards = hazard_frame(
         &ctx.scene,
         &result.truth,
-        &result.seethru,
+        FrameView::Over(&result.seethru),
         maps,
         bound_arcmin,
         driver.central_pixel_arcmin(),

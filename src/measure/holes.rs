@@ -11,6 +11,7 @@ use serde_json::json;
 use crate::measure::maps::write_mask_png;
 use crate::measure::metrics::{MetricMaps, psnr, stats};
 use crate::render::frame::Frame;
+use crate::render::frame_over::FrameView;
 use crate::scene::Obstacle;
 use crate::system::display::MISSING_ID;
 use crate::util::color::encode_srgb8;
@@ -107,7 +108,8 @@ pub fn attach_holes(
     obstacle: &Obstacle,
     fill: impl serde::Serialize,
 ) -> Option<Vec<bool>> {
-    let driver_views = [&result.truth, &result.occluded, &result.seethru];
+    let [truth, seethru, occluded] = result.measured_views();
+    let driver_views = [truth, occluded, seethru];
     attach_view_holes(
         metrics,
         maps,
@@ -124,11 +126,14 @@ pub fn attach_view_holes(
     metrics: &mut serde_json::Value,
     maps: &MetricMaps,
     display_holes: Option<&[bool]>,
-    [truth, occluded, seethru]: [&Frame; 3],
+    [truth, occluded, seethru]: [FrameView<'_>; 3],
     obstacle: &Obstacle,
     fill: impl serde::Serialize,
 ) -> Option<Vec<bool>> {
-    let mask = driver_hole_mask(obstacle, occluded, maps, display_holes?);
+    let display_holes = display_holes?;
+    // Only a run with holes (`--method depth`) reads the whole frames.
+    let [truth, occluded, seethru] = [truth, occluded, seethru].map(FrameView::whole);
+    let mask = driver_hole_mask(obstacle, occluded, maps, display_holes);
     metrics["holes"] = hole_metrics(&mask, maps, truth, seethru, fill);
     Some(mask)
 }

@@ -17,7 +17,7 @@ use crate::analysis::physical::ARCMIN_PER_RAD;
 use crate::render::accel::Hit;
 use crate::render::accel::make_ray;
 use crate::render::bvh_packet::{PACKET, PacketStack, RayPacket};
-use crate::render::frame::Frame;
+use crate::render::frame_over::FrameView;
 use crate::render::integrator::RenderContext;
 use crate::render::ray::TraceRay;
 use crate::render::simd::Isa;
@@ -370,7 +370,7 @@ pub fn measure(
     ctx: &RenderContext,
     scene: &Scene,
     driver_eye: DVec3,
-    frames: [&Frame; 3],
+    frames: [FrameView<'_>; 3],
     band: u32,
 ) -> (MetricMaps, serde_json::Value) {
     measure_with(ctx, scene, driver_eye, frames, band, Flip::Computed)
@@ -397,21 +397,23 @@ pub fn measure_with(
     ctx: &RenderContext,
     scene: &Scene,
     driver_eye: DVec3,
-    frames: [&Frame; 3],
+    frames: [FrameView<'_>; 3],
     band: u32,
     flip: Flip,
 ) -> (MetricMaps, serde_json::Value) {
     let [truth, seethru, occluded] = frames;
-    let (w, h) = (truth.width as usize, truth.height as usize);
+    let (w, h) = (truth.width() as usize, truth.height() as usize);
     let obstacle = &scene.obstacle;
     let placement = DisplayPlacement::new(obstacle);
     let [dw, dh] = obstacle.display_resolution;
-    let display: Vec<bool> = occluded
-        .object_id
-        .iter()
-        .zip(&occluded.part_id)
-        .map(|(&o, &p)| ctx.world.is_display(o, p))
-        .collect();
+    let mut display: Vec<bool> = Vec::with_capacity(w * h);
+    for y in 0..h as u32 {
+        let parts = occluded.row(|f| &f.part_id, y);
+        for (ids, parts) in occluded.row(|f| &f.object_id, y).iter().zip(parts) {
+            let shown = ids.iter().zip(parts);
+            display.extend(shown.map(|(&o, &p)| ctx.world.is_display(o, p)));
+        }
+    }
     // Every statistic is over display pixels, taken in index order (row by row): the same
     // sums as a pass over the whole frame, without visiting the rest of it. What is kept per
     // display pixel is kept in that order (index k of `on_display`), not over the frame.
@@ -435,7 +437,7 @@ pub fn measure_with(
         };
         let mut hidden_query = None;
         // The display pixel coordinates of the point: a curved display's from its UVs.
-        let uv = placement.pixel_coords(occluded.position[i]);
+        let uv = placement.pixel_coords(occluded.get(|f| &f.position, i));
         let (u, v) = (uv.x, uv.y);
         out.sides = [
             u < band as f64,
@@ -443,8 +445,8 @@ pub fn measure_with(
             v < band as f64,
             v >= (dh - band) as f64,
         ];
-        let t = truth.position[i];
-        let true_dir = shown_direction(t, truth.normal[i], driver_eye);
+        let t = truth.get(|f| &f.position, i);
+        let true_dir = shown_direction(t, truth.get(|f| &f.normal, i), driver_eye);
         // Can the frontal camera see the truth's point, or its sky direction?
         if let Some(d) = true_dir {
             let (inside, to, distance) = if t.is_finite() {
@@ -473,16 +475,17 @@ pub fn measure_with(
                 hidden_query = Some((to.normalize().as_vec3(), reach));
             }
         }
-        if seethru.object_id[i] == MISSING_ID {
+        if seethru.get(|f| &f.object_id, i) == MISSING_ID {
             out.class.blank = true;
             return (out, hidden_query);
         }
-        let shown_dir = shown_direction(seethru.position[i], seethru.normal[i], driver_eye);
+        let shown = seethru.get(|f| &f.position, i);
+        let shown_dir = shown_direction(shown, seethru.get(|f| &f.normal, i), driver_eye);
         match (shown_dir, true_dir) {
             (Some(a), Some(b)) => {
                 out.misregistration = (angle_between(a, b) * ARCMIN_PER_RAD) as f32;
                 out.class.truth_sky = !t.is_finite();
-                out.class.shown_sky = !seethru.position[i].is_finite();
+                out.class.shown_sky = !shown.is_finite();
             }
             _ => out.class.undefined = true,
         }
@@ -538,11 +541,11 @@ pub fn measure_with(
     // Colours of the display's pixels only.
     let srgb_t: Vec<[u8; 3]> = on_display
         .iter()
-        .map(|&i| encode_srgb8(truth.color[i]))
+        .map(|&i| encode_srgb8(truth.get(|f| &f.color, i)))
         .collect();
     let srgb_s: Vec<[u8; 3]> = on_display
         .iter()
-        .map(|&i| encode_srgb8(seethru.color[i]))
+        .map(|&i| encode_srgb8(seethru.get(|f| &f.color, i)))
         .collect();
     // SSIM's windows and FLIP's filters see the display pixels in their bounding box, which
     // holds every pixel a window or filter of theirs would read.

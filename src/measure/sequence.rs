@@ -14,6 +14,7 @@ use crate::measure::hazard::{DEFAULT_BOUND_ARCMIN, HazardSeen, hazard_seen};
 use crate::measure::metrics::{Flip, MetricMaps, measure_with};
 use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::Frame;
+use crate::render::frame_over::FrameView;
 use crate::render::integrator::RenderContext;
 use crate::render::settings::RenderSettings;
 use crate::scene::world::view_bit;
@@ -438,7 +439,7 @@ impl SequenceStepper {
             &ctx,
             &measured,
             driver.position(),
-            [truth, seethru, occluded],
+            [truth, seethru, occluded].map(FrameView::from),
             self.how.band,
             self.how.flip,
         );

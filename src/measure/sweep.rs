@@ -199,7 +199,7 @@ pub fn sweep(
                     &ctx,
                     &ctx.scene,
                     ctx.scene.eye(),
-                    [&result.truth, &result.seethru, &result.occluded],
+                    result.measured_views(),
                     options.band,
                 );
                 let values = metric_row(&metrics, &result.report);

@@ -217,13 +217,7 @@ translate = [0.0, 0.0, -10.0]
     };
     let r = run(&ctx, &options)?;
     let eye = ctx.scene.eye();
-    let (_, metrics) = measure(
-        &ctx,
-        &ctx.scene,
-        eye,
-        [&r.truth, &r.seethru, &r.occluded],
-        5,
-    );
+    let (_, metrics) = measure(&ctx, &ctx.scene, eye, r.measured_views(), 5);
     metrics["display"]["misregistration_arcmin"]["mean"]
         .as_f64()
         .ok_or_else(|| anyhow::anyhow!("the head-error wall shows no display pixel"))

@@ -171,7 +171,7 @@ pub fn reproduce_named(
                 &ctx,
                 &ctx.scene,
                 ctx.scene.eye(),
-                [&result.truth, &result.seethru, &result.occluded],
+                result.measured_views(),
                 5,
             );
             frame_png(&result.truth, &out.join(&dir).join("truth.png"))?;

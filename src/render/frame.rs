@@ -60,8 +60,11 @@ impl Pixel {
 
 /// A band of whole rows of a frame, writable on its own (one per worker task).
 pub struct Rows<'a> {
-    /// Index of the band's first row in the frame.
+    /// Image row of the band's first row.
     pub y: u32,
+    /// Image column of the frame's first column (0 unless the frame is a rectangle of a
+    /// larger image: the patch of a view rendered over another).
+    x0: u32,
     width: usize,
     color: &'a mut [Vec3],
     depth: &'a mut [f32],
@@ -82,10 +85,11 @@ impl Rows<'_> {
         self.depth.is_empty()
     }
 
-    /// Writes pixel `x` of the band's row `row` (counted from the band's first).
+    /// Writes the pixel of image column `x` in the band's row `row` (counted from the band's
+    /// first).
     #[inline]
     pub fn set(&mut self, x: u32, row: u32, p: Pixel) {
-        let i = row as usize * self.width + x as usize;
+        let i = row as usize * self.width + (x - self.x0) as usize;
         self.color[i] = p.color;
         self.depth[i] = p.depth;
         self.camera_z[i] = p.camera_z;
@@ -116,6 +120,12 @@ impl Frame {
 
     /// The frame as bands of `rows` rows (the last may be shorter), top to bottom.
     pub fn bands_mut(&mut self, rows: u32) -> Vec<Rows<'_>> {
+        self.bands_mut_at(rows, 0, 0)
+    }
+
+    /// [`Frame::bands_mut`] of a frame whose pixel (0, 0) is pixel (`x0`, `y0`) of a larger
+    /// image: the bands are addressed in the image's rows and columns.
+    pub fn bands_mut_at(&mut self, rows: u32, x0: u32, y0: u32) -> Vec<Rows<'_>> {
         let width = self.width as usize;
         let n = width * rows.max(1) as usize;
         self.color
@@ -130,7 +140,8 @@ impl Frame {
             .map(
                 |(i, ((((((color, depth), camera_z), position), normal), object_id), part_id))| {
                     Rows {
-                        y: i as u32 * rows.max(1),
+                        y: y0 + i as u32 * rows.max(1),
+                        x0,
                         width,
                         color,
                         depth,

@@ -25,7 +25,8 @@ use crate::render::bvh::Stack;
 use crate::render::bvh_packet::{PACKET, PacketStack, RayPacket};
 use crate::render::camera_rays::CameraRays;
 use crate::render::footprint::{PixelRect, footprint};
-use crate::render::frame::{Frame, Pixel};
+use crate::render::frame::{Frame, Pixel, Rows};
+use crate::render::frame_over::FrameOver;
 use crate::render::moving::MovingLayer;
 use crate::render::ray::{Hit, TraceRay};
 use crate::render::screen::{Screen, Shown};
@@ -202,24 +203,29 @@ impl RenderContext {
 
     /// Renders `view` (with `display` for the `seethru` view) from `camera`, given `base`, the
     /// same camera's frame in `base_view` with the same settings: only the pixels where the
-    /// two views can differ are traced, the others are copied. The result is bit for bit
-    /// the frame [`RenderContext::render`] (or [`RenderContext::render_seethru`]) gives.
+    /// two views can differ are traced, the others are `base`'s, shared rather than copied.
+    /// The result is bit for bit the frame [`RenderContext::render`] (or
+    /// [`RenderContext::render_seethru`]) gives.
     #[allow(clippy::too_many_arguments)]
     pub fn render_over(
         &self,
         camera: &Camera,
-        base: &Frame,
+        base: &Arc<Frame>,
         base_view: u8,
         view: u8,
         display: Option<&dyn Screen>,
         settings: RenderSettings,
         label: &str,
-    ) -> (Frame, RenderStats) {
+    ) -> (FrameOver, RenderStats) {
         assert_eq!((base.width, base.height), (camera.width, camera.height));
         let region = self.difference_region(camera, base_view, view);
-        let mut frame = base.clone();
-        let stats = self.render_rect(camera, view, display, settings, region, &mut frame, label);
-        (frame, stats)
+        let mut patch = Frame::new(region.x1 - region.x0, region.y1 - region.y0);
+        let bands = patch.bands_mut_at(BAND_ROWS, region.x0, region.y0);
+        let tracer = Tracer::best();
+        let stats = self.render_bands(
+            camera, view, display, settings, region, bands, label, tracer,
+        );
+        (FrameOver::new(Arc::clone(base), region, patch), stats)
     }
 
     /// The pixels of `camera` where views `a` and `b` can differ (see [`Accel::difference`]).
@@ -312,6 +318,26 @@ impl RenderContext {
         tracer: Tracer,
     ) -> RenderStats {
         assert_eq!((frame.width, frame.height), (camera.width, camera.height));
+        let bands = frame.bands_mut(BAND_ROWS);
+        self.render_bands(
+            camera, view, display, settings, region, bands, label, tracer,
+        )
+    }
+
+    /// Renders the pixels of `region` of `view` into `bands` (of a frame of the camera's size,
+    /// or of the region alone), each pixel as [`RenderContext::render`] gives it.
+    #[allow(clippy::too_many_arguments)]
+    fn render_bands(
+        &self,
+        camera: &Camera,
+        view: u8,
+        display: Option<&dyn Screen>,
+        settings: RenderSettings,
+        region: PixelRect,
+        bands: Vec<Rows<'_>>,
+        label: &str,
+        tracer: Tracer,
+    ) -> RenderStats {
         let start = Instant::now();
         let job = PixelJob {
             rays: CameraRays::new(camera),
@@ -320,8 +346,7 @@ impl RenderContext {
             display,
             spp: settings.spp,
         };
-        let bands: Vec<_> = frame
-            .bands_mut(BAND_ROWS)
+        let bands: Vec<_> = bands
             .into_iter()
             .filter(|b| b.y < region.y1 && b.y + b.len() > region.y0)
             .collect();

@@ -9,6 +9,7 @@ pub mod camera_rays;
 pub mod cancel;
 pub mod footprint;
 pub mod frame;
+pub mod frame_over;
 pub mod integrator;
 pub mod moving;
 pub mod packets;

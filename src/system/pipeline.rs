@@ -2,7 +2,7 @@
 //! model crops the frontal render, the display shows it, and the driver's view with the
 //! display in it is rendered beside the ground truth.
 
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
@@ -12,6 +12,7 @@ use serde_json::json;
 use crate::geometry::camera::Camera;
 use crate::geometry::homography::homography;
 use crate::render::frame::Frame;
+use crate::render::frame_over::{FrameOver, FrameView};
 use crate::render::integrator::RenderContext;
 use crate::render::settings::{RenderSettings, check_spp};
 use crate::render::views::View;
@@ -34,12 +35,13 @@ use crate::util::number::short;
 
 /// Everything a run produces.
 pub struct RunResult {
-    pub truth: Frame,
-    pub occluded: Frame,
+    /// Shared with `occluded` and `seethru`, which are it outside the obstacle's footprint.
+    pub truth: Arc<Frame>,
+    pub occluded: FrameOver,
     pub frontal: Frame,
     pub back: Frame,
     pub display: Frame,
-    pub seethru: Frame,
+    pub seethru: FrameOver,
     pub crop: Crop,
     /// The eye the compensation used, world frame.
     pub eye_used: DVec3,
@@ -50,6 +52,17 @@ pub struct RunResult {
     pub holes: Option<Vec<bool>>,
     /// `run.json`.
     pub report: serde_json::Value,
+}
+
+impl RunResult {
+    /// The driver's views `truth`, `seethru` and `occluded`, in the metrics' order.
+    pub fn measured_views(&self) -> [FrameView<'_>; 3] {
+        [
+            FrameView::Whole(&self.truth),
+            FrameView::Over(&self.seethru),
+            FrameView::Over(&self.occluded),
+        ]
+    }
 }
 
 /// The eye the system believes in: true, or estimated from the back image; plus errors.
@@ -334,18 +347,24 @@ pub fn run(ctx: &RenderContext, options: &RunOptions) -> Result<RunResult> {
 
 /// Refuses a run whose display covers no pixel of the driver's view (`occluded`): nothing to
 /// measure. (A sweep keeps such a configuration as a row of undefined metrics.)
-pub fn check_display_seen(ctx: &RenderContext, occluded: &Frame) -> Result<()> {
+pub fn check_display_seen<'a>(
+    ctx: &RenderContext,
+    occluded: impl Into<FrameView<'a>>,
+) -> Result<()> {
+    let occluded = occluded.into();
     let display_face = |(&o, &p): (&u32, &u32)| ctx.world.is_display(o, p);
-    if !occluded
-        .object_id
-        .iter()
-        .zip(&occluded.part_id)
-        .any(display_face)
-    {
+    let seen = (0..occluded.height()).any(|y| {
+        let parts = occluded.row(|f| &f.part_id, y);
+        let ids = occluded.row(|f| &f.object_id, y);
+        ids.iter()
+            .zip(parts)
+            .any(|(ids, parts)| ids.iter().zip(parts).any(display_face))
+    });
+    if !seen {
         bail!(
             "the display covers no pixel of the driver's {}×{} view: the driver looks away from it, or it is too small or too far to cover a pixel; nothing to measure",
-            occluded.width,
-            occluded.height
+            occluded.width(),
+            occluded.height()
         );
     }
     Ok(())
@@ -396,34 +415,45 @@ pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Res
 /// The six views of a run, each set once, as [`run_staged`] makes it.
 #[derive(Default)]
 pub struct RunViews {
-    pub truth: OnceLock<Frame>,
-    pub occluded: OnceLock<Frame>,
+    pub truth: OnceLock<Arc<Frame>>,
+    pub occluded: OnceLock<FrameOver>,
     pub frontal: OnceLock<Frame>,
     pub back: OnceLock<Frame>,
     pub display: OnceLock<Frame>,
-    pub seethru: OnceLock<Frame>,
+    pub seethru: OnceLock<FrameOver>,
 }
 
+/// What a run hands a caller as each view is made: the view's file name and its frame.
+pub type Ready<'v> = dyn Fn(&'static str, FrameView<'v>) + Sync + 'v;
+
 impl RunViews {
-    /// Sets view `name`'s frame and hands it to `ready`.
-    fn set<'v>(
+    /// View `name` (`truth`, `occluded`, `frontal`, `back`, `display`, `seethru`), once set.
+    pub fn get(&self, name: &str) -> Option<FrameView<'_>> {
+        fn whole(slot: &OnceLock<Frame>) -> Option<FrameView<'_>> {
+            slot.get().map(FrameView::Whole)
+        }
+        match name {
+            "truth" => self.truth.get().map(|f| FrameView::Whole(f)),
+            "occluded" => self.occluded.get().map(FrameView::Over),
+            "seethru" => self.seethru.get().map(FrameView::Over),
+            "frontal" => whole(&self.frontal),
+            "back" => whole(&self.back),
+            "display" => whole(&self.display),
+            _ => None,
+        }
+    }
+
+    /// Sets `slot`, view `name`'s, to `frame` and hands the view to `ready`.
+    fn set<'v, F>(
         &'v self,
         name: &'static str,
-        frame: Frame,
-        ready: &(dyn Fn(&'static str, &'v Frame) + Sync),
-    ) -> &'v Frame {
-        let slot = match name {
-            "truth" => &self.truth,
-            "occluded" => &self.occluded,
-            "frontal" => &self.frontal,
-            "back" => &self.back,
-            "display" => &self.display,
-            _ => &self.seethru,
-        };
+        slot: &'v OnceLock<F>,
+        frame: F,
+        ready: &Ready<'v>,
+    ) -> &'v F {
         assert!(slot.set(frame).is_ok(), "the {name} view is made once");
-        let frame = slot.get().expect("just set");
-        ready(name, frame);
-        frame
+        ready(name, self.get(name).expect("just set"));
+        slot.get().expect("just set")
     }
 }
 
@@ -440,8 +470,9 @@ pub struct RunRest {
 impl RunRest {
     /// The whole [`RunResult`], with the views [`run_staged`] filled.
     pub fn with_views(self, views: RunViews) -> RunResult {
-        let take =
-            |slot: OnceLock<Frame>| slot.into_inner().expect("a finished run set every view");
+        fn take<F>(slot: OnceLock<F>) -> F {
+            slot.into_inner().expect("a finished run set every view")
+        }
         RunResult {
             truth: take(views.truth),
             occluded: take(views.occluded),
@@ -467,7 +498,7 @@ pub fn run_staged<'v>(
     options: &RunOptions,
     given: Given,
     views: &'v RunViews,
-    ready: &(dyn Fn(&'static str, &'v Frame) + Sync),
+    ready: &Ready<'v>,
 ) -> Result<RunRest> {
     let truth = given.truth;
     let mut scene = ctx.scene.clone();
@@ -513,12 +544,12 @@ pub fn run_staged<'v>(
         Some(b) => b.clone(),
         None => timed(&mut timings, &scene.back, View::Back),
     };
-    let back = views.set("back", back, ready);
+    let back = views.set("back", &views.back, back, ready);
     let frontal = match given.frontal {
         Some(f) => f.clone(),
         None => timed(&mut timings, &scene.frontal, View::Frontal),
     };
-    let frontal = views.set("frontal", frontal, ready);
+    let frontal = views.set("frontal", &views.frontal, frontal, ready);
     let (eye_used, head_fix) = eye_for_compensation(scene, back, options)?;
     let (crop, d2_used) = crop_for(scene, eye_used, frontal, options)?;
     let map = frontal_map(scene, crop, options)?;
@@ -553,17 +584,17 @@ pub fn run_staged<'v>(
         .filter(|&&i| i == MISSING_ID)
         .count() as f64
         / display.object_id.len() as f64;
-    let display = views.set("display", display, ready);
+    let display = views.set("display", &views.display, display, ready);
     // `occluded` and `seethru` differ from `truth` only where the obstacle can be seen:
     // only those pixels are traced again.
     let truth = match truth {
         Some(t) => {
             assert_eq!((t.width, t.height), (driver.width, driver.height));
-            t.clone()
+            Arc::new(t.clone())
         }
-        None => timed(&mut timings, &driver, View::Truth),
+        None => Arc::new(timed(&mut timings, &driver, View::Truth)),
     };
-    let truth = views.set("truth", truth, ready);
+    let truth = views.set("truth", &views.truth, truth, ready);
     let (occluded, stats) = ctx.render_over(
         &driver,
         truth,
@@ -574,7 +605,7 @@ pub fn run_staged<'v>(
         "occluded",
     );
     timings.insert("occluded".into(), json!(stats.seconds));
-    views.set("occluded", occluded, ready);
+    views.set("occluded", &views.occluded, occluded, ready);
     let placement = DisplayPlacement::new(&scene.obstacle);
     let surface = match options.display {
         _ if given_display => DisplaySurface::Pixels {
@@ -601,7 +632,7 @@ pub fn run_staged<'v>(
         "seethru",
     );
     timings.insert("seethru".into(), json!(stats.seconds));
-    views.set("seethru", seethru, ready);
+    views.set("seethru", &views.seethru, seethru, ready);
 
     let mut report = report(
         scene,
