@@ -187,6 +187,7 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
+    use crate::render::frame::Pixel;
 
     /// A `w`×`h` frame whose every buffer holds `seed` + the pixel index, so that each pixel
     /// of each buffer says where it came from.
@@ -211,53 +212,25 @@ mod tests {
     fn a_frame_over_another_reads_as_the_base_overwritten_inside_the_rectangle() {
         let (w, h) = (7, 5);
         let base = Arc::new(numbered(w, h, 0));
+        let rect = |x0, y0, x1, y1| PixelRect { x0, y0, x1, y1 };
         for rect in [
-            PixelRect {
-                x0: 2,
-                y0: 1,
-                x1: 5,
-                y1: 4,
-            },
-            PixelRect {
-                x0: 0,
-                y0: 0,
-                x1: 7,
-                y1: 5,
-            },
-            PixelRect {
-                x0: 0,
-                y0: 3,
-                x1: 1,
-                y1: 5,
-            },
-            PixelRect {
-                x0: 6,
-                y0: 0,
-                x1: 7,
-                y1: 1,
-            },
-            PixelRect {
-                x0: 3,
-                y0: 2,
-                x1: 3,
-                y1: 2,
-            },
+            rect(2, 1, 5, 4),
+            rect(0, 0, 7, 5),
+            rect(0, 3, 1, 5),
+            rect(6, 0, 7, 1),
+            rect(3, 2, 3, 2),
         ] {
             let patch = numbered(rect.x1 - rect.x0, rect.y1 - rect.y0, 1000);
-            let mut expected = Frame::clone(&base);
-            for y in rect.y0..rect.y1 {
-                for x in rect.x0..rect.x1 {
-                    let p = patch.pixel(x - rect.x0, y - rect.y0);
-                    let i = expected.index(x, y);
-                    expected.color[i] = p.color;
-                    expected.depth[i] = p.depth;
-                    expected.camera_z[i] = p.camera_z;
-                    expected.position[i] = p.position;
-                    expected.normal[i] = p.normal;
-                    expected.object_id[i] = p.object_id;
-                    expected.part_id[i] = p.part_id;
-                }
-            }
+            let pixels: Vec<Pixel> = (0..w * h)
+                .map(|i| {
+                    let (x, y) = (i % w, i / w);
+                    match (rect.x0..rect.x1).contains(&x) && (rect.y0..rect.y1).contains(&y) {
+                        true => patch.pixel(x - rect.x0, y - rect.y0),
+                        false => base.pixel(x, y),
+                    }
+                })
+                .collect();
+            let expected = Frame::from_pixels(w, h, &pixels);
             let over = FrameOver::new(base.clone(), rect, patch);
             let view = FrameView::Over(&over);
             for y in 0..h {
