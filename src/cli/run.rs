@@ -14,7 +14,6 @@ use seethru::measure::headline::{read_results, summary_text};
 use seethru::measure::holes::{attach_view_holes, write_hole_mask};
 use seethru::measure::maps::write_metrics_scaled;
 use seethru::measure::metrics::measure;
-use seethru::render::frame_over::FrameView;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::scene::lens_keys::read_calibration_file;
@@ -291,9 +290,7 @@ fn write_run(
         }
     });
     let measured = rayon::scope(|s| -> Result<_> {
-        // Each view is fetched again from `views`: the frame handed over lives as long as the
-        // run, not the scope.
-        let ready = |name: &'static str, _: FrameView<'_>| match name {
+        let ready = |name: &'static str| match name {
             "truth" => {
                 let frame = views_ref.truth.get().expect("just set");
                 s.spawn(move |s| {

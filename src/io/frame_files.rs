@@ -203,7 +203,8 @@ pub fn write_view_exr_like<'a>(
             (*name, plane)
         })
         .collect();
-    write_exr_planes(over.base(), &planes, path, like, false).map(|_| ())
+    let size = (over.base().width, over.base().height);
+    write_exr_planes(size, &planes, path, like, false).map(|_| ())
 }
 
 /// [`write_view_exr`], returning the file's blocks for the next file ([`write_view_exr_like`];
@@ -224,13 +225,14 @@ fn write_planes<'a>(
     like: Option<&exr_zip::Zipped>,
     keep: bool,
 ) -> Result<Option<exr_zip::Zipped<'a>>> {
-    write_exr_planes(frame, &view_planes(frame, content), path, like, keep)
+    let planes = view_planes(frame, content);
+    write_exr_planes((frame.width, frame.height), &planes, path, like, keep)
 }
 
-/// `planes` of a frame of `size`'s size into `path` (nothing without planes:
+/// `planes` of a frame of `size` (width, height) pixels into `path` (nothing without planes:
 /// [`ExrContent::None`]), blocks reused from `like`; with `keep`, returns the file's blocks.
 fn write_exr_planes<'a>(
-    size: &Frame,
+    (width, height): (u32, u32),
     planes: &[(&str, exr_zip::Plane<'a>)],
     path: &Path,
     like: Option<&exr_zip::Zipped>,
@@ -239,7 +241,7 @@ fn write_exr_planes<'a>(
     if planes.is_empty() {
         return Ok(None);
     }
-    let (width, height) = (size.width as usize, size.height as usize);
+    let (width, height) = (width as usize, height as usize);
     let mut zipped = None;
     write_atomically(path, |file| {
         zipped = exr_zip::write_planes_like(width, height, planes, like, keep, file)?;

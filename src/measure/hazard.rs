@@ -56,12 +56,12 @@ pub fn hazard_frame(
             continue;
         }
         let id = index as u32 + 1;
+        let shows_it = |i| seethru.get(|f| &f.object_id, i) == id;
         let (mut truth_pixels, mut hidden, mut shown) = (0u64, 0u64, 0u64);
         let (mut hidden_sum, mut shown_sum, mut shown_any) = ([0.0f64; 2], [0.0f64; 2], 0u64);
         for i in 0..truth.object_id.len() {
             // Pixel corners: the half pixel to their centres cancels in the centroids' gap.
             let at = [(i % w) as f64, (i / w) as f64];
-            let shows_it = |i| seethru.get(|f| &f.object_id, i) == id;
             if maps.display[i] && shows_it(i) {
                 shown_any += 1;
                 shown_sum = [shown_sum[0] + at[0], shown_sum[1] + at[1]];

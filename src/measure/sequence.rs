@@ -561,14 +561,8 @@ fn copy_rect(from: &Frame, to: &mut Frame, rect: PixelRect) {
         return;
     }
     for y in rect.y0 as usize..rect.y1 as usize {
-        let r = y * w + rect.x0 as usize..y * w + rect.x1 as usize;
-        to.color[r.clone()].copy_from_slice(&from.color[r.clone()]);
-        to.depth[r.clone()].copy_from_slice(&from.depth[r.clone()]);
-        to.camera_z[r.clone()].copy_from_slice(&from.camera_z[r.clone()]);
-        to.position[r.clone()].copy_from_slice(&from.position[r.clone()]);
-        to.normal[r.clone()].copy_from_slice(&from.normal[r.clone()]);
-        to.object_id[r.clone()].copy_from_slice(&from.object_id[r.clone()]);
-        to.part_id[r.clone()].copy_from_slice(&from.part_id[r]);
+        let at = y * w + rect.x0 as usize;
+        to.copy_pixels(at, from, at, (rect.x1 - rect.x0) as usize);
     }
 }
 

@@ -182,6 +182,19 @@ impl Frame {
         frame
     }
 
+    /// Every AOV of `count` pixels of `from` (from its index `from_at`) into this frame's
+    /// pixels from index `at`.
+    pub fn copy_pixels(&mut self, at: usize, from: &Frame, from_at: usize, count: usize) {
+        let (to, r) = (at..at + count, from_at..from_at + count);
+        self.color[to.clone()].copy_from_slice(&from.color[r.clone()]);
+        self.depth[to.clone()].copy_from_slice(&from.depth[r.clone()]);
+        self.camera_z[to.clone()].copy_from_slice(&from.camera_z[r.clone()]);
+        self.position[to.clone()].copy_from_slice(&from.position[r.clone()]);
+        self.normal[to.clone()].copy_from_slice(&from.normal[r.clone()]);
+        self.object_id[to.clone()].copy_from_slice(&from.object_id[r.clone()]);
+        self.part_id[to].copy_from_slice(&from.part_id[r]);
+    }
+
     pub fn index(&self, x: u32, y: u32) -> usize {
         y as usize * self.width as usize + x as usize
     }

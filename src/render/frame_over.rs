@@ -60,16 +60,8 @@ impl FrameOver {
             let mut whole = Frame::clone(&self.base);
             let (r, pw) = (self.rect, self.patch.width as usize);
             for y in r.y0..r.y1 {
-                let to = whole.index(r.x0, y)..whole.index(r.x1, y);
-                let from = (y - r.y0) as usize * pw..(y - r.y0 + 1) as usize * pw;
-                let p = &self.patch;
-                whole.color[to.clone()].copy_from_slice(&p.color[from.clone()]);
-                whole.depth[to.clone()].copy_from_slice(&p.depth[from.clone()]);
-                whole.camera_z[to.clone()].copy_from_slice(&p.camera_z[from.clone()]);
-                whole.position[to.clone()].copy_from_slice(&p.position[from.clone()]);
-                whole.normal[to.clone()].copy_from_slice(&p.normal[from.clone()]);
-                whole.object_id[to.clone()].copy_from_slice(&p.object_id[from.clone()]);
-                whole.part_id[to].copy_from_slice(&p.part_id[from]);
+                let from = (y - r.y0) as usize * pw;
+                whole.copy_pixels(whole.index(r.x0, y), &self.patch, from, pw);
             }
             whole
         })

@@ -408,7 +408,7 @@ pub struct Given<'a> {
 /// [`run_with_truth`] with whatever [`Given`] holds.
 pub fn run_given(ctx: &RenderContext, options: &RunOptions, given: Given) -> Result<RunResult> {
     let views = RunViews::default();
-    let rest = run_staged(ctx, options, given, &views, &|_, _| {})?;
+    let rest = run_staged(ctx, options, given, &views, &|_| {})?;
     Ok(rest.with_views(views))
 }
 
@@ -423,8 +423,9 @@ pub struct RunViews {
     pub seethru: OnceLock<FrameOver>,
 }
 
-/// What a run hands a caller as each view is made: the view's file name and its frame.
-pub type Ready<'v> = dyn Fn(&'static str, FrameView<'v>) + Sync + 'v;
+/// What a run tells a caller as each view is made: the view's file name (the caller reads
+/// the view from the [`RunViews`], for as long as they live).
+pub type Ready<'a> = dyn Fn(&'static str) + Sync + 'a;
 
 impl RunViews {
     /// View `name` (`truth`, `occluded`, `frontal`, `back`, `display`, `seethru`), once set.
@@ -443,16 +444,10 @@ impl RunViews {
         }
     }
 
-    /// Sets `slot`, view `name`'s, to `frame` and hands the view to `ready`.
-    fn set<'v, F>(
-        &'v self,
-        name: &'static str,
-        slot: &'v OnceLock<F>,
-        frame: F,
-        ready: &Ready<'v>,
-    ) -> &'v F {
+    /// Sets `slot`, view `name`'s, to `frame` and tells `ready`.
+    fn set<'v, F>(name: &'static str, slot: &'v OnceLock<F>, frame: F, ready: &Ready<'_>) -> &'v F {
         assert!(slot.set(frame).is_ok(), "the {name} view is made once");
-        ready(name, self.get(name).expect("just set"));
+        ready(name);
         slot.get().expect("just set")
     }
 }
@@ -490,15 +485,15 @@ impl RunRest {
     }
 }
 
-/// [`run_given`], setting each view in `views` as soon as it is made and handing it to
-/// `ready` (with its file name: `truth`, `occluded`, `frontal`, `back`, `display`, `seethru`),
+/// [`run_given`], setting each view in `views` as soon as it is made and telling `ready`
+/// (its file name: `truth`, `occluded`, `frontal`, `back`, `display`, `seethru`),
 /// so that a caller can write it while the next one renders. On success every view is set.
-pub fn run_staged<'v>(
+pub fn run_staged(
     ctx: &RenderContext,
     options: &RunOptions,
     given: Given,
-    views: &'v RunViews,
-    ready: &Ready<'v>,
+    views: &RunViews,
+    ready: &Ready<'_>,
 ) -> Result<RunRest> {
     let truth = given.truth;
     let mut scene = ctx.scene.clone();
@@ -544,12 +539,12 @@ pub fn run_staged<'v>(
         Some(b) => b.clone(),
         None => timed(&mut timings, &scene.back, View::Back),
     };
-    let back = views.set("back", &views.back, back, ready);
+    let back = RunViews::set("back", &views.back, back, ready);
     let frontal = match given.frontal {
         Some(f) => f.clone(),
         None => timed(&mut timings, &scene.frontal, View::Frontal),
     };
-    let frontal = views.set("frontal", &views.frontal, frontal, ready);
+    let frontal = RunViews::set("frontal", &views.frontal, frontal, ready);
     let (eye_used, head_fix) = eye_for_compensation(scene, back, options)?;
     let (crop, d2_used) = crop_for(scene, eye_used, frontal, options)?;
     let map = frontal_map(scene, crop, options)?;
@@ -584,7 +579,7 @@ pub fn run_staged<'v>(
         .filter(|&&i| i == MISSING_ID)
         .count() as f64
         / display.object_id.len() as f64;
-    let display = views.set("display", &views.display, display, ready);
+    let display = RunViews::set("display", &views.display, display, ready);
     // `occluded` and `seethru` differ from `truth` only where the obstacle can be seen:
     // only those pixels are traced again.
     let truth = match truth {
@@ -594,7 +589,7 @@ pub fn run_staged<'v>(
         }
         None => Arc::new(timed(&mut timings, &driver, View::Truth)),
     };
-    let truth = views.set("truth", &views.truth, truth, ready);
+    let truth = RunViews::set("truth", &views.truth, truth, ready);
     let (occluded, stats) = ctx.render_over(
         &driver,
         truth,
@@ -605,7 +600,7 @@ pub fn run_staged<'v>(
         "occluded",
     );
     timings.insert("occluded".into(), json!(stats.seconds));
-    views.set("occluded", &views.occluded, occluded, ready);
+    RunViews::set("occluded", &views.occluded, occluded, ready);
     let placement = DisplayPlacement::new(&scene.obstacle);
     let surface = match options.display {
         _ if given_display => DisplaySurface::Pixels {
@@ -632,7 +627,7 @@ pub fn run_staged<'v>(
         "seethru",
     );
     timings.insert("seethru".into(), json!(stats.seconds));
-    views.set("seethru", &views.seethru, seethru, ready);
+    RunViews::set("seethru", &views.seethru, seethru, ready);
 
     let mut report = report(
         scene,
