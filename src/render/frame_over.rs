@@ -225,6 +225,7 @@ mod tests {
             let expected = Frame::from_pixels(w, h, &pixels);
             let over = FrameOver::new(base.clone(), rect, patch);
             let view = FrameView::Over(&over);
+            assert_eq!((view.width(), view.height()), (w, h), "{rect:?}");
             for y in 0..h {
                 let ids: Vec<u32> = view.row(|f| &f.object_id, y).concat();
                 let row = expected.index(0, y)..expected.index(0, y + 1);
@@ -247,6 +248,7 @@ mod tests {
     fn a_whole_frames_view_reads_the_frame() {
         let frame = numbered(4, 3, 5);
         let view = FrameView::from(&frame);
+        assert_eq!((view.width(), view.height()), (4, 3));
         assert_eq!(view.row(|f| &f.depth, 2), [&frame.depth[8..12], &[], &[]]);
         assert_eq!(view.get(|f| &f.object_id, 6), 11);
         assert!(std::ptr::eq(view.whole(), &frame));
