@@ -623,12 +623,22 @@ mod tests {
         };
         let base_n = [0, 1, 2].map(|k| Plane::Component(&n, k));
         let patch_n = [0, 1, 2].map(|k| Plane::Component(&patch_n, k));
-        let mut planes = vec![("Y", over(&base, &over_patch))];
+        // Ids, the same inside the rectangle: an `Over` of u32 samples is a u32 channel.
+        let ids: Vec<u32> = (0..width * height).map(|i| (i % 7) as u32).collect();
+        let patch_ids: Vec<u32> = (0..width * height)
+            .filter(|&i| inside(i))
+            .map(|i| ids[i])
+            .collect();
+        let (base_ids, over_ids) = (Plane::U32(&ids), Plane::U32(&patch_ids));
+        let mut planes = vec![
+            ("Y", over(&base, &over_patch)),
+            ("id", over(&base_ids, &over_ids)),
+        ];
         let names = ["N.X", "N.Y", "N.Z"];
         planes.extend((0..3).map(|k| (names[k], over(&base_n[k], &patch_n[k]))));
-        let mut whole_planes = vec![("Y", Plane::F32(&whole))];
+        let mut whole_planes = vec![("Y", Plane::F32(&whole)), ("id", base_ids)];
         whole_planes.extend((0..3).map(|k| (names[k], Plane::Component(&whole_n, k))));
-        let mut base_planes = vec![("Y", base)];
+        let mut base_planes = vec![("Y", base), ("id", base_ids)];
         base_planes.extend((0..3).map(|k| (names[k], base_n[k])));
         let write = |planes: &[(&str, Plane)], like: Option<&Zipped>| {
             let mut file = std::io::Cursor::new(Vec::new());
