@@ -227,13 +227,6 @@ impl Plane<'_> {
         })
     }
 
-    fn is_u32(&self) -> bool {
-        match self {
-            Plane::Over { base, .. } => base.is_u32(),
-            plane => matches!(plane, Plane::U32(_)),
-        }
-    }
-
     fn len(&self) -> Option<usize> {
         match self {
             Plane::F32(v) => Some(v.len()),
@@ -322,15 +315,14 @@ pub fn write_planes_like<'a>(
         })
         .collect();
     // `like` serves when its blocks are laid out as these: same width (and so the same
-    // blocks, its planes holding as many pixels), same channels and sample types.
-    let like =
-        like.filter(|like| {
-            like.width == width
-                && like.planes.len() == sorted.len()
-                && like.planes.iter().zip(&sorted).all(|((a, p), (b, q))| {
-                    a == b && p.len() == q.len() && p.is_u32() == q.is_u32()
-                })
-        });
+    // blocks, its planes holding as many pixels) and the same channels. Their sample types
+    // need not match: every sample is 4 bytes, and a block's bytes are its samples' bytes.
+    let like = like.filter(|like| {
+        like.width == width
+            && like.planes.len() == sorted.len()
+            && (like.planes.iter().zip(&sorted))
+                .all(|((a, p), (b, q))| a == b && p.len() == q.len())
+    });
     let headers = image.layer_data.infer_headers(&image.attributes);
     let samples = |planes: &[(String, Plane)], index: BlockIndex| {
         let (x0, y0) = (index.pixel_position.x(), index.pixel_position.y());
@@ -587,56 +579,57 @@ mod tests {
     /// and take the other's blocks exactly where the whole frame's samples would.
     #[test]
     fn planes_over_a_base_write_the_whole_frames_file() {
-        let (width, height) = (150usize, 70usize);
+        let (width, height) = (270usize, 70usize);
         let a: Vec<f32> = bytes(width * height, 3, 256)
             .iter()
             .map(|&b| f32::from(b) * 0.61)
             .collect();
         let n: Vec<Vec3> = a.iter().map(|&v| Vec3::new(v, -v, 0.5 * v)).collect();
-        // Columns 60..70 of rows 10..30 (tiles (0, 0) and (1, 0)): as `a` but for one sample
-        // in tile (1, 0); the normals differ there too.
+        let ids: Vec<u32> = (0..width * height).map(|i| (i % 7) as u32).collect();
+        // Columns 60..200 of rows 10..30, across tiles (0, 0) to (3, 0): the same samples in
+        // tile (0, 0); one sample of each kind changed in the others, alone in its tile, so
+        // that each kind's comparison decides a tile of its own.
         let rect = PixelRect {
             x0: 60,
             y0: 10,
-            x1: 70,
+            x1: 200,
             y1: 30,
         };
-        let inside = |i: usize| (60..70).contains(&(i % width)) && (10..30).contains(&(i / width));
-        let (patch, patch_n): (Vec<f32>, Vec<Vec3>) = (0..width * height)
-            .filter(|&i| inside(i))
-            .map(|i| match i == 20 * width + 66 {
-                true => (a[i] + 1.0, -n[i]),
-                false => (a[i], n[i]),
-            })
-            .unzip();
-        let mut whole = a.clone();
-        let mut whole_n = n.clone();
-        let changed = 20 * width + 66;
-        whole[changed] += 1.0;
-        whole_n[changed] = -whole_n[changed];
-        let (base, over_patch) = (Plane::F32(&a), Plane::F32(&patch));
+        let inside = |i: usize| (60..200).contains(&(i % width)) && (10..30).contains(&(i / width));
+        let (mut whole, mut whole_n, mut whole_ids) = (a.clone(), n.clone(), ids.clone());
+        whole[20 * width + 66] += 1.0;
+        whole_n[12 * width + 140].y += 1.0;
+        whole_ids[25 * width + 195] += 1;
+        let patch_of = |i: usize| inside(i).then_some(i);
+        let patch: Vec<f32> = (0..width * height)
+            .filter_map(patch_of)
+            .map(|i| whole[i])
+            .collect();
+        let patch_n: Vec<Vec3> = (0..width * height)
+            .filter_map(patch_of)
+            .map(|i| whole_n[i])
+            .collect();
+        let patch_ids: Vec<u32> = (0..width * height)
+            .filter_map(patch_of)
+            .map(|i| whole_ids[i])
+            .collect();
         let over = |base, patch| Plane::Over {
             base,
             patch,
             rect,
             width,
         };
+        let (base, over_patch) = (Plane::F32(&a), Plane::F32(&patch));
+        let (base_ids, over_ids) = (Plane::U32(&ids), Plane::U32(&patch_ids));
         let base_n = [0, 1, 2].map(|k| Plane::Component(&n, k));
         let patch_n = [0, 1, 2].map(|k| Plane::Component(&patch_n, k));
-        // Ids, the same inside the rectangle: an `Over` of u32 samples is a u32 channel.
-        let ids: Vec<u32> = (0..width * height).map(|i| (i % 7) as u32).collect();
-        let patch_ids: Vec<u32> = (0..width * height)
-            .filter(|&i| inside(i))
-            .map(|i| ids[i])
-            .collect();
-        let (base_ids, over_ids) = (Plane::U32(&ids), Plane::U32(&patch_ids));
         let mut planes = vec![
             ("Y", over(&base, &over_patch)),
             ("id", over(&base_ids, &over_ids)),
         ];
         let names = ["N.X", "N.Y", "N.Z"];
         planes.extend((0..3).map(|k| (names[k], over(&base_n[k], &patch_n[k]))));
-        let mut whole_planes = vec![("Y", Plane::F32(&whole)), ("id", base_ids)];
+        let mut whole_planes = vec![("Y", Plane::F32(&whole)), ("id", Plane::U32(&whole_ids))];
         whole_planes.extend((0..3).map(|k| (names[k], Plane::Component(&whole_n, k))));
         let mut base_planes = vec![("Y", base), ("id", base_ids)];
         base_planes.extend((0..3).map(|k| (names[k], base_n[k])));
@@ -669,7 +662,8 @@ mod tests {
         let (_, over_blocks) = write(&planes, Some(&like));
         let (_, whole_blocks) = write(&whole_planes, Some(&like));
         assert_eq!(taken(&over_blocks), taken(&whole_blocks));
-        assert_eq!(taken(&over_blocks), [true, false, true, true, true, true]);
+        let unchanged = [true, false, false, false, true];
+        assert_eq!(taken(&over_blocks), [unchanged, [true; 5]].concat());
     }
 
     #[test]
