@@ -56,7 +56,8 @@ pub fn id_color(id: u32) -> [u8; 3] {
     ]
 }
 
-/// Object ids in false colour, for looking at; part ids modulate the brightness.
+/// Object ids in false colour ([`id_color`]), for looking at; part `p` darkens its object's
+/// colour to (8 − p mod 4)/8 of it (rounded down), so that neighbouring parts differ.
 pub fn write_id_png<'a>(frame: impl Into<FrameView<'a>>, path: &Path) -> Result<()> {
     let frame = frame.into();
     let (w, h) = (frame.width(), frame.height());
@@ -589,4 +590,34 @@ fn write_frame_files(
         exr,
     );
     pngs.and(exr)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::frame::Pixel;
+
+    #[test]
+    fn an_id_png_darkens_each_part_by_an_eighth_over_four_parts() {
+        let pixel = |object_id, part_id| Pixel {
+            object_id,
+            part_id,
+            ..Pixel::SKY
+        };
+        let parts = [0, 1, 2, 3, 4, 7];
+        let mut pixels: Vec<Pixel> = parts.iter().map(|&p| pixel(5, p)).collect();
+        pixels.push(pixel(0, 2));
+        let frame = Frame::from_pixels(pixels.len() as u32, 1, &pixels);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("ids.png");
+        write_id_png(&frame, &path).unwrap();
+        let png = image::open(&path).unwrap().to_rgb8();
+        let colour = id_color(5);
+        let darkened = |eighths: u32| colour.map(|c| (u32::from(c) * eighths / 8) as u8);
+        let expected = [8, 7, 6, 5, 8, 5].map(darkened);
+        for (x, want) in expected.iter().enumerate() {
+            assert_eq!(png.get_pixel(x as u32, 0).0, *want, "part {}", parts[x]);
+        }
+        assert_eq!(png.get_pixel(6, 0).0, [0, 0, 0], "sky, whatever its part");
+    }
 }
