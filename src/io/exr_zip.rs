@@ -623,15 +623,22 @@ mod tests {
         let (base_ids, over_ids) = (Plane::U32(&ids), Plane::U32(&patch_ids));
         let base_n = [0, 1, 2].map(|k| Plane::Component(&n, k));
         let patch_n = [0, 1, 2].map(|k| Plane::Component(&patch_n, k));
+        // A constant alpha too: compared by its bytes.
+        let alpha = ("A", Plane::Constant(1.0));
         let mut planes = vec![
             ("Y", over(&base, &over_patch)),
             ("id", over(&base_ids, &over_ids)),
+            alpha,
         ];
         let names = ["N.X", "N.Y", "N.Z"];
         planes.extend((0..3).map(|k| (names[k], over(&base_n[k], &patch_n[k]))));
-        let mut whole_planes = vec![("Y", Plane::F32(&whole)), ("id", Plane::U32(&whole_ids))];
+        let mut whole_planes = vec![
+            ("Y", Plane::F32(&whole)),
+            ("id", Plane::U32(&whole_ids)),
+            alpha,
+        ];
         whole_planes.extend((0..3).map(|k| (names[k], Plane::Component(&whole_n, k))));
-        let mut base_planes = vec![("Y", base), ("id", base_ids)];
+        let mut base_planes = vec![("Y", base), ("id", base_ids), alpha];
         base_planes.extend((0..3).map(|k| (names[k], base_n[k])));
         let write = |planes: &[(&str, Plane)], like: Option<&Zipped>| {
             let mut file = std::io::Cursor::new(Vec::new());
