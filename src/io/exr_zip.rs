@@ -600,19 +600,14 @@ mod tests {
         whole[20 * width + 66] += 1.0;
         whole_n[12 * width + 140].y += 1.0;
         whole_ids[25 * width + 195] += 1;
-        let patch_of = |i: usize| inside(i).then_some(i);
-        let patch: Vec<f32> = (0..width * height)
-            .filter_map(patch_of)
-            .map(|i| whole[i])
-            .collect();
-        let patch_n: Vec<Vec3> = (0..width * height)
-            .filter_map(patch_of)
-            .map(|i| whole_n[i])
-            .collect();
-        let patch_ids: Vec<u32> = (0..width * height)
-            .filter_map(patch_of)
-            .map(|i| whole_ids[i])
-            .collect();
+        fn cut<T: Copy>(whole: &[T], inside: impl Fn(usize) -> bool) -> Vec<T> {
+            (0..whole.len())
+                .filter(|&i| inside(i))
+                .map(|i| whole[i])
+                .collect()
+        }
+        let (patch, patch_n) = (cut(&whole, inside), cut(&whole_n, inside));
+        let patch_ids = cut(&whole_ids, inside);
         let over = |base, patch| Plane::Over {
             base,
             patch,
