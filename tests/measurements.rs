@@ -16,7 +16,6 @@ use seethru::measure::{
     ratio_setup::{Compensation, Setup, build_scene},
 };
 use seethru::render::frame::Frame;
-use seethru::render::frame_over::FrameView;
 use seethru::render::integrator::RenderContext;
 use seethru::system::display::{DisplayModel, MISSING_ID};
 use seethru::system::{
@@ -300,6 +299,18 @@ fn measured(ctx: &RenderContext, r: &RunResult) -> (MetricMaps, serde_json::Valu
     measure(ctx, &ctx.scene, ctx.scene.eye(), r.measured_views(), 5)
 }
 
+/// [`measured`] of `shown` against `truth` in place of the run's seethru and truth (the
+/// run's occluded view beside them).
+fn measured_as(
+    ctx: &RenderContext,
+    r: &RunResult,
+    truth: &Frame,
+    shown: &Frame,
+) -> (MetricMaps, serde_json::Value) {
+    let views = [truth.into(), shown.into(), (&r.occluded).into()];
+    measure(ctx, &ctx.scene, ctx.scene.eye(), views, 5)
+}
+
 /// A wall at `wall` metres behind a display at the origin; the model plane at `d2`.
 fn wall_run(wall: f64, d2: f64) -> (RenderContext, RunResult) {
     let setup = common::WallScene {
@@ -337,17 +348,7 @@ fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
         let axis = v.cross(DVec3::new(0.3, 1.0, 0.2)).normalize();
         *p = (eye + DQuat::from_axis_angle(axis, (10.0f64 / 60.0).to_radians()) * v).as_vec3();
     }
-    let (maps, json) = measure(
-        &ctx,
-        &ctx.scene,
-        eye,
-        [
-            FrameView::from(&r.truth),
-            FrameView::from(&turned),
-            FrameView::from(&r.occluded),
-        ],
-        5,
-    );
+    let (maps, json) = measured_as(&ctx, &r, &r.truth, &turned);
     let shown: Vec<f32> = maps
         .misregistration
         .iter()
@@ -377,17 +378,7 @@ fn misregistration_is_zero_on_the_model_plane_and_analytic_off_it() {
         blind.position[i] = Vec3::NAN;
         blind.normal[i] = Vec3::ZERO;
     }
-    let (_, json) = measure(
-        &ctx,
-        &ctx.scene,
-        eye,
-        [
-            FrameView::from(&r.truth),
-            FrameView::from(&blind),
-            FrameView::from(&r.occluded),
-        ],
-        5,
-    );
+    let (_, json) = measured_as(&ctx, &r, &r.truth, &blind);
     assert_eq!(json["undefined_pixels"].as_u64(), Some(100));
     assert_eq!(
         json["display"]["misregistration_arcmin"]["count"]
@@ -707,20 +698,9 @@ fn scramble_outside(frames: [&Frame; 2], mask: &[bool]) -> [Frame; 2] {
 #[test]
 fn masked_ssim_and_flip_see_only_the_display() {
     let (ctx, r) = wall_run(12.0, 6.0);
-    let eye = ctx.scene.eye();
     let (maps, before) = measured(&ctx, &r);
     let [truth, seethru] = scramble_outside([&r.truth, &r.seethru], &maps.display);
-    let (_, after) = measure(
-        &ctx,
-        &ctx.scene,
-        eye,
-        [
-            FrameView::from(&truth),
-            FrameView::from(&seethru),
-            FrameView::from(&r.occluded),
-        ],
-        5,
-    );
+    let (_, after) = measured_as(&ctx, &r, &truth, &seethru);
     for region in ["display", "border"] {
         for metric in ["ssim", "flip_mean", "psnr_db"] {
             let (a, b) = (&before[region][metric], &after[region][metric]);
@@ -732,17 +712,7 @@ fn masked_ssim_and_flip_see_only_the_display() {
         }
     }
     // Changing the seethru frame outside the mask alone changes nothing either.
-    let (_, one_sided) = measure(
-        &ctx,
-        &ctx.scene,
-        eye,
-        [
-            FrameView::from(&r.truth),
-            FrameView::from(&seethru),
-            FrameView::from(&r.occluded),
-        ],
-        5,
-    );
+    let (_, one_sided) = measured_as(&ctx, &r, &r.truth, &seethru);
     assert_eq!(
         before["border"]["flip_mean"],
         one_sided["border"]["flip_mean"]
@@ -756,17 +726,7 @@ fn masked_ssim_and_flip_see_only_the_display() {
         f
     };
     let (a, b) = (flat(&r.truth, 0.2), flat(&r.seethru, 0.3));
-    let (_, json) = measure(
-        &ctx,
-        &ctx.scene,
-        eye,
-        [
-            FrameView::from(&a),
-            FrameView::from(&b),
-            FrameView::from(&r.occluded),
-        ],
-        5,
-    );
+    let (_, json) = measured_as(&ctx, &r, &a, &b);
     let lum = |v: f32| encode_srgb8(Vec3::splat(v))[0] as f64;
     let (la, lb) = (lum(0.2), lum(0.3));
     let c1 = (0.01f64 * 255.0).powi(2);
@@ -1061,17 +1021,7 @@ fn ssim_windows_are_seven_pixels_wide() {
     };
     let (a, mut b) = (flat(0.2), flat(0.2));
     b.color[inner] = Vec3::splat(0.5);
-    let (_, json) = measure(
-        &ctx,
-        &ctx.scene,
-        ctx.scene.eye(),
-        [
-            FrameView::from(&a),
-            FrameView::from(&b),
-            FrameView::from(&r.occluded),
-        ],
-        5,
-    );
+    let (_, json) = measured_as(&ctx, &r, &a, &b);
     let lum = |v: f32| encode_srgb8(Vec3::splat(v))[0] as f64;
     let (l, delta) = (lum(0.2), lum(0.5) - lum(0.2));
     let (c1, c2) = ((0.01f64 * 255.0).powi(2), (0.03f64 * 255.0).powi(2));
