@@ -124,8 +124,12 @@ impl Frame {
     }
 
     /// [`Frame::bands_mut`] of a frame whose pixel (0, 0) is pixel (`x0`, `y0`) of a larger
-    /// image: the bands are addressed in the image's rows and columns.
+    /// image: the bands are addressed in the image's rows and columns. A frame without pixels
+    /// (no columns or no rows: a rectangle that covers nothing) has no bands.
     pub fn bands_mut_at(&mut self, rows: u32, x0: u32, y0: u32) -> Vec<Rows<'_>> {
+        if self.width == 0 || self.height == 0 {
+            return Vec::new();
+        }
         let width = self.width as usize;
         let n = width * rows.max(1) as usize;
         self.color
@@ -232,5 +236,27 @@ impl Frame {
             && v(&self.normal, &other.normal)
             && self.object_id == other.object_id
             && self.part_id == other.part_id
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_frame_without_pixels_has_no_bands_and_a_frame_with_pixels_is_covered_by_its_bands() {
+        // A rectangle that covers nothing (an eye that does not see the obstacle) is a frame
+        // with no columns or no rows: it has no bands, whatever the band height.
+        for (w, h) in [(0, 0), (0, 5), (7, 0)] {
+            for rows in [0, 1, 16] {
+                assert!(Frame::new(w, h).bands_mut_at(rows, 3, 4).is_empty(), "{w}×{h}");
+            }
+        }
+        // A frame with pixels: bands of `rows` rows (the last shorter), addressed in the
+        // larger image's rows, that cover every row once.
+        let mut frame = Frame::new(3, 7);
+        let bands = frame.bands_mut_at(3, 10, 20);
+        let spans: Vec<(u32, u32)> = bands.iter().map(|b| (b.y, b.len())).collect();
+        assert_eq!(spans, [(20, 3), (23, 3), (26, 1)]);
     }
 }
