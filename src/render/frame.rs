@@ -249,7 +249,10 @@ mod tests {
         // with no columns or no rows: it has no bands, whatever the band height.
         for (w, h) in [(0, 0), (0, 5), (7, 0)] {
             for rows in [0, 1, 16] {
-                assert!(Frame::new(w, h).bands_mut_at(rows, 3, 4).is_empty(), "{w}×{h}");
+                assert!(
+                    Frame::new(w, h).bands_mut_at(rows, 3, 4).is_empty(),
+                    "{w}×{h}"
+                );
             }
         }
         // A frame with pixels: bands of `rows` rows (the last shorter), addressed in the
