@@ -502,11 +502,107 @@ fn output_errors_name_the_users_path() {
     for (out, words) in [
         ("f/sub", &["f/sub", "f is a file, not a folder"][..]),
         ("f/a/b", &["f/a/b", "f is a file, not a folder"]),
-        ("/proc/self/nope", &["the output /proc/self/nope"]),
+        (
+            "/proc/self/nope",
+            &["--out /proc/self/nope", "cannot write into /proc/self"],
+        ),
     ] {
         args[3] = out;
         let err = refused(dir.path(), &args, 1, words);
         assert!(!err.contains(".tmp-"), "{err}");
     }
     assert_eq!(listing(dir.path()), before);
+}
+
+#[test]
+fn an_output_over_an_input_or_where_nothing_can_be_written_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("scene.toml"), common::MINIMAL).unwrap();
+    std::fs::write(
+        dir.path().join("mine.toml"),
+        "[[case]]\nname = \"a\"\nscene = \"scene.toml\"\ncommand = \"run\"\nexpect = [\"misregistration.mean <= 1000\"]\n",
+    )
+    .unwrap();
+    let before = contents(dir.path());
+    // Each refusal names the option and the path, and leaves the folder as it was: no case
+    // ran (no `seethru-check` folder), the expectations are intact.
+    for (args, words) in [
+        (
+            &["check", "mine.toml", "--junit", "mine.toml"][..],
+            &["--junit mine.toml", "EXPECTATIONS", "would destroy"][..],
+        ),
+        (
+            &["check", "mine.toml", "--junit", "./sub/../mine.toml"],
+            &["--junit", "would destroy"],
+        ),
+        (
+            &["check", "mine.toml", "--junit", "/proc/x.xml"],
+            &["--junit /proc/x.xml", "cannot write into /proc"],
+        ),
+        (
+            &["check", "mine.toml", "--junit", "."],
+            &["--junit .", "is a folder, not a file"],
+        ),
+        (
+            &["check", "mine.toml", "--out", "."],
+            &["--out .", "holding the input", "would destroy"],
+        ),
+        (
+            &["run", "scene.toml", "--out", "."],
+            &["--out .", "holding the input", "scene.toml"],
+        ),
+        (
+            &[
+                "sweep",
+                "scene.toml",
+                "--param",
+                "d2=2",
+                "--out",
+                "scene.toml",
+            ],
+            &["--out scene.toml", "is the input"],
+        ),
+        (
+            &["render", "scene.toml", "--out", "scene.toml/x"],
+            &["--out scene.toml/x", "scene.toml is a file, not a folder"],
+        ),
+        (
+            &["score", ".", "--display-image", "scene.toml", "--out", "."],
+            &["--out .", "is the input . (INPUTS)"],
+        ),
+    ] {
+        // `check` exits 2 on bad input (1 is its failed-bounds verdict).
+        let code = if args[0] == "check" { 2 } else { 1 };
+        refused(dir.path(), args, code, words);
+        assert_eq!(contents(dir.path()), before, "{args:?}");
+    }
+    // A FIFO where a file is read is refused at once, not read until the writer comes.
+    let fifo = dir.path().join("fifo.toml");
+    if Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success())
+    {
+        refused(
+            dir.path(),
+            &["run", "fifo.toml", "--out", "o"],
+            1,
+            &["fifo.toml", "not a regular file"],
+        );
+        std::fs::create_dir(dir.path().join("cap")).unwrap();
+        std::fs::rename(&fifo, dir.path().join("cap/capture.json")).unwrap();
+        refused(
+            dir.path(),
+            &[
+                "score",
+                "cap",
+                "--display-image",
+                "scene.toml",
+                "--out",
+                "o",
+            ],
+            1,
+            &["capture.json", "not a regular file"],
+        );
+    }
 }

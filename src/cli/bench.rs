@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Result;
+use seethru::io::output_paths::{Input, check_paths};
 use seethru::render::accel::Accel;
 use seethru::render::frame::Frame;
 use seethru::render::integrator::RenderContext;
@@ -55,6 +56,7 @@ pub struct Bench {
 
 impl Bench {
     pub fn run(self) -> Result<()> {
+        check_paths(&[Input::file("SCENE", &self.scene)], &[])?;
         check_resolution(self.width, self.height)?;
         if !(1..=1000).contains(&self.repeat) {
             anyhow::bail!("--repeat {} is out of range [1, 1000]", self.repeat);

@@ -10,6 +10,7 @@ use exr::prelude::{AnyChannel, FlatSamples};
 use seethru::io::atomic::write_text;
 use seethru::io::display_map::write_npy_f32;
 use seethru::io::frame_files::{ExrContent, write_color_png, write_exr_channels, write_view_exr};
+use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
 use seethru::render::frame::Frame;
 use seethru::render::integrator::RenderContext;
@@ -154,6 +155,13 @@ impl CaptureArgs {
     }
 
     pub fn run(self) -> Result<()> {
+        let mut inputs = vec![Input::file("SCENE", &self.scene)];
+        inputs.extend(
+            self.calibration
+                .as_deref()
+                .map(|c| Input::file("--calibration", c)),
+        );
+        check_paths(&inputs, &[Output::folder("--out", &self.out)])?;
         let options = self.options()?;
         with_threads(self.render.threads, || {
             let scene = self.scene()?;

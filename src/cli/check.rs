@@ -12,6 +12,7 @@ use clap::Parser;
 use seethru::io::atomic::{write_atomically, write_text};
 use seethru::io::frame_files::write_png;
 use seethru::io::junit::{Outcome, TestCase, junit_xml};
+use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::measure::expectations::{
     Case, CaseCommand, GOLDEN_METRICS, Relation, read_expectations, rewritten,
 };
@@ -92,6 +93,9 @@ struct CaseResult {
 
 impl Check {
     pub fn run(self) -> Result<()> {
+        let mut outputs = vec![Output::folder("--out", &self.out)];
+        outputs.extend(self.junit.as_deref().map(|j| Output::file("--junit", j)));
+        check_paths(&[Input::file("EXPECTATIONS", &self.expectations)], &outputs)?;
         if self.bless
             && let Some(value) = in_ci()
         {

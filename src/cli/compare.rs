@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_png;
+use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
 use seethru::measure::compare::{Candidate, coloured_strips, html_page, markdown_table};
 use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
@@ -68,6 +69,10 @@ pub struct Compare {
 
 impl Compare {
     pub fn run(self) -> Result<()> {
+        check_paths(
+            &[Input::file("SCENE", &self.scene)],
+            &[Output::folder("--out", &self.out)],
+        )?;
         self.refuse_ignored()?;
         let base = RunOptions {
             head: self.head,

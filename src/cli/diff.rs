@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Result, bail};
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_png;
+use seethru::io::output_paths::{Input, Output, Read, check_paths};
 use seethru::io::staged::StagedDir;
 use seethru::measure::headline::{RUN_HEADLINES, SEQUENCE_HEADLINES, read_results, value_of};
 use seethru::measure::image_diff::{
@@ -107,6 +108,27 @@ impl MetricChange {
 
 impl Diff {
     pub fn run(self) -> Result<()> {
+        let outputs: Vec<Output> = self
+            .out
+            .as_deref()
+            .map(|o| Output::folder("--out", o))
+            .into_iter()
+            .collect();
+        check_paths(
+            &[
+                Input {
+                    option: "A",
+                    path: &self.a,
+                    read: Read::Either,
+                },
+                Input {
+                    option: "B",
+                    path: &self.b,
+                    read: Read::Either,
+                },
+            ],
+            &outputs,
+        )?;
         let (a_dir, b_dir) = (self.a.is_dir(), self.b.is_dir());
         let (diffs, changes) = match (a_dir, b_dir) {
             (true, true) => self.folders()?,

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use seethru::io::export::ExportFormat;
+use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::scene::Scene;
 use seethru::scene::world::World;
 
@@ -24,6 +25,10 @@ pub struct Export {
 
 impl Export {
     pub fn run(self) -> Result<()> {
+        check_paths(
+            &[Input::file("SCENE", &self.scene)],
+            &[Output::file("--out", &self.out)],
+        )?;
         export_scene(&self.scene, &self.out, self.format)
     }
 }

@@ -1,5 +1,6 @@
 //! `seethru figures`: the paper's Fig. 3–5 and the physical-unit sensitivity figure.
 
+use seethru::io::output_paths::{Output, check_paths};
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -14,6 +15,7 @@ pub struct Figures {
 
 impl Figures {
     pub fn run(self) -> Result<()> {
+        check_paths(&[], &[Output::folder("--out", &self.out)])?;
         // Written whole or not at all: a failure leaves `--out` as it was.
         let staged = seethru::io::staged::StagedDir::new(&self.out)?;
         let names = seethru::paper::figures::write_all(staged.path())?;

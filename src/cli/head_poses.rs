@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
+use seethru::io::output_paths::{Input, check_paths};
 use seethru::measure::head_poses::{fit_time_line, pose_grid, pose_table};
 use seethru::scene::Scene;
 use seethru::system::head_pose::prepare_fit;
@@ -38,6 +39,7 @@ pub struct HeadPoses {
 
 impl HeadPoses {
     pub fn run(self) -> Result<()> {
+        check_paths(&[Input::file("SCENE", &self.scene)], &[])?;
         let scene = Scene::load(&self.scene)?;
         let started = std::time::Instant::now();
         prepare_fit();

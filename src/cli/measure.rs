@@ -3,6 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
+use seethru::io::output_paths::{Input, check_paths};
+use seethru::io::run_dir::MAX_RUN_JSON_BYTES;
 use seethru::io::run_dir::{read_measured_frames, read_run_json};
 use seethru::io::staged::StagedDir;
 use seethru::measure::holes::{hole_metrics, read_hole_mask};
@@ -11,6 +13,7 @@ use seethru::measure::metrics::measure;
 use seethru::render::frame_over::FrameView;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
+use seethru::util::input_file::read_input_text;
 
 use crate::cli::args::band;
 
@@ -26,6 +29,7 @@ pub struct Measure {
 
 impl Measure {
     pub fn run(self) -> Result<()> {
+        check_paths(&[Input::folder("DIR", &self.dir)], &[])?;
         let metrics = measure_command(&self.dir, self.band)?;
         println!("{}", serde_json::to_string_pretty(&metrics)?);
         Ok(())
@@ -77,7 +81,7 @@ fn measure_command(dir: &Path, band: u32) -> Result<serde_json::Value> {
     // A depth run's holes, as its holes.png has them.
     if let Some(holes) = read_hole_mask(&dir.join("holes.png"), truth.width, truth.height)? {
         let run: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join("run.json"))?)?;
+            serde_json::from_str(&read_input_text(&dir.join("run.json"), MAX_RUN_JSON_BYTES)?)?;
         let fill = run["scene_model"]["holes"]["fill"].clone();
         metrics["holes"] = hole_metrics(&holes, &maps, &truth, &seethru, fill);
     }

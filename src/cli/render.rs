@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use seethru::io::frame_files::{ExrContent, write_frame};
+use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
 use seethru::render::integrator::RenderContext;
 use seethru::render::settings::{RenderSettings, check_spp, resized};
@@ -34,6 +35,10 @@ pub struct Render {
 
 impl Render {
     pub fn run(self) -> Result<()> {
+        check_paths(
+            &[Input::file("SCENE", &self.scene)],
+            &[Output::folder("--out", &self.out)],
+        )?;
         let views = if self.views.is_empty() {
             View::ALL.to_vec()
         } else {

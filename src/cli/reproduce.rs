@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
+use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::scene::builtin::{BuiltinDas, DAS_PATH};
 
 use seethru::paper::reproduce::reproduce_estimate;
@@ -32,6 +33,13 @@ pub struct Reproduce {
 
 impl Reproduce {
     pub fn run(self) -> Result<()> {
+        let inputs: Vec<Input> = self
+            .scene
+            .as_deref()
+            .map(|s| Input::file("--scene", s))
+            .into_iter()
+            .collect();
+        check_paths(&inputs, &[Output::folder("--out", &self.out)])?;
         // Written whole or not at all: a failure leaves `--out` as it was.
         let (scene, label, _builtin) = match &self.scene {
             Some(path) if !path.exists() => bail!(

@@ -8,6 +8,7 @@ use std::sync::{Mutex, OnceLock};
 use anyhow::Result;
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{ExrContent, write_frame_keeping, write_frame_like};
+use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
 use seethru::measure::hazard::{DEFAULT_BOUND_ARCMIN, run_hazards_json};
 use seethru::measure::headline::{read_results, summary_text};
@@ -110,6 +111,13 @@ pub struct Run {
 
 impl Run {
     pub fn run(self) -> Result<()> {
+        let mut inputs = vec![Input::file("SCENE", &self.scene)];
+        inputs.extend(
+            self.calibration
+                .as_deref()
+                .map(|c| Input::file("--calibration", c)),
+        );
+        check_paths(&inputs, &[Output::folder("--out", &self.out)])?;
         self.scene_model.check_used_by(self.method)?;
         let noisy_sensor = self.method == Method::Depth
             && self.scene_model.depth_sensor != seethru::system::depth_sensor::SensorKind::Ideal;

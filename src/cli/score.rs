@@ -10,6 +10,8 @@ use rayon::prelude::*;
 use seethru::io::atomic::write_text;
 use seethru::io::display_map::{read_display_image, read_map};
 use seethru::io::frame_files::{ExrContent, write_frame_like};
+use seethru::io::output_paths::{Input, Output, check_paths};
+use seethru::io::run_dir::MAX_RUN_JSON_BYTES;
 use seethru::io::staged::StagedDir;
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
@@ -65,13 +67,15 @@ pub struct Recaptured {
 /// checks that the result is the folder's capture.
 pub fn recapture(inputs: &Path) -> Result<Recaptured> {
     let read_json = |path: PathBuf| -> Result<serde_json::Value> {
-        let text = std::fs::read_to_string(&path).with_context(|| {
-            format!(
-                "cannot read {} (is {} a folder written by seethru capture?)",
-                path.display(),
-                inputs.display()
-            )
-        })?;
+        // A capture's JSON is small; a FIFO or a device in its place would block the read.
+        let text = seethru::util::input_file::read_input_text(&path, MAX_RUN_JSON_BYTES)
+            .with_context(|| {
+                format!(
+                    "cannot read {} (is {} a folder written by seethru capture?)",
+                    path.display(),
+                    inputs.display()
+                )
+            })?;
         serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))
     };
     let manifest = read_json(inputs.join("capture.json"))?;
@@ -141,6 +145,14 @@ fn load_image(path: &Path) -> Result<DisplayImage> {
 
 impl Score {
     pub fn run(self) -> Result<()> {
+        let mut inputs = vec![Input::folder("INPUTS", &self.inputs)];
+        inputs.extend(self.map.as_deref().map(|m| Input::file("--map", m)));
+        inputs.extend(
+            self.display_image
+                .as_deref()
+                .map(|m| Input::file("--display-image", m)),
+        );
+        check_paths(&inputs, &[Output::folder("--out", &self.out)])?;
         if self.map.is_none() && self.display_image.is_none() {
             bail!("score needs --map FILE, --display-image FILE or both");
         }

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{ExrContent, write_color_png, write_view_exr};
+use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
 use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
 use seethru::measure::headline::{RunKind, summary_text};
@@ -278,6 +279,19 @@ impl Sequence {
     }
 
     pub fn run(self) -> Result<()> {
+        let mut inputs = vec![Input::file("SCENE", &self.scene)];
+        inputs.extend(
+            self.head_path
+                .as_deref()
+                .map(|p| Input::file("--head-path", p)),
+        );
+        inputs.extend(
+            self.capture
+                .as_deref()
+                .map(|p| Input::folder("--capture", p)),
+        );
+        inputs.extend(self.maps.as_deref().map(|p| Input::folder("--maps", p)));
+        check_paths(&inputs, &[Output::folder("--out", &self.out)])?;
         let threads = self.threads;
         with_threads(threads, || self.run_all())?
     }

@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
+use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::measure::sweep::{
     DEFAULT_BOUND_ARCMIN, SweepOptions, merge_parts_with_bound, samples_drivers, sweep,
 };
@@ -83,6 +84,8 @@ pub struct SweepMerge {
 
 impl SweepMerge {
     pub fn run(self) -> Result<()> {
+        let inputs: Vec<Input> = self.parts.iter().map(|p| Input::file("PARTS", p)).collect();
+        check_paths(&inputs, &[Output::file("--out", &self.out)])?;
         let parts: Vec<&std::path::Path> = self.parts.iter().map(PathBuf::as_path).collect();
         let rows = merge_parts_with_bound(&parts, &self.out, self.bound_arcmin)?;
         seethru::util::progress::summary(format!(
@@ -96,6 +99,10 @@ impl SweepMerge {
 
 impl Sweep {
     pub fn run(self) -> Result<()> {
+        check_paths(
+            &[Input::file("SCENE", &self.scene)],
+            &[Output::file("--out", &self.out)],
+        )?;
         let params = self
             .params
             .iter()

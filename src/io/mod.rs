@@ -10,6 +10,7 @@ pub mod export;
 pub mod exr_zip;
 pub mod frame_files;
 pub mod junit;
+pub mod output_paths;
 pub mod plot;
 pub mod run_dir;
 pub mod staged;

@@ -13,10 +13,11 @@ use anyhow::{Context, Result, bail};
 use exr::prelude::FlatSamples;
 use serde_json::{Value, json};
 
+use crate::io::run_dir::MAX_RUN_JSON_BYTES;
 use crate::measure::metrics::{masked_ssim_map, psnr};
 use crate::scene::limits::{MAX_PIXELS, MAX_RESOLUTION};
 use crate::util::color::{encode_srgb8, luma};
-use crate::util::input_file::not_a_file;
+use crate::util::input_file::{not_a_file, read_input_text};
 use crate::util::quantile::nearest_rank;
 
 /// Pixels per degree of FLIP's standard observer (0.7 m from a 0.7 m wide 4K monitor), used
@@ -446,7 +447,7 @@ pub const DRIVER_VIEWS: [&str; 3] = ["truth", "occluded", "seethru"];
 /// else the standard observer's; with where it came from.
 pub fn pixels_per_degree(dir: &Path, view: &str) -> (f32, String) {
     let from_run = DRIVER_VIEWS.contains(&view).then(|| {
-        let text = std::fs::read_to_string(dir.join("metrics.json")).ok()?;
+        let text = read_input_text(&dir.join("metrics.json"), MAX_RUN_JSON_BYTES).ok()?;
         let json: Value = serde_json::from_str(&text).ok()?;
         json["flip_pixels_per_degree"].as_f64()
     });
