@@ -591,17 +591,12 @@ fn an_output_over_an_input_or_where_nothing_can_be_written_is_refused_before_any
         );
         std::fs::create_dir(dir.path().join("cap")).unwrap();
         std::fs::rename(&fifo, dir.path().join("cap/capture.json")).unwrap();
-        image::RgbImage::new(1, 1).save(dir.path().join("d.png")).unwrap();
+        image::RgbImage::new(1, 1)
+            .save(dir.path().join("d.png"))
+            .unwrap();
         refused(
             dir.path(),
-            &[
-                "score",
-                "cap",
-                "--display-image",
-                "d.png",
-                "--out",
-                "o",
-            ],
+            &["score", "cap", "--display-image", "d.png", "--out", "o"],
             1,
             &["capture.json", "not a regular file"],
         );

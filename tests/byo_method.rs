@@ -300,21 +300,40 @@ fn a_map_for_another_capture_is_refused_by_its_fingerprint() {
     let inputs = capture(dir.path(), &[]);
     let map = dir.path().join("m.npy");
     python("planar_method.py", &[&inputs, &map], &[]);
-    let other = capture(&dir.path().join("other"), &["--head-bias-cm", "1,0,0"]);
-    let (ok, _, err) = seethru(&[
-        "score",
-        other.to_str().unwrap(),
-        "--map",
-        map.to_str().unwrap(),
-        "--out",
-        dir.path().join("s").to_str().unwrap(),
-    ]);
-    assert!(!ok);
-    assert!(
-        err.starts_with("error:") && err.contains("made for capture") && err.contains("m.npy"),
-        "{err}"
-    );
-    assert_eq!(err.lines().count(), 1, "{err}");
+    // Another head estimate; and the same images for a driver's view one pixel wider (the
+    // fingerprint did not cover --width, so the map was scored in another capture's view).
+    let wider: Vec<&str> = SIZES
+        .iter()
+        .map(|&w| if w == "160" { "161" } else { w })
+        .collect();
+    for (name, args) in [("bias", vec!["--head-bias-cm", "1,0,0"]), ("wider", wider)] {
+        let other = dir.path().join(name);
+        let mut capture_args = vec![
+            "capture",
+            "scenes/das.toml",
+            "--out",
+            other.to_str().unwrap(),
+        ];
+        capture_args.extend(&args);
+        if name == "bias" {
+            capture_args.extend(SIZES);
+        }
+        run_ok(&capture_args);
+        let (ok, _, err) = seethru(&[
+            "score",
+            other.to_str().unwrap(),
+            "--map",
+            map.to_str().unwrap(),
+            "--out",
+            dir.path().join("s").to_str().unwrap(),
+        ]);
+        assert!(!ok, "{name}");
+        assert!(
+            err.starts_with("error:") && err.contains("made for capture") && err.contains("m.npy"),
+            "{name}: {err}"
+        );
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
 }
 
 #[test]

@@ -15,6 +15,7 @@ use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
+use crate::geometry::camera::Camera;
 use crate::geometry::opencv::camera_json;
 use crate::render::frame::{Frame, Pixel};
 use crate::render::integrator::RenderContext;
@@ -70,9 +71,9 @@ pub struct Capture {
     pub head: HeadEstimate,
     /// `calibration.json`: the calibrated cameras, display and obstacle frame.
     pub calibration: Value,
-    /// 16 hex digits over the frontal and back images, the head estimate and the calibration
-    /// (not the depth image, which follows from the same settings): a map made for another
-    /// capture is refused by it.
+    /// 16 hex digits over the frontal and back images, the head estimate, the calibration and
+    /// the driver's view size (not the depth image, which follows from the same settings): a
+    /// map made for another capture is refused by it.
     pub fingerprint: String,
     pub truth: CaptureTruth,
 }
@@ -111,7 +112,8 @@ pub fn capture(ctx: &RenderContext, options: &RunOptions, with_depth: bool) -> R
     let mut calibration = calibration_json(scene)?;
     // Before the depth sensor is added: a map made from a capture with depth fits the same
     // capture without (compare's), the sensor being a function of the same settings.
-    let fingerprint = fingerprint(&frontal, &back, &head, &calibration)?;
+    let driver = driver_camera(scene, options)?;
+    let fingerprint = fingerprint(&frontal, &back, &head, &calibration, &driver)?;
     if let Some(d) = &depth {
         let mut sensor = camera_json(&d.camera);
         sensor["model"] = json!(d.model);
@@ -120,7 +122,6 @@ pub fn capture(ctx: &RenderContext, options: &RunOptions, with_depth: bool) -> R
         );
         calibration["depth_sensor"] = sensor;
     }
-    let driver = driver_camera(scene, options)?;
     let truth = render(&driver, View::Truth);
     let true_cameras = json!({
         "frontal": camera_json(&scene.frontal),
@@ -143,14 +144,20 @@ pub fn capture(ctx: &RenderContext, options: &RunOptions, with_depth: bool) -> R
     })
 }
 
-/// 16 hex digits over the images, the head estimate and the calibration ([`Capture::fingerprint`]).
+/// 16 hex digits over the images, the head estimate, the calibration and the size of the
+/// driver's view the capture is scored in ([`Capture::fingerprint`]).
 pub fn fingerprint(
     frontal: &Frame,
     back: &Frame,
     head: &HeadEstimate,
     calibration: &Value,
+    driver: &Camera,
 ) -> Result<String> {
     let mut h = Fnv64::default();
+    // The driver's view is not an input of the method, but a map is scored in it: captures
+    // at `--width 160` and `161` give the method the same images and are still two captures.
+    h.bytes(&driver.width.to_le_bytes())
+        .bytes(&driver.height.to_le_bytes());
     for frame in [frontal, back] {
         h.bytes(&frame.width.to_le_bytes())
             .bytes(&frame.height.to_le_bytes());

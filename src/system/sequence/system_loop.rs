@@ -404,7 +404,8 @@ impl SystemLoop {
                 pose: None,
             };
             let calibration = calibration_json(&geometry)?;
-            let fingerprint = fingerprint(&self.frontal, &back, &head, &calibration)?;
+            let fingerprint =
+                fingerprint(&self.frontal, &back, &head, &calibration, &geometry.driver)?;
             inputs = Some(RefreshInputs {
                 frontal: self.frontal.clone(),
                 back,
