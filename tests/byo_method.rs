@@ -368,7 +368,26 @@ fn bad_maps_and_display_images_get_one_line_each_and_outside_points_count_as_bla
     write_npy_f32(&file("rgb.npy"), &[h, w, 3], &vec![1.0; h * w * 3]).unwrap();
     write_npy_f32(&file("nan.npy"), &[h, w, 2], &vec![f32::NAN; h * w * 2]).unwrap();
     seethru::io::frame_files::write_png(&file("small.png"), 2, 2, vec![0; 12]).unwrap();
+    // Every point inside a 1280-wide frontal image, none inside the capture's 320×180 one (a
+    // map made for another frontal size showed a blank display, scored as coverage 0).
+    write_npy_f32(
+        &file("wide.npy"),
+        &[h, w, 2],
+        &[[900.0, 100.0]; 1].repeat(h * w).concat(),
+    )
+    .unwrap();
+    // One point inside is enough (the rest counts as blank, below).
+    let mut one = [[900.0_f32, 100.0]; 1].repeat(h * w);
+    one[0] = [319.4, 179.4];
+    write_npy_f32(&file("one_inside.npy"), &[h, w, 2], &one.concat()).unwrap();
+    assert!(score_with("--map", &file("one_inside.npy")).0);
+    std::fs::remove_dir_all(file("scored")).unwrap();
     let cases = [
+        (
+            "--map",
+            "wide.npy",
+            "inside the 320×180 frontal image".to_string(),
+        ),
         ("--map", "tall.npy", format!("({h}, {w}, 2)")),
         ("--map", "rgb.npy", "3 channels".to_string()),
         ("--map", "nan.npy", "NaN".to_string()),

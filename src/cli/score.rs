@@ -180,6 +180,7 @@ impl Score {
         };
         seethru::system::capture::check_display_input(
             r.ctx.scene.obstacle.display_resolution,
+            Some([r.capture.frontal.width, r.capture.frontal.height]),
             &r.capture.fingerprint,
             map.as_ref(),
             image.as_ref(),

@@ -68,7 +68,7 @@ pub fn load_maps(
         let file = path.display().to_string();
         // The fingerprint is the refresh's, known once it is rendered: checked then.
         let own = map.fingerprint.clone().unwrap_or_default();
-        check_display_input(display_size, &own, Some(&map), None)
+        check_display_input(display_size, None, &own, Some(&map), None)
             .map_err(|e| anyhow::anyhow!("{file} (frame {frame}): {e}"))?;
         maps.insert(refresh, NamedMap { file, frame, map });
     }

@@ -205,10 +205,12 @@ pub struct Scored {
     pub has_map: bool,
 }
 
-/// Checks a map and an image against the capture's display; one message per fault, naming
-/// what is wrong and what is expected.
+/// Checks a map and an image against the capture's display (and, where it is known, its
+/// `frontal_size`: width, height in pixels); one message per fault, naming what is wrong and
+/// what is expected.
 pub fn check_display_input(
     display_size: [u32; 2],
+    frontal_size: Option<[u32; 2]>,
     fingerprint: &str,
     map: Option<&DisplayMap>,
     image: Option<&DisplayImage>,
@@ -230,6 +232,25 @@ pub fn check_display_input(
         }
         if m.xy.iter().all(|p| p[0].is_nan() || p[1].is_nan()) {
             bail!("every entry of the map is NaN: it shows nothing on the display");
+        }
+        // A map for another frontal size (one made for a capture at the scene's frontal width,
+        // shown by a sequence at the driver view's) shows nothing: say so instead of scoring
+        // a blank display.
+        if let Some([fw, fh]) = frontal_size {
+            let inside = |p: &[f32; 2]| {
+                (-0.5..fw as f32 - 0.5).contains(&p[0]) && (-0.5..fh as f32 - 0.5).contains(&p[1])
+            };
+            if !m.xy.iter().any(inside) {
+                let reach =
+                    m.xy.iter()
+                        .filter(|p| p[0].is_finite() && p[1].is_finite())
+                        .fold([f32::MIN; 2], |r, p| [r[0].max(p[0]), r[1].max(p[1])]);
+                bail!(
+                    "no point of the map lies inside the {fw}×{fh} frontal image (its points reach x = {}, y = {}): it was made for another frontal size (the frontal width must be the capture's)",
+                    reach[0],
+                    reach[1]
+                );
+            }
         }
         if let Some(f) = &m.fingerprint
             && f != fingerprint
@@ -312,7 +333,8 @@ pub fn score(
     image: Option<&DisplayImage>,
 ) -> Result<Scored> {
     let display_size = ctx.scene.obstacle.display_resolution;
-    check_display_input(display_size, &capture.fingerprint, map, image)?;
+    let frontal_size = Some([capture.frontal.width, capture.frontal.height]);
+    check_display_input(display_size, frontal_size, &capture.fingerprint, map, image)?;
     let display = display_from(&capture.frontal, display_size, options, map, image);
     let blank_map_pixels = match map {
         Some(_) => display

@@ -425,8 +425,14 @@ impl SystemLoop {
             })?;
             let size = geometry.obstacle.display_resolution;
             let given = inputs.as_ref().expect("made for the maps");
-            check_display_input(size, &given.fingerprint, Some(&named.map), None)
-                .map_err(|e| anyhow::anyhow!("{} (frame {}): {e}", named.file, named.frame))?;
+            check_display_input(
+                size,
+                Some([self.frontal.width, self.frontal.height]),
+                &given.fingerprint,
+                Some(&named.map),
+                None,
+            )
+            .map_err(|e| anyhow::anyhow!("{} (frame {}): {e}", named.file, named.frame))?;
             display_from(&self.frontal, size, run, Some(&named.map), None)
         } else if curved {
             crate::system::pipeline::curved_planar_display(
