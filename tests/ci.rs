@@ -554,3 +554,63 @@ fn two_run_folders_diff_their_views_and_their_metrics_with_tolerances() {
     assert_eq!(code, 2);
     assert_one_error_line(&err, &["--tolerance coverage.min", "misregistration.mean"]);
 }
+
+#[test]
+fn each_bound_passes_on_its_side_and_fails_on_the_other_and_a_case_is_held_to_its_commands_rules() {
+    let dir = tempfile::tempdir().unwrap();
+    let metrics = measured_das(dir.path());
+    let mean = metrics["display"]["misregistration_arcmin"]["mean"]
+        .as_f64()
+        .unwrap();
+    // (bound, passes): each relation on both sides of the measured mean, the recorded one
+    // far above and far below its tolerance (a comparison without its `abs` passed the
+    // value below).
+    let bounds = [
+        (format!("misregistration.mean <= {}", mean + 1.0), true),
+        (format!("misregistration.mean <= {}", mean - 1.0), false),
+        (format!("misregistration.mean >= {}", mean - 1.0), true),
+        (format!("misregistration.mean >= {}", mean + 1.0), false),
+        (
+            format!("misregistration.mean == {} +- 0.5", mean + 0.25),
+            true,
+        ),
+        (
+            format!("misregistration.mean == {} +- 0.5", mean - 0.25),
+            true,
+        ),
+        (
+            format!("misregistration.mean == {} +- 0.5", mean + 10.0),
+            false,
+        ),
+        (
+            format!("misregistration.mean == {} +- 0.5", mean - 10.0),
+            false,
+        ),
+    ];
+    for (k, (bound, passes)) in bounds.iter().enumerate() {
+        let file = format!("b{k}.toml");
+        std::fs::write(
+            dir.path().join(&file),
+            case("das", std::slice::from_ref(bound), None),
+        )
+        .unwrap();
+        let (code, out, err) = run(dir.path(), &["check", &file, "--out", "c"]);
+        let verdict = if *passes { "PASS" } else { "FAIL" };
+        assert_eq!(code, if *passes { 0 } else { 1 }, "{bound}: {out}{err}");
+        assert!(
+            out.lines()
+                .any(|l| l.contains(bound.as_str()) && l.ends_with(verdict)),
+            "{bound} should {verdict}: {out}"
+        );
+    }
+    // A case whose options its command refuses on its own (`--fill` without a depth method)
+    // could not run: it does not pass.
+    let text = case("fill", &["coverage >= 0".into()], None).replace(
+        "options = [\"--width\", \"96\"]",
+        "options = [\"--width\", \"96\", \"--fill\", \"inpaint\"]",
+    );
+    std::fs::write(dir.path().join("fill.toml"), text).unwrap();
+    let (code, out, err) = run(dir.path(), &["check", "fill.toml", "--out", "c"]);
+    assert_eq!(code, 2, "{out}{err}");
+    assert_one_error_line(&err, &["case fill", "--fill", "--method depth"]);
+}

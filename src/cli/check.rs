@@ -8,7 +8,6 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use clap::Parser;
 use seethru::io::atomic::{write_atomically, write_text};
 use seethru::io::frame_files::write_png;
 use seethru::io::junit::{Outcome, TestCase, junit_xml};
@@ -67,7 +66,9 @@ fn case_args(command: CaseCommand, scene: &Path, out: &Path, options: &[String])
 
 fn parse_case(args: Vec<String>) -> Result<crate::cli::Cli, String> {
     let args = crate::cli::with_negative_values_joined(args.into_iter().map(Into::into));
-    crate::cli::Cli::try_parse_from(args).map_err(|e| {
+    // Parsed as the command line itself is, recording the case's flags: a flag its command
+    // would ignore is refused as `run` alone refuses it.
+    crate::cli::parse(args).map_err(|e| {
         let line = crate::cli::one_line(&e);
         line.strip_prefix("error: ").unwrap_or(&line).to_string()
     })

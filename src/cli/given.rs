@@ -1,18 +1,20 @@
-//! The flags the user typed (as opposed to defaults), recorded once when the command line is
-//! parsed, so that a command can refuse a flag it would ignore ([`super::args::refuse_ignored`]).
+//! The flags the user typed (as opposed to defaults), recorded when a command line is parsed,
+//! so that a command can refuse a flag it would ignore ([`super::args::refuse_ignored`]).
+//! `check` parses each case's command line in turn: the flags are those of the command line
+//! parsed last, so a case is held to the rules its own command line would be on its own.
 
-use std::sync::OnceLock;
+use std::sync::{PoisonError, RwLock};
 
 use clap::parser::ValueSource;
 
-static GIVEN: OnceLock<Vec<String>> = OnceLock::new();
+static GIVEN: RwLock<Vec<String>> = RwLock::new(Vec::new());
 
 /// Records the long flags given on the command line in `matches` (of `command`), down the
-/// subcommands. Called once, by the parser.
+/// subcommands, in place of those of the command line parsed before. Called by the parser.
 pub fn record(command: &clap::Command, matches: &clap::ArgMatches) {
     let mut flags = Vec::new();
     walk(command, matches, &mut flags);
-    let _ = GIVEN.set(flags);
+    *GIVEN.write().unwrap_or_else(PoisonError::into_inner) = flags;
 }
 
 fn walk(command: &clap::Command, matches: &clap::ArgMatches, flags: &mut Vec<String>) {
@@ -33,6 +35,8 @@ fn walk(command: &clap::Command, matches: &clap::ArgMatches, flags: &mut Vec<Str
 /// Whether `flag` (`--ipd`) was on the command line.
 pub fn given(flag: &str) -> bool {
     GIVEN
-        .get()
-        .is_some_and(|flags| flags.iter().any(|f| f == flag))
+        .read()
+        .unwrap_or_else(PoisonError::into_inner)
+        .iter()
+        .any(|f| f == flag)
 }
