@@ -711,3 +711,79 @@ fn a_size_flag_whose_aspect_breaks_the_pixel_limit_is_named() {
     assert!(!err.contains("134217728"), "{err}");
     assert!(!dir.path().join("out").exists());
 }
+
+#[test]
+fn flags_that_diff_and_sweep_merge_would_ignore_are_refused_and_nothing_is_written() {
+    let dir = scratch("", &[]);
+    for k in ["0", "1"] {
+        let (code, err) = run_in(
+            dir.path(),
+            &[
+                "sweep",
+                "scene.toml",
+                "--param",
+                "d2=2,5",
+                "--width",
+                "16",
+                "--shard",
+                &format!("{k}/2"),
+                "--out",
+                &format!("p{k}.csv"),
+            ],
+        );
+        assert_eq!(code, 0, "{err}");
+    }
+    let (code, err) = run_in(
+        dir.path(),
+        &[
+            "render",
+            "scene.toml",
+            "--view",
+            "truth",
+            "--width",
+            "16",
+            "--out",
+            "r",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let before = listing(dir.path());
+    // --bound-arcmin is read only for parts of an eye=eyellipse sweep (it was accepted and
+    // dropped); the merge writes nothing when refused.
+    refused(
+        dir.path(),
+        &[
+            "sweep-merge",
+            "p0.csv",
+            "p1.csv",
+            "--out",
+            "m.csv",
+            "--bound-arcmin",
+            "3",
+        ],
+        1,
+        &["--bound-arcmin", "eye=eyellipse", "(d2)"],
+    );
+    // --tolerance moves metrics.json's values: read only for two run folders.
+    refused(
+        dir.path(),
+        &[
+            "diff",
+            "r/truth.png",
+            "r/truth.png",
+            "--tolerance",
+            "misregistration.mean=1",
+        ],
+        2,
+        &["--tolerance", "two run folders"],
+    );
+    assert_eq!(listing(dir.path()), before);
+    // Without them, both run.
+    let (code, err) = run_in(
+        dir.path(),
+        &["sweep-merge", "p0.csv", "p1.csv", "--out", "m.csv"],
+    );
+    assert_eq!(code, 0, "{err}");
+    let (code, err) = run_in(dir.path(), &["diff", "r/truth.png", "r/truth.png"]);
+    assert_eq!(code, 0, "{err}");
+}

@@ -24,10 +24,13 @@ const HANG: Duration = Duration::from_secs(90);
 struct Case {
     label: String,
     args: Vec<String>,
+    /// The matrix's own calls (each command's smallest call, the calls a later one reads):
+    /// an error there would leave the cases after it testing nothing.
+    must_succeed: bool,
 }
 
 /// What a case did, when it did not pass.
-fn failure(args: &[String]) -> Option<String> {
+fn failure(args: &[String], must_succeed: bool) -> Option<String> {
     let mut child = Command::new(env!("CARGO_BIN_EXE_seethru"))
         .args(args)
         .env("RUST_BACKTRACE", "0")
@@ -64,6 +67,11 @@ fn failure(args: &[String]) -> Option<String> {
     }
     if status.success() {
         return None;
+    }
+    if must_succeed {
+        return Some(format!(
+            "exit {status}, where this call must succeed: {err}"
+        ));
     }
     let errors = err.lines().filter(|l| l.starts_with("error:")).count();
     match status.code() {
@@ -171,6 +179,11 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
     let case = |label: String, args: Vec<String>| Case {
         label: format!("{name} {label}"),
         args,
+        must_succeed: false,
+    };
+    let sure = |label: String, args: Vec<String>| Case {
+        must_succeed: true,
+        ..case(label, args)
     };
     let tiny = words(&["--width", "32", "--spp", "1", "--quiet"]);
     // Independent cases are groups of one; a group runs in order (a score after its capture).
@@ -185,7 +198,7 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
         a
     };
     for (command, options) in run_choices {
-        groups.push(vec![case(command.clone(), base(command, command))]);
+        groups.push(vec![sure(command.clone(), base(command, command))]);
         for (flag, values) in options {
             for value in values {
                 // Each choice in a folder of its own: a case never reads another's output.
@@ -261,7 +274,7 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
         "--out",
         &out("seq_moving"),
     ]);
-    groups.push(vec![case("sequence moving".into(), moving)]);
+    groups.push(vec![sure("sequence moving".into(), moving)]);
     for param in sweep_params() {
         let mut a = words(&["sweep", &s, "--param", &param]);
         if param == "eye=eyellipse" {
@@ -292,14 +305,14 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
         .collect::<Vec<_>>()
     };
     groups.push(vec![
-        case("sweep --shard 1/2".into(), shard("1/2")),
-        case("sweep --shard 2/2".into(), shard("2/2")),
-        case(
+        sure("sweep --shard 0/2".into(), shard("0/2")),
+        sure("sweep --shard 1/2".into(), shard("1/2")),
+        sure(
             "sweep-merge".into(),
             words(&[
                 "sweep-merge",
+                &out("part0.csv"),
                 &out("part1.csv"),
-                &out("part2.csv"),
                 "--quiet",
                 "--out",
             ])
@@ -316,15 +329,15 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
     *run_b.last_mut().unwrap() = out("rb");
     run_b.extend(words(&["--method", "none"]));
     groups.push(vec![
-        case("run --exr all".into(), run_a),
-        case("run --method none".into(), run_b),
-        case("measure".into(), words(&["measure", &out("ra"), "--quiet"])),
+        sure("run --exr all".into(), run_a),
+        sure("run --method none".into(), run_b),
+        sure("measure".into(), words(&["measure", &out("ra"), "--quiet"])),
         // A run folder against itself: `diff` exits 1 where a metric moved (a verdict).
-        case(
+        sure(
             "diff runs".into(),
             words(&["diff", &out("ra"), &out("ra"), "--quiet"]),
         ),
-        case(
+        sure(
             "diff images".into(),
             words(&[
                 "diff",
@@ -333,7 +346,7 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
                 "--quiet",
             ]),
         ),
-        case(
+        sure(
             "diff exr layer".into(),
             words(&[
                 "diff",
@@ -344,7 +357,7 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
                 "--quiet",
             ]),
         ),
-        case(
+        sure(
             "capture".into(),
             words(&[
                 "capture",
@@ -356,7 +369,7 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
                 &out("cap"),
             ]),
         ),
-        case(
+        sure(
             "score --display-image".into(),
             words(&[
                 "score",
@@ -368,7 +381,7 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
                 &out("scored"),
             ]),
         ),
-        case(
+        sure(
             "capture --depth".into(),
             words(&[
                 "capture",
@@ -382,7 +395,7 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
             ]),
         ),
     ]);
-    groups.push(vec![case(
+    groups.push(vec![sure(
         "compare".into(),
         words(&[
             "compare",
@@ -411,7 +424,7 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
         ]),
     )]);
     for ext in ["glb", "obj", "xml"] {
-        groups.push(vec![case(
+        groups.push(vec![sure(
             format!("export {ext}"),
             words(&[
                 "export",
@@ -422,7 +435,7 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
             ]),
         )]);
     }
-    groups.push(vec![case(
+    groups.push(vec![sure(
         "bench".into(),
         words(&[
             "bench", &s, "--width", "32", "--height", "18", "--repeat", "1", "--quiet",
@@ -495,6 +508,7 @@ fn every_command_on_every_bundled_scene_exits_cleanly_or_with_one_error_line() {
         vec![Case {
             label: label.into(),
             args,
+            must_succeed: true,
         }]
     };
     groups.push(once("analyze", words(&["analyze", "--quiet"])));
@@ -538,7 +552,7 @@ fn every_command_on_every_bundled_scene_exits_cleanly_or_with_one_error_line() {
                         return;
                     };
                     for case in group {
-                        if let Some(why) = failure(&case.args) {
+                        if let Some(why) = failure(&case.args, case.must_succeed) {
                             failures.lock().unwrap().push(format!(
                                 "{}: seethru {}\n    {why}",
                                 case.label,

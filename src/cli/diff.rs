@@ -17,7 +17,7 @@ use seethru::measure::image_diff::{
 use seethru::util::number::short;
 use serde_json::{Value, json};
 
-use crate::cli::args::real;
+use crate::cli::args::{ReadWhen, real, refuse_ignored};
 use crate::cli::verdict::ChecksFailed;
 
 /// The views of a run folder that `diff` compares, as their colour PNGs.
@@ -130,6 +130,11 @@ impl Diff {
             &outputs,
         )?;
         let (a_dir, b_dir) = (self.a.is_dir(), self.b.is_dir());
+        refuse_ignored(&[ReadWhen {
+            flag: "--tolerance",
+            read: a_dir && b_dir,
+            when: "when two run folders are compared (their metrics.json)",
+        }])?;
         let (diffs, changes) = match (a_dir, b_dir) {
             (true, true) => self.folders()?,
             (false, false) => {

@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use anyhow::Result;
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::measure::sweep::{
-    DEFAULT_BOUND_ARCMIN, SweepOptions, merge_parts_with_bound, samples_drivers, sweep,
+    BoundIgnored, DEFAULT_BOUND_ARCMIN, SweepOptions, merge_parts_with_bound, samples_drivers,
+    sweep,
 };
 use seethru::measure::sweep_grid::{EYELLIPSE, MAX_VALUES, eyellipse_param, parse_param};
 use seethru::measure::sweep_shard::Shard;
@@ -77,9 +78,9 @@ pub struct SweepMerge {
     #[arg(long)]
     out: PathBuf,
     /// For a sweep of --param eye=eyellipse: the misregistration bound of the share of
-    /// drivers, arcmin in [1e-6, 10800].
-    #[arg(long = "bound-arcmin", default_value_t = DEFAULT_BOUND_ARCMIN, value_parser = positive(10800.0))]
-    bound_arcmin: f64,
+    /// drivers, arcmin in [1e-6, 10800] (default: 1).
+    #[arg(long = "bound-arcmin", value_parser = positive(10800.0))]
+    bound_arcmin: Option<f64>,
 }
 
 impl SweepMerge {
@@ -87,7 +88,21 @@ impl SweepMerge {
         let inputs: Vec<Input> = self.parts.iter().map(|p| Input::file("PARTS", p)).collect();
         check_paths(&inputs, &[Output::file("--out", &self.out)])?;
         let parts: Vec<&std::path::Path> = self.parts.iter().map(PathBuf::as_path).collect();
-        let rows = merge_parts_with_bound(&parts, &self.out, self.bound_arcmin)?;
+        let rows =
+            merge_parts_with_bound(&parts, &self.out, self.bound_arcmin).map_err(|e| {
+                match e.downcast_ref::<BoundIgnored>() {
+                    Some(ignored) => anyhow::anyhow!(
+                        "{}",
+                        ReadWhen {
+                            flag: "--bound-arcmin",
+                            read: false,
+                            when: "for parts of a sweep of --param eye=eyellipse",
+                        }
+                        .refusal("--bound-arcmin", &format!("parameters ({})", ignored.0))
+                    ),
+                    None => e,
+                }
+            })?;
         seethru::util::progress::summary(format!(
             "merged {rows} configurations from {} parts into {}",
             parts.len(),

@@ -18,7 +18,7 @@ use crate::measure::sweep_csv::{
     MAX_SWEEP_CSV_BYTES, METRIC_COLUMNS, decode, encode, finished_rows, header,
 };
 use crate::measure::sweep_grid::{Param, check_grid_size, combinations, configure};
-use crate::measure::sweep_shard::{Shard, merge};
+use crate::measure::sweep_shard::{Shard, join};
 use crate::render::integrator::{RenderContext, same_geometry};
 use crate::render::settings::RenderSettings;
 use crate::scene::Scene;
@@ -254,16 +254,44 @@ pub fn check_out(csv: &Path) -> Result<()> {
 /// Joins the CSVs of a sharded sweep into `out` (byte for byte what one unsharded run writes)
 /// and draws its plot; returns the number of rows.
 pub fn merge_parts(parts: &[&Path], out: &Path) -> Result<usize> {
-    merge_parts_with_bound(parts, out, DEFAULT_BOUND_ARCMIN)
+    merge_parts_with_bound(parts, out, None)
 }
 
+/// A bound of the share of drivers given for parts that sample no drivers' eyes: it would be
+/// ignored. Holds the parts' parameter names.
+#[derive(Debug)]
+pub struct BoundIgnored(pub String);
+
+impl std::fmt::Display for BoundIgnored {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "a bound of the share of drivers is read only for parts of a sweep of eye=eyellipse; these sweep {}",
+            self.0
+        )
+    }
+}
+
+impl std::error::Error for BoundIgnored {}
+
 /// [`merge_parts`], with the share of drivers of an `eye=eyellipse` sweep under
-/// `bound_arcmin`.
-pub fn merge_parts_with_bound(parts: &[&Path], out: &Path, bound_arcmin: f64) -> Result<usize> {
+/// `bound_arcmin` (default [`DEFAULT_BOUND_ARCMIN`]); a bound given for parts that sample no
+/// drivers is refused ([`BoundIgnored`]) before anything is written.
+pub fn merge_parts_with_bound(
+    parts: &[&Path],
+    out: &Path,
+    bound_arcmin: Option<f64>,
+) -> Result<usize> {
     check_out(out)?;
-    let merged = merge(parts, out)?;
+    let merged = join(parts)?;
+    if bound_arcmin.is_some() && !samples_drivers(&merged.params) {
+        let names: Vec<&str> = merged.params.iter().map(|p| p.name.as_str()).collect();
+        return Err(BoundIgnored(names.join(", ")).into());
+    }
+    write_text(out, &merged.text)?;
     plot(out, &merged.params, &merged.body)?;
-    write_driver_shares(out, &merged.params, &merged.body, bound_arcmin)?;
+    let bound = bound_arcmin.unwrap_or(DEFAULT_BOUND_ARCMIN);
+    write_driver_shares(out, &merged.params, &merged.body, bound)?;
     Ok(merged.rows)
 }
 

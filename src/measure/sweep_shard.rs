@@ -60,11 +60,13 @@ impl Shard {
     }
 }
 
-/// What [`merge`] wrote.
+/// What [`merge`] wrote ([`join`] would write).
 pub struct Merged {
     pub rows: usize,
     pub params: Vec<Param>,
     pub body: Vec<(usize, String)>,
+    /// The merged CSV, header first.
+    pub text: String,
 }
 
 /// Joins the CSVs of a sharded sweep into `out`: one header (every part must have the same),
@@ -74,6 +76,13 @@ pub struct Merged {
 /// naming it. The grid's size is the `configurations` the rows record, so a part that never
 /// ran is noticed.
 pub fn merge(parts: &[&Path], out: &Path) -> Result<Merged> {
+    let joined = join(parts)?;
+    write_text(out, &joined.text)?;
+    Ok(joined)
+}
+
+/// [`merge`] without writing: the merged CSV's text in [`Merged::text`].
+pub fn join(parts: &[&Path]) -> Result<Merged> {
     if parts.is_empty() {
         bail!("give the CSVs of the parts to merge");
     }
@@ -190,11 +199,11 @@ pub fn merge(parts: &[&Path], out: &Path) -> Result<Merged> {
         .chain(body.iter().map(|(_, l)| l.clone()))
         .map(|l| l + "\n")
         .collect();
-    write_text(out, &text)?;
     Ok(Merged {
         rows: body.len(),
         params,
         body,
+        text,
     })
 }
 
