@@ -134,6 +134,13 @@ fn a_one_pixel_change_fails_a_tight_bound_and_passes_a_loose_one() {
     );
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("PASS flip_mean <= 0.5"), "{out}");
+    // A lower bound above the measured PSNR fails.
+    let (code, _, err) = run(
+        dir.path(),
+        &["diff", "a.png", "b.png", "--min", "psnr_db=200"],
+    );
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("psnr_db >= 200"), "{err}");
     let heat = image::open(dir.path().join("heat/flip_colour.png")).unwrap();
     assert!(heat.width() > 32 + 100, "{}", heat.width());
 }
@@ -521,6 +528,11 @@ fn two_run_folders_diff_their_views_and_their_metrics_with_tolerances() {
     assert_eq!(change["a"].as_f64().unwrap(), mean("a"));
     assert_eq!(change["b"].as_f64().unwrap(), mean("b"));
     assert_eq!(change["pass"], false);
+    assert!(err.contains("misregistration.mean moved"), "{err}");
+    // The other way round, the metric moves the other way: it fails as well (a comparison
+    // without its `abs` would pass one direction).
+    let (code, _, err) = run(dir.path(), &["diff", "b", "a"]);
+    assert_eq!(code, 1, "{err}");
     assert!(err.contains("misregistration.mean moved"), "{err}");
     // Tolerances wide enough for the change pass (the images are not bounded here).
     let moved = (mean("a") - mean("b")).abs();

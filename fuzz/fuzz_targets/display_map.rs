@@ -31,6 +31,7 @@ fuzz_target!(|data: &[u8]| {
     };
     if let Err(e) = check_display_input(
         [map.width, map.height],
+        Some([64, 36]),
         "0123456789abcdef",
         Some(&map),
         None,

@@ -6,9 +6,10 @@
 use std::path::PathBuf;
 use std::process::Command;
 
-/// The interpreter to run, with every package of `packages` importable (pip names that are
-/// also module names, e.g. `numpy`; more can be added by other tests, they are installed
-/// on first use).
+/// The interpreter to run, with every package of `packages` importable: pip names that are
+/// also module names (`numpy`), or `module=requirement` where they differ
+/// (`cv2=opencv-python-headless<5`); more can be added by other tests, they are installed on
+/// first use.
 pub fn python_with(packages: &[&str]) -> PathBuf {
     if let Some(python) = std::env::var_os("SEETHRU_PYTHON") {
         let python = PathBuf::from(python);
@@ -37,7 +38,7 @@ pub fn python_with(packages: &[&str]) -> PathBuf {
     if check_imports(&python, packages).is_err() {
         let pip = Command::new(&python)
             .args(["-m", "pip", "install", "--quiet"])
-            .args(packages)
+            .args(packages.iter().map(|p| requirement(p)))
             .output()
             .expect("pip runs");
         assert!(
@@ -90,10 +91,20 @@ impl Drop for DirLock {
     }
 }
 
+/// The module a package entry imports (`cv2` of `cv2=opencv-python-headless<5`).
+fn module(package: &str) -> &str {
+    package.split_once('=').map_or(package, |(m, _)| m)
+}
+
+/// What pip installs for a package entry (`opencv-python-headless<5`).
+fn requirement(package: &str) -> &str {
+    package.split_once('=').map_or(package, |(_, r)| r)
+}
+
 fn check_imports(python: &PathBuf, packages: &[&str]) -> Result<(), String> {
     let script = packages
         .iter()
-        .map(|p| format!("import {p}"))
+        .map(|p| format!("import {}", module(p)))
         .collect::<Vec<_>>()
         .join("; ");
     let out = Command::new(python)
