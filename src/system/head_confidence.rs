@@ -1,10 +1,12 @@
 //! How far a face detection can be trusted, from what the detector measured in the image
 //! alone: the face's size, whether the distance the pupils give agrees with the distance the
 //! face's width gives, whether the pupils sit where eyes sit (the face's upper part, about its
-//! middle) and whether the two pupil blobs are alike.
+//! middle) and whether the two pupil blobs are alike; and, for the ellipsoid face whose
+//! orientation is known (it faces the vehicle's forward), how obliquely the back camera sees
+//! it.
 //!
 //! Each cue is scored in [0, 1] by a linear ramp from a "bad" limit (score 0) to a "good"
-//! limit (score 1); the confidence is the product of the five scores, so any one cue that
+//! limit (score 1); the confidence is the product of the six scores, so any one cue that
 //! fails sinks it. The limits were set on the shipped head (das at 640×480: every score 1)
 //! against the slanted-pillar failures of issue 27 (docs/guide/hazards.md).
 
@@ -24,7 +26,7 @@ pub const IRIS_OVER_FACE: f64 = 0.006 / 0.15;
 /// The cue scores and what they were computed from.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct HeadConfidence {
-    /// The product of the five scores below, in [0, 1]; below [`CONFIDENT_HEAD`] the estimate
+    /// The product of the six scores below, in [0, 1]; below [`CONFIDENT_HEAD`] the estimate
     /// is unreliable.
     pub value: f64,
     /// Face width in pixels: score 0 at ≤ 12 px, 1 at ≥ 40 px.
@@ -40,6 +42,14 @@ pub struct HeadConfidence {
     /// Smaller over larger pupil blob area: 0 at ≤ 0.2, 1 at ≥ 0.5 (with the fit: the smaller
     /// blob over an iris disc, [`HeadConfidence::with_fit`]).
     pub pupil_sizes: f64,
+    /// How squarely the back camera sees the face ([`HeadConfidence::with_view`]): 1 at a
+    /// view angle ≤ 40°, 0 at ≥ 55° (as the mesh's fitted yaw: beyond, the far pupil slips
+    /// behind the head's curve and its centroid is biased); 1 where the angle is not known.
+    pub view: f64,
+    /// The angle at the face between its front and the direction to the back camera, degrees,
+    /// [0, 180]: the ellipsoid face's known orientation against the pupils' rays (`None` for
+    /// the mesh face, whose yaw is fitted instead).
+    pub view_angle_deg: Option<f64>,
     /// Face box width, pixels.
     pub face_width_px: f64,
     /// Distance from the pupils over distance from the face width (1: they agree).
@@ -82,8 +92,10 @@ impl HeadConfidence {
         let pupil_height = ramp(pupil_height_in_face, 0.7, 0.45);
         let symmetry = ramp(centre_offset_in_face, 0.5, 0.35);
         let pupil_sizes = ramp(pupil_area_ratio, 0.2, 0.5);
-        HeadConfidence {
-            value: face_size * distance_agreement * pupil_height * symmetry * pupil_sizes,
+        let mut c = HeadConfidence {
+            value: 0.0,
+            view: 1.0,
+            view_angle_deg: None,
             face_size,
             distance_agreement,
             pupil_height,
@@ -95,7 +107,9 @@ impl HeadConfidence {
             centre_offset_in_face,
             pupil_area_ratio,
             fitted: false,
-        }
+        };
+        c.value = c.product();
+        c
     }
 
     /// The cues once the head's yaw is fitted (`system/head_pose.rs`), which explains the
@@ -130,8 +144,30 @@ impl HeadConfidence {
         c.symmetry = ramp(yaw_deg.abs(), 55.0, 40.0) * ramp(margin, 0.0, 0.03);
         c.pupil_height = 1.0;
         c.fitted = true;
-        c.value = c.face_size * c.distance_agreement * c.pupil_height * c.symmetry * c.pupil_sizes;
+        c.value = c.product();
         c
+    }
+
+    /// The cues with the view angle of a face of known orientation (`view_angle_deg`, the
+    /// angle at the face between its front and the back camera, degrees): the frontal
+    /// equations are corrected for the camera's own yaw and pitch (`eye_facing` in
+    /// `system/head.rs`), but not for a far pupil the head's curve half hides.
+    pub fn with_view(&self, view_angle_deg: f64) -> Self {
+        let mut c = *self;
+        c.view_angle_deg = Some(view_angle_deg);
+        c.view = ramp(view_angle_deg, 55.0, 40.0);
+        c.value = c.product();
+        c
+    }
+
+    /// The product of the six scores: any one of them at 0 sinks it.
+    fn product(&self) -> f64 {
+        self.face_size
+            * self.distance_agreement
+            * self.pupil_height
+            * self.symmetry
+            * self.pupil_sizes
+            * self.view
     }
 
     /// Whether the estimate can be relied on (confidence ≥ [`CONFIDENT_HEAD`]).
@@ -178,6 +214,11 @@ impl HeadConfidence {
             out.push(format!(
                 "the pupils' midpoint {} of the face's width off its centre",
                 pct(self.centre_offset_in_face)
+            ));
+        }
+        if let (true, Some(angle)) = (self.view < 1.0, self.view_angle_deg) {
+            out.push(format!(
+                "the face seen {angle:.0}° off its front (beyond 40° the far pupil is half hidden)"
             ));
         }
         if self.pupil_sizes < 1.0 && self.fitted {
