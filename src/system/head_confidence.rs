@@ -258,12 +258,40 @@ mod tests {
         )
     }
 
+    /// The six frontal scores of `c`, named, in the order of the product.
+    fn scores(c: &HeadConfidence) -> [(&'static str, f64); 6] {
+        [
+            ("face_size", c.face_size),
+            ("distance_agreement", c.distance_agreement),
+            ("pupil_height", c.pupil_height),
+            ("symmetry", c.symmetry),
+            ("pupil_sizes", c.pupil_sizes),
+            ("view", c.view),
+        ]
+    }
+
+    /// `cue` alone failed: its score 0, every other score 1, and the confidence below
+    /// [`CONFIDENT_HEAD`], so a product that left that cue out would be caught here.
+    fn sunk_by_alone(c: &HeadConfidence, cue: &str) {
+        for (name, score) in scores(c) {
+            let expected = if name == cue { 0.0 } else { 1.0 };
+            assert_eq!(score, expected, "{name} with {cue} failing: {c:?}");
+        }
+        assert!(
+            c.value < CONFIDENT_HEAD && !c.is_confident(),
+            "{cue} alone should sink the confidence: {c:?}"
+        );
+        assert!(!c.doubts().is_empty(), "{cue}: the warning names a doubt");
+    }
+
     #[test]
-    fn a_well_seen_face_is_trusted_and_each_cue_can_sink_it() {
+    fn a_well_seen_face_is_trusted_and_each_cue_alone_sinks_it() {
         let (b, p, a) = das_like();
         let c = HeadConfidence::of(b, p, a);
         assert!(c.value > 0.95, "{c:?}");
         assert!((c.distance_ratio - 91.0 / (FACE_OVER_FEATURE * 38.6)).abs() < 1e-3);
+        // das's own view angle (29°) changes nothing.
+        assert_eq!(c.with_view(29.0).value, c.value);
         // Tiny face (same proportions, a sixth the size).
         let small = HeadConfidence::of(
             [0, 0, 15, 14],
@@ -271,25 +299,62 @@ mod tests {
             a,
         );
         assert!(small.face_size < 0.2 && !small.is_confident(), "{small:?}");
+        let tiny = HeadConfidence::of(
+            [0, 0, 12, 12],
+            [DVec2::new(1.0, 3.0), DVec2::new(6.1, 3.0)],
+            a,
+        );
+        sunk_by_alone(&tiny, "face_size");
         // Pupils 30% closer than the face's width says: the distances disagree.
         let close = [p[0], p[0] + (p[1] - p[0]) * 0.7];
-        let c = HeadConfidence::of(b, close, a);
-        assert!(c.distance_agreement == 0.0 && !c.is_confident(), "{c:?}");
-        // A "pupil" near the chin.
-        let low = [p[0], DVec2::new(p[1].x, 352.0 + 0.8 * 86.0)];
+        sunk_by_alone(&HeadConfidence::of(b, close, a), "distance_agreement");
+        // "Pupils" near the chin (both: one alone would also lengthen their distance).
+        let chin = 352.0 + 0.8 * 86.0;
+        let low = [DVec2::new(p[0].x, chin), DVec2::new(p[1].x, chin)];
         let c = HeadConfidence::of(b, low, a);
-        assert!(c.pupil_height == 0.0 && !c.is_confident(), "{c:?}");
+        sunk_by_alone(&c, "pupil_height");
         assert!(
             c.doubts().contains("of the face's height"),
             "{}",
             c.doubts()
         );
-        // One blob a sixth of the other.
-        let c = HeadConfidence::of(b, p, [8, 48]);
-        assert!(c.pupil_sizes == 0.0, "{c:?}");
         // Both pupils at the face's right edge.
-        let c = HeadConfidence::of(b, [DVec2::new(170.0, 377.0), DVec2::new(208.6, 377.0)], a);
-        assert!(c.symmetry == 0.0, "{c:?}");
+        let right = [DVec2::new(170.0, 377.0), DVec2::new(208.6, 377.0)];
+        sunk_by_alone(&HeadConfidence::of(b, right, a), "symmetry");
+        // One blob a sixth of the other.
+        sunk_by_alone(&HeadConfidence::of(b, p, [8, 48]), "pupil_sizes");
+        // The face seen 60° off its front (a camera far to its side).
+        let c = HeadConfidence::of(b, p, a).with_view(60.0);
+        sunk_by_alone(&c, "view");
+        assert!(c.doubts().contains("60° off its front"), "{}", c.doubts());
+        // The ramp's limits: 1 up to 40°, 0 from 55°.
+        assert_eq!(HeadConfidence::of(b, p, a).with_view(40.0).view, 1.0);
+        assert_eq!(HeadConfidence::of(b, p, a).with_view(55.0).view, 0.0);
+    }
+
+    #[test]
+    fn a_good_yaw_fit_is_trusted_and_each_of_its_cues_alone_sinks_it() {
+        let (b, p, a) = das_like();
+        let c = HeadConfidence::of(b, p, a);
+        // The good fit: outline 1% of the 91 px face off, 20° of yaw, a 0.05 margin, the
+        // smaller pupil 40 px (an iris disc there: π (0.04 · 91)² = 41.6 px²).
+        let (rms, yaw, margin, iris) = (0.91, 20.0, 0.05, 40);
+        let good = c.with_fit(rms, yaw, margin, iris);
+        assert!(good.fitted && good.value == 1.0, "{good:?}");
+        // The outline 5% of the face's width off the fitted pose.
+        sunk_by_alone(
+            &c.with_fit(0.05 * 91.0, yaw, margin, iris),
+            "distance_agreement",
+        );
+        // A fitted yaw of 60°: beyond 55° the far eye is behind the nose.
+        sunk_by_alone(&c.with_fit(rms, 60.0, margin, iris), "symmetry");
+        sunk_by_alone(&c.with_fit(rms, -60.0, margin, iris), "symmetry");
+        // Another yaw fits as well (no margin).
+        let c0 = c.with_fit(rms, yaw, 0.0, iris);
+        sunk_by_alone(&c0, "symmetry");
+        assert!(c0.doubts().contains("another yaw"), "{}", c0.doubts());
+        // The smaller pupil an eighth of an iris disc: half hidden by a lid.
+        sunk_by_alone(&c.with_fit(rms, yaw, margin, 5), "pupil_sizes");
     }
 
     #[test]
