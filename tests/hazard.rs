@@ -10,7 +10,8 @@ use seethru::system::pipeline::run;
 
 /// das with the pillar turned 31° towards the driver and leaning back (its up vector tilted
 /// 56° towards the driver): the back camera on its top edge sees the head from below and
-/// rolled, and the detector takes a shadowed silhouette for a pupil in the face's lower half.
+/// rolled. The eye is placed in a virtual camera square to the face (issue 51), so the
+/// estimate is right, but the image cues, measured in the rolled image, still doubt it.
 /// The textures and meshes are given as absolute paths so the text can live anywhere.
 fn slanted_text() -> String {
     common::slanted_scene_text("das.toml")
@@ -25,6 +26,19 @@ fn slanted() -> Scene {
     .unwrap()
 }
 
+/// das with its back camera 1.25 m to the display's left, yawed 58° to keep the face in view:
+/// it sees the face 65° off its front, where the far pupil is half hidden and the estimate
+/// is badly wrong.
+fn far_side() -> Scene {
+    let text = std::fs::read_to_string(common::repo_path("scenes/das.toml"))
+        .unwrap()
+        .replace(
+            "[camera.back]",
+            "[camera.back]\nyaw_deg = 58\noffset = [-1.25, 0.3, 0.0]",
+        );
+    common::parse_in(&common::repo_path("scenes"), "far_side.toml", &text).unwrap()
+}
+
 fn estimated() -> RunOptions {
     RunOptions {
         head: HeadSource::Estimated,
@@ -37,7 +51,8 @@ fn estimated() -> RunOptions {
 
 #[test]
 fn the_confidence_is_low_where_the_estimate_is_badly_wrong_and_high_on_das() {
-    let bad = run(&RenderContext::new(slanted()).unwrap(), &estimated()).unwrap();
+    let bad = run(&RenderContext::new(far_side()).unwrap(), &estimated()).unwrap();
+    let slanted = run(&RenderContext::new(slanted()).unwrap(), &estimated()).unwrap();
     let good = run(&RenderContext::new(common::das()).unwrap(), &estimated()).unwrap();
     let error = |r: &seethru::system::pipeline::RunResult| {
         r.report["eye_used"]["error_m"].as_f64().unwrap()
@@ -49,10 +64,18 @@ fn the_confidence_is_low_where_the_estimate_is_badly_wrong_and_high_on_das() {
     };
     assert!(
         error(&bad) > 0.1,
-        "the slanted case is badly wrong: {}",
+        "the far-side case is badly wrong: {}",
         error(&bad)
     );
     assert!(confidence(&bad) < 0.5, "{}", bad.report["head_detection"]);
+    // The slanted pillar's camera pose is corrected for (17.9 cm off before issue 51); the
+    // cues, read in its rolled image, stay doubtful: a false alarm, not a missed failure.
+    assert!(error(&slanted) < 0.03, "{}", error(&slanted));
+    assert!(
+        confidence(&slanted) < 0.5,
+        "{}",
+        slanted.report["head_detection"]
+    );
     assert!(error(&good) < 0.01, "{}", error(&good));
     assert!(confidence(&good) > 0.9, "{}", good.report["head_detection"]);
     // The detection struct carries it (head.json serialises the struct).

@@ -6,7 +6,7 @@
 //! largest dark holes inside it. The known feature `A` is the interpupillary distance, whose
 //! midpoint is the eye point the compensation needs, so no face-model offsets are involved.
 
-use glam::{DVec2, DVec3};
+use glam::{DAffine3, DMat3, DVec2, DVec3};
 
 use crate::analysis::paper::{head_distance, head_offset};
 use crate::geometry::camera::Camera;
@@ -507,6 +507,77 @@ pub fn eye_from_detection(detection: &FaceDetection, back: &Camera, feature_widt
     );
     back.world_from_camera
         .transform_point3(DVec3::new(x, y, -d))
+}
+
+/// The eye from a detection of a face with a known orientation, `world_from_face` (the face
+/// looks down its −z, +y up; the ellipsoid face faces the vehicle's forward): the pupils'
+/// rays are turned from the back camera's frame into a virtual pinhole at the same place that
+/// looks squarely at the face (its axis along the face's +z, the face's interpupillary line
+/// parallel to its image plane), where eqs. d1 and b_h hold; the eye found there goes back
+/// through the virtual camera's pose into the world. A back camera yawed or pitched on the
+/// display is so corrected for: in its own image the pupils lie at different depths and their
+/// distance is foreshortened, which the frontal equations would read as a farther face.
+///
+/// With the back camera already square to the face (das as shipped: within 1e-12 of it), the
+/// frontal equations run on the camera's own pixels, bit for bit [`eye_from_detection`].
+pub fn eye_facing(
+    detection: &FaceDetection,
+    back: &Camera,
+    feature_width: f64,
+    world_from_face: DMat3,
+) -> FacingEye {
+    // The virtual camera looks at the face from in front: half a turn about the face's y.
+    let world_from_virtual = world_from_face * DMat3::from_rotation_y(std::f64::consts::PI);
+    let world_from_back = back.world_from_camera.matrix3;
+    // Rigid rotations: the transpose is the inverse.
+    let virtual_from_back = world_from_virtual.transpose() * world_from_back;
+    let rays = detection
+        .pupils
+        .map(|p| virtual_from_back * back.camera_direction(DVec2::from(p)));
+    let towards_eye = rays[0].normalize_or_zero() + rays[1].normalize_or_zero();
+    // The eye's ray off the virtual axis: the angle at the face between its front and the
+    // camera, which the camera's own yaw or pitch does not change.
+    let view_angle_deg = towards_eye.angle_between(DVec3::NEG_Z).to_degrees();
+    if virtual_from_back.abs_diff_eq(DMat3::IDENTITY, 1e-12) {
+        return FacingEye {
+            eye: eye_from_detection(detection, back, feature_width),
+            view_angle_deg,
+        };
+    }
+    let square = Camera {
+        world_from_camera: DAffine3 {
+            matrix3: world_from_virtual,
+            translation: back.world_from_camera.translation,
+        },
+        lens: None,
+        ..*back
+    };
+    let eye = match rays.map(|r| square.project_camera(r)) {
+        [Some(a), Some(b)] => {
+            let rectified = FaceDetection {
+                pupils: [a.to_array(), b.to_array()],
+                ..*detection
+            };
+            eye_from_detection(&rectified, &square, feature_width)
+        }
+        // A pupil behind the square camera: the face is seen from behind its front, which
+        // no equation corrects; the view angle (≥ 90°) sinks the confidence.
+        _ => eye_from_detection(detection, back, feature_width),
+    };
+    FacingEye {
+        eye,
+        view_angle_deg,
+    }
+}
+
+/// What [`eye_facing`] found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FacingEye {
+    /// The estimated eye (midpoint of the pupils), world frame, metres.
+    pub eye: DVec3,
+    /// The angle at the face between its front (the face's −z) and the direction to the back
+    /// camera, degrees, [0, 180]; from the pupils' rays.
+    pub view_angle_deg: f64,
 }
 
 /// A standard normal deviate from (seed, index), by Box–Muller on hashed uniforms.

@@ -1,10 +1,12 @@
 //! How far a face detection can be trusted, from what the detector measured in the image
 //! alone: the face's size, whether the distance the pupils give agrees with the distance the
 //! face's width gives, whether the pupils sit where eyes sit (the face's upper part, about its
-//! middle) and whether the two pupil blobs are alike.
+//! middle) and whether the two pupil blobs are alike; and, for the ellipsoid face whose
+//! orientation is known (it faces the vehicle's forward), how obliquely the back camera sees
+//! it.
 //!
 //! Each cue is scored in [0, 1] by a linear ramp from a "bad" limit (score 0) to a "good"
-//! limit (score 1); the confidence is the product of the five scores, so any one cue that
+//! limit (score 1); the confidence is the product of the six scores, so any one cue that
 //! fails sinks it. The limits were set on the shipped head (das at 640×480: every score 1)
 //! against the slanted-pillar failures of issue 27 (docs/guide/hazards.md).
 
@@ -24,7 +26,7 @@ pub const IRIS_OVER_FACE: f64 = 0.006 / 0.15;
 /// The cue scores and what they were computed from.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct HeadConfidence {
-    /// The product of the five scores below, in [0, 1]; below [`CONFIDENT_HEAD`] the estimate
+    /// The product of the six scores below, in [0, 1]; below [`CONFIDENT_HEAD`] the estimate
     /// is unreliable.
     pub value: f64,
     /// Face width in pixels: score 0 at ≤ 12 px, 1 at ≥ 40 px.
@@ -40,6 +42,14 @@ pub struct HeadConfidence {
     /// Smaller over larger pupil blob area: 0 at ≤ 0.2, 1 at ≥ 0.5 (with the fit: the smaller
     /// blob over an iris disc, [`HeadConfidence::with_fit`]).
     pub pupil_sizes: f64,
+    /// How squarely the back camera sees the face ([`HeadConfidence::with_view`]): 1 at a
+    /// view angle ≤ 40°, 0 at ≥ 55° (as the mesh's fitted yaw: beyond, the far pupil slips
+    /// behind the head's curve and its centroid is biased); 1 where the angle is not known.
+    pub view: f64,
+    /// The angle at the face between its front and the direction to the back camera, degrees,
+    /// [0, 180]: the ellipsoid face's known orientation against the pupils' rays (`None` for
+    /// the mesh face, whose yaw is fitted instead).
+    pub view_angle_deg: Option<f64>,
     /// Face box width, pixels.
     pub face_width_px: f64,
     /// Distance from the pupils over distance from the face width (1: they agree).
@@ -82,8 +92,10 @@ impl HeadConfidence {
         let pupil_height = ramp(pupil_height_in_face, 0.7, 0.45);
         let symmetry = ramp(centre_offset_in_face, 0.5, 0.35);
         let pupil_sizes = ramp(pupil_area_ratio, 0.2, 0.5);
-        HeadConfidence {
-            value: face_size * distance_agreement * pupil_height * symmetry * pupil_sizes,
+        let mut c = HeadConfidence {
+            value: 0.0,
+            view: 1.0,
+            view_angle_deg: None,
             face_size,
             distance_agreement,
             pupil_height,
@@ -95,7 +107,9 @@ impl HeadConfidence {
             centre_offset_in_face,
             pupil_area_ratio,
             fitted: false,
-        }
+        };
+        c.value = c.product();
+        c
     }
 
     /// The cues once the head's yaw is fitted (`system/head_pose.rs`), which explains the
@@ -130,8 +144,30 @@ impl HeadConfidence {
         c.symmetry = ramp(yaw_deg.abs(), 55.0, 40.0) * ramp(margin, 0.0, 0.03);
         c.pupil_height = 1.0;
         c.fitted = true;
-        c.value = c.face_size * c.distance_agreement * c.pupil_height * c.symmetry * c.pupil_sizes;
+        c.value = c.product();
         c
+    }
+
+    /// The cues with the view angle of a face of known orientation (`view_angle_deg`, the
+    /// angle at the face between its front and the back camera, degrees): the frontal
+    /// equations are corrected for the camera's own yaw and pitch (`eye_facing` in
+    /// `system/head.rs`), but not for a far pupil the head's curve half hides.
+    pub fn with_view(&self, view_angle_deg: f64) -> Self {
+        let mut c = *self;
+        c.view_angle_deg = Some(view_angle_deg);
+        c.view = ramp(view_angle_deg, 55.0, 40.0);
+        c.value = c.product();
+        c
+    }
+
+    /// The product of the six scores: any one of them at 0 sinks it.
+    fn product(&self) -> f64 {
+        self.face_size
+            * self.distance_agreement
+            * self.pupil_height
+            * self.symmetry
+            * self.pupil_sizes
+            * self.view
     }
 
     /// Whether the estimate can be relied on (confidence ≥ [`CONFIDENT_HEAD`]).
@@ -180,6 +216,11 @@ impl HeadConfidence {
                 pct(self.centre_offset_in_face)
             ));
         }
+        if let (true, Some(angle)) = (self.view < 1.0, self.view_angle_deg) {
+            out.push(format!(
+                "the face seen {angle:.0}° off its front (beyond 40° the far pupil is half hidden)"
+            ));
+        }
         if self.pupil_sizes < 1.0 && self.fitted {
             out.push(format!(
                 "a pupil blob only {} of an iris's area (half hidden by a lid or the nose)",
@@ -217,12 +258,40 @@ mod tests {
         )
     }
 
+    /// The six frontal scores of `c`, named, in the order of the product.
+    fn scores(c: &HeadConfidence) -> [(&'static str, f64); 6] {
+        [
+            ("face_size", c.face_size),
+            ("distance_agreement", c.distance_agreement),
+            ("pupil_height", c.pupil_height),
+            ("symmetry", c.symmetry),
+            ("pupil_sizes", c.pupil_sizes),
+            ("view", c.view),
+        ]
+    }
+
+    /// `cue` alone failed: its score 0, every other score 1, and the confidence below
+    /// [`CONFIDENT_HEAD`], so a product that left that cue out would be caught here.
+    fn sunk_by_alone(c: &HeadConfidence, cue: &str) {
+        for (name, score) in scores(c) {
+            let expected = if name == cue { 0.0 } else { 1.0 };
+            assert_eq!(score, expected, "{name} with {cue} failing: {c:?}");
+        }
+        assert!(
+            c.value < CONFIDENT_HEAD && !c.is_confident(),
+            "{cue} alone should sink the confidence: {c:?}"
+        );
+        assert!(!c.doubts().is_empty(), "{cue}: the warning names a doubt");
+    }
+
     #[test]
-    fn a_well_seen_face_is_trusted_and_each_cue_can_sink_it() {
+    fn a_well_seen_face_is_trusted_and_each_cue_alone_sinks_it() {
         let (b, p, a) = das_like();
         let c = HeadConfidence::of(b, p, a);
         assert!(c.value > 0.95, "{c:?}");
         assert!((c.distance_ratio - 91.0 / (FACE_OVER_FEATURE * 38.6)).abs() < 1e-3);
+        // das's own view angle (29°) changes nothing.
+        assert_eq!(c.with_view(29.0).value, c.value);
         // Tiny face (same proportions, a sixth the size).
         let small = HeadConfidence::of(
             [0, 0, 15, 14],
@@ -230,25 +299,62 @@ mod tests {
             a,
         );
         assert!(small.face_size < 0.2 && !small.is_confident(), "{small:?}");
+        let tiny = HeadConfidence::of(
+            [0, 0, 12, 12],
+            [DVec2::new(1.0, 3.0), DVec2::new(6.1, 3.0)],
+            a,
+        );
+        sunk_by_alone(&tiny, "face_size");
         // Pupils 30% closer than the face's width says: the distances disagree.
         let close = [p[0], p[0] + (p[1] - p[0]) * 0.7];
-        let c = HeadConfidence::of(b, close, a);
-        assert!(c.distance_agreement == 0.0 && !c.is_confident(), "{c:?}");
-        // A "pupil" near the chin.
-        let low = [p[0], DVec2::new(p[1].x, 352.0 + 0.8 * 86.0)];
+        sunk_by_alone(&HeadConfidence::of(b, close, a), "distance_agreement");
+        // "Pupils" near the chin (both: one alone would also lengthen their distance).
+        let chin = 352.0 + 0.8 * 86.0;
+        let low = [DVec2::new(p[0].x, chin), DVec2::new(p[1].x, chin)];
         let c = HeadConfidence::of(b, low, a);
-        assert!(c.pupil_height == 0.0 && !c.is_confident(), "{c:?}");
+        sunk_by_alone(&c, "pupil_height");
         assert!(
             c.doubts().contains("of the face's height"),
             "{}",
             c.doubts()
         );
-        // One blob a sixth of the other.
-        let c = HeadConfidence::of(b, p, [8, 48]);
-        assert!(c.pupil_sizes == 0.0, "{c:?}");
         // Both pupils at the face's right edge.
-        let c = HeadConfidence::of(b, [DVec2::new(170.0, 377.0), DVec2::new(208.6, 377.0)], a);
-        assert!(c.symmetry == 0.0, "{c:?}");
+        let right = [DVec2::new(170.0, 377.0), DVec2::new(208.6, 377.0)];
+        sunk_by_alone(&HeadConfidence::of(b, right, a), "symmetry");
+        // One blob a sixth of the other.
+        sunk_by_alone(&HeadConfidence::of(b, p, [8, 48]), "pupil_sizes");
+        // The face seen 60° off its front (a camera far to its side).
+        let c = HeadConfidence::of(b, p, a).with_view(60.0);
+        sunk_by_alone(&c, "view");
+        assert!(c.doubts().contains("60° off its front"), "{}", c.doubts());
+        // The ramp's limits: 1 up to 40°, 0 from 55°.
+        assert_eq!(HeadConfidence::of(b, p, a).with_view(40.0).view, 1.0);
+        assert_eq!(HeadConfidence::of(b, p, a).with_view(55.0).view, 0.0);
+    }
+
+    #[test]
+    fn a_good_yaw_fit_is_trusted_and_each_of_its_cues_alone_sinks_it() {
+        let (b, p, a) = das_like();
+        let c = HeadConfidence::of(b, p, a);
+        // The good fit: outline 1% of the 91 px face off, 20° of yaw, a 0.05 margin, the
+        // smaller pupil 40 px (an iris disc there: π (0.04 · 91)² = 41.6 px²).
+        let (rms, yaw, margin, iris) = (0.91, 20.0, 0.05, 40);
+        let good = c.with_fit(rms, yaw, margin, iris);
+        assert!(good.fitted && good.value == 1.0, "{good:?}");
+        // The outline 5% of the face's width off the fitted pose.
+        sunk_by_alone(
+            &c.with_fit(0.05 * 91.0, yaw, margin, iris),
+            "distance_agreement",
+        );
+        // A fitted yaw of 60°: beyond 55° the far eye is behind the nose.
+        sunk_by_alone(&c.with_fit(rms, 60.0, margin, iris), "symmetry");
+        sunk_by_alone(&c.with_fit(rms, -60.0, margin, iris), "symmetry");
+        // Another yaw fits as well (no margin).
+        let c0 = c.with_fit(rms, yaw, 0.0, iris);
+        sunk_by_alone(&c0, "symmetry");
+        assert!(c0.doubts().contains("another yaw"), "{}", c0.doubts());
+        // The smaller pupil an eighth of an iris disc: half hidden by a lid.
+        sunk_by_alone(&c.with_fit(rms, yaw, margin, 5), "pupil_sizes");
     }
 
     #[test]

@@ -1,17 +1,19 @@
 //! `--head estimated`: the eye from the back camera's image with the tracker the scene's face
 //! calls for (`[camera.driver] face`, [`DriverFace`]). The ellipsoid face (das's) is found by
-//! the frontal detector ([`detect`]) and placed by the paper's eqs. d1 and b_h
-//! ([`eye_from_detection`]); the head mesh, which a pillar camera sees turned, by the
+//! the frontal detector ([`detect`]) and placed by the paper's eqs. d1 and b_h, applied in a
+//! virtual camera square to the face, whose orientation is known (it faces the vehicle's
+//! forward), so that a back camera yawed or pitched on the display is corrected for
+//! ([`eye_facing`]; the view angle it measures is a confidence cue); the head mesh, which a pillar camera sees turned, by the
 //! side-angle detector ([`detect_turned`]) and the yaw fit ([`locate`]), whose eye, yaw and
 //! margin are kept ([`HeadFix::pose`]) and whose cues score the confidence.
 
-use glam::{DVec2, DVec3};
+use glam::{DMat3, DVec2, DVec3};
 
 use crate::geometry::camera::Camera;
 use crate::render::footprint::PixelRect;
 use crate::render::frame::Frame;
 use crate::scene::DriverFace;
-use crate::system::head::{DetectError, FaceDetection, detect, eye_from_detection};
+use crate::system::head::{DetectError, FaceDetection, detect, eye_facing};
 use crate::system::head_pose::{HeadPose, locate};
 use crate::system::head_side::detect_turned;
 
@@ -36,19 +38,28 @@ pub fn detect_face(face: DriverFace, frame: &Frame) -> Result<FaceDetection, Det
 }
 
 /// The eye of a detection of `face` through the believed back camera `back`; `feature_width`
-/// is the interpupillary distance A, metres.
+/// is the interpupillary distance A, metres. `world_from_face` is the orientation the
+/// ellipsoid face is expected to have (it looks down its −z, +y up): facing the vehicle's
+/// forward, [`FACING_FORWARD`] in a scene as written (the mesh face's yaw is fitted instead).
 pub fn fix_from(
     face: DriverFace,
     detection: FaceDetection,
     back: &Camera,
     feature_width: f64,
+    world_from_face: DMat3,
 ) -> HeadFix {
     match face {
-        DriverFace::Ellipsoids => HeadFix {
-            eye: eye_from_detection(&detection, back, feature_width),
-            detection,
-            pose: None,
-        },
+        DriverFace::Ellipsoids => {
+            let facing = eye_facing(&detection, back, feature_width, world_from_face);
+            HeadFix {
+                eye: facing.eye,
+                detection: FaceDetection {
+                    confidence: detection.confidence.with_view(facing.view_angle_deg),
+                    ..detection
+                },
+                pose: None,
+            }
+        }
         DriverFace::Mesh { .. } => {
             let (scored, pose) = locate(&detection, back, feature_width);
             HeadFix {
@@ -60,7 +71,11 @@ pub fn fix_from(
     }
 }
 
-/// [`detect_face`] then [`fix_from`].
+/// The ellipsoid face's expected orientation in a scene as written (at t = 0 of a sequence):
+/// the vehicle drives along world −z, and the driver faces where it goes, upright.
+pub const FACING_FORWARD: DMat3 = DMat3::IDENTITY;
+
+/// [`detect_face`] then [`fix_from`], the face facing forward in the scene's world.
 pub fn estimate(
     face: DriverFace,
     frame: &Frame,
@@ -72,6 +87,7 @@ pub fn estimate(
         detect_face(face, frame)?,
         back,
         feature_width,
+        FACING_FORWARD,
     ))
 }
 

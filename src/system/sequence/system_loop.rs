@@ -32,7 +32,7 @@ use crate::system::display::{
 };
 use crate::system::frontal_map::FrontalMap;
 use crate::system::head::{DetectError, FaceDetection, detect_in, gaussian};
-use crate::system::head_estimate::{detect_face, fix_from, turned_reads};
+use crate::system::head_estimate::{FACING_FORWARD, detect_face, fix_from, turned_reads};
 use crate::system::head_pose::HeadPose;
 use crate::system::options::{HeadSource, Method, RunOptions, WorkingDistance};
 use crate::system::pipeline::{
@@ -273,7 +273,15 @@ impl SystemLoop {
                 // The believed back camera ([calibration]), not the true one; the tracker the
                 // scene's face calls for.
                 let believed = ctx.scene.calibration.back.apply(&back)?;
-                let fix = fix_from(face, detection, &believed, run.feature_width);
+                // The driver faces the vehicle's forward, which turns with the vehicle.
+                let world_from_face = self.rig.world_from_rig(t).matrix3 * FACING_FORWARD;
+                let fix = fix_from(
+                    face,
+                    detection,
+                    &believed,
+                    run.feature_width,
+                    world_from_face,
+                );
                 if run.require_confident_head && !fix.detection.confidence.is_confident() {
                     bail!(
                         "--require-confident-head: {}",
