@@ -155,8 +155,7 @@ impl SensorModel {
 /// it is the quantity the methods interpolate and fit.
 #[derive(Clone, Debug)]
 pub struct DepthMap {
-    /// The sensor as a camera: the frontal camera's pose and field of view at the sensor's
-    /// resolution.
+    /// The sensor as a camera ([`sensor_camera`]): a pinhole at the frontal camera's pose.
     pub camera: Camera,
     pub inverse_depth: Vec<f32>,
     pub model: SensorModel,
@@ -186,6 +185,17 @@ impl DepthMap {
     }
 }
 
+/// The sensor as a camera: the frontal camera's pose, at the sensor's resolution, and a
+/// pinhole: without a lens the frontal camera's own, with one the pinhole of the lens's
+/// intrinsics (its distortion removed). Over a pinhole's image a line of sight is a straight
+/// epipolar line and inverse depth over a plane is affine, which the depth search and the
+/// plane fit rely on; what they find is projected into the frontal image through its lens.
+pub fn sensor_camera(frontal_camera: &Camera, model: &SensorModel) -> Camera {
+    frontal_camera
+        .undistorted()
+        .with_resolution(model.width, model.height)
+}
+
 /// The sensor's depth image of the scene. `frontal` is the frontal render (the ideal
 /// sensor's depth); other sensors are ray cast at their own resolution. Noise is seeded by
 /// `seed` and the pixel index: the same for any thread count.
@@ -196,8 +206,10 @@ pub fn sense(
     model: SensorModel,
     seed: u32,
 ) -> DepthMap {
-    let camera = frontal_camera.with_resolution(model.width, model.height);
-    let depth: Vec<f32> = if model.kind == SensorKind::Ideal {
+    let camera = sensor_camera(frontal_camera, &model);
+    // Without a lens the ideal sensor's pixels are the frontal render's own; with one, its
+    // pinhole grid is not the frontal image's, and is ray cast like the others (exactly).
+    let depth: Vec<f32> = if model.kind == SensorKind::Ideal && frontal_camera.lens.is_none() {
         frontal.camera_z.clone()
     } else {
         let settings = RenderSettings {
