@@ -207,10 +207,13 @@ pub fn compare(
     Ok(out)
 }
 
+/// An RGB8 image: width, height, bytes.
+pub type Rgb8Image = (u32, u32, Vec<u8>);
+
 /// Every row's strip (truth | seethru | misregistration | holes over the display's bounding
 /// box, and the heatmap's colour bar), RGB8 as (width, height, bytes), all on one scale
 /// that none saturates; `None` for a row that did not run.
-pub fn coloured_strips(rows: &[Compared]) -> Result<Vec<Option<(u32, u32, Vec<u8>)>>> {
+pub fn coloured_strips(rows: &[Compared]) -> Result<Vec<Option<Rgb8Image>>> {
     let drafts: Vec<&StripDraft> = rows.iter().filter_map(|r| r.strip.as_ref()).collect();
     let top = shared_heat_top(&drafts);
     rows.iter()

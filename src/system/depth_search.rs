@@ -19,6 +19,10 @@
 //! The background fill takes the farther surface just before the jump on the epipolar line.
 //! A ray that meets nothing up to its vanishing point looks at infinity (sky, or past the
 //! sensor's range: d2 → ∞); one that leaves the sensor's view first shows nothing.
+//!
+//! **Through a lens**: the sensor is a pinhole (`depth_sensor::sensor_camera`), so the walk
+//! is along a straight line; only the point found is carried into the frontal image, through
+//! the frontal camera's lens, and one outside the lens's domain is [`Found::BeyondLens`].
 
 use glam::{DVec2, DVec3};
 

@@ -2,7 +2,9 @@
 //! methods (`depth`, `plane-fit`) know of the scene's geometry.
 //!
 //! The sensor shares the frontal camera's pose and field of view (a co-located RGB-D pair, as
-//! in Baričević et al.), at its own resolution. `ideal` is the frontal render's own depth;
+//! in Baričević et al.), at its own resolution; it is a pinhole, with a frontal lens the
+//! pinhole of the lens's intrinsics ([`sensor_camera`]). `ideal` is the frontal render's own
+//! depth (ray cast on the pinhole's grid when the frontal camera has a lens);
 //! `tof` and `stereo` are ray cast at their resolution and then degraded as real sensors are:
 //! no return past the range limit (or from the sky), seeded Gaussian noise whose σ grows with
 //! distance — linearly for time of flight, quadratically for stereo (a fixed disparity error)
