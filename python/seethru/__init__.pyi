@@ -141,7 +141,8 @@ def compare(
 
     methods: none, planar-inf, planar-auto, plane-fit, ground, depth-ideal, depth-tof,
     depth-stereo (default: compare's six). Options: head, seed, frontal_width, back_width,
-    band, depth_*, fill, width, height, spp, max_memory.
+    band, depth_*, fill, width, height, spp, max_memory. A method the scene does not admit
+    (ground without a road) has a row whose "reason" says why, and no strip.
     """
 
 def ratio(setup: Literal["occlusion", "foreshortening"], **options: Any) -> dict[str, Any]:

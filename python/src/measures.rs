@@ -104,9 +104,12 @@ pub fn compare<'py>(
     let strips = PyDict::new(py);
     let mut json_rows = Vec::new();
     let coloured = coloured_strips(&rows).map_err(to_py)?;
-    for (r, (w, h, rgb)) in rows.into_iter().zip(coloured) {
-        let array = Array3::from_shape_vec((h as usize, w as usize, 3), rgb).expect("RGB8");
-        strips.set_item(r.name, PyArray::from_owned_array(py, array))?;
+    for (r, strip) in rows.into_iter().zip(coloured) {
+        // A method the scene does not admit has a row with its reason and no strip.
+        if let Some((w, h, rgb)) = strip {
+            let array = Array3::from_shape_vec((h as usize, w as usize, 3), rgb).expect("RGB8");
+            strips.set_item(r.name, PyArray::from_owned_array(py, array))?;
+        }
         json_rows.push(r.row);
     }
     out.set_item(

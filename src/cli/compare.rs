@@ -148,7 +148,11 @@ impl Compare {
         let staged = StagedDir::new(&self.out)?;
         let out: &Path = staged.path();
         let mut strips = Vec::new();
-        for (r, (w, h, rgb)) in rows.iter().zip(coloured_strips(&rows)?) {
+        for (r, strip) in rows.iter().zip(coloured_strips(&rows)?) {
+            // A method that did not run has no strip; its row says why.
+            let Some((w, h, rgb)) = strip else {
+                continue;
+            };
             let file = format!("strip_{}.png", r.name);
             write_png(&out.join(&file), w, h, rgb)?;
             strips.push((r.name.as_str(), file));
@@ -163,7 +167,7 @@ impl Compare {
         };
         let title = format!("Compensation methods compared on {}", self.scene.display());
         let md = format!(
-            "# {title}\n\nMisregistration in arc-minutes at the true eye over the display (mean, p95, and the border band of {} display pixels); coverage: fraction of display pixels that show the scene; holes: disocclusions of the depth methods (fill: {:?}); ms/frame: the method's own work (sensor, fit or search, resampling).{hazards}\n\n{table}\n{}",
+            "# {title}\n\nMisregistration in arc-minutes at the true eye over the display (mean, p95, and the border band of {} display pixels); coverage: fraction of display pixels that show the scene; holes: disocclusions of the depth methods (fill: {:?}); ms/frame: the method's own work (sensor, fit or search, resampling); not run because: why a method cannot run on this scene (its row is otherwise empty).{hazards}\n\n{table}\n{}",
             self.band,
             base.scene_model.fill,
             strips

@@ -9,7 +9,12 @@
 use glam::{DAffine3, DMat3, DVec2, DVec3};
 
 use crate::geometry::lens::Lens;
-use crate::geometry::lens_check::LensError;
+use crate::geometry::lens_check::{LensError, MAX_OFF_AXIS};
+
+/// Largest angle between a point's ray and the ray its projection's pixel sees for the
+/// projection to count as inside the lens's domain, radians (1e-7 rad is 0.0003′; Newton's
+/// inverse agrees to ~1e-12 where the map is invertible).
+const DOMAIN_ROUND_TRIP_RAD: f64 = 1e-7;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
@@ -229,6 +234,44 @@ impl Camera {
         ))
     }
 
+    /// [`Camera::project_camera`] where the lens's map can be trusted: `None` behind the
+    /// camera, at [`MAX_OFF_AXIS`] or more off the axis, or where the forward map is not
+    /// inverted by [`Camera::camera_direction`] (past a fold of the distortion, where a
+    /// polynomial lens sends a far-off ray back into the image). The methods that project
+    /// reconstructed 3-D points (ground, plane-fit, depth) call this, so that a point outside
+    /// the lens's domain is a hole, never a wrong pixel. The same as `project_camera`
+    /// without a lens.
+    pub fn project_camera_in_domain(&self, p: DVec3) -> Option<DVec2> {
+        let pixel = self.project_camera(p)?;
+        if self.lens.is_none() {
+            return Some(pixel);
+        }
+        let off_axis = DVec2::new(p.x, p.y).length().atan2(-p.z);
+        if !(pixel.is_finite() && off_axis < MAX_OFF_AXIS) {
+            return None;
+        }
+        // The round trip: the ray the image sees at `pixel` must be `p`'s. Newton's inverse
+        // is exact to ~1e-15 inside the domain; a fold lands on another ray entirely.
+        // atan2(|a × b|, a · b): exact at small angles, where acos loses half the digits.
+        let (back, ray) = (self.camera_direction(pixel).normalize(), p.normalize());
+        let disagreement = back.cross(ray).length().atan2(back.dot(ray));
+        (disagreement < DOMAIN_ROUND_TRIP_RAD).then_some(pixel)
+    }
+
+    /// [`Camera::project_camera_in_domain`] of a world point.
+    pub fn project_point_in_domain(&self, world: DVec3) -> Option<DVec2> {
+        self.project_camera_in_domain(self.world_from_camera.inverse().transform_point3(world))
+    }
+
+    /// [`Camera::project_camera_in_domain`] of a world direction (a point at infinity).
+    pub fn project_direction_in_domain(&self, world_dir: DVec3) -> Option<DVec2> {
+        self.project_camera_in_domain(
+            self.world_from_camera
+                .inverse()
+                .transform_vector3(world_dir),
+        )
+    }
+
     /// Pixel coordinates of a world point; `None` behind the camera. May fall outside the image.
     pub fn project_point(&self, world: DVec3) -> Option<DVec2> {
         self.project_camera(self.world_from_camera.inverse().transform_point3(world))
@@ -322,5 +365,46 @@ mod tests {
         assert_eq!(e, Err(CameraError::DegenerateOrientation));
         let e = Camera::look_at(DVec3::ZERO, DVec3::X, DVec3::Y, 1.6, 10, 10);
         assert!(matches!(e, Err(CameraError::HalfAngleOutOfRange(_))));
+    }
+
+    #[test]
+    fn a_point_past_a_fold_of_the_distortion_is_outside_the_lens_domain() {
+        use crate::geometry::lens::{Distortion, Lens};
+        // Brown k1 = −0.2: the radial map r (1 − 0.2 r²) rises to 0.86 at r = 1.29 and falls
+        // after. The 120 × 80 image (fx = 100) reaches 0.72, inside the rise.
+        let lens = Lens {
+            fx: 100.0,
+            fy: 100.0,
+            cx: 59.5,
+            cy: 39.5,
+            distortion: Distortion::Brown {
+                k1: -0.2,
+                k2: 0.0,
+                k3: 0.0,
+                p1: 0.0,
+                p2: 0.0,
+            },
+        };
+        let camera = Camera::with_lens(DAffine3::IDENTITY, lens, 120, 80).unwrap();
+        // r = 1.9 (62° off the axis) folds back to 0.53: 53 px right of the centre, inside
+        // the image, where the lens sees another ray. Not in the domain.
+        let folded = DVec3::new(1.9, 0.0, -1.0);
+        let wrong = camera.project_camera(folded).unwrap();
+        assert!((wrong.x - 60.0 - 52.9).abs() < 0.1, "{wrong}");
+        assert_eq!(camera.project_camera_in_domain(folded), None);
+        // Inside the rise, the projection itself.
+        let inside = DVec3::new(0.5, -0.3, -1.0);
+        assert_eq!(
+            camera.project_camera_in_domain(inside),
+            camera.project_camera(inside)
+        );
+        // Behind the camera, and without a lens the pinhole's projection bit for bit.
+        assert_eq!(
+            camera.project_camera_in_domain(DVec3::new(0.0, 0.0, 1.0)),
+            None
+        );
+        let pinhole = test_camera();
+        let p = DVec3::new(3.0, -1.0, -9.0);
+        assert_eq!(pinhole.project_point_in_domain(p), pinhole.project_point(p));
     }
 }

@@ -15,7 +15,7 @@ use crate::render::views::View;
 use crate::system::depth_sensor::SensorKind;
 use crate::system::options::{Method, RunOptions, WorkingDistance};
 use crate::system::pipeline::{check_display_seen, driver_camera, run_with_truth};
-use crate::system::scene_model::check_scene_model;
+use crate::system::scene_model::{check_scene_model_options, scene_model_unavailable};
 use crate::util::color::encode_srgb8;
 use crate::util::progress::Progress;
 
@@ -87,11 +87,23 @@ impl Candidate {
 /// One method's row and its strip.
 pub struct Compared {
     pub name: String,
-    /// The row: metrics and cost (see [`compare`]).
+    /// The row: metrics and cost (see [`compare`]), or (the method cannot run on the scene)
+    /// `reason` and no metrics.
     pub row: serde_json::Value,
     /// The strip before its heatmap is coloured: [`coloured_strips`] puts every method's
-    /// strip on one scale.
-    pub strip: StripDraft,
+    /// strip on one scale. `None` for a method that did not run.
+    pub strip: Option<StripDraft>,
+}
+
+impl Compared {
+    /// The row of a method that cannot run on the scene: its name and why, every metric null.
+    pub fn not_run(name: &str, reason: String) -> Self {
+        Compared {
+            name: name.to_string(),
+            row: json!({ "method": name, "reason": reason }),
+            strip: None,
+        }
+    }
 }
 
 /// Runs every candidate at `base` on one scene (the truth rendered once, the same for all)
@@ -109,26 +121,46 @@ pub fn compare(
         spp: base.spp,
         progress: false,
     };
-    // Every method's inputs are checked before anything is rendered.
+    // Every method's flags are checked before anything is rendered (a bad flag fails the
+    // command); a method the scene does not admit (no road for `ground`) gets a row saying so.
+    let mut unavailable = Vec::new();
     for &candidate in candidates {
         let options = candidate.options(base);
+        let mut reason = None;
         if options.method.models_the_scene() {
             let mut scene = scene.clone();
             scene.frontal = options.sized_frontal(scene.frontal)?;
-            check_scene_model(&scene, &options)
+            check_scene_model_options(&scene, &options)
                 .map_err(|e| anyhow::anyhow!("{}: {e:#}", candidate.name()))?;
+            reason = scene_model_unavailable(&scene, options.method);
         }
+        unavailable.push(reason);
     }
     let progress = Progress::new("compare", candidates.len() + 1, base.progress);
     let driver = driver_camera(scene, base)?;
     let (truth, _) = ctx.render(&driver, View::Truth.bit(), settings, "truth");
     progress.advance(1);
     let mut out = Vec::new();
-    for &candidate in candidates {
+    for (&candidate, reason) in candidates.iter().zip(unavailable) {
+        if let Some(reason) = reason {
+            out.push(Compared::not_run(candidate.name(), reason));
+            progress.advance(1);
+            continue;
+        }
         let mut options = candidate.options(base);
         options.progress = false;
-        let result = run_with_truth(ctx, &options, Some(&truth))
-            .and_then(|r| check_display_seen(ctx, &r.occluded).map(|()| r))
+        // A method that fails on this scene's content (a plane fit with no returns where the
+        // display is) gets a row saying why; a display the eye cannot see fails them all.
+        let result = match run_with_truth(ctx, &options, Some(&truth)) {
+            Ok(result) => result,
+            Err(e) if options.method.models_the_scene() => {
+                out.push(Compared::not_run(candidate.name(), format!("{e:#}")));
+                progress.advance(1);
+                continue;
+            }
+            Err(e) => anyhow::bail!("{}: {e:#}", candidate.name()),
+        };
+        check_display_seen(ctx, &result.occluded)
             .map_err(|e| anyhow::anyhow!("{}: {e:#}", candidate.name()))?;
         let frames = result.measured_views();
         let (maps, mut metrics) = measure(ctx, scene, scene.eye(), frames, band);
@@ -145,6 +177,7 @@ pub fn compare(
             // Per `hazard = true` object, as `run`'s hazards.json.
             "hazards": run_hazards_json(ctx, &driver, &result, &maps, hazard_bound_arcmin),
             "method": candidate.name(),
+            "reason": null,
             "misregistration_mean_arcmin": misregistration["mean"],
             "misregistration_p95_arcmin": misregistration["p95"],
             "border_mean_arcmin": metrics["border"]["misregistration_arcmin"]["mean"],
@@ -161,7 +194,12 @@ pub fn compare(
         out.push(Compared {
             name: candidate.name().to_string(),
             row,
-            strip: strip(&maps, &result.truth, &result.seethru, holes.as_deref()),
+            strip: Some(strip(
+                &maps,
+                &result.truth,
+                &result.seethru,
+                holes.as_deref(),
+            )),
         });
         progress.advance(1);
     }
@@ -169,13 +207,18 @@ pub fn compare(
     Ok(out)
 }
 
+/// An RGB8 image: width, height, bytes.
+pub type Rgb8Image = (u32, u32, Vec<u8>);
+
 /// Every row's strip (truth | seethru | misregistration | holes over the display's bounding
 /// box, and the heatmap's colour bar), RGB8 as (width, height, bytes), all on one scale
-/// that none saturates.
-pub fn coloured_strips(rows: &[Compared]) -> Result<Vec<(u32, u32, Vec<u8>)>> {
-    let drafts: Vec<&StripDraft> = rows.iter().map(|r| &r.strip).collect();
+/// that none saturates; `None` for a row that did not run.
+pub fn coloured_strips(rows: &[Compared]) -> Result<Vec<Option<Rgb8Image>>> {
+    let drafts: Vec<&StripDraft> = rows.iter().filter_map(|r| r.strip.as_ref()).collect();
     let top = shared_heat_top(&drafts);
-    drafts.iter().map(|d| finish_strip(d, top)).collect()
+    rows.iter()
+        .map(|r| r.strip.as_ref().map(|d| finish_strip(d, top)).transpose())
+        .collect()
 }
 
 /// A strip before its heatmap panel is coloured: the misregistration of each of that
@@ -295,20 +338,26 @@ pub fn markdown_table(rows: &[Compared]) -> String {
             .cloned()
             .unwrap_or_default()
     };
-    let names: Vec<String> = rows.first().map_or(Vec::new(), |r| {
-        hazards(r)
-            .iter()
-            .map(|h| h["name"].as_str().unwrap_or("?").to_string())
-            .collect()
-    });
+    // The hazard objects are the same in every row that ran.
+    let names: Vec<String> = rows
+        .iter()
+        .find(|r| r.strip.is_some())
+        .map_or(Vec::new(), |r| {
+            hazards(r)
+                .iter()
+                .map(|h| h["name"].as_str().unwrap_or("?").to_string())
+                .collect()
+        });
     let mut s = String::from(
         "| method | mean ′ | p95 ′ | border ′ | coverage | holes | PSNR dB | SSIM | FLIP | ms/frame |",
     );
     for n in &names {
         s += &format!(" {n} visibility | {n} centroid ′ |");
     }
+    s += " not run because |";
     s += "\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|";
     s += &"---:|---:|".repeat(names.len());
+    s += "---|";
     s += "\n";
     for r in rows {
         let v = &r.row;
@@ -325,6 +374,12 @@ pub fn markdown_table(rows: &[Compared]) -> String {
                 g("centroid_error_arcmin", 1)
             );
         }
+        if r.strip.is_none() {
+            extra += &" — | — |".repeat(names.len());
+        }
+        // A `|` in a reason would split its cell.
+        let reason = v["reason"].as_str().unwrap_or("").replace('|', "/");
+        extra += &format!(" {reason} |");
         let f = |key: &str, digits: usize| {
             v[key]
                 .as_f64()

@@ -57,13 +57,14 @@ pub fn compare_maps(
             "ms_per_frame": null,
             "d2_m": null,
             "scene_model": null,
+            "reason": null,
             "external_method": result.report["external_method"],
             "metrics": metrics,
         });
         out.push(Compared {
             name: format!("map_{name}"),
             row,
-            strip: strip(&maps, &result.truth, &result.seethru, None),
+            strip: Some(strip(&maps, &result.truth, &result.seethru, None)),
         });
     }
     Ok(out)

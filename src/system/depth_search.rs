@@ -19,6 +19,10 @@
 //! The background fill takes the farther surface just before the jump on the epipolar line.
 //! A ray that meets nothing up to its vanishing point looks at infinity (sky, or past the
 //! sensor's range: d2 → ∞); one that leaves the sensor's view first shows nothing.
+//!
+//! **Through a lens**: the sensor is a pinhole (`depth_sensor::sensor_camera`), so the walk
+//! is along a straight line; only the point found is carried into the frontal image, through
+//! the frontal camera's lens, and one outside the lens's domain is [`Found::BeyondLens`].
 
 use glam::{DVec2, DVec3};
 
@@ -43,16 +47,20 @@ pub enum Found {
     Hole(DVec2),
     /// The ray leaves the sensor's view before meeting anything.
     Outside,
+    /// The point found is outside the frontal lens's domain
+    /// ([`Camera::project_camera_in_domain`]): behind it, 89° or more off its axis, or past
+    /// a fold of its distortion. A hole with no frontal pixel to fill it from.
+    BeyondLens,
 }
 
 /// The search for one line of sight from `eye` through `on_display` (world).
 pub fn search(map: &DepthMap, frontal: &Camera, eye: DVec3, on_display: DVec3) -> Found {
     let camera = &map.camera;
-    let to_frontal = |p: DVec2| {
-        frontal
-            .project_camera(camera.camera_direction(p))
-            .expect("a sensor pixel is in front of the co-located camera")
-    };
+    // The sensor is a pinhole (its epipolar lines are straight, so the walk below is one
+    // line); the frontal image is read through the frontal camera's own lens.
+    let to_frontal = |p: DVec2| frontal.project_camera_in_domain(camera.camera_direction(p));
+    let seen = |p: DVec2| to_frontal(p).map_or(Found::BeyondLens, Found::Seen);
+    let hole = |p: DVec2| to_frontal(p).map_or(Found::BeyondLens, Found::Hole);
     let camera_from_world = camera.world_from_camera.inverse();
     let origin = camera_from_world.transform_point3(on_display);
     let dir = camera_from_world.transform_vector3(on_display - eye);
@@ -60,7 +68,7 @@ pub fn search(map: &DepthMap, frontal: &Camera, eye: DVec3, on_display: DVec3) -
     if rate <= 1e-12 {
         // The ray does not go deeper: it looks at infinity (or behind the camera).
         return match camera.project_camera(dir) {
-            Some(p) if inside(camera, p) => Found::Seen(to_frontal(p)),
+            Some(p) if inside(camera, p) => seen(p),
             _ => Found::Outside,
         };
     }
@@ -98,16 +106,16 @@ pub fn search(map: &DepthMap, frontal: &Camera, eye: DVec3, on_display: DVec3) -
         // The ray is at or behind the surface of this cell.
         let Some((s_prev, prev_cell, w_prev)) = previous else {
             // Behind a surface from where it enters the view: nothing known in front.
-            return Found::Hole(to_frontal(at(s)));
+            return hole(at(s));
         };
         if prev_cell != cell && w_map > DISCONTINUITY * w_prev {
-            return Found::Hole(to_frontal(at(s_prev)));
+            return hole(at(s_prev));
         }
         let s_hit = (w_map as f64 / w_start).clamp(s, s_prev);
-        return Found::Seen(to_frontal(at(s_hit)));
+        return seen(at(s_hit));
     }
     if s_lo == 0.0 {
-        Found::Seen(to_frontal(far))
+        seen(far)
     } else {
         Found::Outside
     }

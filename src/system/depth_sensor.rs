@@ -2,7 +2,9 @@
 //! methods (`depth`, `plane-fit`) know of the scene's geometry.
 //!
 //! The sensor shares the frontal camera's pose and field of view (a co-located RGB-D pair, as
-//! in Baričević et al.), at its own resolution. `ideal` is the frontal render's own depth;
+//! in Baričević et al.), at its own resolution; it is a pinhole, with a frontal lens the
+//! pinhole of the lens's intrinsics ([`sensor_camera`]). `ideal` is the frontal render's own
+//! depth (ray cast on the pinhole's grid when the frontal camera has a lens);
 //! `tof` and `stereo` are ray cast at their resolution and then degraded as real sensors are:
 //! no return past the range limit (or from the sky), seeded Gaussian noise whose σ grows with
 //! distance — linearly for time of flight, quadratically for stereo (a fixed disparity error)
@@ -155,8 +157,7 @@ impl SensorModel {
 /// it is the quantity the methods interpolate and fit.
 #[derive(Clone, Debug)]
 pub struct DepthMap {
-    /// The sensor as a camera: the frontal camera's pose and field of view at the sensor's
-    /// resolution.
+    /// The sensor as a camera ([`sensor_camera`]): a pinhole at the frontal camera's pose.
     pub camera: Camera,
     pub inverse_depth: Vec<f32>,
     pub model: SensorModel,
@@ -186,6 +187,17 @@ impl DepthMap {
     }
 }
 
+/// The sensor as a camera: the frontal camera's pose, at the sensor's resolution, and a
+/// pinhole: without a lens the frontal camera's own, with one the pinhole of the lens's
+/// intrinsics (its distortion removed). Over a pinhole's image a line of sight is a straight
+/// epipolar line and inverse depth over a plane is affine, which the depth search and the
+/// plane fit rely on; what they find is projected into the frontal image through its lens.
+pub fn sensor_camera(frontal_camera: &Camera, model: &SensorModel) -> Camera {
+    frontal_camera
+        .undistorted()
+        .with_resolution(model.width, model.height)
+}
+
 /// The sensor's depth image of the scene. `frontal` is the frontal render (the ideal
 /// sensor's depth); other sensors are ray cast at their own resolution. Noise is seeded by
 /// `seed` and the pixel index: the same for any thread count.
@@ -196,8 +208,10 @@ pub fn sense(
     model: SensorModel,
     seed: u32,
 ) -> DepthMap {
-    let camera = frontal_camera.with_resolution(model.width, model.height);
-    let depth: Vec<f32> = if model.kind == SensorKind::Ideal {
+    let camera = sensor_camera(frontal_camera, &model);
+    // Without a lens the ideal sensor's pixels are the frontal render's own; with one, its
+    // pinhole grid is not the frontal image's, and is ray cast like the others (exactly).
+    let depth: Vec<f32> = if model.kind == SensorKind::Ideal && frontal_camera.lens.is_none() {
         frontal.camera_z.clone()
     } else {
         let settings = RenderSettings {

@@ -28,39 +28,55 @@ impl Method {
     }
 }
 
-/// Checks the sensor options against the frontal camera, and that `ground` has a road.
+/// Checks the sensor options against the frontal camera, and that the scene admits the
+/// method ([`scene_model_unavailable`]).
 pub fn check_scene_model(scene: &Scene, options: &RunOptions) -> Result<()> {
+    check_scene_model_options(scene, options)?;
+    match scene_model_unavailable(scene, options.method) {
+        Some(reason) => bail!("{reason}"),
+        None => Ok(()),
+    }
+}
+
+/// The checks of the options alone (a bad flag is an error whatever the scene): no ideal
+/// display, and a sensor that fits the frontal camera (`plane-fit`, `depth`).
+pub fn check_scene_model_options(scene: &Scene, options: &RunOptions) -> Result<()> {
     if options.display == DisplayModel::Ideal {
         bail!(
             "--display ideal works with --method none or planar (a crop); ground, plane-fit and depth model the physical display's pixels"
         );
     }
-    // The plane intersections and the epipolar search assume the frontal camera is a pinhole
-    // the compensation knows exactly; a lens or a calibration error is the planar crop's.
-    let method = clap::ValueEnum::to_possible_value(&options.method)
-        .map_or_else(String::new, |v| v.get_name().to_string());
-    if scene.frontal.lens.is_some() {
-        bail!(
-            "--method {method}: the frontal camera has a lens; ground, plane-fit and depth need a pinhole frontal camera (use --method planar with a lens)"
-        );
-    }
-    if !scene.calibration.frontal.is_exact() {
-        bail!(
-            "--method {method}: the [calibration.frontal] is not exact; ground, plane-fit and depth use the true frontal camera (use --method planar to study calibration error)"
-        );
-    }
-    if options.method == Method::Ground {
-        ground_plane(scene)?;
-    } else {
+    if options.method != Method::Ground {
         SensorModel::resolve(&options.scene_model.sensor, &scene.frontal)?;
     }
     Ok(())
 }
 
+/// Why `method` cannot run on `scene` whatever the flags (`None`: it can): `ground` needs a
+/// road, and every scene-model method the true frontal camera. `seethru compare` shows the
+/// reason in the method's row.
+pub fn scene_model_unavailable(scene: &Scene, method: Method) -> Option<String> {
+    // A frontal lens is followed exactly (each reconstructed point is projected through it),
+    // but the reconstruction itself uses the true frontal camera: a calibration error is the
+    // planar crop's to study.
+    let name = clap::ValueEnum::to_possible_value(&method)
+        .map_or_else(String::new, |v| v.get_name().to_string());
+    if !scene.calibration.frontal.is_exact() {
+        return Some(format!(
+            "--method {name}: the [calibration.frontal] is not exact; ground, plane-fit and depth use the true frontal camera (use --method planar to study calibration error)"
+        ));
+    }
+    if method == Method::Ground {
+        return ground_plane(scene).err().map(|e| format!("{e:#}"));
+    }
+    None
+}
+
 /// The display image of a scene-model method, its holes and what it used.
 pub struct SceneModelDisplay {
     pub display: Frame,
-    /// Display pixels (row-major) that are disocclusion holes (`depth` only).
+    /// Display pixels (row-major) that are holes: disocclusions (`depth`), and points
+    /// outside the frontal lens's domain (any of the three).
     pub holes: Vec<bool>,
     /// For `run.json`: the sensor, the plane, the holes.
     pub report: serde_json::Value,
@@ -112,7 +128,9 @@ pub fn scene_model_display(
             Box::new(
                 move |on_display| match plane.frontal_point(eye, on_display, camera) {
                     Some(p) => Found::Seen(p),
-                    None => Found::Outside,
+                    // A pinhole fails only behind itself: nothing to show, as before lenses.
+                    None if camera.lens.is_none() => Found::Outside,
+                    None => Found::BeyondLens,
                 },
             )
         }
@@ -132,7 +150,16 @@ pub fn scene_model_display(
         .par_iter()
         .map(|p| p.map_or(Found::Outside, &found))
         .collect();
-    let holes: Vec<bool> = looks.iter().map(|f| matches!(f, Found::Hole(_))).collect();
+    // A point outside the frontal lens's domain is a hole too (blank, or inpainted), with no
+    // farther surface for the background fill.
+    let holes: Vec<bool> = looks
+        .iter()
+        .map(|f| matches!(f, Found::Hole(_) | Found::BeyondLens))
+        .collect();
+    let beyond_lens = looks
+        .iter()
+        .filter(|f| matches!(f, Found::BeyondLens))
+        .count();
     let mut pixels: Vec<Pixel> = looks
         .par_iter()
         .map(|f| match *f {
@@ -145,12 +172,13 @@ pub fn scene_model_display(
         inpaint(&mut pixels, &holes, dw as usize);
     }
     let hole_count = holes.iter().filter(|&&h| h).count();
-    if method == Method::Depth {
+    if method == Method::Depth || beyond_lens > 0 {
         report.insert(
             "holes".into(),
             json!({
                 "display_pixels": hole_count,
                 "fraction_of_display": hole_count as f64 / holes.len() as f64,
+                "beyond_frontal_lens_display_pixels": beyond_lens,
                 "fill": options.fill,
             }),
         );

@@ -22,15 +22,17 @@ pub struct ScenePlane {
 impl ScenePlane {
     /// Where the frontal camera must look for the display point `on_display` (world) seen
     /// from `eye`: the eye's ray meets the plane beyond the display, or (never meeting it)
-    /// its direction at infinity. Pixel coordinates; `None` behind the camera.
+    /// its direction at infinity. Pixel coordinates through the frontal camera's lens;
+    /// `None` behind the camera or outside its lens's domain
+    /// ([`Camera::project_camera_in_domain`]).
     pub fn frontal_point(&self, eye: DVec3, on_display: DVec3, frontal: &Camera) -> Option<DVec2> {
         let dir = on_display - eye;
         let along = self.normal.dot(dir);
         let t = (self.offset - self.normal.dot(eye)) / along;
         if t.is_finite() && t > 1.0 {
-            frontal.project_point(eye + dir * t)
+            frontal.project_point_in_domain(eye + dir * t)
         } else {
-            frontal.project_direction(dir)
+            frontal.project_direction_in_domain(dir)
         }
     }
 
@@ -222,5 +224,88 @@ mod tests {
         let hit = eye + (down - eye) * ((-1.2 - eye.y) / (down.y - eye.y));
         assert!((p - frontal.project_point(hit).unwrap()).length() < 1e-9);
         assert!((ground.tilt_from_horizontal_deg()).abs() < 1e-9);
+    }
+
+    /// The ground's frontal point through a lens, against its brute-force twin: the ray the
+    /// lens sees at that pixel (pixel → ray, Newton's inverse) cast to the plane meets the eye's
+    /// ray there (or, above the horizon, runs parallel to it). A projection that skipped the
+    /// distortion would miss by many pixels' worth of rays.
+    #[test]
+    fn the_frontal_point_through_a_lens_is_where_the_lens_sees_the_eye_s_ground_point() {
+        use crate::geometry::lens::{Distortion, Lens};
+        let pose = Camera::look_at(
+            DVec3::ZERO,
+            DVec3::new(0.2, -0.1, -1.0),
+            DVec3::Y,
+            0.7,
+            1,
+            1,
+        )
+        .unwrap()
+        .world_from_camera;
+        let fisheye = Lens {
+            fx: 200.0,
+            fy: 200.0,
+            cx: 255.5,
+            cy: 143.5,
+            distortion: Distortion::Fisheye {
+                k1: -0.012,
+                k2: 0.003,
+                k3: -0.0005,
+                k4: 0.0,
+            },
+        };
+        let brown = Lens {
+            fx: 260.0,
+            fy: 255.0,
+            cx: 250.0,
+            cy: 150.0,
+            distortion: Distortion::Brown {
+                k1: -0.1,
+                k2: 0.01,
+                k3: 0.0,
+                p1: 0.001,
+                p2: -0.0005,
+            },
+        };
+        let ground = ScenePlane {
+            normal: DVec3::Y,
+            offset: -1.2,
+        };
+        let eye = DVec3::new(0.3, 0.0, 0.7);
+        for lens in [fisheye, brown] {
+            let frontal = Camera::with_lens(pose, lens, 512, 288).unwrap();
+            let mut checked = [0, 0];
+            for i in 0..15 {
+                for j in 0..15 {
+                    // A display 0.8 m ahead of the eye, 0.6 × 0.6 m: rays below and above
+                    // the horizon.
+                    let on_display =
+                        DVec3::new(-0.3 + 0.04 * i as f64, -0.3 + 0.04 * j as f64, -0.1);
+                    let Some(pixel) = ground.frontal_point(eye, on_display, &frontal) else {
+                        continue;
+                    };
+                    let (origin, dir) = frontal.world_ray(pixel);
+                    let sight = (on_display - eye).normalize();
+                    let t_eye = (ground.offset - eye.y) / sight.y;
+                    if sight.y < 0.0 && t_eye > (on_display - eye).length() {
+                        let hit = eye + sight * t_eye;
+                        let t = (ground.offset - origin.y) / dir.y;
+                        let error = (origin + dir * t - hit).length() / hit.length();
+                        assert!(error < 1e-9, "{lens:?} {on_display}: {error}");
+                        checked[0] += 1;
+                    } else {
+                        // |a × b| for unit vectors: exact at small angles (acos loses half the digits).
+                        let angle = dir.cross(sight).length();
+                        assert!(
+                            dir.dot(sight) > 0.0 && angle < 1e-9,
+                            "{lens:?} {on_display}: {angle}"
+                        );
+                        checked[1] += 1;
+                    }
+                }
+            }
+            assert!(checked[0] > 50 && checked[1] > 10, "{checked:?}");
+        }
     }
 }
