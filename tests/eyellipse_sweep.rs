@@ -106,7 +106,10 @@ fn each_driver_is_a_row_and_the_share_is_recounted_from_them() {
         .collect();
     let merged = dir.path().join("merged.csv");
     let paths: Vec<&std::path::Path> = parts.iter().map(|p| p.as_path()).collect();
-    assert_eq!(merge_parts_with_bound(&paths, &merged, Some(bound)).unwrap(), 6);
+    assert_eq!(
+        merge_parts_with_bound(&paths, &merged, Some(bound)).unwrap(),
+        6
+    );
     assert_eq!(std::fs::read_to_string(&merged).unwrap(), text);
     let merged_shares: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(dir.path().join("merged_drivers.json")).unwrap(),

@@ -656,7 +656,7 @@ fn sequence_estimates_its_memory_first_and_messages_name_the_form_and_the_file()
         dir.path(),
         &["export", "scene.toml", "--out", "/proc/x.obj"],
         1,
-        &["cannot write the output /proc/x.obj"],
+        &["--out /proc/x.obj", "cannot write into /proc"],
     );
 }
 
