@@ -522,11 +522,41 @@ fn every_command_on_every_bundled_scene_exits_cleanly_or_with_one_error_line() {
     ));
     groups.push(once(
         "ratio occlusion",
-        words(&["ratio", "occlusion", "--quiet"]),
+        words(&[
+            "ratio",
+            "occlusion",
+            "--L",
+            "5",
+            "--b1",
+            "-0.35",
+            "--d2",
+            "6.3",
+            "--d1",
+            "2.5",
+            "--bh",
+            "1.75",
+            "--quiet",
+        ]),
     ));
     groups.push(once(
         "ratio foreshortening",
-        words(&["ratio", "foreshortening", "--quiet"]),
+        words(&[
+            "ratio",
+            "foreshortening",
+            "--l",
+            "5",
+            "--b1",
+            "-1.5",
+            "--d2",
+            "1.3",
+            "--d1",
+            "2",
+            "--bh",
+            "0.7",
+            "--gamma",
+            "90",
+            "--quiet",
+        ]),
     ));
     groups.push(once(
         "check",
