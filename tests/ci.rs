@@ -244,6 +244,75 @@ fn bad_inputs_exit_2_with_one_line_each() {
     assert_eq!(code, 1);
 }
 
+/// Each flag of `diff` and `check`, given a value outside its range or form, is refused
+/// before any work, in one line naming the flag (or the file) and what it accepts.
+#[test]
+fn each_flag_of_diff_and_check_refuses_a_bad_value_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    pattern().save(dir.path().join("a.png")).unwrap();
+    let scene = common::repo_path("scenes/das.toml");
+    std::fs::write(
+        dir.path().join("e.toml"),
+        format!(
+            "[[case]]\nname = \"a\"\nscene = {:?}\ncommand = \"run\"\noptions = [\"--width\", \"8\"]\nexpect = [\"coverage >= 0\"]\n",
+            scene.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let diff = ["diff", "a.png", "a.png"];
+    let cases: Vec<(Vec<&str>, &[&str])> = vec![
+        (vec!["--ppd", "0"], &["--ppd", "[1, 1000]"]),
+        (vec!["--ppd", "1001"], &["--ppd", "[1, 1000]"]),
+        (vec!["--ppd", "nan"], &["--ppd", "[1, 1000]"]),
+        (vec!["--max", "flip_mean"], &["--max", "NAME=VALUE"]),
+        (
+            vec!["--max", "flip_mean=x"],
+            &["--max", "not a finite number"],
+        ),
+        (
+            vec!["--min", "psnr_db=inf"],
+            &["--min", "not a finite number"],
+        ),
+        (vec!["--min", "=1"], &["--min", "unknown metric", "psnr_db"]),
+        (vec!["--layer", "nope"], &["no layer `nope`", "colour"]),
+        (
+            vec!["--tolerance", "coverage=-1"],
+            &["--tolerance", "[0, 1000000000]"],
+        ),
+        (
+            vec!["--tolerance", "x=1"],
+            &["--tolerance", "unknown metric `x`"],
+        ),
+        (vec!["--out", "a.png"], &["--out a.png"]),
+    ];
+    for (flags, words) in cases {
+        let args: Vec<&str> = diff.iter().copied().chain(flags).collect();
+        let (code, out, err) = run(dir.path(), &args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(out.is_empty(), "{args:?}: {out}");
+        assert_one_error_line(&err, words);
+    }
+    let check: [(&[&str], &[&str]); 4] = [
+        (
+            &["check", "e.toml", "--case", "nope"],
+            &["--case nope", "cases: a"],
+        ),
+        (
+            &["check", "e.toml", "--junit", "e.toml"],
+            &["--junit e.toml", "input"],
+        ),
+        (&["check", "e.toml", "--out", "e.toml"], &["--out e.toml"]),
+        (&["check", "none.toml"], &["none.toml"]),
+    ];
+    for (args, words) in check {
+        let (code, _, err) = run(dir.path(), args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert_one_error_line(&err, words);
+    }
+    // Nothing ran: no case folder, no report.
+    assert!(!dir.path().join("seethru-check").exists());
+}
+
 /// The mean misregistration of das at the test's size, from a `seethru run`.
 fn measured_das(dir: &Path) -> serde_json::Value {
     let scene = common::repo_path("scenes/das.toml");

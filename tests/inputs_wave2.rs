@@ -1199,3 +1199,47 @@ fn the_sweeps_eyellipse_flags_are_read_refused_and_take_spaced_values() {
     assert!(!dir.path().join("no.csv").exists());
     assert!(!dir.path().join("no_drivers.json").exists());
 }
+
+/// A capture folder whose record was edited (a flag that is no string, no working folder) is
+/// refused by `score` in one line naming the file and the key, before anything is captured
+/// again; the untouched folder scores.
+#[test]
+fn score_refuses_an_edited_capture_record_by_file_and_key() {
+    let dir = common::refusal::scratch("", &[]);
+    let inputs = score_inputs(dir.path());
+    let command_file = dir.path().join(&inputs).join("truth/capture_command.json");
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&command_file).unwrap()).unwrap();
+    let score = |out: &str| {
+        run_in(
+            dir.path(),
+            &["score", &inputs, "--map", "map.npy", "--out", out],
+        )
+    };
+    let (code, err) = score("s");
+    assert_eq!(code, 0, "{err}");
+    let mut flag_not_a_string = record.clone();
+    flag_not_a_string["args"][1] = 16.into();
+    let mut no_cwd = record.clone();
+    no_cwd.as_object_mut().unwrap().remove("cwd");
+    for (edited, words) in [
+        (
+            flag_not_a_string,
+            ["capture_command.json", "args[1] must be a string"],
+        ),
+        (no_cwd, ["capture_command.json", "no key cwd"]),
+    ] {
+        std::fs::write(&command_file, edited.to_string()).unwrap();
+        let (code, err) = score("s2");
+        assert_ne!(code, 0);
+        let err = err.trim_end();
+        assert!(
+            err.lines().count() == 1 && err.starts_with("error: "),
+            "{err}"
+        );
+        for w in words {
+            assert!(err.contains(w), "`{w}` not in {err}");
+        }
+        assert!(!dir.path().join("s2").exists());
+    }
+}

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Result, bail};
 use exr::prelude::{AnyChannel, FlatSamples};
 use seethru::io::atomic::write_text;
+use seethru::io::capture_folder::{COMMAND_FILE, MANIFEST_FILE, command_json};
 use seethru::io::display_map::write_npy_f32;
 use seethru::io::frame_files::{ExrContent, write_color_png, write_exr_channels, write_view_exr};
 use seethru::io::output_paths::{Input, Output, check_paths};
@@ -28,9 +29,6 @@ use crate::cli::args::{
 };
 use crate::cli::run_eyes::EyesFlag;
 use crate::cli::scene_model_args::SceneModelArgs;
-
-/// The name of the file in `truth/` that lets `score` capture again.
-pub const COMMAND_FILE: &str = "capture_command.json";
 
 /// The capture's flags parsed alone (what `score` reads back from `truth/`).
 #[derive(clap::Parser)]
@@ -197,11 +195,7 @@ impl CaptureArgs {
             .filter(|a| a != "--quiet")
             .map(|a| a.to_string_lossy().into_owned())
             .collect();
-        Ok(json!({
-            "cwd": std::env::current_dir()?.display().to_string(),
-            "args": args,
-            "note": "seethru score parses these flags again (relative paths from cwd) and captures again, checking the fingerprint",
-        }))
+        Ok(command_json(&std::env::current_dir()?, &args))
     }
 }
 
@@ -289,7 +283,7 @@ pub fn write_capture(
     )?;
     // Last: a folder with capture.json holds a finished capture.
     write_text(
-        &out.join("capture.json"),
+        &out.join(MANIFEST_FILE),
         &serde_json::to_string_pretty(&json!({
             "fingerprint": c.fingerprint,
             "display_resolution_px": [c.calibration["display"]["resolution_px"][0], c.calibration["display"]["resolution_px"][1]],

@@ -3,15 +3,15 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::Parser;
 use glam::Vec3;
 use rayon::prelude::*;
 use seethru::io::atomic::write_text;
+use seethru::io::capture_folder::{command_path, read_capture_record};
 use seethru::io::display_map::{read_display_image, read_map};
 use seethru::io::frame_files::{ExrContent, write_frame_like};
 use seethru::io::output_paths::{Input, Output, check_paths};
-use seethru::io::run_dir::MAX_RUN_JSON_BYTES;
 use seethru::io::staged::StagedDir;
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
@@ -22,7 +22,7 @@ use seethru::system::display::Filter;
 use seethru::system::options::RunOptions;
 
 use crate::cli::args::{band, choice, threads};
-use crate::cli::capture::{COMMAND_FILE, CaptureCommand};
+use crate::cli::capture::CaptureCommand;
 
 #[derive(clap::Args)]
 pub struct Score {
@@ -66,39 +66,17 @@ pub struct Recaptured {
 /// Reads `inputs/capture.json` and `inputs/truth/capture_command.json`, captures again and
 /// checks that the result is the folder's capture.
 pub fn recapture(inputs: &Path) -> Result<Recaptured> {
-    let read_json = |path: PathBuf| -> Result<serde_json::Value> {
-        // A capture's JSON is small; a FIFO or a device in its place would block the read.
-        let text = seethru::util::input_file::read_input_text(&path, MAX_RUN_JSON_BYTES)
-            .with_context(|| {
-                format!(
-                    "cannot read {} (is {} a folder written by seethru capture?)",
-                    path.display(),
-                    inputs.display()
-                )
-            })?;
-        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))
-    };
-    let manifest = read_json(inputs.join("capture.json"))?;
-    let command = read_json(inputs.join("truth").join(COMMAND_FILE))?;
-    let fingerprint = manifest["fingerprint"]
-        .as_str()
-        .with_context(|| format!("{}: no fingerprint", inputs.join("capture.json").display()))?
-        .to_string();
-    let cwd = PathBuf::from(command["cwd"].as_str().unwrap_or("."));
+    let record = read_capture_record(inputs)?;
+    let fingerprint = record.fingerprint;
+    let cwd = record.cwd;
     let argv: Vec<std::ffi::OsString> = std::iter::once("seethru capture".into())
-        .chain(
-            command["args"]
-                .as_array()
-                .into_iter()
-                .flatten()
-                .filter_map(|a| a.as_str().map(Into::into)),
-        )
+        .chain(record.args.into_iter().map(Into::into))
         .collect();
     let mut args = CaptureCommand::try_parse_from(crate::cli::with_negative_values_joined(argv))
         .map_err(|e| {
             anyhow::anyhow!(
                 "{}: the capture's flags do not parse: {}",
-                inputs.join("truth").join(COMMAND_FILE).display(),
+                command_path(inputs).display(),
                 crate::cli::one_line(&e).trim_start_matches("error: ")
             )
         })?

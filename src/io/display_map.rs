@@ -88,7 +88,7 @@ fn sidecar_fingerprint(path: &Path) -> Result<Option<String>> {
 
 /// A stated capture fingerprint, refused unless it is one (16 hex digits, as
 /// `capture::fingerprint` writes them): it is echoed in the messages of a mismatch.
-fn fingerprint_text(text: &str) -> Result<String> {
+pub fn fingerprint_text(text: &str) -> Result<String> {
     if text.len() == 16 && text.bytes().all(|b| b.is_ascii_hexdigit()) {
         Ok(text.to_string())
     } else {

@@ -4,6 +4,7 @@
 pub mod animation;
 pub mod atomic;
 pub mod caption;
+pub mod capture_folder;
 pub mod colour_bar;
 pub mod display_map;
 pub mod export;
