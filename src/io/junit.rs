@@ -125,6 +125,11 @@ mod tests {
             escape("a<b & \"c\" 'd'>\u{1}"),
             "a&lt;b &amp; &quot;c&quot; &apos;d&apos;&gt;\\u{1}"
         );
+        // XML 1.0 has no U+FFFE nor U+FFFF, nor control characters but tab and line breaks.
+        assert_eq!(
+            escape("\u{fffe}\u{ffff}\u{1f}\t\n"),
+            "\\u{fffe}\\u{ffff}\\u{1f}\t\n"
+        );
     }
 
     #[test]
