@@ -22,7 +22,7 @@ use crate::borrowed::{CaptureBuffers, read_only_view};
 use crate::errors::{bad_value, to_py};
 use crate::frame::PyFrame;
 use crate::interrupt::detached;
-use crate::options::{choice_of, int_in, run_choices};
+use crate::options::{Caller, choice_of, int_in, run_choices};
 use crate::run::{PyRun, json_to_py, measured};
 use crate::scene::{PyScene, context_for};
 
@@ -73,7 +73,7 @@ pub fn capture(
     depth: bool,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PyCapture> {
-    let choices = run_choices(options)?;
+    let choices = run_choices(options, Caller::Capture { depth })?;
     let (the_scene, cached) = {
         let s = scene.borrow();
         (s.scene.clone(), s.context.clone())

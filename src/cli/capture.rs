@@ -18,14 +18,14 @@ use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::scene::lens_keys::read_calibration_file;
 use seethru::system::capture::{Capture, capture};
-use seethru::system::depth_sensor::SensorKind;
 use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
 use seethru::system::memory::{check_memory, run_estimate};
 use seethru::system::options::{HeadSource, RunOptions};
+use seethru::system::reads::capture_reads;
 use serde_json::json;
 
 use crate::cli::args::{
-    HeadErrorArgs, ReadWhen, RenderArgs, choice, pixels, positive, refuse_ignored, with_threads,
+    HeadErrorArgs, RenderArgs, choice, pixels, positive, refuse_ignored, with_threads,
 };
 use crate::cli::run_eyes::EyesFlag;
 use crate::cli::scene_model_args::SceneModelArgs;
@@ -96,31 +96,7 @@ impl CaptureArgs {
         if self.eyes == EyesFlag::Both {
             bail!("--eyes both: a capture is for one eye (mono, left or right)");
         }
-        if self.scene_model.fill != seethru::system::scene_model::Fill::None {
-            bail!("--fill is the built-in depth method's; a capture has no holes to fill");
-        }
-        // Depth flags without --depth would be ignored: refused.
-        if !self.depth {
-            self.scene_model
-                .check_used_by(seethru::system::options::Method::Planar)
-                .map_err(|e| anyhow::anyhow!("{e} (capture: add --depth)"))?;
-        }
-        let noisy_depth = self.depth && self.scene_model.depth_sensor != SensorKind::Ideal;
-        let mut rules = self.head_errors.rules(true, self.head, noisy_depth);
-        rules.extend([
-            ReadWhen {
-                flag: "--require-confident-head",
-                read: self.head == HeadSource::Estimated,
-                when: "with --head estimated (only the face detector's estimate has a confidence)",
-            },
-            ReadWhen {
-                flag: "--ipd",
-                read: self.eyes != EyesFlag::Mono || self.target_eye != Eye::Cyclopean,
-                when: "with --eyes left or right, or --target-eye left or right",
-            },
-        ]);
-        refuse_ignored(&rules)?;
-        Ok(RunOptions {
+        let options = RunOptions {
             head: self.head,
             head_bias_cm: self.head_errors.head_bias_cm,
             head_jitter_cm: self.head_errors.head_jitter_cm,
@@ -140,7 +116,9 @@ impl CaptureArgs {
             scene_model: self.scene_model.options(),
             progress: true,
             ..RunOptions::default()
-        })
+        };
+        refuse_ignored(&capture_reads(&options, self.depth))?;
+        Ok(options)
     }
 
     /// The scene with the capture's calibration file, if any.
