@@ -1,5 +1,4 @@
-//! Wave 2's inputs held to wave 1's standard: spaces around every choice value are ignored,
-//! and every flag of `run`, `sequence` and `compare` either changes the output or is refused
+//! Every flag is read or refused: spaces around every choice value are ignored, and every flag of `run`, `sequence` and `compare` either changes the output or is refused
 //! where the other flags make the command ignore it. Both walk the commands' own `--help`,
 //! so a flag added later is checked too.
 
