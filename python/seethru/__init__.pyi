@@ -174,11 +174,18 @@ class Capture:
     fingerprint: str
     display_resolution: tuple[int, int]
     """(width, height) display pixels: a map is (height, width, 2)."""
+    def save(self, path: str | PathLike[str], exr: Literal["all", "lean", "colour", "none"] = "all") -> None:
+        """Writes the folder `seethru capture --exr EXR` writes, which `seethru score` reads;
+        refused for a scene changed in memory (the folder names its scene file)."""
 
 def capture(scene: Scene, depth: bool = False, **options: Any) -> Capture:
     """`seethru capture` in memory, with its flags as keywords: head, head_bias_cm,
     head_jitter_cm, seed, feature_width, require_confident_head, frontal_width, back_width,
     eyes, ipd, target_eye, depth_* (with depth=True), width, height, spp, max_memory."""
+
+def load_capture(path: str | PathLike[str]) -> Capture:
+    """A folder written by `seethru capture` or `Capture.save`, captured again from its
+    `truth/capture_spec.json` and checked against its fingerprint, as `seethru score` reads it."""
 
 def score(
     capture: Capture,
