@@ -10,7 +10,7 @@ Errors raise :class:`ValueError` (bad input: a scene key, an option's range) or
 :class:`OSError` (a file that cannot be read) with the command line's one-line message.
 """
 
-from ._native import Capture, Frame, Run, Scene, __version__, analyze, capture, compare, frame_pool, ratio, read_frame
+from ._native import Capture, Frame, Run, Scene, __version__, analyze, capture, compare, frame_pool, load_capture, ratio, read_frame
 from ._native import run as _run
 from ._native import score as _score
 from ._native import Sequence, Step
@@ -19,7 +19,7 @@ from ._native import sequence as _sequence
 import numpy as _np
 
 __all__ = [
-    "Capture", "Frame", "Run", "Scene", "analyze", "capture", "compare", "frame_pool", "ratio", "read_frame", "run",
+    "Capture", "Frame", "Run", "Scene", "analyze", "capture", "compare", "frame_pool", "load_capture", "ratio", "read_frame", "run",
     "score", "sequence", "Sequence", "Step", "__version__",
 ]
 

@@ -88,6 +88,8 @@ class Run:
     """metrics.json's content."""
     report: dict[str, Any]
     """run.json's content."""
+    hazards: dict[str, Any] | None
+    """hazards.json's content (`seethru.run`); None for a score."""
     misregistration: npt.NDArray[np.float32]
     """Arcmin per driver-view pixel, NaN outside the display and on blank pixels; (h, w)."""
     missing: npt.NDArray[np.bool_]
@@ -98,11 +100,12 @@ def run(
     *,
     method: Literal["none", "planar", "ground", "plane-fit", "depth"] = "planar",
     d2: float | str = "inf",
-    head: Literal["oracle", "estimated"] = "oracle",
+    head: Literal["oracle", "estimated", "model"] = "oracle",
     head_bias_cm: tuple[float, float, float] = (0.0, 0.0, 0.0),
     head_jitter_cm: float = 0.0,
     seed: int = 1,
     feature_width: float = 0.064,
+    require_confident_head: bool = False,
     outside: Literal["error", "black"] = "error",
     filter: str = "bilinear",
     display: Literal["pixels", "ideal"] = "pixels",
@@ -112,6 +115,7 @@ def run(
     ipd: float = 0.064,
     target_eye: Literal["cyclopean", "left", "right"] = "cyclopean",
     band: int = 5,
+    hazard_bound_arcmin: float = 30.0,
     depth_sensor: Literal["ideal", "tof", "stereo"] = "ideal",
     depth_resolution: int | None = None,
     depth_range: float | None = None,
@@ -141,7 +145,8 @@ def compare(
 
     methods: none, planar-inf, planar-auto, plane-fit, ground, depth-ideal, depth-tof,
     depth-stereo (default: compare's six). Options: head, seed, frontal_width, back_width,
-    band, depth_*, fill, width, height, spp, max_memory. A method the scene does not admit
+    band, hazard_bound_arcmin, depth_*, fill, width, height, spp, max_memory, each refused
+    where no listed method reads it (as on the command line). A method the scene does not admit
     (ground without a road) has a row whose "reason" says why, and no strip.
     """
 
@@ -169,9 +174,18 @@ class Capture:
     fingerprint: str
     display_resolution: tuple[int, int]
     """(width, height) display pixels: a map is (height, width, 2)."""
+    def save(self, path: str | PathLike[str], exr: Literal["all", "lean", "colour", "none"] = "all") -> None:
+        """Writes the folder `seethru capture --exr EXR` writes, which `seethru score` reads;
+        refused for a scene changed in memory (the folder names its scene file)."""
 
 def capture(scene: Scene, depth: bool = False, **options: Any) -> Capture:
-    """`seethru capture` in memory, with `seethru run`'s keywords."""
+    """`seethru capture` in memory, with its flags as keywords: head, head_bias_cm,
+    head_jitter_cm, seed, feature_width, require_confident_head, frontal_width, back_width,
+    eyes, ipd, target_eye, depth_* (with depth=True), width, height, spp, max_memory."""
+
+def load_capture(path: str | PathLike[str]) -> Capture:
+    """A folder written by `seethru capture` or `Capture.save`, captured again from its
+    `truth/capture_spec.json` and checked against its fingerprint, as `seethru score` reads it."""
 
 def score(
     capture: Capture,

@@ -3,6 +3,7 @@
 //! tracker's output and the calibration as dicts); a score shows a method's display map
 //! and/or image on the display and measures it exactly as `seethru score` does.
 
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use glam::Vec3;
@@ -10,7 +11,12 @@ use numpy::ndarray::ArrayView2;
 use numpy::{PyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use seethru::io::frame_files::ExrContent;
+use seethru::io::output_paths::{Output, check_paths};
+use seethru::io::staged::StagedDir;
+use seethru::measure::capture_files::{capture_spec, recapture, write_scoreable_capture};
 use seethru::render::integrator::RenderContext;
+use seethru::scene::Scene;
 use seethru::system::capture::{
     Capture, DisplayImage, DisplayMap, capture as capture_views, score as score_display,
 };
@@ -22,7 +28,7 @@ use crate::borrowed::{CaptureBuffers, read_only_view};
 use crate::errors::{bad_value, to_py};
 use crate::frame::PyFrame;
 use crate::interrupt::detached;
-use crate::options::{choice_of, int_in, run_choices};
+use crate::options::{Caller, choice_of, int_in, run_choices};
 use crate::run::{PyRun, json_to_py, measured};
 use crate::scene::{PyScene, context_for};
 
@@ -62,6 +68,34 @@ impl PyCapture {
     fn __repr__(&self) -> String {
         format!("<seethru.Capture {}>", self.fingerprint)
     }
+
+    /// Writes the capture folder `seethru capture` writes (`exr` as its `--exr`), which
+    /// `seethru score` and `seethru.load_capture` read. The scene must be its file's: a scene
+    /// changed in memory has no file to capture again from.
+    #[pyo3(signature = (path, exr="all"))]
+    fn save(&self, py: Python<'_>, path: PathBuf, exr: &str) -> PyResult<()> {
+        let exr: ExrContent = choice_of("exr", exr)?;
+        let (captured, context, options) = (
+            self.inner.clone(),
+            self.context.clone(),
+            self.options.clone(),
+        );
+        detached(py, move || -> anyhow::Result<()> {
+            check_paths(&[], &[Output::folder("path", &path)])?;
+            let scene = &context.scene;
+            if Scene::load(&scene.path)? != *scene {
+                anyhow::bail!(
+                    "the capture's scene was changed in memory since it was read from {}: a capture folder names a scene file that makes it again (write the changes to a scene file and capture from it)",
+                    scene.path.display()
+                );
+            }
+            let spec = capture_spec(&scene.path, None, captured.depth.is_some(), &options)?;
+            let staged = StagedDir::new(&path)?;
+            write_scoreable_capture(staged.path(), &captured, &spec, exr)?;
+            staged.commit()
+        })?
+        .map_err(to_py)
+    }
 }
 
 /// Renders what the system receives under `seethru run`'s options (`seethru capture`).
@@ -73,7 +107,7 @@ pub fn capture(
     depth: bool,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PyCapture> {
-    let choices = run_choices(options)?;
+    let choices = run_choices(options, Caller::Capture { depth })?;
     let (the_scene, cached) = {
         let s = scene.borrow();
         (s.scene.clone(), s.context.clone())
@@ -88,6 +122,24 @@ pub fn capture(
     })?
     .map_err(to_py)?;
     scene.borrow_mut().context = Some(context.clone());
+    py_capture(py, context, options, captured)
+}
+
+/// A capture folder written by `seethru capture` (or `Capture.save`), captured again from its
+/// specification and checked against its fingerprint, as `seethru score` reads it.
+#[pyfunction]
+pub fn load_capture(py: Python<'_>, path: PathBuf) -> PyResult<PyCapture> {
+    let again = detached(py, move || recapture(&path))?.map_err(to_py)?;
+    py_capture(py, Arc::new(again.ctx), again.options, again.capture)
+}
+
+/// The Python object of a capture made under `options` in `context`.
+fn py_capture(
+    py: Python<'_>,
+    context: Arc<RenderContext>,
+    options: RunOptions,
+    captured: Capture,
+) -> PyResult<PyCapture> {
     // The capture is kept whole for `score`: numpy views its images, read-only, no copy.
     let captured = Arc::new(captured);
     let owner = Bound::new(

@@ -1,13 +1,16 @@
 //! The library's errors as Python exceptions: `OSError` when a file could not be read or
-//! written, `ValueError` for everything else (bad input), with the command line's message.
+//! written, `ValueError` for everything else (bad input), with the command line's message in
+//! Python's words: a flag the message names (`--head estimated`) is the keyword
+//! (`head estimated`).
 
 use pyo3::PyErr;
 use pyo3::exceptions::{PyOSError, PyValueError};
+use seethru::system::reads::keyword_names;
 use seethru::util::message::{error_text, printable};
 
 /// The one line the command line prints after `error: `, as an exception.
 pub fn to_py(error: anyhow::Error) -> PyErr {
-    let message = printable(&error_text(&error));
+    let message = keyword_names(&printable(&error_text(&error)));
     let from_file = error
         .chain()
         .any(|cause| cause.downcast_ref::<std::io::Error>().is_some());

@@ -30,6 +30,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(frame_pool::frame_pool, m)?)?;
     m.add_function(wrap_pyfunction!(capture::capture, m)?)?;
     m.add_function(wrap_pyfunction!(capture::score, m)?)?;
+    m.add_function(wrap_pyfunction!(capture::load_capture, m)?)?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
     m.add_class::<sequence::PySequence>()?;
     m.add_class::<sequence::PyStep>()?;

@@ -9,7 +9,6 @@ use seethru::analysis::dynamic::error_budget;
 use seethru::analysis::examples::das_geometry;
 use seethru::analysis::paper::{ForeshorteningParams, OcclusionParams};
 use seethru::measure::compare::{Candidate, coloured_strips, compare as compare_methods};
-use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
 use seethru::measure::ratio::measure_ratio;
 use seethru::measure::ratio_setup::{Compensation, Setup};
 use seethru::paper::claims::{AnalyzeParams, evaluate, lens_and_eyes, paper_claims};
@@ -20,27 +19,9 @@ use seethru::system::options::Outside;
 
 use crate::errors::{bad_value, to_py};
 use crate::interrupt::detached;
-use crate::options::{choice_of, run_choices};
+use crate::options::{Caller, choice_of, run_choices};
 use crate::run::json_to_py;
 use crate::scene::{PyScene, context_for};
-
-/// The options of `seethru compare` (the rest of `seethru run`'s are not its).
-const COMPARE_KEYS: [&str; 14] = [
-    "head",
-    "seed",
-    "frontal_width",
-    "back_width",
-    "band",
-    "depth_sensor",
-    "depth_resolution",
-    "depth_range",
-    "depth_noise",
-    "depth_quantum",
-    "fill",
-    "width",
-    "height",
-    "spp",
-];
 
 /// `seethru compare`: methods side by side, `{"rows": [...], "strips": {name: array}}`.
 #[pyfunction]
@@ -51,17 +32,6 @@ pub fn compare<'py>(
     methods: Option<Vec<String>>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if let Some(options) = options {
-        for key in options.keys() {
-            let key: String = key.extract()?;
-            if !COMPARE_KEYS.contains(&key.as_str()) && key != "max_memory" {
-                return Err(bad_value(format!(
-                    "unknown option {key:?}: the options are methods, {}, max_memory",
-                    COMPARE_KEYS.join(", ")
-                )));
-            }
-        }
-    }
     let names = methods.unwrap_or_else(|| {
         [
             "planar-inf",
@@ -78,7 +48,12 @@ pub fn compare<'py>(
         .iter()
         .map(|m| choice_of::<Candidate>("methods", m))
         .collect::<PyResult<Vec<_>>>()?;
-    let mut choices = run_choices(options)?;
+    let mut choices = run_choices(
+        options,
+        Caller::Compare {
+            candidates: &candidates,
+        },
+    )?;
     // As `seethru compare`: a crop past the frontal view is black and counted.
     choices.options.outside = Outside::Black;
     let (the_scene, cached) = {
@@ -94,7 +69,7 @@ pub fn compare<'py>(
             &candidates,
             &choices.options,
             choices.band,
-            DEFAULT_BOUND_ARCMIN,
+            choices.hazard_bound_arcmin,
         )?;
         Ok((ctx, rows))
     })?

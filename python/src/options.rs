@@ -4,6 +4,8 @@
 use clap::ValueEnum;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use seethru::measure::compare::{Candidate, compare_reads};
+use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
 use seethru::render::settings::MAX_SPP;
 use seethru::scene::source::MAX_RESOLUTION;
 use seethru::system::depth_sensor::{SensorKind, SensorOptions};
@@ -11,8 +13,9 @@ use seethru::system::display::{DisplayModel, Filter};
 use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
 use seethru::system::memory::DEFAULT_MAX_MEMORY_GIB;
 use seethru::system::options::{
-    HeadSource, MAX_HEAD_BIAS_CM, Method, Outside, RunOptions, WorkingDistance,
+    HeadSource, MAX_HEAD_BIAS_CM, Outside, RunOptions, WorkingDistance,
 };
+use seethru::system::reads::{ReadWhen, capture_reads, first_ignored, run_reads};
 use seethru::system::scene_model::{Fill, SceneModelOptions};
 
 use crate::errors::bad_value;
@@ -77,8 +80,9 @@ pub fn working_distance(key: &str, value: &Bound<'_, PyAny>) -> PyResult<Working
     }
 }
 
-/// The keywords `seethru.run` accepts, in `seethru run`'s order.
-pub const RUN_KEYS: [&str; 25] = [
+/// The keywords `seethru.run` accepts, in `seethru run`'s order (its flags less those that
+/// name files, threads or progress).
+pub const RUN_KEYS: [&str; 27] = [
     "method",
     "d2",
     "head",
@@ -86,6 +90,7 @@ pub const RUN_KEYS: [&str; 25] = [
     "head_jitter_cm",
     "seed",
     "feature_width",
+    "require_confident_head",
     "outside",
     "filter",
     "display",
@@ -95,6 +100,7 @@ pub const RUN_KEYS: [&str; 25] = [
     "ipd",
     "target_eye",
     "band",
+    "hazard_bound_arcmin",
     "depth_sensor",
     "depth_resolution",
     "depth_range",
@@ -106,36 +112,109 @@ pub const RUN_KEYS: [&str; 25] = [
     "spp",
 ];
 
-/// The depth sensor's settings: read by plane-fit and depth only.
-const DEPTH_SETTINGS: [&str; 4] = [
+/// The keywords `seethru.capture` accepts besides `depth`, in `seethru capture`'s order.
+pub const CAPTURE_KEYS: [&str; 20] = [
+    "head",
+    "head_bias_cm",
+    "head_jitter_cm",
+    "seed",
+    "feature_width",
+    "require_confident_head",
+    "frontal_width",
+    "back_width",
+    "eyes",
+    "ipd",
+    "target_eye",
+    "depth_sensor",
     "depth_resolution",
     "depth_range",
     "depth_noise",
     "depth_quantum",
+    "fill",
+    "width",
+    "height",
+    "spp",
 ];
+
+/// The keywords `seethru.compare` accepts besides `methods`, in `seethru compare`'s order.
+pub const COMPARE_KEYS: [&str; 15] = [
+    "head",
+    "seed",
+    "frontal_width",
+    "back_width",
+    "band",
+    "hazard_bound_arcmin",
+    "depth_sensor",
+    "depth_resolution",
+    "depth_range",
+    "depth_noise",
+    "depth_quantum",
+    "fill",
+    "width",
+    "height",
+    "spp",
+];
+
+/// The function whose keywords are read, with what decides which of them it reads: the
+/// rules are the library's, those of the command of the same name.
+pub enum Caller<'a> {
+    Run,
+    Capture { depth: bool },
+    Compare { candidates: &'a [Candidate] },
+}
+
+impl Caller<'_> {
+    fn keys(&self) -> &'static [&'static str] {
+        match self {
+            Caller::Run => &RUN_KEYS,
+            Caller::Capture { .. } => &CAPTURE_KEYS,
+            Caller::Compare { .. } => &COMPARE_KEYS,
+        }
+    }
+
+    fn reads(&self, options: &RunOptions) -> Vec<ReadWhen> {
+        match self {
+            Caller::Run => run_reads(options, false),
+            Caller::Capture { depth } => capture_reads(options, *depth),
+            Caller::Compare { candidates } => compare_reads(candidates, false, options),
+        }
+    }
+}
 
 /// What `seethru.run` runs with: the pipeline's options, the border band and the memory limit.
 pub struct RunChoices {
     pub options: RunOptions,
     pub band: u32,
+    /// Hazard visibility's misregistration bound, arcmin.
+    pub hazard_bound_arcmin: f64,
     pub max_memory: f64,
 }
 
-/// Reads `seethru.run`'s keywords; defaults are `seethru run`'s.
-pub fn run_choices(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<RunChoices> {
+/// Reads the keywords of `caller`; defaults are its command's. A keyword the call would
+/// ignore under the others given is refused, in the command's words with keyword names.
+pub fn run_choices(kwargs: Option<&Bound<'_, PyDict>>, caller: Caller) -> PyResult<RunChoices> {
     let mut options = RunOptions::default();
     let mut sensor = SensorOptions::default();
     let mut fill = Fill::None;
     let (mut band, mut max_memory) = (5u32, DEFAULT_MAX_MEMORY_GIB);
+    let mut hazard_bound_arcmin = HAZARD_BOUND_ARCMIN;
+    let mut given: Vec<String> = Vec::new();
     let (mut eyes, mut target, mut ipd) = ("mono".to_string(), Eye::Cyclopean, 0.064);
-    let mut depth_settings: Vec<String> = Vec::new();
     if let Some(kwargs) = kwargs {
         for (key, value) in kwargs.iter() {
             let key: String = key.extract()?;
             // None stands for the default, as an absent flag does.
-            if value.is_none() && (RUN_KEYS.contains(&key.as_str()) || key == "max_memory") {
+            let known = caller.keys().contains(&key.as_str()) || key == "max_memory";
+            if !known {
+                return Err(bad_value(format!(
+                    "unknown option {key:?}: the options are {}, max_memory",
+                    caller.keys().join(", ")
+                )));
+            }
+            if value.is_none() {
                 continue;
             }
+            given.push(format!("--{}", key.replace('_', "-")));
             let text = || -> PyResult<String> {
                 value
                     .extract::<String>()
@@ -175,6 +254,12 @@ pub fn run_choices(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<RunChoices> {
                 "head_jitter_cm" => options.head_jitter_cm = real(0.0, 100.0)?,
                 "seed" => options.seed = int(0, u32::MAX as i64)? as u32,
                 "feature_width" => options.feature_width = real(MIN_POSITIVE, 1.0)?,
+                "require_confident_head" => {
+                    options.require_confident_head = value
+                        .extract::<bool>()
+                        .map_err(|_| bad_value(format!("{key}: True or False is needed")))?;
+                }
+                "hazard_bound_arcmin" => hazard_bound_arcmin = real(MIN_POSITIVE, 10800.0)?,
                 "outside" => options.outside = choice::<Outside>(&key, &text()?)?,
                 "filter" => options.filter = choice::<Filter>(&key, &text()?)?,
                 "display" => options.display = choice::<DisplayModel>(&key, &text()?)?,
@@ -201,34 +286,9 @@ pub fn run_choices(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<RunChoices> {
                 "height" => options.height = side()?,
                 "spp" => options.spp = int(1, MAX_SPP as i64)? as u32,
                 "max_memory" => max_memory = real(MIN_POSITIVE, 4096.0)?,
-                _ => {
-                    return Err(bad_value(format!(
-                        "unknown option {key:?}: the options are {}, max_memory",
-                        RUN_KEYS.join(", ")
-                    )));
-                }
-            }
-            if DEPTH_SETTINGS.contains(&key.as_str()) {
-                depth_settings.push(key);
+                _ => unreachable!("every key of {:?} is read", caller.keys()),
             }
         }
-    }
-    // As `seethru run`: options the method would ignore are refused.
-    let reads_depth = matches!(options.method, Method::PlaneFit | Method::Depth);
-    if !reads_depth {
-        if sensor.kind != SensorKind::Ideal {
-            return Err(bad_value(
-                "depth_sensor is read by method plane-fit and depth only, not by this method",
-            ));
-        }
-        if let Some(flag) = depth_settings.first() {
-            return Err(bad_value(format!(
-                "{flag} is read by method plane-fit and depth only, not by this method"
-            )));
-        }
-    }
-    if options.method != Method::Depth && fill != Fill::None {
-        return Err(bad_value("fill fills the holes of method depth only"));
     }
     options.eyes = Eyes {
         view: match eyes.as_str() {
@@ -241,9 +301,15 @@ pub fn run_choices(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<RunChoices> {
     };
     options.scene_model = SceneModelOptions { sensor, fill };
     options.progress = false;
+    if let Some(rule) = first_ignored(&caller.reads(&options), |flag| {
+        given.iter().any(|g| g == flag)
+    }) {
+        return Err(bad_value(rule.keyword_refusal()));
+    }
     Ok(RunChoices {
         options,
         band,
+        hazard_bound_arcmin,
         max_memory,
     })
 }

@@ -8,18 +8,20 @@ use numpy::ndarray::Array2;
 use numpy::{PyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use seethru::measure::hazard::run_hazards_json;
 use seethru::measure::holes::attach_holes;
 use seethru::measure::metrics::{MetricMaps, measure};
 use seethru::render::integrator::RenderContext;
 use seethru::system::memory::{check_memory, run_estimate};
 use seethru::system::options::RunOptions;
 use seethru::system::pipeline::RunResult;
+use seethru::system::pipeline::driver_camera;
 use seethru::system::pipeline::run as run_pipeline;
 
 use crate::errors::to_py;
 use crate::frame::PyFrame;
 use crate::interrupt::detached;
-use crate::options::run_choices;
+use crate::options::{Caller, run_choices};
 use crate::scene::{PyScene, context_for};
 
 /// What one run gives: its six views, its metrics and its report.
@@ -34,6 +36,10 @@ pub struct PyRun {
     /// run.json's content.
     #[pyo3(get)]
     report: Py<PyAny>,
+    /// hazards.json's content: each object marked `hazard = true`, how much of it the
+    /// obstacle hides and the display shows within `hazard_bound_arcmin`.
+    #[pyo3(get)]
+    hazards: Py<PyAny>,
     /// Misregistration per driver-view pixel, arcmin; NaN outside the display and on blank
     /// pixels; (height, width) float32 (misregistration.exr's Y).
     #[pyo3(get)]
@@ -46,7 +52,7 @@ pub struct PyRun {
 #[pymethods]
 impl PyRun {
     fn __repr__(&self) -> String {
-        "<seethru.Run: frames, metrics, report, misregistration, missing>".to_string()
+        "<seethru.Run: frames, metrics, report, hazards, misregistration, missing>".to_string()
     }
 }
 
@@ -65,22 +71,26 @@ pub fn run(
     scene: &Bound<'_, PyScene>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PyRun> {
-    let choices = run_choices(options)?;
+    let choices = run_choices(options, Caller::Run)?;
     let (the_scene, cached) = {
         let s = scene.borrow();
         (s.scene.clone(), s.context.clone())
     };
     let estimate = run_estimate(&the_scene, &choices.options).map_err(to_py)?;
     check_memory(&estimate, choices.max_memory).map_err(to_py)?;
-    let (context, result, maps, metrics) = detached(py, move || -> anyhow::Result<_> {
+    let (context, result, maps, metrics, hazards) = detached(py, move || -> anyhow::Result<_> {
         let ctx = context_for(cached, the_scene)?;
         let result = run_pipeline(&ctx, &choices.options)?;
         let (maps, metrics) = measured(&ctx, &choices.options, &result, choices.band);
-        Ok((ctx, result, maps, metrics))
+        let driver = driver_camera(&ctx.scene, &choices.options)?;
+        let hazards = run_hazards_json(&ctx, &driver, &result, &maps, choices.hazard_bound_arcmin);
+        Ok((ctx, result, maps, metrics, hazards))
     })?
     .map_err(to_py)?;
     scene.borrow_mut().context = Some(context);
-    PyRun::new(py, result, maps, &metrics)
+    let mut run = PyRun::new(py, result, maps, &metrics)?;
+    run.hazards = json_to_py(py, &hazards)?;
+    Ok(run)
 }
 
 /// The maps and metrics.json of a run, as `seethru run` measures them.
@@ -142,6 +152,7 @@ impl PyRun {
             frames: dict.unbind(),
             metrics,
             report,
+            hazards: py.None(),
             misregistration,
             missing,
         })

@@ -17,7 +17,7 @@ use numpy::ndarray::Array2;
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
+use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
 use seethru::measure::metrics::Flip;
 use seethru::measure::sequence::{FrameRecord, Measuring, SequenceStepper};
 use seethru::render::frame::Frame;
@@ -414,7 +414,7 @@ pub fn sequence(
     let spp = k.int("spp", 1, 1, MAX_SPP as i64)? as u32;
     let band = k.int("band", 5, 1, 1000)? as u32;
     let flip = Flip::asked(k.flag("flip")?);
-    let bound = k.real("hazard_bound_arcmin", DEFAULT_BOUND_ARCMIN, 1e-6, 10800.0)?;
+    let bound = k.real("hazard_bound_arcmin", HAZARD_BOUND_ARCMIN, 1e-6, 10800.0)?;
     let max_memory = k.real("max_memory", DEFAULT_MAX_MEMORY_GIB, 1e-6, 4096.0)?;
     let given: Vec<String> = SEQUENCE_KEYS
         .iter()

@@ -56,3 +56,46 @@ def test_a_shifted_map_is_worse_and_a_bad_map_is_refused():
         seethru.score(cap, map=m[:-1])
     with pytest.raises(ValueError, match="score needs map=, display_image= or both"):
         seethru.score(cap)
+
+
+def _metrics_of(folder: pathlib.Path) -> dict:
+    import json
+
+    return json.loads((folder / "metrics.json").read_text())
+
+
+def test_python_scores_a_folder_the_cli_captured_and_the_cli_a_folder_python_saved(tmp_path):
+    from conftest import seethru_cli
+
+    flags = ["--width", "96", "--frontal-width", "192", "--back-width", "96", "--spp", "1"]
+    cli = seethru_cli("capture", str(SCENE), "--out", str(tmp_path / "cli_cap"), *flags, "--depth")
+    assert cli.returncode == 0, cli.stderr
+    loaded = seethru.load_capture(tmp_path / "cli_cap")
+    assert loaded.inverse_depth is not None
+    m = planar_map(loaded.calibration, {"head": loaded.head})
+    np.save(tmp_path / "map.npy", m.astype(np.float32))
+    # Python's score of the CLI's folder is the CLI's score of it.
+    cli = seethru_cli("score", str(tmp_path / "cli_cap"), "--map", str(tmp_path / "map.npy"), "--out", str(tmp_path / "s1"))
+    assert cli.returncode == 0, cli.stderr
+    assert seethru.score(loaded, map=m).metrics == _metrics_of(tmp_path / "s1")
+    # The other way: a capture made in Python, saved, is the folder the CLI captures.
+    scene = seethru.Scene.load(SCENE)
+    cap = seethru.capture(scene, depth=True, width=96, frontal_width=192, back_width=96, spp=1)
+    assert cap.fingerprint == loaded.fingerprint
+    cap.save(tmp_path / "py_cap")
+    cli = seethru_cli("score", str(tmp_path / "py_cap"), "--map", str(tmp_path / "map.npy"), "--out", str(tmp_path / "s2"))
+    assert cli.returncode == 0, cli.stderr
+    assert _metrics_of(tmp_path / "s2") == _metrics_of(tmp_path / "s1")
+
+
+def test_a_capture_of_a_scene_changed_in_memory_is_not_saved(tmp_path):
+    scene = seethru.Scene.load(SCENE)
+    x, y, z = scene.eye
+    scene.eye = (x + 0.01, y, z)
+    cap = seethru.capture(scene, width=32, spp=1)
+    with pytest.raises(ValueError, match="changed in memory"):
+        cap.save(tmp_path / "c")
+    assert not (tmp_path / "c").exists()
+    # Not a capture folder: named.
+    with pytest.raises(OSError, match="capture.json"):
+        seethru.load_capture(tmp_path / "nothing")

@@ -44,7 +44,7 @@ def test_run_options_are_checked():
         seethru.run(scene, colour=1)
     with pytest.raises(ValueError, match=r"band=0 is out of range: must be an integer in \[1, 1000\]"):
         seethru.run(scene, band=0)
-    with pytest.raises(ValueError, match="fill fills the holes of method depth only"):
+    with pytest.raises(ValueError, match=r"fill is read only by method depth \(its disocclusion holes\)"):
         seethru.run(scene, fill="inpaint")
 
 

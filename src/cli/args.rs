@@ -5,7 +5,7 @@ use anyhow::{Result, bail};
 use seethru::render::settings::MAX_SPP;
 use seethru::scene::source::MAX_RESOLUTION;
 use seethru::system::memory::DEFAULT_MAX_MEMORY_GIB;
-use seethru::system::options::{HeadSource, MAX_HEAD_BIAS_CM};
+use seethru::system::options::MAX_HEAD_BIAS_CM;
 use seethru::util::number::short;
 
 /// Most worker threads a command accepts.
@@ -147,27 +147,6 @@ pub struct HeadErrorArgs {
     pub require_confident_head: bool,
 }
 
-impl HeadErrorArgs {
-    /// The rules of these flags ([`refuse_ignored`]): none is read where the method uses no
-    /// eye (`eye_used` false: `--method none`); the feature width is the detector's, read
-    /// with `head` estimated only (`--require-confident-head` is refused by the pipeline); the seed is read by the
-    /// jitter, the tracker model (`head` model: its noise and dropouts), or where
-    /// `other_seed_reader` (a noisy depth sensor, the plane fit) says so.
-    pub fn rules(
-        &self,
-        eye_used: bool,
-        head: HeadSource,
-        other_seed_reader: bool,
-    ) -> Vec<ReadWhen> {
-        seethru::system::reads::head_error_reads(
-            eye_used,
-            head,
-            self.head_jitter_cm > 0.0,
-            other_seed_reader,
-        )
-    }
-}
-
 /// `--max-memory`, GiB in [1e-6, 4096].
 pub fn max_memory(text: &str) -> Result<f64, String> {
     positive(4096.0)(text)
@@ -228,17 +207,14 @@ impl<T: clap::ValueEnum + Clone + Send + Sync + 'static> clap::builder::TypedVal
 
 /// A flag read only under some of the other settings, for [`refuse_ignored`]; the rules are
 /// the library's, shared with the Python package.
-pub use seethru::system::reads::{EYE_METHODS, ReadWhen};
+pub use seethru::system::reads::ReadWhen;
 
 /// Refuses a flag given on the command line that the command would ignore under the other
 /// settings given: the user's intent is not dropped without a word. One rule per flag that
 /// is read only sometimes; the flags given are the parser's ([`crate::cli::given`]), so a
 /// flag set to its default value is refused too.
 pub fn refuse_ignored(rules: &[ReadWhen]) -> Result<()> {
-    if let Some(rule) = rules
-        .iter()
-        .find(|r| !r.read && crate::cli::given::given(r.flag))
-    {
+    if let Some(rule) = seethru::system::reads::first_ignored(rules, crate::cli::given::given) {
         bail!("{}", rule.refusal(rule.flag, "flags"));
     }
     Ok(())

@@ -8,11 +8,12 @@ use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_png;
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
-use seethru::measure::compare::{Candidate, coloured_strips, html_page, markdown_table};
-use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
+use seethru::measure::compare::{
+    Candidate, coloured_strips, compare_reads, html_page, markdown_table,
+};
+use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
-use seethru::system::depth_sensor::SensorKind;
 use seethru::system::memory::{check_memory, run_estimate};
 use seethru::system::options::{HeadSource, Outside, RunOptions};
 
@@ -57,7 +58,7 @@ pub struct Compare {
     /// Hazard visibility: a hidden hazard pixel counts as shown when the display shows the
     /// same object within this misregistration, arc-minutes in [1e-6, 10800] (a scene with
     /// an object marked `hazard = true` only).
-    #[arg(long = "hazard-bound-arcmin", default_value_t = DEFAULT_BOUND_ARCMIN, value_parser = positive(10800.0))]
+    #[arg(long = "hazard-bound-arcmin", default_value_t = HAZARD_BOUND_ARCMIN, value_parser = positive(10800.0))]
     hazard_bound_arcmin: f64,
     /// The depth sensor (its kind is the method's for depth-tof and depth-stereo) and fill.
     #[command(flatten)]
@@ -73,7 +74,6 @@ impl Compare {
             &[Input::file("SCENE", &self.scene)],
             &[Output::folder("--out", &self.out)],
         )?;
-        self.refuse_ignored()?;
         let base = RunOptions {
             head: self.head,
             seed: self.seed,
@@ -89,43 +89,23 @@ impl Compare {
             progress: true,
             ..RunOptions::default()
         };
+        self.refuse_ignored(&base)?;
         with_threads(self.render.threads, || self.write(&base))?
     }
 
     /// Refuses the flags no listed method would read ([`refuse_ignored`]).
-    fn refuse_ignored(&self) -> Result<()> {
+    fn refuse_ignored(&self, base: &RunOptions) -> Result<()> {
         use crate::cli::compare_methods::MethodSpec;
-        let any = |these: &[Candidate]| {
-            self.methods
-                .iter()
-                .any(|m| matches!(m, MethodSpec::Builtin(c) if these.contains(c)))
-        };
-        use Candidate::{DepthIdeal, DepthStereo, DepthTof, PlaneFit};
-        let mut rules = SceneModelArgs::rules(
-            any(&[PlaneFit, DepthIdeal, DepthTof, DepthStereo]),
-            any(&[PlaneFit, DepthIdeal]),
-            any(&[DepthIdeal, DepthTof, DepthStereo]),
-            "when --methods lists plane-fit or a depth method (the sensor's kind: plane-fit or depth-ideal)",
-            "when --methods lists a depth method (their disocclusion holes)",
-        );
-        let noisy_kind = self.scene_model.depth_sensor != SensorKind::Ideal;
-        rules.push(ReadWhen {
-            flag: "--seed",
-            read: any(&[PlaneFit, DepthTof, DepthStereo])
-                || (noisy_kind && any(&[DepthIdeal]))
-                || self.head == HeadSource::Model,
-            when: "with --head model (the tracker model's noise and dropouts) or when --methods lists plane-fit or a noisy depth sensor",
-        });
-        rules.push(ReadWhen {
-            flag: "--back-width",
-            read: self.head == HeadSource::Estimated
-                || self
-                    .methods
-                    .iter()
-                    .any(|m| matches!(m, MethodSpec::Map { .. })),
-            when: "with --head estimated or a map: method (the back camera is rendered for the face detector and for the capture a map is checked against)",
-        });
-        refuse_ignored(&rules)
+        let candidates: Vec<Candidate> = self
+            .methods
+            .iter()
+            .filter_map(|m| match m {
+                MethodSpec::Builtin(c) => Some(*c),
+                MethodSpec::Map { .. } => None,
+            })
+            .collect();
+        let maps = candidates.len() < self.methods.len();
+        refuse_ignored(&compare_reads(&candidates, maps, base))
     }
 
     fn write(&self, base: &RunOptions) -> Result<()> {

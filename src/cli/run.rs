@@ -10,7 +10,7 @@ use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{ExrContent, write_frame_keeping, write_frame_like};
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
-use seethru::measure::hazard::{DEFAULT_BOUND_ARCMIN, run_hazards_json};
+use seethru::measure::hazard::{HAZARD_BOUND_ARCMIN, run_hazards_json};
 use seethru::measure::headline::{read_results, summary_text};
 use seethru::measure::holes::{attach_view_holes, write_hole_mask};
 use seethru::measure::maps::write_metrics_scaled;
@@ -25,10 +25,10 @@ use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingD
 use seethru::system::pipeline::{
     Given, RunResult, RunViews, check_display_seen, driver_camera, run_staged,
 };
+use seethru::system::reads::run_reads;
 
 use crate::cli::args::{
-    EYE_METHODS, HeadErrorArgs, ReadWhen, RenderArgs, band, choice, pixels, positive,
-    refuse_ignored, with_threads,
+    HeadErrorArgs, RenderArgs, band, choice, pixels, positive, refuse_ignored, with_threads,
 };
 use crate::cli::run_eyes::EyesFlag;
 use crate::cli::scene_model_args::SceneModelArgs;
@@ -95,7 +95,7 @@ pub struct Run {
     band: u32,
     /// Hazard visibility: a hidden hazard pixel counts as shown when the display shows the
     /// same object within this misregistration, arc-minutes in [1e-6, 10800].
-    #[arg(long = "hazard-bound-arcmin", default_value_t = DEFAULT_BOUND_ARCMIN, value_parser = positive(10800.0))]
+    #[arg(long = "hazard-bound-arcmin", default_value_t = HAZARD_BOUND_ARCMIN, value_parser = positive(10800.0))]
     hazard_bound_arcmin: f64,
     /// Top of misregistration.png's scale, arc-minutes in [1e-6, 10000], so that heatmaps of
     /// runs compare (default: the 99th percentile of the display's values, labelled).
@@ -118,39 +118,6 @@ impl Run {
                 .map(|c| Input::file("--calibration", c)),
         );
         check_paths(&inputs, &[Output::folder("--out", &self.out)])?;
-        self.scene_model.check_used_by(self.method)?;
-        let noisy_sensor = self.method == Method::Depth
-            && self.scene_model.depth_sensor != seethru::system::depth_sensor::SensorKind::Ideal;
-        let eye_used = self.method != Method::None;
-        let mut rules = self.head_errors.rules(
-            eye_used,
-            self.head,
-            self.method == Method::PlaneFit || noisy_sensor,
-        );
-        rules.extend([
-            ReadWhen {
-                flag: "--head",
-                read: eye_used,
-                when: EYE_METHODS,
-            },
-            ReadWhen {
-                flag: "--target-eye",
-                read: eye_used,
-                when: EYE_METHODS,
-            },
-            ReadWhen {
-                flag: "--ipd",
-                read: self.eyes != EyesFlag::Mono
-                    || (eye_used && self.target_eye != Eye::Cyclopean),
-                when: "with --eyes left, right or both, or --target-eye left or right",
-            },
-            ReadWhen {
-                flag: "--d2",
-                read: !matches!(self.method, Method::None | Method::Depth),
-                when: "by --method planar, ground and plane-fit",
-            },
-        ]);
-        refuse_ignored(&rules)?;
         let options = RunOptions {
             method: self.method,
             d2: self.d2,
@@ -177,6 +144,7 @@ impl Run {
             progress: true,
         };
         let both = self.eyes == EyesFlag::Both;
+        refuse_ignored(&run_reads(&options, both))?;
         let (scene, out, max_memory) = (&self.scene, &self.out, self.render.max_memory);
         let writes = RunWrites {
             band: self.band,

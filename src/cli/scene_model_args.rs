@@ -2,10 +2,9 @@
 //! and the filling of disocclusion holes. Shared by `run` and `compare`.
 
 use seethru::system::depth_sensor::{SensorKind, SensorOptions};
-use seethru::system::options::Method;
 use seethru::system::scene_model::{Fill, SceneModelOptions};
 
-use crate::cli::args::{ReadWhen, choice, pixels, positive, real, refuse_ignored};
+use crate::cli::args::{choice, pixels, positive, real};
 
 #[derive(clap::Args, Clone)]
 pub struct SceneModelArgs {
@@ -37,52 +36,6 @@ pub struct SceneModelArgs {
 }
 
 impl SceneModelArgs {
-    /// Refuses flags that `method` would ignore without a word: a sensor or its settings for
-    /// a method that reads no depth, a fill for a method that leaves no holes. (The settings
-    /// of the ideal sensor, which has none, are refused where the sensor is resolved.)
-    pub fn check_used_by(&self, method: Method) -> anyhow::Result<()> {
-        let reads_depth = matches!(method, Method::PlaneFit | Method::Depth);
-        refuse_ignored(&Self::rules(
-            reads_depth,
-            reads_depth,
-            method == Method::Depth,
-            "by --method plane-fit and depth",
-            "by --method depth (its disocclusion holes)",
-        ))
-    }
-
-    /// The rules of these flags: the sensor's settings are read when `reads_depth`, its kind
-    /// when `reads_kind`, the fill when `fills`; `depth_when` and `fill_when` say by what.
-    pub fn rules(
-        reads_depth: bool,
-        reads_kind: bool,
-        fills: bool,
-        depth_when: &'static str,
-        fill_when: &'static str,
-    ) -> Vec<ReadWhen> {
-        let depth = |flag| ReadWhen {
-            flag,
-            read: reads_depth,
-            when: depth_when,
-        };
-        vec![
-            ReadWhen {
-                flag: "--depth-sensor",
-                read: reads_kind,
-                when: depth_when,
-            },
-            depth("--depth-resolution"),
-            depth("--depth-range"),
-            depth("--depth-noise"),
-            depth("--depth-quantum"),
-            ReadWhen {
-                flag: "--fill",
-                read: fills,
-                when: fill_when,
-            },
-        ]
-    }
-
     pub fn options(&self) -> SceneModelOptions {
         SceneModelOptions {
             sensor: SensorOptions {

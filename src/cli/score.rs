@@ -4,25 +4,21 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
-use clap::Parser;
 use glam::Vec3;
 use rayon::prelude::*;
 use seethru::io::atomic::write_text;
-use seethru::io::capture_folder::{command_path, read_capture_record};
 use seethru::io::display_map::{read_display_image, read_map};
 use seethru::io::frame_files::{ExrContent, write_frame_like};
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
+use seethru::measure::capture_files::recapture;
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
 use seethru::render::frame_over::FrameView;
-use seethru::render::integrator::RenderContext;
-use seethru::system::capture::{Capture, DisplayImage, DisplayMap, capture, score};
+use seethru::system::capture::{DisplayImage, DisplayMap, score};
 use seethru::system::display::Filter;
-use seethru::system::options::RunOptions;
 
 use crate::cli::args::{band, choice, threads};
-use crate::cli::capture::CaptureCommand;
 
 #[derive(clap::Args)]
 pub struct Score {
@@ -53,52 +49,6 @@ pub struct Score {
     /// lean (R, G, B, Z, N and the ids), colour (R, G, B, A only) or none (the PNGs only).
     #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
     exr: ExrContent,
-}
-
-/// A capture folder captured again in memory: its flags, context and capture, the
-/// fingerprint checked against the folder's.
-pub struct Recaptured {
-    pub options: RunOptions,
-    pub ctx: RenderContext,
-    pub capture: Capture,
-}
-
-/// Reads `inputs/capture.json` and `inputs/truth/capture_command.json`, captures again and
-/// checks that the result is the folder's capture.
-pub fn recapture(inputs: &Path) -> Result<Recaptured> {
-    let record = read_capture_record(inputs)?;
-    let fingerprint = record.fingerprint;
-    let cwd = record.cwd;
-    let argv: Vec<std::ffi::OsString> = std::iter::once("seethru capture".into())
-        .chain(record.args.into_iter().map(Into::into))
-        .collect();
-    let mut args = CaptureCommand::try_parse_from(crate::cli::with_negative_values_joined(argv))
-        .map_err(|e| {
-            anyhow::anyhow!(
-                "{}: the capture's flags do not parse: {}",
-                command_path(inputs).display(),
-                crate::cli::one_line(&e).trim_start_matches("error: ")
-            )
-        })?
-        .args;
-    args.scene = cwd.join(&args.scene);
-    args.calibration = args.calibration.map(|c| cwd.join(c));
-    let mut options = args.options()?;
-    options.progress = false;
-    let ctx = RenderContext::new(args.scene()?)?;
-    let capture = capture(&ctx, &options, args.depth)?;
-    if capture.fingerprint != fingerprint {
-        bail!(
-            "{}: captured again, the inputs' fingerprint is {} but the folder's is {fingerprint}: the scene, its assets or seethru changed since the capture; capture again",
-            inputs.display(),
-            capture.fingerprint
-        );
-    }
-    Ok(Recaptured {
-        options,
-        ctx,
-        capture,
-    })
 }
 
 /// A map file as the system's map; errors name the file.

@@ -8,7 +8,7 @@ use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{ExrContent, write_color_png, write_view_exr};
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
-use seethru::measure::hazard::DEFAULT_BOUND_ARCMIN;
+use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
 use seethru::measure::headline::{RunKind, summary_text};
 use seethru::measure::metrics::Flip;
 use seethru::measure::sequence::{Measuring, SequenceRun, head_warning, run_sequence_hazards};
@@ -195,7 +195,7 @@ pub struct Sequence {
     band: u32,
     /// Hazard visibility: a hidden hazard pixel counts as shown when the display shows the
     /// same object within this misregistration, arc-minutes in [1e-6, 10800].
-    #[arg(long = "hazard-bound-arcmin", default_value_t = DEFAULT_BOUND_ARCMIN, value_parser = positive(10800.0))]
+    #[arg(long = "hazard-bound-arcmin", default_value_t = HAZARD_BOUND_ARCMIN, value_parser = positive(10800.0))]
     hazard_bound_arcmin: f64,
     /// Worker threads in [1, 1024] (default: all cores). Output is identical for any value.
     #[arg(long, value_parser = threads)]

@@ -9,13 +9,13 @@ use std::sync::Arc;
 use anyhow::{Result, bail};
 use seethru::io::atomic::write_text;
 use seethru::io::frame_files::ExrContent;
+use seethru::measure::capture_files::write_capture_folder;
 use seethru::measure::sequence::FrameImages;
 use seethru::system::capture::check_display_input;
 use seethru::system::sequence::byo::NamedMap;
 use seethru::system::sequence::timeline::Timeline;
 use serde_json::{Value, json};
 
-use crate::cli::capture::write_capture;
 use crate::cli::score::load_map;
 
 /// The folder (in `--capture`) and map stem (in `--maps`) of the refresh first shown at
@@ -101,7 +101,12 @@ pub fn write_frame(
     let mut world_from_obstacle = Value::Null;
     if let Some(c) = &f.capture {
         *last_folder = frame_name(f.record.frame);
-        write_capture(&dir.join(last_folder.as_str()), c, command, exr)?;
+        write_capture_folder(
+            &dir.join(last_folder.as_str()),
+            c,
+            ("sequence_command.json", command),
+            exr,
+        )?;
         world_from_obstacle = c.calibration["obstacle_frame"]["world_from_obstacle"].clone();
     }
     Ok(index_row(f, last_folder, world_from_obstacle))

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::measure::sweep::{
-    BoundIgnored, DEFAULT_BOUND_ARCMIN, SweepOptions, merge_parts_with_bound, samples_drivers,
+    BoundIgnored, DRIVER_SHARE_BOUND_ARCMIN, SweepOptions, merge_parts_with_bound, samples_drivers,
     sweep,
 };
 use seethru::measure::sweep_grid::{EYELLIPSE, MAX_VALUES, eyellipse_param, parse_param};
@@ -64,7 +64,7 @@ pub struct Sweep {
     seed: u64,
     /// With --param eye=eyellipse: the misregistration bound of the share of drivers
     /// (`<out stem>_drivers.json`), arcmin in [1e-6, 10800].
-    #[arg(long = "bound-arcmin", default_value_t = DEFAULT_BOUND_ARCMIN, value_parser = positive(10800.0))]
+    #[arg(long = "bound-arcmin", default_value_t = DRIVER_SHARE_BOUND_ARCMIN, value_parser = positive(10800.0))]
     bound_arcmin: f64,
 }
 

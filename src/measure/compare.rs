@@ -13,8 +13,9 @@ use crate::render::integrator::RenderContext;
 use crate::render::settings::RenderSettings;
 use crate::render::views::View;
 use crate::system::depth_sensor::SensorKind;
-use crate::system::options::{Method, RunOptions, WorkingDistance};
+use crate::system::options::{HeadSource, Method, RunOptions, WorkingDistance};
 use crate::system::pipeline::{check_display_seen, driver_camera, run_with_truth};
+use crate::system::reads::{ReadWhen, scene_model_reads};
 use crate::system::scene_model::{check_scene_model_options, scene_model_unavailable};
 use crate::util::color::encode_srgb8;
 use crate::util::progress::Progress;
@@ -38,6 +39,35 @@ pub enum Candidate {
     DepthTof,
     /// Per-pixel reprojection with the stereo sensor's depth.
     DepthStereo,
+}
+
+/// `compare`'s rules (`seethru compare`, `seethru.compare`): the settings no listed method
+/// reads. `candidates` are the built-in methods listed, `maps` whether an outside method's
+/// map is listed too, `options` the run options given.
+pub fn compare_reads(candidates: &[Candidate], maps: bool, options: &RunOptions) -> Vec<ReadWhen> {
+    use Candidate::{DepthIdeal, DepthStereo, DepthTof, PlaneFit};
+    let any = |these: &[Candidate]| candidates.iter().any(|c| these.contains(c));
+    let mut rules = scene_model_reads(
+        any(&[PlaneFit, DepthIdeal, DepthTof, DepthStereo]),
+        any(&[PlaneFit, DepthIdeal]),
+        any(&[DepthIdeal, DepthTof, DepthStereo]),
+        "when --methods lists plane-fit or a depth method (the sensor's kind: plane-fit or depth-ideal)",
+        "when --methods lists a depth method (their disocclusion holes)",
+    );
+    let noisy_kind = options.scene_model.sensor.kind != SensorKind::Ideal;
+    rules.push(ReadWhen {
+        flag: "--seed",
+        read: any(&[PlaneFit, DepthTof, DepthStereo])
+            || (noisy_kind && any(&[DepthIdeal]))
+            || options.head == HeadSource::Model,
+        when: "with --head model (the tracker model's noise and dropouts) or when --methods lists plane-fit or a noisy depth sensor",
+    });
+    rules.push(ReadWhen {
+        flag: "--back-width",
+        read: options.head == HeadSource::Estimated || maps,
+        when: "with --head estimated or a map: method (the back camera is rendered for the face detector and for the capture a map is checked against)",
+    });
+    rules
 }
 
 impl Candidate {

@@ -16,7 +16,7 @@ use crate::system::pipeline::RunResult;
 
 /// Default bound of `--hazard-bound-arcmin`: a pixel counts as showing the hazard when the
 /// shown point is within this angle of the true one, arc-minutes.
-pub const DEFAULT_BOUND_ARCMIN: f64 = 30.0;
+pub const HAZARD_BOUND_ARCMIN: f64 = 30.0;
 
 /// One hazard object in one frame.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]

@@ -2,6 +2,7 @@
 //! the observed p_cam/p_user of the paper's setups, and sweeps over parameters.
 
 pub mod binocular;
+pub mod capture_files;
 pub mod compare;
 pub mod compare_external;
 pub mod driver_share;

@@ -10,7 +10,7 @@ use glam::DVec3;
 use obvhs::aabb::Aabb;
 
 use crate::geometry::opencv::camera_json;
-use crate::measure::hazard::{DEFAULT_BOUND_ARCMIN, HazardSeen, hazard_seen};
+use crate::measure::hazard::{HAZARD_BOUND_ARCMIN, HazardSeen, hazard_seen};
 use crate::measure::metrics::{Flip, MetricMaps, measure_with};
 use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::Frame;
@@ -214,7 +214,7 @@ pub fn run_sequence_labelled(
     label: &str,
     on_frame: &mut dyn FnMut(FrameImages) -> Result<()>,
 ) -> Result<SequenceRun> {
-    run_sequence_hazards(scene, options, how, DEFAULT_BOUND_ARCMIN, label, on_frame)
+    run_sequence_hazards(scene, options, how, HAZARD_BOUND_ARCMIN, label, on_frame)
 }
 
 /// As [`run_sequence_labelled`], hazard visibility scored within `hazard_bound_arcmin`.

@@ -63,7 +63,7 @@ pub struct SweepOptions {
 }
 
 /// The default bound of the share of drivers, arcmin: the 1′ of the plots and the paper.
-pub const DEFAULT_BOUND_ARCMIN: f64 = 1.0;
+pub const DRIVER_SHARE_BOUND_ARCMIN: f64 = 1.0;
 
 /// Runs the sweep; writes `csv` (and `<csv>.png`); returns the number of rows computed now.
 pub fn sweep(
@@ -275,7 +275,7 @@ impl std::fmt::Display for BoundIgnored {
 impl std::error::Error for BoundIgnored {}
 
 /// [`merge_parts`], with the share of drivers of an `eye=eyellipse` sweep under
-/// `bound_arcmin` (default [`DEFAULT_BOUND_ARCMIN`]); a bound given for parts that sample no
+/// `bound_arcmin` (default [`DRIVER_SHARE_BOUND_ARCMIN`]); a bound given for parts that sample no
 /// drivers is refused ([`BoundIgnored`]) before anything is written.
 pub fn merge_parts_with_bound(
     parts: &[&Path],
@@ -290,7 +290,7 @@ pub fn merge_parts_with_bound(
     }
     write_text(out, &merged.text)?;
     plot(out, &merged.params, &merged.body)?;
-    let bound = bound_arcmin.unwrap_or(DEFAULT_BOUND_ARCMIN);
+    let bound = bound_arcmin.unwrap_or(DRIVER_SHARE_BOUND_ARCMIN);
     write_driver_shares(out, &merged.params, &merged.body, bound)?;
     Ok(merged.rows)
 }

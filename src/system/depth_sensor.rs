@@ -22,7 +22,9 @@ use crate::system::head::gaussian;
 use crate::util::sampling::hash_words;
 
 /// The kind of depth sensor.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum SensorKind {
     /// The frontal render's exact depth, at its resolution: no noise, no range limit.
@@ -34,7 +36,8 @@ pub enum SensorKind {
 }
 
 /// The sensor the user asked for; `None` takes the kind's default.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SensorOptions {
     pub kind: SensorKind,
     /// Sensor image width, pixels (its height follows the frontal camera's aspect).

@@ -16,7 +16,9 @@ use crate::system::point_model::PointModel;
 pub const MISSING_ID: u32 = u32::MAX;
 
 /// How colour is resampled from the frontal image (geometric AOVs are always nearest).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Filter {
     /// Bilinear interpolation of the four nearest frontal pixels.
@@ -245,7 +247,9 @@ impl Screen for DisplaySurface {
 }
 
 /// How the `seethru` view models the display.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum DisplayModel {
     /// The physical display's pixels, resampled from the frontal image.

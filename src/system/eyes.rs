@@ -12,7 +12,9 @@ use crate::scene::Obstacle;
 pub const MAX_IPD: f64 = 0.1;
 
 /// One eye of the driver.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Eye {
     /// The midpoint of the pupils: the scene's driver camera.
@@ -33,7 +35,8 @@ impl Eye {
 }
 
 /// Which eye looks and which eye the compensation serves.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Eyes {
     /// The eye the driver views (truth, occluded, seethru) are rendered from.
     pub view: Eye,

@@ -10,7 +10,9 @@ use crate::system::scene_model_options::SceneModelOptions;
 use crate::util::number::short;
 
 /// How the display image is made.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Method {
     /// The whole frontal image scaled into the display: the naive baseline.
@@ -26,8 +28,9 @@ pub enum Method {
     Depth,
 }
 
-/// The working distance of the planar model.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The working distance of the planar model; written as `inf`, `auto` or the metres.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "String", into = "String")]
 pub enum WorkingDistance {
     /// `d2 → ∞`, the paper's proposal.
     Infinity,
@@ -59,11 +62,31 @@ impl std::str::FromStr for WorkingDistance {
     }
 }
 
+impl TryFrom<String> for WorkingDistance {
+    type Error = String;
+    fn try_from(text: String) -> Result<Self, String> {
+        text.parse()
+    }
+}
+
+impl From<WorkingDistance> for String {
+    fn from(d: WorkingDistance) -> String {
+        match d {
+            WorkingDistance::Infinity => "inf".into(),
+            WorkingDistance::Auto => "auto".into(),
+            // Rust's shortest round-trip form: the same f64 reads back.
+            WorkingDistance::Metres(m) => m.to_string(),
+        }
+    }
+}
+
 /// Most centimetres of head bias on each axis (`--head-bias-cm`, a sweep's `head_bias_x_cm`).
 pub const MAX_HEAD_BIAS_CM: f64 = 500.0;
 
 /// Where the head position comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum HeadSource {
     /// The true eye position.
@@ -76,7 +99,9 @@ pub enum HeadSource {
 }
 
 /// What to do when the crop needs more than the frontal camera sees.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Outside {
     /// Stop with an error naming the side, the amount and the admissible head region.
@@ -85,7 +110,10 @@ pub enum Outside {
     Black,
 }
 
-#[derive(Clone, Debug)]
+/// Written whole (a capture folder's `truth/capture_spec.json`) and read back the same;
+/// every field is required when read, an unknown one refused.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RunOptions {
     pub method: Method,
     pub d2: WorkingDistance,
@@ -116,6 +144,8 @@ pub struct RunOptions {
     pub eyes: Eyes,
     /// The depth sensor and hole filling of `ground`, `plane-fit` and `depth`.
     pub scene_model: SceneModelOptions,
+    /// Progress bars on stderr: the front end's, never written.
+    #[serde(skip)]
     pub progress: bool,
 }
 

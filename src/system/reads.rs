@@ -4,6 +4,7 @@
 //! with the same words.
 
 use crate::scene::Scene;
+use crate::system::eyes::Eye;
 use crate::system::options::{HeadSource, Method, RunOptions};
 use crate::system::sequence::head_motion::HeadPreset;
 
@@ -21,17 +22,26 @@ pub struct ReadWhen {
     pub when: &'static str,
 }
 
-/// `--sway-cm` → `sway_cm`, and so every flag in a text (Python's keyword names).
+/// `--sway-cm` → `sway_cm`, and so every flag in a text (Python's keyword names). A flag
+/// starts a word (after the start, a space or an opening mark): the `--` inside a path or a
+/// value (`runs--old`) is left alone.
 pub fn keyword_names(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     let mut rest = text;
     while let Some(at) = rest.find("--") {
-        out.push_str(&rest[..at]);
+        let before = rest[..at].chars().last().or_else(|| out.chars().last());
+        let starts_word = before.is_none_or(|c| c.is_whitespace() || "(`'\"[,;:/".contains(c));
         let name = &rest[at + 2..];
         let end = name
             .find(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
             .unwrap_or(name.len());
-        out.push_str(&name[..end].replace('-', "_"));
+        out.push_str(&rest[..at]);
+        if starts_word && end > 0 {
+            out.push_str(&name[..end].replace('-', "_"));
+        } else {
+            out.push_str("--");
+            out.push_str(&name[..end]);
+        }
         rest = &name[end..];
     }
     out.push_str(rest);
@@ -87,6 +97,134 @@ pub fn head_error_reads(
             when: "with --head-jitter-cm > 0, the tracker model's head, a noisy depth sensor or the plane fit",
         },
     ]
+}
+
+/// The scene-model settings' rules: the sensor's settings are read when `reads_depth`, its
+/// kind when `reads_kind`, the fill when `fills`; `depth_when` and `fill_when` say by what.
+pub fn scene_model_reads(
+    reads_depth: bool,
+    reads_kind: bool,
+    fills: bool,
+    depth_when: &'static str,
+    fill_when: &'static str,
+) -> Vec<ReadWhen> {
+    let depth = |flag| ReadWhen {
+        flag,
+        read: reads_depth,
+        when: depth_when,
+    };
+    vec![
+        ReadWhen {
+            flag: "--depth-sensor",
+            read: reads_kind,
+            when: depth_when,
+        },
+        depth("--depth-resolution"),
+        depth("--depth-range"),
+        depth("--depth-noise"),
+        depth("--depth-quantum"),
+        ReadWhen {
+            flag: "--fill",
+            read: fills,
+            when: fill_when,
+        },
+    ]
+}
+
+/// The scene-model settings' rules for one run of `method`: a sensor or its settings for a
+/// method that reads no depth, a fill for a method that leaves no holes, are ignored. (The
+/// settings of the ideal sensor, which has none, are refused where the sensor is resolved.)
+pub fn method_scene_model_reads(method: Method) -> Vec<ReadWhen> {
+    let reads_depth = matches!(method, Method::PlaneFit | Method::Depth);
+    scene_model_reads(
+        reads_depth,
+        reads_depth,
+        method == Method::Depth,
+        "by --method plane-fit and depth",
+        "by --method depth (its disocclusion holes)",
+    )
+}
+
+/// One run's rules (`seethru run`, `seethru.run`), in the order they are checked: `options`
+/// as given; `both_eyes` when each eye is run in turn (`--eyes both`).
+pub fn run_reads(options: &RunOptions, both_eyes: bool) -> Vec<ReadWhen> {
+    let method = options.method;
+    let noisy_sensor = method == Method::Depth
+        && options.scene_model.sensor.kind != crate::system::depth_sensor::SensorKind::Ideal;
+    let eye_used = method != Method::None;
+    let mut rules = method_scene_model_reads(method);
+    rules.extend(head_error_reads(
+        eye_used,
+        options.head,
+        options.head_jitter_cm > 0.0,
+        method == Method::PlaneFit || noisy_sensor,
+    ));
+    let eyes = &options.eyes;
+    rules.extend([
+        ReadWhen {
+            flag: "--head",
+            read: eye_used,
+            when: EYE_METHODS,
+        },
+        ReadWhen {
+            flag: "--target-eye",
+            read: eye_used,
+            when: EYE_METHODS,
+        },
+        ReadWhen {
+            flag: "--ipd",
+            read: both_eyes
+                || eyes.view != Eye::Cyclopean
+                || (eye_used && eyes.target != Eye::Cyclopean),
+            when: "with --eyes left, right or both, or --target-eye left or right",
+        },
+        ReadWhen {
+            flag: "--d2",
+            read: !matches!(method, Method::None | Method::Depth),
+            when: "by --method planar, ground and plane-fit",
+        },
+    ]);
+    rules
+}
+
+/// A capture's rules (`seethru capture`, `seethru.capture`): `options` as given, `depth`
+/// whether the capture records the depth sensor's map. A capture serves every method, so
+/// the head settings are read whatever the method; it has no holes to fill.
+pub fn capture_reads(options: &RunOptions, depth: bool) -> Vec<ReadWhen> {
+    let noisy_depth =
+        depth && options.scene_model.sensor.kind != crate::system::depth_sensor::SensorKind::Ideal;
+    let mut rules = scene_model_reads(
+        depth,
+        depth,
+        false,
+        "with --depth (the capture's depth map)",
+        "by --method depth, not by a capture (it has no holes to fill)",
+    );
+    rules.extend(head_error_reads(
+        true,
+        options.head,
+        options.head_jitter_cm > 0.0,
+        noisy_depth,
+    ));
+    let eyes = &options.eyes;
+    rules.extend([
+        ReadWhen {
+            flag: "--require-confident-head",
+            read: options.head == HeadSource::Estimated,
+            when: "with --head estimated (only the face detector's estimate has a confidence)",
+        },
+        ReadWhen {
+            flag: "--ipd",
+            read: eyes.view != Eye::Cyclopean || eyes.target != Eye::Cyclopean,
+            when: "with --eyes left or right, or --target-eye left or right",
+        },
+    ]);
+    rules
+}
+
+/// The first rule of `rules` whose setting is given (`given`, by its flag) but not read.
+pub fn first_ignored(rules: &[ReadWhen], given: impl Fn(&str) -> bool) -> Option<&ReadWhen> {
+    rules.iter().find(|r| !r.read && given(r.flag))
 }
 
 /// A sequence's rules, in the order they are checked: `run` holds its pipeline's options,
@@ -161,6 +299,10 @@ mod tests {
         assert_eq!(
             keyword_names("--sway-cm is read only with --head sway (and no --head-path)"),
             "sway_cm is read only with head sway (and no head_path)"
+        );
+        assert_eq!(
+            keyword_names("`--width/--height`: runs--old/a.toml, -- --x"),
+            "`width/height`: runs--old/a.toml, -- x"
         );
     }
 

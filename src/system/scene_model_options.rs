@@ -4,7 +4,9 @@
 use crate::system::depth_sensor::SensorOptions;
 
 /// How disocclusion holes of `--method depth` are filled.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Fill {
     /// Shown black and counted as blank.
@@ -17,7 +19,8 @@ pub enum Fill {
 }
 
 /// The depth sensor and the hole filling of the scene-model methods.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SceneModelOptions {
     pub sensor: SensorOptions,
     pub fill: Fill,

@@ -1,5 +1,4 @@
-//! Wave 2's inputs held to wave 1's standard: spaces around every choice value are ignored,
-//! and every flag of `run`, `sequence` and `compare` either changes the output or is refused
+//! Every flag is read or refused: spaces around every choice value are ignored, and every flag of `run`, `sequence` and `compare` either changes the output or is refused
 //! where the other flags make the command ignore it. Both walk the commands' own `--help`,
 //! so a flag added later is checked too.
 
@@ -803,11 +802,8 @@ fn every_spaced_choice_value_gives_the_unspaced_output() {
             &[][..],
         ),
         (&["run"], &["--width", "16", "--spp", "1"], &[]),
-        (
-            &["capture"],
-            &["--width", "16", "--spp", "1"],
-            &["capture_command.json"],
-        ),
+        // capture_spec.json holds the parsed options: spaced values give the same file.
+        (&["capture"], &["--width", "16", "--spp", "1"], &[]),
         (&["export"], &[], &[]),
     ] {
         let positional = "scene.toml";
@@ -870,7 +866,7 @@ fn score_inputs(dir: &Path) -> String {
 
 #[test]
 fn every_flag_of_capture_changes_the_output_or_is_refused() {
-    // truth/capture_command.json records the command line: the other files must show it.
+    // truth/capture_spec.json records the options: the other files must show them.
     let mut wrong = Vec::new();
     for base in [
         &["--spp", "1", "--width", "16"][..],
@@ -892,7 +888,7 @@ fn every_flag_of_capture_changes_the_output_or_is_refused() {
         wrong.extend(each_flag_is_read_or_refused(
             &["capture"],
             base,
-            &["capture_command.json"],
+            &["capture_spec.json"],
             &[],
         ));
     }
@@ -1200,16 +1196,16 @@ fn the_sweeps_eyellipse_flags_are_read_refused_and_take_spaced_values() {
     assert!(!dir.path().join("no_drivers.json").exists());
 }
 
-/// A capture folder whose record was edited (a flag that is no string, no working folder) is
-/// refused by `score` in one line naming the file and the key, before anything is captured
-/// again; the untouched folder scores.
+/// A capture folder whose specification was edited (a file that is no path, an option out of
+/// its range or unknown) is refused by `score` in one line naming the file and the key; the
+/// untouched folder scores.
 #[test]
-fn score_refuses_an_edited_capture_record_by_file_and_key() {
+fn score_refuses_an_edited_capture_spec_by_file_and_key() {
     let dir = common::refusal::scratch("", &[]);
     let inputs = score_inputs(dir.path());
-    let command_file = dir.path().join(&inputs).join("truth/capture_command.json");
-    let record: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&command_file).unwrap()).unwrap();
+    let spec_file = dir.path().join(&inputs).join("truth/capture_spec.json");
+    let spec: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&spec_file).unwrap()).unwrap();
     let score = |out: &str| {
         run_in(
             dir.path(),
@@ -1218,18 +1214,35 @@ fn score_refuses_an_edited_capture_record_by_file_and_key() {
     };
     let (code, err) = score("s");
     assert_eq!(code, 0, "{err}");
-    let mut flag_not_a_string = record.clone();
-    flag_not_a_string["args"][1] = 16.into();
-    let mut no_cwd = record.clone();
-    no_cwd.as_object_mut().unwrap().remove("cwd");
-    for (edited, words) in [
+    let edited = |edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut s = spec.clone();
+        edit(&mut s);
+        s
+    };
+    for (spec, words) in [
         (
-            flag_not_a_string,
-            ["capture_command.json", "args[1] must be a string"],
+            edited(&|s| s["scene"] = "scene.toml".into()),
+            &[
+                "capture_spec.json",
+                "scene must be the scene file (an absolute path)",
+            ][..],
         ),
-        (no_cwd, ["capture_command.json", "no key cwd"]),
+        (
+            edited(&|s| s["run_options"]["spp"] = 0.into()),
+            &["capture_spec.json: capturing again", "spp 0", "[1, 4096]"],
+        ),
+        (
+            edited(&|s| s["run_options"]["colour"] = 1.into()),
+            &["capture_spec.json: run_options", "unknown field `colour`"],
+        ),
+        (
+            edited(&|s| {
+                s["run_options"].as_object_mut().unwrap().remove("seed");
+            }),
+            &["capture_spec.json: run_options", "missing field `seed`"],
+        ),
     ] {
-        std::fs::write(&command_file, edited.to_string()).unwrap();
+        std::fs::write(&spec_file, spec.to_string()).unwrap();
         let (code, err) = score("s2");
         assert_ne!(code, 0);
         let err = err.trim_end();
