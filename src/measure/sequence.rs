@@ -16,6 +16,7 @@ use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::Frame;
 use crate::render::frame_over::FrameView;
 use crate::render::integrator::RenderContext;
+use crate::render::render_job::RenderJob;
 use crate::render::settings::RenderSettings;
 use crate::scene::world::view_bit;
 use crate::scene::{Obstacle, Scene};
@@ -508,25 +509,21 @@ pub fn render_truth_and_occluded(
     last: PixelRect,
 ) -> PixelRect {
     let driver = ctx.scene.driver;
-    ctx.render_rect(
-        &driver,
-        view_bit::TRUTH,
-        None,
-        settings,
-        region,
+    ctx.render_into(
+        RenderJob::new(&driver, view_bit::TRUTH)
+            .settings(settings)
+            .region(region)
+            .label("truth"),
         truth,
-        "truth",
     );
     copy_rect(truth, occluded, union(region, last));
     let around = ctx.difference_region(&driver, view_bit::TRUTH, view_bit::OCCLUDED);
-    ctx.render_rect(
-        &driver,
-        view_bit::OCCLUDED,
-        None,
-        settings,
-        around,
+    ctx.render_into(
+        RenderJob::new(&driver, view_bit::OCCLUDED)
+            .settings(settings)
+            .region(around)
+            .label("occluded"),
         occluded,
-        "occluded",
     );
     around
 }
