@@ -7,7 +7,7 @@ use std::path::Path;
 
 use seethru::analysis::dynamic::{Motion, dynamic_misregistration};
 use seethru::analysis::physical::ARCMIN_PER_RAD;
-use seethru::measure::metrics::Flip;
+use seethru::measure::image_metrics::Flip;
 use seethru::measure::sequence::{SequenceStepper, run_sequence};
 use seethru::render::integrator::RenderContext;
 use seethru::render::render_job::RenderJob;

@@ -11,7 +11,8 @@ use obvhs::aabb::Aabb;
 
 use crate::geometry::opencv::camera_json;
 use crate::measure::hazard::{DEFAULT_BOUND_ARCMIN, HazardSeen, hazard_seen};
-use crate::measure::metrics::{Flip, MetricMaps, measure_with};
+use crate::measure::image_metrics::Flip;
+use crate::measure::metrics::{MetricMaps, measure_with};
 use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::Frame;
 use crate::render::frame_over::FrameView;
