@@ -16,7 +16,7 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 use seethru::render::frame::Frame;
 use seethru::render::integrator::RenderContext;
-use seethru::render::settings::RenderSettings;
+use seethru::render::render_job::RenderJob;
 use seethru::render::simd::Isa;
 use seethru::render::throughput::{
     camera_batch, cosine_batch, shadow_batch, trace_any, trace_any_per_ray, trace_closest,
@@ -142,11 +142,8 @@ fn measure() -> Result<()> {
     })?;
     row("truth frame (per pixel)", primary.rays.len(), &mut || {
         ctx.render_into(
-            &camera,
-            View::Truth.bit(),
-            RenderSettings::default(),
+            RenderJob::new(&camera, View::Truth.bit()).label("truth"),
             &mut frame,
-            "truth",
         );
     })?;
     Ok(())

@@ -13,6 +13,7 @@ use seethru::render::bvh_packet::{PACKET, PacketStack, RayPacket};
 use seethru::render::camera_rays::CameraRays;
 use seethru::render::moving::MovingParts;
 use seethru::render::ray::TraceRay;
+use seethru::render::render_job::RenderJob;
 use seethru::render::simd::Isa;
 use seethru::render::views::View;
 use seethru::scene::Scene;
@@ -424,7 +425,11 @@ fn build_and_render_within(
                 spp: 1,
                 progress: false,
             };
-            let _ = ctx.render(&camera, view_bit::TRUTH, settings, "truth");
+            let _ = ctx.render(
+                RenderJob::new(&camera, view_bit::TRUTH)
+                    .settings(settings)
+                    .label("truth"),
+            );
         });
         let _ = send.send(ctx.map_err(|e| format!("{e:#}")));
     });

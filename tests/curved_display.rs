@@ -531,7 +531,7 @@ fn run_metrics(scene: &seethru::scene::Scene, options: &RunOptions) -> serde_jso
 /// the display's pixels show what `run`'s do: the same misregistration and PSNR.
 #[test]
 fn a_sequence_shows_the_ideal_curved_display_exactly() {
-    use seethru::measure::metrics::Flip;
+    use seethru::measure::image_metrics::Flip;
     use seethru::measure::sequence::run_sequence;
     let text = wall(
         "display_shape = \"cylinder\"\ndisplay_radius = 0.2\ndisplay_segments = 48",
@@ -819,7 +819,7 @@ fn the_border_bands_of_a_curved_display_follow_its_uvs() {
 /// does (the same PSNR and misregistration).
 #[test]
 fn a_one_column_curved_display_shows_in_a_sequence_what_run_shows() {
-    use seethru::measure::metrics::Flip;
+    use seethru::measure::image_metrics::Flip;
     use seethru::measure::sequence::run_sequence;
     let text = common::WallScene {
         display_resolution: [1, 100],

@@ -9,7 +9,7 @@ use seethru::io::frame_files::{
 };
 use seethru::io::run_dir::read_measured_frames;
 use seethru::render::frame::Frame;
-use seethru::render::{integrator::RenderContext, settings::RenderSettings};
+use seethru::render::{integrator::RenderContext, render_job::RenderJob, settings::RenderSettings};
 use seethru::scene::world::view_bit;
 use seethru::util::sampling::hash_u32;
 
@@ -20,7 +20,12 @@ fn rendered() -> Frame {
         spp: 2,
         progress: false,
     };
-    ctx.render(&camera, view_bit::TRUTH, settings, "test").0
+    ctx.render(
+        RenderJob::new(&camera, view_bit::TRUTH)
+            .settings(settings)
+            .label("test"),
+    )
+    .0
 }
 
 /// Every channel of the first layer of `path`, by name, as the exr crate reads it.

@@ -6,7 +6,7 @@ mod common;
 use common::golden;
 
 use seethru::render::views::View;
-use seethru::render::{integrator::RenderContext, settings::RenderSettings};
+use seethru::render::{integrator::RenderContext, render_job::RenderJob, settings::RenderSettings};
 use seethru::system::{options::RunOptions, pipeline::run};
 use seethru::util::color::encode_srgb8;
 
@@ -21,13 +21,12 @@ fn views_match_their_goldens() {
             camera.with_resolution(192, 108)
         };
         let (frame, _) = ctx.render(
-            &camera,
-            view.bit(),
-            RenderSettings {
-                spp: 4,
-                progress: false,
-            },
-            view.name(),
+            RenderJob::new(&camera, view.bit())
+                .settings(RenderSettings {
+                    spp: 4,
+                    progress: false,
+                })
+                .label(view.name()),
         );
         let img = image::RgbImage::from_fn(frame.width, frame.height, |x, y| {
             image::Rgb(encode_srgb8(frame.color[frame.index(x, y)]))
@@ -151,7 +150,11 @@ fn a_fisheye_frontal_render_matches_its_golden() {
         spp: 4,
         progress: false,
     };
-    let (frame, _) = ctx.render(&camera, View::Frontal.bit(), settings, "frontal");
+    let (frame, _) = ctx.render(
+        RenderJob::new(&camera, View::Frontal.bit())
+            .settings(settings)
+            .label("frontal"),
+    );
     // Every pixel's centre ray came through the lens: its world point projects back onto
     // the pixel's centre through the forward model.
     for y in 0..frame.height {

@@ -7,6 +7,7 @@ mod common;
 use glam::DVec3;
 use seethru::render::footprint::PixelRect;
 use seethru::render::integrator::RenderContext;
+use seethru::render::render_job::RenderJob;
 use seethru::render::settings::RenderSettings;
 use seethru::render::views::View;
 use seethru::system::head::{DetectError, detect, detect_in};
@@ -34,7 +35,12 @@ fn back_image(offset: DVec3) -> seethru::render::frame::Frame {
         spp: 4,
         progress: false,
     };
-    ctx.render(&back, View::Back.bit(), settings, "back").0
+    ctx.render(
+        RenderJob::new(&back, View::Back.bit())
+            .settings(settings)
+            .label("back"),
+    )
+    .0
 }
 
 /// The pixels `detect_in` says it depended on are enough: searching only them gives the

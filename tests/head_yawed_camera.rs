@@ -7,6 +7,7 @@
 mod common;
 
 use seethru::render::integrator::RenderContext;
+use seethru::render::render_job::RenderJob;
 use seethru::render::settings::RenderSettings;
 use seethru::render::views::View;
 use seethru::scene::Scene;
@@ -30,7 +31,11 @@ fn estimated(scene: Scene) -> (f64, f64, Option<String>) {
         progress: false,
     };
     let back = ctx
-        .render(&ctx.scene.back, View::Back.bit(), settings, "back")
+        .render(
+            RenderJob::new(&ctx.scene.back, View::Back.bit())
+                .settings(settings)
+                .label("back"),
+        )
         .0;
     let believed = ctx.scene.calibration.back.apply(&ctx.scene.back).unwrap();
     let fix = estimate(ctx.scene.face, &back, &believed, 0.064).unwrap();

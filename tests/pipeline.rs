@@ -6,7 +6,7 @@ mod common;
 use glam::DVec3;
 use seethru::analysis::paper::{CropParams, Side};
 use seethru::render::views::View;
-use seethru::render::{integrator::RenderContext, settings::RenderSettings};
+use seethru::render::{integrator::RenderContext, render_job::RenderJob, settings::RenderSettings};
 use seethru::scene::shapes::box_face;
 use seethru::system::display::{
     DisplayModel, DisplayPlacement, DisplaySurface, IdealMap, MISSING_ID,
@@ -231,13 +231,12 @@ fn the_head_tracker_recovers_the_eye_better_at_higher_resolution() {
         let back = ctx.scene.back.with_resolution(w, h);
         let frame = ctx
             .render(
-                &back,
-                View::Back.bit(),
-                RenderSettings {
-                    spp: 1,
-                    progress: false,
-                },
-                "back",
+                RenderJob::new(&back, View::Back.bit())
+                    .settings(RenderSettings {
+                        spp: 1,
+                        progress: false,
+                    })
+                    .label("back"),
             )
             .0;
         let detection = detect(&frame).unwrap();
@@ -483,8 +482,16 @@ fn driver_views_rendered_over_the_truth_equal_separate_renders() {
             spp: 2,
             progress: false,
         };
-        let (truth, _) = ctx.render(&driver, View::Truth.bit(), settings, "truth");
-        let (occluded, _) = ctx.render(&driver, View::Occluded.bit(), settings, "occluded");
+        let (truth, _) = ctx.render(
+            RenderJob::new(&driver, View::Truth.bit())
+                .settings(settings)
+                .label("truth"),
+        );
+        let (occluded, _) = ctx.render(
+            RenderJob::new(&driver, View::Occluded.bit())
+                .settings(settings)
+                .label("occluded"),
+        );
         assert!(r.truth.bit_identical(&truth), "{display:?} truth");
         assert!(r.occluded.bit_identical(&occluded), "{display:?} occluded");
         let mut frontal = ctx.scene.frontal;
@@ -504,18 +511,16 @@ fn driver_views_rendered_over_the_truth_equal_separate_renders() {
                 placement,
             },
         };
-        let (seethru, _) = ctx.render_seethru(&driver, &surface, settings);
+        let (seethru, _) = ctx.render(RenderJob::seethru(&driver, &surface).settings(settings));
         assert!(r.seethru.bit_identical(&seethru), "{display:?} seethru");
         // The views do differ, and only inside the display's neighbourhood was traced again.
         assert!(!truth.bit_identical(&occluded) && !occluded.bit_identical(&seethru));
         let (over, stats) = ctx.render_over(
-            &driver,
+            RenderJob::new(&driver, View::Occluded.bit())
+                .settings(settings)
+                .label("occluded"),
             &r.truth,
             View::Truth.bit(),
-            View::Occluded.bit(),
-            None,
-            settings,
-            "occluded",
         );
         assert!(stats.primary_rays < 160 * 90 * 2 / 4, "{stats:?}");
         // Only the traced rectangle is the view's own; the rest is truth's, not a copy.

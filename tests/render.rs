@@ -6,7 +6,7 @@ use glam::{DVec2, DVec3};
 use seethru::io::frame_files::{read_exr, write_exr};
 use seethru::render::frame::Frame;
 use seethru::render::views::View;
-use seethru::render::{integrator::RenderContext, settings::RenderSettings};
+use seethru::render::{integrator::RenderContext, render_job::RenderJob, settings::RenderSettings};
 use seethru::scene::world::view_bit;
 
 fn minimal_context() -> RenderContext {
@@ -25,7 +25,7 @@ fn sphere_distance(origin: DVec3, dir: DVec3, centre: DVec3, radius: f64) -> Opt
 fn sphere_and_plane_depths_are_analytic() {
     let ctx = minimal_context();
     let camera = ctx.scene.driver.with_resolution(160, 90);
-    let (frame, _) = ctx.render(&camera, view_bit::TRUTH, RenderSettings::default(), "test");
+    let (frame, _) = ctx.render(RenderJob::new(&camera, view_bit::TRUTH).label("test"));
     let (mut sphere_pixels, mut ground_pixels) = (0, 0);
     for y in 0..frame.height {
         for x in 0..frame.width {
@@ -88,7 +88,14 @@ fn images_do_not_depend_on_the_thread_count() {
                 .num_threads(threads)
                 .build()
                 .unwrap();
-            pool.install(|| ctx.render(&camera, view.bit(), settings, "test").0)
+            pool.install(|| {
+                ctx.render(
+                    RenderJob::new(&camera, view.bit())
+                        .settings(settings)
+                        .label("test"),
+                )
+                .0
+            })
         };
         let (one, two, three) = (render(1), render(2), render(3));
         assert!(
@@ -104,13 +111,12 @@ fn images_do_not_depend_on_the_thread_count() {
 fn exr_round_trip_keeps_every_aov_bit_exact() {
     let ctx = minimal_context();
     let (frame, _) = ctx.render(
-        &ctx.scene.driver,
-        view_bit::TRUTH,
-        RenderSettings {
-            spp: 2,
-            progress: false,
-        },
-        "test",
+        RenderJob::new(&ctx.scene.driver, view_bit::TRUTH)
+            .settings(RenderSettings {
+                spp: 2,
+                progress: false,
+            })
+            .label("test"),
     );
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("frame.exr");
@@ -127,12 +133,7 @@ fn simple_exr_readers_find_the_colour_as_plain_rgba() {
     // first part. They must get the linear colour, bit for bit, and the AOV layers must sit
     // under the names docs/reference/outputs.md documents.
     let ctx = minimal_context();
-    let (frame, _) = ctx.render(
-        &ctx.scene.driver,
-        view_bit::TRUTH,
-        RenderSettings::default(),
-        "test",
-    );
+    let (frame, _) = ctx.render(RenderJob::new(&ctx.scene.driver, view_bit::TRUTH).label("test"));
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("frame.exr");
     write_exr(&frame, &path).unwrap();
@@ -187,24 +188,22 @@ fn more_samples_smooth_edges_but_keep_centre_aovs() {
     let ctx = minimal_context();
     let one = ctx
         .render(
-            &ctx.scene.driver,
-            view_bit::TRUTH,
-            RenderSettings {
-                spp: 1,
-                progress: false,
-            },
-            "t",
+            RenderJob::new(&ctx.scene.driver, view_bit::TRUTH)
+                .settings(RenderSettings {
+                    spp: 1,
+                    progress: false,
+                })
+                .label("t"),
         )
         .0;
     let many = ctx
         .render(
-            &ctx.scene.driver,
-            view_bit::TRUTH,
-            RenderSettings {
-                spp: 16,
-                progress: false,
-            },
-            "t",
+            RenderJob::new(&ctx.scene.driver, view_bit::TRUTH)
+                .settings(RenderSettings {
+                    spp: 16,
+                    progress: false,
+                })
+                .label("t"),
         )
         .0;
     assert_eq!(one.object_id, many.object_id);
@@ -220,8 +219,8 @@ fn more_samples_smooth_edges_but_keep_centre_aovs() {
 }
 
 /// Every tracer: one ray at a time, and 4×4 packets on each instruction set this CPU has.
-fn tracers() -> Vec<seethru::render::integrator::Tracer> {
-    use seethru::render::integrator::Tracer;
+fn tracers() -> Vec<seethru::render::render_job::Tracer> {
+    use seethru::render::render_job::Tracer;
     use seethru::render::simd::Isa;
     let mut out = vec![Tracer::PerRay];
     out.extend(
@@ -256,12 +255,22 @@ fn packets_render_every_view_as_the_per_ray_path_does_on_every_isa_and_thread_co
     for view in [View::Truth, View::Occluded, View::Frontal, View::Back] {
         let camera = view.camera(&ctx.scene).with_resolution(70, 41);
         let want = on_threads(1, || {
-            ctx.render_traced(&camera, view.bit(), settings, tracers[0])
+            ctx.render(
+                RenderJob::new(&camera, view.bit())
+                    .settings(settings)
+                    .tracer(tracers[0]),
+            )
+            .0
         });
         for &tracer in &tracers {
             for threads in [1, 3] {
                 let got = on_threads(threads, || {
-                    ctx.render_traced(&camera, view.bit(), settings, tracer)
+                    ctx.render(
+                        RenderJob::new(&camera, view.bit())
+                            .settings(settings)
+                            .tracer(tracer),
+                    )
+                    .0
                 });
                 assert!(
                     got.bit_identical(&want),
@@ -299,21 +308,37 @@ fn packets_render_every_view_as_the_per_ray_path_does_on_every_isa_and_thread_co
             },
         };
         let driver = ctx.scene.driver.with_resolution(70, 41);
-        let want = ctx.render_seethru_traced(&driver, &surface, settings, tracers[0]);
+        let want = ctx
+            .render(
+                RenderJob::seethru(&driver, &surface)
+                    .settings(settings)
+                    .tracer(tracers[0]),
+            )
+            .0;
         // The display covers some pixels: the comparison sees it.
         let shown = want
             .object_id
             .iter()
             .zip(
-                &ctx.render_traced(&driver, View::Occluded.bit(), settings, tracers[0])
-                    .object_id,
+                &ctx.render(
+                    RenderJob::new(&driver, View::Occluded.bit())
+                        .settings(settings)
+                        .tracer(tracers[0]),
+                )
+                .0
+                .object_id,
             )
             .filter(|(a, b)| a != b)
             .count();
         assert!(shown > 20, "{display:?}: {shown}");
         for &tracer in &tracers {
             let got = on_threads(2, || {
-                ctx.render_seethru_traced(&driver, &surface, settings, tracer)
+                ctx.render(
+                    RenderJob::seethru(&driver, &surface)
+                        .settings(settings)
+                        .tracer(tracer),
+                )
+                .0
             });
             assert!(got.bit_identical(&want), "{display:?} {tracer:?}");
         }
@@ -359,9 +384,21 @@ fn packets_trace_a_sequences_moving_part_as_the_per_ray_path_does() {
         (s.driver.with_resolution(90, 50), view_bit::OCCLUDED),
         (s.back.with_resolution(66, 50), view_bit::BACK),
     ] {
-        let want = layered.render_traced(&camera, view, settings, tracers[0]);
+        let want = layered
+            .render(
+                RenderJob::new(&camera, view)
+                    .settings(settings)
+                    .tracer(tracers[0]),
+            )
+            .0;
         for &tracer in &tracers[1..] {
-            let got = layered.render_traced(&camera, view, settings, tracer);
+            let got = layered
+                .render(
+                    RenderJob::new(&camera, view)
+                        .settings(settings)
+                        .tracer(tracer),
+                )
+                .0;
             assert!(got.bit_identical(&want), "view {view} {tracer:?}");
         }
     }

@@ -7,9 +7,10 @@ use std::path::Path;
 
 use seethru::analysis::dynamic::{Motion, dynamic_misregistration};
 use seethru::analysis::physical::ARCMIN_PER_RAD;
-use seethru::measure::metrics::Flip;
+use seethru::measure::image_metrics::Flip;
 use seethru::measure::sequence::{SequenceStepper, run_sequence};
 use seethru::render::integrator::RenderContext;
+use seethru::render::render_job::RenderJob;
 use seethru::render::settings::RenderSettings;
 use seethru::scene::world::view_bit;
 use seethru::system::options::{Method, RunOptions, WorkingDistance};
@@ -195,8 +196,16 @@ fn the_moving_part_renders_as_a_whole_rebuilt_world() {
         (s.driver.with_resolution(128, 72), view_bit::OCCLUDED),
         (s.back.with_resolution(96, 72), view_bit::BACK),
     ] {
-        let (a, _) = layered.render(&camera, view, settings, "layered");
-        let (b, _) = whole.render(&camera, view, settings, "whole");
+        let (a, _) = layered.render(
+            RenderJob::new(&camera, view)
+                .settings(settings)
+                .label("layered"),
+        );
+        let (b, _) = whole.render(
+            RenderJob::new(&camera, view)
+                .settings(settings)
+                .label("whole"),
+        );
         let differ = a
             .object_id
             .iter()

@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 use seethru::geometry::camera::Camera;
 use seethru::render::frame::Frame;
 use seethru::render::integrator::RenderContext;
+use seethru::render::render_job::RenderJob;
 use seethru::render::settings::{MAX_SPP, RenderSettings, resized};
 use seethru::render::views::View;
 use seethru::scene::Scene;
@@ -260,7 +261,12 @@ impl PyScene {
         };
         let render = move |frame: &mut Frame| -> anyhow::Result<Arc<RenderContext>> {
             let context = context_for(cached, scene)?;
-            context.render_into(&camera, view.bit(), settings, frame, view.name());
+            context.render_into(
+                RenderJob::new(&camera, view.bit())
+                    .settings(settings)
+                    .label(view.name()),
+                frame,
+            );
             Ok(context)
         };
         match out {

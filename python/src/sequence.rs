@@ -18,7 +18,7 @@ use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
-use seethru::measure::metrics::Flip;
+use seethru::measure::image_metrics::Flip;
 use seethru::measure::sequence::{FrameRecord, Measuring, SequenceStepper};
 use seethru::render::frame::Frame;
 use seethru::render::settings::MAX_SPP;

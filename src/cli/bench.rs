@@ -9,7 +9,8 @@ use seethru::io::output_paths::{Input, check_paths};
 use seethru::render::accel::Accel;
 use seethru::render::frame::Frame;
 use seethru::render::integrator::RenderContext;
-use seethru::render::settings::{RenderSettings, check_resolution};
+use seethru::render::render_job::RenderJob;
+use seethru::render::settings::check_resolution;
 use seethru::render::simd::Isa;
 use seethru::render::throughput::{
     Batch, camera_batch, cosine_batch, shadow_batch, trace_any, trace_any_per_ray, trace_closest,
@@ -301,11 +302,8 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         let mut frame = Frame::new(camera.width, camera.height);
         let (seconds, busy) = timed_busy(options.repeat, threads, || {
             ctx.render_into(
-                &camera,
-                view.bit(),
-                RenderSettings::default(),
+                RenderJob::new(&camera, view.bit()).label(view.name()),
                 &mut frame,
-                view.name(),
             );
         });
         let ms: Vec<f64> = seconds.iter().map(|s| s * 1e3).collect();

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use seethru::render::integrator::RenderContext;
+use seethru::render::render_job::RenderJob;
 use seethru::render::settings::RenderSettings;
 use seethru::render::views::View;
 use seethru::system::compensation::{ModelPlane, compute_crop};
@@ -39,7 +40,11 @@ pub fn method_costs(ctx: &RenderContext, repeat: usize, quiet: bool) -> Result<s
             spp: 1,
             progress: false,
         };
-        let (frontal, _) = ctx.render(&scene.frontal, View::Frontal.bit(), settings, "frontal");
+        let (frontal, _) = ctx.render(
+            RenderJob::new(&scene.frontal, View::Frontal.bit())
+                .settings(settings)
+                .label("frontal"),
+        );
         let eye = scene.eye();
         let size = scene.obstacle.display_resolution;
         let crop = compute_crop(

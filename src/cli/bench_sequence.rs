@@ -3,7 +3,7 @@
 //! loop with the truth and the metrics, at 640×360, 1 spp, on the bench's threads.
 
 use anyhow::Result;
-use seethru::measure::metrics::Flip;
+use seethru::measure::image_metrics::Flip;
 use seethru::measure::sequence::{Measuring, SequenceRun, run_sequence};
 use seethru::scene::Scene;
 use seethru::system::options::{HeadSource, Outside, RunOptions};

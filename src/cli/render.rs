@@ -7,6 +7,7 @@ use seethru::io::frame_files::{ExrContent, write_frame};
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
 use seethru::render::integrator::RenderContext;
+use seethru::render::render_job::RenderJob;
 use seethru::render::settings::{RenderSettings, check_spp, resized};
 use seethru::render::views::View;
 use seethru::scene::Scene;
@@ -82,7 +83,11 @@ fn render_views(
     };
     let mut rendered = Vec::new();
     for (view, camera) in views.iter().zip(&cameras) {
-        let (frame, stats) = context.render(camera, view.bit(), settings, view.name());
+        let (frame, stats) = context.render(
+            RenderJob::new(camera, view.bit())
+                .settings(settings)
+                .label(view.name()),
+        );
         write_frame(&frame, staged.path(), view.name(), exr)?;
         rendered.push(format!(
             "{} {}×{} in {:.2} s",

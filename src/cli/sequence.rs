@@ -10,7 +10,7 @@ use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
 use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
 use seethru::measure::headline::{RunKind, summary_text};
-use seethru::measure::metrics::Flip;
+use seethru::measure::image_metrics::Flip;
 use seethru::measure::sequence::{Measuring, SequenceRun, head_warning, run_sequence_hazards};
 use seethru::measure::sequence_files::{
     Preview, frames_csv, hazard_figure, latency_figure, over_time_figure, summary,

@@ -10,6 +10,7 @@ use crate::measure::maps::{heat_color, p99_top};
 use crate::measure::metrics::{MetricMaps, measure};
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
+use crate::render::render_job::RenderJob;
 use crate::render::settings::RenderSettings;
 use crate::render::views::View;
 use crate::system::depth_sensor::SensorKind;
@@ -168,7 +169,11 @@ pub fn compare(
     }
     let progress = Progress::new("compare", candidates.len() + 1, base.progress);
     let driver = driver_camera(scene, base)?;
-    let (truth, _) = ctx.render(&driver, View::Truth.bit(), settings, "truth");
+    let (truth, _) = ctx.render(
+        RenderJob::new(&driver, View::Truth.bit())
+            .settings(settings)
+            .label("truth"),
+    );
     progress.advance(1);
     let mut out = Vec::new();
     for (&candidate, reason) in candidates.iter().zip(unavailable) {

@@ -13,6 +13,7 @@ use glam::{DAffine3, DVec3};
 use crate::geometry::camera::Camera;
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
+use crate::render::render_job::RenderJob;
 use crate::render::settings::RenderSettings;
 use crate::render::views::View;
 use crate::scene::Scene;
@@ -107,7 +108,11 @@ pub fn posed_view(
         spp: 1,
         progress: false,
     };
-    let (frame, _) = ctx.render(back, View::Back.bit(), settings, "back");
+    let (frame, _) = ctx.render(
+        RenderJob::new(back, View::Back.bit())
+            .settings(settings)
+            .label("back"),
+    );
     Ok((frame, eye, facing_deg + yaw_deg))
 }
 

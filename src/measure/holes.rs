@@ -8,8 +8,10 @@ use std::path::Path;
 use anyhow::Result;
 use serde_json::json;
 
+use crate::measure::image_metrics::psnr;
 use crate::measure::maps::write_mask_png;
-use crate::measure::metrics::{MetricMaps, psnr, stats};
+use crate::measure::metrics::MetricMaps;
+use crate::measure::metrics_json::stats;
 use crate::render::frame::Frame;
 use crate::render::frame_over::FrameView;
 use crate::scene::Obstacle;

@@ -14,7 +14,7 @@ use exr::prelude::FlatSamples;
 use serde_json::{Value, json};
 
 use crate::io::run_dir::MAX_RUN_JSON_BYTES;
-use crate::measure::metrics::{masked_ssim_map, psnr};
+use crate::measure::image_metrics::{masked_ssim_map, psnr};
 use crate::scene::limits::{MAX_PIXELS, MAX_RESOLUTION};
 use crate::util::color::{encode_srgb8, luma};
 use crate::util::input_file::{not_a_file, read_input_text};

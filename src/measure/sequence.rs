@@ -11,11 +11,13 @@ use obvhs::aabb::Aabb;
 
 use crate::geometry::opencv::camera_json;
 use crate::measure::hazard::{HAZARD_BOUND_ARCMIN, HazardSeen, hazard_seen};
-use crate::measure::metrics::{Flip, MetricMaps, measure_with};
+use crate::measure::image_metrics::Flip;
+use crate::measure::metrics::{MetricMaps, measure_with};
 use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::Frame;
 use crate::render::frame_over::FrameView;
 use crate::render::integrator::RenderContext;
+use crate::render::render_job::RenderJob;
 use crate::render::settings::RenderSettings;
 use crate::scene::world::view_bit;
 use crate::scene::{Obstacle, Scene};
@@ -508,25 +510,21 @@ pub fn render_truth_and_occluded(
     last: PixelRect,
 ) -> PixelRect {
     let driver = ctx.scene.driver;
-    ctx.render_rect(
-        &driver,
-        view_bit::TRUTH,
-        None,
-        settings,
-        region,
+    ctx.render_into(
+        RenderJob::new(&driver, view_bit::TRUTH)
+            .settings(settings)
+            .region(region)
+            .label("truth"),
         truth,
-        "truth",
     );
     copy_rect(truth, occluded, union(region, last));
     let around = ctx.difference_region(&driver, view_bit::TRUTH, view_bit::OCCLUDED);
-    ctx.render_rect(
-        &driver,
-        view_bit::OCCLUDED,
-        None,
-        settings,
-        around,
+    ctx.render_into(
+        RenderJob::new(&driver, view_bit::OCCLUDED)
+            .settings(settings)
+            .region(around)
+            .label("occluded"),
         occluded,
-        "occluded",
     );
     around
 }

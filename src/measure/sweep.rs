@@ -20,6 +20,7 @@ use crate::measure::sweep_csv::{
 use crate::measure::sweep_grid::{Param, check_grid_size, combinations, configure};
 use crate::measure::sweep_shard::{Shard, join};
 use crate::render::integrator::{RenderContext, same_geometry};
+use crate::render::render_job::RenderJob;
 use crate::render::settings::RenderSettings;
 use crate::scene::Scene;
 use crate::scene::fingerprint::fingerprint;
@@ -187,8 +188,11 @@ pub fn sweep(
                 progress: false,
             };
             let driver = driver_camera(scene, run_options)?;
-            let (truth, _) =
-                worlds[world_of[members[0]]].render(&driver, view_bit::TRUTH, settings, "truth");
+            let (truth, _) = worlds[world_of[members[0]]].render(
+                RenderJob::new(&driver, view_bit::TRUTH)
+                    .settings(settings)
+                    .label("truth"),
+            );
             members.par_iter().try_for_each(|&j| -> Result<()> {
                 let (index, scene, run_options) = &jobs[j];
                 let config = &configs[*index];

@@ -1,69 +1,36 @@
 //! The integrator: primary rays per pixel, Lambert shading with the sun (hard shadow ray)
-//! and sky ambient, textures, and the AOVs of the pixel-centre ray.
+//! and sky ambient, textures, and the AOVs of the pixel-centre ray. A render job
+//! (render/render_job.rs) runs it over the bands of a frame.
 //!
-//! Frames are rendered in bands of rows on the rayon pool, each band written straight into
-//! the frame's buffers; every pixel depends only on its own coordinates, so images are the
-//! same for any number of threads. Views of one camera that differ only by a few primitives
-//! (`truth`, `occluded`, `seethru`) are rendered once and re-rendered only where those
-//! primitives can be seen ([`RenderContext::render_over`]).
-//!
-//! Within a band, pixels are traced in 4×4 tiles ([`Tracer::Packets`]): the tile's camera rays
-//! as one packet ([`crate::render::bvh_packet`]), then the shadow rays toward the sun from its
-//! lit hits as another. The per-ray path ([`Tracer::PerRay`]) gives the same image bit for bit
-//! and is the packets' twin in tests.
+//! A pixel is traced on its own (`render_pixel`), or with the others of its 4×4 tile
+//! (`render_tile`): the tile's camera rays as one packet ([`crate::render::bvh_packet`]), then
+//! the shadow rays toward the sun from its lit hits as another. Both give the same image bit
+//! for bit; the per-ray path is the packets' twin in tests.
 
 use std::sync::Arc;
-use std::time::Instant;
 
 use anyhow::Result;
 use glam::{DAffine3, Vec3};
-use rayon::prelude::*;
 
 use crate::geometry::camera::Camera;
-use crate::render::accel::{Accel, Difference, make_ray};
+use crate::render::accel::{Accel, make_ray};
 use crate::render::bvh::Stack;
 use crate::render::bvh_packet::{PACKET, PacketStack, RayPacket};
 use crate::render::camera_rays::CameraRays;
-use crate::render::footprint::{PixelRect, footprint};
-use crate::render::frame::{Frame, Pixel, Rows};
-use crate::render::frame_over::FrameOver;
+use crate::render::frame::{Pixel, Rows};
 use crate::render::moving::MovingLayer;
 use crate::render::ray::{Hit, TraceRay};
 use crate::render::screen::{Screen, Shown};
-use crate::render::settings::RenderSettings;
 use crate::render::simd::Isa;
 use crate::render::sky::SkyModel;
 use crate::scene::Scene;
 use crate::scene::texture::Texture;
 use crate::scene::world::{SurfaceHit, SurfaceMaterial, World, view_bit};
-use crate::util::progress::Progress;
 use crate::util::sampling::pixel_offset;
 
 thread_local! {
     /// The traversal stack of [`RenderContext::trace`].
     static STACK: std::cell::RefCell<Stack> = std::cell::RefCell::new(Stack::new());
-}
-
-/// Rows per rayon task: small enough to balance many threads, large enough to amortise; a
-/// band is one row of tiles.
-const BAND_ROWS: u32 = 4;
-/// Columns of a tile: a band's rows × these make one packet.
-const TILE_COLUMNS: u32 = PACKET as u32 / BAND_ROWS;
-
-/// How a render traces its camera rays and the sun's shadow rays.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Tracer {
-    /// One ray at a time: the packets' twin.
-    PerRay,
-    /// 4×4 tiles of pixels as packets of 16 rays, on the given instruction set's kernels.
-    Packets(Isa),
-}
-
-impl Tracer {
-    /// Packets on the CPU's widest instruction set: what every render uses.
-    pub fn best() -> Tracer {
-        Tracer::Packets(Isa::best())
-    }
 }
 
 /// The parts of Lambert shading known before the shadow ray is traced.
@@ -74,13 +41,6 @@ struct Shading {
     light: Vec3,
     /// Cosine of the sun to the normal: a shadow ray is traced where it is positive.
     cos: f32,
-}
-
-#[derive(Clone, Copy, Debug, Default)]
-pub struct RenderStats {
-    pub primary_rays: u64,
-    pub shadow_rays: u64,
-    pub seconds: f64,
 }
 
 /// Everything needed to render a scene from any camera. The world, its hierarchy and the
@@ -97,12 +57,31 @@ pub struct RenderContext {
 }
 
 /// What every pixel of one render shares.
-struct PixelJob<'a> {
+pub(super) struct PixelJob<'a> {
     rays: CameraRays,
     camera_from_world: DAffine3,
     view: u8,
     display: Option<&'a dyn Screen>,
     spp: u32,
+}
+
+impl<'a> PixelJob<'a> {
+    /// The pixels of `camera` in `view` (`display`: what the display shows, for `seethru`),
+    /// `spp` samples each.
+    pub(super) fn new(
+        camera: &Camera,
+        view: u8,
+        display: Option<&'a dyn Screen>,
+        spp: u32,
+    ) -> PixelJob<'a> {
+        PixelJob {
+            rays: CameraRays::new(camera),
+            camera_from_world: camera.world_from_camera.inverse(),
+            view,
+            display,
+            spp,
+        }
+    }
 }
 
 impl RenderContext {
@@ -150,269 +129,8 @@ impl RenderContext {
         })
     }
 
-    /// Renders the frame seen by `camera`, showing the primitives visible in `view`
-    /// (a [`view_bit`]).
-    pub fn render(
-        &self,
-        camera: &Camera,
-        view: u8,
-        settings: RenderSettings,
-        label: &str,
-    ) -> (Frame, RenderStats) {
-        let mut frame = Frame::new(camera.width, camera.height);
-        let stats = self.render_into(camera, view, settings, &mut frame, label);
-        (frame, stats)
-    }
-
-    /// [`RenderContext::render`] into an existing frame of the camera's size, so that a
-    /// sequence of renders reuses its buffers.
-    pub fn render_into(
-        &self,
-        camera: &Camera,
-        view: u8,
-        settings: RenderSettings,
-        frame: &mut Frame,
-        label: &str,
-    ) -> RenderStats {
-        let region = PixelRect::full(camera);
-        self.render_rect(camera, view, None, settings, region, frame, label)
-    }
-
-    /// The `seethru` view: the driver's eye with the obstacle present and its display showing
-    /// `display`. Where a ray meets the display face, the pixel takes the display pixel there
-    /// — colour and every AOV, so the frame holds the world point and id the display shows.
-    pub fn render_seethru(
-        &self,
-        camera: &Camera,
-        display: &dyn Screen,
-        settings: RenderSettings,
-    ) -> (Frame, RenderStats) {
-        let mut frame = Frame::new(camera.width, camera.height);
-        let region = PixelRect::full(camera);
-        let stats = self.render_rect(
-            camera,
-            view_bit::SEETHRU,
-            Some(display),
-            settings,
-            region,
-            &mut frame,
-            "seethru",
-        );
-        (frame, stats)
-    }
-
-    /// Renders `view` (with `display` for the `seethru` view) from `camera`, given `base`, the
-    /// same camera's frame in `base_view` with the same settings: only the pixels where the
-    /// two views can differ are traced, the others are `base`'s, shared rather than copied.
-    /// The result is bit for bit the frame [`RenderContext::render`] (or
-    /// [`RenderContext::render_seethru`]) gives.
-    #[allow(clippy::too_many_arguments)]
-    pub fn render_over(
-        &self,
-        camera: &Camera,
-        base: &Arc<Frame>,
-        base_view: u8,
-        view: u8,
-        display: Option<&dyn Screen>,
-        settings: RenderSettings,
-        label: &str,
-    ) -> (FrameOver, RenderStats) {
-        assert_eq!((base.width, base.height), (camera.width, camera.height));
-        let region = self.difference_region(camera, base_view, view);
-        let mut patch = Frame::new(region.x1 - region.x0, region.y1 - region.y0);
-        let bands = patch.bands_mut_at(BAND_ROWS, region.x0, region.y0);
-        let tracer = Tracer::best();
-        let stats = self.render_bands(
-            camera, view, display, settings, region, bands, label, tracer,
-        );
-        (FrameOver::new(Arc::clone(base), region, patch), stats)
-    }
-
-    /// The pixels of `camera` where views `a` and `b` can differ (see [`Accel::difference`]).
-    pub fn difference_region(&self, camera: &Camera, a: u8, b: u8) -> PixelRect {
-        let difference = match &self.moving {
-            Some(m) => self.accel.difference(a, b).union(m.accel.difference(a, b)),
-            None => self.accel.difference(a, b),
-        };
-        match difference {
-            Difference::None => PixelRect {
-                x0: 0,
-                y0: 0,
-                x1: 0,
-                y1: 0,
-            },
-            Difference::Within(bounds) => footprint(camera, &bounds),
-            Difference::Everywhere => PixelRect::full(camera),
-        }
-    }
-
-    /// Renders only the pixels of `region` of `view` (with `display` for `seethru`) into
-    /// `frame`, a frame of the camera's size; the other pixels keep what they held. Each
-    /// pixel is what [`RenderContext::render`] gives it.
-    #[allow(clippy::too_many_arguments)]
-    pub fn render_rect(
-        &self,
-        camera: &Camera,
-        view: u8,
-        display: Option<&dyn Screen>,
-        settings: RenderSettings,
-        region: PixelRect,
-        frame: &mut Frame,
-        label: &str,
-    ) -> RenderStats {
-        let tracer = Tracer::best();
-        self.render_rect_traced(
-            camera, view, display, settings, region, frame, label, tracer,
-        )
-    }
-
-    /// [`RenderContext::render`] traced by `tracer`: every tracer gives the same frame.
-    pub fn render_traced(
-        &self,
-        camera: &Camera,
-        view: u8,
-        settings: RenderSettings,
-        tracer: Tracer,
-    ) -> Frame {
-        let mut frame = Frame::new(camera.width, camera.height);
-        let region = PixelRect::full(camera);
-        self.render_rect_traced(camera, view, None, settings, region, &mut frame, "", tracer);
-        frame
-    }
-
-    /// [`RenderContext::render_seethru`] traced by `tracer`.
-    pub fn render_seethru_traced(
-        &self,
-        camera: &Camera,
-        display: &dyn Screen,
-        settings: RenderSettings,
-        tracer: Tracer,
-    ) -> Frame {
-        let mut frame = Frame::new(camera.width, camera.height);
-        let region = PixelRect::full(camera);
-        let view = view_bit::SEETHRU;
-        self.render_rect_traced(
-            camera,
-            view,
-            Some(display),
-            settings,
-            region,
-            &mut frame,
-            "",
-            tracer,
-        );
-        frame
-    }
-
-    /// [`RenderContext::render_rect`] traced by `tracer`.
-    #[allow(clippy::too_many_arguments)]
-    fn render_rect_traced(
-        &self,
-        camera: &Camera,
-        view: u8,
-        display: Option<&dyn Screen>,
-        settings: RenderSettings,
-        region: PixelRect,
-        frame: &mut Frame,
-        label: &str,
-        tracer: Tracer,
-    ) -> RenderStats {
-        assert_eq!((frame.width, frame.height), (camera.width, camera.height));
-        let bands = frame.bands_mut(BAND_ROWS);
-        self.render_bands(
-            camera, view, display, settings, region, bands, label, tracer,
-        )
-    }
-
-    /// Renders the pixels of `region` of `view` into `bands` (of a frame of the camera's size,
-    /// or of the region alone), each pixel as [`RenderContext::render`] gives it.
-    #[allow(clippy::too_many_arguments)]
-    fn render_bands(
-        &self,
-        camera: &Camera,
-        view: u8,
-        display: Option<&dyn Screen>,
-        settings: RenderSettings,
-        region: PixelRect,
-        bands: Vec<Rows<'_>>,
-        label: &str,
-        tracer: Tracer,
-    ) -> RenderStats {
-        let start = Instant::now();
-        let job = PixelJob {
-            rays: CameraRays::new(camera),
-            camera_from_world: camera.world_from_camera.inverse(),
-            view,
-            display,
-            spp: settings.spp,
-        };
-        let bands: Vec<_> = bands
-            .into_iter()
-            .filter(|b| b.y < region.y1 && b.y + b.len() > region.y0)
-            .collect();
-        let progress = Progress::new(format!("rendering {label}"), bands.len(), settings.progress);
-        let shadow_rays: u64 = bands
-            .into_par_iter()
-            .map(|mut band| {
-                Stack::with_thread_stack(|stack| {
-                    PacketStack::with_thread_stack(|packet_stack| {
-                        let mut shadows = 0;
-                        // A cancelled render (render/cancel.rs) leaves its remaining bands as they are.
-                        if crate::render::cancel::requested() {
-                            return shadows;
-                        }
-                        // The band's rows inside the region.
-                        let rows = region.y0.max(band.y) - band.y
-                            ..region.y1.min(band.y + band.len()) - band.y;
-                        match tracer {
-                            Tracer::PerRay => {
-                                for row in rows {
-                                    for x in region.x0..region.x1 {
-                                        let pixel = self.render_pixel(
-                                            &job,
-                                            x,
-                                            band.y + row,
-                                            stack,
-                                            &mut shadows,
-                                        );
-                                        band.set(x, row, pixel);
-                                    }
-                                }
-                            }
-                            Tracer::Packets(isa) => {
-                                for x0 in (region.x0..region.x1).step_by(TILE_COLUMNS as usize) {
-                                    let tile = Tile {
-                                        isa,
-                                        y: band.y,
-                                        rows: rows.clone(),
-                                        columns: x0..(x0 + TILE_COLUMNS).min(region.x1),
-                                    };
-                                    self.render_tile(
-                                        &job,
-                                        &tile,
-                                        &mut band,
-                                        stack,
-                                        packet_stack,
-                                        &mut shadows,
-                                    );
-                                }
-                            }
-                        }
-                        progress.advance(1);
-                        shadows
-                    })
-                })
-            })
-            .sum();
-        progress.finish();
-        RenderStats {
-            primary_rays: region.pixels() * u64::from(settings.spp),
-            shadow_rays,
-            seconds: start.elapsed().as_secs_f64(),
-        }
-    }
-
-    fn render_pixel(
+    /// One pixel: its `spp` samples, each ray traced on its own.
+    pub(super) fn render_pixel(
         &self,
         job: &PixelJob,
         x: u32,
@@ -450,11 +168,11 @@ impl RenderContext {
     /// The pixels of `tile` of `band`, as [`RenderContext::render_pixel`] gives each: its
     /// camera rays traced as one packet, then the sun's shadow rays from its lit hits as
     /// another, sample by sample.
-    fn render_tile(
+    pub(super) fn render_tile(
         &self,
         job: &PixelJob,
         tile: &Tile,
-        band: &mut crate::render::frame::Rows,
+        band: &mut Rows,
         stack: &mut Stack,
         packet_stack: &mut PacketStack,
         shadows: &mut u64,
@@ -743,11 +461,11 @@ impl RenderContext {
 
 /// The pixels of one packet: a band's `rows` (counted from the band's first row, frame row
 /// `y`) × `columns`.
-struct Tile {
-    isa: Isa,
-    y: u32,
-    rows: std::ops::Range<u32>,
-    columns: std::ops::Range<u32>,
+pub(super) struct Tile {
+    pub(super) isa: Isa,
+    pub(super) y: u32,
+    pub(super) rows: std::ops::Range<u32>,
+    pub(super) columns: std::ops::Range<u32>,
 }
 
 /// The AOVs of a pixel's centre sample (its colour is set after): the surface `hit` along

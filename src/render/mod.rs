@@ -14,6 +14,7 @@ pub mod integrator;
 pub mod moving;
 pub mod packets;
 pub mod ray;
+pub mod render_job;
 pub mod screen;
 pub mod settings;
 pub mod simd;

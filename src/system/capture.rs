@@ -19,6 +19,7 @@ use crate::geometry::camera::Camera;
 use crate::geometry::opencv::camera_json;
 use crate::render::frame::{Frame, Pixel};
 use crate::render::integrator::RenderContext;
+use crate::render::render_job::RenderJob;
 use crate::render::settings::{RenderSettings, check_spp};
 use crate::render::views::View;
 use crate::system::calibration_json::calibration_json;
@@ -92,7 +93,14 @@ pub fn capture(ctx: &RenderContext, options: &RunOptions, with_depth: bool) -> R
         spp: options.spp,
         progress: options.progress,
     };
-    let render = |camera, view: View| ctx.render(camera, view.bit(), settings, view.name()).0;
+    let render = |camera, view: View| {
+        ctx.render(
+            RenderJob::new(camera, view.bit())
+                .settings(settings)
+                .label(view.name()),
+        )
+        .0
+    };
     let back = render(&scene.back, View::Back);
     let frontal = render(&scene.frontal, View::Frontal);
     let (eye, fix) = eye_for_compensation(scene, &back, options)?;

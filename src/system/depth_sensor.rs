@@ -16,6 +16,7 @@ use anyhow::{Result, bail};
 use crate::geometry::camera::Camera;
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
+use crate::render::render_job::RenderJob;
 use crate::render::settings::RenderSettings;
 use crate::scene::world::view_bit;
 use crate::system::head::gaussian;
@@ -221,9 +222,13 @@ pub fn sense(
             spp: 1,
             progress: false,
         };
-        ctx.render(&camera, view_bit::FRONTAL, settings, "depth sensor")
-            .0
-            .camera_z
+        ctx.render(
+            RenderJob::new(&camera, view_bit::FRONTAL)
+                .settings(settings)
+                .label("depth sensor"),
+        )
+        .0
+        .camera_z
     };
     let noise_seed = hash_words(&[seed, 0xDE97_5E45]);
     let inverse_depth = depth

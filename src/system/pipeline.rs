@@ -14,6 +14,7 @@ use crate::geometry::homography::homography;
 use crate::render::frame::Frame;
 use crate::render::frame_over::{FrameOver, FrameView};
 use crate::render::integrator::RenderContext;
+use crate::render::render_job::RenderJob;
 use crate::render::settings::{RenderSettings, check_spp};
 use crate::render::views::View;
 use crate::scene::world::view_bit;
@@ -531,7 +532,11 @@ pub fn run_staged(
     let mut timings = serde_json::Map::new();
     let timed =
         |timings: &mut serde_json::Map<String, serde_json::Value>, camera: &Camera, view: View| {
-            let (frame, stats) = ctx.render(camera, view.bit(), settings, view.name());
+            let (frame, stats) = ctx.render(
+                RenderJob::new(camera, view.bit())
+                    .settings(settings)
+                    .label(view.name()),
+            );
             timings.insert(view.name().into(), json!(stats.seconds));
             frame
         };
@@ -591,13 +596,11 @@ pub fn run_staged(
     };
     let truth = RunViews::set("truth", &views.truth, truth, ready);
     let (occluded, stats) = ctx.render_over(
-        &driver,
+        RenderJob::new(&driver, view_bit::OCCLUDED)
+            .settings(settings)
+            .label("occluded"),
         truth,
         view_bit::TRUTH,
-        view_bit::OCCLUDED,
-        None,
-        settings,
-        "occluded",
     );
     timings.insert("occluded".into(), json!(stats.seconds));
     RunViews::set("occluded", &views.occluded, occluded, ready);
@@ -618,13 +621,9 @@ pub fn run_staged(
         },
     };
     let (seethru, stats) = ctx.render_over(
-        &driver,
+        RenderJob::seethru(&driver, &surface).settings(settings),
         truth,
         view_bit::TRUTH,
-        view_bit::SEETHRU,
-        Some(&surface),
-        settings,
-        "seethru",
     );
     timings.insert("seethru".into(), json!(stats.seconds));
     RunViews::set("seethru", &views.seethru, seethru, ready);

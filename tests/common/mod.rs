@@ -302,7 +302,9 @@ pub fn expected_coverage(
 
 /// How a test measures a sequence: the truth and the metrics (FLIP only when `flip` says),
 /// the window around the display, a 5-pixel band, no progress bar.
-pub fn measuring(flip: seethru::measure::metrics::Flip) -> seethru::measure::sequence::Measuring {
+pub fn measuring(
+    flip: seethru::measure::image_metrics::Flip,
+) -> seethru::measure::sequence::Measuring {
     seethru::measure::sequence::Measuring {
         metrics: true,
         full_frames: false,

@@ -19,6 +19,7 @@ use crate::render::footprint::PixelRect;
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::render::moving::MovingParts;
+use crate::render::render_job::RenderJob;
 use crate::render::settings::{RenderSettings, check_spp};
 use crate::render::sky::SkyModel;
 use crate::scene::DriverFace;
@@ -362,11 +363,10 @@ impl SystemLoop {
         let (crop, d2_used) = if full {
             let f = Instant::now();
             capture.render_into(
-                &frontal_camera,
-                view_bit::FRONTAL,
-                settings,
+                RenderJob::new(&frontal_camera, view_bit::FRONTAL)
+                    .settings(settings)
+                    .label("frontal"),
                 &mut self.frontal,
-                "frontal",
             );
             frontal_seconds = f.elapsed().as_secs_f64();
             self.frontal_pixels +=
@@ -380,14 +380,12 @@ impl SystemLoop {
                 crop_rect(&frontal_map(&geometry, crop.0, run)?, &frontal_camera)
             };
             let f = Instant::now();
-            capture.render_rect(
-                &frontal_camera,
-                view_bit::FRONTAL,
-                None,
-                settings,
-                rect,
+            capture.render_into(
+                RenderJob::new(&frontal_camera, view_bit::FRONTAL)
+                    .settings(settings)
+                    .region(rect)
+                    .label("frontal"),
                 &mut self.frontal,
-                "frontal",
             );
             frontal_seconds = f.elapsed().as_secs_f64();
             self.frontal_pixels += rect.pixels();
@@ -403,7 +401,11 @@ impl SystemLoop {
                 spp: run.spp.max(BACK_MIN_SPP),
                 progress: false,
             };
-            let (back, _) = b.render(&back_true, view_bit::BACK, back_settings, "back");
+            let (back, _) = b.render(
+                RenderJob::new(&back_true, view_bit::BACK)
+                    .settings(back_settings)
+                    .label("back"),
+            );
             let head = HeadEstimate {
                 source: run.head,
                 eye_world_m: eye_world.to_array(),
@@ -508,14 +510,11 @@ impl SystemLoop {
         };
         let region = ctx.difference_region(&driver, view_bit::TRUTH, view_bit::SEETHRU);
         let settings = self.settings();
-        ctx.render_rect(
-            &driver,
-            view_bit::SEETHRU,
-            Some(&surface),
-            settings,
-            region,
+        ctx.render_into(
+            RenderJob::seethru(&driver, &surface)
+                .settings(settings)
+                .region(region),
             frame,
-            "seethru",
         );
         self.surface = Some(surface);
         self.seconds.seethru += start.elapsed().as_secs_f64();
@@ -604,7 +603,13 @@ impl BackTracker {
             self.region = None;
         }
         let render = |frame: &mut Frame, region: PixelRect| {
-            ctx.render_rect(&back, view_bit::BACK, None, settings, region, frame, "back");
+            ctx.render_into(
+                RenderJob::new(&back, view_bit::BACK)
+                    .settings(settings)
+                    .region(region)
+                    .label("back"),
+                frame,
+            );
         };
         // The detection in `region` and the pixels it depended on, if they lie inside it.
         let find = |frame: &mut Frame, region: PixelRect| match face {
