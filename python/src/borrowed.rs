@@ -15,7 +15,8 @@
 use std::sync::{Arc, Mutex, MutexGuard};
 
 use numpy::ndarray::{ArrayView, ArrayViewMut, Dimension};
-use numpy::{Element, PyArray, PyArrayMethods};
+use numpy::npyffi::flags::NPY_ARRAY_WRITEABLE;
+use numpy::{Element, PyArray, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use seethru::render::frame::Frame;
 use seethru::system::capture::Capture;
@@ -49,12 +50,16 @@ pub fn read_only_view<'py, T: Element, D: Dimension>(
 #[pyclass(name = "_FrameBuffers", module = "seethru", frozen)]
 pub struct FrameBuffers {
     frame: Mutex<Frame>,
+    /// A render writes the frame now (`Scene.render(out=)`, between its checks and its
+    /// return): its arrays are read-only to Python meanwhile.
+    pub rendering: std::sync::atomic::AtomicBool,
 }
 
 impl FrameBuffers {
     pub fn new(frame: Frame) -> FrameBuffers {
         FrameBuffers {
             frame: Mutex::new(frame),
+            rendering: std::sync::atomic::AtomicBool::new(false),
         }
     }
 
@@ -70,6 +75,24 @@ impl Drop for FrameBuffers {
     fn drop(&mut self) {
         let frame = self.frame.get_mut().unwrap_or_else(|e| e.into_inner());
         frame_pool::give(std::mem::replace(frame, Frame::new(0, 0)));
+    }
+}
+
+/// Sets or clears numpy's WRITEABLE flag of `array`, an array of a frame ([`frame_view`]):
+/// cleared while a render writes the frame, so that Python cannot write it meanwhile, set
+/// again after. numpy's own `setflags(write=True)` refuses (the arrays' base, the frame's
+/// owner, exposes no buffer for numpy to check), hence the flag bit itself.
+pub fn set_frame_array_writeable(array: &Bound<'_, PyUntypedArray>, writeable: bool) {
+    // SAFETY: `array` is a live numpy array (the `Bound` keeps it alive, the GIL is held), so
+    // its object may be written; the flag is set back only on arrays `frame_view` made over
+    // the frame's mutable buffers, which are writable memory for as long as the array lives.
+    unsafe {
+        let object = array.as_array_ptr();
+        if writeable {
+            (*object).fields.flags |= NPY_ARRAY_WRITEABLE;
+        } else {
+            (*object).fields.flags &= !NPY_ARRAY_WRITEABLE;
+        }
     }
 }
 

@@ -6,15 +6,22 @@
 //! are so a test can tell.
 use std::collections::HashMap;
 use std::path::PathBuf;
+use std::sync::atomic::Ordering;
 
 use glam::Vec3;
+
 use numpy::ndarray::{ArrayView2, ArrayView3, ArrayViewMut2, ArrayViewMut3};
-use numpy::{PyArray, PyArray2, PyArray3, PyArrayMethods, PyReadwriteArray2, PyReadwriteArray3};
+use numpy::{
+    PyArray, PyArray2, PyArray3, PyArrayMethods, PyReadwriteArray2, PyReadwriteArray3,
+    PyUntypedArray,
+};
 use pyo3::prelude::*;
 use seethru::render::frame::Frame;
 use seethru::system::capture::Capture;
 
-use crate::borrowed::{CaptureBuffers, FrameBuffers, frame_view, read_only_view};
+use crate::borrowed::{
+    CaptureBuffers, FrameBuffers, frame_view, read_only_view, set_frame_array_writeable,
+};
 
 use crate::errors::{bad_value, to_py};
 
@@ -59,11 +66,26 @@ pub struct PyFrame {
 
 /// rust-numpy's exclusive borrows of every array of a frame: while they are held, no other
 /// Rust code (a render into the same frame, a seethru call reading one of its arrays) can
-/// borrow them.
+/// borrow them; and the arrays are not writable from Python (numpy's `flags.writeable` is
+/// False), so that a plain write from another thread, while the render runs without the
+/// GIL, raises instead of racing with it. Writable again when dropped. A view a user took of
+/// an array before the render keeps its own flag: numpy cannot reach it.
 pub struct WriteBorrows<'py> {
     _vectors: [PyReadwriteArray3<'py, f32>; 3],
     _scalars: [PyReadwriteArray2<'py, f32>; 2],
     _ids: [PyReadwriteArray2<'py, u32>; 2],
+    arrays: Vec<Bound<'py, PyUntypedArray>>,
+    buffers: Bound<'py, FrameBuffers>,
+}
+
+impl Drop for WriteBorrows<'_> {
+    fn drop(&mut self) {
+        self.buffers.get().rendering.store(false, Ordering::SeqCst);
+        for array in &self.arrays {
+            // Each was writable when the render began: a read-only array is refused.
+            set_frame_array_writeable(array, true);
+        }
+    }
 }
 
 #[pymethods]
@@ -150,6 +172,12 @@ impl PyFrame {
                 self.view
             )));
         };
+        // Checked before the arrays' flags, which a render in progress has cleared.
+        if buffers.get().rendering.load(Ordering::SeqCst) {
+            return Err(bad_value(
+                "out: frame.colour is in use by another call (a render into it in another thread); wait for it to return",
+            ));
+        }
         if self.view != view {
             return Err(bad_value(format!(
                 "out: the frame is a {:?} view and this render is {view:?}; pass a frame rendered from the same view",
@@ -175,7 +203,7 @@ impl PyFrame {
                 )),
             })
         }
-        let borrows = WriteBorrows {
+        let mut borrows = WriteBorrows {
             _vectors: [
                 borrow("colour", self.colour.bind(py))?,
                 borrow("position", self.position.bind(py))?,
@@ -189,7 +217,22 @@ impl PyFrame {
                 borrow("object_id", self.object_id.bind(py))?,
                 borrow("part_id", self.part_id.bind(py))?,
             ],
+            arrays: Vec::new(),
+            buffers: buffers.bind(py).clone(),
         };
+        buffers.get().rendering.store(true, Ordering::SeqCst);
+        for array in [
+            self.colour.bind(py).as_untyped(),
+            self.position.bind(py).as_untyped(),
+            self.normal.bind(py).as_untyped(),
+            self.depth.bind(py).as_untyped(),
+            self.camera_z.bind(py).as_untyped(),
+            self.object_id.bind(py).as_untyped(),
+            self.part_id.bind(py).as_untyped(),
+        ] {
+            set_frame_array_writeable(array, false);
+            borrows.arrays.push(array.clone());
+        }
         Ok((buffers.clone_ref(py), borrows))
     }
 

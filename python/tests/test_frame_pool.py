@@ -167,3 +167,28 @@ def test_two_renders_into_one_frame_at_once_refuse_one(scene):
         assert errors[0].startswith("out: frame.colour is in use by another call")
         return
     pytest.fail("the two renders never overlapped")
+
+
+def test_a_frame_is_read_only_to_python_while_a_render_writes_it(scene):
+    frame = scene.render("truth", width=640, spp=1)
+    done = threading.Event()
+
+    def render():
+        scene.copy().render("truth", width=640, spp=64, out=frame)
+        done.set()
+
+    worker = threading.Thread(target=render)
+    worker.start()
+    refused = 0
+    while not done.is_set():
+        try:
+            frame.colour[0, 0, 0] = 0.5
+        except ValueError as e:
+            assert "read-only" in str(e)
+            refused += 1
+        time.sleep(0.001)
+    worker.join()
+    assert refused > 0, "a plain write raced with the render"
+    # Writable again once the render has returned.
+    frame.colour[0, 0, 0] = 0.5
+    assert all(getattr(frame, a).flags.writeable for a in ("colour", "position", "normal", "depth", "camera_z", "object_id", "part_id"))
