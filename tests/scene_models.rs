@@ -8,7 +8,7 @@ use glam::{DAffine3, DVec2, DVec3};
 use seethru::analysis::depth_error::{mean_misregistration, surface_shift};
 use seethru::analysis::physical::ARCMIN_PER_RAD;
 use seethru::geometry::camera::Camera;
-use seethru::measure::holes::attach_holes;
+use seethru::measure::measured_run::{MeasureSettings, MeasuredRun, measure_run};
 use seethru::measure::metrics::measure;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
@@ -78,6 +78,12 @@ fn options(method: Method) -> RunOptions {
         ..RunOptions::default()
     }
 }
+
+/// The border band and hazard bound of `seethru run`'s defaults.
+const SETTINGS: MeasureSettings = MeasureSettings {
+    band: 5,
+    hazard_bound_arcmin: 30.0,
+};
 
 fn display_mask(ctx: &RenderContext, r: &RunResult) -> Vec<bool> {
     let (maps, _) = measure(ctx, &ctx.scene, ctx.scene.eye(), r.measured_views(), 5);
@@ -327,10 +333,15 @@ fn holes_of_a_sideways_eye_are_the_disoccluded_area() {
         DVec3::new(0.2, 0.0, 0.7),
         20.0,
     );
-    let r = run(&ctx, &depth(SensorKind::Ideal)).unwrap();
-    let frames = r.measured_views();
-    let (maps, mut metrics) = measure(&ctx, &ctx.scene, ctx.scene.eye(), frames, 5);
-    let holes = attach_holes(&mut metrics, &maps, &r, &ctx.scene.obstacle, "none").unwrap();
+    let options = depth(SensorKind::Ideal);
+    let r = run(&ctx, &options).unwrap();
+    let MeasuredRun {
+        maps,
+        metrics,
+        holes,
+        ..
+    } = measure_run(&ctx, &options, &r, SETTINGS).unwrap();
+    let holes = holes.unwrap();
     assert_eq!(metrics["missing"]["outside_frontal_view"], 0);
     let hidden = metrics["missing"]["hidden_from_frontal"].as_u64().unwrap() as i64;
     let found = holes.iter().filter(|&&h| h).count() as i64;
@@ -514,9 +525,13 @@ fn depth_noise_grows_the_misregistration_as_the_formula_predicts() {
         o.scene_model.sensor.quantum_1m = Some(0.0);
         o.scene_model.sensor.noise_1m = Some(sigma_1m);
         let r = run(&ctx, &o).unwrap();
-        let frames = r.measured_views();
-        let (maps, mut metrics) = measure(&ctx, &ctx.scene, eye, frames, 5);
-        let holes = attach_holes(&mut metrics, &maps, &r, &ctx.scene.obstacle, "none").unwrap();
+        let MeasuredRun {
+            maps,
+            metrics,
+            holes,
+            ..
+        } = measure_run(&ctx, &o, &r, SETTINGS).unwrap();
+        let holes = holes.unwrap();
         let (mut measured, mut predicted, mut n) = (0.0, 0.0, 0);
         for i in (0..maps.display.len()).filter(|&i| maps.display[i] && !holes[i]) {
             let t = r.truth.position[i].as_dvec3();

@@ -88,8 +88,8 @@ class Run:
     """metrics.json's content."""
     report: dict[str, Any]
     """run.json's content."""
-    hazards: dict[str, Any] | None
-    """hazards.json's content (`seethru.run`); None for a score."""
+    hazards: dict[str, Any]
+    """hazards.json's content (a score's at the default bound, 30 arcmin)."""
     misregistration: npt.NDArray[np.float32]
     """Arcmin per driver-view pixel, NaN outside the display and on blank pixels; (h, w)."""
     missing: npt.NDArray[np.bool_]

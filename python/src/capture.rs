@@ -15,6 +15,8 @@ use seethru::io::frame_files::ExrContent;
 use seethru::io::output_paths::{Output, check_paths};
 use seethru::io::staged::StagedDir;
 use seethru::measure::capture_files::{capture_spec, recapture, write_scoreable_capture};
+use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
+use seethru::measure::measured_run::{MeasureSettings, measure_run};
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::system::capture::{
@@ -29,7 +31,7 @@ use crate::errors::{bad_value, to_py};
 use crate::frame::PyFrame;
 use crate::interrupt::detached;
 use crate::options::{Caller, choice_of, int_in, run_choices};
-use crate::run::{PyRun, json_to_py, measured};
+use crate::run::{PyRun, json_to_py};
 use crate::scene::{PyScene, context_for};
 
 /// What a see-through system's algorithm receives; its truth stays inside for `score`.
@@ -238,18 +240,15 @@ pub fn score(
     let (inner, context) = (c.inner.clone(), c.context.clone());
     let mut options = c.options.clone();
     options.filter = filter;
-    let (result, maps, metrics) = detached(py, move || -> anyhow::Result<_> {
+    let settings = MeasureSettings {
+        band,
+        hazard_bound_arcmin: HAZARD_BOUND_ARCMIN,
+    };
+    let (result, measured) = detached(py, move || -> anyhow::Result<_> {
         let scored = score_display(&context, &options, &inner, map.as_ref(), image.as_ref())?;
-        let (maps, mut metrics) = measured(&context, &options, &scored.run, band);
-        // As `seethru score` adds them.
-        metrics["external_method"] = scored.run.report["external_method"].clone();
-        if !scored.has_map {
-            metrics["misregistration_needs_a_map"] = serde_json::json!(
-                "the display image alone carries no geometry: misregistration is undefined on every display pixel (counted in undefined_pixels); give --map for it"
-            );
-        }
-        Ok((scored.run, maps, metrics))
+        let measured = measure_run(&context, &options, &scored.run, settings)?;
+        Ok((scored.run, measured))
     })?
     .map_err(to_py)?;
-    PyRun::new(py, result, maps, &metrics)
+    PyRun::new(py, result, measured)
 }

@@ -8,14 +8,9 @@ use numpy::ndarray::Array2;
 use numpy::{PyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use seethru::measure::hazard::run_hazards_json;
-use seethru::measure::holes::attach_holes;
-use seethru::measure::metrics::{MetricMaps, measure};
-use seethru::render::integrator::RenderContext;
+use seethru::measure::measured_run::{MeasureSettings, MeasuredRun, measure_run};
 use seethru::system::memory::{check_memory, run_estimate};
-use seethru::system::options::RunOptions;
 use seethru::system::pipeline::RunResult;
-use seethru::system::pipeline::driver_camera;
 use seethru::system::pipeline::run as run_pipeline;
 
 use crate::errors::to_py;
@@ -78,49 +73,30 @@ pub fn run(
     };
     let estimate = run_estimate(&the_scene, &choices.options).map_err(to_py)?;
     check_memory(&estimate, choices.max_memory).map_err(to_py)?;
-    let (context, result, maps, metrics, hazards) = detached(py, move || -> anyhow::Result<_> {
+    let settings = MeasureSettings {
+        band: choices.band,
+        hazard_bound_arcmin: choices.hazard_bound_arcmin,
+    };
+    let (context, result, measured) = detached(py, move || -> anyhow::Result<_> {
         let ctx = context_for(cached, the_scene)?;
         let result = run_pipeline(&ctx, &choices.options)?;
-        let (maps, metrics) = measured(&ctx, &choices.options, &result, choices.band);
-        let driver = driver_camera(&ctx.scene, &choices.options)?;
-        let hazards = run_hazards_json(&ctx, &driver, &result, &maps, choices.hazard_bound_arcmin);
-        Ok((ctx, result, maps, metrics, hazards))
+        let measured = measure_run(&ctx, &choices.options, &result, settings)?;
+        Ok((ctx, result, measured))
     })?
     .map_err(to_py)?;
     scene.borrow_mut().context = Some(context);
-    let mut run = PyRun::new(py, result, maps, &metrics)?;
-    run.hazards = json_to_py(py, &hazards)?;
-    Ok(run)
-}
-
-/// The maps and metrics.json of a run, as `seethru run` measures them.
-pub fn measured(
-    ctx: &RenderContext,
-    options: &RunOptions,
-    result: &RunResult,
-    band: u32,
-) -> (MetricMaps, serde_json::Value) {
-    let eye = options.eyes.view_camera(&ctx.scene.driver).position();
-    let frames = result.measured_views();
-    let (maps, mut metrics) = measure(ctx, &ctx.scene, eye, frames, band);
-    attach_holes(
-        &mut metrics,
-        &maps,
-        result,
-        &ctx.scene.obstacle,
-        options.scene_model.fill,
-    );
-    (maps, metrics)
+    PyRun::new(py, result, measured)
 }
 
 impl PyRun {
     /// A run's frames, maps, metrics and report handed to Python.
-    pub fn new(
-        py: Python<'_>,
-        result: RunResult,
-        maps: MetricMaps,
-        metrics: &serde_json::Value,
-    ) -> PyResult<PyRun> {
+    pub fn new(py: Python<'_>, result: RunResult, measured: MeasuredRun) -> PyResult<PyRun> {
+        let MeasuredRun {
+            maps,
+            metrics,
+            hazards,
+            ..
+        } = measured;
         let (w, h) = (maps.width as usize, maps.height as usize);
         let misregistration = PyArray::from_owned_array(
             py,
@@ -133,7 +109,8 @@ impl PyRun {
         )
         .unbind();
         let report = json_to_py(py, &result.report)?;
-        let metrics = json_to_py(py, metrics)?;
+        let metrics = json_to_py(py, &metrics)?;
+        let hazards = json_to_py(py, &hazards)?;
         let dict = PyDict::new(py);
         // The views rendered over truth made whole first: then truth is theirs no longer, and
         // is handed over without a copy.
@@ -152,7 +129,7 @@ impl PyRun {
             frames: dict.unbind(),
             metrics,
             report,
-            hazards: py.None(),
+            hazards,
             misregistration,
             missing,
         })

@@ -77,7 +77,11 @@ def test_python_scores_a_folder_the_cli_captured_and_the_cli_a_folder_python_sav
     # Python's score of the CLI's folder is the CLI's score of it.
     cli = seethru_cli("score", str(tmp_path / "cli_cap"), "--map", str(tmp_path / "map.npy"), "--out", str(tmp_path / "s1"))
     assert cli.returncode == 0, cli.stderr
-    assert seethru.score(loaded, map=m).metrics == _metrics_of(tmp_path / "s1")
+    scored = seethru.score(loaded, map=m)
+    assert scored.metrics == _metrics_of(tmp_path / "s1")
+    import json
+
+    assert scored.hazards == json.loads((tmp_path / "s1" / "hazards.json").read_text())
     # The other way: a capture made in Python, saved, is the folder the CLI captures.
     scene = seethru.Scene.load(SCENE)
     cap = seethru.capture(scene, depth=True, width=96, frontal_width=192, back_width=96, spp=1)

@@ -10,11 +10,11 @@ use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{ExrContent, write_frame_keeping, write_frame_like};
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
-use seethru::measure::hazard::{HAZARD_BOUND_ARCMIN, run_hazards_json};
+use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
 use seethru::measure::headline::{read_results, summary_text};
-use seethru::measure::holes::{attach_view_holes, write_hole_mask};
+use seethru::measure::holes::write_hole_mask;
 use seethru::measure::maps::write_metrics_scaled;
-use seethru::measure::metrics::measure;
+use seethru::measure::measured_run::{DriverViews, hazards_of, measure_views, view_eye};
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::scene::lens_keys::read_calibration_file;
@@ -22,9 +22,7 @@ use seethru::system::display::{DisplayModel, Filter};
 use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
 use seethru::system::memory::{both_eyes_estimate, check_memory, run_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
-use seethru::system::pipeline::{
-    Given, RunResult, RunViews, check_display_seen, driver_camera, run_staged,
-};
+use seethru::system::pipeline::{Given, RunResult, RunViews, check_display_seen, run_staged};
 use seethru::system::reads::run_reads;
 
 use crate::cli::args::{
@@ -290,17 +288,13 @@ fn write_run(
         let [truth, occluded, seethru] = ["truth", "occluded", "seethru"]
             .map(|name| views_ref.get(name).expect("a finished run set every view"));
         check_display_seen(ctx, occluded)?;
-        // The eye the views were rendered from.
-        let eye = options.eyes.view_camera(&ctx.scene.driver).position();
-        let (maps, mut metrics) = measure(ctx, &ctx.scene, eye, [truth, seethru, occluded], band);
-        let holes = attach_view_holes(
-            &mut metrics,
-            &maps,
-            rest.holes.as_deref(),
-            [truth, occluded, seethru],
-            &ctx.scene.obstacle,
-            options.scene_model.fill,
-        );
+        let views = DriverViews {
+            views: [truth, occluded, seethru],
+            display_holes: rest.holes.as_deref(),
+            external_method: None,
+        };
+        let (maps, metrics, holes) =
+            measure_views(ctx, options, view_eye(ctx, options), &views, band);
         if let Some(holes) = &holes {
             write_hole_mask(&out.join("holes.png"), &maps, holes)?;
         }
@@ -315,8 +309,7 @@ fn write_run(
     if let Some(d) = result.detection.filter(|d| !d.confidence.is_confident()) {
         eprintln!("warning: {}", d.confidence.warning(""));
     }
-    let driver = driver_camera(&ctx.scene, options)?;
-    let hazards = run_hazards_json(ctx, &driver, &result, &maps, hazard_bound);
+    let hazards = hazards_of(ctx, options, &result, &maps, hazard_bound)?;
     // Beside metrics.json (which `measure` recomputes from the frames alone).
     write_text(
         &out.join("hazards.json"),

@@ -12,8 +12,9 @@ use seethru::io::frame_files::{ExrContent, write_frame_like};
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
 use seethru::measure::capture_files::recapture;
+use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
 use seethru::measure::maps::write_metrics;
-use seethru::measure::metrics::measure;
+use seethru::measure::measured_run::{MeasureSettings, MeasuredRun, measure_run};
 use seethru::render::frame_over::FrameView;
 use seethru::system::capture::{DisplayImage, DisplayMap, score};
 use seethru::system::display::Filter;
@@ -127,16 +128,26 @@ impl Score {
         views
             .par_iter()
             .try_for_each(|&(name, frame)| write_frame_like(frame, out, name, self.exr, None))?;
-        let eye = r.options.eyes.view_camera(&r.ctx.scene.driver).position();
-        let frames = result.measured_views();
-        let (maps, mut metrics) = measure(&r.ctx, &r.ctx.scene, eye, frames, self.band);
-        metrics["external_method"] = result.report["external_method"].clone();
-        if !scored.has_map {
-            metrics["misregistration_needs_a_map"] = serde_json::json!(
-                "the display image alone carries no geometry: misregistration is undefined on every display pixel (counted in undefined_pixels); give --map for it"
-            );
-        }
+        let MeasuredRun {
+            maps,
+            metrics,
+            hazards,
+            ..
+        } = measure_run(
+            &r.ctx,
+            &r.options,
+            result,
+            MeasureSettings {
+                band: self.band,
+                hazard_bound_arcmin: HAZARD_BOUND_ARCMIN,
+            },
+        )?;
         write_metrics(out, &maps, &result.truth, &metrics)?;
+        // As `run` writes it, at its default bound.
+        write_text(
+            &out.join("hazards.json"),
+            &serde_json::to_string_pretty(&hazards)?,
+        )?;
         write_text(
             &out.join("run.json"),
             &serde_json::to_string_pretty(&result.report)?,

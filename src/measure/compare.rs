@@ -4,10 +4,9 @@
 use anyhow::Result;
 use serde_json::json;
 
-use crate::measure::hazard::run_hazards_json;
-use crate::measure::holes::attach_holes;
 use crate::measure::maps::{heat_color, p99_top};
-use crate::measure::metrics::{MetricMaps, measure};
+use crate::measure::measured_run::{MeasureSettings, MeasuredRun, measure_run};
+use crate::measure::metrics::MetricMaps;
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::render::render_job::RenderJob;
@@ -197,20 +196,21 @@ pub fn compare(
         };
         check_display_seen(ctx, &result.occluded)
             .map_err(|e| anyhow::anyhow!("{}: {e:#}", candidate.name()))?;
-        let frames = result.measured_views();
-        let (maps, mut metrics) = measure(ctx, scene, scene.eye(), frames, band);
-        let holes = attach_holes(
-            &mut metrics,
-            &maps,
-            &result,
-            &scene.obstacle,
-            options.scene_model.fill,
-        );
+        let settings = MeasureSettings {
+            band,
+            hazard_bound_arcmin,
+        };
+        let MeasuredRun {
+            maps,
+            metrics,
+            holes,
+            hazards,
+        } = measure_run(ctx, &options, &result, settings)?;
         let display = &metrics["display"];
         let misregistration = &display["misregistration_arcmin"];
         let row = json!({
             // Per `hazard = true` object, as `run`'s hazards.json.
-            "hazards": run_hazards_json(ctx, &driver, &result, &maps, hazard_bound_arcmin),
+            "hazards": hazards,
             "method": candidate.name(),
             "reason": null,
             "misregistration_mean_arcmin": misregistration["mean"],

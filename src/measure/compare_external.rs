@@ -6,12 +6,10 @@ use anyhow::Result;
 use serde_json::json;
 
 use crate::measure::compare::{Compared, strip};
-use crate::measure::hazard::run_hazards_json;
-use crate::measure::metrics::measure;
+use crate::measure::measured_run::{MeasureSettings, MeasuredRun, measure_run};
 use crate::render::integrator::RenderContext;
 use crate::system::capture::{DisplayMap, capture, score};
 use crate::system::options::RunOptions;
-use crate::system::pipeline::driver_camera;
 
 /// One row per `(name, map)`, at the capture of `base`; the border band is `band` display
 /// pixels, the hazards' bound `hazard_bound_arcmin`.
@@ -28,7 +26,6 @@ pub fn compare_maps(
     let mut options = base.clone();
     options.progress = false;
     let captured = capture(ctx, &options, false)?;
-    let scene = &ctx.scene;
     let mut out = Vec::new();
     for (name, map) in maps {
         let scored = score(ctx, &options, &captured, Some(map), None).map_err(|e| {
@@ -37,14 +34,20 @@ pub fn compare_maps(
             )
         })?;
         let result = &scored.run;
-        let frames = result.measured_views();
-        let eye = options.eyes.view_camera(&scene.driver).position();
-        let (maps, metrics) = measure(ctx, scene, eye, frames, band);
+        let settings = MeasureSettings {
+            band,
+            hazard_bound_arcmin,
+        };
+        let MeasuredRun {
+            maps,
+            metrics,
+            hazards,
+            ..
+        } = measure_run(ctx, &options, result, settings)?;
         let display = &metrics["display"];
         let misregistration = &display["misregistration_arcmin"];
-        let driver = driver_camera(scene, &options)?;
         let row = json!({
-            "hazards": run_hazards_json(ctx, &driver, result, &maps, hazard_bound_arcmin),
+            "hazards": hazards,
             "method": format!("map:{name}"),
             "misregistration_mean_arcmin": misregistration["mean"],
             "misregistration_p95_arcmin": misregistration["p95"],

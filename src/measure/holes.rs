@@ -102,28 +102,8 @@ pub fn write_hole_mask(path: &Path, maps: &MetricMaps, holes: &[bool]) -> Result
     write_mask_png(path, maps, holes)
 }
 
-/// Adds `holes` to a run's metrics when its method found holes; returns the driver-view mask.
-pub fn attach_holes(
-    metrics: &mut serde_json::Value,
-    maps: &MetricMaps,
-    result: &crate::system::pipeline::RunResult,
-    obstacle: &Obstacle,
-    fill: impl serde::Serialize,
-) -> Option<Vec<bool>> {
-    let [truth, seethru, occluded] = result.measured_views();
-    let driver_views = [truth, occluded, seethru];
-    attach_view_holes(
-        metrics,
-        maps,
-        result.holes.as_deref(),
-        driver_views,
-        obstacle,
-        fill,
-    )
-}
-
-/// [`attach_holes`] given a run's display holes and its `truth`, `occluded` and `seethru`
-/// views, while the run's other views are still being written (`seethru run`).
+/// The `holes` metrics of a run's display holes seen in its `truth`, `occluded` and `seethru`
+/// views, attached to `metrics`; the driver-view hole mask, if the run has holes.
 pub fn attach_view_holes(
     metrics: &mut serde_json::Value,
     maps: &MetricMaps,

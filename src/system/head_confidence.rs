@@ -358,6 +358,29 @@ mod tests {
     }
 
     #[test]
+    fn the_view_angle_is_a_doubt_only_where_it_lowers_the_confidence() {
+        let (face_box, pupils, areas) = das_like();
+        let c = HeadConfidence::of(face_box, pupils, areas);
+        // At 40° and below the far pupil is seen whole: a full score, no word of it.
+        for angle in [0.0, 20.0, 40.0] {
+            let seen = c.with_view(angle);
+            assert_eq!(seen.view, 1.0);
+            assert!(
+                !seen.doubts().contains("off its front"),
+                "{}",
+                seen.doubts()
+            );
+        }
+        let far = c.with_view(50.0);
+        assert!(far.view < 1.0);
+        assert!(
+            far.doubts().contains("the face seen 50° off its front"),
+            "{}",
+            far.doubts()
+        );
+    }
+
+    #[test]
     fn ramps_are_linear_between_their_limits() {
         assert_eq!(ramp(26.0, 12.0, 40.0), 0.5);
         assert!((ramp(0.13, 0.2, 0.06) - 0.5).abs() < 1e-12);
