@@ -133,6 +133,33 @@ mod tests {
     }
 
     #[test]
+    fn a_case_with_no_output_has_no_system_out() {
+        let case = |name: &str, output: &str| TestCase {
+            name: name.into(),
+            classname: "seethru.check.e".into(),
+            seconds: 0.5,
+            outcome: Outcome::Passed,
+            output: output.into(),
+        };
+        let xml = junit_xml("e.toml", &[case("quiet", ""), case("said", "a <= 1")]);
+        let doc = roxmltree::Document::parse(&xml).unwrap();
+        let outputs: Vec<(&str, usize)> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("testcase"))
+            .map(|c| {
+                let name = c.attribute("name").unwrap();
+                (
+                    name,
+                    c.children()
+                        .filter(|n| n.has_tag_name("system-out"))
+                        .count(),
+                )
+            })
+            .collect();
+        assert_eq!(outputs, [("quiet", 0), ("said", 1)]);
+    }
+
+    #[test]
     fn counts_and_elements_follow_the_outcomes() {
         let case = |name: &str, outcome| TestCase {
             name: name.into(),
