@@ -341,6 +341,12 @@ mod tests {
         if made.is_ok_and(|s| s.success()) {
             let err = check_input(&input(&fifo, Read::File)).unwrap_err();
             assert!(err.to_string().contains("not a regular file"), "{err}");
+            // An input that may be a file or a folder (`diff`'s) is neither as a pipe.
+            let err = check_input(&input(&fifo, Read::Either)).unwrap_err();
+            assert!(
+                err.to_string().contains("not a regular file or a folder"),
+                "{err}"
+            );
         }
         for (path, read, says) in [
             (
@@ -356,5 +362,7 @@ mod tests {
         check_input(&input(&file, Read::File)).unwrap();
         check_input(&input(&dir.path().join("none"), Read::File)).unwrap();
         check_input(&input(dir.path(), Read::Folder)).unwrap();
+        check_input(&input(&file, Read::Either)).unwrap();
+        check_input(&input(dir.path(), Read::Either)).unwrap();
     }
 }
