@@ -365,4 +365,17 @@ mod tests {
         check_input(&input(&file, Read::Either)).unwrap();
         check_input(&input(dir.path(), Read::Either)).unwrap();
     }
+
+    #[test]
+    fn a_probe_left_by_this_process_does_not_make_a_folder_unwritable() {
+        // A probe of the same name (a process of this id killed between creating and removing
+        // it) proves the folder takes files; it is someone's file: left alone.
+        let dir = tempfile::tempdir().unwrap();
+        let left = dir
+            .path()
+            .join(format!(".seethru-probe-{}", std::process::id()));
+        std::fs::write(&left, "x").unwrap();
+        check_output(&output(&dir.path().join("r.xml"), Written::File)).unwrap();
+        assert_eq!(std::fs::read_to_string(&left).unwrap(), "x");
+    }
 }
