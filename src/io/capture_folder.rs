@@ -99,21 +99,23 @@ pub fn parse_capture_record(
         ),
         None => bail!("{}: no key fingerprint", manifest_path.display()),
     };
-    let file = |key: &str, what: &str| -> Result<Option<PathBuf>> {
+    // A file: an absolute path, or null where `optional` (no calibration file).
+    let file = |key: &str, what: &str, optional: bool| -> Result<Option<PathBuf>> {
         match spec.get(key) {
             Some(Value::String(s)) if Path::new(s).is_absolute() => Ok(Some(PathBuf::from(s))),
-            Some(Value::Null) if key == "calibration" => Ok(None),
+            Some(Value::Null) if optional => Ok(None),
             Some(other) => bail!(
                 "{}: {key} must be {what} (an absolute path{}), got {}",
                 spec_path.display(),
-                if key == "calibration" { " or null" } else { "" },
+                if optional { " or null" } else { "" },
                 shown(other)
             ),
             None => bail!("{}: no key {key} ({what})", spec_path.display()),
         }
     };
-    let scene = file("scene", "the scene file")?.expect("a scene is required");
-    let calibration = file("calibration", "the calibration file")?;
+    let scene = file("scene", "the scene file", false)?
+        .with_context(|| format!("{}: no scene file", spec_path.display()))?;
+    let calibration = file("calibration", "the calibration file", true)?;
     let depth = match spec.get("depth") {
         Some(Value::Bool(b)) => *b,
         Some(other) => bail!(
