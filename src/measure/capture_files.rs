@@ -96,6 +96,16 @@ pub fn write_scoreable_capture(
     write_capture_folder(out, c, (SPEC_FILE, &spec_json(spec)), exr)
 }
 
+/// depth.npy's axial depth, metres, of the sensor's inverse depth `inverse` (1/m): NaN where
+/// the sensor has no return (0: sky, past its range), not the infinity 1/0 would give.
+pub fn axial_depth(inverse: f32) -> f32 {
+    if inverse > 0.0 {
+        1.0 / inverse
+    } else {
+        f32::NAN
+    }
+}
+
 /// Only the colour of a frame (the rest of its AOVs is the renderer's truth).
 fn write_colour_exr(frame: &Frame, path: &Path) -> Result<()> {
     let channels = ["R", "G", "B"]
@@ -131,12 +141,7 @@ pub fn write_capture_folder(
     }
     files.extend(["head.json".to_string(), "calibration.json".to_string()]);
     if let Some(d) = &c.depth {
-        // Axial depth, metres; NaN where the sensor has no return (sky, past its range).
-        let depth: Vec<f32> = d
-            .inverse_depth
-            .iter()
-            .map(|&v| if v > 0.0 { 1.0 / v } else { f32::NAN })
-            .collect();
+        let depth: Vec<f32> = d.inverse_depth.iter().map(|&v| axial_depth(v)).collect();
         let [w, h] = [d.camera.width, d.camera.height];
         write_npy_f32(&out.join("depth.npy"), &[h as usize, w as usize], &depth)?;
         // depth.exr is no colour: only `--exr lean` and `all` write it (depth.npy holds the
@@ -191,4 +196,16 @@ pub fn write_capture_folder(
         }))?,
     )?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn no_return_is_nan_and_a_return_its_distance() {
+        assert!(axial_depth(0.0).is_nan());
+        assert_eq!(axial_depth(0.5), 2.0);
+        assert_eq!(axial_depth(4.0), 0.25);
+    }
 }
