@@ -455,6 +455,35 @@ pub fn html_page(title: &str, table_md: &str, strips: &[(&str, String)]) -> Stri
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Whether `compare --methods <candidates>` reads `--seed` under `options`.
+    fn seed_read(candidates: &[Candidate], options: &RunOptions) -> bool {
+        compare_reads(candidates, false, options)
+            .into_iter()
+            .find(|r| r.flag == "--seed")
+            .unwrap()
+            .read
+    }
+
+    #[test]
+    fn the_seed_is_read_by_what_draws_noise_and_by_nothing_else() {
+        use Candidate::{DepthIdeal, Ground, PlanarInf, PlaneFit};
+        let oracle = RunOptions::default();
+        let mut tof = RunOptions::default();
+        tof.scene_model.sensor.kind = SensorKind::Tof;
+        let model = RunOptions {
+            head: HeadSource::Model,
+            ..RunOptions::default()
+        };
+        // depth-ideal draws noise only from a noisy sensor kind.
+        assert!(!seed_read(&[DepthIdeal], &oracle));
+        assert!(seed_read(&[DepthIdeal], &tof));
+        // A noisy kind alone, for methods that read no sensor, draws nothing.
+        assert!(!seed_read(&[Ground, PlanarInf], &tof));
+        // The tracker model draws its noise and dropouts for any method.
+        assert!(seed_read(&[Ground], &model));
+        assert!(seed_read(&[PlaneFit], &oracle));
+    }
     use glam::Vec3;
 
     const WHITE: [u8; 3] = [255, 255, 255];
