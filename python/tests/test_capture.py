@@ -103,3 +103,17 @@ def test_a_capture_of_a_scene_changed_in_memory_is_not_saved(tmp_path):
     # Not a capture folder: named.
     with pytest.raises(OSError, match="capture.json"):
         seethru.load_capture(tmp_path / "nothing")
+
+
+def test_an_image_alone_says_misregistration_needs_a_map():
+    scene = seethru.Scene.load(SCENE)
+    cap = seethru.capture(scene, width=48, spp=1)
+    w, h = cap.display_resolution
+    image = np.full((h, w, 3), 0.5, np.float32)
+    alone = seethru.score(cap, display_image=image).metrics
+    assert "misregistration_needs_a_map" in alone
+    assert alone["external_method"]["display_from"] == "image"
+    m = planar_map(cap.calibration, {"head": cap.head}).astype(np.float32)
+    with_map = seethru.score(cap, map=m, display_image=image).metrics
+    assert "misregistration_needs_a_map" not in with_map
+    assert with_map["external_method"]["display_from"] == "map and image"
