@@ -307,6 +307,28 @@ mod tests {
     }
 
     #[test]
+    fn a_runs_seed_is_read_by_a_noisy_sensor_of_the_depth_method() {
+        use crate::system::depth_sensor::SensorKind;
+        let seed_read = |method, kind| {
+            let mut options = RunOptions {
+                method,
+                ..RunOptions::default()
+            };
+            options.scene_model.sensor.kind = kind;
+            run_reads(&options, false)
+                .into_iter()
+                .find(|r| r.flag == "--seed")
+                .unwrap()
+                .read
+        };
+        assert!(seed_read(Method::Depth, SensorKind::Tof));
+        assert!(seed_read(Method::Depth, SensorKind::Stereo));
+        assert!(!seed_read(Method::Depth, SensorKind::Ideal));
+        assert!(seed_read(Method::PlaneFit, SensorKind::Ideal));
+        assert!(!seed_read(Method::Planar, SensorKind::Tof));
+    }
+
+    #[test]
     fn the_sway_settings_are_read_with_sway_only() {
         let run = RunOptions::default();
         let read = |head| {
