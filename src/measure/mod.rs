@@ -23,6 +23,8 @@ pub mod ratio;
 pub mod ratio_setup;
 pub mod sequence;
 pub mod sequence_files;
+pub mod sequence_records;
+pub mod sequence_regions;
 pub mod sweep;
 pub mod sweep_csv;
 pub mod sweep_grid;
