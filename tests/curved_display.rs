@@ -553,7 +553,7 @@ fn a_sequence_shows_the_ideal_curved_display_exactly() {
         let largest = |f: fn(&FrameMetrics) -> f64| metrics.iter().map(f).fold(0.0, f64::max);
         (largest(|m| m.mean_arcmin), largest(|m| m.psnr_db))
     };
-    use seethru::measure::sequence::FrameMetrics;
+    use seethru::measure::sequence_records::FrameMetrics;
     use seethru::system::display::DisplayModel;
     let (ideal, _) = largest_over_frames(DisplayModel::Ideal);
     let (pixels, pixels_psnr) = largest_over_frames(DisplayModel::Pixels);

@@ -1,5 +1,5 @@
 //! The sequence's head tracker renders the back camera only around the last face and detects
-//! there (`system/head.rs` `detect_in`, `system/sequence/system_loop.rs` `BackTracker`): its
+//! there (`system/head.rs` `detect_in`, `system/sequence/back_tracker.rs` `BackTracker`): its
 //! estimates against the whole image's, bit for bit.
 
 mod common;

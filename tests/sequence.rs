@@ -491,7 +491,7 @@ fn a_sequence_computes_flip_only_when_asked() {
     for (a, b) in with.iter().zip(&without) {
         assert!(a.flip > 0.0 && a.flip <= 1.0, "{}", a.flip);
         assert!(b.flip.is_nan(), "{}", b.flip);
-        let others = |m: &seethru::measure::sequence::FrameMetrics| {
+        let others = |m: &seethru::measure::sequence_records::FrameMetrics| {
             [
                 m.coverage,
                 m.mean_arcmin,
@@ -1007,8 +1007,8 @@ fn frames_csv_and_summary_hold_what_the_sequence_was_asked_for() {
 /// (and 2 to 5 % right of the longest latency); a curve below 1′ gets the axis to 1.1′.
 #[test]
 fn the_misregistration_figures_hold_their_points_with_a_little_headroom() {
-    use seethru::measure::sequence::FrameMetrics;
     use seethru::measure::sequence_files::{latency_figure, over_time_figure};
+    use seethru::measure::sequence_records::FrameMetrics;
     let wall = common::WallScene::default();
     let scene = wall.scene();
     let how = common::measuring(Flip::Skipped);

@@ -17,8 +17,9 @@ use seethru::measure::expectations::{
 };
 use seethru::measure::headline::{read_results, value_of};
 use seethru::measure::image_diff::{
-    LayerDiff, diff_layer, flip_heatmap, paired_layers, pixels_per_degree, read_picture,
+    LayerDiff, diff_layer, flip_heatmap, paired_layers, pixels_per_degree,
 };
+use seethru::measure::picture_layers::read_picture;
 use seethru::util::number::short;
 
 use crate::cli::verdict::ChecksFailed;

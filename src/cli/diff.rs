@@ -9,11 +9,12 @@ use seethru::io::atomic::write_text;
 use seethru::io::frame_files::write_png;
 use seethru::io::output_paths::{Input, Output, Read, check_paths};
 use seethru::io::staged::StagedDir;
+use seethru::measure::diff_thresholds::{BoundKind, Threshold, Verdict, check_thresholds};
 use seethru::measure::headline::{RUN_HEADLINES, SEQUENCE_HEADLINES, read_results, value_of};
 use seethru::measure::image_diff::{
-    BoundKind, LayerDiff, Picture, Threshold, Verdict, check_thresholds, diff_layer, flip_heatmap,
-    number, paired_layers, pixels_per_degree, read_picture,
+    LayerDiff, diff_layer, flip_heatmap, number, paired_layers, pixels_per_degree,
 };
+use seethru::measure::picture_layers::{Picture, read_picture};
 use seethru::util::number::short;
 use serde_json::{Value, json};
 

@@ -11,10 +11,11 @@ use seethru::io::staged::StagedDir;
 use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
 use seethru::measure::headline::{RunKind, summary_text};
 use seethru::measure::image_metrics::Flip;
-use seethru::measure::sequence::{Measuring, SequenceRun, head_warning, run_sequence_hazards};
+use seethru::measure::sequence::{Measuring, SequenceRun, run_sequence_hazards};
 use seethru::measure::sequence_files::{
     Preview, frames_csv, hazard_figure, latency_figure, over_time_figure, summary,
 };
+use seethru::measure::sequence_records::head_warning;
 use seethru::scene::Scene;
 use seethru::scene::head_path::HeadPath;
 use seethru::system::display::{DisplayModel, Filter};

@@ -6,190 +6,25 @@
 //! non-finite one (sky depth is +inf in one and a distance in the other) cannot give an
 //! absolute error; it is counted in `nonfinite_mismatch_pixels` and left out of the errors'
 //! mean and maximum, and it counts as a differing pixel.
+//!
+//! The images are read into layers by measure/picture_layers.rs; the bounds `--max` and
+//! `--min` put on these metrics are measure/diff_thresholds.rs's.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use anyhow::{Context, Result, bail};
-use exr::prelude::FlatSamples;
+use anyhow::{Result, bail};
 use serde_json::{Value, json};
 
 use crate::io::run_dir::MAX_RUN_JSON_BYTES;
 use crate::measure::image_metrics::{masked_ssim_map, psnr};
-use crate::scene::limits::{MAX_PIXELS, MAX_RESOLUTION};
+use crate::measure::picture_layers::{Layer, LayerKind, Picture};
 use crate::util::color::{encode_srgb8, luma};
-use crate::util::input_file::{not_a_file, read_input_text};
+use crate::util::input_file::read_input_text;
 use crate::util::quantile::nearest_rank;
 
 /// Pixels per degree of FLIP's standard observer (0.7 m from a 0.7 m wide 4K monitor), used
 /// where the run does not give the driver camera's.
 pub const STANDARD_PPD: f32 = 67.0;
-
-/// What the values of a layer are.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LayerKind {
-    /// 8-bit sRGB colour, [0, 255] per channel (a PNG).
-    Srgb8,
-    /// Linear RGB colour, [0, ∞) per channel (an EXR's `R`, `G`, `B`).
-    LinearColour,
-    /// Any other channels (depth in m, positions, normals, ids, masks).
-    Data,
-}
-
-/// One layer of an image: channels that belong together (`P.X`, `P.Y`, `P.Z` → `P`).
-pub struct Layer {
-    pub name: String,
-    pub kind: LayerKind,
-    /// Channel names as in the file.
-    pub channels: Vec<String>,
-    /// Values per channel, row-major, `width × height` each.
-    pub values: Vec<Vec<f64>>,
-}
-
-/// An image read for comparison.
-pub struct Picture {
-    pub path: PathBuf,
-    pub width: u32,
-    pub height: u32,
-    pub layers: Vec<Layer>,
-}
-
-impl Picture {
-    pub fn layer(&self, name: &str) -> Option<&Layer> {
-        self.layers.iter().find(|l| l.name == name)
-    }
-
-    pub fn layer_names(&self) -> Vec<&str> {
-        self.layers.iter().map(|l| l.name.as_str()).collect()
-    }
-}
-
-/// The layer a channel of an EXR belongs to: `R`, `G`, `B` form `colour`; `P.X` belongs to `P`.
-fn layer_of(channel: &str) -> &str {
-    match channel {
-        "R" | "G" | "B" => "colour",
-        _ => channel.rsplit_once('.').map_or(channel, |(layer, _)| layer),
-    }
-}
-
-fn check_size(width: usize, height: usize) -> Result<()> {
-    if width == 0
-        || height == 0
-        || width > MAX_RESOLUTION as usize
-        || height > MAX_RESOLUTION as usize
-        || (width as u64) * (height as u64) > MAX_PIXELS
-    {
-        bail!(
-            "the image is {width}×{height}: each side must be in [1, {MAX_RESOLUTION}], at most {MAX_PIXELS} pixels"
-        );
-    }
-    Ok(())
-}
-
-/// Reads a PNG (one `colour` layer, 8-bit sRGB) or an EXR (its channels grouped into layers).
-/// Errors name the file.
-pub fn read_picture(path: &Path) -> Result<Picture> {
-    crate::util::input_file::note_input(path);
-    if let Some(why) = not_a_file(path) {
-        bail!("cannot read {}: {why}", path.display());
-    }
-    let is_exr = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-    let picture = if is_exr {
-        read_exr_layers(path)
-    } else {
-        read_png(path)
-    };
-    picture.with_context(|| format!("cannot read {}", path.display()))
-}
-
-fn read_png(path: &Path) -> Result<Picture> {
-    let reader = image::ImageReader::open(path)?
-        .with_guessed_format()
-        .context("not a readable image")?;
-    let (w, h) = reader
-        .into_dimensions()
-        .map_err(|e| anyhow::anyhow!("not a readable PNG: {e}"))?;
-    check_size(w as usize, h as usize)?;
-    let image = image::ImageReader::open(path)?
-        .with_guessed_format()?
-        .decode()
-        .map_err(|e| anyhow::anyhow!("not a readable PNG: {e}"))?
-        .to_rgb8();
-    let values = (0..3)
-        .map(|c| image.pixels().map(|p| p[c] as f64).collect())
-        .collect();
-    Ok(Picture {
-        path: path.to_path_buf(),
-        width: w,
-        height: h,
-        layers: vec![Layer {
-            name: "colour".into(),
-            kind: LayerKind::Srgb8,
-            channels: ["R", "G", "B"].map(String::from).to_vec(),
-            values,
-        }],
-    })
-}
-
-fn read_exr_layers(path: &Path) -> Result<Picture> {
-    let file = std::fs::File::open(path)?;
-    let meta = exr::meta::MetaData::read_from_unbuffered(file, false)
-        .map_err(|e| anyhow::anyhow!("not a readable EXR: {e}"))?;
-    let header = meta.headers.first().context("the file has no layer")?;
-    check_size(header.layer_size.width(), header.layer_size.height())?;
-    let image = crate::io::frame_files::read_first_layer(|r| r.from_file(path))?;
-    let layer = &image.layer_data;
-    let (width, height) = (layer.size.width() as u32, layer.size.height() as u32);
-    let mut layers: Vec<Layer> = Vec::new();
-    for channel in &layer.channel_data.list {
-        let name = channel.name.to_string();
-        let values: Vec<f64> = match &channel.sample_data {
-            FlatSamples::F16(v) => v.iter().map(|x| x.to_f64()).collect(),
-            FlatSamples::F32(v) => v.iter().map(|&x| x as f64).collect(),
-            FlatSamples::U32(v) => v.iter().map(|&x| x as f64).collect(),
-        };
-        let layer_name = layer_of(&name).to_string();
-        match layers.iter_mut().find(|l| l.name == layer_name) {
-            Some(l) => {
-                l.channels.push(name);
-                l.values.push(values);
-            }
-            None => layers.push(Layer {
-                kind: if layer_name == "colour" {
-                    LayerKind::LinearColour
-                } else {
-                    LayerKind::Data
-                },
-                name: layer_name,
-                channels: vec![name],
-                values: vec![values],
-            }),
-        }
-    }
-    // The colour channels in R, G, B order (EXR sorts channels by name: B, G, R).
-    for l in layers
-        .iter_mut()
-        .filter(|l| l.kind == LayerKind::LinearColour)
-    {
-        let mut pairs: Vec<(String, Vec<f64>)> =
-            l.channels.drain(..).zip(l.values.drain(..)).collect();
-        pairs.sort_by_key(|(n, _)| ["R", "G", "B"].iter().position(|c| c == n));
-        (l.channels, l.values) = pairs.into_iter().unzip();
-        if l.channels.len() != 3 {
-            bail!(
-                "the colour layer has channels {} (expected R, G and B)",
-                l.channels.join(", ")
-            );
-        }
-    }
-    Ok(Picture {
-        path: path.to_path_buf(),
-        width,
-        height,
-        layers,
-    })
-}
 
 /// The 8-bit sRGB pixels of a colour layer.
 fn srgb8(layer: &Layer) -> Vec<[u8; 3]> {
@@ -482,157 +317,9 @@ pub fn flip_heatmap(flip: &[f32], width: u32, height: u32) -> Result<(u32, u32, 
     crate::io::colour_bar::with_colour_bar(width, height, &rgb, &bar)
 }
 
-/// Which way a threshold bounds a metric.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BoundKind {
-    /// The value must be at most the bound (`--max`).
-    AtMost,
-    /// The value must be at least the bound (`--min`).
-    AtLeast,
-}
-
-/// A threshold on one metric of one layer (`layer.metric`), or of every layer that has the
-/// metric (`metric`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Threshold {
-    pub layer: Option<String>,
-    pub metric: String,
-    pub kind: BoundKind,
-    pub value: f64,
-}
-
-impl Threshold {
-    /// Reads `NAME=VALUE` (NAME: `metric` or `layer.metric`, metric one of
-    /// [`KNOWN_METRICS`]; VALUE a finite number).
-    pub fn parse(text: &str, kind: BoundKind) -> Result<Self, String> {
-        let (name, value) = text
-            .split_once('=')
-            .ok_or_else(|| format!("`{text}` is not NAME=VALUE (e.g. flip_mean=0.05)"))?;
-        let (layer, metric) = match name.trim().rsplit_once('.') {
-            Some((layer, metric)) => (Some(layer.to_string()), metric),
-            None => (None, name.trim()),
-        };
-        if !KNOWN_METRICS.iter().any(|m| m.0 == metric) {
-            return Err(format!(
-                "unknown metric `{metric}` (known: {})",
-                known_metric_names()
-            ));
-        }
-        let value = value
-            .trim()
-            .parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| format!("the bound `{}` is not a finite number", value.trim()))?;
-        Ok(Self {
-            layer,
-            metric: metric.to_string(),
-            kind,
-            value,
-        })
-    }
-
-    pub fn holds(&self, value: f64) -> bool {
-        match self.kind {
-            BoundKind::AtMost => value <= self.value,
-            BoundKind::AtLeast => value >= self.value,
-        }
-    }
-
-    pub fn describe(&self) -> String {
-        let op = match self.kind {
-            BoundKind::AtMost => "<=",
-            BoundKind::AtLeast => ">=",
-        };
-        let name = match &self.layer {
-            Some(l) => format!("{l}.{}", self.metric),
-            None => self.metric.clone(),
-        };
-        format!("{name} {op} {}", crate::util::number::short(self.value))
-    }
-}
-
-/// One threshold checked against one layer.
-pub struct Verdict {
-    pub threshold: String,
-    pub layer: String,
-    pub value: f64,
-    pub pass: bool,
-}
-
-/// Checks every threshold against the layers it names. A threshold that names a layer no
-/// diff has, or a metric no named layer has (FLIP of a depth layer), is an error.
-pub fn check_thresholds(diffs: &[LayerDiff], thresholds: &[Threshold]) -> Result<Vec<Verdict>> {
-    let mut verdicts = Vec::new();
-    for t in thresholds {
-        let layers: Vec<&LayerDiff> = match &t.layer {
-            Some(name) => {
-                let d = diffs.iter().find(|d| &d.name == name).with_context(|| {
-                    format!(
-                        "threshold `{}`: no layer `{name}` was compared (layers: {})",
-                        t.describe(),
-                        diffs
-                            .iter()
-                            .map(|d| d.name.as_str())
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    )
-                })?;
-                vec![d]
-            }
-            None => diffs
-                .iter()
-                .filter(|d| d.metric(&t.metric).is_some())
-                .collect(),
-        };
-        let mut any = false;
-        for d in layers {
-            let Some(value) = d.metric(&t.metric) else {
-                bail!(
-                    "threshold `{}`: layer `{}` has no {} (FLIP, PSNR and SSIM are of colour layers)",
-                    t.describe(),
-                    d.name,
-                    t.metric
-                );
-            };
-            any = true;
-            verdicts.push(Verdict {
-                threshold: t.describe(),
-                layer: d.name.clone(),
-                value,
-                // NaN never passes a bound.
-                pass: t.holds(value),
-            });
-        }
-        if !any {
-            bail!(
-                "threshold `{}`: no compared layer has {} (FLIP, PSNR and SSIM are of colour layers)",
-                t.describe(),
-                t.metric
-            );
-        }
-    }
-    Ok(verdicts)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Each side in [1, MAX_RESOLUTION] and the area at most MAX_PIXELS, every bound
-    /// inclusive, each rule refusing alone.
-    #[test]
-    fn picture_sizes_are_checked_at_their_bounds() {
-        let max = MAX_RESOLUTION as usize;
-        let tall = (MAX_PIXELS / u64::from(MAX_RESOLUTION)) as usize;
-        for (w, h) in [(1, 1), (max, 1), (1, max), (max, tall), (tall, max)] {
-            assert!(check_size(w, h).is_ok(), "{w}×{h}");
-        }
-        for (w, h) in [(0, 1), (1, 0), (max + 1, 1), (1, max + 1), (max, tall + 1)] {
-            let e = check_size(w, h).unwrap_err().to_string();
-            assert!(e.contains(&format!("{w}×{h}")), "{e}");
-        }
-    }
 
     /// A driver view is seen at the driver camera's pixels per degree, read from the run's
     /// metrics.json when it is a positive number; any other view, no file, or a value that
@@ -691,29 +378,6 @@ mod tests {
         assert!(mid[0] > 150 && mid[1] < 80, "{mid:?}");
     }
 
-    /// EXR stores channels sorted by name (B, G, R); the colour layer reads back as R, G, B.
-    #[test]
-    fn an_exr_colour_layer_reads_as_r_g_b() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("c.exr");
-        let channel =
-            |name: &str, v: f32| exr::prelude::AnyChannel::new(name, FlatSamples::F32(vec![v; 2]));
-        let channels = vec![channel("R", 1.0), channel("G", 2.0), channel("B", 3.0)];
-        crate::io::frame_files::write_exr_channels(&path, 2, 1, channels).unwrap();
-        let picture = read_picture(&path).unwrap();
-        let colour = picture.layers.iter().find(|l| l.name == "colour").unwrap();
-        assert_eq!(colour.channels, ["R", "G", "B"]);
-        assert_eq!(colour.values, [vec![1.0; 2], vec![2.0; 2], vec![3.0; 2]]);
-    }
-
-    #[test]
-    fn channels_group_into_layers() {
-        assert_eq!(layer_of("R"), "colour");
-        assert_eq!(layer_of("P.X"), "P");
-        assert_eq!(layer_of("camera_z.Z"), "camera_z");
-        assert_eq!(layer_of("Z"), "Z");
-    }
-
     fn data_layer(values: Vec<f64>) -> Layer {
         Layer {
             name: "Z".into(),
@@ -738,23 +402,5 @@ mod tests {
         assert_eq!(d.metric("differing_fraction"), Some(0.75));
         assert_eq!(d.metric("nonfinite_mismatch_pixels"), Some(4.0));
         assert_eq!(d.metric("flip_mean"), None);
-    }
-
-    #[test]
-    fn thresholds_read_and_refuse() {
-        let t = Threshold::parse("seethru.flip_mean=0.05", BoundKind::AtMost).unwrap();
-        assert_eq!(t.layer.as_deref(), Some("seethru"));
-        assert!(t.holds(0.05) && !t.holds(0.0500001));
-        let e = Threshold::parse("flop=1", BoundKind::AtMost).unwrap_err();
-        assert!(
-            e.contains("unknown metric `flop`") && e.contains("flip_mean"),
-            "{e}"
-        );
-        assert!(Threshold::parse("psnr_db=nan", BoundKind::AtLeast).is_err());
-        assert!(
-            !Threshold::parse("psnr_db=40", BoundKind::AtLeast)
-                .unwrap()
-                .holds(f64::NAN)
-        );
     }
 }

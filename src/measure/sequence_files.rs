@@ -13,7 +13,8 @@ use crate::io::colour_bar::{BAR_COLUMN, ColourBar, with_colour_bar};
 use crate::io::plot::{Figure, Series};
 use crate::measure::hazard::{HIDDEN_BELOW, HazardSeen, hazard_times};
 use crate::measure::maps::{heat_color, p99_top};
-use crate::measure::sequence::{FrameImages, FrameMetrics, FrameRecord, SequenceRun};
+use crate::measure::sequence::{FrameImages, SequenceRun};
+use crate::measure::sequence_records::{FrameMetrics, FrameRecord};
 use crate::system::sequence::timeline::Timeline;
 use crate::util::color::encode_srgb8;
 

@@ -6,11 +6,15 @@
 //! - `predict`: the head estimate carried to display time;
 //! - `system_loop`: per displayed frame, the system's work — frontal render at its capture
 //!   time, head estimate, prediction, compensation, the display image — and the `seethru` view;
-//!   the static world's hierarchy is built once, what moves gets its own small one per instant.
+//!   the static world's hierarchy is built once, what moves gets its own small one per instant;
+//! - `frontal_region`: the frontal pixels a refresh renders (what the crop reads);
+//! - `back_tracker`: the back camera rendered and searched only around the last face.
 //!
 //! The truth and the metrics of every frame are `measure::sequence`'s.
 
+mod back_tracker;
 pub mod byo;
+mod frontal_region;
 pub mod head_motion;
 pub mod predict;
 pub mod system_loop;

@@ -5,12 +5,15 @@
 //! The static world and its hierarchy are built once; what moves (the obstacle, what rides
 //! with the vehicle or the head, objects on keyframed paths) is a small world of its own whose
 //! hierarchy is refitted for each instant ([`MovingParts::at`]).
+//!
+//! The frontal pixels a refresh renders are system/sequence/frontal_region.rs's; the back
+//! camera's tracking of the face, system/sequence/back_tracker.rs's.
 
 use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 
 use crate::geometry::camera::Camera;
 use crate::geometry::lens::Lens;
@@ -22,37 +25,32 @@ use crate::render::moving::MovingParts;
 use crate::render::render_job::RenderJob;
 use crate::render::settings::{RenderSettings, check_spp};
 use crate::render::sky::SkyModel;
-use crate::scene::DriverFace;
 use crate::scene::Scene;
 use crate::scene::world::{World, view_bit};
 use crate::system::calibration_json::calibration_json;
 use crate::system::capture::{HeadEstimate, check_display_input, display_from, fingerprint};
-use crate::system::compensation::{Crop, ModelPlane};
+use crate::system::compensation::Crop;
 use crate::system::display::{
     DisplayModel, DisplayPlacement, DisplaySurface, IdealMap, resample_through,
 };
-use crate::system::frontal_map::FrontalMap;
-use crate::system::head::{DetectError, FaceDetection, detect_in, gaussian};
-use crate::system::head_estimate::{FACING_FORWARD, detect_face, fix_from, turned_reads};
+use crate::system::head::gaussian;
+use crate::system::head_estimate::{FACING_FORWARD, fix_from};
 use crate::system::head_pose::HeadPose;
 use crate::system::options::{HeadSource, Method, RunOptions, WorkingDistance};
 use crate::system::pipeline::{
     check_crop_in_view, crop_for, driver_camera, frontal_map, ideal_map,
 };
-use crate::system::point_model::PointModel;
+use crate::system::sequence::back_tracker::BackTracker;
 use crate::system::sequence::byo::{Byo, RefreshInputs};
+use crate::system::sequence::frontal_region::{crop_rect, curved_rect};
 use crate::system::sequence::head_motion::HeadMotion;
 use crate::system::sequence::predict::{Prediction, Predictor};
 use crate::system::sequence::timeline::{FrameTimes, Rig, Timeline};
-use crate::system::surface_map::display_points;
 use crate::system::tracker_model::WEBCAM_LANDMARKS;
 use crate::util::number::short;
 
 /// Fewest samples per pixel of the back camera's image.
 pub const BACK_MIN_SPP: u32 = 4;
-
-/// Frontal pixels rendered around the crop: the bicubic filter reads two beyond it.
-const CROP_MARGIN_PX: f64 = 3.0;
 
 /// Everything a sequence is asked for.
 #[derive(Clone, Debug)]
@@ -522,150 +520,6 @@ impl SystemLoop {
     }
 }
 
-/// The frontal pixels a crop reads, with a margin for the filters, within the image.
-fn crop_rect(map: &FrontalMap, camera: &Camera) -> PixelRect {
-    let (min, max) = map.bounds();
-    rect_around(min, max, camera)
-}
-
-/// The frontal pixels a curved display's planar model reads (every display pixel's model
-/// point for the eye at `eye`, world, and the model plane at `d2`), with a margin for the
-/// filters, within the image; empty when the camera sees none of them.
-fn curved_rect(scene: &Scene, eye: DVec3, d2: Option<f64>, camera: &Camera) -> Result<PixelRect> {
-    let plane = d2.map_or(ModelPlane::Infinity, ModelPlane::At);
-    let model = PointModel::new(scene, eye, plane)?;
-    let (min, max) = display_points(&scene.obstacle)
-        .into_iter()
-        .flatten()
-        .filter_map(|p| model.frontal_point(p))
-        .filter(|p| p.is_finite())
-        .fold(
-            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-            |(lo, hi), p| (lo.min(p), hi.max(p)),
-        );
-    if min.x > max.x {
-        return Ok(PixelRect {
-            x0: 0,
-            y0: 0,
-            x1: 0,
-            y1: 0,
-        });
-    }
-    Ok(rect_around(min, max, camera))
-}
-
-/// The pixels of `camera` from `min` to `max` (continuous), with the filters' margin.
-fn rect_around(min: DVec2, max: DVec2, camera: &Camera) -> PixelRect {
-    let lo = (min - DVec2::splat(CROP_MARGIN_PX)).floor();
-    let hi = (max + DVec2::splat(CROP_MARGIN_PX)).ceil();
-    let clamp = |v: f64, size: u32| v.clamp(0.0, size as f64) as u32;
-    PixelRect {
-        x0: clamp(lo.x, camera.width),
-        y0: clamp(lo.y, camera.height),
-        x1: clamp(hi.x, camera.width),
-        y1: clamp(hi.y, camera.height),
-    }
-}
-
-/// The back camera's image of the head, rendered only where the face can be: the pixels the
-/// last detection depended on ([`detect_in`] reports them for the ellipsoid face; for the mesh
-/// face [`turned_reads`] bounds what [`detect_face`] reads, and the pixels outside the region
-/// are blanked), grown by a quarter of their size and 4 px on each side for the head's motion
-/// until the next sample. When the face is not found there whole, or on the first sample, the
-/// whole image is rendered and searched, as [`crate::system::head::detect`] does. So every
-/// estimate is bit for bit the whole image's (but for a skin region larger than the face
-/// wholly outside the region, which the whole image's detector would take for the face), and
-/// each sample depends only on the one before: deterministic.
-struct BackTracker {
-    frame: Frame,
-    region: Option<PixelRect>,
-}
-
-impl BackTracker {
-    fn new(back: &Camera) -> BackTracker {
-        BackTracker {
-            frame: Frame::new(back.width, back.height),
-            region: None,
-        }
-    }
-
-    /// The head detection of `face` in the back camera's image of `ctx` (its true back
-    /// camera), and the pixels rendered for it.
-    fn detect(
-        &mut self,
-        ctx: &RenderContext,
-        face: DriverFace,
-        settings: RenderSettings,
-    ) -> (Result<FaceDetection, DetectError>, u64) {
-        let back = ctx.scene.back;
-        if (self.frame.width, self.frame.height) != (back.width, back.height) {
-            self.frame = Frame::new(back.width, back.height);
-            self.region = None;
-        }
-        let render = |frame: &mut Frame, region: PixelRect| {
-            ctx.render_into(
-                RenderJob::new(&back, view_bit::BACK)
-                    .settings(settings)
-                    .region(region)
-                    .label("back"),
-                frame,
-            );
-        };
-        // The detection in `region` and the pixels it depended on, if they lie inside it.
-        let find = |frame: &mut Frame, region: PixelRect| match face {
-            DriverFace::Ellipsoids => {
-                detect_in(frame, region).map(|found| (found.detection, found.used, found.whole))
-            }
-            DriverFace::Mesh { .. } => {
-                // Only the region's pixels: the rest blank (no skin, no colour step).
-                blank_outside(frame, region);
-                detect_face(face, frame).map(|d| {
-                    let used = turned_reads(&d, &back);
-                    (d, used, contains(region, used))
-                })
-            }
-        };
-        let mut pixels = 0;
-        let tracked = self.region.and_then(|region| {
-            render(&mut self.frame, region);
-            pixels += region.pixels();
-            find(&mut self.frame, region).ok().filter(|found| found.2)
-        });
-        let (detection, used) = match tracked {
-            Some((detection, used, _)) => (detection, used),
-            None => {
-                self.region = None;
-                let full = PixelRect::full(&back);
-                render(&mut self.frame, full);
-                pixels += full.pixels();
-                match find(&mut self.frame, full) {
-                    Ok((detection, used, _)) => (detection, used),
-                    Err(e) => return (Err(e), pixels),
-                }
-            }
-        };
-        // The next search: the pixels used, grown by a quarter of their size and 4 px a side.
-        self.region = Some(used.grown(4, 4, &back));
-        (Ok(detection), pixels)
-    }
-}
-
-/// Sets the colour of every pixel outside `region` to black.
-fn blank_outside(frame: &mut Frame, region: PixelRect) {
-    let w = frame.width as usize;
-    for (i, c) in frame.color.iter_mut().enumerate() {
-        let (x, y) = ((i % w) as u32, (i / w) as u32);
-        if x < region.x0 || x >= region.x1 || y < region.y0 || y >= region.y1 {
-            *c = glam::Vec3::ZERO;
-        }
-    }
-}
-
-/// Whether `outer` holds every pixel of `inner`.
-fn contains(outer: PixelRect, inner: PixelRect) -> bool {
-    inner.x0 >= outer.x0 && inner.y0 >= outer.y0 && inner.x1 <= outer.x1 && inner.y1 <= outer.y1
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -682,49 +536,5 @@ mod tests {
             seethru: 16.0,
         };
         assert_eq!(seconds.total(), 31.0);
-    }
-
-    /// The pixels from `min` to `max` with the filters' 3 pixels on each side, whole pixels
-    /// outwards, clamped to the image.
-    #[test]
-    fn a_rect_around_points_holds_the_filters_margin_within_the_image() {
-        let camera = Camera::new(glam::DAffine3::IDENTITY, 0.5, 640, 480).unwrap();
-        let rect = rect_around(DVec2::new(10.2, 20.7), DVec2::new(30.1, 40.0), &camera);
-        assert_eq!((rect.x0, rect.y0, rect.x1, rect.y1), (7, 17, 34, 43));
-        let rect = rect_around(DVec2::new(-5.0, 2.5), DVec2::new(700.0, 477.5), &camera);
-        assert_eq!((rect.x0, rect.y0, rect.x1, rect.y1), (0, 0, 640, 480));
-    }
-
-    /// Every pixel outside the region is black, every pixel inside kept: each side's edge
-    /// pixels on both sides of it.
-    #[test]
-    fn blanking_outside_a_region_keeps_exactly_the_region() {
-        let mut frame = Frame::new(8, 6);
-        frame.color.fill(glam::Vec3::ONE);
-        let region = PixelRect {
-            x0: 2,
-            y0: 1,
-            x1: 5,
-            y1: 4,
-        };
-        blank_outside(&mut frame, region);
-        for y in 0..6 {
-            for x in 0..8 {
-                let inside = (2..5).contains(&x) && (1..4).contains(&y);
-                let expected = if inside {
-                    glam::Vec3::ONE
-                } else {
-                    glam::Vec3::ZERO
-                };
-                assert_eq!(frame.color[frame.index(x, y)], expected, "({x}, {y})");
-            }
-        }
-        assert!(contains(region, region));
-        for (x0, y0, x1, y1) in [(1, 1, 4, 4), (2, 0, 5, 4), (2, 1, 6, 4), (2, 1, 5, 5)] {
-            assert!(
-                !contains(region, PixelRect { x0, y0, x1, y1 }),
-                "{x0} {y0} {x1} {y1}"
-            );
-        }
     }
 }
