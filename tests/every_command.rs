@@ -471,6 +471,7 @@ fn every_command_on_every_bundled_scene_exits_cleanly_or_with_one_error_line() {
         "check",
         "capture",
         "score",
+        "spec",
     ];
     for command in commands() {
         assert!(
@@ -512,6 +513,12 @@ fn every_command_on_every_bundled_scene_exits_cleanly_or_with_one_error_line() {
         }]
     };
     groups.push(once("analyze", words(&["analyze", "--quiet"])));
+    for command in ["run", "capture", "compare"] {
+        groups.push(once(
+            &format!("spec {command}"),
+            words(&["spec", command, "--quiet"]),
+        ));
+    }
     groups.push(once(
         "figures",
         words(&["figures", "--quiet", "--out", &out("fig")]),

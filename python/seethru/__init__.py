@@ -10,7 +10,7 @@ Errors raise :class:`ValueError` (bad input: a scene key, an option's range) or
 :class:`OSError` (a file that cannot be read) with the command line's one-line message.
 """
 
-from ._native import Capture, Frame, Run, Scene, __version__, analyze, capture, compare, frame_pool, load_capture, ratio, read_frame
+from ._native import Capture, Frame, Run, Scene, __version__, analyze, capture, compare, frame_pool, load_capture, options, ratio, read_frame, spec
 from ._native import run as _run
 from ._native import score as _score
 from ._native import Sequence, Step
@@ -19,7 +19,7 @@ from ._native import sequence as _sequence
 import numpy as _np
 
 __all__ = [
-    "Capture", "Frame", "Run", "Scene", "analyze", "capture", "compare", "frame_pool", "load_capture", "ratio", "read_frame", "run",
+    "Capture", "Frame", "Run", "Scene", "analyze", "capture", "compare", "frame_pool", "load_capture", "options", "ratio", "read_frame", "run", "spec",
     "score", "sequence", "Sequence", "Step", "__version__",
 ]
 
@@ -27,15 +27,12 @@ __all__ = [
 def run(scene: Scene, **options) -> Run:
     """Runs the see-through system on ``scene``, as ``seethru run`` does.
 
-    The keywords are ``seethru run``'s flags with ``_`` for ``-`` and the same defaults and
-    ranges: ``method`` ("none", "planar", "ground", "plane-fit", "depth"), ``d2`` (a float in
-    metres, ``float("inf")``, "inf" or "auto"), ``head`` ("oracle", "estimated"),
-    ``head_bias_cm`` (x, y, z), ``head_jitter_cm``, ``seed``, ``feature_width``, ``outside``
-    ("error", "black"), ``filter``, ``display`` ("pixels", "ideal"), ``frontal_width``,
-    ``back_width``, ``eyes`` ("mono", "left", "right"), ``ipd``, ``target_eye``, ``band``,
-    ``depth_sensor``, ``depth_resolution``, ``depth_range``, ``depth_noise``,
-    ``depth_quantum``, ``fill``, ``width``, ``height``, ``spp`` (default 4) and
-    ``max_memory`` (GiB). An unknown keyword, or one the method would ignore, is refused.
+    The keywords are ``seethru run``'s flags with ``_`` for ``-``, with the same types,
+    defaults and ranges: the library's option table, listed by :func:`options` and in
+    docs/reference/options.md. ``None`` stands for the default. An unknown keyword, or one the
+    other settings make the run ignore, is refused with the command line's words; so is
+    ``eyes="both"`` (one call is one run: run "left" and "right").
+    :func:`spec` checks the keywords without running.
 
     Returns a :class:`Run`: ``frames`` (the six views), ``metrics`` (metrics.json's content),
     ``report`` (run.json's content), ``misregistration`` and ``missing`` (driver-view maps).

@@ -98,6 +98,7 @@ class Run:
 def run(
     scene: Scene,
     *,
+    # The option table's (run): tests/option_table.rs checks it (SEETHRU_BLESS=1 rewrites it).
     method: Literal["none", "planar", "ground", "plane-fit", "depth"] = "planar",
     d2: float | str = "inf",
     head: Literal["oracle", "estimated", "model"] = "oracle",
@@ -107,7 +108,7 @@ def run(
     feature_width: float = 0.064,
     require_confident_head: bool = False,
     outside: Literal["error", "black"] = "error",
-    filter: str = "bilinear",
+    filter: Literal["bilinear", "bicubic"] = "bilinear",
     display: Literal["pixels", "ideal"] = "pixels",
     frontal_width: int | None = None,
     back_width: int | None = None,
@@ -126,8 +127,18 @@ def run(
     height: int | None = None,
     spp: int = 4,
     max_memory: float = 8.0,
+    # End of the option table's.
 ) -> Run:
     """Runs the see-through system as `seethru run` does, returning instead of writing."""
+
+def options() -> list[dict[str, Any]]:
+    """The option table of run, capture and compare (the flags of the commands of the same
+    names): name, flag, kind, min, max, choices, unit, default, default_derived, help,
+    read_with and commands per option, in `seethru run --help`'s order."""
+
+def spec(command: Literal["run", "capture", "compare"], **options: Any) -> dict[str, Any]:
+    """The run specification `command` would make of `options`, every option checked and
+    nothing rendered ({"command", "options": {name: value}}), as `seethru spec` prints it."""
 
 def read_frame(path: str | PathLike[str]) -> Frame:
     """Reads an EXR written by `seethru render`/`run` as a Frame."""
@@ -139,14 +150,31 @@ def frame_pool(clear: bool = False) -> dict[str, int]:
 def compare(
     scene: Scene,
     methods: list[str] | None = None,
-    **options: Any,
+    *,
+    # The option table's (compare): tests/option_table.rs checks it (SEETHRU_BLESS=1 rewrites it).
+    head: Literal["oracle", "estimated", "model"] = "oracle",
+    seed: int = 1,
+    frontal_width: int | None = None,
+    back_width: int | None = None,
+    band: int = 5,
+    hazard_bound_arcmin: float = 30.0,
+    depth_sensor: Literal["ideal", "tof", "stereo"] = "ideal",
+    depth_resolution: int | None = None,
+    depth_range: float | None = None,
+    depth_noise: float | None = None,
+    depth_quantum: float | None = None,
+    fill: Literal["none", "background", "inpaint"] = "none",
+    width: int | None = None,
+    height: int | None = None,
+    spp: int = 4,
+    max_memory: float = 8.0,
+    # End of the option table's.
 ) -> dict[str, Any]:
     """`seethru compare`: {"rows": compare.json's rows, "strips": {method: (h, w, 3) uint8}}.
 
     methods: none, planar-inf, planar-auto, plane-fit, ground, depth-ideal, depth-tof,
-    depth-stereo (default: compare's six). Options: head, seed, frontal_width, back_width,
-    band, hazard_bound_arcmin, depth_*, fill, width, height, spp, max_memory, each refused
-    where no listed method reads it (as on the command line). A method the scene does not admit
+    depth-stereo (default: compare's six). Each option is refused where no listed method reads
+    it (as on the command line). A method the scene does not admit
     (ground without a road) has a row whose "reason" says why, and no strip.
     """
 
@@ -178,10 +206,34 @@ class Capture:
         """Writes the folder `seethru capture --exr EXR` writes, which `seethru score` reads;
         refused for a scene changed in memory (the folder names its scene file)."""
 
-def capture(scene: Scene, depth: bool = False, **options: Any) -> Capture:
-    """`seethru capture` in memory, with its flags as keywords: head, head_bias_cm,
-    head_jitter_cm, seed, feature_width, require_confident_head, frontal_width, back_width,
-    eyes, ipd, target_eye, depth_* (with depth=True), width, height, spp, max_memory."""
+def capture(
+    scene: Scene,
+    depth: bool = False,
+    *,
+    # The option table's (capture): tests/option_table.rs checks it (SEETHRU_BLESS=1 rewrites it).
+    head: Literal["oracle", "estimated", "model"] = "oracle",
+    head_bias_cm: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    head_jitter_cm: float = 0.0,
+    seed: int = 1,
+    feature_width: float = 0.064,
+    require_confident_head: bool = False,
+    frontal_width: int | None = None,
+    back_width: int | None = None,
+    eyes: Literal["mono", "left", "right"] = "mono",
+    ipd: float = 0.064,
+    target_eye: Literal["cyclopean", "left", "right"] = "cyclopean",
+    depth_sensor: Literal["ideal", "tof", "stereo"] = "ideal",
+    depth_resolution: int | None = None,
+    depth_range: float | None = None,
+    depth_noise: float | None = None,
+    depth_quantum: float | None = None,
+    width: int | None = None,
+    height: int | None = None,
+    spp: int = 4,
+    max_memory: float = 8.0,
+    # End of the option table's.
+) -> Capture:
+    """`seethru capture` in memory, with its flags as keywords (depth_* with depth=True)."""
 
 def load_capture(path: str | PathLike[str]) -> Capture:
     """A folder written by `seethru capture` or `Capture.save`, captured again from its

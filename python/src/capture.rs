@@ -30,9 +30,10 @@ use crate::borrowed::{CaptureBuffers, read_only_view};
 use crate::errors::{bad_value, to_py};
 use crate::frame::PyFrame;
 use crate::interrupt::detached;
-use crate::options::{Caller, choice_of, int_in, run_choices};
+use crate::options::{choice_of, int_in, run_spec};
 use crate::run::{PyRun, json_to_py};
 use crate::scene::{PyScene, context_for};
+use seethru::measure::option_table::{Command, Value, option};
 
 /// What a see-through system's algorithm receives; its truth stays inside for `score`.
 #[pyclass(name = "Capture", module = "seethru", frozen)]
@@ -109,13 +110,17 @@ pub fn capture(
     depth: bool,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PyCapture> {
-    let choices = run_choices(options, Caller::Capture { depth })?;
+    let depth_given = match depth {
+        true => vec![(option("depth").expect("in the table"), Value::Switch(true))],
+        false => Vec::new(),
+    };
+    let choices = run_spec(options, Command::Capture, depth_given)?;
     let (the_scene, cached) = {
         let s = scene.borrow();
         (s.scene.clone(), s.context.clone())
     };
     let estimate = run_estimate(&the_scene, &choices.options).map_err(to_py)?;
-    check_memory(&estimate, choices.max_memory).map_err(to_py)?;
+    check_memory(&estimate, choices.max_memory_gib).map_err(to_py)?;
     let options = choices.options.clone();
     let (context, captured) = detached(py, move || -> anyhow::Result<_> {
         let ctx = context_for(cached, the_scene)?;

@@ -12,6 +12,7 @@ mod frame;
 mod frame_pool;
 mod interrupt;
 mod measures;
+mod option_table;
 mod options;
 mod run;
 mod scene;
@@ -32,6 +33,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(capture::score, m)?)?;
     m.add_function(wrap_pyfunction!(capture::load_capture, m)?)?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
+    m.add_function(wrap_pyfunction!(option_table::options, m)?)?;
+    m.add_function(wrap_pyfunction!(option_table::spec, m)?)?;
     m.add_class::<sequence::PySequence>()?;
     m.add_class::<sequence::PyStep>()?;
     m.add_function(wrap_pyfunction!(sequence::sequence, m)?)?;

@@ -15,13 +15,15 @@ use seethru::paper::claims::{AnalyzeParams, evaluate, lens_and_eyes, paper_claim
 use seethru::render::settings::check_resolution;
 use seethru::scene::source::MAX_RESOLUTION;
 use seethru::system::memory::{check_memory, run_estimate};
-use seethru::system::options::Outside;
 
 use crate::errors::{bad_value, to_py};
 use crate::interrupt::detached;
-use crate::options::{Caller, choice_of, run_choices};
+use crate::options::{choice_of, run_spec, spelled};
 use crate::run::json_to_py;
 use crate::scene::{PyScene, context_for};
+use seethru::measure::compare::compare_reads;
+use seethru::measure::option_table::Command;
+use seethru::system::reads::hazard_bound_reads;
 
 /// `seethru compare`: methods side by side, `{"rows": [...], "strips": {name: array}}`.
 #[pyfunction]
@@ -48,28 +50,27 @@ pub fn compare<'py>(
         .iter()
         .map(|m| choice_of::<Candidate>("methods", m))
         .collect::<PyResult<Vec<_>>>()?;
-    let mut choices = run_choices(
-        options,
-        Caller::Compare {
-            candidates: &candidates,
-        },
-    )?;
-    // As `seethru compare`: a crop past the frontal view is black and counted.
-    choices.options.outside = Outside::Black;
+    let choices = run_spec(options, Command::Compare, Vec::new())?;
+    choices
+        .refuse_ignored(&compare_reads(&candidates, false, &choices.options))
+        .map_err(spelled)?;
     let (the_scene, cached) = {
         let s = scene.borrow();
         (s.scene.clone(), s.context.clone())
     };
+    choices
+        .refuse_ignored(&[hazard_bound_reads(&the_scene)])
+        .map_err(spelled)?;
     let estimate = run_estimate(&the_scene, &choices.options).map_err(to_py)?;
-    check_memory(&estimate, choices.max_memory).map_err(to_py)?;
+    check_memory(&estimate, choices.max_memory_gib).map_err(to_py)?;
     let (context, rows) = detached(py, move || -> anyhow::Result<_> {
         let ctx = context_for(cached, the_scene)?;
         let rows = compare_methods(
             &ctx,
             &candidates,
             &choices.options,
-            choices.band,
-            choices.hazard_bound_arcmin,
+            choices.measure.band,
+            choices.measure.hazard_bound_arcmin,
         )?;
         Ok((ctx, rows))
     })?

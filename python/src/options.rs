@@ -1,22 +1,14 @@
-//! The keyword arguments of `seethru.run`, with the ranges and choices of the command line's
-//! flags of the same names (`seethru run --help`): unknown keywords are refused.
+//! Keyword arguments: those of `seethru.run`, `capture` and `compare` read through the
+//! library's option table (the command line's flags of the same names), and the others
+//! (`sequence`, `ratio`, …) one by one with their ranges; unknown keywords are refused.
 
 use clap::ValueEnum;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
-use seethru::measure::compare::{Candidate, compare_reads};
-use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
-use seethru::render::settings::MAX_SPP;
+use pyo3::types::{PyBool, PyDict};
+use seethru::measure::option_table::{Command, Kind, OptionSpec, Value, option, options_of};
+use seethru::measure::run_spec::{RunSpec, SpecError};
 use seethru::scene::source::MAX_RESOLUTION;
-use seethru::system::depth_sensor::{SensorKind, SensorOptions};
-use seethru::system::display::{DisplayModel, Filter};
-use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
-use seethru::system::memory::DEFAULT_MAX_MEMORY_GIB;
-use seethru::system::options::{
-    HeadSource, MAX_HEAD_BIAS_CM, Outside, RunOptions, WorkingDistance,
-};
-use seethru::system::reads::{ReadWhen, capture_reads, first_ignored, run_reads};
-use seethru::system::scene_model::{Fill, SceneModelOptions};
+use seethru::system::options::{MAX_HEAD_BIAS_CM, WorkingDistance};
 
 use crate::errors::bad_value;
 
@@ -80,238 +72,109 @@ pub fn working_distance(key: &str, value: &Bound<'_, PyAny>) -> PyResult<Working
     }
 }
 
-/// The keywords `seethru.run` accepts, in `seethru run`'s order (its flags less those that
-/// name files, threads or progress).
-pub const RUN_KEYS: [&str; 27] = [
-    "method",
-    "d2",
-    "head",
-    "head_bias_cm",
-    "head_jitter_cm",
-    "seed",
-    "feature_width",
-    "require_confident_head",
-    "outside",
-    "filter",
-    "display",
-    "frontal_width",
-    "back_width",
-    "eyes",
-    "ipd",
-    "target_eye",
-    "band",
-    "hazard_bound_arcmin",
-    "depth_sensor",
-    "depth_resolution",
-    "depth_range",
-    "depth_noise",
-    "depth_quantum",
-    "fill",
-    "width",
-    "height",
-    "spp",
-];
-
-/// The keywords `seethru.capture` accepts besides `depth`, in `seethru capture`'s order.
-pub const CAPTURE_KEYS: [&str; 20] = [
-    "head",
-    "head_bias_cm",
-    "head_jitter_cm",
-    "seed",
-    "feature_width",
-    "require_confident_head",
-    "frontal_width",
-    "back_width",
-    "eyes",
-    "ipd",
-    "target_eye",
-    "depth_sensor",
-    "depth_resolution",
-    "depth_range",
-    "depth_noise",
-    "depth_quantum",
-    "fill",
-    "width",
-    "height",
-    "spp",
-];
-
-/// The keywords `seethru.compare` accepts besides `methods`, in `seethru compare`'s order.
-pub const COMPARE_KEYS: [&str; 15] = [
-    "head",
-    "seed",
-    "frontal_width",
-    "back_width",
-    "band",
-    "hazard_bound_arcmin",
-    "depth_sensor",
-    "depth_resolution",
-    "depth_range",
-    "depth_noise",
-    "depth_quantum",
-    "fill",
-    "width",
-    "height",
-    "spp",
-];
-
-/// The function whose keywords are read, with what decides which of them it reads: the
-/// rules are the library's, those of the command of the same name.
-pub enum Caller<'a> {
-    Run,
-    Capture { depth: bool },
-    Compare { candidates: &'a [Candidate] },
-}
-
-impl Caller<'_> {
-    fn keys(&self) -> &'static [&'static str] {
-        match self {
-            Caller::Run => &RUN_KEYS,
-            Caller::Capture { .. } => &CAPTURE_KEYS,
-            Caller::Compare { .. } => &COMPARE_KEYS,
-        }
-    }
-
-    fn reads(&self, options: &RunOptions) -> Vec<ReadWhen> {
-        match self {
-            Caller::Run => run_reads(options, false),
-            Caller::Capture { depth } => capture_reads(options, *depth),
-            Caller::Compare { candidates } => compare_reads(candidates, false, options),
-        }
-    }
-}
-
-/// What `seethru.run` runs with: the pipeline's options, the border band and the memory limit.
-pub struct RunChoices {
-    pub options: RunOptions,
-    pub band: u32,
-    /// Hazard visibility's misregistration bound, arcmin.
-    pub hazard_bound_arcmin: f64,
-    pub max_memory: f64,
-}
-
-/// Reads the keywords of `caller`; defaults are its command's. A keyword the call would
-/// ignore under the others given is refused, in the command's words with keyword names.
-pub fn run_choices(kwargs: Option<&Bound<'_, PyDict>>, caller: Caller) -> PyResult<RunChoices> {
-    let mut options = RunOptions::default();
-    let mut sensor = SensorOptions::default();
-    let mut fill = Fill::None;
-    let (mut band, mut max_memory) = (5u32, DEFAULT_MAX_MEMORY_GIB);
-    let mut hazard_bound_arcmin = HAZARD_BOUND_ARCMIN;
-    let mut given: Vec<String> = Vec::new();
-    let (mut eyes, mut target, mut ipd) = ("mono".to_string(), Eye::Cyclopean, 0.064);
+/// The run specification of `command` from its keywords, read through the library's option
+/// table (the same names, kinds, ranges and defaults as the command's flags) with `extra`
+/// given besides (`capture`'s `depth`); a keyword None is absent, as a flag left off.
+pub fn run_spec(
+    kwargs: Option<&Bound<'_, PyDict>>,
+    command: Command,
+    extra: Vec<(&'static OptionSpec, Value)>,
+) -> PyResult<RunSpec> {
+    let mut given = extra;
     if let Some(kwargs) = kwargs {
         for (key, value) in kwargs.iter() {
             let key: String = key.extract()?;
-            // None stands for the default, as an absent flag does.
-            let known = caller.keys().contains(&key.as_str()) || key == "max_memory";
-            if !known {
+            let Some(option) = option(&key).filter(|o| o.taken_by(command)) else {
+                let names: Vec<&str> = options_of(command).map(|o| o.name).collect();
                 return Err(bad_value(format!(
-                    "unknown option {key:?}: the options are {}, max_memory",
-                    caller.keys().join(", ")
+                    "unknown option {key:?}: the options are {}",
+                    names.join(", ")
                 )));
-            }
+            };
             if value.is_none() {
                 continue;
             }
-            given.push(format!("--{}", key.replace('_', "-")));
-            let text = || -> PyResult<String> {
-                value
-                    .extract::<String>()
-                    .map_err(|_| bad_value(format!("{key}: a string is needed")))
-            };
-            let int = |min: i64, max: i64| -> PyResult<i64> {
-                let v: i64 = value
-                    .extract()
-                    .map_err(|_| bad_value(format!("{key}: an integer is needed")))?;
-                int_in(&key, v, min, max)
-            };
-            let real = |min: f64, max: f64| -> PyResult<f64> {
-                let v: f64 = value
-                    .extract()
-                    .map_err(|_| bad_value(format!("{key}: a number is needed")))?;
-                real_in(&key, v, min, max)
-            };
-            let side = || int(1, MAX_RESOLUTION as i64).map(|v| Some(v as u32));
-            match key.as_str() {
-                "method" => options.method = choice(&key, &text()?)?,
-                "d2" => options.d2 = working_distance(&key, &value)?,
-                "head" => options.head = choice::<HeadSource>(&key, &text()?)?,
-                "head_bias_cm" => {
-                    let v: [f64; 3] = value.extract().map_err(|_| {
-                        bad_value("head_bias_cm: three numbers (x, y, z) are needed")
-                    })?;
-                    for (axis, c) in ["x", "y", "z"].iter().zip(v) {
-                        real_in(
-                            &format!("head_bias_cm {axis}"),
-                            c,
-                            -MAX_HEAD_BIAS_CM,
-                            MAX_HEAD_BIAS_CM,
-                        )?;
-                    }
-                    options.head_bias_cm = v;
-                }
-                "head_jitter_cm" => options.head_jitter_cm = real(0.0, 100.0)?,
-                "seed" => options.seed = int(0, u32::MAX as i64)? as u32,
-                "feature_width" => options.feature_width = real(MIN_POSITIVE, 1.0)?,
-                "require_confident_head" => {
-                    options.require_confident_head = value
-                        .extract::<bool>()
-                        .map_err(|_| bad_value(format!("{key}: True or False is needed")))?;
-                }
-                "hazard_bound_arcmin" => hazard_bound_arcmin = real(MIN_POSITIVE, 10800.0)?,
-                "outside" => options.outside = choice::<Outside>(&key, &text()?)?,
-                "filter" => options.filter = choice::<Filter>(&key, &text()?)?,
-                "display" => options.display = choice::<DisplayModel>(&key, &text()?)?,
-                "frontal_width" => options.frontal_width = side()?,
-                "back_width" => options.back_width = side()?,
-                "eyes" => {
-                    eyes = text()?;
-                    if !["mono", "left", "right"].contains(&eyes.as_str()) {
-                        return Err(bad_value(format!(
-                            "eyes={eyes:?} is not one of mono, left, right (for both eyes, run left and right)"
-                        )));
-                    }
-                }
-                "ipd" => ipd = real(MIN_POSITIVE, MAX_IPD)?,
-                "target_eye" => target = choice::<Eye>(&key, &text()?)?,
-                "band" => band = int(1, 1000)? as u32,
-                "depth_sensor" => sensor.kind = choice::<SensorKind>(&key, &text()?)?,
-                "depth_resolution" => sensor.width = side()?,
-                "depth_range" => sensor.range_m = Some(real(MIN_POSITIVE, 1e6)?),
-                "depth_noise" => sensor.noise_1m = Some(real(0.0, 10.0)?),
-                "depth_quantum" => sensor.quantum_1m = Some(real(0.0, 10.0)?),
-                "fill" => fill = choice::<Fill>(&key, &text()?)?,
-                "width" => options.width = side()?,
-                "height" => options.height = side()?,
-                "spp" => options.spp = int(1, MAX_SPP as i64)? as u32,
-                "max_memory" => max_memory = real(MIN_POSITIVE, 4096.0)?,
-                _ => unreachable!("every key of {:?} is read", caller.keys()),
+            if let Some(value) = value_of(option, &value)? {
+                given.push((option, value));
             }
         }
     }
-    options.eyes = Eyes {
-        view: match eyes.as_str() {
-            "left" => Eye::Left,
-            "right" => Eye::Right,
-            _ => Eye::Cyclopean,
-        },
-        target,
-        ipd,
-    };
-    options.scene_model = SceneModelOptions { sensor, fill };
-    options.progress = false;
-    if let Some(rule) = first_ignored(&caller.reads(&options), |flag| {
-        given.iter().any(|g| g == flag)
-    }) {
-        return Err(bad_value(rule.keyword_refusal()));
+    RunSpec::build(command, &given).map_err(spelled)
+}
+
+/// A [`SpecError`] in Python's words: keyword names.
+pub fn spelled(error: SpecError) -> PyErr {
+    match error {
+        SpecError::Value { option, value, why } => bad_value(format!("{option}={value}: {why}")),
+        SpecError::Unknown { option, command } => bad_value(format!(
+            "unknown option {option:?}: not one of seethru.{}'s",
+            command.name()
+        )),
+        SpecError::Ignored(rule) => bad_value(rule.keyword_refusal()),
     }
-    Ok(RunChoices {
-        options,
-        band,
-        hazard_bound_arcmin,
-        max_memory,
-    })
+}
+
+/// The value of `option` given as the Python object `value`, of the option's type, read by the
+/// option's own parser (so with the command line's ranges); `None` for a switch given False
+/// (as a flag left off).
+fn value_of(option: &'static OptionSpec, value: &Bound<'_, PyAny>) -> PyResult<Option<Value>> {
+    let name = option.name;
+    let shown = value
+        .repr()
+        .map_or_else(|_| "?".to_string(), |r| r.to_string());
+    let wrong_type = || bad_value(format!("{name}={shown}: must be {}", option.kind.need()));
+    let is_bool = value.is_instance_of::<PyBool>();
+    let number = || -> PyResult<f64> {
+        match is_bool {
+            true => Err(wrong_type()),
+            false => value.extract::<f64>().map_err(|_| wrong_type()),
+        }
+    };
+    let text = match option.kind {
+        Kind::Switch => {
+            return match is_bool {
+                true => Ok(value.extract::<bool>()?.then_some(Value::Switch(true))),
+                false => Err(wrong_type()),
+            };
+        }
+        Kind::Choice(_) => {
+            let text: String = value.extract().map_err(|_| wrong_type())?;
+            return option.parse(&text).map(Some).map_err(|_| {
+                bad_value(format!(
+                    "{name}={text:?} is not one of {}",
+                    names_of(option)
+                ))
+            });
+        }
+        Kind::Integer { .. } => match is_bool {
+            true => return Err(wrong_type()),
+            false => value
+                .extract::<i64>()
+                .map_err(|_| wrong_type())?
+                .to_string(),
+        },
+        Kind::Real { .. } => number()?.to_string(),
+        Kind::Triple { .. } => {
+            let xyz: [f64; 3] = value.extract().map_err(|_| wrong_type())?;
+            xyz.map(|v| v.to_string()).join(",")
+        }
+        Kind::Distance { .. } => match value.extract::<String>() {
+            Ok(text) => text,
+            Err(_) => number()?.to_string(),
+        },
+    };
+    option
+        .parse(&text)
+        .map(Some)
+        .map_err(|why| bad_value(format!("{name}={shown} is out of range: {why}")))
+}
+
+/// The choices of a choice option, comma-separated.
+fn names_of(option: &OptionSpec) -> String {
+    match option.kind {
+        Kind::Choice(_) => option.kind.choices().join(", "),
+        _ => String::new(),
+    }
 }
 
 /// Keyword arguments read one by one with their ranges; [`Keywords::finish`] refuses the rest.

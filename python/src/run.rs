@@ -8,7 +8,7 @@ use numpy::ndarray::Array2;
 use numpy::{PyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use seethru::measure::measured_run::{MeasureSettings, MeasuredRun, measure_run};
+use seethru::measure::measured_run::{MeasuredRun, measure_run};
 use seethru::system::memory::{check_memory, run_estimate};
 use seethru::system::pipeline::RunResult;
 use seethru::system::pipeline::run as run_pipeline;
@@ -16,8 +16,10 @@ use seethru::system::pipeline::run as run_pipeline;
 use crate::errors::to_py;
 use crate::frame::PyFrame;
 use crate::interrupt::detached;
-use crate::options::{Caller, run_choices};
+use crate::options::run_spec;
 use crate::scene::{PyScene, context_for};
+use seethru::measure::option_table::Command;
+use seethru::system::reads::hazard_bound_reads;
 
 /// What one run gives: its six views, its metrics and its report.
 #[pyclass(name = "Run", module = "seethru", frozen)]
@@ -66,21 +68,25 @@ pub fn run(
     scene: &Bound<'_, PyScene>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PyRun> {
-    let choices = run_choices(options, Caller::Run)?;
+    let spec = run_spec(options, Command::Run, Vec::new())?;
+    if spec.both_eyes {
+        return Err(crate::errors::bad_value(
+            "eyes=\"both\": seethru.run returns one run: run eyes=\"left\" and eyes=\"right\" (the command line's --eyes both runs each into its own folder)",
+        ));
+    }
     let (the_scene, cached) = {
         let s = scene.borrow();
         (s.scene.clone(), s.context.clone())
     };
-    let estimate = run_estimate(&the_scene, &choices.options).map_err(to_py)?;
-    check_memory(&estimate, choices.max_memory).map_err(to_py)?;
-    let settings = MeasureSettings {
-        band: choices.band,
-        hazard_bound_arcmin: choices.hazard_bound_arcmin,
-    };
+    spec.refuse_ignored(&[hazard_bound_reads(&the_scene)])
+        .map_err(crate::options::spelled)?;
+    let estimate = run_estimate(&the_scene, &spec.options).map_err(to_py)?;
+    check_memory(&estimate, spec.max_memory_gib).map_err(to_py)?;
+    let settings = spec.measure;
     let (context, result, measured) = detached(py, move || -> anyhow::Result<_> {
         let ctx = context_for(cached, the_scene)?;
-        let result = run_pipeline(&ctx, &choices.options)?;
-        let measured = measure_run(&ctx, &choices.options, &result, settings)?;
+        let result = run_pipeline(&ctx, &spec.options)?;
+        let measured = measure_run(&ctx, &spec.options, &result, settings)?;
         Ok((ctx, result, measured))
     })?
     .map_err(to_py)?;

@@ -446,10 +446,9 @@ pub fn sequence(
     };
     // As `seethru sequence`: a setting the others make it ignore is refused.
     let refuse = |rules: &[ReadWhen]| -> PyResult<()> {
-        let keyword = |r: &ReadWhen| r.flag.trim_start_matches("--").replace('-', "_");
         match rules
             .iter()
-            .find(|r| !r.read && given.contains(&keyword(r)))
+            .find(|r| !r.read && given.iter().any(|g| g == r.option))
         {
             Some(r) => Err(bad_value(r.keyword_refusal())),
             None => Ok(()),

@@ -11,7 +11,7 @@ import seethru
 from conftest import REPO, SCENE, seethru_cli
 
 # Flags that name files, threads or progress, or are another argument in Python.
-NOT_KEYWORDS = {"out", "quiet", "calibration", "threads", "exr", "heatmap_max", "methods", "depth", "help"}
+NOT_KEYWORDS = {"out", "quiet", "calibration", "threads", "exr", "heatmap_max", "methods", "help"}
 
 
 def keyword_names(text: str) -> str:
@@ -52,7 +52,7 @@ REFUSED = [
     ("run", dict(depth_noise=0.01), ["--depth-noise", "0.01"]),
     ("run", dict(require_confident_head=True), ["--require-confident-head"]),
     ("capture", dict(depth_noise=0.01), ["--depth-noise", "0.01"]),
-    ("capture", dict(depth=True, fill="inpaint"), ["--depth", "--fill", "inpaint"]),
+    ("capture", dict(depth=True, require_confident_head=True), ["--depth", "--require-confident-head"]),
     ("capture", dict(feature_width=0.07), ["--feature-width", "0.07"]),
     ("compare", dict(methods=["planar-inf"], depth_noise=0.01), ["--methods", "planar-inf", "--depth-noise", "0.01"]),
     ("compare", dict(methods=["ground"], seed=3), ["--methods", "ground", "--seed", "3"]),

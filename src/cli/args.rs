@@ -214,8 +214,9 @@ pub use seethru::system::reads::ReadWhen;
 /// is read only sometimes; the flags given are the parser's ([`crate::cli::given`]), so a
 /// flag set to its default value is refused too.
 pub fn refuse_ignored(rules: &[ReadWhen]) -> Result<()> {
-    if let Some(rule) = seethru::system::reads::first_ignored(rules, crate::cli::given::given) {
-        bail!("{}", rule.refusal(rule.flag, "flags"));
+    let given = |option: &str| crate::cli::given::given(&seethru::system::reads::flag_of(option));
+    if let Some(rule) = seethru::system::reads::first_ignored(rules, given) {
+        bail!("{}", rule.flag_refusal());
     }
     Ok(())
 }

@@ -5,23 +5,18 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use seethru::io::frame_files::ExrContent;
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
 use seethru::measure::capture_files::{capture_spec, spec_scene, write_scoreable_capture};
 use seethru::render::integrator::RenderContext;
 use seethru::system::capture::capture;
-use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
 use seethru::system::memory::{check_memory, run_estimate};
-use seethru::system::options::{HeadSource, RunOptions};
-use seethru::system::reads::capture_reads;
+use seethru::system::options::RunOptions;
 
-use crate::cli::args::{
-    HeadErrorArgs, RenderArgs, choice, pixels, positive, refuse_ignored, with_threads,
-};
-use crate::cli::run_eyes::EyesFlag;
-use crate::cli::scene_model_args::SceneModelArgs;
+use crate::cli::args::{choice, threads, with_threads};
+use crate::cli::option_args::{self, OptionArgs};
 
 /// The flags of a capture (run's flags that decide what the system receives).
 #[derive(clap::Args)]
@@ -36,76 +31,21 @@ pub struct CaptureArgs {
     /// the cameras calibration.json states.
     #[arg(long, value_name = "FILE")]
     pub calibration: Option<PathBuf>,
-    /// oracle: the true eye; estimated: face detection on the back camera's image.
-    #[arg(long, value_enum, value_parser = choice::<HeadSource>(), default_value_t = HeadSource::Oracle)]
-    pub head: HeadSource,
-    /// Head-tracking errors and the detector's feature width.
+    /// The capture's options: the option table's (`seethru::measure::option_table`).
     #[command(flatten)]
-    pub head_errors: HeadErrorArgs,
-    /// Frontal camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
-    #[arg(long = "frontal-width", value_parser = pixels)]
-    pub frontal_width: Option<u32>,
-    /// Back camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
-    #[arg(long = "back-width", value_parser = pixels)]
-    pub back_width: Option<u32>,
-    /// The eye the driver's views are rendered from: mono, left or right (not both).
-    #[arg(long, value_enum, value_parser = choice::<EyesFlag>(), default_value_t = EyesFlag::Mono)]
-    pub eyes: EyesFlag,
-    /// Interpupillary distance, metres in [1e-6, 0.1].
-    #[arg(long, default_value_t = 0.064, value_parser = positive(MAX_IPD))]
-    pub ipd: f64,
-    /// The eye the head estimate is for.
-    #[arg(long = "target-eye", value_enum, value_parser = choice::<Eye>(), default_value_t = Eye::Cyclopean)]
-    pub target_eye: Eye,
-    /// Write the depth sensor's image (depth.npy, depth.exr), as --method depth models it
-    /// with --depth-sensor and its settings.
-    #[arg(long)]
-    pub depth: bool,
-    /// The depth sensor (with --depth).
-    #[command(flatten)]
-    pub scene_model: SceneModelArgs,
+    pub options: OptionArgs<option_args::Capture>,
     /// Which EXRs the capture writes: all (frontal.exr and back.exr in colour, depth.exr with
     /// --depth, truth/truth.exr with every AOV), lean (as all, truth/truth.exr with R, G, B,
     /// Z, N and the ids), colour (the colour EXRs only: truth/truth.exr is R, G, B, A, no
     /// depth.exr) or none (PNGs, depth.npy and the JSON files only).
     #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
     pub exr: ExrContent,
-    /// Sizes of the driver's view (the truth), samples, threads.
-    #[command(flatten)]
-    pub render: RenderArgs,
+    /// Worker threads in [1, 1024] (default: all cores). Images are identical for any value.
+    #[arg(long, value_parser = threads)]
+    pub threads: Option<usize>,
 }
 
 impl CaptureArgs {
-    /// The run options of the capture (the method's choices left at their defaults).
-    pub fn options(&self) -> Result<RunOptions> {
-        if self.eyes == EyesFlag::Both {
-            bail!("--eyes both: a capture is for one eye (mono, left or right)");
-        }
-        let options = RunOptions {
-            head: self.head,
-            head_bias_cm: self.head_errors.head_bias_cm,
-            head_jitter_cm: self.head_errors.head_jitter_cm,
-            seed: self.head_errors.seed,
-            feature_width: self.head_errors.feature_width,
-            require_confident_head: self.head_errors.require_confident_head,
-            width: self.render.width,
-            height: self.render.height,
-            frontal_width: self.frontal_width,
-            back_width: self.back_width,
-            spp: self.render.spp,
-            eyes: Eyes {
-                view: self.eyes.view(),
-                target: self.target_eye,
-                ipd: self.ipd,
-            },
-            scene_model: self.scene_model.options(),
-            progress: true,
-            ..RunOptions::default()
-        };
-        refuse_ignored(&capture_reads(&options, self.depth))?;
-        Ok(options)
-    }
-
     pub fn run(self) -> Result<()> {
         let mut inputs = vec![Input::file("SCENE", &self.scene)];
         inputs.extend(
@@ -114,18 +54,22 @@ impl CaptureArgs {
                 .map(|c| Input::file("--calibration", c)),
         );
         check_paths(&inputs, &[Output::folder("--out", &self.out)])?;
-        let options = self.options()?;
+        let run = self.options.spec()?;
+        let options = RunOptions {
+            progress: true,
+            ..run.options
+        };
         let spec = capture_spec(
             &self.scene,
             self.calibration.as_deref(),
-            self.depth,
+            run.depth,
             &options,
         )?;
-        with_threads(self.render.threads, || {
+        with_threads(self.threads, || {
             let scene = spec_scene(&spec)?;
-            check_memory(&run_estimate(&scene, &options)?, self.render.max_memory)?;
+            check_memory(&run_estimate(&scene, &options)?, run.max_memory_gib)?;
             let ctx = RenderContext::new(scene)?;
-            let captured = capture(&ctx, &options, self.depth)?;
+            let captured = capture(&ctx, &options, run.depth)?;
             let staged = StagedDir::new(&self.out)?;
             write_scoreable_capture(staged.path(), &captured, &spec, self.exr)?;
             staged.commit()?;

@@ -11,16 +11,15 @@ use seethru::io::staged::StagedDir;
 use seethru::measure::compare::{
     Candidate, coloured_strips, compare_reads, html_page, markdown_table,
 };
-use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
+use seethru::measure::run_spec::RunSpec;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::system::memory::{check_memory, run_estimate};
-use seethru::system::options::{HeadSource, Outside, RunOptions};
+use seethru::system::options::RunOptions;
+use seethru::system::reads::hazard_bound_reads;
 
-use crate::cli::args::{
-    ReadWhen, RenderArgs, band, choice, integer, pixels, positive, refuse_ignored, with_threads,
-};
-use crate::cli::scene_model_args::SceneModelArgs;
+use crate::cli::args::{refuse_ignored, threads, with_threads};
+use crate::cli::option_args::{self, OptionArgs};
 
 #[derive(clap::Args)]
 pub struct Compare {
@@ -40,32 +39,12 @@ pub struct Compare {
     /// Output directory: compare.md, compare.json, compare.html and strip_<method>.png.
     #[arg(long, default_value = "compare")]
     out: PathBuf,
-    /// oracle: the true eye; estimated: face detection on the back camera's image.
-    #[arg(long, value_enum, value_parser = choice::<HeadSource>(), default_value_t = HeadSource::Oracle)]
-    head: HeadSource,
-    /// Seed of the depth noise and the plane fit, an integer in [0, 4294967295].
-    #[arg(long, default_value_t = 1, value_parser = integer::<u32>(0, u32::MAX as u64))]
-    seed: u32,
-    /// Frontal camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
-    #[arg(long = "frontal-width", value_parser = pixels)]
-    frontal_width: Option<u32>,
-    /// Back camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
-    #[arg(long = "back-width", value_parser = pixels)]
-    back_width: Option<u32>,
-    /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
-    #[arg(long, default_value_t = 5, value_parser = band)]
-    band: u32,
-    /// Hazard visibility: a hidden hazard pixel counts as shown when the display shows the
-    /// same object within this misregistration, arc-minutes in [1e-6, 10800] (a scene with
-    /// an object marked `hazard = true` only).
-    #[arg(long = "hazard-bound-arcmin", default_value_t = HAZARD_BOUND_ARCMIN, value_parser = positive(10800.0))]
-    hazard_bound_arcmin: f64,
-    /// The depth sensor (its kind is the method's for depth-tof and depth-stereo) and fill.
+    /// The run's options: the option table's (`seethru::measure::option_table`).
     #[command(flatten)]
-    scene_model: SceneModelArgs,
-    /// Sizes of the driver views, samples, threads.
-    #[command(flatten)]
-    render: RenderArgs,
+    options: OptionArgs<option_args::Compare>,
+    /// Worker threads in [1, 1024] (default: all cores). Images are identical for any value.
+    #[arg(long, value_parser = threads)]
+    threads: Option<usize>,
 }
 
 impl Compare {
@@ -74,23 +53,13 @@ impl Compare {
             &[Input::file("SCENE", &self.scene)],
             &[Output::folder("--out", &self.out)],
         )?;
+        let spec = self.options.spec()?;
         let base = RunOptions {
-            head: self.head,
-            seed: self.seed,
-            width: self.render.width,
-            height: self.render.height,
-            frontal_width: self.frontal_width,
-            back_width: self.back_width,
-            spp: self.render.spp,
-            // A crop past the frontal view is shown black and counted, not an error: every
-            // method gets its row.
-            outside: Outside::Black,
-            scene_model: self.scene_model.options(),
             progress: true,
-            ..RunOptions::default()
+            ..spec.options
         };
         self.refuse_ignored(&base)?;
-        with_threads(self.render.threads, || self.write(&base))?
+        with_threads(self.threads, || self.write(&spec, &base))?
     }
 
     /// Refuses the flags no listed method would read ([`refuse_ignored`]).
@@ -108,21 +77,18 @@ impl Compare {
         refuse_ignored(&compare_reads(&candidates, maps, base))
     }
 
-    fn write(&self, base: &RunOptions) -> Result<()> {
+    fn write(&self, spec: &RunSpec, base: &RunOptions) -> Result<()> {
+        let (band, hazard_bound_arcmin) = (spec.measure.band, spec.measure.hazard_bound_arcmin);
         let scene = Scene::load(&self.scene)?;
-        refuse_ignored(&[ReadWhen {
-            flag: "--hazard-bound-arcmin",
-            read: scene.objects.iter().any(|o| o.hazard),
-            when: "for a scene with an object marked `hazard = true`",
-        }])?;
-        check_memory(&run_estimate(&scene, base)?, self.render.max_memory)?;
+        refuse_ignored(&[hazard_bound_reads(&scene)])?;
+        check_memory(&run_estimate(&scene, base)?, spec.max_memory_gib)?;
         let ctx = RenderContext::new(scene)?;
         let rows = crate::cli::compare_methods::compare_all(
             &ctx,
             &self.methods,
             base,
-            self.band,
-            self.hazard_bound_arcmin,
+            band,
+            hazard_bound_arcmin,
         )?;
         // Written whole or not at all: a failure leaves `--out` as it was.
         let staged = StagedDir::new(&self.out)?;
@@ -141,14 +107,14 @@ impl Compare {
         let hazards = match ctx.scene.objects.iter().any(|o| o.hazard) {
             true => format!(
                 " Per `hazard = true` object: visibility, the fraction of its pixels hidden by the pillar that the display shows as that object within {}′ (— when none is hidden), and the centroid error ′ of what the display shows of it.",
-                self.hazard_bound_arcmin
+                hazard_bound_arcmin
             ),
             false => String::new(),
         };
         let title = format!("Compensation methods compared on {}", self.scene.display());
         let md = format!(
             "# {title}\n\nMisregistration in arc-minutes at the true eye over the display (mean, p95, and the border band of {} display pixels); coverage: fraction of display pixels that show the scene; holes: disocclusions of the depth methods (fill: {:?}); ms/frame: the method's own work (sensor, fit or search, resampling); not run because: why a method cannot run on this scene (its row is otherwise empty).{hazards}\n\n{table}\n{}",
-            self.band,
+            band,
             base.scene_model.fill,
             strips
                 .iter()

@@ -132,7 +132,7 @@ impl Diff {
         )?;
         let (a_dir, b_dir) = (self.a.is_dir(), self.b.is_dir());
         refuse_ignored(&[ReadWhen {
-            flag: "--tolerance",
+            option: "tolerance",
             read: a_dir && b_dir,
             when: "when two run folders are compared (their metrics.json)",
         }])?;

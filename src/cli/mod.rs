@@ -16,15 +16,16 @@ mod figures;
 pub mod given;
 mod head_poses;
 mod measure;
+mod option_args;
 mod ratio;
 mod render;
 mod reproduce;
 mod run;
 mod run_eyes;
-mod scene_model_args;
 mod score;
 mod sequence;
 mod sequence_byo;
+mod spec;
 mod sweep;
 pub mod verdict;
 
@@ -81,7 +82,7 @@ pub enum Command {
     HeadPoses(head_poses::HeadPoses),
     /// The system over time: vehicle and head motion, latencies and prediction, measured frame
     /// by frame against the truth (frames.csv, summary.json, plots, an animated preview).
-    Sequence(sequence::Sequence),
+    Sequence(Box<sequence::Sequence>),
     /// Differences of two images (PNG, EXR layers) or two run folders: FLIP, PSNR, SSIM,
     /// absolute errors, metrics.json; thresholds give exit 1 when exceeded, 2 on bad input.
     Diff(diff::Diff),
@@ -93,6 +94,10 @@ pub enum Command {
     Capture(capture::CaptureArgs),
     /// Score your method's display map (or image) for a capture, measured exactly as `run`.
     Score(score::Score),
+    /// The run specification `run`, `capture` or `compare` would make of these options (JSON),
+    /// every option checked, nothing rendered: the option table's values and defaults.
+    #[command(subcommand)]
+    Spec(spec::Spec),
 }
 
 /// The command line with every negative number that follows an option joined to it
@@ -210,6 +215,7 @@ impl Command {
             Command::Run(c) => c.run(),
             Command::Capture(c) => c.run(),
             Command::Score(c) => c.run(),
+            Command::Spec(c) => c.run(),
             Command::Ratio(c) => c.run(),
             Command::Reproduce(c) => c.run(),
             Command::Sweep(c) => c.run(),

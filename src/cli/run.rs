@@ -10,7 +10,6 @@ use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{ExrContent, write_frame_keeping, write_frame_like};
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
-use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
 use seethru::measure::headline::{read_results, summary_text};
 use seethru::measure::holes::write_hole_mask;
 use seethru::measure::maps::write_metrics_scaled;
@@ -18,18 +17,13 @@ use seethru::measure::measured_run::{DriverViews, hazards_of, measure_views, vie
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::scene::lens_keys::read_calibration_file;
-use seethru::system::display::{DisplayModel, Filter};
-use seethru::system::eyes::{Eye, Eyes, MAX_IPD};
 use seethru::system::memory::{both_eyes_estimate, check_memory, run_estimate};
-use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
+use seethru::system::options::RunOptions;
 use seethru::system::pipeline::{Given, RunResult, RunViews, check_display_seen, run_staged};
-use seethru::system::reads::run_reads;
+use seethru::system::reads::hazard_bound_reads;
 
-use crate::cli::args::{
-    HeadErrorArgs, RenderArgs, band, choice, pixels, positive, refuse_ignored, with_threads,
-};
-use crate::cli::run_eyes::EyesFlag;
-use crate::cli::scene_model_args::SceneModelArgs;
+use crate::cli::args::{choice, positive, refuse_ignored, threads, with_threads};
+use crate::cli::option_args::{self, OptionArgs};
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -43,68 +37,21 @@ pub struct Run {
     /// the compensation's own copy of the cameras.
     #[arg(long, value_name = "FILE")]
     calibration: Option<PathBuf>,
-    /// none: the whole frontal image in the display; planar: the paper's compensation;
-    /// ground: the road plane; plane-fit: a plane fitted to the depth sensor's points; depth:
-    /// per-pixel reprojection with the depth sensor's depth.
-    #[arg(long, value_enum, value_parser = choice::<Method>(), default_value_t = Method::Planar)]
-    method: Method,
-    /// Working distance of the planar model: inf, auto (median frontal depth behind the
-    /// display) or metres in [1e-6, 1e6].
-    #[arg(long, default_value = "inf", value_name = "METRES|inf|auto")]
-    d2: WorkingDistance,
-    /// oracle: the true eye; estimated: face detection on the back camera's image.
-    #[arg(long, value_enum, value_parser = choice::<HeadSource>(), default_value_t = HeadSource::Oracle)]
-    head: HeadSource,
-    /// Head-tracking errors and the detector's feature width.
+    /// The run's options: the option table's (`seethru::measure::option_table`).
     #[command(flatten)]
-    head_errors: HeadErrorArgs,
-    /// When the crop leaves the frontal view: error, or black (flagged as missing).
-    #[arg(long, value_enum, value_parser = choice::<Outside>(), default_value_t = Outside::Error)]
-    outside: Outside,
-    /// Colour resampling of the display image.
-    #[arg(long, value_enum, value_parser = choice::<Filter>(), default_value_t = Filter::Bilinear)]
-    filter: Filter,
-    /// pixels: the physical display; ideal: unlimited display and frontal resolution, so
-    /// that only the planar model's error remains.
-    #[arg(long, value_enum, value_parser = choice::<DisplayModel>(), default_value_t = DisplayModel::Pixels)]
-    display: DisplayModel,
-    /// Frontal camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
-    #[arg(long = "frontal-width", value_parser = pixels)]
-    frontal_width: Option<u32>,
-    /// Back camera width, pixels in [1, 16384] (aspect ratio kept; default: the scene's).
-    #[arg(long = "back-width", value_parser = pixels)]
-    back_width: Option<u32>,
-    /// The eyes the driver's views are rendered from.
-    #[arg(long, value_enum, value_parser = choice::<EyesFlag>(), default_value_t = EyesFlag::Mono)]
-    eyes: EyesFlag,
-    /// Interpupillary distance, metres in [1e-6, 0.1].
-    #[arg(long, default_value_t = 0.064, value_parser = positive(MAX_IPD))]
-    ipd: f64,
-    /// The eye the compensation serves.
-    #[arg(long = "target-eye", value_enum, value_parser = choice::<Eye>(), default_value_t = Eye::Cyclopean)]
-    target_eye: Eye,
+    options: OptionArgs<option_args::Run>,
     /// What each view's EXR holds: none; colour (R, G, B, A); lean (R, G, B, Z, N and the
     /// ids: every AOV that no other channel gives); all (lean with A, P and camera_z.Z: what
     /// `seethru measure` reads back).
     #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::Lean)]
     exr: ExrContent,
-    /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
-    #[arg(long, default_value_t = 5, value_parser = band)]
-    band: u32,
-    /// Hazard visibility: a hidden hazard pixel counts as shown when the display shows the
-    /// same object within this misregistration, arc-minutes in [1e-6, 10800].
-    #[arg(long = "hazard-bound-arcmin", default_value_t = HAZARD_BOUND_ARCMIN, value_parser = positive(10800.0))]
-    hazard_bound_arcmin: f64,
     /// Top of misregistration.png's scale, arc-minutes in [1e-6, 10000], so that heatmaps of
     /// runs compare (default: the 99th percentile of the display's values, labelled).
     #[arg(long = "heatmap-max", value_name = "ARCMIN", value_parser = positive(1e4))]
     heatmap_max: Option<f64>,
-    /// The depth sensor and hole filling of ground, plane-fit and depth.
-    #[command(flatten)]
-    scene_model: SceneModelArgs,
-    /// Sizes (width and height: the driver views truth, occluded, seethru), samples, threads.
-    #[command(flatten)]
-    render: RenderArgs,
+    /// Worker threads in [1, 1024] (default: all cores). Images are identical for any value.
+    #[arg(long, value_parser = threads)]
+    threads: Option<usize>,
 }
 
 impl Run {
@@ -116,42 +63,21 @@ impl Run {
                 .map(|c| Input::file("--calibration", c)),
         );
         check_paths(&inputs, &[Output::folder("--out", &self.out)])?;
+        let spec = self.options.spec()?;
         let options = RunOptions {
-            method: self.method,
-            d2: self.d2,
-            head: self.head,
-            head_bias_cm: self.head_errors.head_bias_cm,
-            head_jitter_cm: self.head_errors.head_jitter_cm,
-            seed: self.head_errors.seed,
-            require_confident_head: self.head_errors.require_confident_head,
-            feature_width: self.head_errors.feature_width,
-            width: self.render.width,
-            height: self.render.height,
-            frontal_width: self.frontal_width,
-            back_width: self.back_width,
-            spp: self.render.spp,
-            outside: self.outside,
-            filter: self.filter,
-            display: self.display,
-            eyes: Eyes {
-                view: self.eyes.view(),
-                target: self.target_eye,
-                ipd: self.ipd,
-            },
-            scene_model: self.scene_model.options(),
             progress: true,
+            ..spec.options
         };
-        let both = self.eyes == EyesFlag::Both;
-        refuse_ignored(&run_reads(&options, both))?;
-        let (scene, out, max_memory) = (&self.scene, &self.out, self.render.max_memory);
+        let both = spec.both_eyes;
+        let (scene, out, max_memory) = (&self.scene, &self.out, spec.max_memory_gib);
         let writes = RunWrites {
-            band: self.band,
+            band: spec.measure.band,
             exr: self.exr,
-            hazard_bound_arcmin: self.hazard_bound_arcmin,
+            hazard_bound_arcmin: spec.measure.hazard_bound_arcmin,
             heatmap_max_arcmin: self.heatmap_max.map(|v| v as f32),
         };
         let calibration = self.calibration.as_deref();
-        with_threads(self.render.threads, || {
+        with_threads(self.threads, || {
             run_command(scene, calibration, out, &options, writes, max_memory, both)
         })?
     }
@@ -182,6 +108,7 @@ fn run_command(
     both: bool,
 ) -> Result<()> {
     let mut scene = Scene::load(scene_path)?;
+    refuse_ignored(&[hazard_bound_reads(&scene)])?;
     if let Some(path) = calibration {
         scene.calibration = read_calibration_file(path, &scene.frontal, &scene.back)?;
     }

@@ -10,31 +10,6 @@ use seethru::system::eyes::{Eye, Eyes};
 use seethru::system::options::RunOptions;
 use seethru::system::pipeline::RunResult;
 
-/// Which eyes `run` looks with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum EyesFlag {
-    /// The scene's driver camera, the cyclopean eye.
-    Mono,
-    /// The left eye, ipd/2 left of the cyclopean eye.
-    Left,
-    /// The right eye.
-    Right,
-    /// Each eye into OUT/left and OUT/right, and the binocular mismatch into OUT.
-    Both,
-}
-
-impl EyesFlag {
-    /// The eye a single run views from (`both` starts from the cyclopean eye and runs each).
-    pub fn view(self) -> seethru::system::eyes::Eye {
-        use seethru::system::eyes::Eye;
-        match self {
-            EyesFlag::Left => Eye::Left,
-            EyesFlag::Right => Eye::Right,
-            EyesFlag::Mono | EyesFlag::Both => Eye::Cyclopean,
-        }
-    }
-}
-
 /// Runs each eye through `write_run(options, dir)` into `out` and writes the binocular
 /// outputs there; returns the summary line, naming `shown_out` (where `out` will be moved).
 pub fn run_both(

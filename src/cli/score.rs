@@ -87,7 +87,7 @@ impl Score {
         }
         // Given even at its default, --filter without a map would be ignored.
         crate::cli::args::refuse_ignored(&[crate::cli::args::ReadWhen {
-            flag: "--filter",
+            option: "filter",
             read: self.map.is_some() && self.display_image.is_none(),
             when: "with --map and no --display-image (it resamples the frontal image's colours at the map's points; a display image replaces them)",
         }])?;

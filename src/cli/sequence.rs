@@ -303,7 +303,7 @@ impl Sequence {
         let run = self.options(&HeadMotion::Still, 0.0).run;
         let mut rules = sequence_reads(&run, preset, self.maps.is_some());
         rules.push(ReadWhen {
-            flag: "--exr",
+            option: "exr",
             read: self.capture.is_some() || self.frames == FramesFormat::Exr,
             when: "with --capture or --frames exr (nothing else is written as EXR)",
         });

@@ -94,7 +94,7 @@ impl SweepMerge {
                     Some(ignored) => anyhow::anyhow!(
                         "{}",
                         ReadWhen {
-                            flag: "--bound-arcmin",
+                            option: "bound_arcmin",
                             read: false,
                             when: "for parts of a sweep of --param eye=eyellipse",
                         }
@@ -134,17 +134,17 @@ impl Sweep {
         let when = "with --param eye=eyellipse";
         refuse_ignored(&[
             ReadWhen {
-                flag: "--samples",
+                option: "samples",
                 read: drivers,
                 when,
             },
             ReadWhen {
-                flag: "--seed",
+                option: "seed",
                 read: drivers,
                 when,
             },
             ReadWhen {
-                flag: "--bound-arcmin",
+                option: "bound_arcmin",
                 read: drivers,
                 when,
             },

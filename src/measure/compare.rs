@@ -56,14 +56,14 @@ pub fn compare_reads(candidates: &[Candidate], maps: bool, options: &RunOptions)
     );
     let noisy_kind = options.scene_model.sensor.kind != SensorKind::Ideal;
     rules.push(ReadWhen {
-        flag: "--seed",
+        option: "seed",
         read: any(&[PlaneFit, DepthTof, DepthStereo])
             || (noisy_kind && any(&[DepthIdeal]))
             || options.head == HeadSource::Model,
         when: "with --head model (the tracker model's noise and dropouts) or when --methods lists plane-fit or a noisy depth sensor",
     });
     rules.push(ReadWhen {
-        flag: "--back-width",
+        option: "back_width",
         read: options.head == HeadSource::Estimated || maps,
         when: "with --head estimated or a map: method (the back camera is rendered for the face detector and for the capture a map is checked against)",
     });
@@ -460,7 +460,7 @@ mod tests {
     fn seed_read(candidates: &[Candidate], options: &RunOptions) -> bool {
         compare_reads(candidates, false, options)
             .into_iter()
-            .find(|r| r.flag == "--seed")
+            .find(|r| r.option == "seed")
             .unwrap()
             .read
     }

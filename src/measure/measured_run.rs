@@ -15,13 +15,22 @@ use crate::render::integrator::RenderContext;
 use crate::system::options::RunOptions;
 use crate::system::pipeline::{RunResult, driver_camera};
 
-/// How a run is measured: the flags that shape its numbers, not the system's.
-#[derive(Clone, Copy, Debug)]
+/// How a run is measured: the options that shape its numbers, not the system's.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MeasureSettings {
     /// Width of the border band of the mismatch metrics, display pixels in [1, 1000].
     pub band: u32,
     /// A hidden hazard pixel counts as shown within this misregistration, arcmin.
     pub hazard_bound_arcmin: f64,
+}
+
+impl Default for MeasureSettings {
+    fn default() -> Self {
+        MeasureSettings {
+            band: 5,
+            hazard_bound_arcmin: crate::measure::hazard::HAZARD_BOUND_ARCMIN,
+        }
+    }
 }
 
 /// A run's measurement.

@@ -34,6 +34,31 @@ impl Eye {
     }
 }
 
+/// The eyes a run looks with (`eyes`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Viewing {
+    /// The scene's driver camera, the cyclopean eye.
+    Mono,
+    /// The left eye, ipd/2 left of the cyclopean eye.
+    Left,
+    /// The right eye.
+    Right,
+    /// Each eye in turn (`seethru run`: into OUT/left and OUT/right, with the binocular
+    /// mismatch into OUT).
+    Both,
+}
+
+impl Viewing {
+    /// The eye a single run views from (`both` starts from the cyclopean eye and runs each).
+    pub fn view(self) -> Eye {
+        match self {
+            Viewing::Left => Eye::Left,
+            Viewing::Right => Eye::Right,
+            Viewing::Mono | Viewing::Both => Eye::Cyclopean,
+        }
+    }
+}
+
 /// Which eye looks and which eye the compensation serves.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]

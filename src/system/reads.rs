@@ -12,14 +12,19 @@ use crate::system::sequence::head_motion::HeadPreset;
 pub const EYE_METHODS: &str = "by the methods that compensate for the eye (not --method none)";
 
 /// A setting that a command reads only under some of its other settings.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ReadWhen {
-    /// The flag as typed, `--ipd`.
-    pub flag: &'static str,
+    /// The option's name, `ipd`: each front end spells it (`--ipd`, `ipd=`).
+    pub option: &'static str,
     /// Whether the command, with the settings given, reads it.
     pub read: bool,
     /// The settings that read it, for the message: `with --eyes left, right or both`.
     pub when: &'static str,
+}
+
+/// The command line's flag of the option `name`: `sway_cm` → `--sway-cm`.
+pub fn flag_of(name: &str) -> String {
+    format!("--{}", name.replace('_', "-"))
 }
 
 /// `--sway-cm` → `sway_cm`, and so every flag in a text (Python's keyword names). A flag
@@ -57,9 +62,14 @@ impl ReadWhen {
         )
     }
 
+    /// The refusal in the command line's words: `--ipd is read only …`.
+    pub fn flag_refusal(&self) -> String {
+        self.refusal(&flag_of(self.option), "flags")
+    }
+
     /// The refusal in Python's words: keyword names for flags, `options` for the rest.
     pub fn keyword_refusal(&self) -> String {
-        keyword_names(&self.refusal(self.flag, "options"))
+        keyword_names(&self.refusal(self.option, "options"))
     }
 }
 
@@ -77,22 +87,22 @@ pub fn head_error_reads(
     let eye = EYE_METHODS;
     vec![
         ReadWhen {
-            flag: "--head-bias-cm",
+            option: "head_bias_cm",
             read: eye_used,
             when: eye,
         },
         ReadWhen {
-            flag: "--head-jitter-cm",
+            option: "head_jitter_cm",
             read: eye_used,
             when: eye,
         },
         ReadWhen {
-            flag: "--feature-width",
+            option: "feature_width",
             read: eye_used && head == HeadSource::Estimated,
             when: "with an estimated head (face detection), not the oracle, and a method that compensates for the eye",
         },
         ReadWhen {
-            flag: "--seed",
+            option: "seed",
             read: (eye_used && (jitter || head == HeadSource::Model)) || other_seed_reader,
             when: "with --head-jitter-cm > 0, the tracker model's head, a noisy depth sensor or the plane fit",
         },
@@ -108,23 +118,23 @@ pub fn scene_model_reads(
     depth_when: &'static str,
     fill_when: &'static str,
 ) -> Vec<ReadWhen> {
-    let depth = |flag| ReadWhen {
-        flag,
+    let depth = |option| ReadWhen {
+        option,
         read: reads_depth,
         when: depth_when,
     };
     vec![
         ReadWhen {
-            flag: "--depth-sensor",
+            option: "depth_sensor",
             read: reads_kind,
             when: depth_when,
         },
-        depth("--depth-resolution"),
-        depth("--depth-range"),
-        depth("--depth-noise"),
-        depth("--depth-quantum"),
+        depth("depth_resolution"),
+        depth("depth_range"),
+        depth("depth_noise"),
+        depth("depth_quantum"),
         ReadWhen {
-            flag: "--fill",
+            option: "fill",
             read: fills,
             when: fill_when,
         },
@@ -162,24 +172,24 @@ pub fn run_reads(options: &RunOptions, both_eyes: bool) -> Vec<ReadWhen> {
     let eyes = &options.eyes;
     rules.extend([
         ReadWhen {
-            flag: "--head",
+            option: "head",
             read: eye_used,
             when: EYE_METHODS,
         },
         ReadWhen {
-            flag: "--target-eye",
+            option: "target_eye",
             read: eye_used,
             when: EYE_METHODS,
         },
         ReadWhen {
-            flag: "--ipd",
+            option: "ipd",
             read: both_eyes
                 || eyes.view != Eye::Cyclopean
                 || (eye_used && eyes.target != Eye::Cyclopean),
             when: "with --eyes left, right or both, or --target-eye left or right",
         },
         ReadWhen {
-            flag: "--d2",
+            option: "d2",
             read: !matches!(method, Method::None | Method::Depth),
             when: "by --method planar, ground and plane-fit",
         },
@@ -209,12 +219,12 @@ pub fn capture_reads(options: &RunOptions, depth: bool) -> Vec<ReadWhen> {
     let eyes = &options.eyes;
     rules.extend([
         ReadWhen {
-            flag: "--require-confident-head",
+            option: "require_confident_head",
             read: options.head == HeadSource::Estimated,
             when: "with --head estimated (only the face detector's estimate has a confidence)",
         },
         ReadWhen {
-            flag: "--ipd",
+            option: "ipd",
             read: eyes.view != Eye::Cyclopean || eyes.target != Eye::Cyclopean,
             when: "with --eyes left or right, or --target-eye left or right",
         },
@@ -222,9 +232,10 @@ pub fn capture_reads(options: &RunOptions, depth: bool) -> Vec<ReadWhen> {
     rules
 }
 
-/// The first rule of `rules` whose setting is given (`given`, by its flag) but not read.
+/// The first rule of `rules` whose setting is given (`given`, by its option's name) but not
+/// read.
 pub fn first_ignored(rules: &[ReadWhen], given: impl Fn(&str) -> bool) -> Option<&ReadWhen> {
-    rules.iter().find(|r| !r.read && given(r.flag))
+    rules.iter().find(|r| !r.read && given(r.option))
 }
 
 /// A sequence's rules, in the order they are checked: `run` holds its pipeline's options,
@@ -237,43 +248,39 @@ pub fn sequence_reads(run: &RunOptions, head: Option<HeadPreset>, maps: bool) ->
     let eye_used = run.method != Method::None;
     let estimated = run.head == HeadSource::Estimated;
     let mut rules = head_error_reads(eye_used, run.head, run.head_jitter_cm > 0.0, false);
-    let eye = |flag| ReadWhen {
-        flag,
+    let eye = |option| ReadWhen {
+        option,
         read: eye_used,
         when: EYE_METHODS,
     };
-    let with = |flag, read, when| ReadWhen { flag, read, when };
+    let with = |option, read, when| ReadWhen { option, read, when };
     rules.extend([
-        eye("--head-source"),
-        eye("--predict"),
-        eye("--latency-tracking"),
+        eye("head_source"),
+        eye("predict"),
+        eye("latency_tracking"),
         with(
-            "--reproject",
+            "reproject",
             run.method == Method::Planar,
             "by --method planar (none shows the whole frontal image as captured)",
         ),
         with(
-            "--back-width",
+            "back_width",
             eye_used && estimated,
             "with --head-source estimated (the back camera is rendered for the face detector only)",
         ),
-        with("--sway-cm", preset(HeadPreset::Sway), sway),
-        with("--sway-hz", preset(HeadPreset::Sway), sway),
-        with("--lean-cm", preset(HeadPreset::Lean), lean),
-        with("--lean-s", preset(HeadPreset::Lean), lean),
-        with("--lean-at", preset(HeadPreset::Lean), lean),
+        with("sway_cm", preset(HeadPreset::Sway), sway),
+        with("sway_hz", preset(HeadPreset::Sway), sway),
+        with("lean_cm", preset(HeadPreset::Lean), lean),
+        with("lean_s", preset(HeadPreset::Lean), lean),
+        with("lean_at", preset(HeadPreset::Lean), lean),
         with(
-            "--d2",
+            "d2",
             run.method == Method::Planar && !maps,
             "by --method planar without --maps",
         ),
+        with("method", !maps, "without --maps (the maps are the method)"),
         with(
-            "--method",
-            !maps,
-            "without --maps (the maps are the method)",
-        ),
-        with(
-            "--display",
+            "display",
             !maps,
             "without --maps (a map is shown on the display's pixels)",
         ),
@@ -284,7 +291,7 @@ pub fn sequence_reads(run: &RunOptions, head: Option<HeadPreset>, maps: bool) ->
 /// `--hazard-bound-arcmin`'s rule: read for a scene with hazard objects only.
 pub fn hazard_bound_reads(scene: &Scene) -> ReadWhen {
     ReadWhen {
-        flag: "--hazard-bound-arcmin",
+        option: "hazard_bound_arcmin",
         read: scene.objects.iter().any(|o| o.hazard),
         when: "for a scene with an object marked `hazard = true`",
     }
@@ -317,7 +324,7 @@ mod tests {
             options.scene_model.sensor.kind = kind;
             run_reads(&options, false)
                 .into_iter()
-                .find(|r| r.flag == "--seed")
+                .find(|r| r.option == "seed")
                 .unwrap()
                 .read
         };
@@ -334,7 +341,7 @@ mod tests {
         let read = |head| {
             sequence_reads(&run, head, false)
                 .into_iter()
-                .find(|r| r.flag == "--sway-hz")
+                .find(|r| r.option == "sway_hz")
                 .unwrap()
                 .read
         };

@@ -1,0 +1,631 @@
+//! Every option of a run, declared once: its name, type, unit, range or choices, default,
+//! one-line help, the settings under which it is read and the commands that take it.
+//!
+//! The command line's flags (`--head-jitter-cm`) are made from this table, the Python
+//! keywords (`head_jitter_cm=`) are read through it, and the stubs (`__init__.pyi`) and
+//! `docs/reference/options.md` are checked against it by `tests/option_table.rs`, which fails
+//! on drift. [`crate::measure::run_spec`] builds one validated run from the values. Adding an
+//! option is a row here plus the line that stores it (`RunSpec::set`).
+//!
+//! The table sits in `measure/` because a run's options include its measurement's (`band`,
+//! `hazard_bound_arcmin`); what only a front end has (output folders, EXR contents, threads,
+//! progress) is that front end's.
+
+use crate::render::settings::MAX_SPP;
+use crate::scene::limits::{MAX_COORDINATE, MIN_LENGTH};
+use crate::scene::source::MAX_RESOLUTION;
+use crate::system::depth_sensor::SensorKind;
+use crate::system::display::{DisplayModel, Filter};
+use crate::system::eyes::{Eye, MAX_IPD, Viewing};
+use crate::system::options::{HeadSource, MAX_HEAD_BIAS_CM, Method, Outside};
+use crate::system::scene_model_options::Fill;
+use crate::util::number::short;
+
+/// The commands whose options the table declares (with the Python functions of the same
+/// names).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Command {
+    /// `seethru run`, `seethru.run`.
+    Run,
+    /// `seethru capture`, `seethru.capture`.
+    Capture,
+    /// `seethru compare`, `seethru.compare`.
+    Compare,
+}
+
+impl Command {
+    pub const ALL: [Command; 3] = [Command::Run, Command::Capture, Command::Compare];
+
+    /// `run`, `capture`, `compare`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Command::Run => "run",
+            Command::Capture => "capture",
+            Command::Compare => "compare",
+        }
+    }
+}
+
+/// The type of an option's value, with its range or choices.
+#[derive(Clone, Copy, Debug)]
+pub enum Kind {
+    /// An integer in `[min, max]`.
+    Integer { min: u64, max: u64 },
+    /// A finite number in `[min, max]`.
+    Real { min: f64, max: f64 },
+    /// Three numbers x, y, z, each in `[-max, max]`.
+    Triple { max: f64 },
+    /// `inf`, `auto` or metres in `[min, max]`: a working distance.
+    Distance { min: f64, max: f64 },
+    /// One of a fixed list of names, each with its help (a `clap::ValueEnum`'s variants).
+    Choice(fn() -> Vec<clap::builder::PossibleValue>),
+    /// On or off: a flag without a value on the command line, a bool in Python.
+    Switch,
+}
+
+/// A value enum's variants as typed (`plane-fit`), with their doc comments as help.
+pub fn choice_values<T: clap::ValueEnum>() -> Vec<clap::builder::PossibleValue> {
+    T::value_variants()
+        .iter()
+        .filter_map(|v| v.to_possible_value())
+        .collect()
+}
+
+/// The variant of `T` named `name` (one of [`choice_names`]).
+pub fn choice_of<T: clap::ValueEnum + Clone>(name: &str) -> Option<T> {
+    T::value_variants()
+        .iter()
+        .find(|v| v.to_possible_value().is_some_and(|p| p.get_name() == name))
+        .cloned()
+}
+
+/// An option's value, read and checked.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Value {
+    Integer(u64),
+    Real(f64),
+    Triple([f64; 3]),
+    /// `inf` is `f64::INFINITY`; `auto` is `None`.
+    Distance(Option<f64>),
+    Choice(String),
+    Switch(bool),
+}
+
+impl Value {
+    /// The value in JSON, as `seethru spec` prints it and `seethru.spec` returns it.
+    pub fn to_json(&self) -> serde_json::Value {
+        use serde_json::json;
+        match self {
+            Value::Integer(v) => json!(v),
+            Value::Real(v) => json!(v),
+            Value::Triple(v) => json!(v),
+            Value::Distance(None) => json!("auto"),
+            Value::Distance(Some(v)) if v.is_infinite() => json!("inf"),
+            Value::Distance(Some(v)) => json!(v),
+            Value::Choice(v) => json!(v),
+            Value::Switch(v) => json!(v),
+        }
+    }
+}
+
+/// What an option is when not given.
+#[derive(Clone, Copy, Debug)]
+pub enum Default {
+    /// This value, written as on the command line.
+    Value(&'static str),
+    /// No value: the run takes it from elsewhere, as the text says (`the scene's`).
+    Derived(&'static str),
+}
+
+/// One option.
+#[derive(Clone, Copy, Debug)]
+pub struct OptionSpec {
+    /// The name: `head_jitter_cm` (Python's keyword; the flag is `--head-jitter-cm`).
+    pub name: &'static str,
+    pub kind: Kind,
+    /// The unit of a number (`pixels`, `metres`, `cm`, `arcmin`, `GiB`), empty for none.
+    pub unit: &'static str,
+    pub default: Default,
+    /// One line: what the option does.
+    pub help: &'static str,
+    /// Settings under which it is read (`method=depth`), empty for always; the rules
+    /// themselves are `system::reads`'s, and a test holds each option read under these.
+    pub read_with: &'static [(&'static str, &'static str)],
+    /// The commands that take it.
+    pub commands: &'static [Command],
+}
+
+impl Kind {
+    /// The names of a choice (`plane-fit`), none for another kind.
+    pub fn choices(&self) -> Vec<String> {
+        match self {
+            Kind::Choice(values) => values().iter().map(|p| p.get_name().to_string()).collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// What a value must be, for errors and help: `an integer in [1, 16384]`.
+    pub fn need(&self) -> String {
+        match self {
+            Kind::Integer { min, max } => format!("an integer in [{min}, {max}]"),
+            Kind::Real { min, max } => format!("a number in [{}, {}]", short(*min), short(*max)),
+            Kind::Triple { max } => {
+                format!("x,y,z: three numbers in [{}, {}]", short(-max), short(*max))
+            }
+            Kind::Distance { min, max } => format!(
+                "inf, auto or a distance in metres in [{}, {}]",
+                short(*min),
+                short(*max)
+            ),
+            Kind::Choice(_) => format!("one of {}", self.choices().join(", ")),
+            Kind::Switch => "true or false".to_string(),
+        }
+    }
+}
+
+/// A finite number in `[min, max]` read from `text` (spaces around it ignored).
+fn real_in(text: &str, min: f64, max: f64) -> Option<f64> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && (min..=max).contains(v))
+}
+
+impl OptionSpec {
+    /// The command line's flag: `--head-jitter-cm`.
+    pub fn flag(&self) -> String {
+        crate::system::reads::flag_of(self.name)
+    }
+
+    /// Reads a value written as on the command line (spaces around it ignored); the error
+    /// says what it must be: `must be an integer in [1, 16384]`.
+    pub fn parse(&self, text: &str) -> Result<Value, String> {
+        let t = text.trim();
+        let value = match self.kind {
+            Kind::Integer { min, max } => t
+                .parse::<u64>()
+                .ok()
+                .filter(|v| (min..=max).contains(v))
+                .map(Value::Integer),
+            Kind::Real { min, max } => real_in(t, min, max).map(Value::Real),
+            Kind::Triple { max } => {
+                let parts: Vec<Option<f64>> = t.split(',').map(|p| real_in(p, -max, max)).collect();
+                match parts.as_slice() {
+                    [Some(x), Some(y), Some(z)] => Some(Value::Triple([*x, *y, *z])),
+                    _ => None,
+                }
+            }
+            Kind::Distance { min, max } => match t {
+                "inf" | "infinity" => Some(Value::Distance(Some(f64::INFINITY))),
+                "auto" => Some(Value::Distance(None)),
+                _ => real_in(t, min, max).map(|v| Value::Distance(Some(v))),
+            },
+            Kind::Choice(_) => self
+                .kind
+                .choices()
+                .into_iter()
+                .find(|n| n == t)
+                .map(Value::Choice),
+            Kind::Switch => match t {
+                "true" => Some(Value::Switch(true)),
+                "false" => Some(Value::Switch(false)),
+                _ => None,
+            },
+        };
+        value.ok_or_else(|| format!("must be {}", self.kind.need()))
+    }
+
+    /// The default value, `None` where it is derived.
+    pub fn default_value(&self) -> Option<Value> {
+        match self.default {
+            Default::Value(text) => Some(
+                self.parse(text)
+                    .unwrap_or_else(|e| panic!("the table's default of {}: {e}", self.name)),
+            ),
+            Default::Derived(_) => None,
+        }
+    }
+
+    /// Whether `command` takes this option.
+    pub fn taken_by(&self, command: Command) -> bool {
+        self.commands.contains(&command)
+    }
+}
+
+/// The option named `name`, if any.
+pub fn option(name: &str) -> Option<&'static OptionSpec> {
+    OPTIONS.iter().find(|o| o.name == name)
+}
+
+/// The options `command` takes, in the table's order.
+pub fn options_of(command: Command) -> impl Iterator<Item = &'static OptionSpec> {
+    OPTIONS.iter().filter(move |o| o.taken_by(command))
+}
+
+const PIXELS: Kind = Kind::Integer {
+    min: 1,
+    max: MAX_RESOLUTION as u64,
+};
+const ALL: &[Command] = &[Command::Run, Command::Capture, Command::Compare];
+const RUN: &[Command] = &[Command::Run];
+const RUN_CAPTURE: &[Command] = &[Command::Run, Command::Capture];
+const RUN_COMPARE: &[Command] = &[Command::Run, Command::Compare];
+const CAPTURE: &[Command] = &[Command::Capture];
+const ESTIMATED: &[(&str, &str)] = &[("head", "estimated")];
+/// The scene model's depth sensor is read by `method` depth in a run, by `depth` in a capture.
+const DEPTH: &[(&str, &str)] = &[("method", "depth"), ("depth", "true")];
+/// A sensor's settings: those of a noisy one (the ideal sensor has none).
+const NOISY_DEPTH: &[(&str, &str)] = &[
+    ("method", "depth"),
+    ("depth", "true"),
+    ("depth_sensor", "tof"),
+];
+
+/// The table: every option of `run`, `capture` and `compare`, in `seethru run --help`'s order.
+pub static OPTIONS: &[OptionSpec] = &[
+    OptionSpec {
+        name: "method",
+        kind: Kind::Choice(choice_values::<Method>),
+        unit: "",
+        default: Default::Value("planar"),
+        help: "How the display image is made: none (the whole frontal image), planar (the paper's compensation), ground (the road plane), plane-fit (a plane fitted to the depth sensor's points) or depth (per-pixel reprojection with the depth sensor's depth).",
+        read_with: &[],
+        commands: RUN,
+    },
+    OptionSpec {
+        name: "d2",
+        kind: Kind::Distance {
+            min: MIN_LENGTH,
+            max: MAX_COORDINATE,
+        },
+        unit: "metres",
+        default: Default::Value("inf"),
+        help: "Working distance of the planar model: inf, auto (the median frontal depth behind the display) or metres.",
+        read_with: &[],
+        commands: RUN,
+    },
+    OptionSpec {
+        name: "head",
+        kind: Kind::Choice(choice_values::<HeadSource>),
+        unit: "",
+        default: Default::Value("oracle"),
+        help: "Where the eye comes from: oracle (the true eye), estimated (face detection on the back camera's image) or model (a tracker's noise and dropouts).",
+        read_with: &[],
+        commands: ALL,
+    },
+    OptionSpec {
+        name: "head_bias_cm",
+        kind: Kind::Triple {
+            max: MAX_HEAD_BIAS_CM,
+        },
+        unit: "cm",
+        default: Default::Value("0,0,0"),
+        help: "Head-tracking bias x,y,z in the obstacle's frame (e.g. 1,0,0 or -1,0,0).",
+        read_with: &[],
+        commands: RUN_CAPTURE,
+    },
+    OptionSpec {
+        name: "head_jitter_cm",
+        kind: Kind::Real {
+            min: 0.0,
+            max: 100.0,
+        },
+        unit: "cm",
+        default: Default::Value("0"),
+        help: "Head-tracking jitter: the standard deviation per axis of each estimate.",
+        read_with: &[],
+        commands: RUN_CAPTURE,
+    },
+    OptionSpec {
+        name: "seed",
+        kind: Kind::Integer {
+            min: 0,
+            max: u32::MAX as u64,
+        },
+        unit: "",
+        default: Default::Value("1"),
+        help: "Seed of the head jitter, the tracker model's noise, the depth sensor's noise and the plane fit.",
+        read_with: &[("head_jitter_cm", "1")],
+        commands: ALL,
+    },
+    OptionSpec {
+        name: "feature_width",
+        kind: Kind::Real {
+            min: MIN_LENGTH,
+            max: 1.0,
+        },
+        unit: "metres",
+        default: Default::Value("0.064"),
+        help: "The face detector's known feature width A (the interpupillary distance).",
+        read_with: ESTIMATED,
+        commands: RUN_CAPTURE,
+    },
+    OptionSpec {
+        name: "require_confident_head",
+        kind: Kind::Switch,
+        unit: "",
+        default: Default::Value("false"),
+        help: "Stop with an error when a head estimate's confidence is below 0.5 (else a warning); image-based head estimates only.",
+        read_with: ESTIMATED,
+        commands: RUN_CAPTURE,
+    },
+    OptionSpec {
+        name: "outside",
+        kind: Kind::Choice(choice_values::<Outside>),
+        unit: "",
+        default: Default::Value("error"),
+        help: "When the crop leaves the frontal view: error, or black (counted as missing).",
+        read_with: &[],
+        commands: RUN,
+    },
+    OptionSpec {
+        name: "filter",
+        kind: Kind::Choice(choice_values::<Filter>),
+        unit: "",
+        default: Default::Value("bilinear"),
+        help: "Colour resampling of the display image.",
+        read_with: &[],
+        commands: RUN,
+    },
+    OptionSpec {
+        name: "display",
+        kind: Kind::Choice(choice_values::<DisplayModel>),
+        unit: "",
+        default: Default::Value("pixels"),
+        help: "pixels: the physical display; ideal: unlimited display and frontal resolution, so that only the planar model's error remains.",
+        read_with: &[],
+        commands: RUN,
+    },
+    OptionSpec {
+        name: "frontal_width",
+        kind: PIXELS,
+        unit: "pixels",
+        default: Default::Derived("the scene's"),
+        help: "Frontal camera width (aspect ratio kept).",
+        read_with: &[],
+        commands: ALL,
+    },
+    OptionSpec {
+        name: "back_width",
+        kind: PIXELS,
+        unit: "pixels",
+        default: Default::Derived("the scene's"),
+        help: "Back camera width (aspect ratio kept).",
+        read_with: &[],
+        commands: ALL,
+    },
+    OptionSpec {
+        name: "eyes",
+        kind: Kind::Choice(choice_values::<Viewing>),
+        unit: "",
+        default: Default::Value("mono"),
+        help: "The eyes the driver's views are rendered from: mono (the scene's driver camera), left, right, or both (each in turn, with their binocular mismatch; `seethru run` only).",
+        read_with: &[],
+        commands: RUN_CAPTURE,
+    },
+    OptionSpec {
+        name: "ipd",
+        kind: Kind::Real {
+            min: MIN_LENGTH,
+            max: MAX_IPD,
+        },
+        unit: "metres",
+        default: Default::Value("0.064"),
+        help: "Interpupillary distance.",
+        read_with: &[("eyes", "left")],
+        commands: RUN_CAPTURE,
+    },
+    OptionSpec {
+        name: "target_eye",
+        kind: Kind::Choice(choice_values::<Eye>),
+        unit: "",
+        default: Default::Value("cyclopean"),
+        help: "The eye the compensation (a capture's head estimate) is for.",
+        read_with: &[],
+        commands: RUN_CAPTURE,
+    },
+    OptionSpec {
+        name: "depth",
+        kind: Kind::Switch,
+        unit: "",
+        default: Default::Value("false"),
+        help: "Write the depth sensor's image (depth.npy, depth.exr), as method depth models it with depth_sensor and its settings.",
+        read_with: &[],
+        commands: CAPTURE,
+    },
+    OptionSpec {
+        name: "band",
+        kind: Kind::Integer { min: 1, max: 1000 },
+        unit: "pixels",
+        default: Default::Value("5"),
+        help: "Width of the border band of the mismatch metrics, in display pixels.",
+        read_with: &[],
+        commands: RUN_COMPARE,
+    },
+    OptionSpec {
+        name: "hazard_bound_arcmin",
+        kind: Kind::Real {
+            min: MIN_LENGTH,
+            max: 10800.0,
+        },
+        unit: "arcmin",
+        default: Default::Value(HAZARD_BOUND_ARCMIN_TEXT),
+        help: "Hazard visibility: a hidden hazard pixel counts as shown when the display shows the same object within this misregistration.",
+        read_with: &[],
+        commands: RUN_COMPARE,
+    },
+    OptionSpec {
+        name: "depth_sensor",
+        kind: Kind::Choice(choice_values::<SensorKind>),
+        unit: "",
+        default: Default::Value("ideal"),
+        help: "Depth sensor of plane-fit and depth: ideal (the frontal render's depth), tof (σ ∝ z, 320 px wide, 15 m range, 1 cm at 1 m, 1 mm steps) or stereo (σ ∝ z², half the frontal width, 80 m, 2 mm at 1 m, inverse-depth steps of 0.0005 /m).",
+        read_with: DEPTH,
+        commands: ALL,
+    },
+    OptionSpec {
+        name: "depth_resolution",
+        kind: PIXELS,
+        unit: "pixels",
+        default: Default::Derived("the sensor's"),
+        help: "Depth sensor width, at most the frontal camera's (aspect kept; tof and stereo only).",
+        read_with: NOISY_DEPTH,
+        commands: ALL,
+    },
+    OptionSpec {
+        name: "depth_range",
+        kind: Kind::Real {
+            min: MIN_LENGTH,
+            max: MAX_COORDINATE,
+        },
+        unit: "metres",
+        default: Default::Derived("the sensor's"),
+        help: "Depth sensor range: no return past it (d2 → ∞ there; tof and stereo only).",
+        read_with: NOISY_DEPTH,
+        commands: ALL,
+    },
+    OptionSpec {
+        name: "depth_noise",
+        kind: Kind::Real {
+            min: 0.0,
+            max: 10.0,
+        },
+        unit: "metres",
+        default: Default::Derived("the sensor's"),
+        help: "Depth noise σ at 1 m, growing as z (tof) or z² (stereo), seeded by seed (tof and stereo only).",
+        read_with: NOISY_DEPTH,
+        commands: ALL,
+    },
+    OptionSpec {
+        name: "depth_quantum",
+        kind: Kind::Real {
+            min: 0.0,
+            max: 10.0,
+        },
+        unit: "metres",
+        default: Default::Derived("the sensor's"),
+        help: "Depth quantisation step at 1 m (0: none): constant for tof, growing as z² for stereo (tof and stereo only).",
+        read_with: NOISY_DEPTH,
+        commands: ALL,
+    },
+    OptionSpec {
+        name: "fill",
+        kind: Kind::Choice(choice_values::<Fill>),
+        unit: "",
+        default: Default::Value("none"),
+        help: "Disocclusion holes of method depth: none (black, counted blank), background (the nearest farther surface on the epipolar line) or inpaint (diffused from around).",
+        read_with: &[("method", "depth")],
+        commands: RUN_COMPARE,
+    },
+    OptionSpec {
+        name: "width",
+        kind: PIXELS,
+        unit: "pixels",
+        default: Default::Derived("the driver camera's"),
+        help: "Width of the driver's views (truth, occluded, seethru).",
+        read_with: &[],
+        commands: ALL,
+    },
+    OptionSpec {
+        name: "height",
+        kind: PIXELS,
+        unit: "pixels",
+        default: Default::Derived("from the width and the driver camera's aspect"),
+        help: "Height of the driver's views.",
+        read_with: &[],
+        commands: ALL,
+    },
+    OptionSpec {
+        name: "spp",
+        kind: Kind::Integer {
+            min: 1,
+            max: MAX_SPP as u64,
+        },
+        unit: "",
+        default: Default::Value("4"),
+        help: "Samples per pixel (anti-aliasing of the colour; AOVs are at pixel centres).",
+        read_with: &[],
+        commands: ALL,
+    },
+    OptionSpec {
+        name: "max_memory",
+        kind: Kind::Real {
+            min: MIN_LENGTH,
+            max: 4096.0,
+        },
+        unit: "GiB",
+        default: Default::Value(DEFAULT_MAX_MEMORY_TEXT),
+        help: "Refuse to start when the estimated memory exceeds this.",
+        read_with: &[],
+        commands: ALL,
+    },
+];
+
+/// [`crate::measure::hazard::HAZARD_BOUND_ARCMIN`] as the table's default text (a test holds them equal).
+const HAZARD_BOUND_ARCMIN_TEXT: &str = "30";
+/// [`crate::system::memory::DEFAULT_MAX_MEMORY_GIB`] as the table's default text (a test holds them equal).
+const DEFAULT_MAX_MEMORY_TEXT: &str = "8";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::hazard::HAZARD_BOUND_ARCMIN;
+    use crate::system::memory::DEFAULT_MAX_MEMORY_GIB;
+
+    #[test]
+    fn every_default_is_a_value_of_its_option_and_the_constants_agree() {
+        for o in OPTIONS {
+            let _ = o.default_value();
+        }
+        let real = |name| match option(name).unwrap().default_value() {
+            Some(Value::Real(v)) => v,
+            other => panic!("{name}: {other:?}"),
+        };
+        assert_eq!(real("hazard_bound_arcmin"), HAZARD_BOUND_ARCMIN);
+        assert_eq!(real("max_memory"), DEFAULT_MAX_MEMORY_GIB);
+    }
+
+    #[test]
+    fn names_are_unique_and_every_command_takes_some() {
+        for (i, o) in OPTIONS.iter().enumerate() {
+            assert!(OPTIONS[..i].iter().all(|p| p.name != o.name), "{}", o.name);
+            assert!(!o.commands.is_empty(), "{}", o.name);
+        }
+    }
+
+    #[test]
+    fn values_at_the_ends_of_a_range_are_read_and_one_beyond_is_refused() {
+        let width = option("width").unwrap();
+        assert_eq!(width.parse(" 1 "), Ok(Value::Integer(1)));
+        assert_eq!(width.parse("16384"), Ok(Value::Integer(16384)));
+        for bad in ["0", "16385", "-1", "1.5", "x", "4294967297"] {
+            assert_eq!(
+                width.parse(bad),
+                Err("must be an integer in [1, 16384]".into()),
+                "{bad}"
+            );
+        }
+        let bias = option("head_bias_cm").unwrap();
+        assert_eq!(
+            bias.parse("-500,0,1.5"),
+            Ok(Value::Triple([-500.0, 0.0, 1.5]))
+        );
+        for bad in ["-500.1,0,0", "1,2", "1,2,3,4", "nan,0,0", "1,inf,0"] {
+            assert!(bias.parse(bad).is_err(), "{bad}");
+        }
+        let d2 = option("d2").unwrap();
+        assert_eq!(d2.parse("auto"), Ok(Value::Distance(None)));
+        assert_eq!(d2.parse("inf"), Ok(Value::Distance(Some(f64::INFINITY))));
+        assert_eq!(d2.parse("1e-6"), Ok(Value::Distance(Some(1e-6))));
+        assert!(d2.parse("0").is_err() && d2.parse("1000001").is_err());
+        let method = option("method").unwrap();
+        assert_eq!(
+            method.parse("plane-fit"),
+            Ok(Value::Choice("plane-fit".into()))
+        );
+        assert_eq!(
+            method.parse("plane_fit"),
+            Err("must be one of none, planar, ground, plane-fit, depth".into())
+        );
+    }
+}

@@ -1,0 +1,221 @@
+//! The option table (`src/measure/option_table.rs`) against everything said of it elsewhere:
+//! `docs/reference/options.md` and the Python stubs' signatures are made from the table here
+//! and must match it (`SEETHRU_BLESS=1` rewrites them), and every flag of `run`, `capture` and
+//! `compare` is either the table's or one of the few that only the command line has. (The
+//! walk through both front ends, value by value, is `python/tests/test_option_table.py`.)
+
+mod common;
+
+use seethru::measure::option_table::{Command, Default, Kind, OPTIONS, OptionSpec, options_of};
+
+/// The flags of each command that are not options of a run: files, output formats, threads.
+fn command_line_only(command: Command) -> &'static [&'static str] {
+    match command {
+        Command::Run => &[
+            "out",
+            "calibration",
+            "exr",
+            "heatmap-max",
+            "threads",
+            "quiet",
+            "help",
+        ],
+        Command::Capture => &["out", "calibration", "exr", "threads", "quiet", "help"],
+        Command::Compare => &["methods", "out", "threads", "quiet", "help"],
+    }
+}
+
+/// Python's type and default of an option, as the stubs write them: `int | None = None`.
+fn python_annotation(option: &OptionSpec) -> String {
+    let ty = match option.kind {
+        Kind::Integer { .. } => "int".to_string(),
+        Kind::Real { .. } => "float".to_string(),
+        Kind::Triple { .. } => "tuple[float, float, float]".to_string(),
+        Kind::Distance { .. } => "float | str".to_string(),
+        Kind::Switch => "bool".to_string(),
+        Kind::Choice(_) => {
+            // A call is one run: `both` is the command line's alone.
+            let names: Vec<String> = option
+                .kind
+                .choices()
+                .into_iter()
+                .filter(|n| !(option.name == "eyes" && n == "both"))
+                .map(|n| format!("\"{n}\""))
+                .collect();
+            format!("Literal[{}]", names.join(", "))
+        }
+    };
+    let Default::Value(text) = option.default else {
+        return format!("{ty} | None = None");
+    };
+    let number = |v: f64| match v.fract() == 0.0 {
+        true => format!("{v:.1}"),
+        false => v.to_string(),
+    };
+    let default = match option.kind {
+        Kind::Choice(_) | Kind::Distance { .. } => format!("\"{text}\""),
+        Kind::Switch => if text == "true" { "True" } else { "False" }.to_string(),
+        Kind::Real { .. } => number(text.parse().unwrap()),
+        Kind::Triple { .. } => {
+            let xyz: Vec<String> = text
+                .split(',')
+                .map(|v| number(v.parse().unwrap()))
+                .collect();
+            format!("({})", xyz.join(", "))
+        }
+        Kind::Integer { .. } => text.to_string(),
+    };
+    format!("{ty} = {default}")
+}
+
+fn stub_block(command: Command) -> String {
+    let mut block = format!(
+        "    # The option table's ({}): tests/option_table.rs checks it (SEETHRU_BLESS=1 rewrites it).\n",
+        command.name()
+    );
+    // A capture's `depth` is a parameter of its own, before the keywords.
+    for option in
+        options_of(command).filter(|o| !(command == Command::Capture && o.name == "depth"))
+    {
+        block.push_str(&format!(
+            "    {}: {},\n",
+            option.name,
+            python_annotation(option)
+        ));
+    }
+    block.push_str("    # End of the option table's.\n");
+    block
+}
+
+fn range_of(option: &OptionSpec) -> String {
+    match option.kind {
+        Kind::Choice(_) => option.kind.choices().join(", "),
+        Kind::Switch => "on or off".to_string(),
+        kind => kind.need(),
+    }
+}
+
+fn options_page() -> String {
+    let mut page = String::from(
+        "# Options of run, capture and compare\n\n\
+         Generated from the option table, `src/measure/option_table.rs`, by\n\
+         `SEETHRU_BLESS=1 cargo test --release --test option_table` (the test fails when this page\n\
+         and the table differ). Each option is a flag of the commands listed\n\
+         (`--head-jitter-cm`) and a keyword of the Python functions of the same names\n\
+         (`head_jitter_cm=`), with the same type, range and default; `seethru spec COMMAND\n\
+         [FLAGS]` and `seethru.spec(command, **options)` print the run they make, checked.\n\
+         \"Read with\" names settings under which the option is read: given where the others make\n\
+         the command ignore it, an option is refused ([flags read or refused](flags-read-or-refused.md)).\n\n\
+         | Option | Flag | Value | Unit | Default | Commands | Read with | What it does |\n\
+         |---|---|---|---|---|---|---|---|\n",
+    );
+    for o in OPTIONS {
+        let default = match o.default {
+            Default::Value(text) => format!("`{text}`"),
+            Default::Derived(what) => what.to_string(),
+        };
+        let commands: Vec<&str> = o.commands.iter().map(|c| c.name()).collect();
+        let read_with: Vec<String> = o
+            .read_with
+            .iter()
+            .map(|(k, v)| format!("`{k}={v}`"))
+            .collect();
+        page.push_str(&format!(
+            "| `{}` | `{}` | {} | {} | {} | {} | {} | {} |\n",
+            o.name,
+            o.flag(),
+            range_of(o),
+            o.unit,
+            default,
+            commands.join(", "),
+            if read_with.is_empty() {
+                "the defaults".to_string()
+            } else {
+                read_with.join(" or ")
+            },
+            o.help.replace('|', "\\|"),
+        ));
+    }
+    page.push_str(
+        "\nThe command line's own flags (files, output formats, threads) are in \
+         [the command line](command-line.md); `sequence`'s options are its own (`seethru \
+         sequence --help`).\n",
+    );
+    page
+}
+
+fn blessing() -> bool {
+    std::env::var_os("SEETHRU_BLESS").is_some_and(|v| v == "1")
+}
+
+#[test]
+fn the_options_page_is_the_tables() {
+    let path = common::repo_path("docs/reference/options.md");
+    let page = options_page();
+    if blessing() {
+        std::fs::write(&path, &page).unwrap();
+    }
+    let written = std::fs::read_to_string(&path).unwrap_or_default();
+    assert!(
+        written == page,
+        "docs/reference/options.md differs from the option table: SEETHRU_BLESS=1 cargo test --release --test option_table rewrites it"
+    );
+}
+
+#[test]
+fn the_python_stubs_declare_the_tables_keywords() {
+    let path = common::repo_path("python/seethru/__init__.pyi");
+    let mut stubs = std::fs::read_to_string(&path).unwrap();
+    let start = |c: Command| format!("    # The option table's ({}):", c.name());
+    let end = "    # End of the option table's.\n";
+    for command in Command::ALL {
+        let at = stubs
+            .find(&start(command))
+            .unwrap_or_else(|| panic!("the stubs have no table block for {}", command.name()));
+        let stop = at + stubs[at..].find(end).expect("the block's end") + end.len();
+        let expected = stub_block(command);
+        if blessing() {
+            stubs.replace_range(at..stop, &expected);
+            continue;
+        }
+        assert!(
+            stubs[at..stop] == expected,
+            "__init__.pyi's keywords of {} differ from the option table:\n{}\nexpected:\n{expected}",
+            command.name(),
+            &stubs[at..stop]
+        );
+    }
+    if blessing() {
+        std::fs::write(&path, stubs).unwrap();
+    }
+}
+
+#[test]
+fn every_flag_of_the_commands_is_the_tables_or_the_command_lines_own() {
+    for command in Command::ALL {
+        let (ok, text, _) = common::seethru(&[command.name(), "--help"]);
+        assert!(ok);
+        let flags: Vec<&str> = text
+            .lines()
+            .filter_map(|l| l.trim_start().strip_prefix("--"))
+            .map(|l| l.split([' ', '<']).next().unwrap())
+            .collect();
+        let table: Vec<String> = options_of(command)
+            .map(|o| o.name.replace('_', "-"))
+            .collect();
+        for flag in &flags {
+            assert!(
+                table.iter().any(|t| t == flag) || command_line_only(command).contains(flag),
+                "seethru {} --{flag}: neither the option table's nor the command line's own",
+                command.name()
+            );
+        }
+        for option in &table {
+            assert!(
+                flags.contains(&option.as_str()),
+                "seethru {} has no --{option}",
+                command.name()
+            );
+        }
+    }
+}
