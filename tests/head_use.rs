@@ -114,6 +114,69 @@ fn the_mesh_face_on_a_slanted_pillar_warns() {
     assert!(!dir.path().join("refused").exists(), "nothing written");
 }
 
+/// `--min-head-confidence` is the bound the estimate's confidence is held to. On the slanted
+/// mesh face (confidence 0.04): just above it, `--require-confident-head` refuses, naming the
+/// bound; just below, the run passes without the warning that the default 0.5 gives.
+#[test]
+fn the_head_confidence_bound_is_the_users() {
+    let dir = tempfile::tempdir().unwrap();
+    let slanted = dir.path().join("slanted_mesh.toml");
+    std::fs::write(&slanted, common::slanted_scene_text("das_mesh_head.toml")).unwrap();
+    let run = |out: &str, extra: &[&str]| {
+        common::seethru(&common::estimated_run_args(
+            &slanted,
+            &dir.path().join(out),
+            extra,
+        ))
+    };
+    let report = |out: &str| -> serde_json::Value {
+        serde_json::from_str(
+            &std::fs::read_to_string(dir.path().join(out).join("run.json")).unwrap(),
+        )
+        .unwrap()
+    };
+    let (ok, _, err) = run("warned", &[]);
+    assert!(
+        ok && err.contains("warning: head estimate unreliable"),
+        "{err}"
+    );
+    let confidence = report("warned")["head_detection"]["confidence"]["value"]
+        .as_f64()
+        .unwrap();
+    assert!((0.01..0.5).contains(&confidence), "{confidence}");
+    let above = confidence + 0.005;
+    let (ok, _, err) = run(
+        "above",
+        &[
+            "--require-confident-head",
+            "--min-head-confidence",
+            &above.to_string(),
+        ],
+    );
+    assert!(!ok && err.contains("head estimate unreliable"), "{err}");
+    assert!(
+        err.contains(&format!("< {}", seethru::util::number::short(above))),
+        "{err}"
+    );
+    assert!(!dir.path().join("above").exists(), "nothing written");
+    let below = confidence - 0.005;
+    let (ok, _, err) = run(
+        "below",
+        &[
+            "--require-confident-head",
+            "--min-head-confidence",
+            &below.to_string(),
+        ],
+    );
+    assert!(ok && !err.contains("warning:"), "{err}");
+    // serde_json's reading is not correctly rounded: equal but for the last bits.
+    let written = report("below")["options"]["min_head_confidence"]
+        .as_f64()
+        .unwrap();
+    assert!((written - below).abs() < 1e-15, "{written} {below}");
+    assert!(report("below")["head_detection"]["warning"].is_null());
+}
+
 /// The scene key: a value outside its list, `face_yaw_deg` without the mesh face or out of
 /// [−80, 80], and the mesh face beside an object of the file named `head` (das's ellipsoid
 /// head: two faces) are each one `error:` line naming the file, line and key.

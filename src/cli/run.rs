@@ -233,8 +233,12 @@ fn write_run(
     }
     let (rest, maps) = measured?;
     let result = rest.with_views(views);
-    if let Some(d) = result.detection.filter(|d| !d.confidence.is_confident()) {
-        eprintln!("warning: {}", d.confidence.warning(""));
+    let min = options.min_head_confidence;
+    if let Some(d) = result
+        .detection
+        .filter(|d| !d.confidence.is_confident_at(min))
+    {
+        eprintln!("warning: {}", d.confidence.warning_at("", min));
     }
     let hazards = hazards_of(ctx, options, &result, &maps, hazard_bound)?;
     // Beside metrics.json (which `measure` recomputes from the frames alone).

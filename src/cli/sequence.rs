@@ -259,6 +259,7 @@ impl Sequence {
                 // One eye, the scene's driver camera; the scene-model methods are refused.
                 eyes: Default::default(),
                 scene_model: Default::default(),
+                ..RunOptions::default()
             },
             timeline: Timeline {
                 duration: self.duration,

@@ -350,6 +350,15 @@ pub static OPTIONS: &[OptionSpec] = &[
         commands: RUN_CAPTURE,
     },
     OptionSpec {
+        name: "min_head_confidence",
+        kind: Kind::Real { min: 0.0, max: 1.0 },
+        unit: "",
+        default: Default::Value("0.5"),
+        help: "The confidence below which a head estimate is unreliable: warned about, or refused with require_confident_head.",
+        read_with: ESTIMATED,
+        commands: RUN_CAPTURE,
+    },
+    OptionSpec {
         name: "outside",
         kind: Kind::Choice(choice_values::<Outside>),
         unit: "",

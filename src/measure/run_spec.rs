@@ -149,6 +149,7 @@ impl RunSpec {
             "seed" => o.seed = value.integer() as u32,
             "feature_width" => o.feature_width = value.real(),
             "require_confident_head" => o.require_confident_head = value.switch(),
+            "min_head_confidence" => o.min_head_confidence = value.real(),
             "outside" => o.outside = value.choice::<Outside>(),
             "filter" => o.filter = value.choice::<Filter>(),
             "display" => o.display = value.choice::<DisplayModel>(),

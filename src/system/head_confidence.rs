@@ -172,7 +172,13 @@ impl HeadConfidence {
 
     /// Whether the estimate can be relied on (confidence ≥ [`CONFIDENT_HEAD`]).
     pub fn is_confident(&self) -> bool {
-        self.value >= CONFIDENT_HEAD
+        self.is_confident_at(CONFIDENT_HEAD)
+    }
+
+    /// Whether the estimate can be relied on under the user's threshold `min` in [0, 1]
+    /// (a run's `min_head_confidence`).
+    pub fn is_confident_at(&self, min: f64) -> bool {
+        self.value >= min
     }
 
     /// The cues that scored below 1, in words, e.g. "a pupil at 63% of the face's height".
@@ -237,9 +243,15 @@ impl HeadConfidence {
 
     /// The one-line `warning:` text for an unreliable estimate (without the prefix).
     pub fn warning(&self, context: &str) -> String {
+        self.warning_at(context, CONFIDENT_HEAD)
+    }
+
+    /// [`Self::warning`] under the threshold `min`.
+    pub fn warning_at(&self, context: &str, min: f64) -> String {
         format!(
-            "{context}head estimate unreliable: confidence {:.2} < {CONFIDENT_HEAD} ({}); the eye may be centimetres off (--require-confident-head makes this an error)",
+            "{context}head estimate unreliable: confidence {:.2} < {} ({}); the eye may be centimetres off (--require-confident-head makes this an error)",
             self.value,
+            crate::util::number::short(min),
             self.doubts()
         )
     }

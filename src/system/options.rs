@@ -110,6 +110,10 @@ pub enum Outside {
     Black,
 }
 
+fn default_min_head_confidence() -> f64 {
+    crate::system::head_confidence::CONFIDENT_HEAD
+}
+
 /// Written whole (a capture folder's `truth/capture_spec.json`) and read back the same;
 /// every field is required when read, an unknown one refused.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -127,6 +131,11 @@ pub struct RunOptions {
     /// Refuse a head estimate whose confidence is below `head::CONFIDENT_HEAD` (`--head
     /// estimated` only).
     pub require_confident_head: bool,
+    /// The confidence in [0, 1] below which a head estimate is unreliable: warned about, or
+    /// refused with `require_confident_head`. Capture folders written before it existed hold
+    /// none: theirs was [`crate::system::head_confidence::CONFIDENT_HEAD`].
+    #[serde(default = "default_min_head_confidence")]
+    pub min_head_confidence: f64,
     /// Feature width `A` the detector measures (interpupillary distance), metres.
     pub feature_width: f64,
     /// Driver-view resolution overrides (truth, occluded, seethru).
@@ -176,6 +185,7 @@ impl Default for RunOptions {
             head_jitter_cm: 0.0,
             seed: 1,
             require_confident_head: false,
+            min_head_confidence: default_min_head_confidence(),
             feature_width: 0.064,
             width: None,
             height: None,

@@ -80,10 +80,13 @@ pub fn eye_for_compensation(
             // scene's face calls for.
             let believed = scene.calibration.back.apply(&scene.back)?;
             let fix = estimate(scene.face, back, &believed, options.feature_width)?;
-            if options.require_confident_head && !fix.detection.confidence.is_confident() {
+            let confidence = &fix.detection.confidence;
+            if options.require_confident_head
+                && !confidence.is_confident_at(options.min_head_confidence)
+            {
                 bail!(
                     "--require-confident-head: {}",
-                    fix.detection.confidence.warning("")
+                    confidence.warning_at("", options.min_head_confidence)
                 );
             }
             (

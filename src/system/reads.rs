@@ -97,6 +97,11 @@ pub fn head_error_reads(
             when: eye,
         },
         ReadWhen {
+            option: "min_head_confidence",
+            read: eye_used && head == HeadSource::Estimated,
+            when: "with an estimated head (face detection: only its estimate has a confidence) and a method that compensates for the eye",
+        },
+        ReadWhen {
             option: "feature_width",
             read: eye_used && head == HeadSource::Estimated,
             when: "with an estimated head (face detection), not the oracle, and a method that compensates for the eye",

@@ -41,6 +41,7 @@ pub fn report(
             "head_jitter_cm": options.head_jitter_cm,
             "seed": options.seed,
             "require_confident_head": options.require_confident_head,
+            "min_head_confidence": options.min_head_confidence,
             "feature_width_m": options.feature_width,
             "spp": options.spp,
             "outside": options.outside,
@@ -53,7 +54,7 @@ pub fn report(
         "head_model": (options.head == HeadSource::Model).then_some(WEBCAM_LANDMARKS),
         "head_detection": head.map(|h| {
             let d = &h.detection;
-            json!({"face_box_px": d.face_box, "pupils_px": d.pupils, "feature_px": d.feature_px(), "pupil_areas_px": d.pupil_areas_px, "confidence": d.confidence, "face": face_name(scene.face), "tracker": tracker_name(scene.face), "fit": h.pose, "warning": (!d.confidence.is_confident()).then(|| d.confidence.warning(""))})
+            json!({"face_box_px": d.face_box, "pupils_px": d.pupils, "feature_px": d.feature_px(), "pupil_areas_px": d.pupil_areas_px, "confidence": d.confidence, "face": face_name(scene.face), "tracker": tracker_name(scene.face), "fit": h.pose, "warning": (!d.confidence.is_confident_at(options.min_head_confidence)).then(|| d.confidence.warning_at("", options.min_head_confidence))})
         }),
         "d2_m": d2_used.map_or(json!("inf"), |d| json!(d)),
         "frontal_half_angle_deg": scene.frontal.half_angle_x.to_degrees(),

@@ -281,7 +281,12 @@ impl SystemLoop {
                     run.feature_width,
                     world_from_face,
                 );
-                if run.require_confident_head && !fix.detection.confidence.is_confident() {
+                if run.require_confident_head
+                    && !fix
+                        .detection
+                        .confidence
+                        .is_confident_at(run.min_head_confidence)
+                {
                     bail!(
                         "--require-confident-head: {}",
                         fix.detection
