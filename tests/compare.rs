@@ -38,7 +38,7 @@ fn bad_method_inputs_give_one_line_each() {
         ),
         (
             vec!["run", "scenes/das.toml", "--out", out, "--method", "depth", "--depth-sensor", "tof", "--depth-resolution", "0"],
-            "error: invalid value '0' for '--depth-resolution <DEPTH_RESOLUTION>': must be an integer in [1, 16384]".into(),
+            "error: invalid value '0' for '--depth-resolution <PIXELS>': must be an integer in [1, 16384]".into(),
         ),
         (
             [vec!["run", "scenes/das.toml", "--out", out, "--method", "depth", "--depth-sensor", "tof", "--depth-resolution", "65"], small.to_vec()].concat(),
@@ -46,7 +46,7 @@ fn bad_method_inputs_give_one_line_each() {
         ),
         (
             vec!["run", "scenes/das.toml", "--out", out, "--method", "depth", "--depth-sensor", "stereo", "--depth-noise", "-0.01"],
-            "error: invalid value '-0.01' for '--depth-noise <DEPTH_NOISE>': must be a number in [0, 10]".into(),
+            "error: invalid value '-0.01' for '--depth-noise <METRES>': must be a number in [0, 10]".into(),
         ),
         (
             [vec!["run", "scenes/das.toml", "--out", out, "--method", "depth", "--depth-noise", "0.01"], small.to_vec()].concat(),

@@ -106,6 +106,9 @@ fn options_page() -> String {
          [FLAGS]` and `seethru.spec(command, **options)` print the run they make, checked.\n\
          \"Read with\" names settings under which the option is read: given where the others make\n\
          the command ignore it, an option is refused ([flags read or refused](flags-read-or-refused.md)).\n\n\
+         ```sh\n\
+         seethru spec run --method depth --depth-sensor tof --depth-noise 0.01\n\
+         ```\n\n\
          | Option | Flag | Value | Unit | Default | Commands | Read with | What it does |\n\
          |---|---|---|---|---|---|---|---|\n",
     );

@@ -4,7 +4,7 @@
 //! The command line's flags (`--head-jitter-cm`) are made from this table, the Python
 //! keywords (`head_jitter_cm=`) are read through it, and the stubs (`__init__.pyi`) and
 //! `docs/reference/options.md` are checked against it by `tests/option_table.rs`, which fails
-//! on drift. [`crate::measure::run_spec`] builds one validated run from the values. Adding an
+//! on drift. `measure/run_spec.rs` builds one validated run from the values. Adding an
 //! option is a row here plus the line that stores it (`RunSpec::set`).
 //!
 //! The table sits in `measure/` because a run's options include its measurement's (`band`,
