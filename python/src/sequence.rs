@@ -29,7 +29,7 @@ use seethru::scene::source::MAX_RESOLUTION;
 use seethru::system::display::{DisplayModel, Filter};
 use seethru::system::memory::{DEFAULT_MAX_MEMORY_GIB, check_memory, sequence_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
-use seethru::system::reads::{ReadWhen, hazard_bound_reads, sequence_reads};
+use seethru::system::reads::{ReadWhen, first_ignored, hazard_bound_reads, sequence_reads};
 use seethru::system::sequence::head_motion::{HeadMotion, HeadPreset};
 use seethru::system::sequence::predict::Prediction;
 use seethru::system::sequence::system_loop::SequenceOptions;
@@ -446,10 +446,7 @@ pub fn sequence(
     };
     // As `seethru sequence`: a setting the others make it ignore is refused.
     let refuse = |rules: &[ReadWhen]| -> PyResult<()> {
-        match rules
-            .iter()
-            .find(|r| !r.read && given.iter().any(|g| g == r.option))
-        {
+        match first_ignored(rules, |option| given.iter().any(|g| g == option)) {
             Some(r) => Err(bad_value(r.keyword_refusal())),
             None => Ok(()),
         }
