@@ -522,7 +522,7 @@ fn run_metrics(scene: &seethru::scene::Scene, options: &RunOptions) -> serde_jso
         r.measured_views(),
         5,
     );
-    metrics
+    metrics.to_json()
 }
 
 /// `sequence --display ideal` on a curved display: a still head and vehicle with the model
@@ -798,6 +798,7 @@ fn the_border_bands_of_a_curved_display_follow_its_uvs() {
         count(&|u| u < band as f64),
         count(&|u| u >= w - band as f64),
     );
+    let metrics = metrics.to_json();
     let sides = &metrics["border_per_side"];
     let (got_left, got_right) = (
         sides["left"]["pixels"].as_f64().unwrap(),

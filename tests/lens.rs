@@ -211,6 +211,7 @@ fn small(display: DisplayModel) -> RunOptions {
 
 fn misregistration_mean(ctx: &RenderContext, r: &RunResult) -> f64 {
     let (_, m) = measure(ctx, &ctx.scene, ctx.scene.eye(), r.measured_views(), 5);
+    let m = m.to_json();
     assert_eq!(m["coverage"], 1.0);
     m["display"]["misregistration_arcmin"]["mean"]
         .as_f64()

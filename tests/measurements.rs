@@ -296,7 +296,8 @@ fn setup_parameters_are_checked_at_their_bounds() {
 
 /// The metrics of a run's own frames, as `run` computes them (border band 5 display pixels).
 fn measured(ctx: &RenderContext, r: &RunResult) -> (MetricMaps, serde_json::Value) {
-    measure(ctx, &ctx.scene, ctx.scene.eye(), r.measured_views(), 5)
+    let (maps, metrics) = measure(ctx, &ctx.scene, ctx.scene.eye(), r.measured_views(), 5);
+    (maps, metrics.to_json())
 }
 
 /// [`measured`] of `shown` against `truth` in place of the run's seethru and truth (the
@@ -308,7 +309,8 @@ fn measured_as(
     shown: &Frame,
 ) -> (MetricMaps, serde_json::Value) {
     let views = [truth.into(), shown.into(), (&r.occluded).into()];
-    measure(ctx, &ctx.scene, ctx.scene.eye(), views, 5)
+    let (maps, metrics) = measure(ctx, &ctx.scene, ctx.scene.eye(), views, 5);
+    (maps, metrics.to_json())
 }
 
 /// A wall at `wall` metres behind a display at the origin; the model plane at `d2`.

@@ -342,6 +342,7 @@ fn holes_of_a_sideways_eye_are_the_disoccluded_area() {
         ..
     } = measure_run(&ctx, &options, &r, SETTINGS).unwrap();
     let holes = holes.unwrap();
+    let metrics = metrics.to_json();
     assert_eq!(metrics["missing"]["outside_frontal_view"], 0);
     let hidden = metrics["missing"]["hidden_from_frontal"].as_u64().unwrap() as i64;
     let found = holes.iter().filter(|&&h| h).count() as i64;
@@ -549,7 +550,7 @@ fn depth_noise_grows_the_misregistration_as_the_formula_predicts() {
         let (measured, predicted) = (measured / n as f64, predicted / n as f64);
         eprintln!(
             "{kind:?} σ₁ = {sigma_1m}: measured {measured:.3}′, predicted {predicted:.3}′ over {n}, holes {}",
-            metrics["holes"]["fraction"]
+            metrics.holes.as_ref().unwrap()["fraction"]
         );
         assert!(n > 5000, "{n}");
         if sigma_1m == 0.0 {

@@ -115,7 +115,7 @@ impl PyRun {
         )
         .unbind();
         let report = json_to_py(py, &result.report)?;
-        let metrics = json_to_py(py, &metrics)?;
+        let metrics = json_to_py(py, &metrics.to_json())?;
         let hazards = json_to_py(py, &hazards)?;
         let dict = PyDict::new(py);
         // The views rendered over truth made whole first: then truth is theirs no longer, and

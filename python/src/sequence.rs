@@ -282,7 +282,7 @@ fn step(stepper: &mut SequenceStepper) -> anyhow::Result<Stepped> {
         images.truth.clone(),
         images.seethru.clone(),
         images.maps.misregistration.clone(),
-        images.metrics_json.clone(),
+        images.metrics.to_json(),
     ))
 }
 

@@ -10,6 +10,7 @@ use seethru::io::staged::StagedDir;
 use seethru::measure::holes::{hole_metrics, read_hole_mask};
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
+use seethru::measure::metrics_json::Metrics;
 use seethru::render::frame_over::FrameView;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
@@ -31,13 +32,13 @@ impl Measure {
     pub fn run(self) -> Result<()> {
         check_paths(&[Input::folder("DIR", &self.dir)], &[])?;
         let metrics = measure_command(&self.dir, self.band)?;
-        println!("{}", serde_json::to_string_pretty(&metrics)?);
+        println!("{}", serde_json::to_string_pretty(&metrics.to_json())?);
         Ok(())
     }
 }
 
 /// `seethru measure`: the metrics of a run directory, from its saved EXRs.
-fn measure_command(dir: &Path, band: u32) -> Result<serde_json::Value> {
+fn measure_command(dir: &Path, band: u32) -> Result<Metrics> {
     let record = read_run_json(dir)?;
     let run_json = dir.join("run.json");
     // `run` records the scene as given (relative to the folder it was started in) and
@@ -83,7 +84,7 @@ fn measure_command(dir: &Path, band: u32) -> Result<serde_json::Value> {
         let run: serde_json::Value =
             serde_json::from_str(&read_input_text(&dir.join("run.json"), MAX_RUN_JSON_BYTES)?)?;
         let fill = run["scene_model"]["holes"]["fill"].clone();
-        metrics["holes"] = hole_metrics(&holes, &maps, &truth, &seethru, fill);
+        metrics.holes = Some(hole_metrics(&holes, &maps, &truth, &seethru, fill));
     }
     // Whole or not at all: staged beside the run folder, moved in when all are written.
     let staged = StagedDir::new(dir)?;

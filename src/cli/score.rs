@@ -153,17 +153,13 @@ impl Score {
             &serde_json::to_string_pretty(&result.report)?,
         )?;
         staged.commit()?;
-        let d = &metrics["display"];
+        let (d, b) = (&metrics.display, &metrics.border);
         let misregistration = match scored.has_map {
             true => format!(
                 "misregistration mean {:.3} arcmin (p95 {:.3}) over {} pixels",
-                d["misregistration_arcmin"]["mean"]
-                    .as_f64()
-                    .unwrap_or(f64::NAN),
-                d["misregistration_arcmin"]["p95"]
-                    .as_f64()
-                    .unwrap_or(f64::NAN),
-                d["misregistration_arcmin"]["count"]
+                d.misregistration_arcmin.mean,
+                d.misregistration_arcmin.p95,
+                d.misregistration_arcmin.count
             ),
             false => "misregistration needs a map (image only)".to_string(),
         };
@@ -172,12 +168,10 @@ impl Score {
             name(&self.map)
                 .or(name(&self.display_image))
                 .unwrap_or_default(),
-            100.0 * metrics["coverage"].as_f64().unwrap_or(f64::NAN),
-            metrics["border"]["misregistration_arcmin"]["mean"]
-                .as_f64()
-                .unwrap_or(f64::NAN),
-            d["psnr_db"].as_f64().unwrap_or(f64::NAN),
-            d["ssim"].as_f64().unwrap_or(f64::NAN),
+            100.0 * metrics.coverage,
+            b.misregistration_arcmin.mean,
+            d.psnr_db,
+            d.ssim,
             self.out.display()
         ));
         Ok(())

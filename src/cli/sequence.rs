@@ -13,7 +13,8 @@ use seethru::measure::headline::{RunKind, summary_text};
 use seethru::measure::image_metrics::Flip;
 use seethru::measure::sequence::{Measuring, SequenceRun, run_sequence_hazards};
 use seethru::measure::sequence_files::{
-    Preview, frames_csv, hazard_figure, latency_figure, over_time_figure, summary,
+    Preview, frames_csv, hazard_figure, latency_figure, mean_of_frame_stats, over_time_figure,
+    summary,
 };
 use seethru::measure::sequence_records::head_warning;
 use seethru::scene::Scene;
@@ -470,13 +471,8 @@ impl Sequence {
         for (ms, run) in runs {
             let timeline = self.options(&HeadMotion::Still, *ms).timeline;
             let s = summary(run, &timeline);
-            let m = &s["misregistration_arcmin"];
-            let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
-            points.push((
-                *ms,
-                f(&m["mean_of_frame_means"]),
-                f(&m["mean_of_frame_p95"]),
-            ));
+            let [mean, p95] = mean_of_frame_stats(run);
+            points.push((*ms, mean, p95));
             per_latency
                 .push(json!({"latency_camera_ms": ms, "dir": latency_dir(*ms), "summary": s}));
         }

@@ -206,25 +206,25 @@ pub fn compare(
             holes,
             hazards,
         } = measure_run(ctx, &options, &result, settings)?;
-        let display = &metrics["display"];
-        let misregistration = &display["misregistration_arcmin"];
+        let display = &metrics.display;
+        let misregistration = &display.misregistration_arcmin;
         let row = json!({
             // Per `hazard = true` object, as `run`'s hazards.json.
             "hazards": hazards,
             "method": candidate.name(),
             "reason": null,
-            "misregistration_mean_arcmin": misregistration["mean"],
-            "misregistration_p95_arcmin": misregistration["p95"],
-            "border_mean_arcmin": metrics["border"]["misregistration_arcmin"]["mean"],
-            "coverage": metrics["coverage"],
-            "holes_fraction": metrics.get("holes").map_or(json!(0.0), |h| h["fraction"].clone()),
-            "psnr_db": display["psnr_db"],
-            "ssim": display["ssim"],
-            "flip_mean": display["flip_mean"],
+            "misregistration_mean_arcmin": misregistration.mean,
+            "misregistration_p95_arcmin": misregistration.p95,
+            "border_mean_arcmin": metrics.border.misregistration_arcmin.mean,
+            "coverage": metrics.coverage,
+            "holes_fraction": metrics.holes.as_ref().map_or(json!(0.0), |h| h["fraction"].clone()),
+            "psnr_db": display.psnr_db,
+            "ssim": display.ssim,
+            "flip_mean": display.flip_mean,
             "ms_per_frame": result.report["timings_s"]["display"].as_f64().map(|s| s * 1e3),
             "d2_m": result.report["d2_m"],
             "scene_model": result.report.get("scene_model"),
-            "metrics": metrics,
+            "metrics": metrics.to_json(),
         });
         out.push(Compared {
             name: candidate.name().to_string(),

@@ -44,25 +44,25 @@ pub fn compare_maps(
             hazards,
             ..
         } = measure_run(ctx, &options, result, settings)?;
-        let display = &metrics["display"];
-        let misregistration = &display["misregistration_arcmin"];
+        let display = &metrics.display;
+        let misregistration = &display.misregistration_arcmin;
         let row = json!({
             "hazards": hazards,
             "method": format!("map:{name}"),
-            "misregistration_mean_arcmin": misregistration["mean"],
-            "misregistration_p95_arcmin": misregistration["p95"],
-            "border_mean_arcmin": metrics["border"]["misregistration_arcmin"]["mean"],
-            "coverage": metrics["coverage"],
+            "misregistration_mean_arcmin": misregistration.mean,
+            "misregistration_p95_arcmin": misregistration.p95,
+            "border_mean_arcmin": metrics.border.misregistration_arcmin.mean,
+            "coverage": metrics.coverage,
             "holes_fraction": 0.0,
-            "psnr_db": display["psnr_db"],
-            "ssim": display["ssim"],
-            "flip_mean": display["flip_mean"],
+            "psnr_db": display.psnr_db,
+            "ssim": display.ssim,
+            "flip_mean": display.flip_mean,
             "ms_per_frame": null,
             "d2_m": null,
             "scene_model": null,
             "reason": null,
             "external_method": result.report["external_method"],
-            "metrics": metrics,
+            "metrics": metrics.to_json(),
         });
         out.push(Compared {
             name: format!("map_{name}"),

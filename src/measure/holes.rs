@@ -11,7 +11,7 @@ use serde_json::json;
 use crate::measure::image_metrics::psnr;
 use crate::measure::maps::write_mask_png;
 use crate::measure::metrics::MetricMaps;
-use crate::measure::metrics_json::stats;
+use crate::measure::metrics_json::{Metrics, Stats};
 use crate::render::frame::Frame;
 use crate::render::frame_over::FrameView;
 use crate::scene::Obstacle;
@@ -81,7 +81,7 @@ pub fn hole_metrics(
         json!({
             "pixels": pixels,
             "coverage": if pixels == 0 { f64::NAN } else { 1.0 - blank as f64 / pixels as f64 },
-            "misregistration_arcmin": stats(&mut values),
+            "misregistration_arcmin": Stats::of(&mut values),
             "psnr_db": psnr(&srgb_t, &srgb_s, &mask),
             "ssim": mean_over(&maps.ssim),
             "flip_mean": mean_over(&maps.flip),
@@ -105,7 +105,7 @@ pub fn write_hole_mask(path: &Path, maps: &MetricMaps, holes: &[bool]) -> Result
 /// The `holes` metrics of a run's display holes seen in its `truth`, `occluded` and `seethru`
 /// views, attached to `metrics`; the driver-view hole mask, if the run has holes.
 pub fn attach_view_holes(
-    metrics: &mut serde_json::Value,
+    metrics: &mut Metrics,
     maps: &MetricMaps,
     display_holes: Option<&[bool]>,
     [truth, occluded, seethru]: [FrameView<'_>; 3],
@@ -116,7 +116,7 @@ pub fn attach_view_holes(
     // Only a run with holes (`--method depth`) reads the whole frames.
     let [truth, occluded, seethru] = [truth, occluded, seethru].map(FrameView::whole);
     let mask = driver_hole_mask(obstacle, occluded, maps, display_holes);
-    metrics["holes"] = hole_metrics(&mask, maps, truth, seethru, fill);
+    metrics.holes = Some(hole_metrics(&mask, maps, truth, seethru, fill));
     Some(mask)
 }
 

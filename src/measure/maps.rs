@@ -10,6 +10,7 @@ use crate::io::atomic::write_text;
 use crate::io::colour_bar::{ColourBar, with_colour_bar};
 use crate::io::frame_files::{write_exr_channels, write_png};
 use crate::measure::metrics::MetricMaps;
+use crate::measure::metrics_json::Metrics;
 use crate::render::frame::Frame;
 use crate::util::color::encode_srgb8;
 
@@ -96,9 +97,9 @@ pub fn write_metrics(
     dir: &Path,
     maps: &MetricMaps,
     truth: &Frame,
-    json: &serde_json::Value,
+    metrics: &Metrics,
 ) -> Result<()> {
-    write_metrics_scaled(dir, maps, truth, json, None)
+    write_metrics_scaled(dir, maps, truth, metrics, None)
 }
 
 /// [`write_metrics`] with the heatmap's scale fixed at `heat_max` arc-minutes when given.
@@ -106,12 +107,12 @@ pub fn write_metrics_scaled(
     dir: &Path,
     maps: &MetricMaps,
     truth: &Frame,
-    json: &serde_json::Value,
+    metrics: &Metrics,
     heat_max: Option<f32>,
 ) -> Result<()> {
     write_text(
         &dir.join("metrics.json"),
-        &serde_json::to_string_pretty(json)?,
+        &serde_json::to_string_pretty(&metrics.to_json())?,
     )?;
     // The three images side by side (a run's last writes, while its other views may be
     // written already); the first error in this order.

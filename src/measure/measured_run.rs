@@ -4,12 +4,13 @@
 
 use anyhow::Result;
 use glam::DVec3;
-use serde_json::{Value, json};
+use serde_json::Value;
 
 use crate::geometry::camera::Camera;
 use crate::measure::hazard::run_hazards_json;
 use crate::measure::holes::attach_view_holes;
 use crate::measure::metrics::{MetricMaps, measure};
+use crate::measure::metrics_json::Metrics;
 use crate::render::frame_over::FrameView;
 use crate::render::integrator::RenderContext;
 use crate::system::options::RunOptions;
@@ -38,7 +39,7 @@ pub struct MeasuredRun {
     /// Per driver-view pixel: misregistration, missing, … (the heatmaps' values).
     pub maps: MetricMaps,
     /// metrics.json's content.
-    pub metrics: Value,
+    pub metrics: Metrics,
     /// The driver-view pixels that show a hole of the display (`--method depth`), if any.
     pub holes: Option<Vec<bool>>,
     /// hazards.json's content.
@@ -63,7 +64,7 @@ pub fn measure_views(
     eye: DVec3,
     views: &DriverViews<'_>,
     band: u32,
-) -> (MetricMaps, Value, Option<Vec<bool>>) {
+) -> (MetricMaps, Metrics, Option<Vec<bool>>) {
     let [truth, occluded, seethru] = views.views;
     let (maps, mut metrics) = measure(ctx, &ctx.scene, eye, [truth, seethru, occluded], band);
     let holes = attach_view_holes(
@@ -75,13 +76,13 @@ pub fn measure_views(
         options.scene_model.fill,
     );
     if let Some(external) = views.external_method {
-        metrics["external_method"] = external.clone();
+        metrics.external_method = Some(external.clone());
         if !external["display_from"]
             .as_str()
             .is_some_and(|s| s.contains("map"))
         {
-            metrics["misregistration_needs_a_map"] = json!(
-                "the display image alone carries no geometry: misregistration is undefined on every display pixel (counted in undefined_pixels); give --map for it"
+            metrics.misregistration_needs_a_map = Some(
+                "the display image alone carries no geometry: misregistration is undefined on every display pixel (counted in undefined_pixels); give --map for it",
             );
         }
     }

@@ -15,7 +15,7 @@
 use glam::DVec3;
 
 use crate::measure::image_metrics::{DisplayImages, Flip};
-use crate::measure::metrics_json::metrics_json;
+use crate::measure::metrics_json::{Metrics, display_metrics};
 use crate::measure::misregistration::{Measured, measure_display_pixels};
 use crate::render::frame_over::FrameView;
 use crate::render::integrator::RenderContext;
@@ -64,7 +64,7 @@ impl MetricMaps {
     }
 }
 
-/// Computes the maps and the metrics JSON. `truth`, `seethru` and `occluded` are frames of the
+/// Computes the maps and the metrics (metrics.json). `truth`, `seethru` and `occluded` are frames of the
 /// driver's camera at `driver_eye` (as rendered by `run`); `band` is the border band width in
 /// display pixels.
 pub fn measure(
@@ -73,7 +73,7 @@ pub fn measure(
     driver_eye: DVec3,
     frames: [FrameView<'_>; 3],
     band: u32,
-) -> (MetricMaps, serde_json::Value) {
+) -> (MetricMaps, Metrics) {
     measure_with(ctx, scene, driver_eye, frames, band, Flip::Computed)
 }
 
@@ -85,7 +85,7 @@ pub fn measure_with(
     frames: [FrameView<'_>; 3],
     band: u32,
     flip: Flip,
-) -> (MetricMaps, serde_json::Value) {
+) -> (MetricMaps, Metrics) {
     let [truth, seethru, occluded] = frames;
     let display = display_mask(ctx, occluded);
     // Every statistic is over display pixels, taken in index order (row by row): the same
@@ -95,9 +95,9 @@ pub fn measure_with(
     let measured = measure_display_pixels(ctx, scene, driver_eye, frames, &on_display, band);
     let images = DisplayImages::score(truth, seethru, &on_display, &scene.driver, flip);
     let width = truth.width() as usize;
-    let json = metrics_json(scene, width, &measured, &images, band, flip);
+    let metrics = display_metrics(scene, width, &measured, &images, band, flip);
     let maps = MetricMaps::of(truth, display, &on_display, &measured, &images);
-    (maps, json)
+    (maps, metrics)
 }
 
 /// Which pixels of `occluded` (the driver's view with the obstacle) show the display.

@@ -15,6 +15,7 @@ use crate::geometry::opencv::camera_json;
 use crate::measure::hazard::{HAZARD_BOUND_ARCMIN, hazard_seen};
 use crate::measure::image_metrics::Flip;
 use crate::measure::metrics::{MetricMaps, measure_with};
+use crate::measure::metrics_json::Metrics;
 use crate::measure::sequence_records::{FrameMetrics, FrameRecord};
 use crate::measure::sequence_regions::{
     NOTHING, copy_rect, render_truth_and_occluded, union, window,
@@ -36,8 +37,8 @@ pub struct FrameImages<'a> {
     pub truth: &'a Frame,
     pub seethru: &'a Frame,
     pub maps: &'a MetricMaps,
-    /// The frame's metrics: `run`'s metrics.json content for this instant.
-    pub metrics_json: &'a serde_json::Value,
+    /// The frame's metrics: `run`'s metrics.json for this instant.
+    pub metrics: &'a Metrics,
     /// The driver-view pixels rendered for every frame (the display's neighbourhood over the
     /// whole sequence), where previews are cut.
     pub window: PixelRect,
@@ -144,7 +145,7 @@ pub struct SequenceStepper {
     /// The capture of the last frame made, until [`SequenceStepper::step`] hands it out.
     capture: Option<Capture>,
     maps: Option<MetricMaps>,
-    metrics_json: serde_json::Value,
+    metrics: Option<Metrics>,
     records: Vec<FrameRecord>,
     refreshes: std::collections::BTreeSet<i64>,
     truth_seconds: f64,
@@ -199,7 +200,7 @@ impl SequenceStepper {
             window,
             region,
             maps: None,
-            metrics_json: serde_json::Value::Null,
+            metrics: None,
             records: Vec::with_capacity(frames),
             refreshes: Default::default(),
             truth_seconds: 0.0,
@@ -237,12 +238,13 @@ impl SequenceStepper {
     fn last_step(&mut self) -> FrameStep<'_> {
         let capture = self.capture.take();
         let record = self.records.last().expect("a frame was made");
-        let images = self.maps.as_ref().map(|maps| FrameImages {
+        let measured = self.maps.as_ref().zip(self.metrics.as_ref());
+        let images = measured.map(|(maps, metrics)| FrameImages {
             record,
             truth: &self.truth,
             seethru: &self.seethru,
             maps,
-            metrics_json: &self.metrics_json,
+            metrics,
             window: self.window,
             capture,
         });
@@ -316,7 +318,7 @@ impl SequenceStepper {
         let mut measured = ctx.scene.clone();
         measured.frontal = shown.frontal;
         let (truth, seethru) = (&self.truth, &self.seethru);
-        let (maps, json) = measure_with(
+        let (maps, metrics) = measure_with(
             &ctx,
             &measured,
             driver.position(),
@@ -332,7 +334,7 @@ impl SequenceStepper {
             driver.central_pixel_arcmin(),
         );
         self.metrics_seconds += t1.elapsed().as_secs_f64();
-        record.metrics = Some(FrameMetrics::from_json(&json));
+        record.metrics = Some(FrameMetrics::of(&metrics));
         let capture = system.take_inputs().map(|i| Capture {
             frontal: i.frontal,
             back: i.back,
@@ -353,7 +355,7 @@ impl SequenceStepper {
         });
         self.records.push(record);
         self.maps = Some(maps);
-        self.metrics_json = json;
+        self.metrics = Some(metrics);
         self.capture = capture;
         Ok(true)
     }

@@ -183,6 +183,17 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
     if n == 0 { f64::NAN } else { s / n as f64 }
 }
 
+/// The means over `run`'s measured frames of their mean and of their p95 misregistration,
+/// arc-minutes (NaN without a measured frame): the summary's `mean_of_frame_means` and
+/// `mean_of_frame_p95`.
+pub fn mean_of_frame_stats(run: &SequenceRun) -> [f64; 2] {
+    let m = || run.records.iter().filter_map(|r| r.metrics);
+    [
+        mean(m().map(|x| x.mean_arcmin)),
+        mean(m().map(|x| x.p95_arcmin)),
+    ]
+}
+
 /// The sequence's figures over its frames: means of the per-frame statistics, the extremes,
 /// and the coverage they were taken at.
 pub fn summary(run: &SequenceRun, timeline: &Timeline) -> serde_json::Value {
@@ -198,8 +209,8 @@ pub fn summary(run: &SequenceRun, timeline: &Timeline) -> serde_json::Value {
         "latency_camera_ms": timeline.latency_camera * 1e3,
         "latency_tracking_ms": timeline.latency_tracking * 1e3,
         "misregistration_arcmin": {
-            "mean_of_frame_means": mean(m.iter().map(|x| x.mean_arcmin)),
-            "mean_of_frame_p95": mean(m.iter().map(|x| x.p95_arcmin)),
+            "mean_of_frame_means": mean_of_frame_stats(run)[0],
+            "mean_of_frame_p95": mean_of_frame_stats(run)[1],
             "max_of_frame_p95": m.iter().map(|x| x.p95_arcmin).fold(f64::NAN, f64::max),
             "max": m.iter().map(|x| x.max_arcmin).fold(f64::NAN, f64::max),
         },

@@ -6,12 +6,13 @@
 use glam::DVec3;
 
 use crate::measure::hazard::HazardSeen;
+use crate::measure::metrics_json::Metrics;
 use crate::system::head::CONFIDENT_HEAD;
 use crate::system::head_pose::HeadPose;
 use crate::system::sequence::timeline::FrameTimes;
 use crate::util::number::short;
 
-/// The metrics of one frame (from `measure`'s JSON).
+/// The metrics of one frame (of `measure`'s [`Metrics`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct FrameMetrics {
     pub display_pixels: u64,
@@ -31,20 +32,20 @@ pub struct FrameMetrics {
 }
 
 impl FrameMetrics {
-    pub(crate) fn from_json(j: &serde_json::Value) -> FrameMetrics {
-        let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
-        let d = &j["display"];
+    /// The frame's figures of its `metrics`.
+    pub(crate) fn of(metrics: &Metrics) -> FrameMetrics {
+        let d = &metrics.display;
         FrameMetrics {
-            display_pixels: j["display_pixels"].as_u64().unwrap_or(0),
-            coverage: f(&j["coverage"]),
-            mean_arcmin: f(&d["misregistration_arcmin"]["mean"]),
-            p95_arcmin: f(&d["misregistration_arcmin"]["p95"]),
-            max_arcmin: f(&d["misregistration_arcmin"]["max"]),
-            border_mean_arcmin: f(&j["border"]["misregistration_arcmin"]["mean"]),
-            psnr_db: f(&d["psnr_db"]),
-            ssim: f(&d["ssim"]),
-            flip: f(&d["flip_mean"]),
-            missing_fraction: f(&j["missing"]["fraction"]),
+            display_pixels: metrics.display_pixels as u64,
+            coverage: metrics.coverage,
+            mean_arcmin: d.misregistration_arcmin.mean,
+            p95_arcmin: d.misregistration_arcmin.p95,
+            max_arcmin: d.misregistration_arcmin.max,
+            border_mean_arcmin: metrics.border.misregistration_arcmin.mean,
+            psnr_db: d.psnr_db,
+            ssim: d.ssim,
+            flip: d.flip_mean,
+            missing_fraction: metrics.missing.fraction,
         }
     }
 }

@@ -14,6 +14,7 @@ use rayon::prelude::*;
 use crate::io::atomic::write_text;
 use crate::io::plot::{Figure, Series};
 use crate::measure::metrics::measure;
+use crate::measure::metrics_json::Metrics;
 use crate::measure::sweep_csv::{
     MAX_SWEEP_CSV_BYTES, METRIC_COLUMNS, decode, encode, finished_rows, header,
 };
@@ -26,27 +27,27 @@ use crate::scene::Scene;
 use crate::scene::fingerprint::fingerprint;
 use crate::scene::world::view_bit;
 use crate::system::options::{HeadSource, Outside, RunOptions};
-use crate::system::pipeline::{driver_camera, run_with_truth};
+use crate::system::pipeline::{RunResult, driver_camera, run_with_truth};
 use crate::util::input_file::{not_a_file, read_input_text};
 use crate::util::progress::Progress;
 
-fn metric_row(metrics: &serde_json::Value, report: &serde_json::Value) -> Vec<f64> {
-    let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
-    let d = &metrics["display"];
-    let b = &metrics["border"];
+/// A row's metrics, in the order of the CSV's metric columns: the run `result`'s `metrics`.
+fn metric_row(metrics: &Metrics, result: &RunResult) -> Vec<f64> {
+    let (d, b) = (&metrics.display, &metrics.border);
+    let ratios = result.crop.ratios();
     vec![
-        f(&d["misregistration_arcmin"]["mean"]),
-        f(&d["misregistration_arcmin"]["p95"]),
-        f(&d["misregistration_arcmin"]["max"]),
-        f(&b["misregistration_arcmin"]["mean"]),
-        f(&b["misregistration_arcmin"]["p95"]),
-        f(&d["psnr_db"]),
-        f(&d["ssim"]),
-        f(&metrics["missing"]["fraction"]),
-        f(&report["missing_fraction"]),
-        f(&report["crop"]["R1_left"]),
-        f(&report["crop"]["R2_right"]),
-        f(&metrics["coverage"]),
+        d.misregistration_arcmin.mean,
+        d.misregistration_arcmin.p95,
+        d.misregistration_arcmin.max,
+        b.misregistration_arcmin.mean,
+        b.misregistration_arcmin.p95,
+        d.psnr_db,
+        d.ssim,
+        metrics.missing.fraction,
+        result.missing_fraction,
+        ratios.left,
+        ratios.right,
+        metrics.coverage,
     ]
 }
 
@@ -206,7 +207,7 @@ pub fn sweep(
                     result.measured_views(),
                     options.band,
                 );
-                let values = metric_row(&metrics, &result.report);
+                let values = metric_row(&metrics, &result);
                 let fields: Vec<String> = std::iter::once(index.to_string())
                     .chain(config.iter().map(|(_, v)| v.clone()))
                     .chain(values.iter().map(|v| format!("{v}")))

@@ -218,9 +218,11 @@ translate = [0.0, 0.0, -10.0]
     let r = run(&ctx, &options)?;
     let eye = ctx.scene.eye();
     let (_, metrics) = measure(&ctx, &ctx.scene, eye, r.measured_views(), 5);
-    metrics["display"]["misregistration_arcmin"]["mean"]
-        .as_f64()
-        .ok_or_else(|| anyhow::anyhow!("the head-error wall shows no display pixel"))
+    let mean = metrics.display.misregistration_arcmin.mean;
+    match mean.is_nan() {
+        true => anyhow::bail!("the head-error wall shows no display pixel"),
+        false => Ok(mean),
+    }
 }
 
 /// A parameter set for evaluating every closed form (lengths in m, angles in degrees).

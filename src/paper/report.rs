@@ -19,7 +19,7 @@ pub struct Sizes {
 pub struct CaseResult {
     pub name: String,
     pub dir: String,
-    pub metrics: serde_json::Value,
+    pub metrics: crate::measure::metrics_json::Metrics,
     pub run: serde_json::Value,
 }
 
@@ -63,8 +63,12 @@ fn img_tag(html: bool, dir: &Path, rel: &str, width: Width) -> Result<String> {
     ))
 }
 
-fn num(v: &serde_json::Value) -> String {
-    v.as_f64().map_or("—".into(), |x| format!("{x:.2}"))
+/// A statistic to two decimals; "—" for none (NaN, or an infinite PSNR: JSON's null).
+fn num(x: f64) -> String {
+    match !x.is_finite() {
+        true => "—".into(),
+        false => format!("{x:.2}"),
+    }
 }
 
 pub fn render_report(
@@ -96,23 +100,22 @@ pub fn render_report(
     );
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
     for c in cases {
-        let d = &c.metrics["display"];
-        let b = &c.metrics["border"];
-        let coverage = c.metrics["coverage"].as_f64().unwrap_or(f64::NAN);
+        let (d, b) = (&c.metrics.display, &c.metrics.border);
+        let coverage = c.metrics.coverage;
         let _ = writeln!(
             md,
             "| {} | {:.1}%{} | {} | {} | {} | {} | {} | {} | {} | {:.1}% |",
             c.name,
             100.0 * coverage,
             if coverage < 1.0 { " †" } else { "" },
-            num(&d["misregistration_arcmin"]["mean"]),
-            num(&d["misregistration_arcmin"]["p95"]),
-            num(&d["misregistration_arcmin"]["max"]),
-            num(&b["misregistration_arcmin"]["mean"]),
-            num(&b["misregistration_arcmin"]["p95"]),
-            num(&d["psnr_db"]),
-            num(&d["ssim"]),
-            100.0 * c.metrics["missing"]["fraction"].as_f64().unwrap_or(0.0)
+            num(d.misregistration_arcmin.mean),
+            num(d.misregistration_arcmin.p95),
+            num(d.misregistration_arcmin.max),
+            num(b.misregistration_arcmin.mean),
+            num(b.misregistration_arcmin.p95),
+            num(d.psnr_db),
+            num(d.ssim),
+            100.0 * c.metrics.missing.fraction
         );
     }
     let _ = writeln!(
@@ -159,8 +162,8 @@ pub fn render_report(
         let _ = writeln!(
             md,
             "R1 = {}, R2 = {}. {} Coverage of the display in the driver's view: {:.1}%; {:.1}% of the display image's own pixels are black.\n",
-            num(&crop["R1_left"]),
-            num(&crop["R2_right"]),
+            num(crop["R1_left"].as_f64().unwrap_or(f64::NAN)),
+            num(crop["R2_right"].as_f64().unwrap_or(f64::NAN)),
             if outside.is_empty() {
                 "The crop lies inside the frontal view.".to_string()
             } else {
@@ -169,7 +172,7 @@ pub fn render_report(
                     outside.join(", ")
                 )
             },
-            100.0 * c.metrics["coverage"].as_f64().unwrap_or(f64::NAN),
+            100.0 * c.metrics.coverage,
             100.0 * c.run["missing_fraction"].as_f64().unwrap_or(0.0),
         );
         for image in ["truth.png", "seethru.png"] {

@@ -205,7 +205,7 @@ pub fn reproduce_named(
     let report = json!({
         "quick": quick,
         "scene": scene_name,
-        "cases": cases.iter().map(|c| json!({"name": c.name, "dir": c.dir, "metrics": c.metrics, "run": c.run})).collect::<Vec<_>>(),
+        "cases": cases.iter().map(|c| json!({"name": c.name, "dir": c.dir, "metrics": c.metrics.to_json(), "run": c.run})).collect::<Vec<_>>(),
         "equal_coverage": equal,
         "ratios": ratios.iter().map(|(n, d, r)| json!({"name": n, "dir": d, "result": r})).collect::<Vec<_>>(),
         "figures": figures,

@@ -51,6 +51,9 @@ pub struct RunResult {
     pub head_pose: Option<HeadPose>,
     /// Display pixels (row-major) that are disocclusion holes: `--method depth` only.
     pub holes: Option<Vec<bool>>,
+    /// Fraction of the display's pixels that show nothing (their crop point is outside the
+    /// frontal image), [0, 1]: run.json's `missing_fraction`.
+    pub missing_fraction: f64,
     /// `run.json`.
     pub report: serde_json::Value,
 }
@@ -463,6 +466,7 @@ pub struct RunRest {
     pub detection: Option<FaceDetection>,
     pub head_pose: Option<HeadPose>,
     pub holes: Option<Vec<bool>>,
+    pub missing_fraction: f64,
     pub report: serde_json::Value,
 }
 
@@ -484,6 +488,7 @@ impl RunRest {
             detection: self.detection,
             head_pose: self.head_pose,
             holes: self.holes,
+            missing_fraction: self.missing_fraction,
             report: self.report,
         }
     }
@@ -659,6 +664,7 @@ pub fn run_staged(
         detection: head_fix.map(|f| f.detection),
         head_pose: head_fix.and_then(|f| f.pose),
         holes: scene_model.map(|m| m.holes),
+        missing_fraction: missing,
         report,
     })
 }
