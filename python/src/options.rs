@@ -8,12 +8,9 @@ use pyo3::types::{PyBool, PyDict};
 use seethru::measure::option_table::{Command, Kind, OptionSpec, Value, option, options_of};
 use seethru::measure::run_spec::{RunSpec, SpecError};
 use seethru::scene::source::MAX_RESOLUTION;
-use seethru::system::options::{MAX_HEAD_BIAS_CM, WorkingDistance};
+use seethru::system::options::MAX_HEAD_BIAS_CM;
 
 use crate::errors::bad_value;
-
-/// Smallest positive size, distance or width accepted (as on the command line).
-const MIN_POSITIVE: f64 = 1e-6;
 
 pub fn int_in(key: &str, v: i64, min: i64, max: i64) -> PyResult<i64> {
     match (min..=max).contains(&v) {
@@ -57,19 +54,6 @@ fn choice<T: ValueEnum>(key: &str, value: &str) -> PyResult<T> {
                 names().join(", ")
             ))
         })
-}
-
-/// A working distance: a number of metres in [1e-6, 1e6], inf (a float or "inf") or "auto".
-pub fn working_distance(key: &str, value: &Bound<'_, PyAny>) -> PyResult<WorkingDistance> {
-    match value.extract::<f64>() {
-        Ok(v) if v == f64::INFINITY => Ok(WorkingDistance::Infinity),
-        Ok(v) => real_in(key, v, MIN_POSITIVE, 1e6).map(WorkingDistance::Metres),
-        Err(_) => value
-            .extract::<String>()
-            .map_err(|_| bad_value(format!("{key}: a number, inf or auto is needed")))?
-            .parse()
-            .map_err(|e: String| bad_value(format!("{key}={e}"))),
-    }
 }
 
 /// The run specification of `command` from its keywords, read through the library's option
@@ -206,6 +190,16 @@ impl<'py> Keywords<'py> {
             .map(|(_, v)| v.clone())
     }
 
+    /// The value of the option table's `name`, if given: read by the table's parser, so with
+    /// its range and `seethru.run`'s words when refused.
+    pub fn table(&mut self, name: &'static str) -> PyResult<Option<Value>> {
+        let spec = option(name).unwrap_or_else(|| panic!("{name} is not in the option table"));
+        match self.value(name) {
+            None => Ok(None),
+            Some(v) => Ok(Some(value_of(spec, &v)?.unwrap_or(Value::Switch(false)))),
+        }
+    }
+
     pub fn real(&mut self, key: &'static str, default: f64, min: f64, max: f64) -> PyResult<f64> {
         match self.value(key) {
             None => Ok(default),
@@ -287,14 +281,6 @@ impl<'py> Keywords<'py> {
             Some(v) => v
                 .extract::<bool>()
                 .map_err(|_| bad_value(format!("{key}: True or False is needed"))),
-        }
-    }
-
-    /// An optional image side, pixels in [1, 16384].
-    pub fn side(&mut self, key: &'static str) -> PyResult<Option<u32>> {
-        match self.value(key) {
-            None => Ok(None),
-            Some(_) => Ok(Some(self.int(key, 1, 1, MAX_RESOLUTION as i64)? as u32)),
         }
     }
 

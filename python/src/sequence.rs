@@ -22,10 +22,8 @@ use seethru::measure::image_metrics::Flip;
 use seethru::measure::sequence::{Measuring, SequenceStepper};
 use seethru::measure::sequence_records::FrameRecord;
 use seethru::render::frame::Frame;
-use seethru::render::settings::MAX_SPP;
 use seethru::scene::Scene;
 use seethru::scene::head_path::HeadPath;
-use seethru::scene::source::MAX_RESOLUTION;
 use seethru::system::display::{DisplayModel, Filter};
 use seethru::system::memory::{DEFAULT_MAX_MEMORY_GIB, check_memory, sequence_estimate};
 use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
@@ -39,9 +37,10 @@ use seethru::util::number::short;
 use crate::errors::{bad_value, to_py};
 use crate::frame::PyFrame;
 use crate::interrupt::detached;
-use crate::options::{Keywords, real_in, working_distance};
+use crate::options::{Keywords, real_in};
 use crate::run::json_to_py;
 use crate::scene::PyScene;
+use seethru::measure::option_table::Value;
 
 /// Longest latency, ms; most camera latencies in one sequence (as `seethru sequence`).
 const MAX_LATENCY_MS: f64 = 10_000.0;
@@ -393,30 +392,39 @@ pub fn sequence(
     let latency_tracking = k.real("latency_tracking", 0.0, 0.0, MAX_LATENCY_MS)?;
     let predict: Prediction = k.choice("predict", Prediction::None)?;
     let reproject = k.flag("reproject")?;
-    let method: Method = k.choice("method", Method::Planar)?;
-    let d2 = match k.any("d2") {
-        None => WorkingDistance::Infinity,
-        Some(v) => working_distance("d2", &v)?,
-    };
+    // The options a sequence shares with a run are read by the option table's parsers (its
+    // ranges, `seethru.run`'s words); the defaults are the sequence's own.
+    let method: Method = k.table("method")?.map_or(Method::Planar, |v| v.choice());
+    let d2 = k
+        .table("d2")?
+        .map_or(WorkingDistance::Infinity, |v| v.working_distance());
     let head_source: HeadSource = k.choice("head_source", HeadSource::Oracle)?;
-    let head_bias_cm = k.head_bias_cm()?;
-    let head_jitter_cm = k.real("head_jitter_cm", 0.0, 0.0, 100.0)?;
-    let seed = k.int("seed", 1, 0, u32::MAX as i64)? as u32;
-    let feature_width = k.real("feature_width", 0.064, 1e-6, 1.0)?;
-    let require_confident_head = k.flag("require_confident_head")?;
-    let outside: Outside = k.choice("outside", Outside::Black)?;
-    let filter: Filter = k.choice("filter", Filter::Bilinear)?;
-    let display: DisplayModel = k.choice("display", DisplayModel::Pixels)?;
-    let side = MAX_RESOLUTION as i64;
-    let width = k.int("width", 640, 1, side)? as u32;
-    let height = k.side("height")?;
-    let frontal_width = k.side("frontal_width")?;
-    let back_width = k.side("back_width")?;
-    let spp = k.int("spp", 1, 1, MAX_SPP as i64)? as u32;
-    let band = k.int("band", 5, 1, 1000)? as u32;
+    let head_bias_cm = k.table("head_bias_cm")?.map_or([0.0; 3], |v| v.triple());
+    let head_jitter_cm = k.table("head_jitter_cm")?.map_or(0.0, |v| v.real());
+    let seed = k.table("seed")?.map_or(1, |v| v.integer() as u32);
+    let feature_width = k.table("feature_width")?.map_or(0.064, |v| v.real());
+    let require_confident_head = k
+        .table("require_confident_head")?
+        .is_some_and(|v| v.switch());
+    let outside: Outside = k.table("outside")?.map_or(Outside::Black, |v| v.choice());
+    let filter: Filter = k.table("filter")?.map_or(Filter::Bilinear, |v| v.choice());
+    let display = k
+        .table("display")?
+        .map_or(DisplayModel::Pixels, |v| v.choice());
+    let pixels = |v: Value| v.integer() as u32;
+    let width = k.table("width")?.map_or(640, pixels);
+    let height = k.table("height")?.map(pixels);
+    let frontal_width = k.table("frontal_width")?.map(pixels);
+    let back_width = k.table("back_width")?.map(pixels);
+    let spp = k.table("spp")?.map_or(1, pixels);
+    let band = k.table("band")?.map_or(5, pixels);
     let flip = Flip::asked(k.flag("flip")?);
-    let bound = k.real("hazard_bound_arcmin", HAZARD_BOUND_ARCMIN, 1e-6, 10800.0)?;
-    let max_memory = k.real("max_memory", DEFAULT_MAX_MEMORY_GIB, 1e-6, 4096.0)?;
+    let bound = k
+        .table("hazard_bound_arcmin")?
+        .map_or(HAZARD_BOUND_ARCMIN, |v| v.real());
+    let max_memory = k
+        .table("max_memory")?
+        .map_or(DEFAULT_MAX_MEMORY_GIB, |v| v.real());
     let given: Vec<String> = SEQUENCE_KEYS
         .iter()
         // A switch given False is absent, as a flag left off the command line.

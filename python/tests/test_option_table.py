@@ -172,3 +172,33 @@ def test_run_measures_what_the_command_line_writes_for_the_smoke_matrix(tmp_path
         assert error is None, (keywords, error)
         assert run.metrics == json.loads((out / "metrics.json").read_text()), keywords
         assert run.hazards == json.loads((out / "hazards.json").read_text()), keywords
+
+
+def sequence_keywords() -> set[str]:
+    """The keywords of `seethru.sequence`: the flags of `seethru sequence --help`."""
+    import re
+
+    help_text = seethru_cli("sequence", "--help").stdout
+    return {f.replace("-", "_") for f in re.findall(r"--([a-z0-9-]+)", help_text)}
+
+
+# The options a sequence shares with a run: the table's, but `head` (a sequence's `head` is
+# the head's motion; its source is `head_source`).
+SHARED = [o for o in OPTIONS if o["name"] in sequence_keywords() and o["name"] != "head"]
+REFUSED = [(o, v) for o in SHARED for v, taken in cases(o) if taken is False]
+
+
+@pytest.mark.parametrize("option,value", REFUSED, ids=[f"{o['name']}-{v!r}" for o, v in REFUSED])
+def test_sequence_refuses_a_shared_option_in_the_words_of_run(option, value):
+    # One parser per option: a sequence reads what it shares with a run through the table, so
+    # a bad value is refused with the same words (and range) as by `seethru.run`.
+    scene = seethru.Scene.load(REPO / "scenes" / "das.toml")
+    with pytest.raises(ValueError) as by_sequence:
+        seethru.sequence(scene, **{option["name"]: value})
+    with pytest.raises(ValueError) as by_run:
+        seethru.spec("run", **{option["name"]: value})
+    assert str(by_sequence.value) == str(by_run.value)
+
+
+def test_a_sequence_shares_most_of_a_runs_options():
+    assert len(SHARED) >= 17, [o["name"] for o in SHARED]

@@ -136,13 +136,7 @@ impl RunSpec {
         let sensor = &mut o.scene_model.sensor;
         match name {
             "method" => o.method = value.choice::<Method>(),
-            "d2" => {
-                o.d2 = match value {
-                    Value::Distance(None) => WorkingDistance::Auto,
-                    Value::Distance(Some(v)) if v.is_infinite() => WorkingDistance::Infinity,
-                    _ => WorkingDistance::Metres(value.real()),
-                }
-            }
+            "d2" => o.d2 = value.working_distance(),
             "head" => o.head = value.choice::<HeadSource>(),
             "head_bias_cm" => o.head_bias_cm = value.triple(),
             "head_jitter_cm" => o.head_jitter_cm = value.real(),
@@ -197,35 +191,43 @@ impl RunSpec {
 /// The typed reads of a value whose kind the table fixes (a mismatch is a bug of the table,
 /// which `every_option_reaches_the_run` walks).
 impl Value {
-    fn integer(&self) -> u64 {
+    pub fn integer(&self) -> u64 {
         match self {
             Value::Integer(v) => *v,
             other => unreachable!("an integer option holds {other:?}"),
         }
     }
 
-    fn real(&self) -> f64 {
+    pub fn working_distance(&self) -> WorkingDistance {
+        match self {
+            Value::Distance(None) => WorkingDistance::Auto,
+            Value::Distance(Some(v)) if v.is_infinite() => WorkingDistance::Infinity,
+            _ => WorkingDistance::Metres(self.real()),
+        }
+    }
+
+    pub fn real(&self) -> f64 {
         match self {
             Value::Real(v) | Value::Distance(Some(v)) => *v,
             other => unreachable!("a number option holds {other:?}"),
         }
     }
 
-    fn triple(&self) -> [f64; 3] {
+    pub fn triple(&self) -> [f64; 3] {
         match self {
             Value::Triple(v) => *v,
             other => unreachable!("a triple option holds {other:?}"),
         }
     }
 
-    fn switch(&self) -> bool {
+    pub fn switch(&self) -> bool {
         match self {
             Value::Switch(v) => *v,
             other => unreachable!("a switch holds {other:?}"),
         }
     }
 
-    fn choice<T: clap::ValueEnum + Clone>(&self) -> T {
+    pub fn choice<T: clap::ValueEnum + Clone>(&self) -> T {
         match self {
             Value::Choice(name) => choice_of(name).expect("a choice of the option's list"),
             other => unreachable!("a choice option holds {other:?}"),
