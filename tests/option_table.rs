@@ -22,11 +22,43 @@ fn command_line_only(command: Command) -> &'static [&'static str] {
         ],
         Command::Capture => &["out", "calibration", "exr", "threads", "quiet", "help"],
         Command::Compare => &["methods", "out", "threads", "quiet", "help"],
+        // A sequence's own options (Python's keywords too, `SEQUENCE_KEYS`): its timeline, the
+        // vehicle's and the head's motion, the head's source, what it writes.
+        Command::Sequence => &[
+            "out",
+            "quiet",
+            "duration",
+            "fps",
+            "display-hz",
+            "speed",
+            "yaw-rate",
+            "head",
+            "head-path",
+            "sway-cm",
+            "sway-hz",
+            "lean-cm",
+            "lean-s",
+            "lean-at",
+            "latency-camera",
+            "latency-tracking",
+            "predict",
+            "reproject",
+            "frames",
+            "flip",
+            "exr",
+            "head-source",
+            "threads",
+            "heatmap-max",
+            "capture",
+            "maps",
+            "help",
+        ],
     }
 }
 
-/// Python's type and default of an option, as the stubs write them: `int | None = None`.
-fn python_annotation(option: &OptionSpec) -> String {
+/// Python's type and default of an option of `command`, as the stubs write them:
+/// `int | None = None`.
+fn python_annotation(option: &OptionSpec, command: Command) -> String {
     let ty = match option.kind {
         Kind::Integer { .. } => "int".to_string(),
         Kind::Real { .. } => "float".to_string(),
@@ -45,7 +77,7 @@ fn python_annotation(option: &OptionSpec) -> String {
             format!("Literal[{}]", names.join(", "))
         }
     };
-    let Default::Value(text) = option.default else {
+    let Default::Value(text) = option.default_for(command) else {
         return format!("{ty} | None = None");
     };
     let number = |v: f64| match v.fract() == 0.0 {
@@ -80,7 +112,7 @@ fn stub_block(command: Command) -> String {
         block.push_str(&format!(
             "    {}: {},\n",
             option.name,
-            python_annotation(option)
+            python_annotation(option, command)
         ));
     }
     block.push_str("    # End of the option table's.\n");
@@ -97,7 +129,7 @@ fn range_of(option: &OptionSpec) -> String {
 
 fn options_page() -> String {
     let mut page = String::from(
-        "# Options of run, capture and compare\n\n\
+        "# Options of run, capture, compare and sequence\n\n\
          Generated from the option table, `src/measure/option_table.rs`, by\n\
          `SEETHRU_BLESS=1 cargo test --release --test option_table` (the test fails when this page\n\
          and the table differ). Each option is a flag of the commands listed\n\
@@ -113,10 +145,20 @@ fn options_page() -> String {
          |---|---|---|---|---|---|---|---|\n",
     );
     for o in OPTIONS {
-        let default = match o.default {
+        let shown = |default: Default| match default {
             Default::Value(text) => format!("`{text}`"),
             Default::Derived(what) => what.to_string(),
         };
+        let mut default = shown(o.default);
+        for command in Command::ALL.into_iter().filter(|&c| o.taken_by(c)) {
+            if o.default_for(command) != o.default {
+                default.push_str(&format!(
+                    " ({}: {})",
+                    command.name(),
+                    shown(o.default_for(command))
+                ));
+            }
+        }
         let commands: Vec<&str> = o.commands.iter().map(|c| c.name()).collect();
         let read_with: Vec<String> = o
             .read_with
@@ -141,8 +183,10 @@ fn options_page() -> String {
     }
     page.push_str(
         "\nThe command line's own flags (files, output formats, threads) are in \
-         [the command line](command-line.md); `sequence`'s options are its own (`seethru \
-         sequence --help`).\n",
+         [the command line](command-line.md). A sequence takes the options it shares with a \
+         run from this table, with its own defaults where they differ; its timeline, the \
+         vehicle's and the head's motion and the head's source (`head_source`: a sequence's \
+         `head` is the head's motion) are its own (`seethru sequence --help`).\n",
     );
     page
 }

@@ -133,11 +133,13 @@ def run(
     """Runs the see-through system as `seethru run` does, returning instead of writing."""
 
 def options() -> list[dict[str, Any]]:
-    """The option table of run, capture and compare (the flags of the commands of the same
-    names): name, flag, kind, min, max, choices, unit, default, default_derived, help,
-    read_with and commands per option, in `seethru run --help`'s order."""
+    """The option table of run, capture and compare, and of what sequence shares with them
+    (the flags of the commands of the same names): name, flag, kind, min, max, choices, unit,
+    default, default_derived, command_defaults (a command's own default where it differs:
+    {"sequence": 1} for spp), help, read_with and commands per option, in `seethru run
+    --help`'s order."""
 
-def spec(command: Literal["run", "capture", "compare"], **options: Any) -> dict[str, Any]:
+def spec(command: Literal["run", "capture", "compare", "sequence"], **options: Any) -> dict[str, Any]:
     """The run specification `command` would make of `options`, every option checked and
     nothing rendered ({"command", "options": {name: value}}), as `seethru spec` prints it."""
 
@@ -302,26 +304,29 @@ def sequence(
     latency_tracking: float = 0.0,
     predict: Literal["none", "constant-velocity", "kalman"] = "none",
     reproject: bool = False,
-    method: str = "planar",
-    d2: float | str = float("inf"),
     head_source: Literal["oracle", "estimated", "model"] = "oracle",
+    flip: bool = False,
+    # The option table's (sequence): tests/option_table.rs checks it (SEETHRU_BLESS=1 rewrites it).
+    method: Literal["none", "planar", "ground", "plane-fit", "depth"] = "planar",
+    d2: float | str = "inf",
     head_bias_cm: tuple[float, float, float] = (0.0, 0.0, 0.0),
     head_jitter_cm: float = 0.0,
     seed: int = 1,
     feature_width: float = 0.064,
     require_confident_head: bool = False,
-    outside: Literal["black", "error"] = "black",
-    filter: str = "bilinear",
+    min_head_confidence: float = 0.5,
+    outside: Literal["error", "black"] = "black",
+    filter: Literal["bilinear", "bicubic"] = "bilinear",
     display: Literal["pixels", "ideal"] = "pixels",
-    width: int = 640,
-    height: int | None = None,
     frontal_width: int | None = None,
     back_width: int | None = None,
-    spp: int = 1,
     band: int = 5,
-    flip: bool = False,
-    hazard_bound_arcmin: float = ...,
-    max_memory: float = ...,
+    hazard_bound_arcmin: float = 30.0,
+    width: int = 640,
+    height: int | None = None,
+    spp: int = 1,
+    max_memory: float = 8.0,
+    # End of the option table's.
 ) -> Sequence:
     """`seethru sequence` as an iterator of measured frames, the command's loop options as
     keywords (refused as it refuses them); `predictor(info)` supplies the eye per refresh."""

@@ -15,14 +15,15 @@ fn command_named(name: &str) -> PyResult<Command> {
         .find(|c| c.name() == name)
         .ok_or_else(|| {
             bad_value(format!(
-                "command={name:?} is not one of run, capture, compare"
+                "command={name:?} is not one of run, capture, compare, sequence"
             ))
         })
 }
 
-/// Every option of `seethru.run`, `capture` and `compare` (the flags of the commands of the
-/// same names): a list of dicts with name, flag, kind, min, max, choices, unit, default,
-/// help, read_with and commands, in the table's order.
+/// Every option of `seethru.run`, `capture` and `compare`, and those `sequence` shares with
+/// them (the flags of the commands of the same names): a list of dicts with name, flag, kind,
+/// min, max, choices, unit, default (and command_defaults where a command's differs), help,
+/// read_with and commands, in the table's order.
 #[pyfunction]
 pub fn options(py: Python<'_>) -> PyResult<Py<PyAny>> {
     let rows: Vec<serde_json::Value> = OPTIONS
@@ -44,8 +45,20 @@ pub fn options(py: Python<'_>) -> PyResult<Py<PyAny>> {
                 Default::Derived(what) => Some(what),
                 Default::Value(_) => None,
             };
+            // A command's own default where it differs (a sequence's `spp` 1).
+            let own_defaults: serde_json::Map<String, serde_json::Value> = Command::ALL
+                .into_iter()
+                .filter(|&c| o.taken_by(c) && o.default_for(c) != o.default)
+                .map(|c| {
+                    let value = o
+                        .default_value_for(c)
+                        .map_or(serde_json::Value::Null, |v| v.to_json());
+                    (c.name().to_string(), value)
+                })
+                .collect();
             serde_json::json!({
                 "name": o.name,
+                "command_defaults": own_defaults,
                 "flag": o.flag(),
                 "kind": kind,
                 "min": min,

@@ -190,6 +190,18 @@ impl<'py> Keywords<'py> {
             .map(|(_, v)| v.clone())
     }
 
+    /// The run specification of `command` from the keywords of its table options (each read
+    /// by the table's parser); the others are left for the caller to read.
+    pub fn spec(&mut self, command: Command) -> PyResult<RunSpec> {
+        let mut given = Vec::new();
+        for option in options_of(command) {
+            if let Some(value) = self.table(option.name)? {
+                given.push((option, value));
+            }
+        }
+        RunSpec::build(command, &given).map_err(spelled)
+    }
+
     /// The value of the option table's `name`, if given: read by the table's parser, so with
     /// its range and `seethru.run`'s words when refused.
     pub fn table(&mut self, name: &'static str) -> PyResult<Option<Value>> {

@@ -17,16 +17,14 @@ use numpy::ndarray::Array2;
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
 use seethru::measure::image_metrics::Flip;
 use seethru::measure::sequence::{Measuring, SequenceStepper};
 use seethru::measure::sequence_records::FrameRecord;
 use seethru::render::frame::Frame;
 use seethru::scene::Scene;
 use seethru::scene::head_path::HeadPath;
-use seethru::system::display::{DisplayModel, Filter};
-use seethru::system::memory::{DEFAULT_MAX_MEMORY_GIB, check_memory, sequence_estimate};
-use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
+use seethru::system::memory::{check_memory, sequence_estimate};
+use seethru::system::options::{HeadSource, RunOptions};
 use seethru::system::reads::{ReadWhen, first_ignored, hazard_bound_reads, sequence_reads};
 use seethru::system::sequence::head_motion::{HeadMotion, HeadPreset};
 use seethru::system::sequence::predict::Prediction;
@@ -40,7 +38,7 @@ use crate::interrupt::detached;
 use crate::options::{Keywords, real_in};
 use crate::run::json_to_py;
 use crate::scene::PyScene;
-use seethru::measure::option_table::Value;
+use seethru::measure::option_table::Command;
 
 /// Longest latency, ms; most camera latencies in one sequence (as `seethru sequence`).
 const MAX_LATENCY_MS: f64 = 10_000.0;
@@ -286,7 +284,7 @@ fn step(stepper: &mut SequenceStepper) -> anyhow::Result<Stepped> {
 }
 
 /// The keywords of [`sequence`], in `seethru sequence --help`'s order.
-pub const SEQUENCE_KEYS: [&str; 36] = [
+pub const SEQUENCE_KEYS: [&str; 37] = [
     "duration",
     "fps",
     "display_hz",
@@ -311,6 +309,7 @@ pub const SEQUENCE_KEYS: [&str; 36] = [
     "seed",
     "feature_width",
     "require_confident_head",
+    "min_head_confidence",
     "outside",
     "filter",
     "display",
@@ -392,39 +391,11 @@ pub fn sequence(
     let latency_tracking = k.real("latency_tracking", 0.0, 0.0, MAX_LATENCY_MS)?;
     let predict: Prediction = k.choice("predict", Prediction::None)?;
     let reproject = k.flag("reproject")?;
-    // The options a sequence shares with a run are read by the option table's parsers (its
-    // ranges, `seethru.run`'s words); the defaults are the sequence's own.
-    let method: Method = k.table("method")?.map_or(Method::Planar, |v| v.choice());
-    let d2 = k
-        .table("d2")?
-        .map_or(WorkingDistance::Infinity, |v| v.working_distance());
+    // The options a sequence shares with a run: read by the option table, with its
+    // ranges, refusals and the sequence's defaults (`COMMAND_DEFAULTS`).
+    let spec = k.spec(Command::Sequence)?;
     let head_source: HeadSource = k.choice("head_source", HeadSource::Oracle)?;
-    let head_bias_cm = k.table("head_bias_cm")?.map_or([0.0; 3], |v| v.triple());
-    let head_jitter_cm = k.table("head_jitter_cm")?.map_or(0.0, |v| v.real());
-    let seed = k.table("seed")?.map_or(1, |v| v.integer() as u32);
-    let feature_width = k.table("feature_width")?.map_or(0.064, |v| v.real());
-    let require_confident_head = k
-        .table("require_confident_head")?
-        .is_some_and(|v| v.switch());
-    let outside: Outside = k.table("outside")?.map_or(Outside::Black, |v| v.choice());
-    let filter: Filter = k.table("filter")?.map_or(Filter::Bilinear, |v| v.choice());
-    let display = k
-        .table("display")?
-        .map_or(DisplayModel::Pixels, |v| v.choice());
-    let pixels = |v: Value| v.integer() as u32;
-    let width = k.table("width")?.map_or(640, pixels);
-    let height = k.table("height")?.map(pixels);
-    let frontal_width = k.table("frontal_width")?.map(pixels);
-    let back_width = k.table("back_width")?.map(pixels);
-    let spp = k.table("spp")?.map_or(1, pixels);
-    let band = k.table("band")?.map_or(5, pixels);
     let flip = Flip::asked(k.flag("flip")?);
-    let bound = k
-        .table("hazard_bound_arcmin")?
-        .map_or(HAZARD_BOUND_ARCMIN, |v| v.real());
-    let max_memory = k
-        .table("max_memory")?
-        .map_or(DEFAULT_MAX_MEMORY_GIB, |v| v.real());
     let given: Vec<String> = SEQUENCE_KEYS
         .iter()
         // A switch given False is absent, as a flag left off the command line.
@@ -433,24 +404,8 @@ pub fn sequence(
         .collect();
     k.finish()?;
     let run = RunOptions {
-        method,
-        d2,
         head: head_source,
-        head_bias_cm,
-        head_jitter_cm,
-        require_confident_head,
-        seed,
-        feature_width,
-        width: Some(width),
-        height,
-        frontal_width: Some(frontal_width.unwrap_or(width)),
-        back_width,
-        spp,
-        outside,
-        filter,
-        display,
-        progress: false,
-        ..RunOptions::default()
+        ..spec.options.clone()
     };
     // As `seethru sequence`: a setting the others make it ignore is refused.
     let refuse = |rules: &[ReadWhen]| -> PyResult<()> {
@@ -528,12 +483,12 @@ pub fn sequence(
         all.len() as u64,
     )
     .map_err(to_py)?;
-    check_memory(&estimate, max_memory).map_err(to_py)?;
+    check_memory(&estimate, spec.max_memory_gib).map_err(to_py)?;
     let frames = all.iter().map(|(_, o)| o.timeline.frames()).sum();
     let how = Measuring {
         metrics: true,
         full_frames: true,
-        band,
+        band: spec.measure.band,
         progress: false,
         flip,
     };
@@ -542,7 +497,7 @@ pub fn sequence(
         pending: all,
         scene: the_scene,
         how,
-        hazard_bound_arcmin: bound,
+        hazard_bound_arcmin: spec.measure.hazard_bound_arcmin,
         predictor,
         frames,
         refresh: None,
@@ -550,6 +505,7 @@ pub fn sequence(
     // The first latency's system is made now, so that its errors are raised here.
     let (ms, options) = sequence.pending.pop_front().expect("one latency at least");
     let scene = sequence.scene.clone();
+    let bound = spec.measure.hazard_bound_arcmin;
     let stepper = detached(py, move || {
         SequenceStepper::new(&scene, options, how, bound)
     })?

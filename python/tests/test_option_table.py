@@ -15,7 +15,7 @@ from conftest import REPO, seethru_cli
 from test_run_options import keyword_names
 
 OPTIONS = seethru.options()
-COMMANDS = ["run", "capture", "compare"]
+COMMANDS = ["run", "capture", "compare", "sequence"]
 
 
 def text(value) -> str:
@@ -196,7 +196,7 @@ def test_sequence_refuses_a_shared_option_in_the_words_of_run(option, value):
     with pytest.raises(ValueError) as by_sequence:
         seethru.sequence(scene, **{option["name"]: value})
     with pytest.raises(ValueError) as by_run:
-        seethru.spec("run", **{option["name"]: value})
+        seethru.spec("sequence", **{option["name"]: value})
     assert str(by_sequence.value) == str(by_run.value)
 
 

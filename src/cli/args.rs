@@ -123,30 +123,6 @@ pub struct MemoryLimit {
     pub max_memory: f64,
 }
 
-/// The head-tracking errors a run injects and the detector's feature width: shared by `run`
-/// and `sequence`.
-#[derive(clap::Args)]
-pub struct HeadErrorArgs {
-    /// Head-tracking bias, obstacle frame, centimetres: x,y,z, each in [-500, 500]
-    /// (e.g. `1,0,0` or `-1,0,0`).
-    #[arg(long = "head-bias-cm", value_name = "X,Y,Z", allow_hyphen_values = true, default_value = "0,0,0", value_parser = head_bias_cm)]
-    pub head_bias_cm: [f64; 3],
-    /// Head-tracking jitter, standard deviation per axis (per estimate in a sequence),
-    /// centimetres in [0, 100].
-    #[arg(long = "head-jitter-cm", default_value_t = 0.0, value_parser = real(0.0, 100.0))]
-    pub head_jitter_cm: f64,
-    /// Seed of the jitter (and of the depth sensor's noise), an integer in [0, 4294967295].
-    #[arg(long, default_value_t = 1, value_parser = integer::<u32>(0, u32::MAX as u64))]
-    pub seed: u32,
-    /// The detector's known feature width A (interpupillary distance), metres in [1e-6, 1].
-    #[arg(long = "feature-width", default_value_t = 0.064, value_parser = positive(1.0))]
-    pub feature_width: f64,
-    /// Stop with an error when a head estimate's confidence is below 0.5 (else a warning);
-    /// image-based head estimates only.
-    #[arg(long = "require-confident-head")]
-    pub require_confident_head: bool,
-}
-
 /// `--max-memory`, GiB in [1e-6, 4096].
 pub fn max_memory(text: &str) -> Result<f64, String> {
     positive(4096.0)(text)

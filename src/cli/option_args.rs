@@ -24,6 +24,8 @@ pub struct Run;
 pub struct Capture;
 /// `seethru compare`'s options.
 pub struct Compare;
+/// The options `seethru sequence` shares with a run.
+pub struct Sequence;
 
 impl TableCommand for Run {
     const COMMAND: Command = Command::Run;
@@ -33,6 +35,9 @@ impl TableCommand for Capture {
 }
 impl TableCommand for Compare {
     const COMMAND: Command = Command::Compare;
+}
+impl TableCommand for Sequence {
+    const COMMAND: Command = Command::Sequence;
 }
 
 /// The table's options of command `C` given on the command line.
@@ -62,8 +67,9 @@ pub fn spelled(error: SpecError) -> anyhow::Error {
     }
 }
 
-/// `--help`'s text of an option: the table's help, the unit and range, a derived default.
-fn help_of(option: &OptionSpec) -> String {
+/// `--help`'s text of an option of `command`: the table's help, the unit and range, a derived
+/// default.
+fn help_of(option: &OptionSpec, command: Command) -> String {
     let mut help = option.help.to_string();
     let need = option.kind.need();
     match (option.kind, option.unit) {
@@ -74,7 +80,7 @@ fn help_of(option: &OptionSpec) -> String {
         }
         (_, unit) => help.push_str(&format!(" In {unit}: {need}.")),
     }
-    if let Default::Derived(what) = option.default {
+    if let Default::Derived(what) = option.default_for(command) {
         help.push_str(&format!(" Default: {what}."));
     }
     help
@@ -117,11 +123,11 @@ impl TypedValueParser for ChoiceValue {
     }
 }
 
-/// The flag of `option`.
-fn arg_of(option: &'static OptionSpec) -> Arg {
+/// The flag of `option` in `command`.
+fn arg_of(option: &'static OptionSpec, command: Command) -> Arg {
     let arg = Arg::new(option.name)
         .long(option.name.replace('_', "-"))
-        .help(help_of(option));
+        .help(help_of(option, command));
     let arg = match option.kind {
         Kind::Switch => return arg.action(ArgAction::SetTrue),
         Kind::Choice(values) => arg.value_parser(ChoiceValue(values())),
@@ -131,7 +137,7 @@ fn arg_of(option: &'static OptionSpec) -> Arg {
         _ => arg.value_parser(move |text: &str| option.parse(text)),
     };
     let arg = arg.value_name(value_name(option));
-    match option.default {
+    match option.default_for(command) {
         Default::Value(text) => arg.default_value(text),
         Default::Derived(_) => arg,
     }
@@ -139,7 +145,7 @@ fn arg_of(option: &'static OptionSpec) -> Arg {
 
 impl<C: TableCommand> clap::Args for OptionArgs<C> {
     fn augment_args(cmd: clap::Command) -> clap::Command {
-        options_of(C::COMMAND).fold(cmd, |cmd, option| cmd.arg(arg_of(option)))
+        options_of(C::COMMAND).fold(cmd, |cmd, option| cmd.arg(arg_of(option, C::COMMAND)))
     }
 
     fn augment_args_for_update(cmd: clap::Command) -> clap::Command {

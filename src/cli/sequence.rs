@@ -8,9 +8,9 @@ use seethru::io::atomic::write_text;
 use seethru::io::frame_files::{ExrContent, write_color_png, write_view_exr};
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
-use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
 use seethru::measure::headline::{RunKind, summary_text};
 use seethru::measure::image_metrics::Flip;
+use seethru::measure::run_spec::RunSpec;
 use seethru::measure::sequence::{Measuring, SequenceRun, run_sequence_hazards};
 use seethru::measure::sequence_files::{
     Preview, frames_csv, hazard_figure, latency_figure, mean_of_frame_stats, over_time_figure,
@@ -19,9 +19,8 @@ use seethru::measure::sequence_files::{
 use seethru::measure::sequence_records::head_warning;
 use seethru::scene::Scene;
 use seethru::scene::head_path::HeadPath;
-use seethru::system::display::{DisplayModel, Filter};
-use seethru::system::memory::{DEFAULT_MAX_MEMORY_GIB, check_memory, sequence_estimate};
-use seethru::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
+use seethru::system::memory::{check_memory, sequence_estimate};
+use seethru::system::options::{HeadSource, RunOptions};
 use seethru::system::reads::{hazard_bound_reads, sequence_reads};
 use seethru::system::sequence::head_motion::{HeadMotion, HeadPreset};
 use seethru::system::sequence::predict::Prediction;
@@ -30,10 +29,8 @@ use seethru::system::sequence::timeline::Timeline;
 use seethru::util::progress::summary as say;
 use serde_json::json;
 
-use crate::cli::args::{
-    HeadErrorArgs, ReadWhen, band, choice, max_memory, pixels, positive, real, refuse_ignored,
-    samples, threads, with_threads,
-};
+use crate::cli::args::{ReadWhen, choice, positive, real, refuse_ignored, threads, with_threads};
+use crate::cli::option_args::{self, OptionArgs};
 
 /// Longest latency, ms.
 const MAX_LATENCY_MS: f64 = 10_000.0;
@@ -155,50 +152,13 @@ pub struct Sequence {
     /// (--capture: PNGs and JSON only).
     #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
     exr: ExrContent,
-    /// none: the whole frontal image in the display; planar: the paper's compensation.
-    #[arg(long, value_enum, value_parser = choice::<Method>(), default_value_t = Method::Planar)]
-    method: Method,
-    /// Working distance of the planar model: inf, auto or metres in [1e-6, 1e6].
-    #[arg(long, default_value = "inf", value_name = "METRES|inf|auto")]
-    d2: WorkingDistance,
     /// oracle: the true eye (late by the tracking latency); estimated: face detection on the
     /// back camera's image of its time.
     #[arg(long = "head-source", value_enum, value_parser = choice::<HeadSource>(), default_value_t = HeadSource::Oracle)]
     head_source: HeadSource,
-    /// Head-tracking errors and the detector's feature width.
+    /// The options a sequence shares with a run, from the option table.
     #[command(flatten)]
-    head_errors: HeadErrorArgs,
-    /// When the crop leaves the frontal view: black (counted, coverage < 1) or error.
-    #[arg(long, value_enum, value_parser = choice::<Outside>(), default_value_t = Outside::Black)]
-    outside: Outside,
-    /// Colour resampling of the display image.
-    #[arg(long, value_enum, value_parser = choice::<Filter>(), default_value_t = Filter::Bilinear)]
-    filter: Filter,
-    /// pixels: the physical display; ideal: unlimited display and frontal resolution.
-    #[arg(long, value_enum, value_parser = choice::<DisplayModel>(), default_value_t = DisplayModel::Pixels)]
-    display: DisplayModel,
-    /// Driver view width, pixels in [1, 16384] (the height follows the camera's aspect).
-    #[arg(long, default_value_t = 640, value_parser = pixels)]
-    width: u32,
-    /// Driver view height, pixels in [1, 16384] (default: from the width).
-    #[arg(long, value_parser = pixels)]
-    height: Option<u32>,
-    /// Frontal camera width, pixels in [1, 16384] (default: the driver view's width).
-    #[arg(long = "frontal-width", value_parser = pixels)]
-    frontal_width: Option<u32>,
-    /// Back camera width, pixels in [1, 16384] (default: the scene's).
-    #[arg(long = "back-width", value_parser = pixels)]
-    back_width: Option<u32>,
-    /// Samples per pixel in [1, 4096].
-    #[arg(long, default_value_t = 1, value_parser = samples)]
-    spp: u32,
-    /// Border band of the metrics, display pixels in [1, 1000].
-    #[arg(long, default_value_t = 5, value_parser = band)]
-    band: u32,
-    /// Hazard visibility: a hidden hazard pixel counts as shown when the display shows the
-    /// same object within this misregistration, arc-minutes in [1e-6, 10800].
-    #[arg(long = "hazard-bound-arcmin", default_value_t = HAZARD_BOUND_ARCMIN, value_parser = positive(10800.0))]
-    hazard_bound_arcmin: f64,
+    run_options: OptionArgs<option_args::Sequence>,
     /// Worker threads in [1, 1024] (default: all cores). Output is identical for any value.
     #[arg(long, value_parser = threads)]
     threads: Option<usize>,
@@ -214,9 +174,6 @@ pub struct Sequence {
     /// (or .exr), one per folder of --capture, scored as the sequence scores its own.
     #[arg(long, value_name = "DIR")]
     maps: Option<PathBuf>,
-    /// Refuse to start when the estimated memory exceeds this, GiB in [1e-6, 4096].
-    #[arg(long = "max-memory", value_name = "GIB", default_value_t = DEFAULT_MAX_MEMORY_GIB, value_parser = max_memory)]
-    max_memory: f64,
 }
 
 impl Sequence {
@@ -236,31 +193,16 @@ impl Sequence {
         })
     }
 
-    /// The options of the sequence at camera latency `latency_ms`.
-    fn options(&self, head: &HeadMotion, latency_ms: f64) -> SequenceOptions {
+    /// The options of the sequence at camera latency `latency_ms`, its run's as `spec` has
+    /// them.
+    fn options(&self, spec: &RunSpec, head: &HeadMotion, latency_ms: f64) -> SequenceOptions {
         SequenceOptions {
             run: RunOptions {
-                method: self.method,
-                d2: self.d2,
                 head: self.head_source,
-                head_bias_cm: self.head_errors.head_bias_cm,
-                head_jitter_cm: self.head_errors.head_jitter_cm,
-                require_confident_head: self.head_errors.require_confident_head,
-                seed: self.head_errors.seed,
-                feature_width: self.head_errors.feature_width,
-                width: Some(self.width),
-                height: self.height,
-                frontal_width: Some(self.frontal_width.unwrap_or(self.width)),
-                back_width: self.back_width,
-                spp: self.spp,
-                outside: self.outside,
-                filter: self.filter,
-                display: self.display,
-                progress: false,
                 // One eye, the scene's driver camera; the scene-model methods are refused.
                 eyes: Default::default(),
                 scene_model: Default::default(),
-                ..RunOptions::default()
+                ..spec.options.clone()
             },
             timeline: Timeline {
                 duration: self.duration,
@@ -300,9 +242,9 @@ impl Sequence {
     }
 
     /// Refuses the flags these settings would ignore ([`refuse_ignored`]).
-    fn refuse_ignored(&self) -> Result<()> {
+    fn refuse_ignored(&self, spec: &RunSpec) -> Result<()> {
         let preset = self.head_path.is_none().then_some(self.head);
-        let run = self.options(&HeadMotion::Still, 0.0).run;
+        let run = self.options(spec, &HeadMotion::Still, 0.0).run;
         let mut rules = sequence_reads(&run, preset, self.maps.is_some());
         rules.push(ReadWhen {
             option: "exr",
@@ -319,7 +261,8 @@ impl Sequence {
     }
 
     fn run_all(&self) -> Result<()> {
-        self.refuse_ignored()?;
+        let spec = self.run_options.spec()?;
+        self.refuse_ignored(&spec)?;
         let head = self.head_motion()?;
         let scene = Scene::load(&self.scene)?;
         refuse_ignored(&[hazard_bound_reads(&scene)])?;
@@ -331,7 +274,7 @@ impl Sequence {
             .latency_camera
             .0
             .iter()
-            .map(|&ms| self.options(&head, ms))
+            .map(|&ms| self.options(&spec, &head, ms))
             .collect();
         for o in &all {
             o.timeline.validate()?;
@@ -361,7 +304,7 @@ impl Sequence {
                 first.timeline.fps,
                 all.len() as u64,
             )?,
-            self.max_memory,
+            spec.max_memory_gib,
         )?;
         // Written whole or not at all: a failure at any latency leaves `--out` as it was.
         let staged = StagedDir::new(&self.out)?;
@@ -387,11 +330,11 @@ impl Sequence {
             let how = Measuring {
                 metrics: true,
                 full_frames: frames != FramesFormat::None,
-                band: self.band,
+                band: spec.measure.band,
                 progress: true,
                 flip: Flip::asked(self.flip),
             };
-            let bound = self.hazard_bound_arcmin;
+            let bound = spec.measure.hazard_bound_arcmin;
             let run = run_sequence_hazards(&scene, options, how, bound, &label, &mut |f| {
                 preview.add(&f);
                 if let Some(c) = &captured {
@@ -442,7 +385,7 @@ impl Sequence {
             )?;
             runs.push((ms, run));
         }
-        self.write_overview(&runs, &out)?;
+        self.write_overview(&spec, &runs, &out)?;
         if let Some(c) = captured {
             crate::cli::sequence_byo::write_index(c.path(), std::mem::take(&mut index))?;
             c.commit()?;
@@ -460,7 +403,12 @@ impl Sequence {
 
     /// The top-level summary and plots: misregistration over time for every latency, and
     /// mean and p95 against latency when there are several.
-    fn write_overview(&self, runs: &[(f64, SequenceRun)], out: &Path) -> Result<()> {
+    fn write_overview(
+        &self,
+        spec: &RunSpec,
+        runs: &[(f64, SequenceRun)],
+        out: &Path,
+    ) -> Result<()> {
         let labelled: Vec<(String, &[_])> = runs
             .iter()
             .map(|(ms, r)| (format!("{ms} ms"), r.records.as_slice()))
@@ -469,7 +417,7 @@ impl Sequence {
         let mut per_latency = Vec::new();
         let mut points = Vec::new();
         for (ms, run) in runs {
-            let timeline = self.options(&HeadMotion::Still, *ms).timeline;
+            let timeline = self.options(spec, &HeadMotion::Still, *ms).timeline;
             let s = summary(run, &timeline);
             let [mean, p95] = mean_of_frame_stats(run);
             points.push((*ms, mean, p95));
@@ -490,12 +438,12 @@ impl Sequence {
             "latency_tracking_ms": self.latency_tracking,
             "predict": self.predict,
             "reproject": self.reproject,
-            "method": self.method,
+            "method": spec.options.method,
             "maps": self.maps.as_ref().map(|m| m.display().to_string()),
-            "d2": format!("{:?}", self.d2),
+            "d2": format!("{:?}", spec.options.d2),
             "head_source": self.head_source,
-            "width": self.width,
-            "spp": self.spp,
+            "width": spec.options.width,
+            "spp": spec.options.spp,
             "sequences": per_latency,
         });
         // Last: a directory with summary.json holds finished sequences.

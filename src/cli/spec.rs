@@ -1,5 +1,6 @@
-//! `seethru spec`: the run specification that `seethru run`, `capture` or `compare` would
-//! make of these options, as JSON, after every check of them: nothing is loaded or rendered.
+//! `seethru spec`: the run specification that `seethru run`, `capture`, `compare` or
+//! `sequence` would make of these options, as JSON, after every check of them: nothing is
+//! loaded or rendered.
 //! `seethru.spec` in Python returns the same, so a script can check its options first.
 
 use anyhow::Result;
@@ -18,6 +19,10 @@ pub enum Spec {
     /// `seethru compare`'s options (less `--methods`, whose rules on the others it does not
     /// apply).
     Compare(OptionArgs<option_args::Compare>),
+    /// The options `seethru sequence` shares with a run, with its defaults (less its own:
+    /// the timeline, the motions, the head's source; and less the rules that read those).
+    #[command(allow_negative_numbers = true)]
+    Sequence(OptionArgs<option_args::Sequence>),
 }
 
 impl Spec {
@@ -26,6 +31,7 @@ impl Spec {
             Spec::Run(options) => options.spec()?,
             Spec::Capture(options) => options.spec()?,
             Spec::Compare(options) => options.spec()?,
+            Spec::Sequence(options) => options.spec()?,
         };
         println!("{}", serde_json::to_string_pretty(&spec.to_json())?);
         Ok(())

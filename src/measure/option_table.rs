@@ -31,17 +31,26 @@ pub enum Command {
     Capture,
     /// `seethru compare`, `seethru.compare`.
     Compare,
+    /// `seethru sequence`, `seethru.sequence`: the options it shares with a run (its own,
+    /// the timeline's and the head's motion, are its front ends').
+    Sequence,
 }
 
 impl Command {
-    pub const ALL: [Command; 3] = [Command::Run, Command::Capture, Command::Compare];
+    pub const ALL: [Command; 4] = [
+        Command::Run,
+        Command::Capture,
+        Command::Compare,
+        Command::Sequence,
+    ];
 
-    /// `run`, `capture`, `compare`.
+    /// `run`, `capture`, `compare`, `sequence`.
     pub fn name(self) -> &'static str {
         match self {
             Command::Run => "run",
             Command::Capture => "capture",
             Command::Compare => "compare",
+            Command::Sequence => "sequence",
         }
     }
 }
@@ -109,7 +118,7 @@ impl Value {
 }
 
 /// What an option is when not given.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Default {
     /// This value, written as on the command line.
     Value(&'static str),
@@ -226,6 +235,26 @@ impl OptionSpec {
         }
     }
 
+    /// What the option is when `command` is not given it: the table's default, or the
+    /// command's own ([`COMMAND_DEFAULTS`]).
+    pub fn default_for(&self, command: Command) -> Default {
+        COMMAND_DEFAULTS
+            .iter()
+            .find(|(c, name, _)| *c == command && *name == self.name)
+            .map_or(self.default, |(_, _, default)| *default)
+    }
+
+    /// The value of [`OptionSpec::default_for`] `command`, `None` where it is derived.
+    pub fn default_value_for(&self, command: Command) -> Option<Value> {
+        match self.default_for(command) {
+            Default::Value(text) => Some(
+                self.parse(text)
+                    .unwrap_or_else(|e| panic!("the default of {}: {e}", self.name)),
+            ),
+            Default::Derived(_) => None,
+        }
+    }
+
     /// Whether `command` takes this option.
     pub fn taken_by(&self, command: Command) -> bool {
         self.commands.contains(&command)
@@ -246,11 +275,34 @@ const PIXELS: Kind = Kind::Integer {
     min: 1,
     max: MAX_RESOLUTION as u64,
 };
-const ALL: &[Command] = &[Command::Run, Command::Capture, Command::Compare];
-const RUN: &[Command] = &[Command::Run];
+const ALL: &[Command] = &[
+    Command::Run,
+    Command::Capture,
+    Command::Compare,
+    Command::Sequence,
+];
+/// Run, capture and compare: a sequence takes its head's source as `head_source`.
+const SINGLE_FRAMES: &[Command] = &[Command::Run, Command::Capture, Command::Compare];
+const RUN_SEQUENCE: &[Command] = &[Command::Run, Command::Sequence];
 const RUN_CAPTURE: &[Command] = &[Command::Run, Command::Capture];
+const RUN_CAPTURE_SEQUENCE: &[Command] = &[Command::Run, Command::Capture, Command::Sequence];
 const RUN_COMPARE: &[Command] = &[Command::Run, Command::Compare];
+const RUN_COMPARE_SEQUENCE: &[Command] = &[Command::Run, Command::Compare, Command::Sequence];
 const CAPTURE: &[Command] = &[Command::Capture];
+
+/// Where a command's default differs from the table's: a sequence renders many frames, so
+/// smaller and with one sample, and a crop past the frontal view is shown black and counted
+/// (a moving eye leaves it now and then) instead of stopping the sequence.
+pub static COMMAND_DEFAULTS: &[(Command, &str, Default)] = &[
+    (Command::Sequence, "outside", Default::Value("black")),
+    (
+        Command::Sequence,
+        "frontal_width",
+        Default::Derived("the driver views' width"),
+    ),
+    (Command::Sequence, "width", Default::Value("640")),
+    (Command::Sequence, "spp", Default::Value("1")),
+];
 const ESTIMATED: &[(&str, &str)] = &[("head", "estimated")];
 /// The scene model's depth sensor is read by `method` depth in a run, by `depth` in a capture.
 const DEPTH: &[(&str, &str)] = &[("method", "depth"), ("depth", "true")];
@@ -261,7 +313,8 @@ const NOISY_DEPTH: &[(&str, &str)] = &[
     ("depth_sensor", "tof"),
 ];
 
-/// The table: every option of `run`, `capture` and `compare`, in `seethru run --help`'s order.
+/// The table: every option of `run`, `capture` and `compare`, and those `sequence` shares
+/// with them, in `seethru run --help`'s order.
 pub static OPTIONS: &[OptionSpec] = &[
     OptionSpec {
         name: "method",
@@ -270,7 +323,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("planar"),
         help: "How the display image is made: none (the whole frontal image), planar (the paper's compensation), ground (the road plane), plane-fit (a plane fitted to the depth sensor's points) or depth (per-pixel reprojection with the depth sensor's depth).",
         read_with: &[],
-        commands: RUN,
+        commands: RUN_SEQUENCE,
     },
     OptionSpec {
         name: "d2",
@@ -282,7 +335,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("inf"),
         help: "Working distance of the planar model: inf, auto (the median frontal depth behind the display) or metres.",
         read_with: &[],
-        commands: RUN,
+        commands: RUN_SEQUENCE,
     },
     OptionSpec {
         name: "head",
@@ -291,7 +344,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("oracle"),
         help: "Where the eye comes from: oracle (the true eye), estimated (face detection on the back camera's image) or model (a tracker's noise and dropouts).",
         read_with: &[],
-        commands: ALL,
+        commands: SINGLE_FRAMES,
     },
     OptionSpec {
         name: "head_bias_cm",
@@ -302,7 +355,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("0,0,0"),
         help: "Head-tracking bias x,y,z in the obstacle's frame (e.g. 1,0,0 or -1,0,0).",
         read_with: &[],
-        commands: RUN_CAPTURE,
+        commands: RUN_CAPTURE_SEQUENCE,
     },
     OptionSpec {
         name: "head_jitter_cm",
@@ -314,7 +367,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("0"),
         help: "Head-tracking jitter: the standard deviation per axis of each estimate.",
         read_with: &[],
-        commands: RUN_CAPTURE,
+        commands: RUN_CAPTURE_SEQUENCE,
     },
     OptionSpec {
         name: "seed",
@@ -338,7 +391,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("0.064"),
         help: "The face detector's known feature width A (the interpupillary distance).",
         read_with: ESTIMATED,
-        commands: RUN_CAPTURE,
+        commands: RUN_CAPTURE_SEQUENCE,
     },
     OptionSpec {
         name: "require_confident_head",
@@ -347,7 +400,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("false"),
         help: "Stop with an error when a head estimate's confidence is below 0.5 (else a warning); image-based head estimates only.",
         read_with: ESTIMATED,
-        commands: RUN_CAPTURE,
+        commands: RUN_CAPTURE_SEQUENCE,
     },
     OptionSpec {
         name: "min_head_confidence",
@@ -356,7 +409,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("0.5"),
         help: "The confidence below which a head estimate is unreliable: warned about, or refused with require_confident_head.",
         read_with: ESTIMATED,
-        commands: RUN_CAPTURE,
+        commands: RUN_CAPTURE_SEQUENCE,
     },
     OptionSpec {
         name: "outside",
@@ -365,7 +418,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("error"),
         help: "When the crop leaves the frontal view: error, or black (counted as missing).",
         read_with: &[],
-        commands: RUN,
+        commands: RUN_SEQUENCE,
     },
     OptionSpec {
         name: "filter",
@@ -374,7 +427,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("bilinear"),
         help: "Colour resampling of the display image.",
         read_with: &[],
-        commands: RUN,
+        commands: RUN_SEQUENCE,
     },
     OptionSpec {
         name: "display",
@@ -383,7 +436,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("pixels"),
         help: "pixels: the physical display; ideal: unlimited display and frontal resolution, so that only the planar model's error remains.",
         read_with: &[],
-        commands: RUN,
+        commands: RUN_SEQUENCE,
     },
     OptionSpec {
         name: "frontal_width",
@@ -449,7 +502,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("5"),
         help: "Width of the border band of the mismatch metrics, in display pixels.",
         read_with: &[],
-        commands: RUN_COMPARE,
+        commands: RUN_COMPARE_SEQUENCE,
     },
     OptionSpec {
         name: "hazard_bound_arcmin",
@@ -461,7 +514,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value(HAZARD_BOUND_ARCMIN_TEXT),
         help: "Hazard visibility: a hidden hazard pixel counts as shown when the display shows the same object within this misregistration.",
         read_with: &[],
-        commands: RUN_COMPARE,
+        commands: RUN_COMPARE_SEQUENCE,
     },
     OptionSpec {
         name: "depth_sensor",
@@ -470,7 +523,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("ideal"),
         help: "Depth sensor of plane-fit and depth: ideal (the frontal render's depth), tof (σ ∝ z, 320 px wide, 15 m range, 1 cm at 1 m, 1 mm steps) or stereo (σ ∝ z², half the frontal width, 80 m, 2 mm at 1 m, inverse-depth steps of 0.0005 /m).",
         read_with: DEPTH,
-        commands: ALL,
+        commands: SINGLE_FRAMES,
     },
     OptionSpec {
         name: "depth_resolution",
@@ -479,7 +532,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Derived("the sensor's"),
         help: "Depth sensor width, at most the frontal camera's (aspect kept; tof and stereo only).",
         read_with: NOISY_DEPTH,
-        commands: ALL,
+        commands: SINGLE_FRAMES,
     },
     OptionSpec {
         name: "depth_range",
@@ -491,7 +544,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Derived("the sensor's"),
         help: "Depth sensor range: no return past it (d2 → ∞ there; tof and stereo only).",
         read_with: NOISY_DEPTH,
-        commands: ALL,
+        commands: SINGLE_FRAMES,
     },
     OptionSpec {
         name: "depth_noise",
@@ -503,7 +556,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Derived("the sensor's"),
         help: "Depth noise σ at 1 m, growing as z (tof) or z² (stereo), seeded by seed (tof and stereo only).",
         read_with: NOISY_DEPTH,
-        commands: ALL,
+        commands: SINGLE_FRAMES,
     },
     OptionSpec {
         name: "depth_quantum",
@@ -515,7 +568,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Derived("the sensor's"),
         help: "Depth quantisation step at 1 m (0: none): constant for tof, growing as z² for stereo (tof and stereo only).",
         read_with: NOISY_DEPTH,
-        commands: ALL,
+        commands: SINGLE_FRAMES,
     },
     OptionSpec {
         name: "fill",

@@ -78,7 +78,7 @@ impl RunSpec {
                     .iter()
                     .find(|(o, _)| o.name == option.name)
                     .map(|(_, v)| v.clone())
-                    .or_else(|| option.default_value());
+                    .or_else(|| option.default_value_for(command));
                 (option, value)
             })
             .collect();
@@ -106,6 +106,10 @@ impl RunSpec {
             // method gets its row.
             spec.options.outside = Outside::Black;
         }
+        if command == Command::Sequence && spec.options.frontal_width.is_none() {
+            // A sequence's frontal camera is as wide as its driver views unless given.
+            spec.options.frontal_width = spec.options.width;
+        }
         if command == Command::Capture && spec.both_eyes {
             return Err(SpecError::Value {
                 option: "eyes",
@@ -116,7 +120,9 @@ impl RunSpec {
         let rules = match command {
             Command::Run => run_reads(&spec.options, spec.both_eyes),
             Command::Capture => capture_reads(&spec.options, spec.depth),
-            Command::Compare => Vec::new(),
+            // A sequence's rules need its own options too (the head's motion, the maps): its
+            // front ends apply `sequence_reads` to the run this builds.
+            Command::Compare | Command::Sequence => Vec::new(),
         };
         spec.refuse_ignored(&rules)?;
         Ok(spec)
@@ -272,7 +278,7 @@ mod tests {
                 let base = RunSpec::build(command, &context).unwrap();
                 for high in [false, true] {
                     let value = end(option, high);
-                    if Some(&value) == option.default_value().as_ref() {
+                    if Some(&value) == option.default_value_for(command).as_ref() {
                         continue;
                     }
                     let mut given = context.clone();
