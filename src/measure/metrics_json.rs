@@ -122,8 +122,9 @@ pub(crate) fn metrics_json(
         "notes": "every display pixel counts. misregistration: angle at the eye between the direction seethru shows and the truth's (towards a world point, or a sky direction), over the covered pixels; coverage: fraction of the region's pixels that show the scene (blank pixels, outside the frontal view, have no misregistration and count in the image metrics as the black they show); undefined_pixels: neither a point nor a direction (0 for frames of this version). Colour metrics on 8-bit sRGB; SSIM on luminance with 7×7 windows inside the display mask; FLIP (NVIDIA, via nv-flip) with the driver's camera as observer, on the display's bounding box with everything outside the display mask set to the same grey in both images",
     });
     if flip == Flip::Skipped {
-        json["flip_not_computed"] =
-            json!("FLIP was not computed (a sequence without --flip): every flip_mean is null");
+        json["flip_not_computed"] = json!(
+            "FLIP was not computed (a sequence without option `flip`): every flip_mean is null"
+        );
     }
     json
 }
