@@ -32,7 +32,7 @@ fn main() -> ExitCode {
             e.exit()
         }
         Err(e) => {
-            eprintln!("{}", printable(&as_flags(&cli::one_line(&e))));
+            eprintln!("{}", printable(&cli::one_line(&e)));
             return ExitCode::from(2);
         }
     };

@@ -192,9 +192,10 @@ pub fn with_flags(value: &serde_json::Value) -> serde_json::Value {
 }
 
 /// A clap error as one line starting `error:`: the message and its tip, without the usage
-/// block and the pointer to `--help`, so that scripts and logs get one line per failure.
+/// block and the pointer to `--help`, so that scripts and logs get one line per failure. A
+/// value parser's message from the library names options as flags.
 pub fn one_line(error: &clap::Error) -> String {
-    let text = error.render().to_string();
+    let text = seethru::util::option_words::as_flags(&error.render().to_string());
     let parts: Vec<&str> = text
         .lines()
         .map(str::trim)
