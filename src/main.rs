@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 use clap::error::ErrorKind;
 use seethru::util::message::{error_text, printable};
+use seethru::util::option_words::as_flags;
 
 fn main() -> ExitCode {
     // `seethru analyze | head`: a reader that closes the pipe early ends the command quietly,
@@ -50,13 +51,14 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         // Thresholds exceeded: the command has said which; exit 1 ("worse"), not an error.
         Err(e) if e.downcast_ref::<cli::verdict::ChecksFailed>().is_some() => {
-            eprintln!("{}", printable(&e.to_string()));
+            eprintln!("{}", printable(&as_flags(&e.to_string())));
             ExitCode::from(1)
         }
         Err(e) => {
             // Messages repeat the input: an 800-digit number stays 12 digits, a line break
-            // in a name is shown as `\n`; each cause is said once.
-            eprintln!("error: {}", printable(&error_text(&e)));
+            // in a name is shown as `\n`; each cause is said once; the options the library's
+            // words name ("option `width`") are the command line's flags (`--width`).
+            eprintln!("error: {}", printable(&as_flags(&error_text(&e))));
             ExitCode::from(error_status)
         }
     }

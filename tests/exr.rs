@@ -189,7 +189,7 @@ fn measuring_a_run_without_aovs_names_the_flag() {
         }
         let err = read_measured_frames(&out).unwrap_err().to_string();
         assert!(
-            err.contains("truth.exr") && err.contains("`--exr all`"),
+            err.contains("truth.exr") && err.contains("option `exr` all"),
             "{err}"
         );
     }

@@ -75,7 +75,7 @@ fn the_ipd_is_checked() {
             .err()
             .expect("bad ipd refused")
             .to_string();
-        assert!(err.contains("--ipd must be in (0, 0.1] m"), "{err}");
+        assert!(err.contains("option `ipd` must be in (0, 0.1] m"), "{err}");
     }
 }
 

@@ -170,7 +170,7 @@ fn impossible_setups_are_rejected() {
     )
     .unwrap_err()
     .to_string();
-    assert!(err.contains("--L must be in (0, d2)"), "{err}");
+    assert!(err.contains("option `L` must be in (0, d2)"), "{err}");
     let err = measure_ratio(
         &foreshortening(1.0, 0.5, 3.0, 1.0, 0.2, 120.0),
         64,
@@ -178,7 +178,7 @@ fn impossible_setups_are_rejected() {
     )
     .unwrap_err()
     .to_string();
-    assert!(err.contains("--gamma"), "{err}");
+    assert!(err.contains("option `gamma`"), "{err}");
     let paper = occlusion(5.0, -0.35, 6.3, 2.5, 1.75);
     for model_d2 in [0.0, -1.0, f64::NAN, f64::NEG_INFINITY] {
         let c = Compensation {
@@ -187,7 +187,7 @@ fn impossible_setups_are_rejected() {
         };
         let err = measure_ratio(&paper, 64, &c).unwrap_err().to_string();
         assert!(
-            err.starts_with("--model-d2 must be") && err.contains("(0, ∞)"),
+            err.starts_with("option `model_d2` must be") && err.contains("(0, ∞)"),
             "{err}"
         );
     }
@@ -199,7 +199,7 @@ fn impossible_setups_are_rejected() {
         };
         let err = measure_ratio(&paper, 64, &c).unwrap_err().to_string();
         assert!(
-            err.contains("--head-bias-cm") && err.contains("(-250, ∞) cm"),
+            err.contains("option `head_bias_cm`") && err.contains("(-250, ∞) cm"),
             "{err}"
         );
     }
@@ -257,15 +257,21 @@ fn setup_parameters_are_checked_at_their_bounds() {
     refused(foreshortening(1.0, 0.5, 0.0, 1.0, 0.2, 45.0), positive);
     refused(occlusion(1.0, f64::NAN, 4.0, 1.0, 0.2), positive);
     refused(occlusion(1.0, 0.5, 4.0, 1.0, f64::INFINITY), positive);
-    refused(occlusion(0.0, 0.5, 4.0, 1.0, 0.2), "--L must be in (0, d2)");
-    refused(occlusion(4.0, 0.5, 4.0, 1.0, 0.2), "--L must be in (0, d2)");
+    refused(
+        occlusion(0.0, 0.5, 4.0, 1.0, 0.2),
+        "option `L` must be in (0, d2)",
+    );
+    refused(
+        occlusion(4.0, 0.5, 4.0, 1.0, 0.2),
+        "option `L` must be in (0, d2)",
+    );
     refused(
         foreshortening(0.0, 0.5, 3.0, 1.0, 0.2, 45.0),
-        "--l must be > 0",
+        "option `l` must be > 0",
     );
     refused(
         foreshortening(1.0, 0.5, 3.0, 1.0, 0.2, 0.0),
-        "--gamma in (0, 90]",
+        "option `gamma` in (0, 90]",
     );
     build_scene(&foreshortening(1.0, 0.5, 3.0, 1.0, 0.2, 90.0), 64, &none).unwrap();
     // p_cam = L b1 / (d2 − L) = b1 here: 1e-6 m is the smallest width measured.

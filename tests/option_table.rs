@@ -266,3 +266,179 @@ fn every_flag_of_the_commands_is_the_tables_or_the_command_lines_own() {
         }
     }
 }
+
+/// The library's errors name an option in neither front end's words but as "option `name`"
+/// (a Rust caller reads that as it is); the command line spells it `--name`, Python `name`.
+#[test]
+fn the_librarys_errors_name_options_in_no_front_ends_words() {
+    use seethru::measure::run_spec::{RunSpec, SpecError};
+    use seethru::util::option_words::{as_flags, as_keywords};
+
+    let spp = seethru::render::settings::check_spp(0).unwrap_err();
+    let text = format!("{spp:#}");
+    assert!(text.starts_with("option `spp` 0 is out of range"), "{text}");
+    assert!(!text.contains("--"), "{text}");
+    assert!(as_flags(&text).starts_with("--spp 0 is out of range"));
+    assert!(as_keywords(&text).starts_with("spp 0 is out of range"));
+
+    // A setting the others make the run ignore: the seed with no noise to draw.
+    let option = |name: &str| OPTIONS.iter().find(|o| o.name == name).unwrap();
+    let given = [
+        (option("method"), option("method").parse("none").unwrap()),
+        (
+            option("head_bias_cm"),
+            option("head_bias_cm").parse("1,0,0").unwrap(),
+        ),
+    ];
+    let Err(SpecError::Ignored(rule)) = RunSpec::build(Command::Run, &given) else {
+        panic!("a head bias with method none is ignored, so refused");
+    };
+    let text = rule.refusal("options");
+    assert_eq!(
+        text,
+        "option `head_bias_cm` is read only by the methods that compensate for the eye (not option `method` none); with the other options given it would be ignored: remove it"
+    );
+    assert!(rule.flag_refusal().starts_with("--head-bias-cm is read only by the methods that compensate for the eye (not --method none); with the other flags given"));
+    assert!(rule.keyword_refusal().starts_with("head_bias_cm is read only by the methods that compensate for the eye (not method none); with the other options given"));
+}
+
+/// The string literals of `text` (Rust source) outside comments, with their line numbers;
+/// the file's unit tests (after `#[cfg(test)]`) are left out: they assert texts, they are none.
+fn string_literals(text: &str) -> Vec<(usize, String)> {
+    let end = text
+        .match_indices("#[cfg(test)]")
+        .map(|(at, mark)| at + mark.len())
+        .find(|&after| text[after..].trim_start().starts_with("mod "))
+        .unwrap_or(text.len());
+    let bytes = &text.as_bytes()[..end];
+    let line = |at: usize| text[..at].matches('\n').count() + 1;
+    let mut found = Vec::new();
+    let mut i = 0;
+    while i < bytes.len() {
+        let rest = &text[i..end];
+        if rest.starts_with("//") {
+            i += rest.find('\n').unwrap_or(rest.len());
+        } else if rest.starts_with("/*") {
+            i += rest.find("*/").map_or(rest.len(), |e| e + 2);
+        } else if (rest.starts_with("r\"") || rest.starts_with("r#"))
+            && (i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_'))
+        {
+            let hashes = rest[1..].chars().take_while(|&c| c == '#').count();
+            if rest[1 + hashes..].starts_with('"') {
+                let close = format!("\"{}", "#".repeat(hashes));
+                let start = i + 2 + hashes;
+                let stop = start + text[start..end].find(&close).unwrap();
+                found.push((line(start), text[start..stop].to_string()));
+                i = stop + close.len();
+            } else {
+                i += 1;
+            }
+        } else if bytes[i] == b'"' {
+            let mut j = i + 1;
+            while bytes[j] != b'"' {
+                j += if bytes[j] == b'\\' { 2 } else { 1 };
+            }
+            found.push((line(i + 1), text[i + 1..j].to_string()));
+            i = j + 1;
+        } else if bytes[i] == b'\'' {
+            // A char literal ('"', '\'') is skipped whole; a lifetime is not one.
+            if rest[1..].starts_with('\\') {
+                i += 2 + rest[2..].find('\'').unwrap() + 1;
+            } else if rest[1..].chars().nth(1) == Some('\'') {
+                i += 1 + rest[1..].chars().next().unwrap().len_utf8() + 1;
+            } else {
+                i += 1;
+            }
+        } else {
+            i += 1;
+        }
+    }
+    found
+}
+
+/// A command-line flag in `literal` (`--width`, starting a word): the library's messages
+/// write "option `width`" instead, which each front end spells.
+fn flag_in(literal: &str) -> Option<String> {
+    let mut rest = literal;
+    let mut before: Option<char> = None;
+    while let Some(at) = rest.find("--") {
+        let prior = rest[..at].chars().last().or(before);
+        let name: String = rest[at + 2..]
+            .chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '-')
+            .collect();
+        let starts_word = prior.is_none_or(|c| !(c.is_alphanumeric() || c == '-' || c == '_'));
+        if starts_word && name.starts_with(|c: char| c.is_ascii_alphabetic()) {
+            return Some(format!("--{name}"));
+        }
+        before = rest[..at + 2].chars().last();
+        rest = &rest[at + 2..];
+    }
+    None
+}
+
+/// Every string of the library (src/ outside the command line: src/cli, src/main.rs) names an
+/// option as "option `name`", never as the command line's flag: a Python user would read
+/// about `--width`. The few strings that hold a flag for another reason are listed, with why.
+#[test]
+fn no_string_of_the_library_names_a_command_line_flag() {
+    // (file, the string's flag, why it is the command line's own word)
+    let allowed: [(&str, &str, &str); 3] = [
+        (
+            "src/measure/expectations.rs",
+            "--out",
+            "an expectation file lists the command line's arguments; `--out` is looked for in them",
+        ),
+        (
+            "src/measure/maps.rs",
+            "--heatmap-max",
+            "the heatmap's scale label, drawn into the image `run` writes: heatmap_max is the command line's alone",
+        ),
+        (
+            "src/measure/sequence_files.rs",
+            "--heatmap-max",
+            "the preview's scale label in summary.json and on the APNG `sequence` writes: the command line's alone",
+        ),
+    ];
+    let src = common::repo_path("src");
+    let mut files = Vec::new();
+    fn walk(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                walk(&path, out);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                out.push(path);
+            }
+        }
+    }
+    walk(&src, &mut files);
+    files.sort();
+    let mut found = Vec::new();
+    for file in &files {
+        let rel = format!("src/{}", file.strip_prefix(&src).unwrap().display());
+        if rel.starts_with("src/cli/") || rel == "src/main.rs" {
+            continue;
+        }
+        let text = std::fs::read_to_string(file).unwrap();
+        for (line, literal) in string_literals(&text) {
+            if let Some(flag) = flag_in(&literal)
+                && !allowed.iter().any(|(f, a, _)| *f == rel && *a == flag)
+            {
+                found.push(format!("{rel}:{line}: {flag} in {literal:?}"));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "write \"option `name`\" instead of the flag (util/option_words.rs):\n{}",
+        found.join("\n")
+    );
+    // The scan sees a flag where there is one.
+    assert_eq!(flag_in("use --outside black"), Some("--outside".into()));
+    assert_eq!(flag_in("--L must be > 0"), Some("--L".into()));
+    assert_eq!(flag_in("runs--old/a.toml, -- x, option `outside`"), None);
+    let sample = "let a = '\"'; // \"--x\"\n let b = \"see --width\"; let c = r#\"--raw\"#;";
+    let literals: Vec<String> = string_literals(sample).into_iter().map(|l| l.1).collect();
+    assert_eq!(literals, ["see --width", "--raw"]);
+}

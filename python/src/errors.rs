@@ -1,16 +1,16 @@
 //! The library's errors as Python exceptions: `OSError` when a file could not be read or
-//! written, `ValueError` for everything else (bad input), with the command line's message in
-//! Python's words: a flag the message names (`--head estimated`) is the keyword
-//! (`head estimated`).
+//! written, `ValueError` for everything else (bad input), with the library's message in
+//! Python's words: an option the message names ("option `head` estimated") is the keyword
+//! (`head estimated`), as the command line's is its flag (`--head estimated`).
 
 use pyo3::PyErr;
 use pyo3::exceptions::{PyOSError, PyValueError};
-use seethru::system::reads::keyword_names;
 use seethru::util::message::{error_text, printable};
+use seethru::util::option_words::as_keywords;
 
 /// The one line the command line prints after `error: `, as an exception.
 pub fn to_py(error: anyhow::Error) -> PyErr {
-    let message = keyword_names(&printable(&error_text(&error)));
+    let message = printable(&as_keywords(&error_text(&error)));
     let from_file = error
         .chain()
         .any(|cause| cause.downcast_ref::<std::io::Error>().is_some());
@@ -20,7 +20,7 @@ pub fn to_py(error: anyhow::Error) -> PyErr {
     }
 }
 
-/// A bad argument of a Python call.
+/// A bad argument of a Python call (in Python's words, where it holds the library's).
 pub fn bad_value(message: impl Into<String>) -> PyErr {
-    PyValueError::new_err(message.into())
+    PyValueError::new_err(as_keywords(&message.into()))
 }

@@ -56,7 +56,10 @@ impl PyRun {
 /// JSON as Python objects, through `json.loads` of the text the command line writes: the
 /// same dict as reading the file.
 pub fn json_to_py(py: Python<'_>, value: &serde_json::Value) -> PyResult<Py<PyAny>> {
-    let text = serde_json::to_string_pretty(value).map_err(|e| to_py(e.into()))?;
+    // The library's words name options ("option `fill`"): Python's are the keywords (`fill`).
+    let mut value = value.clone();
+    seethru::util::option_words::spell_json(&mut value, &seethru::util::option_words::keyword_of);
+    let text = serde_json::to_string_pretty(&value).map_err(|e| to_py(e.into()))?;
     Ok(py.import("json")?.call_method1("loads", (text,))?.unbind())
 }
 

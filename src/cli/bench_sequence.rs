@@ -87,7 +87,7 @@ pub fn bench_sequence(scene: &Scene) -> Result<(Vec<String>, serde_json::Value)>
             // A scene whose face the tracker cannot find (no head, or eyes too small for the
             // back camera) has no estimated-head loop to time: said, not a failed benchmark.
             Err(e) if head == HeadSource::Estimated => {
-                let why = format!("{e:#}");
+                let why = seethru::util::option_words::as_flags(&format!("{e:#}"));
                 lines.push(format!("  {label:<28} not measured: {why}"));
                 out.insert(key.into(), json!({ "not_measured": why }));
                 continue;

@@ -143,7 +143,11 @@ impl Check {
             };
             match self.run_case(case, &mut blessed, &mut updates, &mut result) {
                 Ok(()) => {}
-                Err(e) => result.error = Some(seethru::util::message::error_text(&e)),
+                Err(e) => {
+                    result.error = Some(seethru::util::option_words::as_flags(
+                        &seethru::util::message::error_text(&e),
+                    ))
+                }
             }
             result.seconds = started.elapsed().as_secs_f64();
             results.push(result);

@@ -1,6 +1,7 @@
 //! `seethru compare`: compensation methods side by side on one scene — one table (Markdown,
 //! JSON, HTML) and one image strip per method.
 
+use crate::cli::with_flags;
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
@@ -132,7 +133,7 @@ impl Compare {
         });
         write_text(
             &out.join("compare.json"),
-            &serde_json::to_string_pretty(&json)?,
+            &serde_json::to_string_pretty(&with_flags(&json))?,
         )?;
         staged.commit()?;
         seethru::util::progress::summary(format!(

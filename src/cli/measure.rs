@@ -1,5 +1,6 @@
 //! `seethru measure`: the metrics of a `run` directory recomputed from its EXRs.
 
+use crate::cli::with_flags;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
@@ -32,7 +33,10 @@ impl Measure {
     pub fn run(self) -> Result<()> {
         check_paths(&[Input::folder("DIR", &self.dir)], &[])?;
         let metrics = measure_command(&self.dir, self.band)?;
-        println!("{}", serde_json::to_string_pretty(&metrics.to_json())?);
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&with_flags(&metrics.to_json()))?
+        );
         Ok(())
     }
 }
@@ -88,7 +92,12 @@ fn measure_command(dir: &Path, band: u32) -> Result<Metrics> {
     }
     // Whole or not at all: staged beside the run folder, moved in when all are written.
     let staged = StagedDir::new(dir)?;
-    write_metrics(staged.path(), &maps, &truth, &metrics)?;
+    write_metrics(
+        staged.path(),
+        &maps,
+        &truth,
+        &with_flags(&metrics.to_json()),
+    )?;
     staged.commit()?;
     Ok(metrics)
 }

@@ -183,10 +183,19 @@ fn spaced_triple(command: &clap::Command, args: &[std::ffi::OsString]) -> Option
     })
 }
 
+/// The library's JSON (a report, metrics) as the command line writes it: every option its
+/// words name ("option `fill`") spelled as the flag (`--fill`).
+pub fn with_flags(value: &serde_json::Value) -> serde_json::Value {
+    let mut value = value.clone();
+    seethru::util::option_words::spell_json(&mut value, &seethru::util::option_words::flag_of);
+    value
+}
+
 /// A clap error as one line starting `error:`: the message and its tip, without the usage
-/// block and the pointer to `--help`, so that scripts and logs get one line per failure.
+/// block and the pointer to `--help`, so that scripts and logs get one line per failure. A
+/// value parser's message from the library names options as flags.
 pub fn one_line(error: &clap::Error) -> String {
-    let text = error.render().to_string();
+    let text = seethru::util::option_words::as_flags(&error.render().to_string());
     let parts: Vec<&str> = text
         .lines()
         .map(str::trim)

@@ -1,6 +1,8 @@
 //! `seethru run`: the see-through system end to end on a scene, with every view, run.json and
 //! the metrics written to a directory.
 
+use crate::cli::with_flags;
+use seethru::util::option_words::as_flags;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::{Mutex, OnceLock};
@@ -225,7 +227,13 @@ fn write_run(
         if let Some(holes) = &holes {
             write_hole_mask(&out.join("holes.png"), &maps, holes)?;
         }
-        write_metrics_scaled(out, &maps, truth.whole(), &metrics, heatmap_max)?;
+        write_metrics_scaled(
+            out,
+            &maps,
+            truth.whole(),
+            &with_flags(&metrics.to_json()),
+            heatmap_max,
+        )?;
         Ok((rest, maps))
     });
     if let Some(e) = failed.into_inner().unwrap_or_else(|e| e.into_inner()) {
@@ -238,7 +246,7 @@ fn write_run(
         .detection
         .filter(|d| !d.confidence.is_confident_at(min))
     {
-        eprintln!("warning: {}", d.confidence.warning_at("", min));
+        eprintln!("warning: {}", as_flags(&d.confidence.warning_at("", min)));
     }
     let hazards = hazards_of(ctx, options, &result, &maps, hazard_bound)?;
     // Beside metrics.json (which `measure` recomputes from the frames alone).
@@ -249,7 +257,7 @@ fn write_run(
     // Last: a directory with run.json holds a finished run.
     write_text(
         &out.join("run.json"),
-        &serde_json::to_string_pretty(&result.report)?,
+        &serde_json::to_string_pretty(&with_flags(&result.report))?,
     )?;
     let seen = &result.report["display_seen"];
     if let Some(share) = seen["share"].as_f64()

@@ -1,6 +1,7 @@
 //! `seethru score`: an outside method's display map (and/or display image) for a capture,
 //! shown on the display and measured exactly as `run` measures a built-in method.
 
+use crate::cli::with_flags;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
@@ -142,7 +143,7 @@ impl Score {
                 hazard_bound_arcmin: HAZARD_BOUND_ARCMIN,
             },
         )?;
-        write_metrics(out, &maps, &result.truth, &metrics)?;
+        write_metrics(out, &maps, &result.truth, &with_flags(&metrics.to_json()))?;
         // As `run` writes it, at its default bound.
         write_text(
             &out.join("hazards.json"),
@@ -150,7 +151,7 @@ impl Score {
         )?;
         write_text(
             &out.join("run.json"),
-            &serde_json::to_string_pretty(&result.report)?,
+            &serde_json::to_string_pretty(&with_flags(&result.report))?,
         )?;
         staged.commit()?;
         let (d, b) = (&metrics.display, &metrics.border);

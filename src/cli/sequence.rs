@@ -1,6 +1,8 @@
 //! `seethru sequence`: the see-through system over time — vehicle motion, head motion and
 //! latency — measured frame by frame against the truth at the same instant.
 
+use crate::cli::with_flags;
+use seethru::util::option_words::as_flags;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
@@ -363,7 +365,7 @@ impl Sequence {
                 }
             })?;
             if let Some(w) = head_warning(&run.records) {
-                eprintln!("warning: {w}");
+                eprintln!("warning: {}", as_flags(&w));
             }
             write_text(
                 &dir.join("frames.csv"),
@@ -381,7 +383,7 @@ impl Sequence {
             s["preview_heat_scale"] = json!(chosen);
             write_text(
                 &dir.join("summary.json"),
-                &serde_json::to_string_pretty(&s)?,
+                &serde_json::to_string_pretty(&with_flags(&s))?,
             )?;
             runs.push((ms, run));
         }
@@ -449,7 +451,7 @@ impl Sequence {
         // Last: a directory with summary.json holds finished sequences.
         write_text(
             &out.join("summary.json"),
-            &serde_json::to_string_pretty(&overview)?,
+            &serde_json::to_string_pretty(&with_flags(&overview))?,
         )
         .with_context(|| format!("writing {}", self.out.display()))
     }

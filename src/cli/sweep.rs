@@ -98,7 +98,7 @@ impl SweepMerge {
                             read: false,
                             when: "for parts of a sweep of --param eye=eyellipse",
                         }
-                        .refusal("--bound-arcmin", &format!("parameters ({})", ignored.0))
+                        .refusal(&format!("parameters ({})", ignored.0))
                     ),
                     None => e,
                 }

@@ -433,7 +433,7 @@ pub fn read_exr_from<R: std::io::Read + std::io::Seek + Send>(
             .find(|c| c.name.to_string() == name)
             .map(|c| &c.sample_data)
             .with_context(|| {
-                format!("no channel `{name}` (not written by seethru with `--exr all`?)")
+                format!("no channel `{name}` (not written by seethru with option `exr` all?)")
             })?;
         if samples.len() != pixels {
             bail!(

@@ -92,13 +92,13 @@ pub fn measured_exrs(dir: &Path) -> [PathBuf; 3] {
 /// Reads truth, seethru and occluded from `dir`; they must have the same size.
 pub fn read_measured_frames(dir: &Path) -> Result<[Frame; 3]> {
     let [truth, seethru, occluded] = measured_exrs(dir);
-    // A run written with `--exr lean`, `colour` or `none` lacks AOVs to measure: say which flag.
+    // A run written with `--exr lean`, `colour` or `none` lacks AOVs to measure: say which option.
     let read = |path: &Path| {
         read_exr(path).map_err(|e| {
             let why = format!("{e:#}");
             match !path.exists() || why.contains("no channel") {
                 true => anyhow::anyhow!(
-                    "{why}; the metrics need every AOV of truth, seethru and occluded: write the run with `--exr all` (`run` writes `lean` by default: no `P`)"
+                    "{why}; the metrics need every AOV of truth, seethru and occluded: write the run with option `exr` all (`run` writes `lean` by default: no `P`)"
                 ),
                 false => e,
             }

@@ -51,8 +51,8 @@ pub fn compare_reads(candidates: &[Candidate], maps: bool, options: &RunOptions)
         any(&[PlaneFit, DepthIdeal, DepthTof, DepthStereo]),
         any(&[PlaneFit, DepthIdeal]),
         any(&[DepthIdeal, DepthTof, DepthStereo]),
-        "when --methods lists plane-fit or a depth method (the sensor's kind: plane-fit or depth-ideal)",
-        "when --methods lists a depth method (their disocclusion holes)",
+        "when option `methods` lists plane-fit or a depth method (the sensor's kind: plane-fit or depth-ideal)",
+        "when option `methods` lists a depth method (their disocclusion holes)",
     );
     let noisy_kind = options.scene_model.sensor.kind != SensorKind::Ideal;
     rules.push(ReadWhen {
@@ -60,12 +60,12 @@ pub fn compare_reads(candidates: &[Candidate], maps: bool, options: &RunOptions)
         read: any(&[PlaneFit, DepthTof, DepthStereo])
             || (noisy_kind && any(&[DepthIdeal]))
             || options.head == HeadSource::Model,
-        when: "with --head model (the tracker model's noise and dropouts) or when --methods lists plane-fit or a noisy depth sensor",
+        when: "with option `head` model (the tracker model's noise and dropouts) or when option `methods` lists plane-fit or a noisy depth sensor",
     });
     rules.push(ReadWhen {
         option: "back_width",
         read: options.head == HeadSource::Estimated || maps,
-        when: "with --head estimated or a map: method (the back camera is rendered for the face detector and for the capture a map is checked against)",
+        when: "with option `head` estimated or a map: method (the back camera is rendered for the face detector and for the capture a map is checked against)",
     });
     rules
 }

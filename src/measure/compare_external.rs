@@ -30,7 +30,7 @@ pub fn compare_maps(
     for (name, map) in maps {
         let scored = score(ctx, &options, &captured, Some(map), None).map_err(|e| {
             anyhow::anyhow!(
-                "map:{name}: {e:#} (capture with compare's --width, --height, --frontal-width, --back-width, --spp, --head and --seed)"
+                "map:{name}: {e:#} (capture with compare's option `width`, option `height`, option `frontal_width`, option `back_width`, option `spp`, option `head` and option `seed`)"
             )
         })?;
         let result = &scored.run;

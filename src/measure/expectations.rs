@@ -286,7 +286,7 @@ pub fn expectations_from_source(
         {
             return Err(table.error(
                 "options",
-                "--out is set by seethru check (each case runs into OUT/<name>)",
+                "option `out` is set by seethru check (each case runs into OUT/<name>)",
             ));
         }
         if let Some(why) = check_options(command, &options) {
@@ -438,7 +438,7 @@ mod tests {
         ] {
             let (cases, e) = read("lean", options);
             assert!(
-                cases.is_none() && e.contains("--out is set by seethru check"),
+                cases.is_none() && e.contains("option `out` is set by seethru check"),
                 "{options}: {e}"
             );
         }

@@ -212,7 +212,7 @@ pub fn read_results(dir: &Path) -> Result<(RunKind, Value)> {
         })?;
         if sequences.len() != 1 {
             bail!(
-                "{} holds {} sequences (one per --latency-camera value); compare a folder of one, e.g. {}",
+                "{} holds {} sequences (one per option `latency_camera` value); compare a folder of one, e.g. {}",
                 dir.join("summary.json").display(),
                 sequences.len(),
                 dir.join(sequences[0]["dir"].as_str().unwrap_or("latency_<ms>ms"))

@@ -93,7 +93,7 @@ pub fn hole_metrics(
         "fill": fill,
         "seen": region(&|i| !holes[i]),
         "filled": region(&|i| holes[i]),
-        "notes": "holes: display pixels whose line of sight passes behind a silhouette of the depth sensor's image (a disocclusion: what the eye sees there the frontal camera does not); seen: the other display pixels; filled: the holes as --fill shows them (none: black, counted blank). The totals in `display` include both",
+        "notes": "holes: display pixels whose line of sight passes behind a silhouette of the depth sensor's image (a disocclusion: what the eye sees there the frontal camera does not); seen: the other display pixels; filled: the holes as `fill` shows them (none: black, counted blank). The totals in `display` include both",
     })
 }
 

@@ -10,7 +10,6 @@ use crate::io::atomic::write_text;
 use crate::io::colour_bar::{ColourBar, with_colour_bar};
 use crate::io::frame_files::{write_exr_channels, write_png};
 use crate::measure::metrics::MetricMaps;
-use crate::measure::metrics_json::Metrics;
 use crate::render::frame::Frame;
 use crate::util::color::encode_srgb8;
 
@@ -89,15 +88,15 @@ pub fn heatmap_rgb(
     with_colour_bar(maps.width, maps.height, &rgb, &bar)
 }
 
-/// Writes `metrics.json`, `misregistration.exr` (`Y`: misregistration, arcmin, NaN outside the
-/// display and on blank pixels;
-/// `missing.mask`: 1 where missing — `Y` so that grey-image readers open it),
+/// Writes `metrics.json` (`metrics`: the record's JSON, in the front end's words),
+/// `misregistration.exr` (`Y`: misregistration, arcmin, NaN outside the display and on blank
+/// pixels; `missing.mask`: 1 where missing — `Y` so that grey-image readers open it),
 /// `misregistration.png` (heatmap with colour bar) and `missing.png` into `dir`.
 pub fn write_metrics(
     dir: &Path,
     maps: &MetricMaps,
     truth: &Frame,
-    metrics: &Metrics,
+    metrics: &serde_json::Value,
 ) -> Result<()> {
     write_metrics_scaled(dir, maps, truth, metrics, None)
 }
@@ -107,12 +106,12 @@ pub fn write_metrics_scaled(
     dir: &Path,
     maps: &MetricMaps,
     truth: &Frame,
-    metrics: &Metrics,
+    metrics: &serde_json::Value,
     heat_max: Option<f32>,
 ) -> Result<()> {
     write_text(
         &dir.join("metrics.json"),
-        &serde_json::to_string_pretty(&metrics.to_json())?,
+        &serde_json::to_string_pretty(metrics)?,
     )?;
     // The three images side by side (a run's last writes, while its other views may be
     // written already); the first error in this order.

@@ -82,7 +82,7 @@ pub fn measure_views(
             .is_some_and(|s| s.contains("map"))
         {
             metrics.misregistration_needs_a_map = Some(
-                "the display image alone carries no geometry: misregistration is undefined on every display pixel (counted in undefined_pixels); give --map for it",
+                "the display image alone carries no geometry: misregistration is undefined on every display pixel (counted in undefined_pixels); give option `map` for it",
             );
         }
     }

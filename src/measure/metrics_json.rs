@@ -249,7 +249,7 @@ pub(crate) fn display_metrics(
         flip_pixels_per_degree: ppd,
         notes: NOTES,
         flip_not_computed: (flip == Flip::Skipped).then_some(
-            "FLIP was not computed (a sequence without --flip): every flip_mean is null",
+            "FLIP was not computed (a sequence without option `flip`): every flip_mean is null",
         ),
         holes: None,
         external_method: None,

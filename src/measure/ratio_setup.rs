@@ -107,17 +107,17 @@ impl Setup {
         if let Some(m) = compensation.model_d2
             && (m.is_nan() || m <= 0.0)
         {
-            bail!("--model-d2 must be a distance in metres in (0, ∞) or `inf`, got {m}");
+            bail!("option `model_d2` must be a distance in metres in (0, ∞) or `inf`, got {m}");
         }
         let [bx, by, bz] = compensation.head_bias_cm;
         if ![bx, by, bz].iter().all(|v| v.is_finite()) {
             bail!(
-                "--head-bias-cm must be three finite numbers x,y,z in centimetres, got {bx},{by},{bz}"
+                "option `head_bias_cm` must be three finite numbers x,y,z in centimetres, got {bx},{by},{bz}"
             );
         }
         if d1 + bz / 100.0 <= 0.0 {
             bail!(
-                "--head-bias-cm: z = {bz} cm puts the compensation's eye behind the display (d1 = {d1} m); z must be in ({}, ∞) cm",
+                "option `head_bias_cm`: z = {bz} cm puts the compensation's eye behind the display (d1 = {d1} m); z must be in ({}, ∞) cm",
                 -100.0 * d1
             );
         }
@@ -131,12 +131,12 @@ impl Setup {
         }
         match *self {
             Setup::Occlusion(p) if !(p.l > 0.0 && p.l < p.d2) => {
-                bail!("--L must be in (0, d2) = (0, {}), got {}", p.d2, p.l)
+                bail!("option `L` must be in (0, d2) = (0, {}), got {}", p.d2, p.l)
             }
             Setup::Foreshortening(p)
                 if !(p.l > 0.0 && p.gamma > 0.0 && p.gamma <= std::f64::consts::FRAC_PI_2) =>
             {
-                bail!("--l must be > 0 and --gamma in (0, 90] degrees")
+                bail!("option `l` must be > 0 and option `gamma` in (0, 90] degrees")
             }
             _ => {}
         }

@@ -91,7 +91,7 @@ pub fn head_warning(records: &[FrameRecord]) -> Option<String> {
     let (worst, at) = scored.iter().copied().min_by(|a, b| a.0.total_cmp(&b.0))?;
     (low > 0).then(|| {
         format!(
-            "head estimate unreliable in {low} of {} frames (confidence < {CONFIDENT_HEAD}; lowest {worst:.2}, head sampled at t = {} s): frames.csv's head_confidence column has each (--require-confident-head makes this an error)",
+            "head estimate unreliable in {low} of {} frames (confidence < {CONFIDENT_HEAD}; lowest {worst:.2}, head sampled at t = {} s): frames.csv's head_confidence column has each (option `require_confident_head` makes this an error)",
             scored.len(),
             short(at)
         )

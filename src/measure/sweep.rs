@@ -76,13 +76,13 @@ pub fn sweep(
 ) -> Result<usize> {
     check_out(csv)?;
     if params.is_empty() {
-        bail!("give at least one --param");
+        bail!("give at least one option `param`");
     }
     let mut names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
     names.sort_unstable();
     if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
         bail!(
-            "the parameter `{}` is given twice (one --param per parameter, with all its values)",
+            "the parameter `{}` is given twice (one option `param` per parameter, with all its values)",
             w[0]
         );
     }
@@ -240,18 +240,18 @@ pub fn sweep(
 pub fn check_out(csv: &Path) -> Result<()> {
     let text = csv.to_string_lossy();
     if text.is_empty() {
-        bail!("--out is empty: give the CSV's file name (e.g. sweep.csv)");
+        bail!("option `out` is empty: give the CSV's file name (e.g. sweep.csv)");
     }
     if csv.file_name().is_none() || text.ends_with('/') {
         bail!(
-            "--out {text}: names a folder, not a file; give the CSV's file name (e.g. {}/sweep.csv)",
+            "option `out` {text}: names a folder, not a file; give the CSV's file name (e.g. {}/sweep.csv)",
             text.trim_end_matches('/')
         );
     }
     if std::fs::symlink_metadata(csv).is_ok()
         && let Some(why) = not_a_file(csv)
     {
-        bail!("--out {text}: {why}; give a regular file (a new name, or a CSV to resume)");
+        bail!("option `out` {text}: {why}; give a regular file (a new name, or a CSV to resume)");
     }
     Ok(())
 }
@@ -440,7 +440,7 @@ mod tests {
     fn outputs_that_cannot_be_a_csv_are_refused() {
         let dir = tempfile::tempdir().unwrap();
         for (out, words) in [
-            (Path::new(""), "--out is empty"),
+            (Path::new(""), "option `out` is empty"),
             (dir.path(), "it is a folder, not a file"),
             (Path::new("."), "names a folder, not a file"),
         ] {

@@ -115,10 +115,10 @@ pub const GRID_COLUMN: &str = "configurations";
 /// The columns after it: what a row's results depend on besides its parameter values, with
 /// how a message names each. Resuming or merging refuses rows that differ in any.
 pub const SETTING_COLUMNS: [(&str, &str); 6] = [
-    ("width", "--width"),
-    ("spp", "--spp"),
-    ("head", "--head"),
-    ("band", "--band"),
+    ("width", "option `width`"),
+    ("spp", "option `spp`"),
+    ("head", "option `head`"),
+    ("band", "option `band`"),
     ("scene_hash", "scene_hash"),
     ("seethru_version", "seethru"),
 ];
@@ -297,17 +297,17 @@ pub fn finished_rows(
     match all.next() {
         Some((_, first)) if first == expected => {}
         Some((_, first)) => bail!(
-            "{} exists with other columns: {}; remove it or choose another --out",
+            "{} exists with other columns: {}; remove it or choose another option `out`",
             csv.display(),
             header_difference(&first, &expected)
         ),
         None => bail!(
-            "{} exists but is empty (no header; expected {}); remove it or choose another --out",
+            "{} exists but is empty (no header; expected {}); remove it or choose another option `out`",
             csv.display(),
             columns_text(&expected, params.len())
         ),
     }
-    let hint = "delete the row to compute it again, or choose another --out";
+    let hint = "delete the row to compute it again, or choose another option `out`";
     let place: HashMap<&[(String, String)], usize> = configs
         .iter()
         .enumerate()
@@ -322,7 +322,7 @@ pub fn finished_rows(
         seen.note(&fields, params, index, csv, number)?;
         if let Some((shown, theirs, ours)) = first_difference(settings_of(&fields), settings) {
             bail!(
-                "{}:{number}: computed with {shown} {theirs}, this sweep has {shown} {ours}{}: resuming would mix the two; resume with the same settings, or choose another --out",
+                "{}:{number}: computed with {shown} {theirs}, this sweep has {shown} {ours}{}: resuming would mix the two; resume with the same settings, or choose another option `out`",
                 csv.display(),
                 if shown == "scene_hash" {
                     " (another scene, or the scene file, a mesh or a texture it reads changed)"
@@ -347,7 +347,7 @@ pub fn finished_rows(
     }
     if let Some((line, values)) = first_outside {
         bail!(
-            "{}: {outside} of its {count} rows are outside this sweep's grid (the first, line {line}: {}); resuming would drop them: give --param values that include theirs, or choose another --out",
+            "{}: {outside} of its {count} rows are outside this sweep's grid (the first, line {line}: {}); resuming would drop them: give option `param` values that include theirs, or choose another option `out`",
             csv.display(),
             config_text(&values)
         );
@@ -377,14 +377,14 @@ impl SeenRows {
     ) -> Result<()> {
         if let Some(earlier) = self.line_of_index.insert(index, number) {
             bail!(
-                "{}:{number}: configuration {index} appears twice (also on line {earlier}); remove the file or choose another --out",
+                "{}:{number}: configuration {index} appears twice (also on line {earlier}); remove the file or choose another option `out`",
                 csv.display()
             );
         }
         let values = fields[1..=names.len()].to_vec();
         if let Some(earlier) = self.line_of_values.insert(values, number) {
             bail!(
-                "{}:{number}: the configuration {} appears twice (also on line {earlier}); remove the file or choose another --out",
+                "{}:{number}: the configuration {} appears twice (also on line {earlier}); remove the file or choose another option `out`",
                 csv.display(),
                 config_text(
                     &names
@@ -546,7 +546,9 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            err.starts_with("s.csv:3: computed with --width 64, this sweep has --width 32"),
+            err.starts_with(
+                "s.csv:3: computed with option `width` 64, this sweep has option `width` 32"
+            ),
             "{err}"
         );
         let other = row(0, "20", &[], 2).replace("0123456789abcdef", "fedcba9876543210");

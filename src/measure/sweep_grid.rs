@@ -36,7 +36,7 @@ pub const PARAMETERS: [(&str, &str); 8] = [
     ),
     (
         "eye",
-        "eyellipse: driver eyes drawn from the scene's [eyellipse] (sweep --samples N --seed S)",
+        "eyellipse: driver eyes drawn from the scene's [eyellipse] (sweep option `samples` N option `seed` S)",
     ),
     (
         "head_bias_x_cm",
@@ -103,7 +103,7 @@ pub fn parse_param(spec: &str) -> Result<Param> {
         // The samples are made by [`eyellipse_param`] once --samples and --seed are known.
         if values.trim() != "eyellipse" {
             bail!(
-                "eye = `{}`: the only value is eyellipse (eyes sampled from the scene's [eyellipse] table; choose how many with --samples and their seed with --seed)",
+                "eye = `{}`: the only value is eyellipse (eyes sampled from the scene's [eyellipse] table; choose how many with option `samples` and their seed with option `seed`)",
                 values.trim()
             );
         }
@@ -272,7 +272,7 @@ pub fn check_grid_size(params: &[Param]) -> Result<usize> {
             .map(|p| format!("{} {}", p.name, p.values.len()))
             .collect();
         bail!(
-            "the grid has {} = {} configurations, more than the limit of {MAX_CONFIGURATIONS}: sweep fewer values, or split the grid over several --out files",
+            "the grid has {} = {} configurations, more than the limit of {MAX_CONFIGURATIONS}: sweep fewer values, or split the grid over several option `out` files",
             counts.join(" × "),
             short(product)
         );
@@ -313,7 +313,7 @@ pub fn configure(
                 let (seed, index) = eyellipse_sample(v)?;
                 let ellipse = scene.eyellipse.with_context(|| {
                     format!(
-                        "--param eye=eyellipse: the scene {} has no [eyellipse] table to draw eyes from",
+                        "option `param` eye=eyellipse: the scene {} has no [eyellipse] table to draw eyes from",
                         base.path.display()
                     )
                 })?;

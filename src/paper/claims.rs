@@ -255,20 +255,20 @@ impl AnalyzeParams {
         ];
         for (name, v) in positive {
             if v.is_nan() || v <= 0.0 {
-                return Err(format!("--{name} must be > 0, got {v}"));
+                return Err(format!("option `{name}` must be > 0, got {v}"));
             }
         }
         if !(self.theta_f_deg > 0.0 && self.theta_f_deg < 90.0) {
             return Err(format!(
-                "--theta-f must be in (0, 90) degrees, got {}",
+                "option `theta_f` must be in (0, 90) degrees, got {}",
                 self.theta_f_deg
             ));
         }
         if !self.b_h.is_finite() || !self.b1.is_finite() || !self.gamma_deg.is_finite() {
-            return Err("--bh, --b1 and --gamma must be finite".into());
+            return Err("option `bh`, option `b1` and option `gamma` must be finite".into());
         }
         if self.frontal_px == 0 {
-            return Err("--frontal-px must be ≥ 1".into());
+            return Err("option `frontal_px` must be ≥ 1".into());
         }
         Ok(())
     }

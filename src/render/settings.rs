@@ -28,7 +28,8 @@ impl Default for RenderSettings {
 }
 
 /// Output size of a camera after optional `--width`/`--height` overrides. Given one side
-/// only, the other follows the camera's aspect ratio. `flags` names the overrides in errors.
+/// only, the other follows the camera's aspect ratio. `flags` names the overrides in errors
+/// (in the library's words: "option `width`").
 pub fn resized(
     camera: Camera,
     width: Option<u32>,
@@ -72,7 +73,7 @@ pub fn check_resolution(w: u32, h: u32) -> Result<()> {
 
 pub fn check_spp(spp: u32) -> Result<()> {
     if !(1..=MAX_SPP).contains(&spp) {
-        bail!("--spp {spp} is out of range [1, {MAX_SPP}]");
+        bail!("option `spp` {spp} is out of range [1, {MAX_SPP}]");
     }
     Ok(())
 }

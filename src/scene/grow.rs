@@ -28,7 +28,7 @@ const FIRST_COLUMN_X: f64 = 12.0;
 /// has none).
 pub fn grow(base: &Scene, factor: f64) -> Result<Scene> {
     if !(1.0..=MAX_GROW).contains(&factor) {
-        bail!("--grow {factor} is out of range [1, {MAX_GROW}]");
+        bail!("option `grow` {factor} is out of range [1, {MAX_GROW}]");
     }
     let mut scene = base.clone();
     if factor == 1.0 {

@@ -225,7 +225,9 @@ pub fn check_display_input(
 ) -> Result<()> {
     let [dw, dh] = display_size;
     if map.is_none() && image.is_none() {
-        bail!("a display map or a display image is needed (--map FILE, --display-image FILE)");
+        bail!(
+            "a display map or a display image is needed (option `map` FILE, option `display_image` FILE)"
+        );
     }
     if let Some(m) = map {
         if (m.width, m.height) != (dw, dh) {

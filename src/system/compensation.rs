@@ -100,13 +100,13 @@ impl std::fmt::Display for CropError {
             CropError::EyeBehindDisplay { d1 } => {
                 write!(
                     f,
-                    "the eye the compensation uses must be in front of the display (d1 > 0), got d1 = {} m: check the driver camera's position and --head-bias-cm",
+                    "the eye the compensation uses must be in front of the display (d1 > 0), got d1 = {} m: check the driver camera's position and option `head_bias_cm`",
                     crate::util::number::short(*d1)
                 )
             }
             CropError::BehindFrontalCamera => write!(
                 f,
-                "the model plane point of a display corner is behind the frontal camera: the working distance (--d2) lies nearer than the camera, or the camera faces away from the plane"
+                "the model plane point of a display corner is behind the frontal camera: the working distance (option `d2`) lies nearer than the camera, or the camera faces away from the plane"
             ),
         }
     }

@@ -80,19 +80,19 @@ pub struct SensorModel {
 }
 
 impl SensorModel {
-    /// Resolves `options` for a frontal camera; errors name the flag, value and range.
+    /// Resolves `options` for a frontal camera; errors name the option, value and range.
     pub fn resolve(options: &SensorOptions, frontal: &Camera) -> Result<Self> {
         let fw = frontal.width;
         if options.kind == SensorKind::Ideal {
             let given = [
-                options.width.map(|_| "--depth-resolution"),
-                options.range_m.map(|_| "--depth-range"),
-                options.noise_1m.map(|_| "--depth-noise"),
-                options.quantum_1m.map(|_| "--depth-quantum"),
+                options.width.map(|_| "option `depth_resolution`"),
+                options.range_m.map(|_| "option `depth_range`"),
+                options.noise_1m.map(|_| "option `depth_noise`"),
+                options.quantum_1m.map(|_| "option `depth_quantum`"),
             ];
             if let Some(flag) = given.into_iter().flatten().next() {
                 bail!(
-                    "{flag} does not apply to --depth-sensor ideal (the frontal render's exact depth); use --depth-sensor tof or stereo"
+                    "{flag} does not apply to option `depth_sensor` ideal (the frontal render's exact depth); use option `depth_sensor` tof or stereo"
                 );
             }
         }
@@ -104,7 +104,7 @@ impl SensorModel {
         let width = options.width.unwrap_or(width);
         if width == 0 || width > fw {
             bail!(
-                "--depth-resolution {width} is out of range [1, {fw}] (the frontal camera's width)"
+                "option `depth_resolution` {width} is out of range [1, {fw}] (the frontal camera's width)"
             );
         }
         let height = ((width as u64 * frontal.height as u64 + fw as u64 / 2) / fw as u64)
@@ -118,13 +118,16 @@ impl SensorModel {
             quantum_1m: options.quantum_1m.unwrap_or(quantum),
         };
         if model.range_m.is_nan() || model.range_m <= 0.0 {
-            bail!("--depth-range must be > 0 m, got {}", model.range_m);
+            bail!("option `depth_range` must be > 0 m, got {}", model.range_m);
         }
         if !(model.noise_1m >= 0.0 && model.noise_1m.is_finite()) {
-            bail!("--depth-noise must be ≥ 0 m, got {}", model.noise_1m);
+            bail!("option `depth_noise` must be ≥ 0 m, got {}", model.noise_1m);
         }
         if !(model.quantum_1m >= 0.0 && model.quantum_1m.is_finite()) {
-            bail!("--depth-quantum must be ≥ 0 m, got {}", model.quantum_1m);
+            bail!(
+                "option `depth_quantum` must be ≥ 0 m, got {}",
+                model.quantum_1m
+            );
         }
         Ok(model)
     }

@@ -106,7 +106,7 @@ impl Eyes {
     pub fn check(&self) -> Result<(), String> {
         if !(self.ipd > 0.0 && self.ipd <= MAX_IPD) {
             return Err(format!(
-                "--ipd must be in (0, {MAX_IPD}] m, got {}",
+                "option `ipd` must be in (0, {MAX_IPD}] m, got {}",
                 self.ipd
             ));
         }

@@ -249,7 +249,7 @@ impl HeadConfidence {
     /// [`Self::warning`] under the threshold `min`.
     pub fn warning_at(&self, context: &str, min: f64) -> String {
         format!(
-            "{context}head estimate unreliable: confidence {:.2} < {} ({}); the eye may be centimetres off (--require-confident-head makes this an error)",
+            "{context}head estimate unreliable: confidence {:.2} < {} ({}); the eye may be centimetres off (option `require_confident_head` makes this an error)",
             self.value,
             crate::util::number::short(min),
             self.doubts()

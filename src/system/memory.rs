@@ -192,7 +192,7 @@ pub fn check_memory(estimate: &MemoryEstimate, limit_gib: f64) -> Result<()> {
         // Three significant digits: a small limit must not read "needs 0.0 GiB, more than 0.001".
         let decimals = (2.0 - gib.log10().floor()).clamp(1.0, 9.0) as usize;
         bail!(
-            "this needs about {gib:.decimals$} GiB ({}), more than --max-memory {limit_gib} GiB: lower the resolution, or raise --max-memory if the machine has the memory",
+            "this needs about {gib:.decimals$} GiB ({}), more than option `max_memory` {limit_gib} GiB: lower the resolution, or raise option `max_memory` if the machine has the memory",
             estimate.what
         );
     }

@@ -161,17 +161,22 @@ pub struct RunOptions {
 impl RunOptions {
     /// The driver's camera (as given, before the eye is chosen) at `--width`/`--height`.
     pub fn sized_driver(&self, camera: Camera) -> anyhow::Result<Camera> {
-        resized(camera, self.width, self.height, "--width/--height")
+        resized(
+            camera,
+            self.width,
+            self.height,
+            "option `width`/option `height`",
+        )
     }
 
     /// The frontal camera at `--frontal-width`.
     pub fn sized_frontal(&self, camera: Camera) -> anyhow::Result<Camera> {
-        resized(camera, self.frontal_width, None, "--frontal-width")
+        resized(camera, self.frontal_width, None, "option `frontal_width`")
     }
 
     /// The back camera at `--back-width`.
     pub fn sized_back(&self, camera: Camera) -> anyhow::Result<Camera> {
-        resized(camera, self.back_width, None, "--back-width")
+        resized(camera, self.back_width, None, "option `back_width`")
     }
 }
 

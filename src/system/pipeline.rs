@@ -88,7 +88,7 @@ pub fn eye_for_compensation(
                 && !confidence.is_confident_at(options.min_head_confidence)
             {
                 bail!(
-                    "--require-confident-head: {}",
+                    "option `require_confident_head`: {}",
                     confidence.warning_at("", options.min_head_confidence)
                 );
             }
@@ -275,7 +275,7 @@ pub fn check_crop_in_view(
         )
     };
     bail!(
-        "the crop leaves the frontal camera's view on the {side} by {} px ({}% of the image); at d1 = {} m {region} (use --outside black to show the rest black)",
+        "the crop leaves the frontal camera's view on the {side} by {} px ({}% of the image); at d1 = {} m {region} (use option `outside` black to show the rest black)",
         short(px),
         short(share),
         short(d1),
@@ -315,7 +315,7 @@ pub fn curved_planar_display(
     let (display, missing) = curved_display(frontal, &scene.obstacle, &model, options.filter);
     if missing > 0 && options.outside == Outside::Error {
         bail!(
-            "{missing} of the curved display's {} pixels show a model point the frontal camera does not see (or lie outside its UVs); use --outside black to show them black and count them",
+            "{missing} of the curved display's {} pixels show a model point the frontal camera does not see (or lie outside its UVs); use option `outside` black to show them black and count them",
             display.object_id.len()
         );
     }
@@ -512,7 +512,7 @@ pub fn run_staged(
     check_spp(options.spp)?;
     if !(options.feature_width > 0.0 && options.feature_width.is_finite()) {
         bail!(
-            "--feature-width must be > 0 m, got {}",
+            "option `feature_width` must be > 0 m, got {}",
             options.feature_width
         );
     }
@@ -524,7 +524,7 @@ pub fn run_staged(
     options.eyes.check().map_err(anyhow::Error::msg)?;
     if options.require_confident_head && options.head != HeadSource::Estimated {
         bail!(
-            "--require-confident-head needs --head estimated (only the image-based estimate has a confidence)"
+            "option `require_confident_head` needs option `head` estimated (only the image-based estimate has a confidence)"
         );
     }
     if options.method.models_the_scene() && given.display.is_none() {

@@ -1,7 +1,8 @@
 //! Settings read only under others: a run or a sequence refuses a setting it would ignore,
 //! so the user's intent is not dropped without a word. The rules are the library's, so the
 //! command line (`--sway-cm`) and the Python package (`sway_cm`) refuse the same settings
-//! with the same words.
+//! with the same words: the library's name the option ("option `sway_cm`",
+//! `util::option_words`), each front end spells it.
 
 use crate::scene::Scene;
 use crate::system::eyes::Eye;
@@ -9,7 +10,8 @@ use crate::system::options::{HeadSource, Method, RunOptions};
 use crate::system::sequence::head_motion::HeadPreset;
 
 /// Where [`ReadWhen::when`] says a setting is read only by the methods that use the eye.
-pub const EYE_METHODS: &str = "by the methods that compensate for the eye (not --method none)";
+pub const EYE_METHODS: &str =
+    "by the methods that compensate for the eye (not option `method` none)";
 
 /// A setting that a command reads only under some of its other settings.
 #[derive(Clone, Debug, PartialEq)]
@@ -18,58 +20,32 @@ pub struct ReadWhen {
     pub option: &'static str,
     /// Whether the command, with the settings given, reads it.
     pub read: bool,
-    /// The settings that read it, for the message: `with --eyes left, right or both`.
+    /// The settings that read it, for the message, in the library's words: "with option
+    /// `eyes` left, right or both".
     pub when: &'static str,
 }
 
-/// The command line's flag of the option `name`: `sway_cm` → `--sway-cm`.
-pub fn flag_of(name: &str) -> String {
-    format!("--{}", name.replace('_', "-"))
-}
-
-/// `--sway-cm` → `sway_cm`, and so every flag in a text (Python's keyword names). A flag
-/// starts a word (after the start, a space or an opening mark): the `--` inside a path or a
-/// value (`runs--old`) is left alone.
-pub fn keyword_names(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    let mut rest = text;
-    while let Some(at) = rest.find("--") {
-        let before = rest[..at].chars().last().or_else(|| out.chars().last());
-        let starts_word = before.is_none_or(|c| c.is_whitespace() || "(`'\"[,;:/".contains(c));
-        let name = &rest[at + 2..];
-        let end = name
-            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
-            .unwrap_or(name.len());
-        out.push_str(&rest[..at]);
-        if starts_word && end > 0 {
-            out.push_str(&name[..end].replace('-', "_"));
-        } else {
-            out.push_str("--");
-            out.push_str(&name[..end]);
-        }
-        rest = &name[end..];
-    }
-    out.push_str(rest);
-    out
-}
+pub use crate::util::option_words::flag_of;
+use crate::util::option_words::{as_flags, as_keywords};
 
 impl ReadWhen {
-    /// The refusal of this setting when given: `others` names the rest (`flags`, `options`).
-    pub fn refusal(&self, name: &str, others: &str) -> String {
+    /// The refusal of this setting when given, in the library's words ("option `ipd` is read
+    /// only …"): `others` names the rest (`flags`, `options`).
+    pub fn refusal(&self, others: &str) -> String {
         format!(
-            "{name} is read only {}; with the other {others} given it would be ignored: remove it",
-            self.when
+            "option `{}` is read only {}; with the other {others} given it would be ignored: remove it",
+            self.option, self.when
         )
     }
 
     /// The refusal in the command line's words: `--ipd is read only …`.
     pub fn flag_refusal(&self) -> String {
-        self.refusal(&flag_of(self.option), "flags")
+        as_flags(&self.refusal("flags"))
     }
 
-    /// The refusal in Python's words: keyword names for flags, `options` for the rest.
+    /// The refusal in Python's words: keywords for options, `options` for the rest.
     pub fn keyword_refusal(&self) -> String {
-        keyword_names(&self.refusal(self.option, "options"))
+        as_keywords(&self.refusal("options"))
     }
 }
 
@@ -109,7 +85,7 @@ pub fn head_error_reads(
         ReadWhen {
             option: "seed",
             read: (eye_used && (jitter || head == HeadSource::Model)) || other_seed_reader,
-            when: "with --head-jitter-cm > 0, the tracker model's head, a noisy depth sensor or the plane fit",
+            when: "with option `head_jitter_cm` > 0, the tracker model's head, a noisy depth sensor or the plane fit",
         },
     ]
 }
@@ -155,8 +131,8 @@ pub fn method_scene_model_reads(method: Method) -> Vec<ReadWhen> {
         reads_depth,
         reads_depth,
         method == Method::Depth,
-        "by --method plane-fit and depth",
-        "by --method depth (its disocclusion holes)",
+        "by option `method` plane-fit and depth",
+        "by option `method` depth (its disocclusion holes)",
     )
 }
 
@@ -191,12 +167,12 @@ pub fn run_reads(options: &RunOptions, both_eyes: bool) -> Vec<ReadWhen> {
             read: both_eyes
                 || eyes.view != Eye::Cyclopean
                 || (eye_used && eyes.target != Eye::Cyclopean),
-            when: "with --eyes left, right or both, or --target-eye left or right",
+            when: "with option `eyes` left, right or both, or option `target_eye` left or right",
         },
         ReadWhen {
             option: "d2",
             read: !matches!(method, Method::None | Method::Depth),
-            when: "by --method planar, ground and plane-fit",
+            when: "by option `method` planar, ground and plane-fit",
         },
     ]);
     rules
@@ -212,8 +188,8 @@ pub fn capture_reads(options: &RunOptions, depth: bool) -> Vec<ReadWhen> {
         depth,
         depth,
         false,
-        "with --depth (the capture's depth map)",
-        "by --method depth, not by a capture (it has no holes to fill)",
+        "with option `depth` (the capture's depth map)",
+        "by option `method` depth, not by a capture (it has no holes to fill)",
     );
     rules.extend(head_error_reads(
         true,
@@ -226,12 +202,12 @@ pub fn capture_reads(options: &RunOptions, depth: bool) -> Vec<ReadWhen> {
         ReadWhen {
             option: "require_confident_head",
             read: options.head == HeadSource::Estimated,
-            when: "with --head estimated (only the face detector's estimate has a confidence)",
+            when: "with option `head` estimated (only the face detector's estimate has a confidence)",
         },
         ReadWhen {
             option: "ipd",
             read: eyes.view != Eye::Cyclopean || eyes.target != Eye::Cyclopean,
-            when: "with --eyes left or right, or --target-eye left or right",
+            when: "with option `eyes` left or right, or option `target_eye` left or right",
         },
     ]);
     rules
@@ -248,8 +224,8 @@ pub fn first_ignored(rules: &[ReadWhen], given: impl Fn(&str) -> bool) -> Option
 /// method's maps are shown.
 pub fn sequence_reads(run: &RunOptions, head: Option<HeadPreset>, maps: bool) -> Vec<ReadWhen> {
     let preset = |p: HeadPreset| head == Some(p);
-    let sway = "with --head sway (and no --head-path)";
-    let lean = "with --head lean (and no --head-path)";
+    let sway = "with option `head` sway (and no option `head_path`)";
+    let lean = "with option `head` lean (and no option `head_path`)";
     let eye_used = run.method != Method::None;
     let estimated = run.head == HeadSource::Estimated;
     let mut rules = head_error_reads(eye_used, run.head, run.head_jitter_cm > 0.0, false);
@@ -266,12 +242,12 @@ pub fn sequence_reads(run: &RunOptions, head: Option<HeadPreset>, maps: bool) ->
         with(
             "reproject",
             run.method == Method::Planar,
-            "by --method planar (none shows the whole frontal image as captured)",
+            "by option `method` planar (none shows the whole frontal image as captured)",
         ),
         with(
             "back_width",
             eye_used && estimated,
-            "with --head-source estimated (the back camera is rendered for the face detector only)",
+            "with option `head_source` estimated (the back camera is rendered for the face detector only)",
         ),
         with("sway_cm", preset(HeadPreset::Sway), sway),
         with("sway_hz", preset(HeadPreset::Sway), sway),
@@ -281,13 +257,13 @@ pub fn sequence_reads(run: &RunOptions, head: Option<HeadPreset>, maps: bool) ->
         with(
             "d2",
             run.method == Method::Planar && !maps,
-            "by --method planar without --maps",
+            "by option `method` planar without option `maps`",
         ),
-        with("method", !maps, "without --maps (the maps are the method)"),
+        with("method", !maps, "without option `maps` (the maps are the method)"),
         with(
             "display",
             !maps,
-            "without --maps (a map is shown on the display's pixels)",
+            "without option `maps` (a map is shown on the display's pixels)",
         ),
     ]);
     rules
@@ -305,18 +281,6 @@ pub fn hazard_bound_reads(scene: &Scene) -> ReadWhen {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn flags_become_keyword_names() {
-        assert_eq!(
-            keyword_names("--sway-cm is read only with --head sway (and no --head-path)"),
-            "sway_cm is read only with head sway (and no head_path)"
-        );
-        assert_eq!(
-            keyword_names("`--width/--height`: runs--old/a.toml, -- --x"),
-            "`width/height`: runs--old/a.toml, -- x"
-        );
-    }
 
     #[test]
     fn a_runs_seed_is_read_by_a_noisy_sensor_of_the_depth_method() {

@@ -43,7 +43,7 @@ pub fn check_scene_model(scene: &Scene, options: &RunOptions) -> Result<()> {
 pub fn check_scene_model_options(scene: &Scene, options: &RunOptions) -> Result<()> {
     if options.display == DisplayModel::Ideal {
         bail!(
-            "--display ideal works with --method none or planar (a crop); ground, plane-fit and depth model the physical display's pixels"
+            "option `display` ideal works with option `method` none or planar (a crop); ground, plane-fit and depth model the physical display's pixels"
         );
     }
     if options.method != Method::Ground {
@@ -63,7 +63,7 @@ pub fn scene_model_unavailable(scene: &Scene, method: Method) -> Option<String> 
         .map_or_else(String::new, |v| v.get_name().to_string());
     if !scene.calibration.frontal.is_exact() {
         return Some(format!(
-            "--method {name}: the [calibration.frontal] is not exact; ground, plane-fit and depth use the true frontal camera (use --method planar to study calibration error)"
+            "option `method` {name}: the [calibration.frontal] is not exact; ground, plane-fit and depth use the true frontal camera (use option `method` planar to study calibration error)"
         ));
     }
     if method == Method::Ground {

@@ -65,7 +65,7 @@ pub fn ground_plane(scene: &Scene) -> Result<ScenePlane> {
     match best {
         Some(p) => Ok(p),
         None => bail!(
-            "--method ground: the scene {} has no ground plane (an [[object]] of kind = \"plane\", horizontal within 10°, below the frontal camera)",
+            "option `method` ground: the scene {} has no ground plane (an [[object]] of kind = \"plane\", horizontal within 10°, below the frontal camera)",
             scene.path.display()
         ),
     }
@@ -99,7 +99,7 @@ pub fn fit_plane(map: &DepthMap, min: DVec2, max: DVec2, seed: u32) -> Result<(S
     }
     if points.len() < 3 {
         bail!(
-            "--method plane-fit: the depth sensor has {} returns where the display is; at least 3 are needed (is it all sky or past --depth-range?)",
+            "option `method` plane-fit: the depth sensor has {} returns where the display is; at least 3 are needed (is it all sky or past option `depth_range`?)",
             points.len()
         );
     }
@@ -125,7 +125,9 @@ pub fn fit_plane(map: &DepthMap, min: DVec2, max: DVec2, seed: u32) -> Result<(S
         }
     }
     let Some((mut abc, _)) = best else {
-        bail!("--method plane-fit: the depth sensor's points where the display is lie on a line");
+        bail!(
+            "option `method` plane-fit: the depth sensor's points where the display is lie on a line"
+        );
     };
     // Refit on the inliers, twice (the second round with the refined plane's inliers).
     let mut count = 0;
@@ -147,7 +149,7 @@ pub fn fit_plane(map: &DepthMap, min: DVec2, max: DVec2, seed: u32) -> Result<(S
     let normal_world = camera.world_from_camera.matrix3 * n_camera;
     let scale = normal_world.length();
     if !(scale > 0.0 && scale.is_finite()) {
-        bail!("--method plane-fit: the fitted plane passes through the camera");
+        bail!("option `method` plane-fit: the fitted plane passes through the camera");
     }
     let offset = 1.0 + normal_world.dot(camera.position());
     Ok((

@@ -103,13 +103,13 @@ pub fn export(
         (None, Some(f)) => f,
         (Some(f), named) if named == Some(f) => f,
         (Some(f), _) => bail!(
-            "--format {} writes a .{} file, but --out is {}",
+            "option `format` {} writes a .{} file, but option `out` is {}",
             f.name(),
             f.extension(),
             path.display()
         ),
         (None, None) => bail!(
-            "export writes .obj or .glb (glTF) or .xml (Mitsuba) files, not {}; name the --out file with one of these extensions",
+            "export writes .obj or .glb (glTF) or .xml (Mitsuba) files, not {}; name the option `out` file with one of these extensions",
             path.display()
         ),
     };
@@ -118,7 +118,7 @@ pub fn export(
     // when all are written: a failure leaves no file, and no folder the export created.
     let name = path
         .file_name()
-        .with_context(|| format!("--out {} names no file", path.display()))?;
+        .with_context(|| format!("option `out` {} names no file", path.display()))?;
     let staged = StagedDir::inside(
         path.parent().unwrap_or(Path::new("")),
         &name.to_string_lossy(),
@@ -163,7 +163,7 @@ fn refuse_inputs(scene: &Scene, out: &Path, staged: &StagedDir) -> Result<()> {
             let file = staged.final_path(&staged_file);
             if let Some(input) = crate::util::input_file::input_at(&file) {
                 bail!(
-                    "--out {}: the export would overwrite {}, an input of the scene {} (read as {}); name another --out",
+                    "option `out` {}: the export would overwrite {}, an input of the scene {} (read as {}); name another option `out`",
                     out.display(),
                     file.display(),
                     scene.path.display(),

@@ -151,15 +151,18 @@ impl SystemLoop {
         options.timeline.validate()?;
         if run.method.models_the_scene() {
             bail!(
-                "sequence: --method ground, plane-fit and depth are not modelled over time; use --method planar or none"
+                "sequence: option `method` ground, plane-fit and depth are not modelled over time; use option `method` planar or none"
             );
         }
         if !(run.feature_width > 0.0 && run.feature_width.is_finite()) {
-            bail!("--feature-width must be > 0 m, got {}", run.feature_width);
+            bail!(
+                "option `feature_width` must be > 0 m, got {}",
+                run.feature_width
+            );
         }
         if run.require_confident_head && run.head != HeadSource::Estimated {
             bail!(
-                "--require-confident-head needs --head-source estimated (only the image-based estimate has a confidence)"
+                "option `require_confident_head` needs option `head_source` estimated (only the image-based estimate has a confidence)"
             );
         }
         let mut base = scene.clone();
@@ -288,7 +291,7 @@ impl SystemLoop {
                         .is_confident_at(run.min_head_confidence)
                 {
                     bail!(
-                        "--require-confident-head: {}",
+                        "option `require_confident_head`: {}",
                         fix.detection
                             .confidence
                             .warning(&format!("at t = {} s: ", short(t)))
@@ -352,7 +355,7 @@ impl SystemLoop {
         let byo = self.options.byo.clone();
         if byo.maps.is_some() && (curved || run.display == DisplayModel::Ideal) {
             bail!(
-                "--maps shows a map on a flat display's pixels: not with a curved display or --display ideal"
+                "option `maps` shows a map on a flat display's pixels: not with a curved display or option `display` ideal"
             );
         }
         // A curved display renders only the frontal pixels its model points read, as a flat
@@ -432,7 +435,7 @@ impl SystemLoop {
         let display = if let Some(named) = external {
             let named = named.with_context(|| {
                 format!(
-                    "--maps: no map for refresh {} (frame {frame})",
+                    "option `maps`: no map for refresh {} (frame {frame})",
                     times.refresh
                 )
             })?;

@@ -56,15 +56,15 @@ impl Timeline {
         };
         if !(self.duration > 0.0 && self.duration <= MAX_DURATION_S) {
             bail!(
-                "--duration must be in (0, {MAX_DURATION_S}] s, got {}",
+                "option `duration` must be in (0, {MAX_DURATION_S}] s, got {}",
                 short(self.duration)
             );
         }
-        rate("--fps", self.fps)?;
-        rate("--display-hz", self.display_hz)?;
+        rate("option `fps`", self.fps)?;
+        rate("option `display_hz`", self.display_hz)?;
         for (name, v) in [
-            ("--latency-camera", self.latency_camera),
-            ("--latency-tracking", self.latency_tracking),
+            ("option `latency_camera`", self.latency_camera),
+            ("option `latency_tracking`", self.latency_tracking),
         ] {
             if !(v >= 0.0 && v < self.duration) {
                 bail!(
@@ -76,7 +76,7 @@ impl Timeline {
         }
         if self.frames() > MAX_FRAMES {
             bail!(
-                "--duration × --fps gives {} frames, more than the limit of {MAX_FRAMES}",
+                "option `duration` × option `fps` gives {} frames, more than the limit of {MAX_FRAMES}",
                 self.frames()
             );
         }
@@ -252,7 +252,10 @@ mod tests {
                 .validate()
                 .unwrap_err()
                 .to_string();
-            assert!(err.starts_with("--duration must be in (0, 3600]"), "{err}");
+            assert!(
+                err.starts_with("option `duration` must be in (0, 3600]"),
+                "{err}"
+            );
         }
         // The longest sequence, at a rate that keeps it within the frame limit.
         let longest = Timeline {
