@@ -20,6 +20,7 @@ pub mod metrics;
 pub mod metrics_json;
 pub mod misregistration;
 pub mod option_table;
+pub mod option_value;
 pub mod picture_layers;
 pub mod ratio;
 pub mod ratio_setup;

@@ -11,6 +11,7 @@
 //! `hazard_bound_arcmin`); what only a front end has (output folders, EXR contents, threads,
 //! progress) is that front end's.
 
+pub use crate::measure::option_value::{Default, Kind, Value, choice_of, choice_values};
 use crate::render::settings::MAX_SPP;
 use crate::scene::limits::{MAX_COORDINATE, MIN_LENGTH};
 use crate::scene::source::MAX_RESOLUTION;
@@ -19,7 +20,6 @@ use crate::system::display::{DisplayModel, Filter};
 use crate::system::eyes::{Eye, MAX_IPD, Viewing};
 use crate::system::options::{HeadSource, MAX_HEAD_BIAS_CM, Method, Outside};
 use crate::system::scene_model_options::Fill;
-use crate::util::number::short;
 
 /// The commands whose options the table declares (with the Python functions of the same
 /// names).
@@ -55,77 +55,6 @@ impl Command {
     }
 }
 
-/// The type of an option's value, with its range or choices.
-#[derive(Clone, Copy, Debug)]
-pub enum Kind {
-    /// An integer in `[min, max]`.
-    Integer { min: u64, max: u64 },
-    /// A finite number in `[min, max]`.
-    Real { min: f64, max: f64 },
-    /// Three numbers x, y, z, each in `[-max, max]`.
-    Triple { max: f64 },
-    /// `inf`, `auto` or metres in `[min, max]`: a working distance.
-    Distance { min: f64, max: f64 },
-    /// One of a fixed list of names, each with its help (a `clap::ValueEnum`'s variants).
-    Choice(fn() -> Vec<clap::builder::PossibleValue>),
-    /// On or off: a flag without a value on the command line, a bool in Python.
-    Switch,
-}
-
-/// A value enum's variants as typed (`plane-fit`), with their doc comments as help.
-pub fn choice_values<T: clap::ValueEnum>() -> Vec<clap::builder::PossibleValue> {
-    T::value_variants()
-        .iter()
-        .filter_map(|v| v.to_possible_value())
-        .collect()
-}
-
-/// The variant of `T` named `name` (one of [`choice_names`]).
-pub fn choice_of<T: clap::ValueEnum + Clone>(name: &str) -> Option<T> {
-    T::value_variants()
-        .iter()
-        .find(|v| v.to_possible_value().is_some_and(|p| p.get_name() == name))
-        .cloned()
-}
-
-/// An option's value, read and checked.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Value {
-    Integer(u64),
-    Real(f64),
-    Triple([f64; 3]),
-    /// `inf` is `f64::INFINITY`; `auto` is `None`.
-    Distance(Option<f64>),
-    Choice(String),
-    Switch(bool),
-}
-
-impl Value {
-    /// The value in JSON, as `seethru spec` prints it and `seethru.spec` returns it.
-    pub fn to_json(&self) -> serde_json::Value {
-        use serde_json::json;
-        match self {
-            Value::Integer(v) => json!(v),
-            Value::Real(v) => json!(v),
-            Value::Triple(v) => json!(v),
-            Value::Distance(None) => json!("auto"),
-            Value::Distance(Some(v)) if v.is_infinite() => json!("inf"),
-            Value::Distance(Some(v)) => json!(v),
-            Value::Choice(v) => json!(v),
-            Value::Switch(v) => json!(v),
-        }
-    }
-}
-
-/// What an option is when not given.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Default {
-    /// This value, written as on the command line.
-    Value(&'static str),
-    /// No value: the run takes it from elsewhere, as the text says (`the scene's`).
-    Derived(&'static str),
-}
-
 /// One option.
 #[derive(Clone, Copy, Debug)]
 pub struct OptionSpec {
@@ -144,42 +73,6 @@ pub struct OptionSpec {
     pub commands: &'static [Command],
 }
 
-impl Kind {
-    /// The names of a choice (`plane-fit`), none for another kind.
-    pub fn choices(&self) -> Vec<String> {
-        match self {
-            Kind::Choice(values) => values().iter().map(|p| p.get_name().to_string()).collect(),
-            _ => Vec::new(),
-        }
-    }
-
-    /// What a value must be, for errors and help: `an integer in [1, 16384]`.
-    pub fn need(&self) -> String {
-        match self {
-            Kind::Integer { min, max } => format!("an integer in [{min}, {max}]"),
-            Kind::Real { min, max } => format!("a number in [{}, {}]", short(*min), short(*max)),
-            Kind::Triple { max } => {
-                format!("x,y,z: three numbers in [{}, {}]", short(-max), short(*max))
-            }
-            Kind::Distance { min, max } => format!(
-                "inf, auto or a distance in metres in [{}, {}]",
-                short(*min),
-                short(*max)
-            ),
-            Kind::Choice(_) => format!("one of {}", self.choices().join(", ")),
-            Kind::Switch => "true or false".to_string(),
-        }
-    }
-}
-
-/// A finite number in `[min, max]` read from `text` (spaces around it ignored).
-fn real_in(text: &str, min: f64, max: f64) -> Option<f64> {
-    text.trim()
-        .parse::<f64>()
-        .ok()
-        .filter(|v| v.is_finite() && (min..=max).contains(v))
-}
-
 impl OptionSpec {
     /// The command line's flag: `--head-jitter-cm`.
     pub fn flag(&self) -> String {
@@ -189,39 +82,9 @@ impl OptionSpec {
     /// Reads a value written as on the command line (spaces around it ignored); the error
     /// says what it must be: `must be an integer in [1, 16384]`.
     pub fn parse(&self, text: &str) -> Result<Value, String> {
-        let t = text.trim();
-        let value = match self.kind {
-            Kind::Integer { min, max } => t
-                .parse::<u64>()
-                .ok()
-                .filter(|v| (min..=max).contains(v))
-                .map(Value::Integer),
-            Kind::Real { min, max } => real_in(t, min, max).map(Value::Real),
-            Kind::Triple { max } => {
-                let parts: Vec<Option<f64>> = t.split(',').map(|p| real_in(p, -max, max)).collect();
-                match parts.as_slice() {
-                    [Some(x), Some(y), Some(z)] => Some(Value::Triple([*x, *y, *z])),
-                    _ => None,
-                }
-            }
-            Kind::Distance { min, max } => match t {
-                "inf" | "infinity" => Some(Value::Distance(Some(f64::INFINITY))),
-                "auto" => Some(Value::Distance(None)),
-                _ => real_in(t, min, max).map(|v| Value::Distance(Some(v))),
-            },
-            Kind::Choice(_) => self
-                .kind
-                .choices()
-                .into_iter()
-                .find(|n| n == t)
-                .map(Value::Choice),
-            Kind::Switch => match t {
-                "true" => Some(Value::Switch(true)),
-                "false" => Some(Value::Switch(false)),
-                _ => None,
-            },
-        };
-        value.ok_or_else(|| format!("must be {}", self.kind.need()))
+        self.kind
+            .parse(text)
+            .ok_or_else(|| format!("must be {}", self.kind.need()))
     }
 
     /// The default value, `None` where it is derived.

@@ -4,11 +4,11 @@
 //! for the front end to spell (`--eyes`, `eyes=`).
 
 use crate::measure::measured_run::MeasureSettings;
-use crate::measure::option_table::{Command, OptionSpec, Value, choice_of, options_of};
+use crate::measure::option_table::{Command, OptionSpec, Value, options_of};
 use crate::system::depth_sensor::SensorKind;
 use crate::system::display::{DisplayModel, Filter};
 use crate::system::eyes::{Eye, Viewing};
-use crate::system::options::{HeadSource, Method, Outside, RunOptions, WorkingDistance};
+use crate::system::options::{HeadSource, Method, Outside, RunOptions};
 use crate::system::reads::{ReadWhen, capture_reads, first_ignored, run_reads};
 use crate::system::scene_model_options::Fill;
 
@@ -191,53 +191,6 @@ impl RunSpec {
             })
             .collect();
         serde_json::json!({"command": self.command.name(), "options": options})
-    }
-}
-
-/// The typed reads of a value whose kind the table fixes (a mismatch is a bug of the table,
-/// which `every_option_reaches_the_run` walks).
-impl Value {
-    pub fn integer(&self) -> u64 {
-        match self {
-            Value::Integer(v) => *v,
-            other => unreachable!("an integer option holds {other:?}"),
-        }
-    }
-
-    pub fn working_distance(&self) -> WorkingDistance {
-        match self {
-            Value::Distance(None) => WorkingDistance::Auto,
-            Value::Distance(Some(v)) if v.is_infinite() => WorkingDistance::Infinity,
-            _ => WorkingDistance::Metres(self.real()),
-        }
-    }
-
-    pub fn real(&self) -> f64 {
-        match self {
-            Value::Real(v) | Value::Distance(Some(v)) => *v,
-            other => unreachable!("a number option holds {other:?}"),
-        }
-    }
-
-    pub fn triple(&self) -> [f64; 3] {
-        match self {
-            Value::Triple(v) => *v,
-            other => unreachable!("a triple option holds {other:?}"),
-        }
-    }
-
-    pub fn switch(&self) -> bool {
-        match self {
-            Value::Switch(v) => *v,
-            other => unreachable!("a switch holds {other:?}"),
-        }
-    }
-
-    pub fn choice<T: clap::ValueEnum + Clone>(&self) -> T {
-        match self {
-            Value::Choice(name) => choice_of(name).expect("a choice of the option's list"),
-            other => unreachable!("a choice option holds {other:?}"),
-        }
     }
 }
 
