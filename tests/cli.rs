@@ -78,7 +78,7 @@ fn bad_input_gives_one_line_and_no_output() {
                 "--width",
                 "0",
             ],
-            "error: invalid value '0' for '--width <WIDTH>': must be an integer in [1, 16384]"
+            "error: invalid value '0' for '--width <PIXELS>': must be an integer in [1, 16384]"
                 .into(),
         ),
         (

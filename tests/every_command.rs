@@ -513,7 +513,7 @@ fn every_command_on_every_bundled_scene_exits_cleanly_or_with_one_error_line() {
         }]
     };
     groups.push(once("analyze", words(&["analyze", "--quiet"])));
-    for command in ["run", "capture", "compare", "sequence"] {
+    for command in ["run", "capture", "compare", "sequence", "render"] {
         groups.push(once(
             &format!("spec {command}"),
             words(&["spec", command, "--quiet"]),

@@ -53,6 +53,7 @@ fn command_line_only(command: Command) -> &'static [&'static str] {
             "maps",
             "help",
         ],
+        Command::Render => &["view", "out", "exr", "threads", "quiet", "help"],
     }
 }
 
@@ -100,9 +101,18 @@ fn python_annotation(option: &OptionSpec, command: Command) -> String {
     format!("{ty} = {default}")
 }
 
+/// The indentation of a command's keywords in the stubs: `Scene.render` is a method.
+fn stub_indent(command: Command) -> &'static str {
+    match command {
+        Command::Render => "        ",
+        _ => "    ",
+    }
+}
+
 fn stub_block(command: Command) -> String {
+    let indent = stub_indent(command);
     let mut block = format!(
-        "    # The option table's ({}): tests/option_table.rs checks it (SEETHRU_BLESS=1 rewrites it).\n",
+        "{indent}# The option table's ({}): tests/option_table.rs checks it (SEETHRU_BLESS=1 rewrites it).\n",
         command.name()
     );
     // A capture's `depth` is a parameter of its own, before the keywords.
@@ -110,12 +120,12 @@ fn stub_block(command: Command) -> String {
         options_of(command).filter(|o| !(command == Command::Capture && o.name == "depth"))
     {
         block.push_str(&format!(
-            "    {}: {},\n",
+            "{indent}{}: {},\n",
             option.name,
             python_annotation(option, command)
         ));
     }
-    block.push_str("    # End of the option table's.\n");
+    block.push_str(&format!("{indent}# End of the option table's.\n"));
     block
 }
 
@@ -213,13 +223,14 @@ fn the_options_page_is_the_tables() {
 fn the_python_stubs_declare_the_tables_keywords() {
     let path = common::repo_path("python/seethru/__init__.pyi");
     let mut stubs = std::fs::read_to_string(&path).unwrap();
-    let start = |c: Command| format!("    # The option table's ({}):", c.name());
-    let end = "    # End of the option table's.\n";
+    let start = |c: Command| format!("{}# The option table's ({}):", stub_indent(c), c.name());
+    let end = |c: Command| format!("{}# End of the option table's.\n", stub_indent(c));
     for command in Command::ALL {
         let at = stubs
             .find(&start(command))
             .unwrap_or_else(|| panic!("the stubs have no table block for {}", command.name()));
-        let stop = at + stubs[at..].find(end).expect("the block's end") + end.len();
+        let stop =
+            at + stubs[at..].find(&end(command)).expect("the block's end") + end(command).len();
         let expected = stub_block(command);
         if blessing() {
             stubs.replace_range(at..stop, &expected);

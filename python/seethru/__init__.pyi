@@ -64,9 +64,12 @@ class Scene:
     def render(
         self,
         view: View,
+        # The option table's (render): tests/option_table.rs checks it (SEETHRU_BLESS=1 rewrites it).
         width: int | None = None,
         height: int | None = None,
         spp: int = 4,
+        max_memory: float = 8.0,
+        # End of the option table's.
         out: Frame | None = None,
     ) -> Frame:
         """Renders a view as `seethru render` does (GIL released; Ctrl-C stops it).
@@ -139,7 +142,7 @@ def options() -> list[dict[str, Any]]:
     {"sequence": 1} for spp), help, read_with and commands per option, in `seethru run
     --help`'s order."""
 
-def spec(command: Literal["run", "capture", "compare", "sequence"], **options: Any) -> dict[str, Any]:
+def spec(command: Literal["run", "capture", "compare", "sequence", "render"], **options: Any) -> dict[str, Any]:
     """The run specification `command` would make of `options`, every option checked and
     nothing rendered ({"command", "options": {name: value}}), as `seethru spec` prints it."""
 

@@ -15,7 +15,7 @@ fn command_named(name: &str) -> PyResult<Command> {
         .find(|c| c.name() == name)
         .ok_or_else(|| {
             bad_value(format!(
-                "command={name:?} is not one of run, capture, compare, sequence"
+                "command={name:?} is not one of run, capture, compare, sequence, render"
             ))
         })
 }

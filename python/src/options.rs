@@ -7,7 +7,6 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict};
 use seethru::measure::option_table::{Command, Kind, OptionSpec, Value, option, options_of};
 use seethru::measure::run_spec::{RunSpec, SpecError};
-use seethru::scene::source::MAX_RESOLUTION;
 use seethru::system::options::MAX_HEAD_BIAS_CM;
 
 use crate::errors::bad_value;
@@ -28,12 +27,6 @@ pub fn real_in(key: &str, v: f64, min: f64, max: f64) -> PyResult<f64> {
             "{key}={v} is out of range: must be a number in [{min}, {max}]"
         ))),
     }
-}
-
-/// An optional image side, pixels in [1, 16384].
-pub fn pixels(key: &str, v: Option<i64>) -> PyResult<Option<u32>> {
-    v.map(|v| int_in(key, v, 1, MAX_RESOLUTION as i64).map(|v| v as u32))
-        .transpose()
 }
 
 fn choice<T: ValueEnum>(key: &str, value: &str) -> PyResult<T> {
@@ -81,6 +74,24 @@ pub fn run_spec(
             if let Some(value) = value_of(option, &value)? {
                 given.push((option, value));
             }
+        }
+    }
+    RunSpec::build(command, &given).map_err(spelled)
+}
+
+/// The run specification of `command` from named Python values (each read by its table
+/// option's parser); a value None is not given.
+pub fn spec_of(
+    command: Command,
+    values: &[(&'static str, Option<&Bound<'_, PyAny>>)],
+) -> PyResult<RunSpec> {
+    let mut given = Vec::new();
+    for (name, value) in values {
+        let spec = option(name).unwrap_or_else(|| panic!("{name} is not in the option table"));
+        if let Some(value) = value.filter(|v| !v.is_none())
+            && let Some(value) = value_of(spec, value)?
+        {
+            given.push((spec, value));
         }
     }
     RunSpec::build(command, &given).map_err(spelled)

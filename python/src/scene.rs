@@ -9,20 +9,21 @@ use numpy::PyArray2;
 use numpy::ndarray::Array2;
 use pyo3::prelude::*;
 use seethru::geometry::camera::Camera;
+use seethru::measure::option_table::Command;
 use seethru::render::frame::Frame;
 use seethru::render::integrator::RenderContext;
 use seethru::render::render_job::RenderJob;
-use seethru::render::settings::{MAX_SPP, RenderSettings, resized};
+use seethru::render::settings::{RenderSettings, resized};
 use seethru::render::views::View;
 use seethru::scene::Scene;
 use seethru::scene::limits::{MAX_COORDINATE, MAX_DISPLAY_SIZE, MIN_LENGTH};
-use seethru::system::memory::{DEFAULT_MAX_MEMORY_GIB, check_memory, render_estimate};
+use seethru::system::memory::{check_memory, render_estimate};
 
 use crate::errors::{bad_value, to_py};
 use crate::frame::PyFrame;
 use crate::frame_pool;
 use crate::interrupt::detached;
-use crate::options::{int_in, pixels};
+use crate::options::spec_of;
 
 /// Largest deviation of a pose's rotation from orthonormal that is accepted.
 const ROTATION_TOLERANCE: f64 = 1e-6;
@@ -236,25 +237,42 @@ impl PyScene {
     /// Renders one view (truth, occluded, frontal, back) as `seethru render` does, into a
     /// new frame (its buffers recycled from frames Python has dropped, [`crate::frame_pool`])
     /// or, with `out`, into that frame's own arrays, which it returns.
-    #[pyo3(signature = (view, width=None, height=None, spp=4, out=None))]
+    /// The size, samples and memory bound are the option table's (`seethru render`'s flags).
+    #[pyo3(signature = (view, width=None, height=None, spp=None, max_memory=None, out=None))]
+    #[allow(clippy::too_many_arguments)]
     fn render(
         slf: &Bound<'_, Self>,
         view: &str,
-        width: Option<i64>,
-        height: Option<i64>,
-        spp: i64,
+        width: Option<Bound<'_, PyAny>>,
+        height: Option<Bound<'_, PyAny>>,
+        spp: Option<Bound<'_, PyAny>>,
+        max_memory: Option<Bound<'_, PyAny>>,
         out: Option<Bound<'_, PyFrame>>,
     ) -> PyResult<Py<PyFrame>> {
         let py = slf.py();
         let view = parse_view(view)?;
-        let spp = int_in("spp", spp, 1, MAX_SPP as i64)? as u32;
-        let (width, height) = (pixels("width", width)?, pixels("height", height)?);
+        let spec = spec_of(
+            Command::Render,
+            &[
+                ("width", width.as_ref()),
+                ("height", height.as_ref()),
+                ("spp", spp.as_ref()),
+                ("max_memory", max_memory.as_ref()),
+            ],
+        )?;
+        let options = &spec.options;
+        let (width, height, spp) = (options.width, options.height, options.spp);
         let (scene, cached) = {
             let this = slf.borrow();
             (this.scene.clone(), this.context.clone())
         };
-        let camera =
-            resized(view.camera(&scene), width, height, "--width/--height").map_err(to_py)?;
+        let camera = resized(
+            view.camera(&scene),
+            width,
+            height,
+            "option `width`/option `height`",
+        )
+        .map_err(to_py)?;
         let settings = RenderSettings {
             spp,
             progress: false,
@@ -281,7 +299,7 @@ impl PyScene {
                 Ok(out.unbind())
             }
             None => {
-                check_memory(&render_estimate(&[camera]), DEFAULT_MAX_MEMORY_GIB).map_err(to_py)?;
+                check_memory(&render_estimate(&[camera]), spec.max_memory_gib).map_err(to_py)?;
                 let (context, frame) = detached(py, move || -> anyhow::Result<_> {
                     let mut frame = frame_pool::take(camera.width, camera.height);
                     let context = render(&mut frame)?;

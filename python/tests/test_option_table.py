@@ -15,7 +15,7 @@ from conftest import REPO, seethru_cli
 from test_run_options import keyword_names
 
 OPTIONS = seethru.options()
-COMMANDS = ["run", "capture", "compare", "sequence"]
+COMMANDS = ["run", "capture", "compare", "sequence", "render"]
 
 
 def text(value) -> str:

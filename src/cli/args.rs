@@ -93,28 +93,7 @@ pub fn head_bias_cm(text: &str) -> Result<[f64; 3], String> {
     }
 }
 
-/// Image size, samples and threads: shared by `render` and `run`.
-#[derive(clap::Args)]
-pub struct RenderArgs {
-    /// Image width, pixels in [1, 16384] (default: the camera's; the height follows the aspect
-    /// ratio if not given).
-    #[arg(long, value_parser = pixels)]
-    pub width: Option<u32>,
-    /// Image height, pixels in [1, 16384] (default: from the width and the camera's aspect).
-    #[arg(long, value_parser = pixels)]
-    pub height: Option<u32>,
-    /// Samples per pixel in [1, 4096] (anti-aliasing of the colour; AOVs are at pixel centres).
-    #[arg(long, default_value_t = 4, value_parser = samples)]
-    pub spp: u32,
-    /// Worker threads in [1, 1024] (default: all cores). Images are identical for any value.
-    #[arg(long, value_parser = threads)]
-    pub threads: Option<usize>,
-    /// Refuse to start when the estimated memory exceeds this, GiB in [1e-6, 4096].
-    #[arg(long = "max-memory", value_name = "GIB", default_value_t = DEFAULT_MAX_MEMORY_GIB, value_parser = max_memory)]
-    pub max_memory: f64,
-}
-
-/// `--max-memory` of a command that renders without [`RenderArgs`] (`ratio`, `bench`,
+/// `--max-memory` of a command that renders without the option table (`ratio`, `bench`,
 /// `reproduce`).
 #[derive(clap::Args, Clone, Copy, Debug)]
 pub struct MemoryLimit {

@@ -26,6 +26,8 @@ pub struct Capture;
 pub struct Compare;
 /// The options `seethru sequence` shares with a run.
 pub struct Sequence;
+/// `seethru render`'s size, samples and memory bound.
+pub struct Render;
 
 impl TableCommand for Run {
     const COMMAND: Command = Command::Run;
@@ -38,6 +40,9 @@ impl TableCommand for Compare {
 }
 impl TableCommand for Sequence {
     const COMMAND: Command = Command::Sequence;
+}
+impl TableCommand for Render {
+    const COMMAND: Command = Command::Render;
 }
 
 /// The table's options of command `C` given on the command line.

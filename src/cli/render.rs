@@ -6,14 +6,16 @@ use anyhow::Result;
 use seethru::io::frame_files::{ExrContent, write_frame};
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
+use seethru::measure::run_spec::RunSpec;
 use seethru::render::integrator::RenderContext;
 use seethru::render::render_job::RenderJob;
-use seethru::render::settings::{RenderSettings, check_spp, resized};
+use seethru::render::settings::{RenderSettings, resized};
 use seethru::render::views::View;
 use seethru::scene::Scene;
 use seethru::system::memory::{check_memory, render_estimate};
 
-use crate::cli::args::{RenderArgs, choice, with_threads};
+use crate::cli::args::{choice, threads, with_threads};
+use crate::cli::option_args::{self, OptionArgs};
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -30,8 +32,12 @@ pub struct Render {
     /// ids) or all (every AOV).
     #[arg(long, value_enum, value_parser = choice::<ExrContent>(), default_value_t = ExrContent::All)]
     exr: ExrContent,
+    /// The size, samples and memory bound, from the option table.
     #[command(flatten)]
-    render: RenderArgs,
+    options: OptionArgs<option_args::Render>,
+    /// Worker threads in [1, 1024] (default: all cores). Images are identical for any value.
+    #[arg(long, value_parser = threads)]
+    threads: Option<usize>,
 }
 
 impl Render {
@@ -45,8 +51,9 @@ impl Render {
         } else {
             self.views.clone()
         };
-        with_threads(self.render.threads, || {
-            render_views(&self.scene, &views, &self.out, &self.render, self.exr)
+        let spec = self.options.spec()?;
+        with_threads(self.threads, || {
+            render_views(&self.scene, &views, &self.out, &spec, self.exr)
         })?
     }
 }
@@ -56,10 +63,10 @@ fn render_views(
     scene_path: &Path,
     views: &[View],
     out: &Path,
-    options: &RenderArgs,
+    spec: &RunSpec,
     exr: ExrContent,
 ) -> Result<()> {
-    check_spp(options.spp)?;
+    let options = &spec.options;
     let scene = Scene::load(scene_path)?;
     // Check every camera before the first (possibly long) render.
     let cameras = views
@@ -69,11 +76,11 @@ fn render_views(
                 v.camera(&scene),
                 options.width,
                 options.height,
-                "--width/--height",
+                "option `width`/option `height`",
             )
         })
         .collect::<Result<Vec<_>>>()?;
-    check_memory(&render_estimate(&cameras), options.max_memory)?;
+    check_memory(&render_estimate(&cameras), spec.max_memory_gib)?;
     let context = RenderContext::new(scene)?;
     // Written whole or not at all: a failure leaves `out` as it was.
     let staged = StagedDir::new(out)?;

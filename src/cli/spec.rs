@@ -1,7 +1,7 @@
-//! `seethru spec`: the run specification that `seethru run`, `capture`, `compare` or
-//! `sequence` would make of these options, as JSON, after every check of them: nothing is
-//! loaded or rendered.
-//! `seethru.spec` in Python returns the same, so a script can check its options first.
+//! `seethru spec`: the run specification that `seethru run`, `capture`, `compare`,
+//! `sequence` or `render` would make of these options, as JSON, after every check of them:
+//! nothing is loaded or rendered. `seethru.spec` in Python returns the same, so a script can
+//! check its options first.
 
 use anyhow::Result;
 
@@ -23,6 +23,8 @@ pub enum Spec {
     /// the timeline, the motions, the head's source; and less the rules that read those).
     #[command(allow_negative_numbers = true)]
     Sequence(OptionArgs<option_args::Sequence>),
+    /// `seethru render`'s size, samples and memory bound.
+    Render(OptionArgs<option_args::Render>),
 }
 
 impl Spec {
@@ -32,6 +34,7 @@ impl Spec {
             Spec::Capture(options) => options.spec()?,
             Spec::Compare(options) => options.spec()?,
             Spec::Sequence(options) => options.spec()?,
+            Spec::Render(options) => options.spec()?,
         };
         println!("{}", serde_json::to_string_pretty(&spec.to_json())?);
         Ok(())

@@ -34,23 +34,28 @@ pub enum Command {
     /// `seethru sequence`, `seethru.sequence`: the options it shares with a run (its own,
     /// the timeline's and the head's motion, are its front ends').
     Sequence,
+    /// `seethru render`, `Scene.render`: the size, samples and memory bound of the views it
+    /// renders.
+    Render,
 }
 
 impl Command {
-    pub const ALL: [Command; 4] = [
+    pub const ALL: [Command; 5] = [
         Command::Run,
         Command::Capture,
         Command::Compare,
         Command::Sequence,
+        Command::Render,
     ];
 
-    /// `run`, `capture`, `compare`, `sequence`.
+    /// `run`, `capture`, `compare`, `sequence`, `render`.
     pub fn name(self) -> &'static str {
         match self {
             Command::Run => "run",
             Command::Capture => "capture",
             Command::Compare => "compare",
             Command::Sequence => "sequence",
+            Command::Render => "render",
         }
     }
 }
@@ -138,11 +143,20 @@ const PIXELS: Kind = Kind::Integer {
     min: 1,
     max: MAX_RESOLUTION as u64,
 };
+/// The commands that run the system: each but `render`.
+const RUNS: &[Command] = &[
+    Command::Run,
+    Command::Capture,
+    Command::Compare,
+    Command::Sequence,
+];
+/// Every command: an image's size, samples and memory bound.
 const ALL: &[Command] = &[
     Command::Run,
     Command::Capture,
     Command::Compare,
     Command::Sequence,
+    Command::Render,
 ];
 /// Run, capture and compare: a sequence takes its head's source as `head_source`.
 const SINGLE_FRAMES: &[Command] = &[Command::Run, Command::Capture, Command::Compare];
@@ -165,6 +179,16 @@ pub static COMMAND_DEFAULTS: &[(Command, &str, Default)] = &[
     ),
     (Command::Sequence, "width", Default::Value("640")),
     (Command::Sequence, "spp", Default::Value("1")),
+    (
+        Command::Render,
+        "width",
+        Default::Derived("each view's camera's"),
+    ),
+    (
+        Command::Render,
+        "height",
+        Default::Derived("from the width and each view's camera's aspect"),
+    ),
 ];
 const ESTIMATED: &[(&str, &str)] = &[("head", "estimated")];
 /// The scene model's depth sensor is read by `method` depth in a run, by `depth` in a capture.
@@ -176,8 +200,8 @@ const NOISY_DEPTH: &[(&str, &str)] = &[
     ("depth_sensor", "tof"),
 ];
 
-/// The table: every option of `run`, `capture` and `compare`, and those `sequence` shares
-/// with them, in `seethru run --help`'s order.
+/// The table: every option of `run`, `capture` and `compare`, and those `sequence` and
+/// `render` share with them, in `seethru run --help`'s order.
 pub static OPTIONS: &[OptionSpec] = &[
     OptionSpec {
         name: "method",
@@ -242,7 +266,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Value("1"),
         help: "Seed of the head jitter, the tracker model's noise, the depth sensor's noise and the plane fit.",
         read_with: &[("head_jitter_cm", "1")],
-        commands: ALL,
+        commands: RUNS,
     },
     OptionSpec {
         name: "feature_width",
@@ -308,7 +332,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Derived("the scene's"),
         help: "Frontal camera width (aspect ratio kept).",
         read_with: &[],
-        commands: ALL,
+        commands: RUNS,
     },
     OptionSpec {
         name: "back_width",
@@ -317,7 +341,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         default: Default::Derived("the scene's"),
         help: "Back camera width (aspect ratio kept).",
         read_with: &[],
-        commands: ALL,
+        commands: RUNS,
     },
     OptionSpec {
         name: "eyes",
@@ -447,7 +471,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         kind: PIXELS,
         unit: "pixels",
         default: Default::Derived("the driver camera's"),
-        help: "Width of the driver's views (truth, occluded, seethru).",
+        help: "Width of the views rendered (a run's: the driver's truth, occluded and seethru views).",
         read_with: &[],
         commands: ALL,
     },
@@ -456,7 +480,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         kind: PIXELS,
         unit: "pixels",
         default: Default::Derived("from the width and the driver camera's aspect"),
-        help: "Height of the driver's views.",
+        help: "Height of the views rendered.",
         read_with: &[],
         commands: ALL,
     },

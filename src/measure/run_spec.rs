@@ -122,7 +122,7 @@ impl RunSpec {
             Command::Capture => capture_reads(&spec.options, spec.depth),
             // A sequence's rules need its own options too (the head's motion, the maps): its
             // front ends apply `sequence_reads` to the run this builds.
-            Command::Compare | Command::Sequence => Vec::new(),
+            Command::Compare | Command::Sequence | Command::Render => Vec::new(),
         };
         spec.refuse_ignored(&rules)?;
         Ok(spec)
