@@ -535,6 +535,24 @@ mod tests {
     }
 
     #[test]
+    fn a_commands_own_default_is_of_an_option_it_takes_and_differs_from_the_tables() {
+        for (command, name, default) in COMMAND_DEFAULTS {
+            let o = option(name).unwrap_or_else(|| panic!("{name}"));
+            assert!(o.taken_by(*command), "{} {name}", command.name());
+            assert_ne!(*default, o.default, "{} {name}", command.name());
+            assert_eq!(o.default_for(*command), *default);
+            let _ = o.default_value_for(*command);
+        }
+        // The others keep the table's.
+        let spp = option("spp").unwrap();
+        assert_eq!(spp.default_for(Command::Run), spp.default);
+        assert_eq!(
+            spp.default_value_for(Command::Sequence),
+            Some(Value::Integer(1))
+        );
+    }
+
+    #[test]
     fn names_are_unique_and_every_command_takes_some() {
         for (i, o) in OPTIONS.iter().enumerate() {
             assert!(OPTIONS[..i].iter().all(|p| p.name != o.name), "{}", o.name);
