@@ -10,7 +10,8 @@ use seethru::analysis::{
     paper::{ForeshorteningParams, OcclusionParams},
     physical,
 };
-use seethru::measure::metrics::{MetricMaps, measure};
+use seethru::measure::image_metrics::Flip;
+use seethru::measure::metrics::{MetricMaps, measure, measure_with};
 use seethru::measure::{
     ratio::{RatioResult, measure_ratio},
     ratio_setup::{Compensation, Setup, build_scene},
@@ -640,6 +641,17 @@ fn coverage_counts_the_blank_pixels_and_the_image_metrics_see_them() {
         outside > 300 && reported.abs_diff(outside) <= unsure,
         "{reported} vs {outside}"
     );
+    // The fraction missing: of the display's pixels, those whose truth the frontal camera
+    // cannot see (as the map marks them).
+    let missing = (0..maps.display.len())
+        .filter(|&i| maps.display[i] && maps.missing[i])
+        .count();
+    assert!(missing > 300, "{missing}");
+    let fraction = json["missing"]["fraction"].as_f64().unwrap();
+    assert!(
+        (fraction - missing as f64 / display as f64).abs() < 1e-12,
+        "{fraction} vs {missing} of {display}"
+    );
     let reported = json["blank_pixels"].as_u64().unwrap() as usize;
     assert!(
         reported.abs_diff(blank) <= ambiguous,
@@ -689,6 +701,12 @@ fn coverage_counts_the_blank_pixels_and_the_image_metrics_see_them() {
         (mean_error - reported).abs() < 1e-9,
         "{mean_error} vs {reported}"
     );
+    // FLIP left out (a sequence without `flip`): the record says so and every flip_mean is
+    // NaN (null); computed, neither.
+    let skipped = measure_with(&ctx, &ctx.scene, eye, r.measured_views(), 5, Flip::Skipped).1;
+    assert!(skipped.flip_not_computed.is_some() && skipped.display.flip_mean.is_nan());
+    let computed = measure(&ctx, &ctx.scene, eye, r.measured_views(), 5).1;
+    assert!(computed.flip_not_computed.is_none() && computed.display.flip_mean.is_finite());
 }
 
 /// Both frames with every pixel outside `mask` replaced by a pattern unlike anything inside.
