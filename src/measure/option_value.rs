@@ -195,3 +195,28 @@ impl Value {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn a_distance_is_written_as_given() {
+        assert_eq!(Value::Distance(Some(6.0)).to_json(), json!(6.0));
+        assert_eq!(Value::Distance(Some(f64::INFINITY)).to_json(), json!("inf"));
+        assert_eq!(Value::Distance(None).to_json(), json!("auto"));
+        assert_eq!(
+            Value::Distance(Some(6.0)).working_distance(),
+            WorkingDistance::Metres(6.0)
+        );
+        assert_eq!(
+            Value::Distance(Some(f64::INFINITY)).working_distance(),
+            WorkingDistance::Infinity
+        );
+        assert_eq!(
+            Value::Distance(None).working_distance(),
+            WorkingDistance::Auto
+        );
+    }
+}
