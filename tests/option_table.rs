@@ -139,7 +139,7 @@ fn range_of(option: &OptionSpec) -> String {
 
 fn options_page() -> String {
     let mut page = String::from(
-        "# Options of run, capture, compare and sequence\n\n\
+        "# Options of run, capture, compare, sequence and render\n\n\
          Generated from the option table, `src/measure/option_table.rs`, by\n\
          `SEETHRU_BLESS=1 cargo test --release --test option_table` (the test fails when this page\n\
          and the table differ). Each option is a flag of the commands listed\n\
@@ -196,7 +196,8 @@ fn options_page() -> String {
          [the command line](command-line.md). A sequence takes the options it shares with a \
          run from this table, with its own defaults where they differ; its timeline, the \
          vehicle's and the head's motion and the head's source (`head_source`: a sequence's \
-         `head` is the head's motion) are its own (`seethru sequence --help`).\n",
+         `head` is the head's motion) are its own (`seethru sequence --help`). `render` (and \
+         `Scene.render`) takes the size, samples and memory bound of the views it renders.\n",
     );
     page
 }
