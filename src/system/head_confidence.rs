@@ -300,7 +300,7 @@ mod tests {
     fn a_well_seen_face_is_trusted_and_each_cue_alone_sinks_it() {
         let (b, p, a) = das_like();
         let c = HeadConfidence::of(b, p, a);
-        assert!(c.value > 0.95, "{c:?}");
+        assert!(c.value > 0.95 && c.is_confident(), "{c:?}");
         assert!((c.distance_ratio - 91.0 / (FACE_OVER_FEATURE * 38.6)).abs() < 1e-3);
         // das's own view angle (29°) changes nothing.
         assert_eq!(c.with_view(29.0).value, c.value);
