@@ -94,13 +94,7 @@ impl OptionSpec {
 
     /// The default value, `None` where it is derived.
     pub fn default_value(&self) -> Option<Value> {
-        match self.default {
-            Default::Value(text) => Some(
-                self.parse(text)
-                    .unwrap_or_else(|e| panic!("the table's default of {}: {e}", self.name)),
-            ),
-            Default::Derived(_) => None,
-        }
+        self.value_of_default(self.default)
     }
 
     /// What the option is when `command` is not given it: the table's default, or the
@@ -114,7 +108,12 @@ impl OptionSpec {
 
     /// The value of [`OptionSpec::default_for`] `command`, `None` where it is derived.
     pub fn default_value_for(&self, command: Command) -> Option<Value> {
-        match self.default_for(command) {
+        self.value_of_default(self.default_for(command))
+    }
+
+    /// The value of `default` (one of this option's), `None` where it is derived.
+    fn value_of_default(&self, default: Default) -> Option<Value> {
+        match default {
             Default::Value(text) => Some(
                 self.parse(text)
                     .unwrap_or_else(|e| panic!("the default of {}: {e}", self.name)),

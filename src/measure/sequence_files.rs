@@ -199,6 +199,7 @@ pub fn mean_of_frame_stats(run: &SequenceRun) -> [f64; 2] {
 pub fn summary(run: &SequenceRun, timeline: &Timeline) -> serde_json::Value {
     let m: Vec<FrameMetrics> = run.records.iter().filter_map(|r| r.metrics).collect();
     let frames = run.records.len() as f64;
+    let [frame_means, frame_p95] = mean_of_frame_stats(run);
     let errors: Vec<f64> = run
         .records
         .iter()
@@ -209,8 +210,8 @@ pub fn summary(run: &SequenceRun, timeline: &Timeline) -> serde_json::Value {
         "latency_camera_ms": timeline.latency_camera * 1e3,
         "latency_tracking_ms": timeline.latency_tracking * 1e3,
         "misregistration_arcmin": {
-            "mean_of_frame_means": mean_of_frame_stats(run)[0],
-            "mean_of_frame_p95": mean_of_frame_stats(run)[1],
+            "mean_of_frame_means": frame_means,
+            "mean_of_frame_p95": frame_p95,
             "max_of_frame_p95": m.iter().map(|x| x.p95_arcmin).fold(f64::NAN, f64::max),
             "max": m.iter().map(|x| x.max_arcmin).fold(f64::NAN, f64::max),
         },
