@@ -282,9 +282,28 @@ mod tests {
         ]
     }
 
-    /// `cue` alone failed: its score 0, every other score 1, and the confidence below
-    /// [`CONFIDENT_HEAD`], so a product that left that cue out would be caught here.
-    fn sunk_by_alone(c: &HeadConfidence, cue: &str) {
+    /// Which of the sentences of [`HeadConfidence::doubts`] `c` gets, each by a phrase of it.
+    fn sentences(c: &HeadConfidence) -> Vec<&'static str> {
+        const PHRASES: [&str; 10] = [
+            "px wide",
+            "outline off the fitted pose",
+            "distance from the pupils",
+            "another yaw",
+            "of the face's height",
+            "a fitted yaw",
+            "midpoint",
+            "off its front",
+            "of an iris's area",
+            "the size of the other",
+        ];
+        let doubts = c.doubts();
+        PHRASES.into_iter().filter(|p| doubts.contains(p)).collect()
+    }
+
+    /// `cue` alone failed: its score 0, every other score 1, the confidence below
+    /// [`CONFIDENT_HEAD`] (a product that left that cue out would be caught here), and the
+    /// warning names that cue alone, in the `sentence` that contains the given phrase.
+    fn sunk_by_alone(c: &HeadConfidence, cue: &str, sentence: &str) {
         for (name, score) in scores(c) {
             let expected = if name == cue { 0.0 } else { 1.0 };
             assert_eq!(score, expected, "{name} with {cue} failing: {c:?}");
@@ -293,7 +312,7 @@ mod tests {
             c.value < CONFIDENT_HEAD && !c.is_confident(),
             "{cue} alone should sink the confidence: {c:?}"
         );
-        assert!(!c.doubts().is_empty(), "{cue}: the warning names a doubt");
+        assert_eq!(sentences(c), [sentence], "{cue}: {}", c.doubts());
     }
 
     #[test]
@@ -301,6 +320,7 @@ mod tests {
         let (b, p, a) = das_like();
         let c = HeadConfidence::of(b, p, a);
         assert!(c.value > 0.95 && c.is_confident(), "{c:?}");
+        assert_eq!(c.doubts(), "", "every score 1: nothing to doubt");
         assert!((c.distance_ratio - 91.0 / (FACE_OVER_FEATURE * 38.6)).abs() < 1e-3);
         // das's own view angle (29°) changes nothing.
         assert_eq!(c.with_view(29.0).value, c.value);
@@ -316,15 +336,19 @@ mod tests {
             [DVec2::new(1.0, 3.0), DVec2::new(6.1, 3.0)],
             a,
         );
-        sunk_by_alone(&tiny, "face_size");
+        sunk_by_alone(&tiny, "face_size", "px wide");
         // Pupils 30% closer than the face's width says: the distances disagree.
         let close = [p[0], p[0] + (p[1] - p[0]) * 0.7];
-        sunk_by_alone(&HeadConfidence::of(b, close, a), "distance_agreement");
+        sunk_by_alone(
+            &HeadConfidence::of(b, close, a),
+            "distance_agreement",
+            "distance from the pupils",
+        );
         // "Pupils" near the chin (both: one alone would also lengthen their distance).
         let chin = 352.0 + 0.8 * 86.0;
         let low = [DVec2::new(p[0].x, chin), DVec2::new(p[1].x, chin)];
         let c = HeadConfidence::of(b, low, a);
-        sunk_by_alone(&c, "pupil_height");
+        sunk_by_alone(&c, "pupil_height", "of the face's height");
         assert!(
             c.doubts().contains("of the face's height"),
             "{}",
@@ -332,12 +356,16 @@ mod tests {
         );
         // Both pupils at the face's right edge.
         let right = [DVec2::new(170.0, 377.0), DVec2::new(208.6, 377.0)];
-        sunk_by_alone(&HeadConfidence::of(b, right, a), "symmetry");
+        sunk_by_alone(&HeadConfidence::of(b, right, a), "symmetry", "midpoint");
         // One blob a sixth of the other.
-        sunk_by_alone(&HeadConfidence::of(b, p, [8, 48]), "pupil_sizes");
+        sunk_by_alone(
+            &HeadConfidence::of(b, p, [8, 48]),
+            "pupil_sizes",
+            "the size of the other",
+        );
         // The face seen 60° off its front (a camera far to its side).
         let c = HeadConfidence::of(b, p, a).with_view(60.0);
-        sunk_by_alone(&c, "view");
+        sunk_by_alone(&c, "view", "off its front");
         assert!(c.doubts().contains("60° off its front"), "{}", c.doubts());
         // The ramp's limits: 1 up to 40°, 0 from 55°.
         assert_eq!(HeadConfidence::of(b, p, a).with_view(40.0).view, 1.0);
@@ -353,20 +381,34 @@ mod tests {
         let (rms, yaw, margin, iris) = (0.91, 20.0, 0.05, 40);
         let good = c.with_fit(rms, yaw, margin, iris);
         assert!(good.fitted && good.value == 1.0, "{good:?}");
+        assert_eq!(good.doubts(), "", "every score 1: nothing to doubt");
         // The outline 5% of the face's width off the fitted pose.
         sunk_by_alone(
             &c.with_fit(0.05 * 91.0, yaw, margin, iris),
             "distance_agreement",
+            "outline off the fitted pose",
         );
         // A fitted yaw of 60°: beyond 55° the far eye is behind the nose.
-        sunk_by_alone(&c.with_fit(rms, 60.0, margin, iris), "symmetry");
-        sunk_by_alone(&c.with_fit(rms, -60.0, margin, iris), "symmetry");
+        sunk_by_alone(
+            &c.with_fit(rms, 60.0, margin, iris),
+            "symmetry",
+            "a fitted yaw",
+        );
+        sunk_by_alone(
+            &c.with_fit(rms, -60.0, margin, iris),
+            "symmetry",
+            "a fitted yaw",
+        );
         // Another yaw fits as well (no margin).
         let c0 = c.with_fit(rms, yaw, 0.0, iris);
-        sunk_by_alone(&c0, "symmetry");
+        sunk_by_alone(&c0, "symmetry", "another yaw");
         assert!(c0.doubts().contains("another yaw"), "{}", c0.doubts());
         // The smaller pupil an eighth of an iris disc: half hidden by a lid.
-        sunk_by_alone(&c.with_fit(rms, yaw, margin, 5), "pupil_sizes");
+        sunk_by_alone(
+            &c.with_fit(rms, yaw, margin, 5),
+            "pupil_sizes",
+            "of an iris's area",
+        );
     }
 
     #[test]
@@ -390,6 +432,89 @@ mod tests {
             "{}",
             far.doubts()
         );
+    }
+
+    #[test]
+    fn the_warning_names_each_cue_only_below_its_full_score() {
+        let (b, p, a) = das_like();
+        let c = HeadConfidence::of(b, p, a);
+        // Just below each full score, its sentence alone: the face 39 px wide (every
+        // proportion kept), the distances' ratio e^0.065, the pupils at 46% of the
+        // face's height, their midpoint 0.36 face widths off centre, one blob 0.49 of the
+        // other, the face seen 41° off its front.
+        let scale = 39.0 / 91.0;
+        let scaled = |v: DVec2| (v - DVec2::new(85.0, 352.0)) * scale;
+        let narrow = HeadConfidence::of([0, 0, 39, 37], p.map(scaled), a);
+        let apart = [
+            p[0],
+            p[0] + (p[1] - p[0]) * c.distance_ratio * (-0.065f64).exp(),
+        ];
+        let lower = p.map(|v| DVec2::new(v.x, 352.0 + 0.46 * 86.0));
+        // The midpoint moved to `offset` face widths right of the box's centre (x = 130.5).
+        let off_centre = |q: [DVec2; 2], offset: f64| {
+            let shift = 130.5 + offset * 91.0 - (q[0].x + q[1].x) / 2.0;
+            q.map(|v| v + DVec2::new(shift, 0.0))
+        };
+        let aside = off_centre(p, 0.36);
+        for (case, c, cue, sentence) in [
+            ("narrow", narrow, "face_size", "px wide"),
+            (
+                "apart",
+                HeadConfidence::of(b, apart, a),
+                "distance_agreement",
+                "distance from the pupils",
+            ),
+            (
+                "lower",
+                HeadConfidence::of(b, lower, a),
+                "pupil_height",
+                "of the face's height",
+            ),
+            (
+                "aside",
+                HeadConfidence::of(b, aside, a),
+                "symmetry",
+                "midpoint",
+            ),
+            (
+                "blobs",
+                HeadConfidence::of(b, p, [49, 100]),
+                "pupil_sizes",
+                "the size of the other",
+            ),
+            ("view", c.with_view(41.0), "view", "off its front"),
+        ] {
+            for (name, score) in scores(&c) {
+                let below = name == cue;
+                assert!(
+                    if below {
+                        score > 0.9 && score < 1.0
+                    } else {
+                        score == 1.0
+                    },
+                    "{case}: {name} = {score}: {c:?}"
+                );
+            }
+            assert_eq!(sentences(&c), [sentence], "{case}: {}", c.doubts());
+        }
+        // Pupils high in the face box (2% of its height) are not the fit's margin: no doubt,
+        // and off centre, the midpoint's sentence alone.
+        let high = p.map(|v| DVec2::new(v.x, 352.0 + 0.02 * 86.0));
+        assert_eq!(HeadConfidence::of(b, high, a).doubts(), "");
+        let high_aside = off_centre(high, 0.4);
+        assert_eq!(
+            sentences(&HeadConfidence::of(b, high_aside, a)),
+            ["midpoint"]
+        );
+        // The fit: a yaw of 50° with a margin of exactly 0.03 (a full margin score) is
+        // doubted for its yaw alone; the outline just off, for the outline alone.
+        let (rms, margin, iris) = (0.91, 0.05, 40);
+        let turned = c.with_fit(rms, 50.0, 0.03, iris);
+        assert!(turned.symmetry > 0.0 && turned.symmetry < 1.0, "{turned:?}");
+        assert_eq!(sentences(&turned), ["a fitted yaw"]);
+        let rough = c.with_fit(0.016 * 91.0, 20.0, margin, iris);
+        assert!(rough.distance_agreement < 1.0, "{rough:?}");
+        assert_eq!(sentences(&rough), ["outline off the fitted pose"]);
     }
 
     #[test]
