@@ -10,6 +10,7 @@ use glam::{DAffine3, DMat3, DVec2, DVec3};
 
 use crate::geometry::lens::Lens;
 use crate::geometry::lens_check::{LensError, MAX_OFF_AXIS};
+use crate::geometry::shutter::Shutter;
 
 /// Largest angle between a point's ray and the ray its projection's pixel sees for the
 /// projection to count as inside the lens's domain, radians (1e-7 rad is 0.0003′; Newton's
@@ -31,6 +32,9 @@ pub struct Camera {
     /// `None`: the ideal pinhole of `half_angle_x`. Otherwise the intrinsics and distortion
     /// (OpenCV's conventions, geometry/lens.rs) that rays and projections go through.
     pub lens: Option<Lens>,
+    /// When its rows and samples see the world ([`Shutter::INSTANT`]: all at the frame's
+    /// instant). Only a render in time (a moving camera or world) reads it.
+    pub shutter: Shutter,
 }
 
 /// Why a camera cannot be built.
@@ -88,6 +92,7 @@ impl Camera {
             width,
             height,
             lens: None,
+            shutter: Shutter::INSTANT,
         })
     }
 
@@ -106,6 +111,7 @@ impl Camera {
             width,
             height,
             lens: Some(lens),
+            shutter: Shutter::INSTANT,
         })
     }
 

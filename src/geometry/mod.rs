@@ -1,5 +1,5 @@
 //! The geometry of seeing: cameras (pose, intrinsics, rays, projection), lens models,
-//! calibration errors and homographies.
+//! calibration errors, homographies, and when a camera's rows see (shutters).
 
 pub mod calibration;
 pub mod camera;
@@ -7,3 +7,4 @@ pub mod homography;
 pub mod lens;
 pub mod lens_check;
 pub mod opencv;
+pub mod shutter;

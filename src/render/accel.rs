@@ -242,6 +242,12 @@ impl Accel {
             .any(|g| g.bvh.any(ray, stack))
     }
 
+    /// Whether view `view` shows any primitive of the hierarchy (as a surface, or as the
+    /// shadow it casts on the view's surfaces).
+    pub fn shows(&self, view: u8) -> bool {
+        self.groups.iter().any(|g| g.views & view != 0)
+    }
+
     /// Where images of views `a` and `b` (from one camera) can differ.
     pub fn difference(&self, a: u8, b: u8) -> Difference {
         let mut bounds = Aabb::empty();

@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Frame {
     pub width: u32,
     pub height: u32,

@@ -7,6 +7,7 @@
 //! the shadow rays toward the sun from its lit hits as another. Both give the same image bit
 //! for bit; the per-ray path is the packets' twin in tests.
 
+use std::ops::Range;
 use std::sync::Arc;
 
 use anyhow::Result;
@@ -16,11 +17,11 @@ use crate::geometry::camera::Camera;
 use crate::render::accel::{Accel, make_ray};
 use crate::render::bvh::Stack;
 use crate::render::bvh_packet::{PACKET, PacketStack, RayPacket};
-use crate::render::camera_rays::CameraRays;
 use crate::render::frame::{Pixel, Rows};
 use crate::render::moving::MovingLayer;
 use crate::render::ray::{Hit, TraceRay};
 use crate::render::screen::{Screen, Shown};
+use crate::render::shutter_rays::{CameraAt, PoseAt, ShutterRays};
 use crate::render::simd::Isa;
 use crate::render::sky::SkyModel;
 use crate::scene::Scene;
@@ -58,29 +59,37 @@ pub struct RenderContext {
 
 /// What every pixel of one render shares.
 pub(super) struct PixelJob<'a> {
-    rays: CameraRays,
-    camera_from_world: DAffine3,
+    /// The camera at each instant of its shutter.
+    rays: ShutterRays,
     view: u8,
     display: Option<&'a dyn Screen>,
-    spp: u32,
+    /// The samples traced (of the pixel's `0..spp`): all of them, or one of a render split
+    /// by instant (render/render_job.rs); the AOVs are the first one's.
+    samples: Range<u32>,
 }
 
 impl<'a> PixelJob<'a> {
-    /// The pixels of `camera` in `view` (`display`: what the display shows, for `seethru`),
-    /// `spp` samples each.
+    /// The pixels of `camera` (moving along `pose_at`, `None`: still) in `view` (`display`:
+    /// what the display shows, for `seethru`), samples `samples` of `spp` each.
     pub(super) fn new(
         camera: &Camera,
+        pose_at: Option<PoseAt>,
         view: u8,
         display: Option<&'a dyn Screen>,
         spp: u32,
+        samples: Range<u32>,
     ) -> PixelJob<'a> {
         PixelJob {
-            rays: CameraRays::new(camera),
-            camera_from_world: camera.world_from_camera.inverse(),
+            rays: ShutterRays::new(camera, pose_at, spp),
             view,
             display,
-            spp,
+            samples,
         }
+    }
+
+    /// The number of samples traced.
+    fn count(&self) -> f32 {
+        self.samples.len() as f32
     }
 }
 
@@ -140,10 +149,11 @@ impl RenderContext {
     ) -> Pixel {
         let mut pixel = Pixel::SKY;
         let mut sum = Vec3::ZERO;
-        for sample in 0..job.spp {
+        for sample in job.samples.clone() {
             let (dx, dy) = pixel_offset(x, y, sample);
-            let origin = job.rays.origin;
-            let dir = job.rays.direction(x as f32 + dx, y as f32 + dy);
+            let at = job.rays.at(y, sample);
+            let origin = at.rays.origin;
+            let dir = at.rays.direction(x as f32 + dx, y as f32 + dy);
             let hit = self.trace_with(origin, dir, job.view, stack);
             let shown = match (&hit, job.display) {
                 (Some(s), Some(d)) if self.world.is_display(s.object, s.part) => {
@@ -157,11 +167,11 @@ impl RenderContext {
                 (Some(s), None) => self.shade(s, job.view, stack, shadows),
                 (None, None) => self.sky.radiance(dir),
             };
-            if sample == 0 {
-                pixel = sample_aovs(job, origin, dir, hit, shown);
+            if sample == job.samples.start {
+                pixel = sample_aovs(at, origin, dir, hit, shown);
             }
         }
-        pixel.color = sum / job.spp as f32;
+        pixel.color = sum / job.count();
         pixel
     }
 
@@ -185,19 +195,22 @@ impl RenderContext {
                 n += 1;
             }
         }
-        let origin = job.rays.origin;
         let mut pixels = [Pixel::SKY; PACKET];
         let mut sums = [Vec3::ZERO; PACKET];
         let mut dirs = [Vec3::ZERO; PACKET];
+        let mut origins = [Vec3::ZERO; PACKET];
+        let mut cameras = [job.rays.at(tile.y, 0); PACKET];
         let mut camera = RayPacket::new();
         let mut shadow = RayPacket::new();
-        for sample in 0..job.spp {
+        for sample in job.samples.clone() {
             for (lane, &(x, row)) in at[..n].iter().enumerate() {
                 let y = tile.y + row;
                 let (dx, dy) = pixel_offset(x, y, sample);
-                dirs[lane] = job.rays.direction(x as f32 + dx, y as f32 + dy);
+                cameras[lane] = job.rays.at(y, sample);
+                origins[lane] = cameras[lane].rays.origin;
+                dirs[lane] = cameras[lane].rays.direction(x as f32 + dx, y as f32 + dy);
             }
-            camera.set_from_zero(n, |lane| (origin, dirs[lane]));
+            camera.set_from_zero(n, |lane| (origins[lane], dirs[lane]));
             let moving_hits = self.trace_packet_hits(&mut camera, job.view, tile.isa, packet_stack);
             let mut shown = [None; PACKET];
             let mut shading = [None; PACKET];
@@ -221,8 +234,9 @@ impl RenderContext {
                     }
                     (None, _) => {}
                 }
-                if sample == 0 {
-                    pixels[lane] = sample_aovs(job, origin, dirs[lane], hit, shown[lane]);
+                if sample == job.samples.start {
+                    pixels[lane] =
+                        sample_aovs(cameras[lane], origins[lane], dirs[lane], hit, shown[lane]);
                 }
             }
             let blocked = self.occluded_packet(&shadow, job.view, tile.isa, packet_stack);
@@ -239,7 +253,7 @@ impl RenderContext {
         }
         for (lane, &(x, row)) in at[..n].iter().enumerate() {
             let mut pixel = pixels[lane];
-            pixel.color = sums[lane] / job.spp as f32;
+            pixel.color = sums[lane] / job.count();
             band.set(x, row, pixel);
         }
     }
@@ -471,7 +485,7 @@ pub(super) struct Tile {
 /// The AOVs of a pixel's centre sample (its colour is set after): the surface `hit` along
 /// the ray from `origin` in `dir`, or what the display shows there (`shown`), or the sky.
 fn sample_aovs(
-    job: &PixelJob,
+    camera: &CameraAt,
     origin: Vec3,
     dir: Vec3,
     hit: Option<SurfaceHit>,
@@ -488,7 +502,7 @@ fn sample_aovs(
                     f32::INFINITY
                 },
                 camera_z: if finite {
-                    axial_depth(&job.camera_from_world, d.position)
+                    axial_depth(&camera.camera_from_world, d.position)
                 } else {
                     f32::INFINITY
                 },
@@ -498,7 +512,7 @@ fn sample_aovs(
         (Some(s), None) => Pixel {
             color: Vec3::ZERO,
             depth: s.t,
-            camera_z: axial_depth(&job.camera_from_world, s.position),
+            camera_z: axial_depth(&camera.camera_from_world, s.position),
             position: s.position,
             normal: s.normal,
             object_id: s.object,

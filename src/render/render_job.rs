@@ -22,13 +22,14 @@ use crate::render::frame_over::FrameOver;
 use crate::render::integrator::{PixelJob, RenderContext, Tile};
 use crate::render::screen::Screen;
 use crate::render::settings::RenderSettings;
+use crate::render::shutter_rays::PoseAt;
 use crate::render::simd::Isa;
 use crate::scene::world::view_bit;
 use crate::util::progress::Progress;
 
 /// Rows per rayon task: small enough to balance many threads, large enough to amortise; a
 /// band is one row of tiles.
-const BAND_ROWS: u32 = 4;
+pub(super) const BAND_ROWS: u32 = 4;
 /// Columns of a tile: a band's rows × these make one packet.
 const TILE_COLUMNS: u32 = PACKET as u32 / BAND_ROWS;
 
@@ -60,17 +61,21 @@ pub struct RenderStats {
 /// [`RenderContext::render_into`] or [`RenderContext::render_over`].
 #[derive(Clone, Copy)]
 pub struct RenderJob<'a> {
-    camera: &'a Camera,
+    pub(super) camera: &'a Camera,
     /// A [`view_bit`]: the primitives the render shows.
-    view: u8,
+    pub(super) view: u8,
     /// What the display shows, for the `seethru` view.
     display: Option<&'a dyn Screen>,
-    settings: RenderSettings,
+    pub(super) settings: RenderSettings,
     /// `None`: every pixel of the camera.
-    region: Option<PixelRect>,
+    pub(super) region: Option<PixelRect>,
     /// The name on the progress line.
     label: &'a str,
     tracer: Tracer,
+    /// The camera's pose over its shutter's instants (`None`: still).
+    pub(super) pose_at: Option<PoseAt<'a>>,
+    /// Only this sample of each pixel's `spp` (`None`: all of them).
+    pub(super) sample: Option<u32>,
 }
 
 impl<'a> RenderJob<'a> {
@@ -85,6 +90,8 @@ impl<'a> RenderJob<'a> {
             region: None,
             label: "",
             tracer: Tracer::best(),
+            pose_at: None,
+            sample: None,
         }
     }
 
@@ -114,6 +121,38 @@ impl<'a> RenderJob<'a> {
 
     pub fn label(self, label: &'a str) -> RenderJob<'a> {
         RenderJob { label, ..self }
+    }
+
+    /// The camera moving along `pose_at` (its world_from_camera `dt` seconds after the
+    /// frame's instant): each sample is traced from where the camera is at its instant of
+    /// the camera's shutter ([`crate::geometry::shutter::Shutter`]). The world is the
+    /// context's, of the frame's instant: [`crate::render::in_time`] renders a world that
+    /// moves too.
+    pub fn moving(self, pose_at: PoseAt<'a>) -> RenderJob<'a> {
+        RenderJob {
+            pose_at: Some(pose_at),
+            ..self
+        }
+    }
+
+    /// Only sample `sample` of each pixel's `spp` (its colour that sample's, its AOVs too).
+    pub fn sample(self, sample: u32) -> RenderJob<'a> {
+        RenderJob {
+            sample: Some(sample),
+            ..self
+        }
+    }
+
+    /// The same job seen by `camera` (at one instant: without the job's motion).
+    pub(super) fn seen_by<'b>(self, camera: &'b Camera) -> RenderJob<'b>
+    where
+        'a: 'b,
+    {
+        RenderJob {
+            camera,
+            pose_at: None,
+            ..self
+        }
     }
 
     /// Traced by `tracer`: every tracer gives the same frame.
@@ -181,14 +220,17 @@ impl RenderContext {
 
     /// Renders the pixels of `region` of `job` into `bands` (of a frame of the camera's size,
     /// or of the region alone).
-    fn render_bands(
+    pub(super) fn render_bands(
         &self,
         job: &RenderJob,
         region: PixelRect,
         bands: Vec<Rows<'_>>,
     ) -> RenderStats {
         let start = Instant::now();
-        let pixels = PixelJob::new(job.camera, job.view, job.display, job.settings.spp);
+        let spp = job.settings.spp;
+        let samples = job.sample.map_or(0..spp, |s| s..s + 1);
+        let traced = samples.len() as u64;
+        let pixels = PixelJob::new(job.camera, job.pose_at, job.view, job.display, spp, samples);
         let bands: Vec<_> = bands
             .into_iter()
             .filter(|b| b.y < region.y1 && b.y + b.len() > region.y0)
@@ -254,7 +296,7 @@ impl RenderContext {
             .sum();
         progress.finish();
         RenderStats {
-            primary_rays: region.pixels() * u64::from(job.settings.spp),
+            primary_rays: region.pixels() * traced,
             shadow_rays,
             seconds: start.elapsed().as_secs_f64(),
         }

@@ -21,6 +21,7 @@ pub mod motion;
 pub mod procedural;
 pub mod read;
 pub mod shapes;
+pub mod shutter_keys;
 pub mod source;
 pub mod surface_grid;
 pub mod table_reader;

@@ -554,7 +554,7 @@ pub fn face_object(face: DriverFace, eye: DVec3) -> Option<Object> {
 }
 
 /// A camera mounted on the obstacle: pose from an offset (obstacle frame) and yaw/pitch about
-/// a base viewing direction.
+/// a base viewing direction, its lens and its shutter.
 fn mounted_camera(
     t: &TableReader,
     obstacle: &Obstacle,
@@ -576,13 +576,17 @@ fn mounted_camera(
         base * DMat3::from_rotation_y(yaw) * DMat3::from_rotation_x(pitch),
         offset,
     );
-    crate::scene::lens_keys::read_lens_camera(
+    let camera = crate::scene::lens_keys::read_lens_camera(
         t,
         obstacle.world_from_obstacle * obstacle_from_camera,
         || half_angle(t, default_half_deg),
         w,
         h,
-    )
+    )?;
+    Ok(Camera {
+        shutter: crate::scene::shutter_keys::read_shutter(t)?,
+        ..camera
+    })
 }
 
 fn read_frontal(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, SceneError> {

@@ -3,14 +3,12 @@
 //! (system/sequence/system_loop.rs), which asks it for a detection per head sample: what it
 //! renders and why its estimates equal the whole image's are its own.
 
+use anyhow::Result;
+
 use crate::geometry::camera::Camera;
 use crate::render::footprint::PixelRect;
 use crate::render::frame::Frame;
-use crate::render::integrator::RenderContext;
-use crate::render::render_job::RenderJob;
-use crate::render::settings::RenderSettings;
 use crate::scene::DriverFace;
-use crate::scene::world::view_bit;
 use crate::system::head::{DetectError, FaceDetection, detect_in};
 use crate::system::head_estimate::{detect_face, turned_reads};
 
@@ -23,6 +21,7 @@ use crate::system::head_estimate::{detect_face, turned_reads};
 /// estimate is bit for bit the whole image's (but for a skin region larger than the face
 /// wholly outside the region, which the whole image's detector would take for the face), and
 /// each sample depends only on the one before: deterministic.
+#[derive(Default)]
 pub(crate) struct BackTracker {
     frame: Frame,
     pub(crate) region: Option<PixelRect>,
@@ -36,28 +35,20 @@ impl BackTracker {
         }
     }
 
-    /// The head detection of `face` in the back camera's image of `ctx` (its true back
-    /// camera), and the pixels rendered for it.
+    /// The head detection of `face` in the image of the true back camera `back` that
+    /// `render` renders (the pixels of a region into a frame of the camera's size), and the
+    /// pixels rendered for it.
     pub(crate) fn detect(
         &mut self,
-        ctx: &RenderContext,
+        back: &Camera,
         face: DriverFace,
-        settings: RenderSettings,
-    ) -> (Result<FaceDetection, DetectError>, u64) {
-        let back = ctx.scene.back;
+        render: &mut dyn FnMut(&mut Frame, PixelRect) -> Result<()>,
+    ) -> Result<(Result<FaceDetection, DetectError>, u64)> {
+        let back = *back;
         if (self.frame.width, self.frame.height) != (back.width, back.height) {
             self.frame = Frame::new(back.width, back.height);
             self.region = None;
         }
-        let render = |frame: &mut Frame, region: PixelRect| {
-            ctx.render_into(
-                RenderJob::new(&back, view_bit::BACK)
-                    .settings(settings)
-                    .region(region)
-                    .label("back"),
-                frame,
-            );
-        };
         // The detection in `region` and the pixels it depended on, if they lie inside it.
         let find = |frame: &mut Frame, region: PixelRect| match face {
             DriverFace::Ellipsoids => {
@@ -73,27 +64,28 @@ impl BackTracker {
             }
         };
         let mut pixels = 0;
-        let tracked = self.region.and_then(|region| {
-            render(&mut self.frame, region);
+        let mut tracked = None;
+        if let Some(region) = self.region {
+            render(&mut self.frame, region)?;
             pixels += region.pixels();
-            find(&mut self.frame, region).ok().filter(|found| found.2)
-        });
+            tracked = find(&mut self.frame, region).ok().filter(|found| found.2);
+        }
         let (detection, used) = match tracked {
             Some((detection, used, _)) => (detection, used),
             None => {
                 self.region = None;
                 let full = PixelRect::full(&back);
-                render(&mut self.frame, full);
+                render(&mut self.frame, full)?;
                 pixels += full.pixels();
                 match find(&mut self.frame, full) {
                     Ok((detection, used, _)) => (detection, used),
-                    Err(e) => return (Err(e), pixels),
+                    Err(e) => return Ok((Err(e), pixels)),
                 }
             }
         };
         // The next search: the pixels used, grown by a quarter of their size and 4 px a side.
         self.region = Some(used.grown(4, 4, &back));
-        (Ok(detection), pixels)
+        Ok((Ok(detection), pixels))
     }
 }
 

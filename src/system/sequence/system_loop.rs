@@ -20,6 +20,7 @@ use crate::geometry::lens::Lens;
 use crate::render::accel::Accel;
 use crate::render::footprint::PixelRect;
 use crate::render::frame::Frame;
+use crate::render::in_time::render_in_time;
 use crate::render::integrator::RenderContext;
 use crate::render::moving::MovingParts;
 use crate::render::render_job::RenderJob;
@@ -268,7 +269,16 @@ impl SystemLoop {
                     self.back_tracker.region = None;
                 }
                 let face = ctx.scene.face;
-                let (detection, pixels) = self.back_tracker.detect(&ctx, face, settings);
+                let mut tracker = std::mem::take(&mut self.back_tracker);
+                let found = tracker.detect(&back, face, &mut |frame, region| {
+                    let job = RenderJob::new(&back, view_bit::BACK)
+                        .settings(settings)
+                        .region(region)
+                        .label("back");
+                    self.render_carried(&ctx, t, self.rig.base.back, job, frame)
+                });
+                self.back_tracker = tracker;
+                let (detection, pixels) = found?;
                 self.back_pixels += pixels;
                 let detection =
                     detection.with_context(|| format!("head estimate at t = {} s", short(t)))?;
@@ -363,17 +373,11 @@ impl SystemLoop {
         let full =
             run.method == Method::None || run.d2 == WorkingDistance::Auto || byo.needs_inputs();
         let frontal_camera = capture.scene.frontal;
-        let settings = self.settings();
         // The frontal render is its own stage, not part of the compensation's time.
         let frontal_seconds;
         let (crop, d2_used) = if full {
             let f = Instant::now();
-            capture.render_into(
-                RenderJob::new(&frontal_camera, view_bit::FRONTAL)
-                    .settings(settings)
-                    .label("frontal"),
-                &mut self.frontal,
-            );
+            self.capture_frontal(&capture, times.capture, None)?;
             frontal_seconds = f.elapsed().as_secs_f64();
             self.frontal_pixels +=
                 u64::from(frontal_camera.width) * u64::from(frontal_camera.height);
@@ -386,13 +390,7 @@ impl SystemLoop {
                 crop_rect(&frontal_map(&geometry, crop.0, run)?, &frontal_camera)
             };
             let f = Instant::now();
-            capture.render_into(
-                RenderJob::new(&frontal_camera, view_bit::FRONTAL)
-                    .settings(settings)
-                    .region(rect)
-                    .label("frontal"),
-                &mut self.frontal,
-            );
+            self.capture_frontal(&capture, times.capture, Some(rect))?;
             frontal_seconds = f.elapsed().as_secs_f64();
             self.frontal_pixels += rect.pixels();
             crop
@@ -483,6 +481,46 @@ impl SystemLoop {
             ideal,
         });
         Ok(self.shown.as_ref().expect("just set"))
+    }
+
+    /// The frontal camera's image at capture time `t` (`capture`, the scene then), the
+    /// pixels of `region` (`None`: all), into the loop's frontal frame.
+    fn capture_frontal(
+        &mut self,
+        capture: &RenderContext,
+        t: f64,
+        region: Option<PixelRect>,
+    ) -> Result<()> {
+        let camera = capture.scene.frontal;
+        let mut job = RenderJob::new(&camera, view_bit::FRONTAL)
+            .settings(self.settings())
+            .label("frontal");
+        if let Some(region) = region {
+            job = job.region(region);
+        }
+        let mut frame = std::mem::take(&mut self.frontal);
+        let rendered = self.render_carried(capture, t, self.rig.base.frontal, job, &mut frame);
+        self.frontal = frame;
+        rendered
+    }
+
+    /// Renders `job` of a camera the vehicle carries (`base`, where it is at t = 0) at `t`
+    /// (`ctx`, the scene then) into `frame`, over the camera's shutter: each sample from where
+    /// the vehicle has carried the camera at its instant, over the world of that instant
+    /// where the camera sees what moves (render/in_time.rs).
+    fn render_carried(
+        &mut self,
+        ctx: &RenderContext,
+        t: f64,
+        base: Camera,
+        job: RenderJob,
+        frame: &mut Frame,
+    ) -> Result<()> {
+        let vehicle = self.rig.vehicle;
+        let pose_at = move |dt: f64| vehicle.world_from_rig(t + dt) * base.world_from_camera;
+        let job = job.moving(&pose_at);
+        render_in_time(ctx, &mut |at| self.context_at(at), t, job, frame)?;
+        Ok(())
     }
 
     /// The inputs of the refresh [`SystemLoop::show`] last made, once (`None` after, or

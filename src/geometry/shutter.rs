@@ -1,0 +1,141 @@
+//! When a camera's pixels see the world: the shutter (all rows at once, or rows read out one
+//! after another), the exposure each row integrates over, and the order the rows are read in.
+//!
+//! A frame is named by one instant `t`, the middle of its first row's exposure. Row `r` (the
+//! `k`-th read) is exposed about `t + readout · k / (rows − 1)`; its `spp` samples are spread
+//! over its exposure at the midpoints of `spp` equal slices, the same slices for every pixel.
+//! So a frame is exactly the mean of `spp` instantaneous renders (one per slice) taken row by
+//! row, which is what the renderer's twin checks; a global shutter with no exposure is one
+//! instant, today's image bit for bit.
+
+/// Longest readout or exposure, seconds: a second is a very long exposure for a moving car.
+pub const MAX_SHUTTER_S: f64 = 1.0;
+
+/// Which rows a camera reads first.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RowOrder {
+    /// Row 0 (the image's top) first, as most CMOS sensors read.
+    #[default]
+    TopToBottom,
+    /// The last row first (a sensor mounted upside down).
+    BottomToTop,
+}
+
+impl RowOrder {
+    pub const NAMES: [&'static str; 2] = ["top_to_bottom", "bottom_to_top"];
+}
+
+/// How a camera's rows and samples spread over time.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Shutter {
+    /// Time from the first row's exposure to the last row's, seconds, in [0, 1]; 0 is a
+    /// global shutter (every row at once).
+    pub readout_s: f64,
+    /// Time each row integrates light over, seconds, in [0, 1]; 0 is an instant.
+    pub exposure_s: f64,
+    /// The order the rows are read in (matters only with a readout).
+    pub row_order: RowOrder,
+}
+
+impl Shutter {
+    /// A global shutter with an instantaneous exposure: the whole image at one instant.
+    pub const INSTANT: Shutter = Shutter {
+        readout_s: 0.0,
+        exposure_s: 0.0,
+        row_order: RowOrder::TopToBottom,
+    };
+
+    /// Whether every pixel and sample is at the frame's instant.
+    pub fn is_instant(&self) -> bool {
+        self.readout_s == 0.0 && self.exposure_s == 0.0
+    }
+
+    /// Whether rows are read at different instants (a rolling shutter).
+    pub fn is_rolling(&self) -> bool {
+        self.readout_s > 0.0
+    }
+
+    /// Seconds after the frame's instant at which row `row` of an image `height` rows high is
+    /// exposed (the middle of its exposure).
+    pub fn row_time(&self, row: u32, height: u32) -> f64 {
+        if !self.is_rolling() || height < 2 {
+            return 0.0;
+        }
+        let k = match self.row_order {
+            RowOrder::TopToBottom => row,
+            RowOrder::BottomToTop => height - 1 - row,
+        };
+        self.readout_s * f64::from(k) / f64::from(height - 1)
+    }
+
+    /// Seconds from the middle of a row's exposure at which sample `sample` of `spp` is
+    /// traced: the midpoint of slice `sample` of `spp` equal slices of the exposure.
+    pub fn sample_time(&self, sample: u32, spp: u32) -> f64 {
+        if self.exposure_s == 0.0 {
+            return 0.0;
+        }
+        self.exposure_s * ((f64::from(sample) + 0.5) / f64::from(spp.max(1)) - 0.5)
+    }
+
+    /// Seconds after the frame's instant of sample `sample` (of `spp`) of row `row` (of
+    /// `height`).
+    pub fn instant(&self, row: u32, height: u32, sample: u32, spp: u32) -> f64 {
+        self.row_time(row, height) + self.sample_time(sample, spp)
+    }
+
+    /// The instants of a frame: each row's exposure as (start, end), seconds after the frame's
+    /// instant (`height` of them).
+    pub fn row_exposures(&self, height: u32) -> Vec<(f64, f64)> {
+        (0..height)
+            .map(|row| {
+                let t = self.row_time(row, height);
+                (t - self.exposure_s / 2.0, t + self.exposure_s / 2.0)
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_are_spread_over_the_readout_in_their_order() {
+        let rolling = Shutter {
+            readout_s: 0.03,
+            ..Shutter::INSTANT
+        };
+        assert_eq!(rolling.row_time(0, 481), 0.0);
+        assert!((rolling.row_time(240, 481) - 0.015).abs() < 1e-15);
+        assert!((rolling.row_time(480, 481) - 0.03).abs() < 1e-15);
+        let flipped = Shutter {
+            row_order: RowOrder::BottomToTop,
+            ..rolling
+        };
+        assert!((flipped.row_time(0, 481) - 0.03).abs() < 1e-15);
+        assert_eq!(flipped.row_time(480, 481), 0.0);
+        // One row, or a global shutter: the frame's instant.
+        assert_eq!(rolling.row_time(0, 1), 0.0);
+        assert_eq!(Shutter::INSTANT.row_time(100, 200), 0.0);
+        assert!(Shutter::INSTANT.is_instant() && !rolling.is_instant());
+    }
+
+    #[test]
+    fn samples_sit_at_the_midpoints_of_equal_slices_of_the_exposure() {
+        let s = Shutter {
+            exposure_s: 0.02,
+            ..Shutter::INSTANT
+        };
+        let times: Vec<f64> = (0..4).map(|k| s.sample_time(k, 4)).collect();
+        let expected = [-0.0075, -0.0025, 0.0025, 0.0075];
+        for (t, e) in times.iter().zip(expected) {
+            assert!((t - e).abs() < 1e-15, "{times:?}");
+        }
+        // Centred on the row's time: their mean is 0, their spread the exposure's.
+        assert!(times.iter().sum::<f64>().abs() < 1e-15);
+        assert_eq!(s.sample_time(0, 1), 0.0);
+        assert_eq!(s.row_exposures(3), vec![(-0.01, 0.01); 3]);
+        assert!(!s.is_instant() && !s.is_rolling());
+    }
+}

@@ -1,0 +1,484 @@
+//! Cameras in time (geometry/shutter.rs, render/shutter_rays.rs, render/in_time.rs) against
+//! analytic answers and brute-force twins: a rolling shutter slants a vertical pole by the
+//! camera's yaw over the readout, an exposure blurs a point over the yaw during it, and a
+//! frame in time is the mean of instantaneous renders at the same instants, bit for bit.
+
+mod common;
+
+use glam::{DAffine3, Vec3};
+use seethru::geometry::camera::Camera;
+use seethru::geometry::shutter::Shutter;
+use seethru::render::footprint::PixelRect;
+use seethru::render::frame::Frame;
+use seethru::render::in_time::render_by_instant;
+use seethru::render::integrator::RenderContext;
+use seethru::render::render_job::RenderJob;
+use seethru::render::settings::RenderSettings;
+use seethru::scene::world::view_bit::FRONTAL;
+
+/// A dark wall 10 m ahead of the frontal camera (640×480, 45° half angle: f = 320 px), the
+/// objects `objects` (TOML) in front of it, the frontal camera's shutter keys `shutter`.
+fn scene_text(shutter: &str, objects: &str) -> String {
+    format!(
+        r#"
+[sun]
+intensity = 0.0
+
+[sky]
+ambient = 1.0
+
+[obstacle]
+center = [0.0, 0.0, 0.0]
+
+[camera.driver]
+position = [0.0, 0.0, 0.7]
+look_at = [0.0, 0.0, -6.0]
+
+[camera.frontal]
+resolution = [640, 480]
+half_angle_deg = 45.0
+{shutter}
+
+[camera.back]
+resolution = [32, 24]
+
+[[material]]
+name = "dark"
+color = [0.05, 0.05, 0.05]
+
+[[material]]
+name = "bright"
+color = [0.9, 0.9, 0.9]
+
+[[object]]
+name = "wall"
+kind = "quad"
+material = "dark"
+size = [80.0, 60.0]
+translate = [0.0, 0.0, -10.0]
+{objects}
+"#
+    )
+}
+
+const POLE: &str = r#"
+[[object]]
+name = "pole"
+kind = "box"
+material = "bright"
+size = [0.1, 20.0, 0.1]
+translate = [0.0, 0.0, -5.0]
+"#;
+
+const POINT: &str = r#"
+[[object]]
+name = "point"
+kind = "sphere"
+material = "bright"
+radius = 0.05
+translate = [0.0, 0.0, -5.0]
+"#;
+
+fn context(shutter: &str, objects: &str) -> RenderContext {
+    RenderContext::new(common::parse(&scene_text(shutter, objects)).unwrap()).unwrap()
+}
+
+/// The camera yawing to its left (about its own vertical axis) at `omega` rad/s: its pose
+/// `dt` seconds on.
+fn yawing(camera: Camera, omega: f64) -> impl Fn(f64) -> DAffine3 + Sync {
+    let c = camera.position();
+    move |dt| {
+        DAffine3::from_translation(c)
+            * DAffine3::from_rotation_y(omega * dt)
+            * DAffine3::from_translation(-c)
+            * camera.world_from_camera
+    }
+}
+
+fn settings(spp: u32) -> RenderSettings {
+    RenderSettings {
+        spp,
+        progress: false,
+    }
+}
+
+/// Least-squares slope of `y` over `x`.
+fn slope(points: &[(f64, f64)]) -> f64 {
+    let n = points.len() as f64;
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let sxy: f64 = points.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+    let sxx: f64 = points.iter().map(|(x, _)| (x - mx) * (x - mx)).sum();
+    sxy / sxx
+}
+
+/// The pole's centre column in each row (its object id's pixels), as (row, column).
+fn pole_centres(frame: &Frame, pole_id: u32) -> Vec<(f64, f64)> {
+    (0..frame.height)
+        .filter_map(|y| {
+            let xs: Vec<u32> = (0..frame.width)
+                .filter(|&x| frame.pixel(x, y).object_id == pole_id)
+                .collect();
+            let mean = xs.iter().map(|&x| f64::from(x) + 0.5).sum::<f64>() / xs.len() as f64;
+            (!xs.is_empty()).then_some((f64::from(y), mean))
+        })
+        .collect()
+}
+
+#[test]
+fn a_rolling_shutter_slants_a_vertical_pole_by_the_yaw_over_the_readout() {
+    let (omega, readout) = (3.0, 0.05);
+    let ctx = context("shutter = \"rolling\"\nreadout_ms = 50.0", POLE);
+    let camera = ctx.scene.frontal;
+    assert_eq!(camera.shutter.readout_s, readout);
+    let pole = ctx
+        .scene
+        .objects
+        .iter()
+        .position(|o| o.name == "pole")
+        .unwrap() as u32
+        + 1;
+    let pose_at = yawing(camera, omega);
+    let (frame, _) = ctx.render(
+        RenderJob::new(&camera, FRONTAL)
+            .settings(settings(1))
+            .moving(&pose_at),
+    );
+    let measured = pole_centres(&frame, pole);
+    assert_eq!(measured.len(), 480, "the pole spans every row");
+    // The analytic answer: row r is read T r / (H − 1) after the first, when the camera has
+    // turned ω t to the left; a vertical line straight ahead is then f tan(ω t) right of the
+    // centre. Its slant over the image: the fitted slope times H − 1 (the same fit as the
+    // measurement, so the small curvature of tan cancels).
+    let f = 320.0;
+    let analytic: Vec<(f64, f64)> = (0..480)
+        .map(|r| {
+            let t = readout * f64::from(r) / 479.0;
+            (f64::from(r), 320.0 + f * (omega * t).tan())
+        })
+        .collect();
+    let (got, want) = (slope(&measured) * 479.0, slope(&analytic) * 479.0);
+    assert!(want > 45.0, "ω T = 0.15 rad: about 48 px, got {want}");
+    assert!(
+        (got / want - 1.0).abs() < 0.02,
+        "slant {got:.2} px, ω·T gives {want:.2} px"
+    );
+    // Read from the bottom up, the slant turns over.
+    let flipped = context(
+        "shutter = \"rolling\"\nreadout_ms = 50.0\nrow_order = \"bottom_to_top\"",
+        POLE,
+    );
+    let camera = flipped.scene.frontal;
+    let (frame, _) = flipped.render(
+        RenderJob::new(&camera, FRONTAL)
+            .settings(settings(1))
+            .moving(&pose_at),
+    );
+    let up = slope(&pole_centres(&frame, pole)) * 479.0;
+    assert!((up / -want - 1.0).abs() < 0.02, "bottom to top: {up:.2} px");
+    // A global shutter: every row at once, no slant.
+    let global = context("", POLE);
+    let camera = global.scene.frontal;
+    let (frame, _) = global.render(
+        RenderJob::new(&camera, FRONTAL)
+            .settings(settings(1))
+            .moving(&pose_at),
+    );
+    let still = slope(&pole_centres(&frame, pole)) * 479.0;
+    assert!(still.abs() < 0.5, "global shutter: {still:.3} px");
+}
+
+/// The luminance-weighted mean and variance (px²) of columns of `a − b` over `region`.
+fn column_moments(a: &Frame, b: &Frame, region: PixelRect) -> (f64, f64) {
+    let mut w = Vec::new();
+    for y in region.y0..region.y1 {
+        for x in region.x0..region.x1 {
+            let i = a.index(x, y);
+            let d = (a.color[i] - b.color[i]).dot(Vec3::splat(1.0 / 3.0)) as f64;
+            w.push((f64::from(x) + 0.5, d));
+        }
+    }
+    let total: f64 = w.iter().map(|(_, d)| d).sum();
+    let mean = w.iter().map(|(x, d)| x * d).sum::<f64>() / total;
+    let var = w.iter().map(|(x, d)| (x - mean).powi(2) * d).sum::<f64>() / total;
+    (mean, var)
+}
+
+#[test]
+fn an_exposure_blurs_a_point_by_the_yaw_during_it() {
+    let (omega, exposure, spp) = (2.0, 0.03, 64);
+    // Around the image's centre, where the point is.
+    let region = PixelRect {
+        x0: 280,
+        y0: 228,
+        x1: 360,
+        y1: 252,
+    };
+    // The point's image with the exposure and without, each over the wall alone.
+    let moments = |shutter: &str| {
+        let with = context(shutter, POINT);
+        let without = context(shutter, "");
+        let camera = with.scene.frontal;
+        let pose_at = yawing(camera, omega);
+        let job = RenderJob::new(&camera, FRONTAL)
+            .settings(settings(spp))
+            .region(region)
+            .moving(&pose_at);
+        let (a, _) = with.render(job);
+        let (b, _) = without.render(job);
+        column_moments(&a, &b, region)
+    };
+    let (_, still) = moments("");
+    let (mean, blurred) = moments("exposure_ms = 30.0");
+    // A box of length L adds L²/12 to the variance: over the exposure the camera turns ω E,
+    // and a point straight ahead sweeps f (tan(ω E / 2) + tan(ω E / 2)); the 64 slices
+    // sample that box at their midpoints, whose variance is L² (1 − 1/64²) / 12.
+    let f = 320.0;
+    let want = 2.0 * f * (omega * exposure / 2.0).tan() * (1.0 - 1.0 / 64f64.powi(2)).sqrt();
+    let got = (12.0 * (blurred - still)).sqrt();
+    assert!(
+        (got / want - 1.0).abs() < 0.05,
+        "blur {got:.2} px, ω·E gives {want:.2} px (static variance {still:.2} px²)"
+    );
+    // Centred on the exposure's middle: the point where it is at the frame's instant.
+    assert!((mean - 320.0).abs() < 0.5, "blur centred at {mean:.2}");
+}
+
+/// The mean of `spp` instantaneous renders, render `s` at its sample's instant with sample `s`
+/// alone, summed in order as a pixel's samples are; the AOVs are sample 0's.
+fn mean_of_instants(
+    ctx: &RenderContext,
+    camera: Camera,
+    pose_at: &dyn Fn(f64) -> DAffine3,
+    spp: u32,
+) -> Frame {
+    let shutter = camera.shutter;
+    let mut mean = Frame::new(camera.width, camera.height);
+    let mut sums = vec![Vec3::ZERO; mean.color.len()];
+    for row in 0..camera.height {
+        for s in 0..spp {
+            let dt = shutter.instant(row, camera.height, s, spp);
+            let at = Camera {
+                world_from_camera: pose_at(dt),
+                shutter: Shutter::INSTANT,
+                ..camera
+            };
+            let (frame, _) = ctx.render(
+                RenderJob::new(&at, FRONTAL)
+                    .settings(settings(spp))
+                    .sample(s),
+            );
+            let i = frame.index(0, row);
+            let n = camera.width as usize;
+            if s == 0 {
+                mean.copy_pixels(i, &frame, i, n);
+            }
+            for (sum, c) in sums[i..i + n].iter_mut().zip(&frame.color[i..i + n]) {
+                *sum += *c;
+            }
+        }
+    }
+    for (c, sum) in mean.color.iter_mut().zip(&sums) {
+        *c = *sum / spp as f32;
+    }
+    mean
+}
+
+#[test]
+fn a_frame_in_time_is_the_mean_of_instantaneous_renders_at_its_instants() {
+    let spp = 3;
+    for shutter in [
+        "exposure_ms = 20.0",
+        "shutter = \"rolling\"\nreadout_ms = 30.0",
+        "shutter = \"rolling\"\nreadout_ms = 30.0\nexposure_ms = 10.0\nrow_order = \"bottom_to_top\"",
+    ] {
+        let text = scene_text(shutter, &format!("{POLE}{POINT}"))
+            .replace("resolution = [640, 480]", "resolution = [48, 36]");
+        let ctx = RenderContext::new(common::parse(&text).unwrap()).unwrap();
+        let camera = ctx.scene.frontal;
+        let pose_at = yawing(camera, 4.0);
+        let job = RenderJob::new(&camera, FRONTAL)
+            .settings(settings(spp))
+            .moving(&pose_at);
+        let (one_pass, stats) = ctx.render(job);
+        assert_eq!(stats.primary_rays, 48 * 36 * u64::from(spp));
+        let twin = mean_of_instants(&ctx, camera, &pose_at, spp);
+        assert!(
+            one_pass.bit_identical(&twin),
+            "{shutter}: one pass vs the mean"
+        );
+        // The instant-by-instant path (a context per instant) is the same frame.
+        let mut by_instant = Frame::new(48, 36);
+        let mut context_at = |_t: f64| ctx.with_scene(ctx.scene.clone());
+        render_by_instant(&mut context_at, 0.0, job, &mut by_instant).unwrap();
+        assert!(
+            by_instant.bit_identical(&one_pass),
+            "{shutter}: instant by instant vs one pass"
+        );
+        // And the camera did move: a still render differs.
+        let (still, _) = ctx.render(RenderJob::new(&camera, FRONTAL).settings(settings(spp)));
+        assert!(!still.bit_identical(&one_pass), "{shutter}");
+    }
+}
+
+#[test]
+fn an_instant_shutter_on_a_moving_camera_is_todays_image() {
+    let ctx = context("", POLE);
+    let camera = ctx.scene.frontal;
+    assert!(camera.shutter.is_instant());
+    let pose_at = yawing(camera, 3.0);
+    let job = RenderJob::new(&camera, FRONTAL).settings(settings(2));
+    let (still, _) = ctx.render(job);
+    let (moving, _) = ctx.render(job.moving(&pose_at));
+    assert!(still.bit_identical(&moving));
+}
+
+/// A sequence on the textured wall 6 m ahead (the model plane on it), the vehicle yawing at
+/// ω, the image `latency` s old, the frontal camera's shutter `shutter`: each display pixel
+/// shows a frontal row read `T r / (H − 1)` after the first, so its image is that much
+/// younger, and the mean misregistration is ω times the mean age over the display's pixels,
+/// the rows found by casting the eye's rays through the display onto the wall.
+#[test]
+fn a_rolling_frontal_camera_makes_each_display_row_as_old_as_its_frontal_row() {
+    use seethru::analysis::physical::ARCMIN_PER_RAD;
+    use seethru::measure::image_metrics::Flip;
+    use seethru::measure::sequence::run_sequence;
+    use seethru::system::options::{RunOptions, WorkingDistance};
+    let wall = common::WallScene::default();
+    let (omega, latency, readout) = (20f64.to_radians(), 0.1, 0.06);
+    let mut means = Vec::new();
+    for shutter in ["", "shutter = \"rolling\"\nreadout_ms = 60.0"] {
+        let text = wall
+            .text()
+            .replace("[camera.frontal]", &format!("[camera.frontal]\n{shutter}"));
+        let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+        let run = RunOptions {
+            d2: WorkingDistance::Metres(6.0),
+            spp: 1,
+            ..RunOptions::default()
+        };
+        let mut o = common::still_sequence(run, 6.0 / 30.0, 30.0, latency);
+        o.yaw_rate = omega;
+        let how = common::measuring(Flip::Skipped);
+        let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
+        let m: Vec<f64> = run
+            .records
+            .iter()
+            .map(|r| r.metrics.unwrap().mean_arcmin)
+            .collect();
+        means.push(m.iter().sum::<f64>() / m.len() as f64);
+        // The mean age of the display's pixels: a 60 × 40 grid over the display, each
+        // point's ray from the eye onto the wall, projected into the frontal camera.
+        let (eye, frontal) = (scene.eye(), scene.frontal);
+        let [a, b, _, d] = scene.obstacle.display_corners();
+        let mut age = 0.0;
+        let n = 60 * 40;
+        for i in 0..60 {
+            for j in 0..40 {
+                let (u, v) = ((f64::from(i) + 0.5) / 60.0, (f64::from(j) + 0.5) / 40.0);
+                let p = a + (b - a) * u + (d - a) * v;
+                let on_wall = eye + (p - eye) * ((-6.0 - eye.z) / (p.z - eye.z));
+                let row = frontal.project_point(on_wall).unwrap().y.floor();
+                let rolled = if shutter.is_empty() {
+                    0.0
+                } else {
+                    readout * row / 479.0
+                };
+                age += (latency - rolled) / f64::from(n);
+            }
+        }
+        let predicted = omega * age * ARCMIN_PER_RAD;
+        let mean = means[means.len() - 1];
+        assert!(
+            (mean / predicted - 1.0).abs() < 0.02,
+            "{shutter:?}: measured {mean:.2}′, ω × mean age {predicted:.2}′"
+        );
+    }
+    // The rolling shutter's rows, read later, are younger: less misregistration.
+    assert!(means[1] < means[0] * 0.8, "{means:?}");
+}
+
+/// das's ball rolls across the frontal camera's view while the vehicle drives and turns: with
+/// a rolling shutter and an exposure, the world differs from row to row and slice to slice,
+/// so the frame is rendered instant by instant; its brute-force twin renders the whole frame
+/// at each row's and slice's instant (the moving layer placed then) and keeps that row.
+#[test]
+fn a_moving_world_through_a_rolling_shutter_equals_its_row_by_row_twin() {
+    use seethru::render::in_time::{needs_instants, render_in_time};
+    use seethru::system::options::RunOptions;
+    use seethru::system::sequence::system_loop::SystemLoop;
+    let text = std::fs::read_to_string(common::repo_path("scenes/das.toml"))
+        .unwrap()
+        .replace(
+            "[camera.frontal]",
+            "[camera.frontal]\nshutter = \"rolling\"\nreadout_ms = 30.0\nexposure_ms = 8.0",
+        );
+    let scene = common::parse_in(&common::repo_path("scenes"), "das.toml", &text).unwrap();
+    let run = RunOptions {
+        spp: 2,
+        frontal_width: Some(64),
+        ..RunOptions::default()
+    };
+    let mut o = common::still_sequence(run, 0.2, 10.0, 0.0);
+    (o.speed, o.yaw_rate) = (10.0 / 3.6, 0.3);
+    let mut system = SystemLoop::new(&scene, o).unwrap();
+    let t = 0.3;
+    let ctx = system.context_at(t).unwrap();
+    let camera = ctx.scene.frontal;
+    let (w, h, spp) = (camera.width, camera.height, 2);
+    let vehicle = system.rig.vehicle;
+    let base = system.rig.base.frontal.world_from_camera;
+    let pose_at = move |dt: f64| vehicle.world_from_rig(t + dt) * base;
+    let job = RenderJob::new(&camera, FRONTAL)
+        .settings(settings(spp))
+        .moving(&pose_at);
+    assert!(
+        needs_instants(&ctx, &job),
+        "the ball is in the frontal view"
+    );
+    let mut frame = Frame::new(w, h);
+    render_in_time(&ctx, &mut |at| system.context_at(at), t, job, &mut frame).unwrap();
+    let mut twin = Frame::new(w, h);
+    let mut sums = vec![Vec3::ZERO; twin.color.len()];
+    for row in 0..h {
+        for s in 0..spp {
+            let dt = camera.shutter.instant(row, h, s, spp);
+            let at = system.context_at(t + dt).unwrap();
+            let seen = Camera {
+                shutter: Shutter::INSTANT,
+                ..at.scene.frontal
+            };
+            let (full, _) = at.render(
+                RenderJob::new(&seen, FRONTAL)
+                    .settings(settings(spp))
+                    .sample(s),
+            );
+            let i = full.index(0, row);
+            if s == 0 {
+                twin.copy_pixels(i, &full, i, w as usize);
+            }
+            for (sum, c) in sums[i..i + w as usize]
+                .iter_mut()
+                .zip(&full.color[i..i + w as usize])
+            {
+                *sum += *c;
+            }
+        }
+    }
+    for (c, sum) in twin.color.iter_mut().zip(&sums) {
+        *c = *sum / spp as f32;
+    }
+    assert!(frame.bit_identical(&twin));
+    // The ball is in it, and the one-pass render (the world held at t) differs where it moves.
+    let ball = ctx
+        .scene
+        .objects
+        .iter()
+        .position(|o| o.name == "ball")
+        .unwrap() as u32
+        + 1;
+    assert!(frame.object_id.contains(&ball));
+    let (held, _) = ctx.render(job);
+    assert!(!held.bit_identical(&frame));
+}
