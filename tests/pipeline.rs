@@ -501,6 +501,7 @@ fn driver_views_rendered_over_the_truth_equal_separate_renders() {
             DisplayModel::Pixels => DisplaySurface::Pixels {
                 image: r.display.clone(),
                 placement,
+                scan: None,
             },
             DisplayModel::Ideal => DisplaySurface::Ideal {
                 map: IdealMap::Crop {

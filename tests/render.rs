@@ -297,6 +297,7 @@ fn packets_render_every_view_as_the_per_ray_path_does_on_every_isa_and_thread_co
             DisplayModel::Pixels => DisplaySurface::Pixels {
                 image: r.display.clone(),
                 placement,
+                scan: None,
             },
             DisplayModel::Ideal => DisplaySurface::Ideal {
                 map: IdealMap::Crop {

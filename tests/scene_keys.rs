@@ -119,6 +119,7 @@ fn documented(key: &str) -> Documented {
         k if k.starts_with("calibration.") && k.ends_with("_error_deg") => closed(-10.0, 10.0),
         k if k.ends_with("position_error") => closed(-1.0, 1.0),
         "object.keyframe.t" => RangeAndRule(0.0, 3600.0),
+        k if k.ends_with("exposure_ms") => closed(0.0, 1000.0),
         "object.keyframe.rotate_deg" => closed(-360.0, 360.0),
         other => panic!(
             "`{other}` is not documented in this test: add what docs/reference/scene-format.md says"

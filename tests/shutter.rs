@@ -482,3 +482,218 @@ fn a_moving_world_through_a_rolling_shutter_equals_its_row_by_row_twin() {
     let (held, _) = ctx.render(job);
     assert!(!held.bit_identical(&frame));
 }
+
+/// Each shutter key out of its range, or where the shutter does not read it, is one error
+/// naming the file's line, the key, the value or the rule, and the admissible range.
+#[test]
+fn bad_shutter_keys_are_one_clear_error() {
+    for (keys, words) in [
+        (
+            "readout_ms = 20.0",
+            &["readout_ms", "shutter = \\\"rolling\\\""][..],
+        ),
+        ("row_order = \"bottom_to_top\"", &["row_order", "rolling"]),
+        ("shutter = \"slow\"", &["shutter", "global", "rolling"]),
+        (
+            "shutter = \"rolling\"\nreadout_ms = 0.0",
+            &["readout_ms", "0.001", "1000"],
+        ),
+        (
+            "shutter = \"rolling\"\nreadout_ms = 2000.0",
+            &["readout_ms", "1000"],
+        ),
+        (
+            "shutter = \"rolling\"\nrow_order = \"left\"",
+            &["row_order", "top_to_bottom"],
+        ),
+        ("exposure_ms = -1.0", &["exposure_ms", "0", "1000"]),
+        ("exposure_ms = nan", &["exposure_ms"]),
+    ] {
+        let text = scene_text(keys, "");
+        let error = common::parse(&text).unwrap_err().to_string();
+        assert!(!error.contains('\n'), "{keys}: {error}");
+        assert!(error.contains("scene.toml:"), "{keys}: {error}");
+        for w in words {
+            let w = w.replace("\\\"", "\"");
+            assert!(error.contains(&w), "{keys}: `{w}` missing from: {error}");
+        }
+    }
+    // The display's keys.
+    for (keys, words) in [
+        ("scanout = \"fast\"", &["scanout", "global", "rolling"][..]),
+        ("persistence_ms = 0.0", &["persistence_ms", "0.001", "1000"]),
+        ("persistence_ms = 5000.0", &["persistence_ms", "1000"]),
+    ] {
+        let text = scene_text("", "").replace("[obstacle]", &format!("[obstacle]\n{keys}"));
+        let error = common::parse(&text).unwrap_err().to_string();
+        assert!(
+            !error.contains('\n') && error.contains("scene.toml:"),
+            "{error}"
+        );
+        for w in words {
+            assert!(error.contains(w), "{keys}: `{w}` missing from: {error}");
+        }
+    }
+    // The driver's eye has no shutter: an unknown key.
+    let text =
+        scene_text("", "").replace("[camera.driver]", "[camera.driver]\nshutter = \"rolling\"");
+    let error = common::parse(&text).unwrap_err().to_string();
+    assert!(error.contains("shutter"), "{error}");
+}
+
+/// The wall sequence of [`a_rolling_frontal_camera_makes_each_display_row_as_old_as_its_frontal_row`]
+/// with the display's scan-out keys `obstacle` (TOML lines under `[obstacle]`), sampled 8
+/// times per 30 Hz refresh, the image 50 ms old at its refresh: each frame's records.
+fn scanned_sequence(obstacle: &str) -> Vec<seethru::measure::sequence_records::FrameRecord> {
+    use seethru::measure::image_metrics::Flip;
+    use seethru::measure::sequence::run_sequence;
+    use seethru::system::options::{RunOptions, WorkingDistance};
+    let text = common::WallScene::default()
+        .text()
+        .replace("[obstacle]", &format!("[obstacle]\n{obstacle}"));
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let run = RunOptions {
+        d2: WorkingDistance::Metres(6.0),
+        spp: 1,
+        ..RunOptions::default()
+    };
+    let mut o = common::still_sequence(run, 3.0 / 30.0, 240.0, 0.05);
+    o.timeline.display_hz = 30.0;
+    o.yaw_rate = 20f64.to_radians();
+    let how = common::measuring(Flip::Skipped);
+    run_sequence(&scene, o, how, &mut |_| Ok(()))
+        .unwrap()
+        .records
+}
+
+/// A rolling scan-out lights the display's 100 rows top to bottom over the 33 ms refresh:
+/// at a frame `s` after the refresh began, the rows it has reached show the new image and
+/// the others the previous one, a refresh period older. So the frame's mean misregistration
+/// is ω times the age of the new image plus the period times the share of rows not reached;
+/// with a global scan-out every row is new.
+#[test]
+fn a_rolling_scanout_shows_the_rows_below_the_scan_line_one_refresh_older() {
+    use seethru::analysis::physical::ARCMIN_PER_RAD;
+    let omega = 20f64.to_radians();
+    let period = 1.0 / 30.0;
+    for (keys, rolling) in [("", false), ("scanout = \"rolling\"", true)] {
+        let records = scanned_sequence(keys);
+        assert_eq!(records.len(), 24);
+        for r in records.iter().filter(|r| r.times.refresh > 0) {
+            let m = r.metrics.unwrap();
+            let since = (r.times.display - r.times.refresh_time).max(0.0);
+            let reached = ((since / period * 100.0 + 1e-9).floor() + 1.0).min(100.0);
+            let waiting = if rolling { 1.0 - reached / 100.0 } else { 0.0 };
+            let age = r.times.display - r.times.capture + period * waiting;
+            let predicted = omega * age * ARCMIN_PER_RAD;
+            assert!(
+                (m.mean_arcmin / predicted - 1.0).abs() < 0.03,
+                "{keys:?} frame {}: {:.2}′ measured, ω × age {predicted:.2}′",
+                r.frame,
+                m.mean_arcmin
+            );
+            assert_eq!(m.coverage, 1.0, "{keys:?} frame {}", r.frame);
+        }
+    }
+}
+
+/// A display whose rows stay lit 5 ms after their scan: at each frame only the rows scanned
+/// in the last 5 ms shine, the others are dark and counted as missing; with a global
+/// scan-out the whole display shines for 5 ms after each refresh.
+#[test]
+fn a_short_persistence_lights_only_the_rows_scanned_within_it() {
+    let period = 1.0 / 30.0;
+    for (keys, rolling) in [
+        ("scanout = \"rolling\"\npersistence_ms = 5.0", true),
+        ("persistence_ms = 5.0", false),
+    ] {
+        let records = scanned_sequence(keys);
+        for r in records.iter().filter(|r| r.times.refresh > 0) {
+            let m = r.metrics.unwrap();
+            let since = (r.times.display - r.times.refresh_time).max(0.0);
+            // Rows lit: scanned at period k / 100 within (since − 5 ms, since], counting the
+            // previous refresh's scan (its rows at k / 100 periods − one period).
+            let lit = (0..100)
+                .filter(|&k| {
+                    let scanned = if rolling {
+                        period * f64::from(k) / 100.0
+                    } else {
+                        0.0
+                    };
+                    let ago = if since >= scanned {
+                        since - scanned
+                    } else {
+                        since - scanned + period
+                    };
+                    ago < 0.005
+                })
+                .count() as f64
+                / 100.0;
+            assert!(
+                (m.coverage - lit).abs() < 0.03,
+                "{keys:?} frame {}: coverage {:.3}, rows lit {lit:.3}",
+                r.frame,
+                m.coverage
+            );
+        }
+        // Some frames are dark all over, some lit.
+        let coverages: Vec<f64> = records
+            .iter()
+            .map(|r| r.metrics.unwrap().coverage)
+            .collect();
+        assert!(
+            coverages.iter().any(|c| *c > 0.1),
+            "{keys:?}: {coverages:?}"
+        );
+        assert!(
+            coverages.iter().any(|c| *c < 0.05),
+            "{keys:?}: {coverages:?}"
+        );
+    }
+}
+
+/// A display scan-out the sequence cannot show is refused before any frame, in one line: a
+/// rolling scan-out sampled more slowly than the display refreshes (it shows two refreshes
+/// at once, the one before made), and the ideal display (which has no pixels to scan).
+#[test]
+fn a_scanout_the_sequence_cannot_show_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let das = std::fs::read_to_string(common::repo_path("scenes/das.toml")).unwrap();
+    for (keys, flags, expected) in [
+        (
+            "scanout = \"rolling\"",
+            &["--fps", "20", "--display-hz", "30"][..],
+            "--fps (20) must be at least --display-hz (30)",
+        ),
+        (
+            "persistence_ms = 4.0",
+            &["--display", "ideal"],
+            "not with --display ideal",
+        ),
+    ] {
+        let text = das
+            .replace("[obstacle]", &format!("[obstacle]\n{keys}"))
+            .replace("../assets", &common::repo_path("assets").to_string_lossy());
+        let scene = common::scene_file_in(dir.path(), "scanned.toml", &text);
+        let out = dir.path().join("out");
+        let mut args = vec![
+            "sequence",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--width",
+            "32",
+            "--duration",
+            "0.2",
+        ];
+        args.extend(flags);
+        let (ok, _, err) = common::seethru(&args);
+        assert!(!ok, "{args:?}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(
+            err.starts_with("error:") && err.contains(expected),
+            "{args:?}: {err}"
+        );
+        assert!(!out.exists());
+    }
+}

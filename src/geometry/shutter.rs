@@ -1,5 +1,6 @@
 //! When a camera's pixels see the world: the shutter (all rows at once, or rows read out one
-//! after another), the exposure each row integrates over, and the order the rows are read in.
+//! after another), the exposure each row integrates over, and the order the rows are read in;
+//! and its mirror, when a display's rows show an image: the scan-out and the persistence.
 //!
 //! A frame is named by one instant `t`, the middle of its first row's exposure. Row `r` (the
 //! `k`-th read) is exposed about `t + readout · k / (rows − 1)`; its `spp` samples are spread
@@ -96,9 +97,114 @@ impl Shutter {
     }
 }
 
+/// How a display's rows take a new image: all at once, or scanned top to bottom over the
+/// refresh period; and how long a row stays lit after it is scanned.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Scanout {
+    /// Whether the rows are scanned top to bottom over the refresh period (`false`: every row
+    /// takes the new image at the refresh's instant).
+    pub rolling: bool,
+    /// How long a row stays lit after it is scanned, seconds, in (0, 1] (a strobed or
+    /// low-persistence display); `None`: until it is scanned again (a hold display).
+    pub persistence_s: Option<f64>,
+}
+
+/// What one display row shows at an instant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RowShows {
+    /// The image of the latest refresh.
+    Latest,
+    /// The image of the refresh before it: the scan has not reached the row yet.
+    Previous,
+    /// Nothing: the row's light has gone out (its persistence is over), or no image has
+    /// reached it yet.
+    Dark,
+}
+
+impl Scanout {
+    /// Seconds after a refresh begins at which row `row` (of `rows`, from the top) takes its
+    /// image, the refresh period `period` s.
+    pub fn row_time(&self, row: u32, rows: u32, period: f64) -> f64 {
+        if self.rolling {
+            period * f64::from(row) / f64::from(rows.max(1))
+        } else {
+            0.0
+        }
+    }
+
+    /// What row `row` (of `rows`) shows `since` s after the latest refresh began (whose
+    /// period is `period` s); `has_previous`: whether a refresh came before it.
+    pub fn row_shows(
+        &self,
+        row: u32,
+        rows: u32,
+        since: f64,
+        period: f64,
+        has_previous: bool,
+    ) -> RowShows {
+        let scanned = self.row_time(row, rows, period);
+        let (shows, lit_for) = if since >= scanned {
+            (RowShows::Latest, since - scanned)
+        } else if has_previous {
+            (RowShows::Previous, since - scanned + period)
+        } else {
+            return RowShows::Dark;
+        };
+        match self.persistence_s {
+            Some(p) if lit_for >= p => RowShows::Dark,
+            _ => shows,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_rolling_scanout_shows_the_latest_image_above_the_scan_line() {
+        let rolling = Scanout {
+            rolling: true,
+            persistence_s: None,
+        };
+        let period = 0.04;
+        // 10 ms into a 40 ms refresh of 100 rows: rows 0..=25 scanned (row 25 at 10 ms).
+        let shows: Vec<RowShows> = (0..100)
+            .map(|r| rolling.row_shows(r, 100, 0.01, period, true))
+            .collect();
+        assert!(shows[..=25].iter().all(|s| *s == RowShows::Latest));
+        assert!(shows[26..].iter().all(|s| *s == RowShows::Previous));
+        // No refresh before: the unscanned rows are dark.
+        assert_eq!(
+            rolling.row_shows(26, 100, 0.01, period, false),
+            RowShows::Dark
+        );
+        // A global scan-out: every row the latest at once.
+        let global = Scanout::default();
+        assert!((0..100).all(|r| global.row_shows(r, 100, 0.0, period, true) == RowShows::Latest));
+        // A 5 ms persistence: lit only within 5 ms of its scan.
+        let flash = Scanout {
+            persistence_s: Some(0.005),
+            ..rolling
+        };
+        let lit: Vec<u32> = (0..100)
+            .filter(|&r| flash.row_shows(r, 100, 0.01, period, true) != RowShows::Dark)
+            .collect();
+        // Rows scanned in (5 ms, 10 ms]: 13..=25.
+        assert_eq!(lit, (13..=25).collect::<Vec<_>>());
+        let global_flash = Scanout {
+            persistence_s: Some(0.005),
+            ..global
+        };
+        assert_eq!(
+            global_flash.row_shows(7, 100, 0.004, period, true),
+            RowShows::Latest
+        );
+        assert_eq!(
+            global_flash.row_shows(7, 100, 0.006, period, true),
+            RowShows::Dark
+        );
+    }
 
     #[test]
     fn rows_are_spread_over_the_readout_in_their_order() {

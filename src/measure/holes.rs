@@ -161,6 +161,7 @@ mod tests {
             display_off_color: [0.0; 3],
             body_color: [0.2; 3],
             display_shape: DisplayShape::Flat,
+            scanout: crate::geometry::shutter::Scanout::default(),
         };
         // Driver-view pixels at the display's top-right, bottom-right and top-left corners,
         // a hair outside (as float rounding puts them), in world coordinates.

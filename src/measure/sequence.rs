@@ -289,7 +289,7 @@ impl SequenceStepper {
             hazards: Vec::new(),
         };
         if !self.how.metrics {
-            system.render_seethru(&ctx, &mut self.seethru);
+            system.render_seethru(&ctx, times.display, &mut self.seethru);
             self.records.push(record);
             return Ok(true);
         }
@@ -311,7 +311,7 @@ impl SequenceStepper {
             &mut self.seethru,
             union(self.region, self.seethru_region),
         );
-        self.seethru_region = system.render_seethru(&ctx, &mut self.seethru);
+        self.seethru_region = system.render_seethru(&ctx, times.display, &mut self.seethru);
         let occluded = &self.occluded;
         let t1 = Instant::now();
         // Missing pixels are those the frontal camera, where it was at capture, cannot see.

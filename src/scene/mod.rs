@@ -193,6 +193,9 @@ pub struct Obstacle {
     /// (triangles with UVs in the obstacle frame; `width` × `height` is then its reference
     /// rectangle, which the crop's report and the flat formulas use).
     pub display_shape: display_surface::DisplayShape,
+    /// How the display's rows take each new image and how long they stay lit (a sequence's
+    /// display refreshes; every other command shows one still image).
+    pub scanout: crate::geometry::shutter::Scanout,
 }
 
 impl Obstacle {

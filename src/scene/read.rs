@@ -432,6 +432,7 @@ fn read_obstacle(t: &TableReader, file: &SourceFile) -> Result<Obstacle, SceneEr
         display_off_color: t.color("display_off_color", [0.02, 0.02, 0.025])?,
         body_color: t.color("body_color", [0.18, 0.18, 0.2])?,
         display_shape: crate::scene::display_keys::read_display_shape(t, file, width, height)?,
+        scanout: crate::scene::shutter_keys::read_scanout(t)?,
     };
     let half = DVec3::new(obstacle.width, obstacle.height, 2.0 * obstacle.thickness) / 2.0;
     let curved = crate::scene::display_keys::surface_corners(&obstacle.display_shape);

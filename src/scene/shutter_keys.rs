@@ -1,9 +1,10 @@
 //! The shutter keys of `[camera.frontal]` and `[camera.back]`: `shutter` (`global` or
-//! `rolling`), `readout_ms` and `row_order` (a rolling shutter's), `exposure_ms`. Documented
+//! `rolling`), `readout_ms` and `row_order` (a rolling shutter's), `exposure_ms`; and the
+//! display's of `[obstacle]`: `scanout` (`global` or `rolling`), `persistence_ms`. Documented
 //! in `scenes/reference.toml` and docs/reference/scene-format.md; what they do in
 //! docs/guide/time.md.
 
-use crate::geometry::shutter::{MAX_SHUTTER_S, RowOrder, Shutter};
+use crate::geometry::shutter::{MAX_SHUTTER_S, RowOrder, Scanout, Shutter};
 use crate::scene::source::SceneError;
 use crate::scene::table_reader::TableReader;
 
@@ -44,5 +45,23 @@ pub fn read_shutter(t: &TableReader) -> Result<Shutter, SceneError> {
         readout_s: readout_ms / 1e3,
         exposure_s: exposure_ms / 1e3,
         row_order,
+    })
+}
+
+/// Values of the `scanout` key.
+pub const SCANOUTS: [&str; 2] = ["global", "rolling"];
+
+/// The obstacle table's display scan-out (every row at once, held, without its keys).
+pub fn read_scanout(t: &TableReader) -> Result<Scanout, SceneError> {
+    let rolling = t.choice("scanout", "global", &SCANOUTS)? == "rolling";
+    let persistence_s = match t.opt_f64("persistence_ms")? {
+        None => None,
+        Some(_) => {
+            Some(t.f64_in("persistence_ms", 0.0, MIN_READOUT_MS, MAX_SHUTTER_S * 1e3)? / 1e3)
+        }
+    };
+    Ok(Scanout {
+        rolling,
+        persistence_s,
     })
 }

@@ -4,6 +4,7 @@
 use glam::{DAffine3, DVec2, Vec3};
 
 use crate::geometry::camera::Camera;
+use crate::geometry::shutter::RowShows;
 use crate::render::frame::{Frame, Pixel};
 use crate::render::screen::{Screen, Shown};
 use crate::scene::Obstacle;
@@ -190,6 +191,9 @@ pub enum DisplaySurface {
     Pixels {
         image: Frame,
         placement: DisplayPlacement,
+        /// Which image each row shows at the instant looked at, where not all of them show
+        /// `image` (a scan-out in progress, rows gone dark); `None`: every row `image`.
+        scan: Option<ScannedRows>,
     },
     /// An ideal display and frontal camera of unlimited resolution: the exact point hit is
     /// mapped through the compensation (`map`) into the frontal camera, and a ray from there
@@ -201,14 +205,45 @@ pub enum DisplaySurface {
     },
 }
 
+/// The rows of a display at one instant of a refresh (geometry/shutter.rs's [`Scanout`]).
+///
+/// [`Scanout`]: crate::geometry::shutter::Scanout
+pub struct ScannedRows {
+    /// The image of the refresh before the latest (`None`: there was none).
+    pub previous: Option<std::sync::Arc<Frame>>,
+    /// What each row shows, from the top: one per row of the display image.
+    pub rows: Vec<RowShows>,
+}
+
+/// What a dark display row shows: no light, and no world point (counted as missing).
+const DARK: Pixel = Pixel {
+    color: Vec3::ZERO,
+    object_id: MISSING_ID,
+    ..Pixel::SKY
+};
+
 impl Screen for DisplaySurface {
     fn shown_at(&self, world: Vec3) -> Shown {
         match self {
-            DisplaySurface::Pixels { image, placement } => {
+            DisplaySurface::Pixels {
+                image,
+                placement,
+                scan,
+            } => {
                 let c = placement.pixel_coords(world);
                 let x = (c.x.max(0.0) as u32).min(image.width - 1);
                 let y = (c.y.max(0.0) as u32).min(image.height - 1);
-                Shown::Pixel(image.pixel(x, y))
+                let shown = match scan {
+                    None => image,
+                    Some(scan) => match (scan.rows[y as usize], &scan.previous) {
+                        (RowShows::Latest, _) => image,
+                        (RowShows::Previous, Some(previous)) => &**previous,
+                        (RowShows::Previous, None) | (RowShows::Dark, _) => {
+                            return Shown::Pixel(DARK);
+                        }
+                    },
+                };
+                Shown::Pixel(shown.pixel(x, y))
             }
             DisplaySurface::Ideal {
                 map,

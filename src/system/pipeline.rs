@@ -617,10 +617,12 @@ pub fn run_staged(
         _ if given_display => DisplaySurface::Pixels {
             image: display.clone(),
             placement,
+            scan: None,
         },
         DisplayModel::Pixels => DisplaySurface::Pixels {
             image: display.clone(),
             placement,
+            scan: None,
         },
         DisplayModel::Ideal => DisplaySurface::Ideal {
             map: ideal_map(scene, eye_used, d2_used, curved, crop, &map)?,

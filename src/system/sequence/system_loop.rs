@@ -17,6 +17,7 @@ use glam::DVec3;
 
 use crate::geometry::camera::Camera;
 use crate::geometry::lens::Lens;
+use crate::geometry::shutter::Scanout;
 use crate::render::accel::Accel;
 use crate::render::footprint::PixelRect;
 use crate::render::frame::Frame;
@@ -32,7 +33,7 @@ use crate::system::calibration_json::calibration_json;
 use crate::system::capture::{HeadEstimate, check_display_input, display_from, fingerprint};
 use crate::system::compensation::Crop;
 use crate::system::display::{
-    DisplayModel, DisplayPlacement, DisplaySurface, IdealMap, resample_through,
+    DisplayModel, DisplayPlacement, DisplaySurface, IdealMap, ScannedRows, resample_through,
 };
 use crate::system::head::gaussian;
 use crate::system::head_estimate::{FACING_FORWARD, fix_from};
@@ -125,6 +126,9 @@ pub struct SystemLoop {
     shown: Option<Shown>,
     /// The display showing the image of the last refresh.
     surface: Option<DisplaySurface>,
+    /// The image of the refresh before the last, and its index: what a rolling scan-out
+    /// still shows below its scan line.
+    previous: Option<(i64, Arc<Frame>)>,
     pub seconds: StageSeconds,
     /// Frontal pixels rendered, summed over the refreshes.
     pub frontal_pixels: u64,
@@ -166,6 +170,20 @@ impl SystemLoop {
                 "option `require_confident_head` needs option `head_source` estimated (only the image-based estimate has a confidence)"
             );
         }
+        let scanout = scene.obstacle.scanout;
+        if scanout != Scanout::default() && run.display == DisplayModel::Ideal {
+            bail!(
+                "the display's scanout and persistence_ms are its pixels' timing: not with option `display` ideal (use pixels)"
+            );
+        }
+        let timeline = options.timeline;
+        if scanout.rolling && timeline.fps < timeline.display_hz {
+            bail!(
+                "a rolling scanout shows two refreshes at once: option `fps` ({}) must be at least option `display_hz` ({}), so that every refresh is made",
+                short(timeline.fps),
+                short(timeline.display_hz)
+            );
+        }
         let mut base = scene.clone();
         base.frontal = run.sized_frontal(base.frontal)?;
         base.back = run.sized_back(base.back)?;
@@ -199,6 +217,7 @@ impl SystemLoop {
             frontal,
             shown: None,
             surface: None,
+            previous: None,
             seconds: StageSeconds::default(),
             frontal_pixels: 0,
             model_last: None,
@@ -463,9 +482,16 @@ impl SystemLoop {
         self.seconds.frontal += frontal_seconds;
         self.seconds.compensation += start.elapsed().as_secs_f64() - frontal_seconds;
         self.inputs = inputs;
+        // The image this refresh replaces: a rolling scan-out shows it below its scan line.
+        if let (Some(DisplaySurface::Pixels { image, .. }), Some(last)) =
+            (self.surface.take(), &self.shown)
+        {
+            self.previous = Some((last.times.refresh, Arc::new(image)));
+        }
         self.surface = Some(DisplaySurface::Pixels {
             image: display,
             placement: DisplayPlacement::new(&capture.scene.obstacle),
+            scan: None,
         });
         let ideal = ideal_map(&geometry, eye_world, d2_used, curved, crop, &map)?;
         self.shown = Some(Shown {
@@ -529,10 +555,11 @@ impl SystemLoop {
         self.inputs.take()
     }
 
-    /// The `seethru` view at display time into `frame` (the truth of the same instant, or
-    /// any frame of the driver camera's size: only the pixels where the display can be seen
-    /// are rendered), with what [`SystemLoop::show`] last made. Returns the pixels rendered.
-    pub fn render_seethru(&mut self, ctx: &RenderContext, frame: &mut Frame) -> PixelRect {
+    /// The `seethru` view at display time `t` (`ctx`, the scene then) into `frame` (the truth
+    /// of the same instant, or any frame of the driver camera's size: only the pixels where
+    /// the display can be seen are rendered), with what [`SystemLoop::show`] last made, each
+    /// display row as the scan-out shows it at `t`. Returns the pixels rendered.
+    pub fn render_seethru(&mut self, ctx: &RenderContext, t: f64, frame: &mut Frame) -> PixelRect {
         let start = Instant::now();
         let shown = self.shown.as_ref().expect("show() before render_seethru()");
         let driver = ctx.scene.driver;
@@ -541,10 +568,32 @@ impl SystemLoop {
         let mut surface = self.surface.take().unwrap_or(DisplaySurface::Pixels {
             image: Frame::new(0, 0),
             placement: placement.clone(),
+            scan: None,
         });
+        let scanout = ctx.scene.obstacle.scanout;
+        let period = 1.0 / self.options.timeline.display_hz;
+        let since = (t - shown.times.refresh_time).max(0.0);
+        let previous = self
+            .previous
+            .as_ref()
+            .filter(|(refresh, _)| *refresh == shown.times.refresh - 1)
+            .map(|(_, image)| image.clone());
         surface = match (self.options.run.display, surface) {
             (DisplayModel::Pixels, DisplaySurface::Pixels { image, .. }) => {
-                DisplaySurface::Pixels { image, placement }
+                let scan = (scanout != Scanout::default()).then(|| {
+                    let rows = image.height;
+                    ScannedRows {
+                        rows: (0..rows)
+                            .map(|r| scanout.row_shows(r, rows, since, period, previous.is_some()))
+                            .collect(),
+                        previous,
+                    }
+                });
+                DisplaySurface::Pixels {
+                    image,
+                    placement,
+                    scan,
+                }
             }
             _ => DisplaySurface::Ideal {
                 map: shown.ideal.clone(),
