@@ -2,12 +2,14 @@
 //! after another), the exposure each row integrates over, and the order the rows are read in;
 //! and its mirror, when a display's rows show an image: the scan-out and the persistence.
 //!
-//! A frame is named by one instant `t`, the middle of its first row's exposure. Row `r` (the
-//! `k`-th read) is exposed about `t + readout · k / (rows − 1)`; its `spp` samples are spread
-//! over its exposure at the midpoints of `spp` equal slices, the same slices for every pixel.
-//! So a frame is exactly the mean of `spp` instantaneous renders (one per slice) taken row by
-//! row, which is what the renderer's twin checks; a global shutter with no exposure is one
-//! instant, today's image bit for bit.
+//! A frame is named by one instant `t`: when it is complete, its last row read out (a
+//! camera's latency counts from there, as a driver delivers the image then). Row `r`, the
+//! `k`-th of `rows` read, is read at `t − readout · (rows − 1 − k) / (rows − 1)`, and its
+//! exposure ends there: it spans the `exposure` before. A pixel's `spp` samples are spread over
+//! that exposure at the midpoints of `spp` equal slices, the same slices for every pixel. So a
+//! frame is exactly the mean of `spp` instantaneous renders (one per slice) taken row by row,
+//! which is what the renderer's twin checks; a global shutter with no exposure is one instant,
+//! `t`, today's image bit for bit.
 
 /// Longest readout or exposure, seconds: a second is a very long exposure for a moving car.
 pub const MAX_SHUTTER_S: f64 = 1.0;
@@ -57,26 +59,31 @@ impl Shutter {
         self.readout_s > 0.0
     }
 
-    /// Seconds after the frame's instant at which row `row` of an image `height` rows high is
-    /// exposed (the middle of its exposure).
+    /// Seconds after the frame's instant (≤ 0) at which row `row` of an image `height` rows
+    /// high is read out, the end of its exposure.
     pub fn row_time(&self, row: u32, height: u32) -> f64 {
         if !self.is_rolling() || height < 2 {
             return 0.0;
         }
-        let k = match self.row_order {
-            RowOrder::TopToBottom => row,
-            RowOrder::BottomToTop => height - 1 - row,
+        // Rows still to be read after this one.
+        let after = match self.row_order {
+            RowOrder::TopToBottom => height - 1 - row,
+            RowOrder::BottomToTop => row,
         };
-        self.readout_s * f64::from(k) / f64::from(height - 1)
+        -self.readout_s * f64::from(after) / f64::from(height - 1)
     }
 
-    /// Seconds from the middle of a row's exposure at which sample `sample` of `spp` is
-    /// traced: the midpoint of slice `sample` of `spp` equal slices of the exposure.
+    /// Seconds from a row's readout (≤ 0) at which sample `sample` of `spp` is traced: the
+    /// midpoint of one of `spp` equal slices of the exposure before it, slice
+    /// `(sample + spp / 2) mod spp`, so that sample 0 (the pixel's centre, whose AOVs the
+    /// frame keeps) is in the middle slice: exactly the exposure's middle for an odd `spp`.
     pub fn sample_time(&self, sample: u32, spp: u32) -> f64 {
         if self.exposure_s == 0.0 {
             return 0.0;
         }
-        self.exposure_s * ((f64::from(sample) + 0.5) / f64::from(spp.max(1)) - 0.5)
+        let spp = spp.max(1);
+        let slice = (sample + spp / 2) % spp;
+        self.exposure_s * ((f64::from(slice) + 0.5) / f64::from(spp) - 1.0)
     }
 
     /// Seconds after the frame's instant of sample `sample` (of `spp`) of row `row` (of
@@ -85,13 +92,13 @@ impl Shutter {
         self.row_time(row, height) + self.sample_time(sample, spp)
     }
 
-    /// The instants of a frame: each row's exposure as (start, end), seconds after the frame's
-    /// instant (`height` of them).
+    /// Each row's exposure as (start, end), seconds after the frame's instant (`height` of
+    /// them, from the top).
     pub fn row_exposures(&self, height: u32) -> Vec<(f64, f64)> {
         (0..height)
             .map(|row| {
                 let t = self.row_time(row, height);
-                (t - self.exposure_s / 2.0, t + self.exposure_s / 2.0)
+                (t - self.exposure_s, t)
             })
             .collect()
     }
@@ -212,15 +219,16 @@ mod tests {
             readout_s: 0.03,
             ..Shutter::INSTANT
         };
-        assert_eq!(rolling.row_time(0, 481), 0.0);
-        assert!((rolling.row_time(240, 481) - 0.015).abs() < 1e-15);
-        assert!((rolling.row_time(480, 481) - 0.03).abs() < 1e-15);
+        // The top row read first, 30 ms before the frame is complete; the last at its instant.
+        assert!((rolling.row_time(0, 481) + 0.03).abs() < 1e-15);
+        assert!((rolling.row_time(240, 481) + 0.015).abs() < 1e-15);
+        assert_eq!(rolling.row_time(480, 481), 0.0);
         let flipped = Shutter {
             row_order: RowOrder::BottomToTop,
             ..rolling
         };
-        assert!((flipped.row_time(0, 481) - 0.03).abs() < 1e-15);
-        assert_eq!(flipped.row_time(480, 481), 0.0);
+        assert_eq!(flipped.row_time(0, 481), 0.0);
+        assert!((flipped.row_time(480, 481) + 0.03).abs() < 1e-15);
         // One row, or a global shutter: the frame's instant.
         assert_eq!(rolling.row_time(0, 1), 0.0);
         assert_eq!(Shutter::INSTANT.row_time(100, 200), 0.0);
@@ -233,15 +241,18 @@ mod tests {
             exposure_s: 0.02,
             ..Shutter::INSTANT
         };
+        // Sample 0 in the middle slice (the third of four), the others after it in turn.
         let times: Vec<f64> = (0..4).map(|k| s.sample_time(k, 4)).collect();
-        let expected = [-0.0075, -0.0025, 0.0025, 0.0075];
+        let expected = [-0.0075, -0.0025, -0.0175, -0.0125];
         for (t, e) in times.iter().zip(expected) {
             assert!((t - e).abs() < 1e-15, "{times:?}");
         }
-        // Centred on the row's time: their mean is 0, their spread the exposure's.
-        assert!(times.iter().sum::<f64>().abs() < 1e-15);
-        assert_eq!(s.sample_time(0, 1), 0.0);
-        assert_eq!(s.row_exposures(3), vec![(-0.01, 0.01); 3]);
+        // The exposure ends at the row's readout: their mean is half an exposure before it.
+        assert!((times.iter().sum::<f64>() / 4.0 + 0.01).abs() < 1e-15);
+        assert_eq!(s.sample_time(0, 1), -0.01);
+        // An odd count: sample 0 at the exposure's middle.
+        assert!((s.sample_time(0, 5) + 0.01).abs() < 1e-15);
+        assert_eq!(s.row_exposures(3), vec![(-0.02, 0.0); 3]);
         assert!(!s.is_instant() && !s.is_rolling());
     }
 }

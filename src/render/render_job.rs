@@ -143,16 +143,18 @@ impl<'a> RenderJob<'a> {
         }
     }
 
-    /// The same job seen by `camera` (at one instant: without the job's motion).
-    pub(super) fn seen_by<'b>(self, camera: &'b Camera) -> RenderJob<'b>
-    where
-        'a: 'b,
-    {
-        RenderJob {
-            camera,
-            pose_at: None,
-            ..self
-        }
+    /// What every pixel of the job shares: its camera at each instant of its shutter.
+    pub(super) fn pixels(&self) -> PixelJob<'a> {
+        let spp = self.settings.spp;
+        let samples = self.sample.map_or(0..spp, |s| s..s + 1);
+        PixelJob::new(
+            self.camera,
+            self.pose_at,
+            self.view,
+            self.display,
+            spp,
+            samples,
+        )
     }
 
     /// Traced by `tracer`: every tracer gives the same frame.
@@ -226,11 +228,20 @@ impl RenderContext {
         region: PixelRect,
         bands: Vec<Rows<'_>>,
     ) -> RenderStats {
+        self.render_bands_of(job, &job.pixels(), region, bands)
+    }
+
+    /// [`RenderContext::render_bands`] with the job's pixels made ([`RenderJob::pixels`]),
+    /// so that renders of one job over several contexts share them.
+    pub(super) fn render_bands_of(
+        &self,
+        job: &RenderJob,
+        pixels: &PixelJob,
+        region: PixelRect,
+        bands: Vec<Rows<'_>>,
+    ) -> RenderStats {
         let start = Instant::now();
-        let spp = job.settings.spp;
-        let samples = job.sample.map_or(0..spp, |s| s..s + 1);
-        let traced = samples.len() as u64;
-        let pixels = PixelJob::new(job.camera, job.pose_at, job.view, job.display, spp, samples);
+        let traced = job.sample.map_or(u64::from(job.settings.spp), |_| 1);
         let bands: Vec<_> = bands
             .into_iter()
             .filter(|b| b.y < region.y1 && b.y + b.len() > region.y0)
@@ -259,7 +270,7 @@ impl RenderContext {
                                 for row in rows {
                                     for x in region.x0..region.x1 {
                                         let pixel = self.render_pixel(
-                                            &pixels,
+                                            pixels,
                                             x,
                                             band.y + row,
                                             stack,
@@ -278,7 +289,7 @@ impl RenderContext {
                                         columns: x0..(x0 + TILE_COLUMNS).min(region.x1),
                                     };
                                     self.render_tile(
-                                        &pixels,
+                                        pixels,
                                         &tile,
                                         &mut band,
                                         stack,
