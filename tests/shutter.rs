@@ -339,6 +339,81 @@ fn an_instant_shutter_on_a_moving_camera_is_todays_image() {
     assert!(still.bit_identical(&moving));
 }
 
+/// The mean age, from the frame's completion, of the frontal rows the display's pixels show
+/// on the wall 6 m ahead (a rolling shutter of `readout` s over 480 rows, top to bottom): a
+/// 60 × 40 grid over the display, each point's ray from the eye onto the wall, projected
+/// into the frontal camera.
+fn readout_age(scene: &seethru::scene::Scene, readout: f64) -> f64 {
+    let (eye, frontal) = (scene.eye(), scene.frontal);
+    let [a, b, _, d] = scene.obstacle.display_corners();
+    let mut age = 0.0;
+    for i in 0..60 {
+        for j in 0..40 {
+            let (u, v) = ((f64::from(i) + 0.5) / 60.0, (f64::from(j) + 0.5) / 40.0);
+            let p = a + (b - a) * u + (d - a) * v;
+            let on_wall = eye + (p - eye) * ((-6.0 - eye.z) / (p.z - eye.z));
+            let row = frontal.project_point(on_wall).unwrap().y.floor();
+            age += readout * (479.0 - row) / 479.0 / 2400.0;
+        }
+    }
+    age
+}
+
+/// `run` at one moving instant: the wall 6 m ahead, the vehicle yawing at 20°/s, a rolling
+/// frontal camera: the display's rows show frontal rows read before the frame's instant (the
+/// truth's), so the mean misregistration is ω times their mean age; a global shutter with an
+/// instant exposure refuses the motion (it would change nothing).
+#[test]
+fn a_run_on_a_turning_vehicle_sees_its_rolling_rows_as_old_as_they_are() {
+    use seethru::analysis::physical::ARCMIN_PER_RAD;
+    use seethru::measure::image_metrics::Flip;
+    use seethru::measure::metrics::measure_with;
+    use seethru::render::integrator::RenderContext;
+    use seethru::system::options::{RunOptions, WorkingDistance};
+    use seethru::system::pipeline::run;
+    let text = common::WallScene::default().text().replace(
+        "[camera.frontal]",
+        "[camera.frontal]\nshutter = \"rolling\"\nreadout_ms = 60.0",
+    );
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let ctx = RenderContext::new(scene.clone()).unwrap();
+    let options = RunOptions {
+        d2: WorkingDistance::Metres(6.0),
+        spp: 1,
+        yaw_rate_deg_s: 20.0,
+        ..RunOptions::default()
+    };
+    let mean_of = |options: &RunOptions| {
+        let r = run(&ctx, options).unwrap();
+        let eye = ctx.scene.eye();
+        let views = r.measured_views();
+        measure_with(&ctx, &ctx.scene, eye, views, 5, Flip::Skipped)
+            .1
+            .display
+            .misregistration_arcmin
+            .mean
+    };
+    let mean = mean_of(&options);
+    let predicted = 20f64.to_radians() * readout_age(&scene, 0.06) * ARCMIN_PER_RAD;
+    assert!(
+        (mean / predicted - 1.0).abs() < 0.03,
+        "measured {mean:.2}′, ω × mean readout age {predicted:.2}′"
+    );
+    // Still, the same scene: the static error alone (the resampling quantum), a fifth of it.
+    let still = mean_of(&RunOptions {
+        yaw_rate_deg_s: 0.0,
+        ..options.clone()
+    });
+    assert!(still < 0.2 * predicted, "still: {still:.2}′");
+    // A global instant shutter: the motion would change nothing.
+    let global = common::WallScene::default().context();
+    let error = run(&global, &options).err().unwrap().to_string();
+    assert!(
+        error.contains("option `yaw_rate`") && error.contains("shutter"),
+        "{error}"
+    );
+}
+
 /// A sequence on the textured wall 6 m ahead (the model plane on it), the vehicle yawing at
 /// ω, the image `latency` s old when complete, the frontal camera's shutter `shutter`: each
 /// display pixel shows a frontal row read `T (H − 1 − r) / (H − 1)` before the last, so its
@@ -374,27 +449,12 @@ fn a_rolling_frontal_camera_makes_each_display_row_as_old_as_its_frontal_row() {
             .map(|r| r.metrics.unwrap().mean_arcmin)
             .collect();
         means.push(m.iter().sum::<f64>() / m.len() as f64);
-        // The mean age of the display's pixels: a 60 × 40 grid over the display, each
-        // point's ray from the eye onto the wall, projected into the frontal camera.
-        let (eye, frontal) = (scene.eye(), scene.frontal);
-        let [a, b, _, d] = scene.obstacle.display_corners();
-        let mut age = 0.0;
-        let n = 60 * 40;
-        for i in 0..60 {
-            for j in 0..40 {
-                let (u, v) = ((f64::from(i) + 0.5) / 60.0, (f64::from(j) + 0.5) / 40.0);
-                let p = a + (b - a) * u + (d - a) * v;
-                let on_wall = eye + (p - eye) * ((-6.0 - eye.z) / (p.z - eye.z));
-                let row = frontal.project_point(on_wall).unwrap().y.floor();
-                let rolled = if shutter.is_empty() {
-                    0.0
-                } else {
-                    readout * (479.0 - row) / 479.0
-                };
-                age += (latency + rolled) / f64::from(n);
-            }
-        }
-        let predicted = omega * age * ARCMIN_PER_RAD;
+        let rolled = if shutter.is_empty() {
+            0.0
+        } else {
+            readout_age(&scene, readout)
+        };
+        let predicted = omega * (latency + rolled) * ARCMIN_PER_RAD;
         let mean = means[means.len() - 1];
         assert!(
             (mean / predicted - 1.0).abs() < 0.02,

@@ -288,8 +288,6 @@ pub const SEQUENCE_KEYS: [&str; 37] = [
     "duration",
     "fps",
     "display_hz",
-    "speed",
-    "yaw_rate",
     "head",
     "head_path",
     "sway_cm",
@@ -310,6 +308,8 @@ pub const SEQUENCE_KEYS: [&str; 37] = [
     "feature_width",
     "require_confident_head",
     "min_head_confidence",
+    "speed",
+    "yaw_rate",
     "outside",
     "filter",
     "display",
@@ -373,8 +373,6 @@ pub fn sequence(
     let duration = k.real("duration", 4.0, 1e-6, 3600.0)?;
     let fps = k.real("fps", 60.0, 1e-6, 1000.0)?;
     let display_hz = k.real("display_hz", fps, 1e-6, 1000.0)?;
-    let speed = k.real("speed", 0.0, 0.0, 300.0)?;
-    let yaw_rate = k.real("yaw_rate", 0.0, -180.0, 180.0)?;
     let head: HeadPreset = k.choice("head", HeadPreset::Still)?;
     let head_path = k.string("head_path")?.map(PathBuf::from);
     if head_path.is_some() && k.given("head") {
@@ -460,8 +458,8 @@ pub fn sequence(
                     latency_camera: ms / 1e3,
                     latency_tracking: latency_tracking / 1e3,
                 },
-                speed: speed / 3.6,
-                yaw_rate: yaw_rate.to_radians(),
+                speed: run.speed_kmh / 3.6,
+                yaw_rate: run.yaw_rate_deg_s.to_radians(),
                 head: head.clone(),
                 predict,
                 reproject,

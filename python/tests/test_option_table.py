@@ -46,7 +46,8 @@ def cases(option: dict):
     elif kind in ("number", "distance"):
         yield low, True
         yield high, True
-        yield (low / 2 if low > 0 else -1.0), False
+        # One beyond the low end: half of it above 0, one below it otherwise.
+        yield (low / 2 if low > 0 else low - 1.0), False
         yield high * 1.5 + 1, False
         if kind == "distance":
             yield "inf", True

@@ -100,12 +100,6 @@ pub struct Sequence {
     /// Display refresh rate, Hz in [1e-6, 1000] (sample and hold; default: --fps).
     #[arg(long = "display-hz", value_parser = positive(1000.0))]
     display_hz: Option<f64>,
-    /// Vehicle speed along the road (world −z), km/h in [0, 300].
-    #[arg(long, default_value_t = 0.0, value_parser = real(0.0, 300.0))]
-    speed: f64,
-    /// Vehicle yaw rate, degrees per second in [-180, 180] (> 0 turns left).
-    #[arg(long = "yaw-rate", default_value_t = 0.0, allow_hyphen_values = true, value_parser = real(-180.0, 180.0))]
-    yaw_rate: f64,
     /// Head motion relative to the vehicle: still, sway (lateral sinusoid) or lean (towards
     /// the pillar to look around it).
     #[arg(long, value_enum, value_parser = choice::<HeadPreset>(), default_value_t = HeadPreset::Still)]
@@ -213,8 +207,8 @@ impl Sequence {
                 latency_camera: latency_ms / 1e3,
                 latency_tracking: self.latency_tracking / 1e3,
             },
-            speed: self.speed / 3.6,
-            yaw_rate: self.yaw_rate.to_radians(),
+            speed: spec.options.speed_kmh / 3.6,
+            yaw_rate: spec.options.yaw_rate_deg_s.to_radians(),
             head: head.clone(),
             predict: self.predict,
             reproject: self.reproject,
@@ -434,8 +428,8 @@ impl Sequence {
             "duration_s": self.duration,
             "fps": self.fps,
             "display_hz": self.display_hz.unwrap_or(self.fps),
-            "speed_kmh": self.speed,
-            "yaw_rate_deg_s": self.yaw_rate,
+            "speed_kmh": spec.options.speed_kmh,
+            "yaw_rate_deg_s": spec.options.yaw_rate_deg_s,
             "head": self.head_motion()?.name(),
             "latency_tracking_ms": self.latency_tracking,
             "predict": self.predict,

@@ -298,6 +298,30 @@ pub static OPTIONS: &[OptionSpec] = &[
         commands: RUN_CAPTURE_SEQUENCE,
     },
     OptionSpec {
+        name: "speed",
+        kind: Kind::Real {
+            min: 0.0,
+            max: 300.0,
+        },
+        unit: "km/h",
+        default: Default::Value("0"),
+        help: "Vehicle speed along the road (world -z); a single frame sees it through the frontal camera's rolling readout and exposure.",
+        read_with: &[],
+        commands: RUNS,
+    },
+    OptionSpec {
+        name: "yaw_rate",
+        kind: Kind::Real {
+            min: -180.0,
+            max: 180.0,
+        },
+        unit: "deg/s",
+        default: Default::Value("0"),
+        help: "Vehicle yaw rate about the driver's eye, > 0 turning left; a single frame sees it through the frontal camera's rolling readout and exposure.",
+        read_with: &[],
+        commands: RUNS,
+    },
+    OptionSpec {
         name: "outside",
         kind: Kind::Choice(choice_values::<Outside>),
         unit: "",

@@ -93,13 +93,15 @@ pub fn capture(ctx: &RenderContext, options: &RunOptions, with_depth: bool) -> R
         spp: options.spp,
         progress: options.progress,
     };
+    let frontal_pose = crate::system::pipeline::frontal_pose_at(scene, options)?;
     let render = |camera, view: View| {
-        ctx.render(
-            RenderJob::new(camera, view.bit())
-                .settings(settings)
-                .label(view.name()),
-        )
-        .0
+        let mut job = RenderJob::new(camera, view.bit())
+            .settings(settings)
+            .label(view.name());
+        if let (View::Frontal, Some(pose)) = (view, &frontal_pose) {
+            job = job.moving(pose);
+        }
+        ctx.render(job).0
     };
     let back = render(&scene.back, View::Back);
     let frontal = render(&scene.frontal, View::Frontal);

@@ -153,6 +153,17 @@ pub struct RunOptions {
     pub eyes: Eyes,
     /// The depth sensor and hole filling of `ground`, `plane-fit` and `depth`.
     pub scene_model: SceneModelOptions,
+    /// The vehicle's speed along the road (world −z), km/h, [0, 300]: a single frame's
+    /// frontal camera moves during its rolling readout and exposure (scene keys); a sequence's
+    /// front ends carry it into [`SequenceOptions::speed`] (m/s), which its loop reads.
+    /// Capture folders written before it existed hold none: 0.
+    ///
+    /// [`SequenceOptions::speed`]: crate::system::sequence::system_loop::SequenceOptions
+    #[serde(default)]
+    pub speed_kmh: f64,
+    /// The vehicle's yaw rate about the driver's eye, °/s, [−180, 180], positive turning left.
+    #[serde(default)]
+    pub yaw_rate_deg_s: f64,
     /// Progress bars on stderr: the front end's, never written.
     #[serde(skip)]
     pub progress: bool,
@@ -202,6 +213,8 @@ impl Default for RunOptions {
             display: DisplayModel::Pixels,
             eyes: Eyes::default(),
             scene_model: SceneModelOptions::default(),
+            speed_kmh: 0.0,
+            yaw_rate_deg_s: 0.0,
             progress: false,
         }
     }

@@ -377,6 +377,38 @@ pub fn check_display_seen<'a>(
     Ok(())
 }
 
+/// The frontal camera's pose `dt` seconds after a run's instant, carried by the vehicle's
+/// motion (option `speed`, option `yaw_rate`, about the driver's eye), or `None` where the
+/// vehicle stands still. A moving vehicle with a frontal camera whose shutter is an instant
+/// changes nothing: refused. (The back camera and the head ride the vehicle together: it
+/// films them still.)
+pub fn frontal_pose_at(
+    scene: &Scene,
+    options: &RunOptions,
+) -> Result<Option<impl Fn(f64) -> glam::DAffine3 + Sync + use<>>> {
+    if options.speed_kmh == 0.0 && options.yaw_rate_deg_s == 0.0 {
+        return Ok(None);
+    }
+    if scene.frontal.shutter.is_instant() {
+        let given = if options.speed_kmh != 0.0 {
+            "speed"
+        } else {
+            "yaw_rate"
+        };
+        bail!(
+            "option `{given}` moves the frontal camera during its readout and exposure, but its shutter is an instant (a global shutter, exposure_ms 0): set shutter = \"rolling\" or exposure_ms in [camera.frontal], or leave the option out"
+        );
+    }
+    let motion = crate::scene::motion::VehicleMotion {
+        speed: options.speed_kmh / 3.6,
+        yaw_rate: options.yaw_rate_deg_s.to_radians(),
+        forward: DVec3::NEG_Z,
+        pivot: scene.eye(),
+    };
+    let base = scene.frontal.world_from_camera;
+    Ok(Some(move |dt: f64| motion.world_from_rig(dt) * base))
+}
+
 /// The driver's camera a run renders at: the scene's, resized by the options.
 pub fn driver_camera(scene: &Scene, options: &RunOptions) -> Result<Camera> {
     options.sized_driver(options.eyes.view_camera(&scene.driver))
@@ -537,14 +569,17 @@ pub fn run_staged(
         spp: options.spp,
         progress: options.progress,
     };
+    let frontal_pose = frontal_pose_at(scene, options)?;
     let mut timings = serde_json::Map::new();
     let timed =
         |timings: &mut serde_json::Map<String, serde_json::Value>, camera: &Camera, view: View| {
-            let (frame, stats) = ctx.render(
-                RenderJob::new(camera, view.bit())
-                    .settings(settings)
-                    .label(view.name()),
-            );
+            let mut job = RenderJob::new(camera, view.bit())
+                .settings(settings)
+                .label(view.name());
+            if let (View::Frontal, Some(pose)) = (view, &frontal_pose) {
+                job = job.moving(pose);
+            }
+            let (frame, stats) = ctx.render(job);
             timings.insert(view.name().into(), json!(stats.seconds));
             frame
         };
