@@ -35,6 +35,11 @@ class Frame:
     """Object index in the scene + 1 (obstacle last), 0 for sky; (height, width) uint32."""
     part_id: npt.NDArray[np.uint32]
     """Part of the object (box face, cap, mesh group), 0 for sky; (height, width) uint32."""
+    row_times: npt.NDArray[np.float64] | None
+    """Each row's exposure as (start, end), seconds after the frame's instant (its last row
+    read out), (height, 2) float64, from the camera's shutter keys: zeros for a global
+    shutter with an instant exposure and for the driver's views; None for a frame read from a
+    file and for the display's image."""
     _buffer_addresses: dict[str, int]
 
 class Scene:

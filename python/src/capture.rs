@@ -155,8 +155,10 @@ fn py_capture(
             capture: captured.clone(),
         },
     )?;
-    let frontal = Py::new(py, PyFrame::view_of(&owner, "frontal", |c| &c.frontal))?;
-    let back = Py::new(py, PyFrame::view_of(&owner, "back", |c| &c.back))?;
+    let scene = &context.scene;
+    let frontal = PyFrame::view_of(&owner, "frontal", |c| &c.frontal, scene.frontal.shutter);
+    let back = PyFrame::view_of(&owner, "back", |c| &c.back, scene.back.shutter);
+    let (frontal, back) = (Py::new(py, frontal)?, Py::new(py, back)?);
     let inverse_depth = captured.depth.as_ref().map(|d| {
         let (w, h) = (d.camera.width as usize, d.camera.height as usize);
         read_only_view(&owner, |c| {
@@ -243,6 +245,7 @@ pub fn score(
         .transpose()?;
     let c = capture.get();
     let (inner, context) = (c.inner.clone(), c.context.clone());
+    let shutters = [context.scene.frontal.shutter, context.scene.back.shutter];
     let mut options = c.options.clone();
     options.filter = filter;
     let settings = MeasureSettings {
@@ -255,5 +258,5 @@ pub fn score(
         Ok((scored.run, measured))
     })?
     .map_err(to_py)?;
-    PyRun::new(py, result, measured)
+    PyRun::new(py, result, measured, shutters)
 }

@@ -12,10 +12,11 @@ use glam::Vec3;
 
 use numpy::ndarray::{ArrayView2, ArrayView3, ArrayViewMut2, ArrayViewMut3};
 use numpy::{
-    PyArray, PyArray2, PyArray3, PyArrayMethods, PyReadwriteArray2, PyReadwriteArray3,
-    PyUntypedArray,
+    IntoPyArray, PyArray, PyArray2, PyArray3, PyArrayMethods, PyReadwriteArray2,
+    PyReadwriteArray3, PyUntypedArray,
 };
 use pyo3::prelude::*;
+use seethru::geometry::shutter::Shutter;
 use seethru::render::frame::Frame;
 use seethru::system::capture::Capture;
 
@@ -62,6 +63,9 @@ pub struct PyFrame {
     /// The owner of a render's buffers (writable, recycled when dropped); None for a
     /// capture's read-only views.
     buffers: Option<Py<FrameBuffers>>,
+    /// When the camera's rows see ([`Frame::row_times`]); `None` for a frame read from a
+    /// file or the display's image.
+    shutter: Option<Shutter>,
 }
 
 /// rust-numpy's exclusive borrows of every array of a frame: while they are held, no other
@@ -90,6 +94,25 @@ impl Drop for WriteBorrows<'_> {
 
 #[pymethods]
 impl PyFrame {
+    /// Each row's exposure as (start, end), seconds after the frame's instant (when its last
+    /// row is read out), (height, 2) float64, from the camera's shutter keys (a rolling
+    /// readout, an exposure; docs/guide/time.md): all zeros for a global shutter with an
+    /// instant exposure and for the driver's views; None for a frame read from a file and
+    /// for the display's image.
+    #[getter]
+    fn row_times<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f64>>> {
+        let shutter = self.shutter?;
+        let rows: Vec<[f64; 2]> = shutter
+            .row_exposures(self.height)
+            .into_iter()
+            .map(|(start, end)| [start, end])
+            .collect();
+        Some(
+            numpy::ndarray::Array2::from_shape_fn((rows.len(), 2), |(r, c)| rows[r][c])
+                .into_pyarray(py),
+        )
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<seethru.Frame {} {}×{}>",
@@ -102,7 +125,12 @@ impl PyFrame {
     /// Hands `frame`'s buffers to numpy: writable arrays over them, whose base object
     /// ([`FrameBuffers`]) owns the frame and gives its buffers to [`crate::frame_pool`] when
     /// no frame, array or view of it is left.
-    pub fn new(py: Python<'_>, view: &str, frame: Frame) -> PyResult<PyFrame> {
+    pub fn new(
+        py: Python<'_>,
+        view: &str,
+        frame: Frame,
+        shutter: Option<Shutter>,
+    ) -> PyResult<PyFrame> {
         let (w, h) = (frame.width as usize, frame.height as usize);
         let (width, height) = (frame.width, frame.height);
         let owner = Bound::new(py, FrameBuffers::new(frame))?;
@@ -153,6 +181,7 @@ impl PyFrame {
             part_id,
             buffer_addresses: addresses,
             buffers: Some(owner.unbind()),
+            shutter,
         })
     }
 
@@ -165,6 +194,7 @@ impl PyFrame {
         view: &str,
         width: u32,
         height: u32,
+        shutter: Shutter,
     ) -> PyResult<(Py<FrameBuffers>, WriteBorrows<'py>)> {
         let Some(buffers) = &self.buffers else {
             return Err(bad_value(format!(
@@ -183,6 +213,11 @@ impl PyFrame {
                 "out: the frame is a {:?} view and this render is {view:?}; pass a frame rendered from the same view",
                 self.view
             )));
+        }
+        if self.shutter.is_some_and(|s| s != shutter) {
+            return Err(bad_value(
+                "out: the frame's camera reads its rows at other times (its shutter keys); pass a frame rendered with this scene's camera",
+            ));
         }
         if (self.width, self.height) != (width, height) {
             return Err(bad_value(format!(
@@ -242,6 +277,7 @@ impl PyFrame {
         owner: &Bound<'_, CaptureBuffers>,
         view: &str,
         pick: fn(&Capture) -> &Frame,
+        shutter: Shutter,
     ) -> PyFrame {
         let frame = pick(&owner.get().capture);
         let (w, h) = (frame.width as usize, frame.height as usize);
@@ -288,6 +324,7 @@ impl PyFrame {
             part_id,
             buffer_addresses: addresses,
             buffers: None,
+            shutter: Some(shutter),
         }
     }
 }
@@ -302,5 +339,5 @@ pub fn read_frame(py: Python<'_>, path: PathBuf) -> PyResult<PyFrame> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    PyFrame::new(py, &name, frame)
+    PyFrame::new(py, &name, frame, None)
 }

@@ -7,6 +7,7 @@ use std::sync::Arc;
 use numpy::ndarray::Array2;
 use numpy::{PyArray, PyArray2};
 use pyo3::prelude::*;
+use seethru::geometry::shutter::Shutter;
 use pyo3::types::PyDict;
 use seethru::measure::measured_run::{MeasuredRun, measure_run};
 use seethru::system::memory::{check_memory, run_estimate};
@@ -93,13 +94,20 @@ pub fn run(
         Ok((ctx, result, measured))
     })?
     .map_err(to_py)?;
+    let shutters = [context.scene.frontal.shutter, context.scene.back.shutter];
     scene.borrow_mut().context = Some(context);
-    PyRun::new(py, result, measured)
+    PyRun::new(py, result, measured, shutters)
 }
 
 impl PyRun {
-    /// A run's frames, maps, metrics and report handed to Python.
-    pub fn new(py: Python<'_>, result: RunResult, measured: MeasuredRun) -> PyResult<PyRun> {
+    /// A run's frames, maps, metrics and report handed to Python; `shutters` are its frontal
+    /// and back cameras'.
+    pub fn new(
+        py: Python<'_>,
+        result: RunResult,
+        measured: MeasuredRun,
+        shutters: [Shutter; 2],
+    ) -> PyResult<PyRun> {
         let MeasuredRun {
             maps,
             metrics,
@@ -124,15 +132,17 @@ impl PyRun {
         // The views rendered over truth made whole first: then truth is theirs no longer, and
         // is handed over without a copy.
         let (occluded, seethru) = (result.occluded.into_whole(), result.seethru.into_whole());
-        for (name, frame) in [
-            ("truth", Arc::unwrap_or_clone(result.truth)),
-            ("occluded", occluded),
-            ("frontal", result.frontal),
-            ("back", result.back),
-            ("display", result.display),
-            ("seethru", seethru),
+        // The driver's eye sees each view at one instant; the display's image is no camera's.
+        let instant = Some(Shutter::INSTANT);
+        for (name, frame, shutter) in [
+            ("truth", Arc::unwrap_or_clone(result.truth), instant),
+            ("occluded", occluded, instant),
+            ("frontal", result.frontal, Some(shutters[0])),
+            ("back", result.back, Some(shutters[1])),
+            ("display", result.display, None),
+            ("seethru", seethru, instant),
         ] {
-            dict.set_item(name, PyFrame::new(py, name, frame)?)?;
+            dict.set_item(name, PyFrame::new(py, name, frame, shutter)?)?;
         }
         Ok(PyRun {
             frames: dict.unbind(),
