@@ -754,3 +754,52 @@ fn a_scanout_the_sequence_cannot_show_is_refused() {
         assert!(!out.exists());
     }
 }
+
+/// A frame in time is the same for any number of threads: das's ball rolling through a
+/// rolling, exposed frontal camera (the band-by-band path, contexts made in order) rendered
+/// on 1, 2 and 5 threads, bit for bit.
+#[test]
+fn a_frame_in_time_is_the_same_on_any_number_of_threads() {
+    use seethru::render::in_time::render_in_time;
+    use seethru::system::options::RunOptions;
+    use seethru::system::sequence::system_loop::SystemLoop;
+    let text = std::fs::read_to_string(common::repo_path("scenes/das.toml"))
+        .unwrap()
+        .replace(
+            "[camera.frontal]",
+            "[camera.frontal]\nshutter = \"rolling\"\nreadout_ms = 30.0\nexposure_ms = 8.0",
+        );
+    let scene = common::parse_in(&common::repo_path("scenes"), "das.toml", &text).unwrap();
+    let frames: Vec<Frame> = [1, 2, 5]
+        .into_iter()
+        .map(|threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let run = RunOptions {
+                    spp: 3,
+                    frontal_width: Some(96),
+                    ..RunOptions::default()
+                };
+                let mut o = common::still_sequence(run, 0.2, 10.0, 0.0);
+                (o.speed, o.yaw_rate) = (10.0 / 3.6, 0.3);
+                let mut system = SystemLoop::new(&scene, o).unwrap();
+                let t = 0.3;
+                let ctx = system.context_at(t).unwrap();
+                let camera = ctx.scene.frontal;
+                let vehicle = system.rig.vehicle;
+                let base = system.rig.base.frontal.world_from_camera;
+                let pose_at = move |dt: f64| vehicle.world_from_rig(t + dt) * base;
+                let job = RenderJob::new(&camera, FRONTAL)
+                    .settings(settings(3))
+                    .moving(&pose_at);
+                let mut frame = Frame::new(camera.width, camera.height);
+                render_in_time(&ctx, &mut |at| system.context_at(at), t, job, &mut frame).unwrap();
+                frame
+            })
+        })
+        .collect();
+    assert!(frames[0].bit_identical(&frames[1]) && frames[0].bit_identical(&frames[2]));
+}

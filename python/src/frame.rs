@@ -12,8 +12,8 @@ use glam::Vec3;
 
 use numpy::ndarray::{ArrayView2, ArrayView3, ArrayViewMut2, ArrayViewMut3};
 use numpy::{
-    IntoPyArray, PyArray, PyArray2, PyArray3, PyArrayMethods, PyReadwriteArray2,
-    PyReadwriteArray3, PyUntypedArray,
+    IntoPyArray, PyArray, PyArray2, PyArray3, PyArrayMethods, PyReadwriteArray2, PyReadwriteArray3,
+    PyUntypedArray,
 };
 use pyo3::prelude::*;
 use seethru::geometry::shutter::Shutter;

@@ -290,9 +290,13 @@ impl PyScene {
         match out {
             Some(out) => {
                 // Held until the render has returned: no other call can borrow the arrays.
-                let (buffers, _borrows) =
-                    out.get()
-                        .render_target(py, view.name(), camera.width, camera.height, camera.shutter)?;
+                let (buffers, _borrows) = out.get().render_target(
+                    py,
+                    view.name(),
+                    camera.width,
+                    camera.height,
+                    camera.shutter,
+                )?;
                 let buffers = buffers.get();
                 let context = detached(py, move || render(&mut buffers.frame()))?.map_err(to_py)?;
                 slf.borrow_mut().context = Some(context);
@@ -307,7 +311,10 @@ impl PyScene {
                 })?
                 .map_err(to_py)?;
                 slf.borrow_mut().context = Some(context);
-                Py::new(py, PyFrame::new(py, view.name(), frame, Some(camera.shutter))?)
+                Py::new(
+                    py,
+                    PyFrame::new(py, view.name(), frame, Some(camera.shutter))?,
+                )
             }
         }
     }

@@ -16,8 +16,8 @@ use numpy::PyArray;
 use numpy::ndarray::Array2;
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
-use seethru::geometry::shutter::Shutter;
 use pyo3::types::PyDict;
+use seethru::geometry::shutter::Shutter;
 use seethru::measure::image_metrics::Flip;
 use seethru::measure::sequence::{Measuring, SequenceStepper};
 use seethru::measure::sequence_records::FrameRecord;
@@ -264,8 +264,14 @@ impl PySequence {
             vehicle_yaw_deg: record.vehicle_yaw_deg,
             metrics: json_to_py(py, &json)?,
             hazards: json_to_py(py, &hazards)?,
-            truth: Py::new(py, PyFrame::new(py, "truth", truth, Some(Shutter::INSTANT))?)?,
-            seethru: Py::new(py, PyFrame::new(py, "seethru", seethru, Some(Shutter::INSTANT))?)?,
+            truth: Py::new(
+                py,
+                PyFrame::new(py, "truth", truth, Some(Shutter::INSTANT))?,
+            )?,
+            seethru: Py::new(
+                py,
+                PyFrame::new(py, "seethru", seethru, Some(Shutter::INSTANT))?,
+            )?,
             misregistration,
         }))
     }
