@@ -126,8 +126,8 @@ impl<'a> RenderJob<'a> {
     /// The camera moving along `pose_at` (its world_from_camera `dt` seconds after the
     /// frame's instant): each sample is traced from where the camera is at its instant of
     /// the camera's shutter ([`crate::geometry::shutter::Shutter`]). The world is the
-    /// context's, of the frame's instant: [`crate::render::in_time`] renders a world that
-    /// moves too.
+    /// context's, of the frame's instant (render/in_time.rs renders a world that moves
+    /// too).
     pub fn moving(self, pose_at: PoseAt<'a>) -> RenderJob<'a> {
         RenderJob {
             pose_at: Some(pose_at),
