@@ -155,10 +155,8 @@ pub struct RunOptions {
     pub scene_model: SceneModelOptions,
     /// The vehicle's speed along the road (world −z), km/h, [0, 300]: a single frame's
     /// frontal camera moves during its rolling readout and exposure (scene keys); a sequence's
-    /// front ends carry it into [`SequenceOptions::speed`] (m/s), which its loop reads.
-    /// Capture folders written before it existed hold none: 0.
-    ///
-    /// [`SequenceOptions::speed`]: crate::system::sequence::system_loop::SequenceOptions
+    /// front ends carry it into `SequenceOptions::speed` (m/s, system/sequence/system_loop.rs),
+    /// which its loop reads. Capture folders written before it existed hold none: 0.
     #[serde(default)]
     pub speed_kmh: f64,
     /// The vehicle's yaw rate about the driver's eye, °/s, [−180, 180], positive turning left.
