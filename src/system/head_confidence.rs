@@ -515,6 +515,18 @@ mod tests {
         let rough = c.with_fit(0.016 * 91.0, 20.0, margin, iris);
         assert!(rough.distance_agreement < 1.0, "{rough:?}");
         assert_eq!(sentences(&rough), ["outline off the fitted pose"]);
+        // A yaw of exactly 40° is not doubted, whatever else lowers the symmetry score.
+        let at_limit = c.with_fit(rms, 40.0, 0.02, iris);
+        assert!(at_limit.symmetry < 1.0, "{at_limit:?}");
+        assert_eq!(sentences(&at_limit), ["another yaw"]);
+        // The warning: the context, the value against the threshold, the doubts.
+        let warning = turned.warning("at t = 1 s: ");
+        let expected = format!(
+            "at t = 1 s: head estimate unreliable: confidence {:.2} < 0.5 ({});",
+            turned.value,
+            turned.doubts()
+        );
+        assert!(warning.starts_with(&expected), "{warning}");
     }
 
     #[test]
