@@ -465,16 +465,11 @@ fn a_rolling_frontal_camera_makes_each_display_row_as_old_as_its_frontal_row() {
     assert!(means[1] > means[0] * 1.2, "{means:?}");
 }
 
-/// das's ball rolls across the frontal camera's view while the vehicle drives and turns: with
-/// a rolling shutter and an exposure, the world differs from band to band of rows and slice
-/// to slice, so the frame is rendered instant by instant; its brute-force twin renders the
-/// whole frame (the camera moving) over the world placed at each band's and slice's instant
-/// and keeps that band's rows.
-#[test]
-fn a_moving_world_through_a_rolling_shutter_equals_its_band_by_band_twin() {
-    use seethru::render::in_time::{band_instant, needs_instants, render_in_time};
+/// das's sequence loop with a rolling (30 ms), exposed (8 ms) frontal camera `frontal_width`
+/// pixels wide, driving at 10 km/h and turning at 0.3 rad/s: its ball rolls through the
+/// frontal view.
+fn turning_das(spp: u32, frontal_width: u32) -> seethru::system::sequence::system_loop::SystemLoop {
     use seethru::system::options::RunOptions;
-    use seethru::system::sequence::system_loop::SystemLoop;
     let text = std::fs::read_to_string(common::repo_path("scenes/das.toml"))
         .unwrap()
         .replace(
@@ -483,20 +478,39 @@ fn a_moving_world_through_a_rolling_shutter_equals_its_band_by_band_twin() {
         );
     let scene = common::parse_in(&common::repo_path("scenes"), "das.toml", &text).unwrap();
     let run = RunOptions {
-        spp: 2,
-        frontal_width: Some(64),
+        spp,
+        frontal_width: Some(frontal_width),
         ..RunOptions::default()
     };
     let mut o = common::still_sequence(run, 0.2, 10.0, 0.0);
     (o.speed, o.yaw_rate) = (10.0 / 3.6, 0.3);
-    let mut system = SystemLoop::new(&scene, o).unwrap();
+    seethru::system::sequence::system_loop::SystemLoop::new(&scene, o).unwrap()
+}
+
+/// The frontal camera's pose `dt` after `t`, carried by `system`'s vehicle.
+fn carried(
+    system: &seethru::system::sequence::system_loop::SystemLoop,
+    t: f64,
+) -> impl Fn(f64) -> DAffine3 + Sync + use<> {
+    let vehicle = system.rig.vehicle;
+    let base = system.rig.base.frontal.world_from_camera;
+    move |dt: f64| vehicle.world_from_rig(t + dt) * base
+}
+
+/// das's ball rolls across the frontal camera's view while the vehicle drives and turns: with
+/// a rolling shutter and an exposure, the world differs from band to band of rows and slice
+/// to slice, so the frame is rendered instant by instant; its brute-force twin renders the
+/// whole frame (the camera moving) over the world placed at each band's and slice's instant
+/// and keeps that band's rows.
+#[test]
+fn a_moving_world_through_a_rolling_shutter_equals_its_band_by_band_twin() {
+    use seethru::render::in_time::{band_instant, needs_instants, render_in_time};
+    let mut system = turning_das(2, 64);
     let t = 0.3;
     let ctx = system.context_at(t).unwrap();
     let camera = ctx.scene.frontal;
     let (w, h, spp) = (camera.width, camera.height, 2);
-    let vehicle = system.rig.vehicle;
-    let base = system.rig.base.frontal.world_from_camera;
-    let pose_at = move |dt: f64| vehicle.world_from_rig(t + dt) * base;
+    let pose_at = carried(&system, t);
     let job = RenderJob::new(&camera, FRONTAL)
         .settings(settings(spp))
         .moving(&pose_at);
@@ -761,15 +775,6 @@ fn a_scanout_the_sequence_cannot_show_is_refused() {
 #[test]
 fn a_frame_in_time_is_the_same_on_any_number_of_threads() {
     use seethru::render::in_time::render_in_time;
-    use seethru::system::options::RunOptions;
-    use seethru::system::sequence::system_loop::SystemLoop;
-    let text = std::fs::read_to_string(common::repo_path("scenes/das.toml"))
-        .unwrap()
-        .replace(
-            "[camera.frontal]",
-            "[camera.frontal]\nshutter = \"rolling\"\nreadout_ms = 30.0\nexposure_ms = 8.0",
-        );
-    let scene = common::parse_in(&common::repo_path("scenes"), "das.toml", &text).unwrap();
     let frames: Vec<Frame> = [1, 2, 5]
         .into_iter()
         .map(|threads| {
@@ -778,20 +783,11 @@ fn a_frame_in_time_is_the_same_on_any_number_of_threads() {
                 .build()
                 .unwrap();
             pool.install(|| {
-                let run = RunOptions {
-                    spp: 3,
-                    frontal_width: Some(96),
-                    ..RunOptions::default()
-                };
-                let mut o = common::still_sequence(run, 0.2, 10.0, 0.0);
-                (o.speed, o.yaw_rate) = (10.0 / 3.6, 0.3);
-                let mut system = SystemLoop::new(&scene, o).unwrap();
+                let mut system = turning_das(3, 96);
                 let t = 0.3;
                 let ctx = system.context_at(t).unwrap();
                 let camera = ctx.scene.frontal;
-                let vehicle = system.rig.vehicle;
-                let base = system.rig.base.frontal.world_from_camera;
-                let pose_at = move |dt: f64| vehicle.world_from_rig(t + dt) * base;
+                let pose_at = carried(&system, t);
                 let job = RenderJob::new(&camera, FRONTAL)
                     .settings(settings(3))
                     .moving(&pose_at);
