@@ -32,9 +32,11 @@ const MIN_BANDS_AT_ONCE: usize = 16;
 
 /// Bands whose contexts fit [`CONTEXT_BYTES`] together, `context` being one of them.
 fn bands_at_once(context: &RenderContext) -> usize {
-    let layer = context.moving.as_ref().map_or(0, |m| {
-        m.accel.bytes() + m.world.triangles.len() * std::mem::size_of_val(&m.world.triangles[..1])
-    });
+    let triangle = std::mem::size_of::<obvhs::rt_triangle::RtTriangle>();
+    let layer = context
+        .moving
+        .as_ref()
+        .map_or(0, |m| m.accel.bytes() + m.world.triangles.len() * triangle);
     (CONTEXT_BYTES / layer.max(1)).max(MIN_BANDS_AT_ONCE)
 }
 
@@ -100,6 +102,7 @@ pub fn render_by_instant(
     } else {
         vec![None]
     };
+    let start = std::time::Instant::now();
     let mut stats = RenderStats::default();
     // The region's columns, from the start of its first band (bands start at multiples of
     // BAND_ROWS, so that a pixel's instant does not depend on the region).
@@ -139,7 +142,6 @@ pub fn render_by_instant(
             for s in done {
                 stats.primary_rays += s.primary_rays;
                 stats.shadow_rays += s.shadow_rays;
-                stats.seconds += s.seconds;
             }
         }
         // The first sample's AOVs, every sample's colour summed in order.
@@ -165,5 +167,6 @@ pub fn render_by_instant(
             }
         }
     }
+    stats.seconds = start.elapsed().as_secs_f64();
     Ok(stats)
 }
