@@ -313,6 +313,12 @@ fn a_frame_in_time_is_the_mean_of_instantaneous_renders_at_its_instants() {
             one_pass.bit_identical(&twin),
             "{shutter}: one pass vs the mean"
         );
+        // The packets' twin, one ray at a time, each from its own instant's camera.
+        let (per_ray, _) = ctx.render(job.tracer(seethru::render::render_job::Tracer::PerRay));
+        assert!(
+            per_ray.bit_identical(&one_pass),
+            "{shutter}: per ray vs packets"
+        );
         // The instant-by-instant path (a context per instant) is the same frame.
         let mut by_instant = Frame::new(48, 36);
         let mut context_at = |_t: f64| ctx.with_scene(ctx.scene.clone());

@@ -202,15 +202,31 @@ impl RenderContext {
         let mut cameras = [job.rays.at(tile.y, 0); PACKET];
         let mut camera = RayPacket::new();
         let mut shadow = RayPacket::new();
+        // One instant (a still camera, an instant shutter): one camera for every lane, its
+        // constants loaded once.
+        let single = job.rays.single();
+        if let Some(c) = single {
+            origins = [c.rays.origin; PACKET];
+        }
         for sample in job.samples.clone() {
-            for (lane, &(x, row)) in at[..n].iter().enumerate() {
-                let y = tile.y + row;
-                let (dx, dy) = pixel_offset(x, y, sample);
-                cameras[lane] = job.rays.at(y, sample);
-                origins[lane] = cameras[lane].rays.origin;
-                dirs[lane] = cameras[lane].rays.direction(x as f32 + dx, y as f32 + dy);
+            if let Some(c) = single {
+                let rays = &c.rays;
+                for (lane, &(x, row)) in at[..n].iter().enumerate() {
+                    let y = tile.y + row;
+                    let (dx, dy) = pixel_offset(x, y, sample);
+                    dirs[lane] = rays.direction(x as f32 + dx, y as f32 + dy);
+                }
+                camera.set_from_zero(n, |lane| (rays.origin, dirs[lane]));
+            } else {
+                for (lane, &(x, row)) in at[..n].iter().enumerate() {
+                    let y = tile.y + row;
+                    let (dx, dy) = pixel_offset(x, y, sample);
+                    cameras[lane] = job.rays.at(y, sample);
+                    origins[lane] = cameras[lane].rays.origin;
+                    dirs[lane] = cameras[lane].rays.direction(x as f32 + dx, y as f32 + dy);
+                }
+                camera.set_from_zero(n, |lane| (origins[lane], dirs[lane]));
             }
-            camera.set_from_zero(n, |lane| (origins[lane], dirs[lane]));
             let moving_hits = self.trace_packet_hits(&mut camera, job.view, tile.isa, packet_stack);
             let mut shown = [None; PACKET];
             let mut shading = [None; PACKET];

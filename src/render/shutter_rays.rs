@@ -66,6 +66,12 @@ impl ShutterRays {
         }
     }
 
+    /// The camera of every row and sample, where there is one instant.
+    #[inline]
+    pub fn single(&self) -> Option<&CameraAt> {
+        (self.instants.len() == 1).then(|| &self.instants[0])
+    }
+
     /// The camera where sample `sample` of row `y` sees it.
     #[inline]
     pub fn at(&self, y: u32, sample: u32) -> &CameraAt {
