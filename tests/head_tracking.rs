@@ -171,3 +171,96 @@ fn the_tracked_head_estimates_are_the_whole_images() {
         "tracked {tracked_pixels} of {whole_pixels} back pixels"
     );
 }
+
+/// The box `turned_reads` bounds the mesh face's detector's reads with, for the back tracker
+/// to render and search only there: it holds every pixel the detector read (blanking the
+/// rest of the back image leaves the detection bit for bit), and not much more: the
+/// smallest box that does so, found side by side by brute force (each side moved in while
+/// the detection stays the same), lies inside it, and it is at most 1.6 times that box's area
+/// (1.4 on das's mesh face: the margins of its rules).
+/// Two yaws of the face: turned to the camera, and 35° from it.
+#[test]
+fn the_mesh_faces_reads_are_bounded_tightly() {
+    use seethru::render::frame::Frame;
+    use seethru::scene::DriverFace;
+    use seethru::system::head_estimate::{detect_face, turned_reads};
+    for yaw in ["0.0", "35.0"] {
+        let text = common::das_with_mesh_head_text().replace(
+            "face = \"mesh\"\n",
+            &format!("face = \"mesh\"\nface_yaw_deg = {yaw}\n"),
+        );
+        let scene = common::parse_in(&common::repo_path("scenes"), "mesh.toml", &text).unwrap();
+        let face = scene.face;
+        assert!(matches!(face, DriverFace::Mesh { .. }));
+        let ctx = RenderContext::new(scene).unwrap();
+        let back = ctx.scene.back.with_resolution(320, 240);
+        let settings = RenderSettings {
+            spp: 4,
+            progress: false,
+        };
+        let (frame, _) = ctx.render(RenderJob::new(&back, View::Back.bit()).settings(settings));
+        let detection = detect_face(face, &frame).unwrap();
+        let only = |r: PixelRect| -> Frame {
+            let mut f = frame.clone();
+            for y in 0..f.height {
+                for x in 0..f.width {
+                    if x < r.x0 || x >= r.x1 || y < r.y0 || y >= r.y1 {
+                        let i = f.index(x, y);
+                        f.color[i] = glam::Vec3::ZERO;
+                    }
+                }
+            }
+            f
+        };
+        let same = |r: PixelRect| detect_face(face, &only(r)).is_ok_and(|d| d == detection);
+        let reads = turned_reads(&detection, &back);
+        assert!(
+            same(reads),
+            "yaw {yaw}: {reads:?} leaves out a pixel the detector read"
+        );
+        let mut least = PixelRect::full(&back);
+        while least.x0 + 1 < least.x1
+            && same(PixelRect {
+                x0: least.x0 + 1,
+                ..least
+            })
+        {
+            least.x0 += 1;
+        }
+        while least.x1 > least.x0 + 1
+            && same(PixelRect {
+                x1: least.x1 - 1,
+                ..least
+            })
+        {
+            least.x1 -= 1;
+        }
+        while least.y0 + 1 < least.y1
+            && same(PixelRect {
+                y0: least.y0 + 1,
+                ..least
+            })
+        {
+            least.y0 += 1;
+        }
+        while least.y1 > least.y0 + 1
+            && same(PixelRect {
+                y1: least.y1 - 1,
+                ..least
+            })
+        {
+            least.y1 -= 1;
+        }
+        let inside = reads.x0 <= least.x0
+            && reads.y0 <= least.y0
+            && reads.x1 >= least.x1
+            && reads.y1 >= least.y1;
+        assert!(inside, "yaw {yaw}: {least:?} is not inside {reads:?}");
+        assert!(
+            reads.pixels() * 5 <= least.pixels() * 8,
+            "yaw {yaw}: {reads:?} is {} px, the least box {least:?} {} px",
+            reads.pixels(),
+            least.pixels()
+        );
+    }
+}
