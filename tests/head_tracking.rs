@@ -218,38 +218,19 @@ fn the_mesh_faces_reads_are_bounded_tightly() {
             same(reads),
             "yaw {yaw}: {reads:?} leaves out a pixel the detector read"
         );
+        // Each side moved in by a pixel at a time, while a pixel is left and the detection
+        // stays the same.
+        let steps: [fn(PixelRect) -> PixelRect; 4] = [
+            |r| PixelRect { x0: r.x0 + 1, ..r },
+            |r| PixelRect { x1: r.x1 - 1, ..r },
+            |r| PixelRect { y0: r.y0 + 1, ..r },
+            |r| PixelRect { y1: r.y1 - 1, ..r },
+        ];
         let mut least = PixelRect::full(&back);
-        while least.x0 + 1 < least.x1
-            && same(PixelRect {
-                x0: least.x0 + 1,
-                ..least
-            })
-        {
-            least.x0 += 1;
-        }
-        while least.x1 > least.x0 + 1
-            && same(PixelRect {
-                x1: least.x1 - 1,
-                ..least
-            })
-        {
-            least.x1 -= 1;
-        }
-        while least.y0 + 1 < least.y1
-            && same(PixelRect {
-                y0: least.y0 + 1,
-                ..least
-            })
-        {
-            least.y0 += 1;
-        }
-        while least.y1 > least.y0 + 1
-            && same(PixelRect {
-                y1: least.y1 - 1,
-                ..least
-            })
-        {
-            least.y1 -= 1;
+        for step in steps {
+            while !step(least).is_empty() && same(step(least)) {
+                least = step(least);
+            }
         }
         let inside = reads.x0 <= least.x0
             && reads.y0 <= least.y0

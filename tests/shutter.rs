@@ -140,17 +140,21 @@ fn a_rolling_shutter_slants_a_vertical_pole_by_the_yaw_over_the_readout() {
         .unwrap() as u32
         + 1;
     let pose_at = yawing(camera, omega);
-    let (frame, _) = ctx.render(
-        RenderJob::new(&camera, FRONTAL)
+    // The pole's centre per row, seen by a context's frontal camera on that turn.
+    let centres = |ctx: &RenderContext| {
+        let camera = ctx.scene.frontal;
+        let job = RenderJob::new(&camera, FRONTAL)
             .settings(settings(1))
-            .moving(&pose_at),
-    );
-    let measured = pole_centres(&frame, pole);
+            .moving(&pose_at);
+        pole_centres(&ctx.render(job).0, pole)
+    };
+    let measured = centres(&ctx);
     assert_eq!(measured.len(), 480, "the pole spans every row");
     // The analytic answer: row r is read T (H − 1 − r) / (H − 1) before the last (at the
     // frame's instant), when the camera had turned ω t to the left (t < 0); a vertical line
-    // straight ahead is then f tan(ω t) right of the centre. Its slant over the image: the fitted slope times H − 1 (the same fit as the
-    // measurement, so the small curvature of tan cancels).
+    // straight ahead is then f tan(ω t) right of the centre. Its slant over the image: the
+    // fitted slope times H − 1 (the same fit as the measurement, so the small curvature of tan
+    // cancels).
     let f = 320.0;
     let analytic: Vec<(f64, f64)> = (0..480)
         .map(|r| {
@@ -169,23 +173,10 @@ fn a_rolling_shutter_slants_a_vertical_pole_by_the_yaw_over_the_readout() {
         "shutter = \"rolling\"\nreadout_ms = 50.0\nrow_order = \"bottom_to_top\"",
         POLE,
     );
-    let camera = flipped.scene.frontal;
-    let (frame, _) = flipped.render(
-        RenderJob::new(&camera, FRONTAL)
-            .settings(settings(1))
-            .moving(&pose_at),
-    );
-    let up = slope(&pole_centres(&frame, pole)) * 479.0;
+    let up = slope(&centres(&flipped)) * 479.0;
     assert!((up / -want - 1.0).abs() < 0.02, "bottom to top: {up:.2} px");
     // A global shutter: every row at once, no slant.
-    let global = context("", POLE);
-    let camera = global.scene.frontal;
-    let (frame, _) = global.render(
-        RenderJob::new(&camera, FRONTAL)
-            .settings(settings(1))
-            .moving(&pose_at),
-    );
-    let still = slope(&pole_centres(&frame, pole)) * 479.0;
+    let still = slope(&centres(&context("", POLE))) * 479.0;
     assert!(still.abs() < 0.5, "global shutter: {still:.3} px");
 }
 
