@@ -111,6 +111,7 @@ fn the_tracked_head_estimates_are_the_whole_images() {
             spp: 1,
             outside: Outside::Black,
             require_confident_head: true,
+            speed_kmh: 50.0,
             ..RunOptions::default()
         },
         timeline: Timeline {
@@ -120,8 +121,6 @@ fn the_tracked_head_estimates_are_the_whole_images() {
             latency_camera: 0.05,
             latency_tracking: 0.01,
         },
-        speed: 50.0 / 3.6,
-        yaw_rate: 0.0,
         head: HeadMotion::Lean {
             distance: 0.1,
             duration: 0.3,

@@ -335,6 +335,7 @@ fn the_tracked_mesh_face_estimates_are_the_whole_images() {
             frontal_width: Some(96),
             spp: 1,
             outside: Outside::Black,
+            speed_kmh: 50.0,
             ..RunOptions::default()
         },
         timeline: Timeline {
@@ -344,8 +345,6 @@ fn the_tracked_mesh_face_estimates_are_the_whole_images() {
             latency_camera: 0.05,
             latency_tracking: 0.01,
         },
-        speed: 50.0 / 3.6,
-        yaw_rate: 0.0,
         head: HeadMotion::Lean {
             distance: 0.1,
             duration: 0.3,

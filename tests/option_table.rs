@@ -23,7 +23,9 @@ fn command_line_only(command: Command) -> &'static [&'static str] {
         Command::Capture => &["out", "calibration", "exr", "threads", "quiet", "help"],
         Command::Compare => &["methods", "out", "threads", "quiet", "help"],
         // A sequence's own options (Python's keywords too, `SEQUENCE_KEYS`): its timeline, the
-        // vehicle's and the head's motion, the head's source, what it writes.
+        // vehicle's and the head's motion, the head's source, what it writes; and `budget`, the
+        // command line's alone (it runs the sequence again per effect of time and writes the
+        // split: from Python, the steps are sequences of scenes without the effects).
         Command::Sequence => &[
             "out",
             "quiet",
@@ -51,6 +53,7 @@ fn command_line_only(command: Command) -> &'static [&'static str] {
             "heatmap-max",
             "capture",
             "maps",
+            "budget",
             "help",
         ],
         Command::Render => &["view", "out", "exr", "threads", "quiet", "help"],

@@ -355,7 +355,11 @@ fn packets_trace_a_sequences_moving_part_as_the_per_ray_path_does() {
     use seethru::system::sequence::timeline::Timeline;
     // The ball rolls, the head leans and the rig drives and turns: as tests/sequence.rs.
     let options = SequenceOptions {
-        run: RunOptions::default(),
+        run: RunOptions {
+            speed_kmh: 50.0,
+            yaw_rate_deg_s: 0.1f64.to_degrees(),
+            ..RunOptions::default()
+        },
         timeline: Timeline {
             duration: 2.0,
             fps: 10.0,
@@ -363,8 +367,6 @@ fn packets_trace_a_sequences_moving_part_as_the_per_ray_path_does() {
             latency_camera: 0.0,
             latency_tracking: 0.0,
         },
-        speed: 50.0 / 3.6,
-        yaw_rate: 0.1,
         head: HeadMotion::Lean {
             distance: 0.1,
             duration: 0.3,
@@ -413,7 +415,7 @@ fn a_fan_of_rays_meets_what_each_ray_meets() {
     use seethru::render::bvh_packet::{PACKET, PacketStack};
     use seethru::system::sequence::system_loop::SystemLoop;
     let mut options = common::still_sequence(Default::default(), 2.0, 10.0, 0.0);
-    options.speed = 50.0 / 3.6;
+    options.run.speed_kmh = 50.0;
     let mut system = SystemLoop::new(&common::das(), options).unwrap();
     let layered = system.context_at(1.5).unwrap();
     assert!(layered.moving.is_some(), "das's ball rolls");

@@ -24,6 +24,7 @@ fn options(latency: f64, fps: f64, display_hz: f64, yaw_rate: f64) -> SequenceOp
         run: RunOptions {
             d2: WorkingDistance::Metres(6.0),
             spp: 1,
+            yaw_rate_deg_s: yaw_rate.to_degrees(),
             ..RunOptions::default()
         },
         timeline: Timeline {
@@ -33,8 +34,6 @@ fn options(latency: f64, fps: f64, display_hz: f64, yaw_rate: f64) -> SequenceOp
             latency_camera: latency,
             latency_tracking: 0.0,
         },
-        speed: 0.0,
-        yaw_rate,
         head: HeadMotion::Still,
         predict: Prediction::None,
         reproject: false,
@@ -171,7 +170,7 @@ fn a_run_reports_its_frames_headings_stage_times_and_frontal_pixels() {
 fn the_moving_part_renders_as_a_whole_rebuilt_world() {
     let scene = common::das();
     let mut o = options(0.0, 10.0, 10.0, 0.1);
-    o.speed = 50.0 / 3.6;
+    o.run.speed_kmh = 50.0;
     o.head = HeadMotion::Lean {
         distance: 0.1,
         duration: 0.3,

@@ -336,26 +336,6 @@ fn an_instant_shutter_on_a_moving_camera_is_todays_image() {
     assert!(still.bit_identical(&moving));
 }
 
-/// The mean age, from the frame's completion, of the frontal rows the display's pixels show
-/// on the wall 6 m ahead (a rolling shutter of `readout` s over 480 rows, top to bottom): a
-/// 60 × 40 grid over the display, each point's ray from the eye onto the wall, projected
-/// into the frontal camera.
-fn readout_age(scene: &seethru::scene::Scene, readout: f64) -> f64 {
-    let (eye, frontal) = (scene.eye(), scene.frontal);
-    let [a, b, _, d] = scene.obstacle.display_corners();
-    let mut age = 0.0;
-    for i in 0..60 {
-        for j in 0..40 {
-            let (u, v) = ((f64::from(i) + 0.5) / 60.0, (f64::from(j) + 0.5) / 40.0);
-            let p = a + (b - a) * u + (d - a) * v;
-            let on_wall = eye + (p - eye) * ((-6.0 - eye.z) / (p.z - eye.z));
-            let row = frontal.project_point(on_wall).unwrap().y.floor();
-            age += readout * (479.0 - row) / 479.0 / 2400.0;
-        }
-    }
-    age
-}
-
 /// `run` at one moving instant: the wall 6 m ahead, the vehicle yawing at 20°/s, a rolling
 /// frontal camera: the display's rows show frontal rows read before the frame's instant (the
 /// truth's), so the mean misregistration is ω times their mean age; a global shutter with an
@@ -391,7 +371,7 @@ fn a_run_on_a_turning_vehicle_sees_its_rolling_rows_as_old_as_they_are() {
             .mean
     };
     let mean = mean_of(&options);
-    let predicted = 20f64.to_radians() * readout_age(&scene, 0.06) * ARCMIN_PER_RAD;
+    let predicted = 20f64.to_radians() * common::readout_age(&scene, 0.06, 6.0) * ARCMIN_PER_RAD;
     assert!(
         (mean / predicted - 1.0).abs() < 0.03,
         "measured {mean:.2}′, ω × mean readout age {predicted:.2}′"
@@ -437,7 +417,7 @@ fn a_rolling_frontal_camera_makes_each_display_row_as_old_as_its_frontal_row() {
             ..RunOptions::default()
         };
         let mut o = common::still_sequence(run, 6.0 / 30.0, 30.0, latency);
-        o.yaw_rate = omega;
+        o.run.yaw_rate_deg_s = omega.to_degrees();
         let how = common::measuring(Flip::Skipped);
         let run = run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap();
         let m: Vec<f64> = run
@@ -449,7 +429,7 @@ fn a_rolling_frontal_camera_makes_each_display_row_as_old_as_its_frontal_row() {
         let rolled = if shutter.is_empty() {
             0.0
         } else {
-            readout_age(&scene, readout)
+            common::readout_age(&scene, readout, 6.0)
         };
         let predicted = omega * (latency + rolled) * ARCMIN_PER_RAD;
         let mean = means[means.len() - 1];
@@ -480,7 +460,7 @@ fn turning_das(spp: u32, frontal_width: u32) -> seethru::system::sequence::syste
         ..RunOptions::default()
     };
     let mut o = common::still_sequence(run, 0.2, 10.0, 0.0);
-    (o.speed, o.yaw_rate) = (10.0 / 3.6, 0.3);
+    (o.run.speed_kmh, o.run.yaw_rate_deg_s) = (10.0, 0.3f64.to_degrees());
     seethru::system::sequence::system_loop::SystemLoop::new(&scene, o).unwrap()
 }
 
@@ -612,7 +592,7 @@ fn bad_shutter_keys_are_one_clear_error() {
 /// The wall sequence of [`a_rolling_frontal_camera_makes_each_display_row_as_old_as_its_frontal_row`]
 /// with the display's scan-out keys `obstacle` (TOML lines under `[obstacle]`), sampled 8
 /// times per 30 Hz refresh, the image 50 ms old at its refresh: each frame's records.
-fn scanned_sequence(obstacle: &str) -> Vec<seethru::measure::sequence_records::FrameRecord> {
+fn scanned_sequence(obstacle: &str) -> seethru::measure::sequence::SequenceRun {
     use seethru::measure::image_metrics::Flip;
     use seethru::measure::sequence::run_sequence;
     use seethru::system::options::{RunOptions, WorkingDistance};
@@ -627,11 +607,9 @@ fn scanned_sequence(obstacle: &str) -> Vec<seethru::measure::sequence_records::F
     };
     let mut o = common::still_sequence(run, 3.0 / 30.0, 240.0, 0.05);
     o.timeline.display_hz = 30.0;
-    o.yaw_rate = 20f64.to_radians();
+    o.run.yaw_rate_deg_s = 20.0;
     let how = common::measuring(Flip::Skipped);
-    run_sequence(&scene, o, how, &mut |_| Ok(()))
-        .unwrap()
-        .records
+    run_sequence(&scene, o, how, &mut |_| Ok(())).unwrap()
 }
 
 /// A rolling scan-out lights the display's 100 rows top to bottom over the 33 ms refresh:
@@ -645,9 +623,9 @@ fn a_rolling_scanout_shows_the_rows_below_the_scan_line_one_refresh_older() {
     let omega = 20f64.to_radians();
     let period = 1.0 / 30.0;
     for (keys, rolling) in [("", false), ("scanout = \"rolling\"", true)] {
-        let records = scanned_sequence(keys);
+        let records = scanned_sequence(keys).records;
         assert_eq!(records.len(), 24);
-        for r in records.iter().filter(|r| r.times.refresh > 0) {
+        for r in &records {
             let m = r.metrics.unwrap();
             let since = (r.times.display - r.times.refresh_time).max(0.0);
             let reached = ((since / period * 100.0 + 1e-9).floor() + 1.0).min(100.0);
@@ -675,8 +653,8 @@ fn a_short_persistence_lights_only_the_rows_scanned_within_it() {
         ("scanout = \"rolling\"\npersistence_ms = 5.0", true),
         ("persistence_ms = 5.0", false),
     ] {
-        let records = scanned_sequence(keys);
-        for r in records.iter().filter(|r| r.times.refresh > 0) {
+        let records = scanned_sequence(keys).records;
+        for r in &records {
             let m = r.metrics.unwrap();
             let since = (r.times.display - r.times.refresh_time).max(0.0);
             // Rows lit: scanned at period k / 100 within (since − 5 ms, since], counting the
@@ -704,20 +682,64 @@ fn a_short_persistence_lights_only_the_rows_scanned_within_it() {
                 m.coverage
             );
         }
-        // Some frames are dark all over, some lit.
+        // A global flash lights all or nothing; a rolling one a band of 5 / 33 of the rows,
+        // the first refresh too (the display ran before the sequence).
         let coverages: Vec<f64> = records
             .iter()
             .map(|r| r.metrics.unwrap().coverage)
             .collect();
-        assert!(
-            coverages.iter().any(|c| *c > 0.1),
-            "{keys:?}: {coverages:?}"
-        );
-        assert!(
-            coverages.iter().any(|c| *c < 0.05),
-            "{keys:?}: {coverages:?}"
-        );
+        let (least, most) = coverages
+            .iter()
+            .fold((1.0f64, 0.0f64), |(l, m), &c| (l.min(c), m.max(c)));
+        if rolling {
+            assert!(least > 0.12 && most < 0.18, "{keys:?}: {coverages:?}");
+        } else {
+            assert!(least < 0.05 && most > 0.95, "{keys:?}: {coverages:?}");
+        }
     }
+}
+
+/// A frame whose display is dark all over (between a global 5 ms flash's refreshes) has no
+/// misregistration: the summary's means leave it out and count it, and its coverage (0)
+/// counts in the mean coverage.
+#[test]
+fn a_dark_frame_is_left_out_of_the_means_and_counted() {
+    use seethru::measure::sequence_files::summary;
+    let run = scanned_sequence("persistence_ms = 5.0");
+    let metrics: Vec<_> = run.records.iter().map(|r| r.metrics.unwrap()).collect();
+    let dark: Vec<f64> = metrics
+        .iter()
+        .filter(|m| m.coverage == 0.0)
+        .map(|m| m.mean_arcmin)
+        .collect();
+    assert!(
+        dark.len() > 5 && dark.iter().all(|m| m.is_nan()),
+        "{dark:?}"
+    );
+    let lit: Vec<f64> = metrics
+        .iter()
+        .map(|m| m.mean_arcmin)
+        .filter(|m| !m.is_nan())
+        .collect();
+    let timeline = seethru::system::sequence::timeline::Timeline {
+        duration: 3.0 / 30.0,
+        fps: 240.0,
+        display_hz: 30.0,
+        latency_camera: 0.05,
+        latency_tracking: 0.0,
+    };
+    let s = summary(&run, &timeline);
+    let m = &s["misregistration_arcmin"];
+    assert_eq!(m["frames_left_out"], dark.len());
+    let mean = m["mean_of_frame_means"].as_f64().unwrap();
+    let expected = lit.iter().sum::<f64>() / lit.len() as f64;
+    assert!(
+        (mean - expected).abs() < 1e-9 * expected,
+        "{mean} {expected}"
+    );
+    let coverage = s["coverage"]["mean"].as_f64().unwrap();
+    let all: f64 = metrics.iter().map(|m| m.coverage).sum::<f64>() / metrics.len() as f64;
+    assert!((coverage - all).abs() < 1e-12, "{coverage} {all}");
 }
 
 /// A display scan-out the sequence cannot show is refused before any frame, in one line: a

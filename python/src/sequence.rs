@@ -465,8 +465,6 @@ pub fn sequence(
                     latency_camera: ms / 1e3,
                     latency_tracking: latency_tracking / 1e3,
                 },
-                speed: run.speed_kmh / 3.6,
-                yaw_rate: run.yaw_rate_deg_s.to_radians(),
                 head: head.clone(),
                 predict,
                 reproject,

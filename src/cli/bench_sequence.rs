@@ -26,6 +26,7 @@ fn sequence(scene: &Scene, head: HeadSource, metrics: bool) -> Result<SequenceRu
             back_width: Some(320),
             spp: 1,
             outside: Outside::Black,
+            speed_kmh: 50.0,
             ..RunOptions::default()
         },
         timeline: Timeline {
@@ -35,8 +36,6 @@ fn sequence(scene: &Scene, head: HeadSource, metrics: bool) -> Result<SequenceRu
             latency_camera: 0.05,
             latency_tracking: 0.01,
         },
-        speed: 50.0 / 3.6,
-        yaw_rate: 0.0,
         head: HeadMotion::Lean {
             distance: 0.1,
             duration: 0.3,

@@ -14,6 +14,7 @@ use seethru::measure::headline::{RunKind, summary_text};
 use seethru::measure::image_metrics::Flip;
 use seethru::measure::run_spec::RunSpec;
 use seethru::measure::sequence::{Measuring, SequenceRun, run_sequence_hazards};
+use seethru::measure::sequence_budget::{has_effects_of_time, run_budget};
 use seethru::measure::sequence_files::{
     Preview, frames_csv, hazard_figure, latency_figure, mean_of_frame_stats, over_time_figure,
     summary,
@@ -136,6 +137,12 @@ pub struct Sequence {
     /// Re-project the frontal image by the vehicle's known motion from capture to display.
     #[arg(long)]
     reproject: bool,
+    /// Split the misregistration into what each effect of time adds (latency, sample and
+    /// hold, readout skew, exposure blur, scan-out) by running the sequence again with them
+    /// added one by one: budget.csv, budget_over_time.png and summary.json's `budget` (up to 5
+    /// more sequences).
+    #[arg(long, conflicts_with_all = ["capture", "maps"])]
+    budget: bool,
     /// Write every frame's truth and seethru views (whole driver views) as PNG or EXR.
     #[arg(long, value_enum, value_parser = choice::<FramesFormat>(), default_value_t = FramesFormat::None)]
     frames: FramesFormat,
@@ -207,8 +214,6 @@ impl Sequence {
                 latency_camera: latency_ms / 1e3,
                 latency_tracking: self.latency_tracking / 1e3,
             },
-            speed: spec.options.speed_kmh / 3.6,
-            yaw_rate: spec.options.yaw_rate_deg_s.to_radians(),
             head: head.clone(),
             predict: self.predict,
             reproject: self.reproject,
@@ -275,6 +280,11 @@ impl Sequence {
         for o in &all {
             o.timeline.validate()?;
         }
+        if self.budget && !all.iter().any(|o| has_effects_of_time(&scene, o)) {
+            bail!(
+                "--budget splits the misregistration among the effects of time, and this sequence has none: give --latency-camera or --latency-tracking, a --display-hz below --fps, or set the scene's shutter, readout_ms, exposure_ms or scanout keys"
+            );
+        }
         if (self.capture.is_some() || self.maps.is_some()) && all.len() > 1 {
             bail!(
                 "--capture and --maps take one --latency-camera value, got {}",
@@ -312,7 +322,7 @@ impl Sequence {
             "note": "the sequence that wrote this folder (seethru score reads a single capture's folder, not this one: score a sequence with sequence --maps)",
         });
         let (mut index, mut shown_folder) = (Vec::new(), String::new());
-        let mut runs: Vec<(f64, SequenceRun)> = Vec::new();
+        let mut runs: Vec<(f64, SequenceRun, Option<serde_json::Value>)> = Vec::new();
         let count = all.len();
         let mut headlines: Vec<String> = Vec::new();
         for (k, (options, &ms)) in all.into_iter().zip(&self.latency_camera.0).enumerate() {
@@ -331,6 +341,7 @@ impl Sequence {
                 flip: Flip::asked(self.flip),
             };
             let bound = spec.measure.hazard_bound_arcmin;
+            let asked = options.clone();
             let run = run_sequence_hazards(&scene, options, how, bound, &label, &mut |f| {
                 preview.add(&f);
                 if let Some(c) = &captured {
@@ -372,14 +383,31 @@ impl Sequence {
                 hazard_figure(&run.records, timeline.duration).write(&dir, "hazard_visibility")?;
             }
             let mut s = summary(&run, &timeline);
-            headlines.push(format!("{ms} ms: {}", summary_text(RunKind::Sequence, &s)));
+            let mut budget_json = None;
+            let mut headline = format!("{ms} ms: {}", summary_text(RunKind::Sequence, &s));
+            if self.budget {
+                let how = Measuring {
+                    full_frames: false,
+                    flip: Flip::Skipped,
+                    ..how
+                };
+                let budget = run_budget(&scene, &asked, how, &run, &label)?;
+                write_text(&dir.join("budget.csv"), &budget.csv())?;
+                budget
+                    .figure(timeline.duration)
+                    .write(&dir, "budget_over_time")?;
+                s["budget"] = budget.json();
+                budget_json = Some(s["budget"].clone());
+                headline = format!("{headline}; {}", budget.headline());
+            }
+            headlines.push(headline);
             s["preview_heat_scale_arcmin"] = json!(scale);
             s["preview_heat_scale"] = json!(chosen);
             write_text(
                 &dir.join("summary.json"),
                 &serde_json::to_string_pretty(&with_flags(&s))?,
             )?;
-            runs.push((ms, run));
+            runs.push((ms, run, budget_json));
         }
         self.write_overview(&spec, &runs, &out)?;
         if let Some(c) = captured {
@@ -402,19 +430,22 @@ impl Sequence {
     fn write_overview(
         &self,
         spec: &RunSpec,
-        runs: &[(f64, SequenceRun)],
+        runs: &[(f64, SequenceRun, Option<serde_json::Value>)],
         out: &Path,
     ) -> Result<()> {
         let labelled: Vec<(String, &[_])> = runs
             .iter()
-            .map(|(ms, r)| (format!("{ms} ms"), r.records.as_slice()))
+            .map(|(ms, r, _)| (format!("{ms} ms"), r.records.as_slice()))
             .collect();
         over_time_figure(&labelled, self.duration).write(out, "misregistration_over_time")?;
         let mut per_latency = Vec::new();
         let mut points = Vec::new();
-        for (ms, run) in runs {
+        for (ms, run, budget) in runs {
             let timeline = self.options(spec, &HeadMotion::Still, *ms).timeline;
-            let s = summary(run, &timeline);
+            let mut s = summary(run, &timeline);
+            if let Some(budget) = budget {
+                s["budget"] = budget.clone();
+            }
             let [mean, p95] = mean_of_frame_stats(run);
             points.push((*ms, mean, p95));
             per_latency
@@ -434,6 +465,7 @@ impl Sequence {
             "latency_tracking_ms": self.latency_tracking,
             "predict": self.predict,
             "reproject": self.reproject,
+            "budget": self.budget,
             "method": spec.options.method,
             "maps": self.maps.as_ref().map(|m| m.display().to_string()),
             "d2": format!("{:?}", spec.options.d2),

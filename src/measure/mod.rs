@@ -26,6 +26,7 @@ pub mod ratio;
 pub mod ratio_setup;
 pub mod run_spec;
 pub mod sequence;
+pub mod sequence_budget;
 pub mod sequence_files;
 pub mod sequence_records;
 pub mod sequence_regions;

@@ -183,11 +183,26 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
     if n == 0 { f64::NAN } else { s / n as f64 }
 }
 
+/// The frames' metrics where some display pixel shows the scene: a frame whose display is
+/// dark (between a short persistence's flashes), covered
+/// or off screen has no misregistration to average ([`unmeasured_frames`] counts them).
+fn measured(run: &SequenceRun) -> impl Iterator<Item = FrameMetrics> + '_ {
+    run.records
+        .iter()
+        .filter_map(|r| r.metrics)
+        .filter(|m| m.mean_arcmin.is_finite())
+}
+
+/// The frames without a display pixel that shows the scene, left out of the means.
+pub fn unmeasured_frames(run: &SequenceRun) -> usize {
+    run.records.len() - measured(run).count()
+}
+
 /// The means over `run`'s measured frames of their mean and of their p95 misregistration,
 /// arc-minutes (NaN without a measured frame): the summary's `mean_of_frame_means` and
 /// `mean_of_frame_p95`.
 pub fn mean_of_frame_stats(run: &SequenceRun) -> [f64; 2] {
-    let m = || run.records.iter().filter_map(|r| r.metrics);
+    let m = || measured(run);
     [
         mean(m().map(|x| x.mean_arcmin)),
         mean(m().map(|x| x.p95_arcmin)),
@@ -214,6 +229,7 @@ pub fn summary(run: &SequenceRun, timeline: &Timeline) -> serde_json::Value {
             "mean_of_frame_p95": frame_p95,
             "max_of_frame_p95": m.iter().map(|x| x.p95_arcmin).fold(f64::NAN, f64::max),
             "max": m.iter().map(|x| x.max_arcmin).fold(f64::NAN, f64::max),
+            "frames_left_out": unmeasured_frames(run),
         },
         "coverage": {
             "mean": mean(m.iter().map(|x| x.coverage)),
@@ -238,7 +254,7 @@ pub fn summary(run: &SequenceRun, timeline: &Timeline) -> serde_json::Value {
         "frontal_pixels_per_refresh": run.frontal_pixels_per_refresh,
         "window_px": [run.window.x0, run.window.y0, run.window.x1, run.window.y1],
         "hazards": hazards_summary(run, timeline),
-        "notes": "per-frame statistics over the display pixels that show the scene (coverage beside them); mean_of_frame_means averages the frames' means; eye_error: the compensation's eye against the true eye at display time",
+        "notes": "per-frame statistics over the display pixels that show the scene (coverage beside them); frames where none does (a display dark between a short persistence's flashes) are left out of the misregistration's means and counted in frames_left_out, and count in the coverage; mean_of_frame_means averages the frames' means; eye_error: the compensation's eye against the true eye at display time",
     })
 }
 

@@ -4,10 +4,12 @@
 use crate::geometry::camera::Camera;
 use crate::render::settings::resized;
 use crate::scene::limits::{MAX_COORDINATE, MIN_LENGTH};
+use crate::scene::motion::VehicleMotion;
 use crate::system::display::{DisplayModel, Filter};
 use crate::system::eyes::Eyes;
 use crate::system::scene_model_options::SceneModelOptions;
 use crate::util::number::short;
+use glam::DVec3;
 
 /// How the display image is made.
 #[derive(
@@ -155,8 +157,8 @@ pub struct RunOptions {
     pub scene_model: SceneModelOptions,
     /// The vehicle's speed along the road (world −z), km/h, [0, 300]: a single frame's
     /// frontal camera moves during its rolling readout and exposure (scene keys); a sequence's
-    /// front ends carry it into `SequenceOptions::speed` (m/s, system/sequence/system_loop.rs),
-    /// which its loop reads. Capture folders written before it existed hold none: 0.
+    /// vehicle drives at it ([`RunOptions::vehicle_motion`]). Capture folders written before it
+    /// existed hold none: 0.
     #[serde(default)]
     pub speed_kmh: f64,
     /// The vehicle's yaw rate about the driver's eye, °/s, [−180, 180], positive turning left.
@@ -168,6 +170,17 @@ pub struct RunOptions {
 }
 
 impl RunOptions {
+    /// The vehicle's motion at `speed_kmh` and `yaw_rate_deg_s` along world −z, about
+    /// `pivot` (the driver's eye at t = 0, world frame).
+    pub fn vehicle_motion(&self, pivot: DVec3) -> VehicleMotion {
+        VehicleMotion {
+            speed: self.speed_kmh / 3.6,
+            yaw_rate: self.yaw_rate_deg_s.to_radians(),
+            forward: DVec3::NEG_Z,
+            pivot,
+        }
+    }
+
     /// The driver's camera (as given, before the eye is chosen) at `--width`/`--height`.
     pub fn sized_driver(&self, camera: Camera) -> anyhow::Result<Camera> {
         resized(

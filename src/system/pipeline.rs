@@ -399,12 +399,7 @@ pub fn frontal_pose_at(
             "option `{given}` moves the frontal camera during its readout and exposure, but its shutter is an instant (a global shutter, exposure_ms 0): set shutter = \"rolling\" or exposure_ms in [camera.frontal], or leave the option out"
         );
     }
-    let motion = crate::scene::motion::VehicleMotion {
-        speed: options.speed_kmh / 3.6,
-        yaw_rate: options.yaw_rate_deg_s.to_radians(),
-        forward: DVec3::NEG_Z,
-        pivot: scene.eye(),
-    };
+    let motion = options.vehicle_motion(scene.eye());
     let base = scene.frontal.world_from_camera;
     Ok(Some(move |dt: f64| motion.world_from_rig(dt) * base))
 }

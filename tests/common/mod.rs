@@ -300,6 +300,27 @@ pub fn expected_coverage(
     (display, inside, ambiguous)
 }
 
+/// The mean age, from the frame's completion, of the frontal rows the display's pixels show
+/// on a wall `wall` metres ahead of the display (a rolling shutter of `readout` s, top to
+/// bottom): a 60 × 40 grid over the display, each point's ray from the eye onto the wall,
+/// projected into the frontal camera.
+pub fn readout_age(scene: &seethru::scene::Scene, readout: f64, wall: f64) -> f64 {
+    let (eye, frontal) = (scene.eye(), scene.frontal);
+    let [a, b, _, d] = scene.obstacle.display_corners();
+    let mut age = 0.0;
+    for i in 0..60 {
+        for j in 0..40 {
+            let (u, v) = ((f64::from(i) + 0.5) / 60.0, (f64::from(j) + 0.5) / 40.0);
+            let p = a + (b - a) * u + (d - a) * v;
+            let on_wall = eye + (p - eye) * ((-wall - eye.z) / (p.z - eye.z));
+            let row = frontal.project_point(on_wall).unwrap().y.floor();
+            let last = f64::from(frontal.height - 1);
+            age += readout * (last - row) / last / 2400.0;
+        }
+    }
+    age
+}
+
 /// How a test measures a sequence: the truth and the metrics (FLIP only when `flip` says),
 /// the window around the display, a 5-pixel band, no progress bar.
 pub fn measuring(
@@ -331,8 +352,6 @@ pub fn still_sequence(
             latency_camera,
             latency_tracking: 0.0,
         },
-        speed: 0.0,
-        yaw_rate: 0.0,
         head: seethru::system::sequence::head_motion::HeadMotion::Still,
         predict: seethru::system::sequence::predict::Prediction::None,
         reproject: false,

@@ -57,13 +57,10 @@ pub const BACK_MIN_SPP: u32 = 4;
 /// Everything a sequence is asked for.
 #[derive(Clone, Debug)]
 pub struct SequenceOptions {
-    /// The system's choices (method, d2, head source and its errors, sizes, spp, display).
+    /// The system's choices (method, d2, head source and its errors, sizes, spp, display) and
+    /// the vehicle's speed and yaw rate.
     pub run: RunOptions,
     pub timeline: Timeline,
-    /// Vehicle speed along world −z, m/s.
-    pub speed: f64,
-    /// Vehicle yaw rate, rad/s, positive to the left.
-    pub yaw_rate: f64,
     pub head: HeadMotion,
     pub predict: Prediction,
     /// Re-project the frontal image by the vehicle's known motion from capture to display.
@@ -188,12 +185,22 @@ impl SystemLoop {
         base.frontal = run.sized_frontal(base.frontal)?;
         base.back = run.sized_back(base.back)?;
         base.driver = driver_camera(&base, run)?;
-        let rig = Rig::new(base, options.speed, options.yaw_rate, options.head.clone());
+        let vehicle = options.run.vehicle_motion(base.eye());
+        let rig = Rig::new(base, vehicle, options.head.clone());
         let tl = options.timeline;
-        rig.check_eye((0..tl.frames()).flat_map(|k| {
-            let t = tl.times(k);
-            [t.display, t.head]
-        }))?;
+        let before = scene
+            .obstacle
+            .scanout
+            .rolling
+            .then(|| tl.refresh_times(-1).head);
+        rig.check_eye(
+            (0..tl.frames())
+                .flat_map(|k| {
+                    let t = tl.times(k);
+                    [t.display, t.head]
+                })
+                .chain(before),
+        )?;
         let moves = |i: usize| scene.objects[i].motion.moves();
         let world = World::build_part(scene, &|i| !moves(i), false)?;
         let accel = Accel::build(&world)?;
@@ -356,6 +363,26 @@ impl SystemLoop {
         {
             return Ok(self.shown.as_ref().expect("just checked"));
         }
+        if self.shown.is_none() && self.shows_refresh_before() {
+            // The display has been running before the sequence: below its first refresh's
+            // scan line it shows the refresh before, made as every refresh is. Outside maps
+            // have none (their rows stay dark until scanned).
+            let given = self.eye_given.take();
+            let before = self.options.timeline.refresh_times(times.refresh - 1);
+            self.make_refresh(before)?;
+            self.eye_given = given;
+        }
+        self.make_refresh(times)
+    }
+
+    /// Whether the first refresh shows the one before it (a rolling scan-out, the loop's own
+    /// compensation).
+    fn shows_refresh_before(&self) -> bool {
+        self.rig.base.obstacle.scanout.rolling && self.options.byo.maps.is_none()
+    }
+
+    /// Makes the image of the refresh of `times` and what it shows.
+    fn make_refresh(&mut self, times: FrameTimes) -> Result<&Shown> {
         let (eye_estimated, head_confidence, head_pose) =
             self.estimate_head(times.head, times.refresh)?;
         self.predictor.observe(times.head, eye_estimated);
@@ -452,8 +479,9 @@ impl SystemLoop {
         let display = if let Some(named) = external {
             let named = named.with_context(|| {
                 format!(
-                    "option `maps`: no map for refresh {} (frame {frame})",
-                    times.refresh
+                    "option `maps`: no map for refresh {} (at t = {} s)",
+                    times.refresh,
+                    short(times.refresh_time)
                 )
             })?;
             let size = geometry.obstacle.display_resolution;

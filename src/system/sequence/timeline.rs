@@ -92,10 +92,19 @@ impl Timeline {
         let display = frame as f64 / self.fps;
         // A refresh at exactly the frame's time counts (the 1e-9 absorbs the rounding of k/fps).
         let refresh = (display * self.display_hz + 1e-9).floor() as i64;
+        FrameTimes {
+            display,
+            ..self.refresh_times(refresh)
+        }
+    }
+
+    /// The times of refresh `refresh` (negative: before the sequence), looked at as it is
+    /// shown.
+    pub fn refresh_times(&self, refresh: i64) -> FrameTimes {
         let refresh_time = refresh as f64 / self.display_hz;
         let capture = refresh_time - self.latency_camera;
         FrameTimes {
-            display,
+            display: refresh_time,
             refresh,
             refresh_time,
             capture,
@@ -116,15 +125,9 @@ pub struct Rig {
 }
 
 impl Rig {
-    /// `speed` m/s along world −z, `yaw_rate` rad/s (left > 0).
-    pub fn new(base: Scene, speed: f64, yaw_rate: f64, head: HeadMotion) -> Rig {
+    /// The rig of `base` carried by `vehicle`, the head moving by `head` within it.
+    pub fn new(base: Scene, vehicle: VehicleMotion, head: HeadMotion) -> Rig {
         let eye0 = base.obstacle.in_obstacle_frame(base.eye());
-        let vehicle = VehicleMotion {
-            speed,
-            yaw_rate,
-            forward: DVec3::NEG_Z,
-            pivot: base.eye(),
-        };
         Rig {
             vehicle,
             head,
