@@ -605,6 +605,210 @@ mod tests {
         assert_eq!(gaussian(7, 3), gaussian(7, 3));
     }
 
+    /// A deterministic mask: about `density` of the pixels set.
+    fn mask(w: usize, h: usize, seed: u32, density: f32) -> Vec<bool> {
+        (0..w * h)
+            .map(|i| {
+                let x = crate::util::sampling::hash_u32(seed.wrapping_mul(0x9e37_79b9) ^ i as u32);
+                crate::util::sampling::unit_float(x) < density
+            })
+            .collect()
+    }
+
+    /// The brute-force twin of [`components`]: every set pixel of `rect` takes the least
+    /// label of itself and its 4 neighbours until nothing changes; components are the pixels
+    /// of one label, ordered by their first pixel row by row, each in row order.
+    fn components_by_relaxation(mask: &[bool], w: usize, rect: Rect) -> Vec<Vec<usize>> {
+        let inside = |x: usize, y: usize| {
+            x >= rect.x0 && x < rect.x1 && y >= rect.y0 && y < rect.y1 && mask[y * w + x]
+        };
+        let mut label: Vec<usize> = (0..mask.len()).collect();
+        loop {
+            let mut changed = false;
+            for y in rect.y0..rect.y1 {
+                for x in rect.x0..rect.x1 {
+                    if !inside(x, y) {
+                        continue;
+                    }
+                    let i = y * w + x;
+                    let mut least = label[i];
+                    for (nx, ny) in [
+                        (x.wrapping_sub(1), y),
+                        (x + 1, y),
+                        (x, y.wrapping_sub(1)),
+                        (x, y + 1),
+                    ] {
+                        if nx < w && inside(nx, ny) {
+                            least = least.min(label[ny * w + nx]);
+                        }
+                    }
+                    if least < label[i] {
+                        label[i] = least;
+                        changed = true;
+                    }
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        let mut groups: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+        for y in rect.y0..rect.y1 {
+            for x in rect.x0..rect.x1 {
+                if inside(x, y) {
+                    groups.entry(label[y * w + x]).or_default().push(y * w + x);
+                }
+            }
+        }
+        // A label is its component's least index: its first pixel row by row.
+        groups.into_values().collect()
+    }
+
+    /// [`components`] against its twin on masks from sparse to dense (many small regions to
+    /// one that winds through the image), over the whole image and over a rectangle within
+    /// it (the mask false outside, as the function requires): the same components, in the
+    /// same order, each pixel once.
+    #[test]
+    fn components_are_their_brute_force_twins() {
+        let (w, h) = (37, 23);
+        for (seed, density) in [(1, 0.2), (2, 0.45), (3, 0.6), (4, 0.9)] {
+            let whole = mask(w, h, seed, density);
+            let inner = Rect {
+                x0: 5,
+                y0: 3,
+                x1: 30,
+                y1: 20,
+            };
+            let clipped: Vec<bool> = whole
+                .iter()
+                .enumerate()
+                .map(|(i, &m)| m && i % w >= 5 && i % w < 30 && i / w >= 3 && i / w < 20)
+                .collect();
+            for (m, rect) in [(&whole, Rect::whole(w, h)), (&clipped, inner)] {
+                let mut fast = components(m, w, h, rect);
+                for c in &mut fast {
+                    c.sort_unstable();
+                }
+                let twin = components_by_relaxation(m, w, rect);
+                assert_eq!(fast, twin, "seed {seed}, density {density}, {rect:?}");
+                let count: usize = fast.iter().map(Vec::len).sum();
+                assert_eq!(count, m.iter().filter(|&&b| b).count());
+            }
+        }
+    }
+
+    /// A blob is kept when it has at most `max_area` pixels and touches none of the search
+    /// box's four borders; its pixels are given as image indices.
+    #[test]
+    fn inner_blobs_are_small_and_clear_of_the_boxs_border() {
+        // A 10 × 8 box at (3, 2) of a 20-pixel-wide image.
+        let (x0, y0, x1, y1, w) = (3, 2, 13, 10, 20);
+        let (bw, bh) = (x1 - x0, y1 - y0);
+        let mut dark = vec![false; bw * bh];
+        let mut set = |x: usize, y: usize| dark[y * bw + x] = true;
+        // Inside: a 2 × 2 blob (4 pixels) and a 3 × 2 one (6 pixels).
+        for (x, y) in [(2, 2), (3, 2), (2, 3), (3, 3)] {
+            set(x, y);
+        }
+        for (x, y) in [(6, 4), (7, 4), (8, 4), (6, 5), (7, 5), (8, 5)] {
+            set(x, y);
+        }
+        // One pixel touching each border.
+        for (x, y) in [(0, 4), (bw - 1, 2), (5, 0), (4, bh - 1)] {
+            set(x, y);
+        }
+        let image = |bx: usize, by: usize| (y0 + by) * w + x0 + bx;
+        // components() lists a blob's pixels in flood order: compare each as a set.
+        let sorted = |blobs: Vec<Vec<usize>>| -> Vec<Vec<usize>> {
+            blobs
+                .into_iter()
+                .map(|mut b| {
+                    b.sort_unstable();
+                    b
+                })
+                .collect()
+        };
+        let small = vec![image(2, 2), image(3, 2), image(2, 3), image(3, 3)];
+        let large = vec![
+            image(6, 4),
+            image(7, 4),
+            image(8, 4),
+            image(6, 5),
+            image(7, 5),
+            image(8, 5),
+        ];
+        let found = sorted(inner_blobs(&dark, [x0, y0, x1, y1], w, 6));
+        assert_eq!(found, vec![small.clone(), large]);
+        // One pixel less of room: the 6-pixel blob is too large.
+        let found = sorted(inner_blobs(&dark, [x0, y0, x1, y1], w, 5));
+        assert_eq!(found, vec![small]);
+    }
+
+    /// The face is the largest skin region of at least 20 pixels; its box is its pixels'
+    /// bounds, its luminance their median, and the pupil search box the face box grown by
+    /// an eighth of its larger side (at least 2 pixels), cut at the image's edges.
+    #[test]
+    fn the_face_region_is_the_largest_skin_region_and_its_box() {
+        let (w, h) = (40, 30);
+        let mut skin = vec![false; w * h];
+        let mut rgb = vec![[0u8; 3]; w * h];
+        // A 6 × 5 region (30 pixels) from (1, 2), grey levels rising along its rows; a 5 × 5
+        // one (25 pixels) apart from it.
+        for y in 2..7 {
+            for x in 1..7 {
+                skin[y * w + x] = true;
+                let v = (10 * (y * 6 + x)) as u8;
+                rgb[y * w + x] = [v, v, v];
+            }
+        }
+        for y in 20..25 {
+            for x in 30..35 {
+                skin[y * w + x] = true;
+            }
+        }
+        let r = face_region(&rgb, &skin, w, h, Rect::whole(w, h)).unwrap();
+        assert_eq!(r.face.len(), 30);
+        assert_eq!(r.face_box, [1, 2, 7, 7]);
+        let mut lums: Vec<f32> = r.face.iter().map(|&i| luminance(rgb[i])).collect();
+        lums.sort_by(f32::total_cmp);
+        assert_eq!(r.face_lum, lums[15]);
+        // 6 / 8 rounds to 0: the least margin, 2 pixels, cut at the image's left edge.
+        assert_eq!(r.search, [0, 0, 9, 9]);
+        assert_eq!(r.dark.len(), 81);
+        // A larger face: a margin of a 24-pixel side is 3.
+        let mut big = vec![false; w * h];
+        for y in 3..27 {
+            for x in 10..20 {
+                big[y * w + x] = true;
+            }
+        }
+        let r = face_region(&rgb, &big, w, h, Rect::whole(w, h)).unwrap();
+        assert_eq!((r.face_box, r.search), ([10, 3, 20, 27], [7, 0, 23, 30]));
+        // 19 pixels are no face; 20 are.
+        let mut few = vec![false; w * h];
+        for i in 0..19 {
+            few[5 * w + 10 + i] = true;
+        }
+        let none = face_region(&rgb, &few, w, h, Rect::whole(w, h));
+        assert!(matches!(none, Err(DetectError::NoFace)));
+        few[5 * w + 29] = true;
+        assert!(face_region(&rgb, &few, w, h, Rect::whole(w, h)).is_ok());
+    }
+
+    /// Skin needs a sum of at least 90 and red > green > blue, strictly: a sum of 89, or red
+    /// equal to green, is not skin even where the chromaticities are.
+    #[test]
+    fn skin_has_its_thresholds_where_its_doc_puts_them() {
+        // 40 : 30 : 20 of 90: chromaticities 0.444, 0.333, 0.222, all within their bands.
+        assert!(is_skin([40, 30, 20]));
+        // The same chromaticities within their bands, a sum of 89.
+        assert!(!is_skin([39, 30, 20]));
+        // Chromaticities within their bands (0.36, 0.36, 0.28; 0.4, 0.3, 0.3), but red
+        // equal to green, or green to blue.
+        assert!(!is_skin([36, 36, 28]) && !is_skin([40, 30, 30]));
+        assert!(!is_skin([80, 80, 80]));
+    }
+
     #[test]
     fn skin_is_told_from_hair_grass_asphalt_and_sky() {
         assert!(is_skin([222, 173, 140]) && is_skin([120, 92, 76]));
