@@ -809,6 +809,99 @@ mod tests {
         assert!(!is_skin([80, 80, 80]));
     }
 
+    /// A w × h image of skin at luminance `skin` (grey, plus `slope` per pixel to the
+    /// right) with a dark disc of radius `r` at `centre`, each pixel mixed by the share of
+    /// it the disc covers (16 × 16 samples); and the disc's blob as the detector finds it
+    /// (pixels darker than 0.3 × the skin level).
+    fn pupil_image(
+        (w, h): (usize, usize),
+        centre: DVec2,
+        r: f64,
+        skin: f64,
+        slope: f64,
+    ) -> (Vec<[u8; 3]>, Vec<usize>) {
+        let dark = 20.0;
+        let rgb: Vec<[u8; 3]> = (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as f64, (i / w) as f64);
+                let inside = (0..256)
+                    .filter(|k| {
+                        let p = DVec2::new(
+                            x + (f64::from(k % 16) + 0.5) / 16.0,
+                            y + (f64::from(k / 16) + 0.5) / 16.0,
+                        );
+                        p.distance(centre) < r
+                    })
+                    .count() as f64
+                    / 256.0;
+                let level = skin + slope * x;
+                let v = (level + (dark - level) * inside).round() as u8;
+                [v, v, v]
+            })
+            .collect();
+        let hole = (0..w * h)
+            .filter(|&i| luminance(rgb[i]) < 0.3 * skin as f32)
+            .collect();
+        (rgb, hole)
+    }
+
+    /// A round pupil's centroid is its centre: the rim's mixed pixels weigh by how dark they
+    /// are, so the sub-pixel position is kept to a twentieth of a pixel, at any offset within
+    /// a pixel; and a shading across the face (a tenth of the skin level over the pupil's
+    /// width) moves it by less than a tenth.
+    #[test]
+    fn a_round_pupils_centroid_is_its_centre() {
+        for (dx, dy) in [(0.0, 0.0), (0.25, 0.5), (0.5, 0.125), (0.8, 0.3)] {
+            let centre = DVec2::new(10.0 + dx, 9.0 + dy);
+            let (rgb, hole) = pupil_image((21, 19), centre, 2.6, 180.0, 0.0);
+            let c = pupil_centroid(&rgb, 21, 19, &hole, 180.0);
+            assert!(c.distance(centre) < 0.05, "{centre} found at {c}");
+            let (rgb, hole) = pupil_image((21, 19), centre, 2.6, 180.0, 3.5);
+            let c = pupil_centroid(&rgb, 21, 19, &hole, 180.0 + 35.0);
+            assert!(c.distance(centre) < 0.1, "shaded: {centre} found at {c}");
+        }
+    }
+
+    /// The walk from each pupil outward along the line through both ends where the skin
+    /// does, within a quarter pixel (its step), crossing a non-skin gap narrower than the
+    /// allowance (the eye's white) and stopping at one wider (the background); `used` grows
+    /// to every pixel it read.
+    #[test]
+    fn the_row_edges_are_where_the_skin_ends() {
+        let (w, h) = (80, 30);
+        let mut skin = vec![false; w * h];
+        // Skin on rows 10..20 from x = 12 to 61, with the eyes' whites (2 px) beside the
+        // pupils, and a stray skin pixel 12 px beyond the right edge (past the allowance).
+        for y in 10..20 {
+            for x in 12..61 {
+                skin[y * w + x] = true;
+            }
+            for x in [24, 25, 47, 48] {
+                skin[y * w + x] = false;
+            }
+            skin[y * w + 73] = true;
+        }
+        let pupils = [DVec2::new(26.5, 15.5), DVec2::new(45.5, 15.5)];
+        let mut used = Rect {
+            x0: 20,
+            y0: 12,
+            x1: 50,
+            y1: 18,
+        };
+        let [left, right] = row_edges(&skin, w, h, pupils, 49.0, &mut used);
+        assert!((left.x - 12.0).abs() <= 0.25 && left.y == 15.5, "{left}");
+        assert!((right.x - 61.0).abs() <= 0.25 && right.y == 15.5, "{right}");
+        // Each walk reads a quarter pixel past a gap of 4.9 px (a tenth of the face) beyond
+        // its last skin: from x = 12.0 to 7.0 on the left, 60.75 to 65.75 on the right.
+        let read = Rect {
+            x0: 7,
+            y0: 12,
+            x1: 66,
+            y1: 18,
+        };
+        assert_eq!(used, read);
+    }
+
     #[test]
     fn skin_is_told_from_hair_grass_asphalt_and_sky() {
         assert!(is_skin([222, 173, 140]) && is_skin([120, 92, 76]));
