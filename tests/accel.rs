@@ -210,7 +210,9 @@ fn bench_batches_traced_in_packets_equal_them_traced_ray_by_ray() {
     let scene = common::das();
     let world = World::build(&scene).unwrap();
     let accel = Accel::build(&world).unwrap();
-    let sun = seethru::render::sky::SkyModel::new(&scene.sky, &scene.sun).sun_direction;
+    let sun =
+        seethru::render::sky::SkyModel::new(&scene.sky, &scene.sun, scene.photometry.as_ref())
+            .sun_direction;
     let camera = View::Truth.camera(&scene).with_resolution(61, 37);
     let primary = camera_batch(&camera, view_bit::TRUTH);
     let mut per_ray = vec![None; primary.rays.len()];
@@ -348,7 +350,9 @@ fn coherent_packets_of_every_view_and_their_shadow_rays_equal_brute_force() {
     let scene = common::das();
     let world = World::build(&scene).unwrap();
     let accel = Accel::build(&world).unwrap();
-    let sun = seethru::render::sky::SkyModel::new(&scene.sky, &scene.sun).sun_direction;
+    let sun =
+        seethru::render::sky::SkyModel::new(&scene.sky, &scene.sun, scene.photometry.as_ref())
+            .sun_direction;
     for view in View::ALL {
         let rays = tiled_camera_rays(&view.camera(&scene));
         let hits = compare(&world, &accel, &rays, &[view.bit()]);

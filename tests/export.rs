@@ -553,7 +553,7 @@ fn mitsuba_export_has_three_sensors_with_the_exact_field_of_view() {
 #[test]
 fn two_hemispheres_light_a_surface_as_seethrus_ambient() {
     let scene = common::das();
-    let sky = SkyModel::new(&scene.sky, &scene.sun);
+    let sky = SkyModel::new(&scene.sky, &scene.sun, scene.photometry.as_ref());
     let (up, down) = (sky.ambient(Vec3::Y), sky.ambient(-Vec3::Y));
     assert!(
         (up - down).length() > 0.1,

@@ -22,7 +22,10 @@ class Frame:
     width: int
     height: int
     colour: npt.NDArray[np.float32]
-    """Linear RGB radiance, (height, width, 3) float32 (EXR R, G, B)."""
+    """Linear RGB radiance, (height, width, 3) float32; 1.0 is the PNG's white."""
+    white_cd_m2: float | None
+    """In a scene lit in physical units (`[sun] illuminance_lux`), the luminance of a colour
+    of 1.0, cd/m²: `colour * white_cd_m2` is what its EXR holds. None in relative units."""
     depth: npt.NDArray[np.float32]
     """Distance along the pixel-centre ray, metres, +inf for sky; (height, width) float32."""
     camera_z: npt.NDArray[np.float32]

@@ -36,9 +36,13 @@ pub struct PyFrame {
     width: u32,
     #[pyo3(get)]
     height: u32,
-    /// Linear RGB radiance, (height, width, 3) float32 (EXR R, G, B).
+    /// Linear RGB radiance, (height, width, 3) float32; 1.0 is the PNG's white.
     #[pyo3(get)]
     colour: Py<PyArray3<f32>>,
+    /// In a scene lit in physical units (`[sun] illuminance_lux`), the luminance of a colour
+    /// of 1.0, cd/m² (`colour` × this is what its EXR holds); None in relative units.
+    #[pyo3(get)]
+    white_cd_m2: Option<f32>,
     /// Distance along the pixel-centre ray, metres, +inf for sky; (height, width) float32.
     #[pyo3(get)]
     depth: Py<PyArray2<f32>>,
@@ -132,7 +136,7 @@ impl PyFrame {
         shutter: Option<Shutter>,
     ) -> PyResult<PyFrame> {
         let (w, h) = (frame.width as usize, frame.height as usize);
-        let (width, height) = (frame.width, frame.height);
+        let (width, height, white_cd_m2) = (frame.width, frame.height, frame.white_cd_m2);
         let owner = Bound::new(py, FrameBuffers::new(frame))?;
         let mut addresses = HashMap::new();
         let mut vectors = |name: &str, of: fn(&mut Frame) -> &mut [Vec3]| {
@@ -173,6 +177,7 @@ impl PyFrame {
             width,
             height,
             colour,
+            white_cd_m2,
             depth,
             camera_z,
             position,
@@ -316,6 +321,7 @@ impl PyFrame {
             width: frame.width,
             height: frame.height,
             colour,
+            white_cd_m2: frame.white_cd_m2,
             depth,
             camera_z,
             position,

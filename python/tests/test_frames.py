@@ -8,7 +8,7 @@ import OpenEXR
 import pytest
 
 import seethru
-from conftest import SCENE, SPP, WIDTH
+from conftest import MINIMAL, SCENE, SPP, WIDTH, seethru_cli
 
 
 def exr_channels(path):
@@ -119,3 +119,21 @@ def test_buffers_are_handed_over_without_a_copy():
         assert array.ctypes.data == address, name
         assert array.flags.c_contiguous
     assert len(frame._buffer_addresses) == 7
+
+
+def test_a_photometric_scenes_colour_times_its_white_is_the_exrs_cd_m2(tmp_path):
+    light = (
+        "[sun]\nilluminance_lux = 40000\nelevation_deg = 50\nazimuth_deg = 200\n"
+        "[sky]\nzenith_luminance_cd_m2 = 3000\n[photometry]\nwhite_cd_m2 = 800\n"
+    )
+    path = tmp_path / "lit.toml"
+    path.write_text(light + MINIMAL)
+    frame = seethru.Scene.load(path).render("truth", spp=1)
+    assert frame.white_cd_m2 == 800.0
+    out = tmp_path / "out"
+    done = seethru_cli("render", str(path), "--view", "truth", "--exr", "colour", "--spp", "1", "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    ch = exr_channels(out / "truth.exr")
+    exr = np.stack([ch["R"], ch["G"], ch["B"]], axis=-1)
+    assert np.array_equal(frame.colour * np.float32(800.0), exr)
+    assert seethru.Scene.load(SCENE).render("truth", width=16, spp=1).white_cd_m2 is None

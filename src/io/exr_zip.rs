@@ -105,6 +105,8 @@ pub enum Plane<'a> {
     U32(&'a [u32]),
     /// Component 0, 1 or 2 (x, y, z) of vectors, one per pixel, row-major; written as f32.
     Component(&'a [Vec3], usize),
+    /// [`Plane::Component`] times a factor (a colour in cd/m²: [`crate::render::frame::Frame::white_cd_m2`]).
+    ScaledComponent(&'a [Vec3], usize, f32),
     /// The same f32 at every pixel.
     Constant(f32),
     /// `base`'s samples but inside `rect` (pixels of an image `width` wide), where they are
@@ -167,6 +169,9 @@ impl Plane<'_> {
             Plane::U32(v) => out.extend(v[range].iter().flat_map(|s| s.to_le_bytes())),
             Plane::Component(v, axis) => {
                 out.extend(v[range].iter().flat_map(|s| s[axis].to_le_bytes()))
+            }
+            Plane::ScaledComponent(v, axis, k) => {
+                out.extend(v[range].iter().flat_map(|s| (s[axis] * k).to_le_bytes()))
             }
             Plane::Constant(c) => {
                 let bytes = c.to_le_bytes();
@@ -231,7 +236,7 @@ impl Plane<'_> {
         match self {
             Plane::F32(v) => Some(v.len()),
             Plane::U32(v) => Some(v.len()),
-            Plane::Component(v, _) => Some(v.len()),
+            Plane::Component(v, _) | Plane::ScaledComponent(v, _, _) => Some(v.len()),
             Plane::Constant(_) => None,
             Plane::Over { base, .. } => base.len(),
         }
@@ -248,7 +253,16 @@ pub fn write_planes(
     planes: &[(&str, Plane<'_>)],
     write: impl std::io::Write + std::io::Seek,
 ) -> exr::error::Result<()> {
-    write_planes_like(width, height, planes, None, false, write).map(|_| ())
+    write_planes_like(
+        width,
+        height,
+        planes,
+        None,
+        false,
+        LayerAttributes::default(),
+        write,
+    )
+    .map(|_| ())
 }
 
 /// The compressed blocks of a file [`write_planes_like`] wrote, with the planes they came
@@ -272,6 +286,7 @@ pub fn write_planes_like<'a>(
     planes: &[(&str, Plane<'a>)],
     like: Option<&Zipped>,
     keep: bool,
+    attributes: LayerAttributes,
     write: impl std::io::Write + std::io::Seek,
 ) -> exr::error::Result<Option<Zipped<'a>>> {
     let pixels = width * height;
@@ -294,7 +309,7 @@ pub fn write_planes_like<'a>(
         .collect();
     let layer = Layer::new(
         (width, height),
-        LayerAttributes::default(),
+        attributes,
         ENCODING,
         AnyChannels::sort(channels),
     );
@@ -542,7 +557,15 @@ mod tests {
             like: Option<&Zipped>,
         ) -> (Vec<u8>, Zipped<'a>) {
             let mut file = std::io::Cursor::new(Vec::new());
-            let zipped = write_planes_like(size.0, size.1, planes, like, true, &mut file);
+            let zipped = write_planes_like(
+                size.0,
+                size.1,
+                planes,
+                like,
+                true,
+                LayerAttributes::default(),
+                &mut file,
+            );
             (file.into_inner(), zipped.unwrap().unwrap())
         }
         let size = (width, height);
@@ -564,7 +587,15 @@ mod tests {
         assert!(other.blocks.iter().all(|b| b != &[0xee; 3]));
         let (mut narrow, mut file) = (zipped_a, std::io::Cursor::new(Vec::new()));
         narrow.width = width - 1;
-        let zipped = write_planes_like(width, height, &pb, Some(&narrow), true, &mut file);
+        let zipped = write_planes_like(
+            width,
+            height,
+            &pb,
+            Some(&narrow),
+            true,
+            LayerAttributes::default(),
+            &mut file,
+        );
         assert!(
             zipped
                 .unwrap()
@@ -637,7 +668,15 @@ mod tests {
         base_planes.extend((0..3).map(|k| (names[k], base_n[k])));
         let write = |planes: &[(&str, Plane)], like: Option<&Zipped>| {
             let mut file = std::io::Cursor::new(Vec::new());
-            let zipped = write_planes_like(width, height, planes, like, true, &mut file);
+            let zipped = write_planes_like(
+                width,
+                height,
+                planes,
+                like,
+                true,
+                LayerAttributes::default(),
+                &mut file,
+            );
             (file.into_inner(), zipped.unwrap().unwrap().blocks)
         };
         let mut like = write_planes_like(
@@ -646,6 +685,7 @@ mod tests {
             &base_planes,
             None,
             true,
+            LayerAttributes::default(),
             std::io::Cursor::new(Vec::new()),
         )
         .unwrap()

@@ -143,17 +143,29 @@ pub fn write_view_exr(frame: &Frame, path: &Path, content: ExrContent) -> Result
 }
 
 /// The channels of `content` of `frame` as the file's planes ([`exr_zip::Plane`]).
-fn view_planes(frame: &Frame, content: ExrContent) -> Vec<(&'static str, exr_zip::Plane<'_>)> {
+fn view_planes<'a>(
+    frame: &'a Frame,
+    content: ExrContent,
+) -> Vec<(&'static str, exr_zip::Plane<'a>)> {
     use exr_zip::Plane;
     fn vec<'a>(names: [&'static str; 3], values: &'a [Vec3]) -> [(&'static str, Plane<'a>); 3] {
         [0, 1, 2].map(|i| (names[i], Plane::Component(values, i)))
     }
     let [r, g, b, a] = channel::RGBA;
+    // The colour in cd/m² where the frame's light is in physical units.
+    let colour = |values: &'a [Vec3]| -> [(&'static str, Plane<'a>); 3] {
+        match frame.white_cd_m2 {
+            Some(white) => {
+                [0, 1, 2].map(|i| ([r, g, b][i], Plane::ScaledComponent(values, i, white)))
+            }
+            None => vec([r, g, b], values),
+        }
+    };
     let mut planes: Vec<(&str, Plane)> = match content {
         ExrContent::None => return Vec::new(),
-        ExrContent::Lean => vec([r, g, b], &frame.color).into(),
+        ExrContent::Lean => colour(&frame.color).into(),
         ExrContent::Colour | ExrContent::All => {
-            let mut planes: Vec<_> = vec([r, g, b], &frame.color).into();
+            let mut planes: Vec<_> = colour(&frame.color).into();
             planes.push((a, Plane::Constant(1.0)));
             planes
         }
@@ -205,7 +217,8 @@ pub fn write_view_exr_like<'a>(
         })
         .collect();
     let size = (over.base().width, over.base().height);
-    write_exr_planes(size, &planes, path, like, false).map(|_| ())
+    let attributes = layer_attributes(over.base().white_cd_m2);
+    write_exr_planes(size, &planes, attributes, path, like, false).map(|_| ())
 }
 
 /// [`write_view_exr`], returning the file's blocks for the next file ([`write_view_exr_like`];
@@ -227,7 +240,15 @@ fn write_planes<'a>(
     keep: bool,
 ) -> Result<Option<exr_zip::Zipped<'a>>> {
     let planes = view_planes(frame, content);
-    write_exr_planes((frame.width, frame.height), &planes, path, like, keep)
+    let attributes = layer_attributes(frame.white_cd_m2);
+    write_exr_planes(
+        (frame.width, frame.height),
+        &planes,
+        attributes,
+        path,
+        like,
+        keep,
+    )
 }
 
 /// `planes` of a frame of `size` (width, height) pixels into `path` (nothing without planes:
@@ -235,6 +256,7 @@ fn write_planes<'a>(
 fn write_exr_planes<'a>(
     (width, height): (u32, u32),
     planes: &[(&str, exr_zip::Plane<'a>)],
+    attributes: LayerAttributes,
     path: &Path,
     like: Option<&exr_zip::Zipped>,
     keep: bool,
@@ -245,7 +267,7 @@ fn write_exr_planes<'a>(
     let (width, height) = (width as usize, height as usize);
     let mut zipped = None;
     write_atomically(path, |file| {
-        zipped = exr_zip::write_planes_like(width, height, planes, like, keep, file)?;
+        zipped = exr_zip::write_planes_like(width, height, planes, like, keep, attributes, file)?;
         Ok(())
     })?;
     Ok(zipped)
@@ -257,11 +279,7 @@ fn write_exr_planes<'a>(
 pub fn write_view_exr_copied(frame: &Frame, path: &Path, content: ExrContent) -> Result<()> {
     let mut channels = match content {
         ExrContent::None => return Ok(()),
-        ExrContent::Lean => vec_channels(
-            [channel::RGBA[0], channel::RGBA[1], channel::RGBA[2]],
-            &frame.color,
-        )
-        .into(),
+        ExrContent::Lean => colour_channels(frame)[..3].to_vec(),
         ExrContent::Colour | ExrContent::All => colour_channels(frame),
     };
     if matches!(content, ExrContent::Lean | ExrContent::All) {
@@ -286,14 +304,22 @@ pub fn write_view_exr_copied(frame: &Frame, path: &Path, content: ExrContent) ->
         ));
         channels.extend(vec_channels(channel::P, &frame.position));
     }
-    write_exr_channels(path, frame.width, frame.height, channels)
+    let attributes = layer_attributes(frame.white_cd_m2);
+    write_exr_channels_with(path, frame.width, frame.height, channels, attributes)
 }
 
-/// The colour (`R`, `G`, `B`, linear f32) and an opaque `A`.
+/// The colour (`R`, `G`, `B`, linear f32; cd/m² where the frame's light is in physical
+/// units) and an opaque `A`.
 fn colour_channels(frame: &Frame) -> Vec<AnyChannel<FlatSamples>> {
     let [r, g, b, a] = channel::RGBA;
     let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
-    channels.extend(vec_channels([r, g, b], &frame.color));
+    match frame.white_cd_m2 {
+        Some(white) => {
+            let scaled: Vec<Vec3> = frame.color.iter().map(|c| *c * white).collect();
+            channels.extend(vec_channels([r, g, b], &scaled));
+        }
+        None => channels.extend(vec_channels([r, g, b], &frame.color)),
+    }
     channels.push(AnyChannel::new(
         a,
         FlatSamples::F32(vec![1.0; frame.color.len()]),
@@ -320,9 +346,39 @@ pub fn write_exr_channels(
     height: u32,
     channels: Vec<AnyChannel<FlatSamples>>,
 ) -> Result<()> {
+    write_exr_channels_with(path, width, height, channels, LayerAttributes::default())
+}
+
+/// The name of the header attribute (f32) that gives a photometric frame's white in cd/m²
+/// ([`Frame::white_cd_m2`]): what reading the file back divides its colour by.
+pub const WHITE_ATTRIBUTE: &str = "seethru_white_cd_m2";
+
+/// The header of a frame's EXR: where its colour is in cd/m² (a photometric frame, `white`
+/// its white), OpenEXR's `whiteLuminance` 1 (the luminance of RGB (1, 1, 1) is 1 cd/m²)
+/// and the white in [`WHITE_ATTRIBUTE`].
+pub fn layer_attributes(white_cd_m2: Option<f32>) -> LayerAttributes {
+    let mut attributes = LayerAttributes::default();
+    if let Some(white) = white_cd_m2 {
+        attributes.white_luminance = Some(1.0);
+        attributes.other.insert(
+            Text::from(WHITE_ATTRIBUTE),
+            exr::meta::attribute::AttributeValue::F32(white),
+        );
+    }
+    attributes
+}
+
+/// [`write_exr_channels`] with the header's `attributes`.
+pub fn write_exr_channels_with(
+    path: &Path,
+    width: u32,
+    height: u32,
+    channels: Vec<AnyChannel<FlatSamples>>,
+    attributes: LayerAttributes,
+) -> Result<()> {
     let layer = Layer::new(
         (width as usize, height as usize),
-        LayerAttributes::default(),
+        attributes,
         exr_zip::ENCODING,
         AnyChannels::sort(SmallVec::from_vec(channels)),
     );
@@ -464,10 +520,26 @@ pub fn read_exr_from<R: std::io::Read + std::io::Seek + Send>(
             .collect())
     };
     let [r, g, b, _] = channel::RGBA;
+    // A photometric frame's colour is in cd/m² in the file, in units of its white in memory.
+    let white_cd_m2 = match image
+        .layer_data
+        .attributes
+        .other
+        .get(&Text::from(WHITE_ATTRIBUTE))
+    {
+        None => None,
+        Some(exr::meta::attribute::AttributeValue::F32(w)) if w.is_finite() && *w > 0.0 => Some(*w),
+        Some(other) => bail!("attribute `{WHITE_ATTRIBUTE}` is {other:?}, expected a positive f32"),
+    };
+    let mut color = vec3s([r, g, b])?;
+    if let Some(white) = white_cd_m2 {
+        color.iter_mut().for_each(|c| *c /= white);
+    }
     let frame = Frame {
         width,
         height,
-        color: vec3s([r, g, b])?,
+        color,
+        white_cd_m2,
         depth: f32s(channel::Z)?,
         camera_z: f32s(channel::CAMERA_Z)?,
         position: vec3s(channel::P)?,

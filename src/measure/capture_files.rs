@@ -14,7 +14,10 @@ use crate::io::capture_folder::{
     CaptureSpec, MANIFEST_FILE, SPEC_FILE, read_capture_record, spec_json, spec_path,
 };
 use crate::io::display_map::write_npy_f32;
-use crate::io::frame_files::{ExrContent, write_color_png, write_exr_channels, write_view_exr};
+use crate::io::frame_files::{
+    ExrContent, layer_attributes, write_color_png, write_exr_channels, write_exr_channels_with,
+    write_view_exr,
+};
 use crate::render::frame::Frame;
 use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
@@ -106,19 +109,22 @@ pub fn axial_depth(inverse: f32) -> f32 {
     }
 }
 
-/// Only the colour of a frame (the rest of its AOVs is the renderer's truth).
+/// Only the colour of a frame (the rest of its AOVs is the renderer's truth), in cd/m² where
+/// its light is in physical units.
 fn write_colour_exr(frame: &Frame, path: &Path) -> Result<()> {
+    let scale = frame.white_cd_m2.unwrap_or(1.0);
     let channels = ["R", "G", "B"]
         .iter()
         .enumerate()
         .map(|(k, name)| {
             AnyChannel::new(
                 *name,
-                FlatSamples::F32(frame.color.iter().map(|c| c[k]).collect()),
+                FlatSamples::F32(frame.color.iter().map(|c| c[k] * scale).collect()),
             )
         })
         .collect();
-    write_exr_channels(path, frame.width, frame.height, channels)
+    let attributes = layer_attributes(frame.white_cd_m2);
+    write_exr_channels_with(path, frame.width, frame.height, channels, attributes)
 }
 
 /// The capture's files into `out` (a staging folder): inputs at the top, the truth apart,

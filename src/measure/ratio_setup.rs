@@ -350,6 +350,7 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
             cloud_cover: 0.0,
             ..Sky::default()
         },
+        photometry: None,
         materials,
         objects,
         obstacle,

@@ -11,6 +11,10 @@ pub struct Frame {
     pub height: u32,
     /// Radiance, linear RGB (scene-referred; 1.0 is display white).
     pub color: Vec<Vec3>,
+    /// The luminance of a `color` of 1.0 in a scene lit in physical units, cd/m² (the
+    /// scene's [`crate::scene::Photometry::white_cd_m2`]; its EXRs hold `color` × this);
+    /// `None` in a scene lit in relative units.
+    pub white_cd_m2: Option<f32>,
     /// Distance from the camera centre along the pixel-centre ray, metres; +∞ for sky.
     pub depth: Vec<f32>,
     /// Depth along the camera's viewing axis (−z in camera space), metres; +∞ for sky.
@@ -109,6 +113,7 @@ impl Frame {
             width,
             height,
             color: vec![p.color; n],
+            white_cd_m2: None,
             depth: vec![p.depth; n],
             camera_z: vec![p.camera_z; n],
             position: vec![p.position; n],
@@ -167,6 +172,7 @@ impl Frame {
             width,
             height,
             color: Vec::with_capacity(n),
+            white_cd_m2: None,
             depth: Vec::with_capacity(n),
             camera_z: Vec::with_capacity(n),
             position: Vec::with_capacity(n),

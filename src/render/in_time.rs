@@ -64,6 +64,7 @@ pub fn render_in_time(
     frame: &mut Frame,
 ) -> Result<RenderStats> {
     if needs_instants(context, &job) {
+        frame.white_cd_m2 = context.white_cd_m2();
         render_by_instant(context_at, t, job, frame)
     } else {
         Ok(context.render_into(job, frame))

@@ -102,7 +102,7 @@ impl RenderContext {
                 let accel = Accel::build(&world)?;
                 Ok((world, accel))
             },
-            || SkyModel::new(&scene.sky, &scene.sun),
+            || SkyModel::new(&scene.sky, &scene.sun, scene.photometry.as_ref()),
         );
         let (world, accel) = built?;
         Ok(Self {
@@ -117,10 +117,16 @@ impl RenderContext {
     /// A context for `scene`, reusing this one's world and hierarchy when `scene` differs
     /// from this context's only in its cameras, and its sky when sky and sun are the same.
     pub fn with_scene(&self, scene: Scene) -> Result<Self> {
-        let sky = if (&scene.sky, &scene.sun) == (&self.scene.sky, &self.scene.sun) {
+        let sky = if (&scene.sky, &scene.sun, &scene.photometry)
+            == (&self.scene.sky, &self.scene.sun, &self.scene.photometry)
+        {
             self.sky.clone()
         } else {
-            Arc::new(SkyModel::new(&scene.sky, &scene.sun))
+            Arc::new(SkyModel::new(
+                &scene.sky,
+                &scene.sun,
+                scene.photometry.as_ref(),
+            ))
         };
         let (world, accel) = if same_geometry(&scene, &self.scene) {
             (self.world.clone(), self.accel.clone())

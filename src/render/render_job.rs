@@ -171,11 +171,17 @@ impl RenderContext {
         (frame, stats)
     }
 
+    /// What a frame's 1.0 is in cd/m² in a scene lit in physical units ([`Frame::white_cd_m2`]).
+    pub fn white_cd_m2(&self) -> Option<f32> {
+        (self.scene.photometry.as_ref()).map(|p| p.white_cd_m2 as f32)
+    }
+
     /// Renders `job` into `frame`, a frame of the camera's size, so that a sequence of renders
     /// reuses its buffers: the pixels outside the job's region keep what they held.
     pub fn render_into(&self, job: RenderJob, frame: &mut Frame) -> RenderStats {
         let camera = job.camera;
         assert_eq!((frame.width, frame.height), (camera.width, camera.height));
+        frame.white_cd_m2 = self.white_cd_m2();
         let region = job.region.unwrap_or_else(|| PixelRect::full(camera));
         self.render_bands(&job, region, frame.bands_mut(BAND_ROWS))
     }
@@ -195,6 +201,7 @@ impl RenderContext {
         assert!(job.region.is_none(), "render_over chooses its own region");
         let region = self.difference_region(camera, base_view, job.view);
         let mut patch = Frame::new(region.x1 - region.x0, region.y1 - region.y0);
+        patch.white_cd_m2 = self.white_cd_m2();
         let bands = patch.bands_mut_at(BAND_ROWS, region.x0, region.y0);
         let stats = self.render_bands(&job, region, bands);
         (FrameOver::new(Arc::clone(base), region, patch), stats)

@@ -14,6 +14,7 @@ pub mod grow;
 pub mod head_model;
 pub mod head_path;
 pub mod lens_keys;
+pub mod light_keys;
 pub mod limits;
 pub mod mesh_checks;
 pub mod mesh_io;
@@ -150,6 +151,54 @@ pub struct Sun {
     pub intensity: f64,
 }
 
+/// A scene's light in physical units (`[sun] illuminance_lux`, `[sky]
+/// zenith_luminance_cd_m2`, `[photometry]`). Its renders count radiance in units of
+/// `white_cd_m2` (a frame's linear 1.0, the PNGs' white); its EXRs hold cd/m².
+#[derive(Clone, Debug, PartialEq)]
+pub struct Photometry {
+    /// Illuminance of the sun on a surface facing it, lux, in [0, 150 000].
+    pub sun_illuminance_lux: f64,
+    /// Luminance of the sky at the zenith, cd/m², in [0, 100 000]: the sky's colours (its
+    /// gradient and clouds) are scaled so that the zenith colour has it.
+    pub sky_zenith_cd_m2: f64,
+    /// The luminance shown as white, cd/m², in [1e-6, 1e10]: a frame's linear 1.0. Default:
+    /// [`Photometry::lit_white_cd_m2`].
+    pub white_cd_m2: f64,
+}
+
+impl Photometry {
+    /// cd/m² per unit of the sky's linear colours (the zenith's then has `sky_zenith_cd_m2`).
+    pub fn sky_cd_m2_per_unit(&self, sky: &Sky) -> f64 {
+        let zenith = crate::util::color::srgb_to_linear3(sky.zenith_color);
+        match self.sky_zenith_cd_m2 {
+            0.0 => 0.0,
+            l => l / f64::from(light_keys::luminance(zenith)),
+        }
+    }
+
+    /// cd/m² per unit of the sun's linear colour: its luminance is then `illuminance_lux`.
+    pub fn sun_lux_per_unit(&self, sun: &Sun) -> f64 {
+        let colour = crate::util::color::srgb_to_linear3(sun.color);
+        match self.sun_illuminance_lux {
+            0.0 => 0.0,
+            lux => lux / f64::from(light_keys::luminance(colour)),
+        }
+    }
+
+    /// The luminance of a white Lambertian floor under the sun and the cloudless sky, cd/m²:
+    /// (E_sun · sin⁺(elevation) + E_sky) / π, E_sky = π × the sky's cosine-weighted mean
+    /// luminance ([`Sky::cosine_mean`]).
+    pub fn lit_white_cd_m2(&self, sun: &Sun, sky: &Sky) -> f64 {
+        let sun_part = self.sun_illuminance_lux * sun.direction.y.max(0.0) / std::f64::consts::PI;
+        let [zenith, horizon] = [sky.zenith_color, sky.horizon_color].map(|c| {
+            f64::from(light_keys::luminance(crate::util::color::srgb_to_linear3(
+                c,
+            )))
+        });
+        sun_part + self.sky_cd_m2_per_unit(sky) * Sky::cosine_mean(horizon, zenith)
+    }
+}
+
 /// The sky: a gradient with procedural clouds; also the ambient light.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sky {
@@ -246,6 +295,9 @@ pub struct Scene {
     pub source_hash: String,
     pub sun: Sun,
     pub sky: Sky,
+    /// The light in physical units: `Some` once `[sun] illuminance_lux` is given; `None`
+    /// for a scene lit in relative units (`[sun] intensity`, `[sky] ambient`).
+    pub photometry: Option<Photometry>,
     pub materials: Vec<Material>,
     pub objects: Vec<Object>,
     pub obstacle: Obstacle,
@@ -315,6 +367,15 @@ impl Default for Sun {
             color: [1.0, 0.96, 0.9],
             intensity: 2.6,
         }
+    }
+}
+
+impl Sky {
+    /// The cosine-weighted mean over the upper hemisphere of the gradient from `horizon` to
+    /// `zenith` (radiance h + (z − h)·√y at elevation sine y): 0.2 h + 0.8 z, so that a floor
+    /// under it receives π × that (2π ∫₀¹ L(y) y dy).
+    pub fn cosine_mean(horizon: f64, zenith: f64) -> f64 {
+        0.2 * horizon + 0.8 * zenith
     }
 }
 

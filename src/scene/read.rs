@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use glam::{DAffine3, DMat3, DQuat, DVec3, EulerRot};
 
 use crate::geometry::camera::{Camera, world_from_camera_rotation};
+use crate::scene::light_keys::{read_photometry, read_sky, read_sun};
 use crate::scene::limits::{
     MAX_DISPLAY_SIZE, MAX_LENGTH, MAX_MATERIALS, MAX_MOUNT_OFFSET, MAX_OBJECTS, MAX_ROTATION_DEG,
     MAX_TRIANGLES, MAX_UV_REPEAT, MIN_LENGTH, out_of_world,
@@ -14,7 +15,7 @@ use crate::scene::limits::{
 use crate::scene::motion::read_object_motion;
 use crate::scene::source::{SceneError, SourceFile};
 use crate::scene::table_reader::TableReader;
-use crate::scene::{CameraKind, DriverFace, Material, Object, Obstacle, Scene, Shape, Sky, Sun};
+use crate::scene::{CameraKind, DriverFace, Material, Object, Obstacle, Scene, Shape};
 
 const OBJECT_KINDS: [&str; 7] = ["plane", "box", "sphere", "cylinder", "cone", "quad", "mesh"];
 
@@ -37,8 +38,9 @@ impl Scene {
     pub fn from_source(file: &SourceFile) -> Result<Scene, SceneError> {
         let doc = file.parse()?;
         let root = TableReader::root(file, &doc);
-        let sun = read_sun(&root)?;
-        let sky = read_sky(&root)?;
+        let (sun, sun_lux) = read_sun(&root)?;
+        let (sky, zenith_cd_m2) = read_sky(&root, sun_lux)?;
+        let photometry = read_photometry(&root, &sun, &sky, sun_lux, zenith_cd_m2)?;
         let materials = read_materials(&root, file)?;
         let mut objects = read_objects(&root, &materials, file)?;
         let obstacle_table = root
@@ -67,6 +69,7 @@ impl Scene {
             source_hash: file.content_hash(),
             sun,
             sky,
+            photometry,
             materials,
             objects,
             obstacle,
@@ -103,39 +106,6 @@ fn bounded_tables<'a>(
         )));
     }
     Ok(tables)
-}
-
-fn read_sun(root: &TableReader) -> Result<Sun, SceneError> {
-    let d = Sun::default();
-    let Some(t) = root.table("sun")? else {
-        return Ok(d);
-    };
-    let sun = Sun {
-        direction: t.direction("direction", d.direction.to_array())?,
-        color: t.color("color", d.color)?,
-        intensity: t.f64_in("intensity", d.intensity, 0.0, 1000.0)?,
-    };
-    t.finish()?;
-    Ok(sun)
-}
-
-fn read_sky(root: &TableReader) -> Result<Sky, SceneError> {
-    let d = Sky::default();
-    let Some(t) = root.table("sky")? else {
-        return Ok(d);
-    };
-    let sky = Sky {
-        zenith_color: t.color("zenith_color", d.zenith_color)?,
-        horizon_color: t.color("horizon_color", d.horizon_color)?,
-        ground_color: t.color("ground_color", d.ground_color)?,
-        ambient: t.f64_in("ambient", d.ambient, 0.0, 1000.0)?,
-        cloud_cover: t.f64_in("cloud_cover", d.cloud_cover, 0.0, 1.0)?,
-        cloud_height: length(&t, "cloud_height", d.cloud_height, MAX_LENGTH)?,
-        cloud_size: length(&t, "cloud_size", d.cloud_size, MAX_LENGTH)?,
-        cloud_seed: t.usize_in("cloud_seed", d.cloud_seed as usize, 0, u32::MAX as usize)? as u32,
-    };
-    t.finish()?;
-    Ok(sky)
 }
 
 fn read_materials(root: &TableReader, file: &SourceFile) -> Result<Vec<Material>, SceneError> {

@@ -53,6 +53,7 @@ fn resample_with(
     // Bands of rows in parallel, each pixel on its own: the same image for any number of
     // threads, written in place.
     let mut frame = Frame::new(w, h);
+    frame.white_cd_m2 = frontal.white_cd_m2;
     frame.bands_mut(8).into_par_iter().for_each(|mut band| {
         for row in 0..band.len() {
             let y = band.y + row;

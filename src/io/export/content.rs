@@ -236,7 +236,7 @@ impl<'a> ExportScene<'a> {
             }
         }
 
-        let sky = SkyModel::new(&scene.sky, &scene.sun);
+        let sky = SkyModel::new(&scene.sky, &scene.sun, scene.photometry.as_ref());
         let lighting = Lighting {
             sun_direction: sky.sun_direction,
             sun_irradiance: sky.sun_irradiance * std::f32::consts::PI,

@@ -215,7 +215,11 @@ impl SystemLoop {
         let rig_back = rig.base.back;
         Ok(SystemLoop {
             predictor: Predictor::new(options.predict, sigma),
-            sky: Arc::new(SkyModel::new(&scene.sky, &scene.sun)),
+            sky: Arc::new(SkyModel::new(
+                &scene.sky,
+                &scene.sun,
+                scene.photometry.as_ref(),
+            )),
             world: Arc::new(world),
             accel: Arc::new(accel),
             parts,

@@ -1,0 +1,185 @@
+//! `[sun]`, `[sky]` and `[photometry]`: the scene's light, in relative units (a multiplier
+//! of the sun, one of the sky's ambient light) or, once `[sun] illuminance_lux` is given, in
+//! physical ones (lux and cd/m²: [`Photometry`]).
+
+use glam::DVec3;
+
+use crate::scene::limits::{MAX_LENGTH, MIN_LENGTH};
+use crate::scene::source::SceneError;
+use crate::scene::table_reader::TableReader;
+use crate::scene::{Photometry, Sky, Sun};
+use crate::util::color::srgb_to_linear3;
+
+/// Brightest sunlight at sea level (a clear zenith sun gives about 100–130 klx), lux.
+pub const MAX_SUN_LUX: f64 = 150_000.0;
+/// Brightest sky (a bright overcast or hazy sky near the sun reaches some 10⁴), cd/m².
+pub const MAX_SKY_CD_M2: f64 = 100_000.0;
+/// The range of the luminance shown as white: from below starlight to above the sun's disc.
+pub const WHITE_CD_M2_RANGE: (f64, f64) = (1e-6, 1e10);
+
+/// The luminance Y of linear Rec. 709 / sRGB primaries (ITU-R BT.709): what "cd/m²" means of
+/// an RGB radiance.
+pub fn luminance(rgb: glam::Vec3) -> f32 {
+    0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z
+}
+
+/// The unit direction towards a sun at `elevation_deg` above the horizon and `azimuth_deg`
+/// clockwise from north seen from above, in the world frame: y up, north −z, east +x (the
+/// axes OpenDRIVE's x east, y north map onto).
+pub fn sun_direction(elevation_deg: f64, azimuth_deg: f64) -> DVec3 {
+    let (el, az) = (elevation_deg.to_radians(), azimuth_deg.to_radians());
+    DVec3::new(az.sin() * el.cos(), el.sin(), -az.cos() * el.cos())
+}
+
+/// `[sun]`, with its illuminance in lux when the scene states it.
+pub fn read_sun(root: &TableReader) -> Result<(Sun, Option<f64>), SceneError> {
+    let d = Sun::default();
+    let Some(t) = root.table("sun")? else {
+        return Ok((d, None));
+    };
+    let lux = match t.has("illuminance_lux") {
+        true => Some(t.f64_in("illuminance_lux", 0.0, 0.0, MAX_SUN_LUX)?),
+        false => None,
+    };
+    if lux.is_some() && t.has("intensity") {
+        return Err(t.error(
+            "intensity",
+            "is a relative multiplier: a scene with `illuminance_lux` states its sun in lux; \
+             remove one of the two",
+        ));
+    }
+    let angles = ["elevation_deg", "azimuth_deg"];
+    let direction = if angles.iter().any(|k| t.has(k)) {
+        if t.has("direction") {
+            return Err(t.error(
+                "direction",
+                "give either `direction` or `elevation_deg` and `azimuth_deg`, not both",
+            ));
+        }
+        if let Some(missing) = angles.iter().find(|k| !t.has(k)) {
+            return Err(t.error(
+                missing,
+                "is required with the other angle (degrees: elevation in [-90, 90], azimuth \
+                 in [0, 360] clockwise from north, −z)",
+            ));
+        }
+        let elevation = t.f64_in("elevation_deg", 0.0, -90.0, 90.0)?;
+        let azimuth = t.f64_in("azimuth_deg", 0.0, 0.0, 360.0)?;
+        sun_direction(elevation, azimuth)
+    } else {
+        t.direction("direction", d.direction.to_array())?
+    };
+    let sun = Sun {
+        direction,
+        color: t.color("color", d.color)?,
+        intensity: t.f64_in("intensity", d.intensity, 0.0, 1000.0)?,
+    };
+    if lux.is_some_and(|lux| lux > 0.0) && srgb_to_linear3(sun.color).max_element() == 0.0 {
+        return Err(t.error("color", "is black: a sun with illuminance needs a colour"));
+    }
+    t.finish()?;
+    Ok((sun, lux))
+}
+
+/// `[sky]`, with its zenith luminance in cd/m² in a scene whose sun is in lux (`sun_lux`).
+pub fn read_sky(root: &TableReader, sun_lux: Option<f64>) -> Result<(Sky, f64), SceneError> {
+    let d = Sky::default();
+    let Some(t) = root.table("sky")? else {
+        return Ok((d, 0.0));
+    };
+    let zenith_key = "zenith_luminance_cd_m2";
+    let zenith = match (sun_lux, t.has(zenith_key)) {
+        (None, true) => {
+            return Err(t.error(
+                zenith_key,
+                "needs a sun in lux: add `illuminance_lux` to [sun]",
+            ));
+        }
+        (Some(_), true) => t.f64_in(zenith_key, 0.0, 0.0, MAX_SKY_CD_M2)?,
+        _ => 0.0,
+    };
+    if sun_lux.is_some() && t.has("ambient") {
+        return Err(t.error(
+            "ambient",
+            "is a relative multiplier: a scene with a sun in lux lights its surfaces with the \
+             sky's luminance (`zenith_luminance_cd_m2`); remove `ambient`",
+        ));
+    }
+    let sky = Sky {
+        zenith_color: t.color("zenith_color", d.zenith_color)?,
+        horizon_color: t.color("horizon_color", d.horizon_color)?,
+        ground_color: t.color("ground_color", d.ground_color)?,
+        ambient: t.f64_in("ambient", d.ambient, 0.0, 1000.0)?,
+        cloud_cover: t.f64_in("cloud_cover", d.cloud_cover, 0.0, 1.0)?,
+        cloud_height: t.f64_in("cloud_height", d.cloud_height, MIN_LENGTH, MAX_LENGTH)?,
+        cloud_size: t.f64_in("cloud_size", d.cloud_size, MIN_LENGTH, MAX_LENGTH)?,
+        cloud_seed: t.usize_in("cloud_seed", d.cloud_seed as usize, 0, u32::MAX as usize)? as u32,
+    };
+    if zenith > 0.0 && srgb_to_linear3(sky.zenith_color).max_element() == 0.0 {
+        return Err(t.error(
+            "zenith_color",
+            format!("is black: it cannot have the luminance {zenith} cd/m² ({zenith_key})"),
+        ));
+    }
+    t.finish()?;
+    Ok((sky, zenith))
+}
+
+/// `[photometry]` of a scene whose sun is in lux; refused in any other scene.
+pub fn read_photometry(
+    root: &TableReader,
+    sun: &Sun,
+    sky: &Sky,
+    sun_lux: Option<f64>,
+    zenith_cd_m2: f64,
+) -> Result<Option<Photometry>, SceneError> {
+    let table = root.table("photometry")?;
+    let Some(sun_lux) = sun_lux else {
+        if table.is_some() {
+            return Err(root.error(
+                "photometry",
+                "needs a sun in lux: add `illuminance_lux` to [sun]",
+            ));
+        }
+        return Ok(None);
+    };
+    let mut photometry = Photometry {
+        sun_illuminance_lux: sun_lux,
+        sky_zenith_cd_m2: zenith_cd_m2,
+        white_cd_m2: 0.0,
+    };
+    let lit_white = photometry.lit_white_cd_m2(sun, sky);
+    let (min, max) = WHITE_CD_M2_RANGE;
+    photometry.white_cd_m2 = match table {
+        Some(t) => {
+            let white = match t.has("white_cd_m2") {
+                true => t.f64_in("white_cd_m2", 0.0, min, max)?,
+                false => lit_white,
+            };
+            if white < min {
+                return Err(t.error(
+                    "white_cd_m2",
+                    format!(
+                        "is required where the sun and the sky give no light to a white \
+                         surface (it would be {lit_white} cd/m²): give the luminance the \
+                         images show as white, in [{min}, {max}]"
+                    ),
+                ));
+            }
+            t.finish()?;
+            white
+        }
+        None if lit_white >= min => lit_white,
+        None => {
+            return Err(root.error(
+                "photometry",
+                format!(
+                    "a [photometry] table with `white_cd_m2` is required where the sun and the \
+                     sky give no light to a white surface (it would be {lit_white} cd/m²): \
+                     give the luminance the images show as white, in [{min}, {max}]"
+                ),
+            ));
+        }
+    };
+    Ok(Some(photometry))
+}

@@ -1,0 +1,346 @@
+//! Light in physical units against analytic answers: a Lambertian floor of albedo ρ under a sun
+//! of illuminance E has the luminance ρE/π (and ρ(E sin h/π + L) under a uniform sky of
+//! luminance L), which the EXRs hold in cd/m²; the sun's angles; the keys' errors.
+
+mod common;
+
+use std::path::Path;
+
+use common::{parse, seethru};
+use exr::prelude::{FlatSamples, read_all_flat_layers_from_file};
+use seethru::scene::light_keys::sun_direction;
+use seethru::util::color::srgb_to_linear;
+
+/// A grey floor (sRGB `grey`) filmed from 1.2 m, looking away from the obstacle towards +z,
+/// so that neither the obstacle nor its shadow (the sun comes from the south, +z, behind the
+/// view's far end) is in the picture; `light` holds the `[sun]`, `[sky]` and
+/// `[photometry]` tables.
+fn floor_scene(grey: f64, light: &str) -> String {
+    format!(
+        r#"{light}
+[obstacle]
+center = [0.0, 1.2, -0.8]
+width = 0.3
+height = 0.4
+
+[camera.driver]
+position = [0.0, 1.2, 0.0]
+look_at = [0.0, 0.6, 10.0]
+half_angle_deg = 30.0
+resolution = [48, 32]
+
+[camera.frontal]
+resolution = [16, 12]
+
+[camera.back]
+resolution = [16, 12]
+
+[[material]]
+name = "grey"
+color = [{grey}, {grey}, {grey}]
+
+[[object]]
+name = "floor"
+kind = "plane"
+material = "grey"
+size = [100000.0, 100000.0]
+"#
+    )
+}
+
+/// The truth view's EXR (colour), read with the exr crate alone: per pixel the luminance
+/// Y = 0.2126 R + 0.7152 G + 0.0722 B, and whether the pixel shows the floor (its ids
+/// PNG's colour is not the sky's black).
+fn rendered_luminance(dir: &Path, scene: &str) -> Vec<(f64, bool)> {
+    let file = dir.join("scene.toml");
+    std::fs::write(&file, scene).unwrap();
+    let out = dir.join("out");
+    let (ok, _, stderr) = seethru(&[
+        "render",
+        file.to_str().unwrap(),
+        "--view",
+        "truth",
+        "--exr",
+        "lean",
+        "--quiet",
+        "--spp",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let image = read_all_flat_layers_from_file(out.join("truth.exr")).unwrap();
+    let layer = &image.layer_data[0];
+    let channel = |name: &str| -> Vec<f32> {
+        let c = (layer.channel_data.list.iter())
+            .find(|c| c.name.to_string() == name)
+            .unwrap_or_else(|| panic!("no channel {name}"));
+        match &c.sample_data {
+            FlatSamples::F32(v) => v.clone(),
+            _ => panic!("{name} is not f32"),
+        }
+    };
+    let ids = match &(layer.channel_data.list.iter())
+        .find(|c| c.name.to_string() == "id.object")
+        .unwrap()
+        .sample_data
+    {
+        FlatSamples::U32(v) => v.clone(),
+        _ => panic!("id.object is not u32"),
+    };
+    let (r, g, b) = (channel("R"), channel("G"), channel("B"));
+    (0..r.len())
+        .map(|i| {
+            let y = 0.2126 * r[i] as f64 + 0.7152 * g[i] as f64 + 0.0722 * b[i] as f64;
+            (y, ids[i] != 0)
+        })
+        .collect()
+}
+
+fn relative_error(got: f64, want: f64) -> f64 {
+    (got - want).abs() / want.abs().max(f64::MIN_POSITIVE)
+}
+
+#[test]
+fn a_lambertian_floor_under_the_sun_has_the_luminance_rho_e_over_pi() {
+    let dir = tempfile::tempdir().unwrap();
+    let grey = 0.5;
+    let rho = f64::from(srgb_to_linear(grey as f32));
+    for (lux, elevation) in [(100_000.0, 90.0), (100_000.0, 60.0), (30_000.0, 25.0)] {
+        let light = format!(
+            "[sun]\nilluminance_lux = {lux}\nelevation_deg = {elevation}\nazimuth_deg = 180\n\
+             [sky]\nzenith_luminance_cd_m2 = 0\ncloud_cover = 0\n\
+             [photometry]\nwhite_cd_m2 = 5000\n"
+        );
+        let pixels = rendered_luminance(dir.path(), &floor_scene(grey, &light));
+        let expected = rho * lux * f64::to_radians(elevation).sin() / std::f64::consts::PI;
+        let floor: Vec<f64> = pixels.iter().filter(|p| p.1).map(|p| p.0).collect();
+        assert!(floor.len() > 300, "{} floor pixels", floor.len());
+        for &y in &floor {
+            assert!(
+                relative_error(y, expected) < 0.005,
+                "elevation {elevation}°: Y = {y} cd/m², ρE sin h/π = {expected}"
+            );
+        }
+        // The sky is black: no luminance where nothing is hit (the sun's disc is above the
+        // picture).
+        assert!(pixels.iter().filter(|p| !p.1).all(|p| p.0 == 0.0));
+    }
+}
+
+#[test]
+fn a_uniform_sky_adds_its_luminance_to_a_white_floor_and_shows_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let (lux, elevation, sky) = (50_000.0, 40.0, 3_000.0);
+    // A grey sky at the zenith and the horizon: uniform, so that a floor receives πL.
+    let light = format!(
+        "[sun]\nilluminance_lux = {lux}\nelevation_deg = {elevation}\nazimuth_deg = 180\n\
+         [sky]\nzenith_luminance_cd_m2 = {sky}\nzenith_color = [0.6, 0.6, 0.6]\n\
+         horizon_color = [0.6, 0.6, 0.6]\ncloud_cover = 0\n"
+    );
+    let pixels = rendered_luminance(dir.path(), &floor_scene(1.0, &light));
+    let floor = lux * f64::to_radians(elevation).sin() / std::f64::consts::PI + sky;
+    let (mut floors, mut skies) = (0, 0);
+    for (y, is_floor) in pixels {
+        let expected = if is_floor { floor } else { sky };
+        assert!(
+            relative_error(y, expected) < 0.005,
+            "floor {is_floor}: Y = {y}, expected {expected}"
+        );
+        if is_floor { floors += 1 } else { skies += 1 }
+    }
+    assert!(
+        floors > 300 && skies > 100,
+        "{floors} floor, {skies} sky pixels"
+    );
+}
+
+#[test]
+fn the_white_defaults_to_a_white_floor_under_the_light() {
+    let (lux, elevation, sky) = (80_000.0, 30.0, 2_000.0);
+    let light = format!(
+        "[sun]\nilluminance_lux = {lux}\nelevation_deg = {elevation}\nazimuth_deg = 0\n\
+         [sky]\nzenith_luminance_cd_m2 = {sky}\nzenith_color = [0.5, 0.5, 0.5]\n\
+         horizon_color = [0.5, 0.5, 0.5]\n"
+    );
+    let scene = parse(&floor_scene(0.5, &light)).unwrap();
+    let white = scene.photometry.unwrap().white_cd_m2;
+    let expected = lux * 0.5 / std::f64::consts::PI + sky;
+    assert!(
+        relative_error(white, expected) < 1e-6,
+        "{white} vs {expected}"
+    );
+}
+
+#[test]
+fn the_sun_stands_where_its_elevation_and_azimuth_say() {
+    // North is −z, east +x, up +y.
+    let close = |a: glam::DVec3, b: [f64; 3]| (a - glam::DVec3::from_array(b)).length() < 1e-12;
+    assert!(close(sun_direction(90.0, 123.0), [0.0, 1.0, 0.0]));
+    assert!(close(sun_direction(0.0, 0.0), [0.0, 0.0, -1.0]));
+    assert!(close(sun_direction(0.0, 90.0), [1.0, 0.0, 0.0]));
+    assert!(close(sun_direction(0.0, 180.0), [0.0, 0.0, 1.0]));
+    let h = 30f64.to_radians();
+    assert!(close(sun_direction(30.0, 270.0), [-h.cos(), h.sin(), 0.0]));
+    // Read from a scene, the same direction.
+    let scene = parse(&floor_scene(
+        0.5,
+        "[sun]\nelevation_deg = 30\nazimuth_deg = 270\n",
+    ))
+    .unwrap();
+    assert!(close(scene.sun.direction, [-h.cos(), h.sin(), 0.0]));
+    assert!(scene.photometry.is_none());
+}
+
+#[test]
+fn light_keys_that_contradict_each_other_are_refused_with_the_key_named() {
+    let cases: &[(&str, &str, &str)] = &[
+        (
+            "[sun]\nilluminance_lux = 1000\nintensity = 2\n",
+            "sun.intensity",
+            "relative multiplier",
+        ),
+        (
+            "[sun]\nilluminance_lux = 1000\n[sky]\nambient = 0.5\n",
+            "sky.ambient",
+            "relative multiplier",
+        ),
+        (
+            "[sky]\nzenith_luminance_cd_m2 = 100\n",
+            "sky.zenith_luminance_cd_m2",
+            "needs a sun in lux",
+        ),
+        (
+            "[photometry]\nwhite_cd_m2 = 100\n",
+            "photometry",
+            "needs a sun in lux",
+        ),
+        (
+            "[sun]\ndirection = [0, 1, 0]\nelevation_deg = 30\nazimuth_deg = 0\n",
+            "sun.direction",
+            "not both",
+        ),
+        (
+            "[sun]\nelevation_deg = 30\n",
+            "sun.azimuth_deg",
+            "is required",
+        ),
+        (
+            "[sun]\nilluminance_lux = 1000\ncolor = [0, 0, 0]\n",
+            "sun.color",
+            "black",
+        ),
+        (
+            "[sun]\nilluminance_lux = 1000\n[sky]\nzenith_luminance_cd_m2 = 10\nzenith_color = [0, 0, 0]\n",
+            "sky.zenith_color",
+            "black",
+        ),
+        (
+            "[sun]\nilluminance_lux = 0\n[sky]\nzenith_luminance_cd_m2 = 0\n",
+            "photometry",
+            "no light",
+        ),
+        (
+            "[sun]\nilluminance_lux = 0\n[photometry]\n",
+            "photometry.white_cd_m2",
+            "is required",
+        ),
+        (
+            "[sun]\nilluminance_lux = 1000\n[photometry]\nwhite_cd_m2 = 100\nblack = 1\n",
+            "photometry.black",
+            "unknown key",
+        ),
+    ];
+    for (light, key, words) in cases {
+        let e = parse(&floor_scene(0.5, light)).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("`{key}`")) && e.contains(words),
+            "{light}: {e}"
+        );
+    }
+}
+
+#[test]
+fn each_light_number_is_refused_outside_its_documented_range() {
+    // (table text with X for the value, key, low, high): the bounds are admitted, values
+    // just outside and NaN are not.
+    let cases: &[(&str, &str, f64, f64)] = &[
+        (
+            "[sun]\nilluminance_lux = X\n[photometry]\nwhite_cd_m2 = 100\n",
+            "sun.illuminance_lux",
+            0.0,
+            150_000.0,
+        ),
+        (
+            "[sun]\nilluminance_lux = 1000\n[sky]\nzenith_luminance_cd_m2 = X\n",
+            "sky.zenith_luminance_cd_m2",
+            0.0,
+            100_000.0,
+        ),
+        (
+            "[sun]\nilluminance_lux = 1000\n[photometry]\nwhite_cd_m2 = X\n",
+            "photometry.white_cd_m2",
+            1e-6,
+            1e10,
+        ),
+        (
+            "[sun]\nelevation_deg = X\nazimuth_deg = 10\n",
+            "sun.elevation_deg",
+            -90.0,
+            90.0,
+        ),
+        (
+            "[sun]\nelevation_deg = 10\nazimuth_deg = X\n",
+            "sun.azimuth_deg",
+            0.0,
+            360.0,
+        ),
+    ];
+    for &(text, key, lo, hi) in cases {
+        let with = |x: f64| {
+            let value = if x.is_nan() {
+                "nan".to_string()
+            } else {
+                format!("{x:?}")
+            };
+            parse(&floor_scene(0.5, &text.replace('X', &value)))
+        };
+        for x in [lo, hi] {
+            with(x).unwrap_or_else(|e| panic!("{key} = {x} refused: {e}"));
+        }
+        let below = lo - lo.abs().max(1e-6) * 0.5;
+        for x in [below, hi * 1.5, f64::NAN] {
+            let e = with(x)
+                .expect_err(&format!("{key} = {x} accepted"))
+                .to_string();
+            assert!(e.contains(&format!("`{key}`")), "{key} = {x}: {e}");
+        }
+    }
+}
+
+#[test]
+fn a_photometric_exr_reads_back_in_units_of_the_white() {
+    use seethru::io::frame_files::{read_exr, write_exr};
+    use seethru::render::integrator::RenderContext;
+    use seethru::render::render_job::RenderJob;
+    use seethru::scene::world::view_bit;
+    let light = "[sun]\nilluminance_lux = 20000\n[sky]\nzenith_luminance_cd_m2 = 4000\n\
+                 [photometry]\nwhite_cd_m2 = 700\n";
+    let ctx = RenderContext::new(parse(&floor_scene(0.4, light)).unwrap()).unwrap();
+    let (frame, _) = ctx.render(RenderJob::new(&ctx.scene.driver, view_bit::TRUTH).label("test"));
+    assert_eq!(frame.white_cd_m2, Some(700.0));
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("truth.exr");
+    write_exr(&frame, &path).unwrap();
+    let back = read_exr(&path).unwrap();
+    assert_eq!(back.white_cd_m2, Some(700.0));
+    for (a, b) in frame.color.iter().zip(&back.color) {
+        assert!(
+            (*a - *b).abs().max_element() <= 1e-6 * a.max_element().max(1.0),
+            "{a} {b}"
+        );
+    }
+    // The file's header says its RGB is in cd/m².
+    let meta = exr::meta::MetaData::read_from_file(&path, false).unwrap();
+    assert_eq!(meta.headers[0].own_attributes.white_luminance, Some(1.0));
+}
