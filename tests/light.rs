@@ -344,3 +344,142 @@ fn a_photometric_exr_reads_back_in_units_of_the_white() {
     let meta = exr::meta::MetaData::read_from_file(&path, false).unwrap();
     assert_eq!(meta.headers[0].own_attributes.white_luminance, Some(1.0));
 }
+
+/// A grey wall 20 m behind the display, lit by a white sun behind the driver (elevation 60°,
+/// so that the obstacle's shadow falls below the wall), no sky and a black ground: the wall's
+/// luminance is ρE cos h/π, and the display's face receives E cos h.
+fn display_scene(white: f64, display: &str) -> String {
+    format!(
+        r#"[sun]
+illuminance_lux = 50000
+color = [1.0, 1.0, 1.0]
+elevation_deg = 60
+azimuth_deg = 180
+[sky]
+zenith_luminance_cd_m2 = 0
+ground_color = [0.0, 0.0, 0.0]
+cloud_cover = 0
+[photometry]
+white_cd_m2 = {white}
+
+[obstacle]
+center = [0.0, 1.2, -0.8]
+width = 0.3
+height = 0.4
+{display}
+
+[camera.driver]
+position = [0.0, 1.2, 0.0]
+look_at = [0.0, 1.2, -10.0]
+half_angle_deg = 20.0
+resolution = [64, 36]
+
+[camera.frontal]
+resolution = [64, 36]
+
+[camera.back]
+resolution = [16, 12]
+
+[[material]]
+name = "grey"
+color = [0.6, 0.6, 0.6]
+
+[[object]]
+name = "wall"
+kind = "quad"
+material = "grey"
+size = [200.0, 200.0]
+translate = [0.0, 0.0, -20.0]
+"#
+    )
+}
+
+/// Per pixel of `run`'s seethru view where the driver sees the display (the occluded view's
+/// id is the obstacle's), the luminance there, and the truth's luminance.
+fn display_luminance(dir: &Path, scene: &str) -> Vec<(f64, f64)> {
+    let file = dir.join("scene.toml");
+    std::fs::write(&file, scene).unwrap();
+    let out = dir.join("out");
+    let _ = std::fs::remove_dir_all(&out);
+    let (ok, _, stderr) = seethru(&[
+        "run",
+        file.to_str().unwrap(),
+        "--spp",
+        "1",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let read = |view: &str| -> (Vec<f64>, Vec<u32>) {
+        let image = read_all_flat_layers_from_file(out.join(format!("{view}.exr"))).unwrap();
+        let layer = &image.layer_data[0];
+        let find = |name: &str| {
+            &(layer.channel_data.list.iter())
+                .find(|c| c.name.to_string() == name)
+                .unwrap()
+                .sample_data
+        };
+        let f32s = |name| match find(name) {
+            FlatSamples::F32(v) => v.clone(),
+            _ => panic!(),
+        };
+        let ids = match find("id.object") {
+            FlatSamples::U32(v) => v.clone(),
+            _ => panic!(),
+        };
+        let (r, g, b) = (f32s("R"), f32s("G"), f32s("B"));
+        let y = (0..r.len())
+            .map(|i| 0.2126 * r[i] as f64 + 0.7152 * g[i] as f64 + 0.0722 * b[i] as f64)
+            .collect();
+        (y, ids)
+    };
+    let ((seethru, _), (truth, _), (_, occluded_ids)) =
+        (read("seethru"), read("truth"), read("occluded"));
+    let obstacle = *occluded_ids.iter().max().unwrap();
+    (0..seethru.len())
+        .filter(|&i| occluded_ids[i] == obstacle)
+        .map(|i| (seethru[i], truth[i]))
+        .collect()
+}
+
+#[test]
+fn a_display_emits_between_its_black_and_its_peak_and_reflects_the_light_on_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let (lux, h) = (50_000.0, 60f64.to_radians());
+    let rho = f64::from(srgb_to_linear(0.6));
+    let wall = rho * lux * h.cos() / std::f64::consts::PI;
+    let face = lux * h.cos() / std::f64::consts::PI;
+    let (peak, black) = (500.0, 1.0);
+    // (white, reflectance, expected display luminance)
+    let cases = [
+        // The wall at half the white: half the display's range above its black.
+        (2.0 * wall, 0.0, black + (peak - black) * 0.5),
+        // The wall at four times the white: the display's peak.
+        (wall / 4.0, 0.0, peak),
+        // And a face that reflects 5 % of the sunlight on it.
+        (2.0 * wall, 0.05, black + (peak - black) * 0.5 + 0.05 * face),
+    ];
+    for (white, reflectance, expected) in cases {
+        let display = format!(
+            "display_peak_cd_m2 = {peak}\ndisplay_black_cd_m2 = {black}\n\
+             display_reflectance = {reflectance}\n"
+        );
+        let pixels = display_luminance(dir.path(), &display_scene(white, &display));
+        assert!(pixels.len() > 20, "{} display pixels", pixels.len());
+        for (seen, truth) in pixels {
+            assert!(
+                relative_error(truth, wall) < 0.005,
+                "truth {truth} vs {wall}"
+            );
+            assert!(
+                relative_error(seen, expected) < 0.005,
+                "white {white}, reflectance {reflectance}: {seen} vs {expected} cd/m²"
+            );
+        }
+    }
+    // Without the keys, an ideal display: the wall's luminance, whatever the white.
+    for (seen, _) in display_luminance(dir.path(), &display_scene(wall / 4.0, "")) {
+        assert!(relative_error(seen, wall) < 0.005, "{seen} vs {wall}");
+    }
+}

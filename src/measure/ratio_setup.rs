@@ -231,6 +231,7 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
         body_color: [0.2; 3],
         display_shape: crate::scene::display_surface::DisplayShape::Flat,
         scanout: crate::geometry::shutter::Scanout::default(),
+        display_light: None,
     };
     // The frontal camera (half as tall as wide) must see the direction of every model point
     // the display can ask for: the model eye's ray through a display corner, continued to the

@@ -24,9 +24,9 @@ use crate::render::screen::{Screen, Shown};
 use crate::render::shutter_rays::{CameraAt, PoseAt, ShutterRays};
 use crate::render::simd::Isa;
 use crate::render::sky::SkyModel;
-use crate::scene::Scene;
 use crate::scene::texture::Texture;
 use crate::scene::world::{SurfaceHit, SurfaceMaterial, World, view_bit};
+use crate::scene::{DisplayLight, Scene};
 use crate::util::sampling::pixel_offset;
 
 thread_local! {
@@ -163,7 +163,7 @@ impl RenderContext {
             let hit = self.trace_with(origin, dir, job.view, stack);
             let shown = match (&hit, job.display) {
                 (Some(s), Some(d)) if self.world.is_display(s.object, s.part) => {
-                    Some(self.display_content(d, s.position, stack, shadows))
+                    Some(self.display_content(d, s, job.view, stack, shadows))
                 }
                 _ => None,
             };
@@ -243,7 +243,7 @@ impl RenderContext {
                 let hit = self.lane_surface(&camera, &moving_hits, lane, dirs[lane]);
                 match (&hit, job.display) {
                     (Some(s), Some(d)) if self.world.is_display(s.object, s.part) => {
-                        shown[lane] = Some(self.display_content(d, s.position, stack, shadows));
+                        shown[lane] = Some(self.display_content(d, s, job.view, stack, shadows));
                     }
                     (Some(s), _) => {
                         let sh = self.shade_begin(s);
@@ -356,11 +356,12 @@ impl RenderContext {
     fn display_content(
         &self,
         display: &dyn Screen,
-        at: Vec3,
+        face: &SurfaceHit,
+        view: u8,
         stack: &mut Stack,
         shadows: &mut u64,
     ) -> Pixel {
-        match display.shown_at(at) {
+        let mut pixel = match display.shown_at(face.position) {
             Shown::Pixel(p) => p,
             Shown::FrontalRay(origin, dir) => {
                 match self.trace_with(origin, dir, view_bit::FRONTAL, stack) {
@@ -380,7 +381,48 @@ impl RenderContext {
                     },
                 }
             }
+        };
+        if let Some(light) = &self.scene.obstacle.display_light {
+            pixel.color = self.display_light(light, pixel.color, face, view, stack, shadows);
         }
+        pixel
+    }
+
+    /// What a display of light `light` gives off where it shows `shown` (the frontal
+    /// image's radiance) at `face`: its emission ([`DisplayLight`]) and the light its face
+    /// reflects, in the scene's units.
+    fn display_light(
+        &self,
+        light: &DisplayLight,
+        shown: Vec3,
+        face: &SurfaceHit,
+        view: u8,
+        stack: &mut Stack,
+        shadows: &mut u64,
+    ) -> Vec3 {
+        let white = self
+            .scene
+            .photometry
+            .as_ref()
+            .map_or(1.0, |p| p.white_cd_m2);
+        let black = (light.black_cd_m2 / white) as f32;
+        let range = ((light.peak_cd_m2 - light.black_cd_m2) / white) as f32;
+        let emitted = Vec3::splat(black) + shown.clamp(Vec3::ZERO, Vec3::ONE) * range;
+        if light.reflectance == 0.0 {
+            return emitted;
+        }
+        let cos = face.normal.dot(self.sky.sun_direction);
+        let mut received = self.sky.ambient(face.normal);
+        if cos > 0.0 {
+            *shadows += 1;
+            let ray = shadow_ray(face.position, face.normal, self.sky.sun_direction);
+            let blocked = self.accel.occluded_with(&ray, view, stack)
+                || (self.moving.as_ref()).is_some_and(|m| m.accel.occluded_with(&ray, view, stack));
+            if !blocked {
+                received += self.sky.sun_irradiance * cos;
+            }
+        }
+        emitted + received * light.reflectance as f32
     }
 
     /// [`RenderContext::trace`] of the rays from `origin` along each direction of `dirs` (at

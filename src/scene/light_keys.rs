@@ -7,7 +7,7 @@ use glam::DVec3;
 use crate::scene::limits::{MAX_LENGTH, MIN_LENGTH};
 use crate::scene::source::SceneError;
 use crate::scene::table_reader::TableReader;
-use crate::scene::{Photometry, Sky, Sun};
+use crate::scene::{DisplayLight, Photometry, Sky, Sun};
 use crate::util::color::srgb_to_linear3;
 
 /// Brightest sunlight at sea level (a clear zenith sun gives about 100–130 klx), lux.
@@ -182,4 +182,45 @@ pub fn read_photometry(
         }
     };
     Ok(Some(photometry))
+}
+
+/// The display's luminance range, cd/m²: automotive displays give some 500–1 500, HDR
+/// panels up to 10 000.
+pub const DISPLAY_PEAK_RANGE: (f64, f64) = (0.01, 100_000.0);
+
+/// The `[obstacle]` keys of the display as a light source, in a scene whose light is in
+/// physical units (`photometry`): refused in any other scene. `None` when none is given: an
+/// ideal display, which emits the frontal camera's radiance as it is.
+pub fn read_display_light(
+    t: &TableReader,
+    photometry: Option<&Photometry>,
+) -> Result<Option<DisplayLight>, SceneError> {
+    let keys = [
+        "display_peak_cd_m2",
+        "display_black_cd_m2",
+        "display_reflectance",
+    ];
+    let Some(first) = keys.iter().find(|k| t.has(k)) else {
+        return Ok(None);
+    };
+    if photometry.is_none() {
+        return Err(t.error(
+            first,
+            "needs a sun in lux: add `illuminance_lux` to [sun] (the display's light is in cd/m²)",
+        ));
+    }
+    let (lo, hi) = DISPLAY_PEAK_RANGE;
+    let peak = t.f64_in("display_peak_cd_m2", 1000.0, lo, hi)?;
+    let black = t.f64_in("display_black_cd_m2", 0.0, 0.0, peak)?;
+    if black >= peak {
+        return Err(t.error(
+            "display_black_cd_m2",
+            format!("must be below display_peak_cd_m2 ({peak}), got {black}"),
+        ));
+    }
+    Ok(Some(DisplayLight {
+        peak_cd_m2: peak,
+        black_cd_m2: black,
+        reflectance: t.f64_in("display_reflectance", 0.0, 0.0, 1.0)?,
+    }))
 }

@@ -245,6 +245,26 @@ pub struct Obstacle {
     /// How the display's rows take each new image and how long they stay lit (a sequence's
     /// display refreshes; every other command shows one still image).
     pub scanout: crate::geometry::shutter::Scanout,
+    /// The display as a light source (a scene lit in physical units only); `None`: an ideal
+    /// display, emitting the frontal camera's radiance as it is, unbounded.
+    pub display_light: Option<DisplayLight>,
+}
+
+/// A display's light: what it emits for an image, and what it reflects of the light that
+/// falls on it. Its colour channels emit `black + (peak − black) × the frontal image's
+/// linear value clamped to [0, 1]`, the image's 1.0 being the scene's white
+/// ([`Photometry::white_cd_m2`]): a world brighter than the white, or a peak below it,
+/// shows darker on the display than behind it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DisplayLight {
+    /// Luminance of full white, cd/m², in [0.01, 100 000] (default 1000).
+    pub peak_cd_m2: f64,
+    /// Luminance of black (the backlight's leak), cd/m², in [0, peak) (default 0).
+    pub black_cd_m2: f64,
+    /// Diffuse (Lambertian) reflectance of the display's face, in [0, 1] (default 0): it
+    /// adds reflectance × the illuminance on the face / π (the sky, the ground, the sun
+    /// where it reaches the face).
+    pub reflectance: f64,
 }
 
 impl Obstacle {

@@ -15,7 +15,7 @@ use crate::scene::limits::{
 use crate::scene::motion::read_object_motion;
 use crate::scene::source::{SceneError, SourceFile};
 use crate::scene::table_reader::TableReader;
-use crate::scene::{CameraKind, DriverFace, Material, Object, Obstacle, Scene, Shape};
+use crate::scene::{CameraKind, DriverFace, Material, Object, Obstacle, Photometry, Scene, Shape};
 
 const OBJECT_KINDS: [&str; 7] = ["plane", "box", "sphere", "cylinder", "cone", "quad", "mesh"];
 
@@ -46,7 +46,7 @@ impl Scene {
         let obstacle_table = root
             .table("obstacle")?
             .ok_or_else(|| root.error("obstacle", "the scene needs an [obstacle] table"))?;
-        let obstacle = read_obstacle(&obstacle_table, file)?;
+        let obstacle = read_obstacle(&obstacle_table, file, photometry.as_ref())?;
         obstacle_table.finish()?;
         let cameras = root.table("camera")?.ok_or_else(|| {
             root.error(
@@ -382,7 +382,11 @@ fn read_object(
     })
 }
 
-fn read_obstacle(t: &TableReader, file: &SourceFile) -> Result<Obstacle, SceneError> {
+fn read_obstacle(
+    t: &TableReader,
+    file: &SourceFile,
+    photometry: Option<&Photometry>,
+) -> Result<Obstacle, SceneError> {
     let center = t.point("center", None)?;
     let facing = t.direction("facing", [0.0, 0.0, 1.0])?;
     let up = t.direction("up", [0.0, 1.0, 0.0])?;
@@ -403,6 +407,7 @@ fn read_obstacle(t: &TableReader, file: &SourceFile) -> Result<Obstacle, SceneEr
         body_color: t.color("body_color", [0.18, 0.18, 0.2])?,
         display_shape: crate::scene::display_keys::read_display_shape(t, file, width, height)?,
         scanout: crate::scene::shutter_keys::read_scanout(t)?,
+        display_light: crate::scene::light_keys::read_display_light(t, photometry)?,
     };
     let half = DVec3::new(obstacle.width, obstacle.height, 2.0 * obstacle.thickness) / 2.0;
     let curved = crate::scene::display_keys::surface_corners(&obstacle.display_shape);
