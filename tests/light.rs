@@ -396,7 +396,7 @@ translate = [0.0, 0.0, -20.0]
 
 /// Per pixel of `run`'s seethru view where the driver sees the display (the occluded view's
 /// id is the obstacle's), the luminance there, and the truth's luminance.
-fn display_luminance(dir: &Path, scene: &str) -> Vec<(f64, f64)> {
+fn display_luminance(dir: &Path, scene: &str) -> (Vec<(f64, f64)>, serde_json::Value) {
     let file = dir.join("scene.toml");
     std::fs::write(&file, scene).unwrap();
     let out = dir.join("out");
@@ -406,6 +406,8 @@ fn display_luminance(dir: &Path, scene: &str) -> Vec<(f64, f64)> {
         file.to_str().unwrap(),
         "--spp",
         "1",
+        "--band",
+        "30",
         "--quiet",
         "--out",
         out.to_str().unwrap(),
@@ -437,10 +439,12 @@ fn display_luminance(dir: &Path, scene: &str) -> Vec<(f64, f64)> {
     let ((seethru, _), (truth, _), (_, occluded_ids)) =
         (read("seethru"), read("truth"), read("occluded"));
     let obstacle = *occluded_ids.iter().max().unwrap();
-    (0..seethru.len())
+    let pixels = (0..seethru.len())
         .filter(|&i| occluded_ids[i] == obstacle)
         .map(|i| (seethru[i], truth[i]))
-        .collect()
+        .collect();
+    let metrics = std::fs::read_to_string(out.join("metrics.json")).unwrap();
+    (pixels, serde_json::from_str(&metrics).unwrap())
 }
 
 #[test]
@@ -465,8 +469,19 @@ fn a_display_emits_between_its_black_and_its_peak_and_reflects_the_light_on_it()
             "display_peak_cd_m2 = {peak}\ndisplay_black_cd_m2 = {black}\n\
              display_reflectance = {reflectance}\n"
         );
-        let pixels = display_luminance(dir.path(), &display_scene(white, &display));
+        let (pixels, metrics) = display_luminance(dir.path(), &display_scene(white, &display));
         assert!(pixels.len() > 20, "{} display pixels", pixels.len());
+        // metrics.json: every display pixel's ratio is the analytic one, and a visible step.
+        let lum = &metrics["luminance"]["display"];
+        assert_eq!(lum["pixels"].as_u64(), Some(pixels.len() as u64), "{lum}");
+        let stops = (expected / wall).log2();
+        for stat in ["mean", "max"] {
+            let got = lum["ratio_log2"][stat].as_f64().unwrap();
+            assert!((got - stops).abs() < 0.01, "{stat}: {got} vs {stops} stops");
+        }
+        assert_eq!(lum["visible_share"].as_f64(), Some(1.0), "{lum}");
+        let border = &metrics["luminance"]["border"];
+        assert!(border["pixels"].as_u64().unwrap() > 0, "{border}");
         for (seen, truth) in pixels {
             assert!(
                 relative_error(truth, wall) < 0.005,
@@ -478,8 +493,16 @@ fn a_display_emits_between_its_black_and_its_peak_and_reflects_the_light_on_it()
             );
         }
     }
-    // Without the keys, an ideal display: the wall's luminance, whatever the white.
-    for (seen, _) in display_luminance(dir.path(), &display_scene(wall / 4.0, "")) {
+    // Without the keys, an ideal display: the wall's luminance, whatever the white, and no
+    // visible step.
+    let (pixels, metrics) = display_luminance(dir.path(), &display_scene(wall / 4.0, ""));
+    for (seen, _) in pixels {
         assert!(relative_error(seen, wall) < 0.005, "{seen} vs {wall}");
     }
+    let lum = &metrics["luminance"]["display"];
+    assert_eq!(lum["visible_share"].as_f64(), Some(0.0), "{lum}");
+    assert!(
+        lum["ratio_log2"]["max"].as_f64().unwrap().abs() < 0.01,
+        "{lum}"
+    );
 }

@@ -162,6 +162,7 @@ mod tests {
             body_color: [0.2; 3],
             display_shape: DisplayShape::Flat,
             scanout: crate::geometry::shutter::Scanout::default(),
+            display_light: None,
         };
         // Driver-view pixels at the display's top-right, bottom-right and top-left corners,
         // a hair outside (as float rounding puts them), in world coordinates.

@@ -15,6 +15,7 @@
 use glam::DVec3;
 
 use crate::measure::image_metrics::{DisplayImages, Flip};
+use crate::measure::luminance::luminance_metrics;
 use crate::measure::metrics_json::{Metrics, display_metrics};
 use crate::measure::misregistration::{Measured, measure_display_pixels};
 use crate::render::frame_over::FrameView;
@@ -95,7 +96,20 @@ pub fn measure_with(
     let measured = measure_display_pixels(ctx, scene, driver_eye, frames, &on_display, band);
     let images = DisplayImages::score(truth, seethru, &on_display, &scene.driver, flip);
     let width = truth.width() as usize;
-    let metrics = display_metrics(scene, width, &measured, &images, band, flip);
+    let mut metrics = display_metrics(scene, width, &measured, &images, band, flip);
+    if let Some(photometry) = &scene.photometry {
+        let border: Vec<bool> = measured
+            .iter()
+            .map(|m| m.sides.iter().any(|&s| s))
+            .collect();
+        metrics.luminance = Some(luminance_metrics(
+            photometry,
+            truth,
+            seethru,
+            &on_display,
+            &border,
+        ));
+    }
     let maps = MetricMaps::of(truth, display, &on_display, &measured, &images);
     (maps, metrics)
 }

@@ -125,6 +125,9 @@ pub struct Metrics {
     /// Why misregistration is undefined for an outside method's image without a map.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub misregistration_needs_a_map: Option<&'static str>,
+    /// The display's light against the world's, in a scene lit in physical units.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub luminance: Option<crate::measure::luminance::LuminanceMetrics>,
 }
 
 impl Metrics {
@@ -254,6 +257,7 @@ pub(crate) fn display_metrics(
         holes: None,
         external_method: None,
         misregistration_needs_a_map: None,
+        luminance: None,
     }
 }
 

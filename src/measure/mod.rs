@@ -14,6 +14,7 @@ pub mod headline;
 pub mod holes;
 pub mod image_diff;
 pub mod image_metrics;
+pub mod luminance;
 pub mod maps;
 pub mod measured_run;
 pub mod metrics;
