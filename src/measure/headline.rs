@@ -34,7 +34,7 @@ pub struct Headline {
 /// The headline metrics of a `run`'s `metrics.json`. Tolerances: renders are bit-identical
 /// on one platform; across platforms (libm variants) a few silhouette pixels may change,
 /// which moves a mean by hundredths of an arc-minute.
-pub const RUN_HEADLINES: [Headline; 10] = [
+pub const RUN_HEADLINES: [Headline; 13] = [
     Headline {
         name: "misregistration.mean",
         pointer: "/display/misregistration_arcmin/mean",
@@ -94,6 +94,24 @@ pub const RUN_HEADLINES: [Headline; 10] = [
         pointer: "/display/flip_mean",
         tolerance: 1e-3,
         about: "mean FLIP of seethru against the truth over the display, [0, 1]",
+    },
+    Headline {
+        name: "luminance.ratio_log2.median",
+        pointer: "/luminance/display/ratio_log2_median",
+        tolerance: 0.01,
+        about: "median of log2(display luminance / the truth's) over the display, stops (a scene lit in physical units)",
+    },
+    Headline {
+        name: "luminance.border.ratio_log2.mean",
+        pointer: "/luminance/border/ratio_log2/mean",
+        tolerance: 0.01,
+        about: "mean of that ratio in the border band, stops: the photometric seam",
+    },
+    Headline {
+        name: "luminance.visible_share",
+        pointer: "/luminance/display/visible_share",
+        tolerance: 1e-3,
+        about: "fraction of display pixels whose luminance differs from the truth's by a visible step (Weber contrast > 0.02), [0, 1]",
     },
 ];
 
@@ -175,15 +193,24 @@ pub fn headlines_of(kind: RunKind, json: &Value) -> Vec<(&'static str, f64)> {
         .collect()
 }
 
-/// The summary line's metrics: `misregistration mean 12.3′, p95 20.1′, coverage 0.998`.
+/// The summary line's metrics: `misregistration mean 12.3′, p95 20.1′, coverage 0.998`, and
+/// in a scene lit in physical units the display's luminance against the world's.
 pub fn summary_text(kind: RunKind, json: &Value) -> String {
     let get = |name: &str| kind.headline(name).map_or(f64::NAN, |h| value_of(json, h));
-    format!(
+    let mut text = format!(
         "misregistration mean {:.2}′, p95 {:.2}′, coverage {:.4}",
         get("misregistration.mean"),
         get("misregistration.p95"),
         get("coverage")
-    )
+    );
+    if json.get("luminance").is_some() {
+        text += &format!(
+            ", display luminance {:+.2} stops from the world's (median), a visible step on {:.1} % of it",
+            get("luminance.ratio_log2.median"),
+            100.0 * get("luminance.visible_share")
+        );
+    }
+    text
 }
 
 /// The kind of results folder `dir` is and its metrics JSON: `metrics.json` of a `run`, or
