@@ -190,6 +190,21 @@ fn the_sun_stands_where_its_elevation_and_azimuth_say() {
     .unwrap();
     assert!(close(scene.sun.direction, [-h.cos(), h.sin(), 0.0]));
     assert!(scene.photometry.is_none());
+    // From a date, a time and a place: Berlin (52.52° N, 13.40° E) at the March equinox's
+    // solar noon has the sun due south (+z) at 90° − 52.52° = 37.5°.
+    let scene = parse(&floor_scene(
+        0.5,
+        "[sun]\ndate = \"2026-03-20\"\ntime_utc = \"11:14\"\nlatitude_deg = 52.52\nlongitude_deg = 13.40\n",
+    ))
+    .unwrap();
+    let noon = 37.5f64.to_radians();
+    let expected = glam::DVec3::new(0.0, noon.sin(), noon.cos());
+    let off = scene.sun.direction.angle_between(expected).to_degrees();
+    assert!(
+        off < 0.5,
+        "{} is {off}° from {expected}",
+        scene.sun.direction
+    );
 }
 
 #[test]
@@ -217,8 +232,8 @@ fn light_keys_that_contradict_each_other_are_refused_with_the_key_named() {
         ),
         (
             "[sun]\ndirection = [0, 1, 0]\nelevation_deg = 30\nazimuth_deg = 0\n",
-            "sun.direction",
-            "not both",
+            "sun.elevation_deg",
+            "places the sun as `direction` does",
         ),
         (
             "[sun]\nelevation_deg = 30\n",
@@ -294,6 +309,18 @@ fn each_light_number_is_refused_outside_its_documented_range() {
             "sun.azimuth_deg",
             0.0,
             360.0,
+        ),
+        (
+            "[sun]\ndate = \"2026-06-01\"\ntime_utc = \"12:00\"\nlatitude_deg = X\nlongitude_deg = 0\n",
+            "sun.latitude_deg",
+            -90.0,
+            90.0,
+        ),
+        (
+            "[sun]\ndate = \"2026-06-01\"\ntime_utc = \"12:00\"\nlatitude_deg = 0\nlongitude_deg = X\n",
+            "sun.longitude_deg",
+            -180.0,
+            180.0,
         ),
     ];
     for &(text, key, lo, hi) in cases {

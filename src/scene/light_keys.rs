@@ -6,6 +6,7 @@ use glam::DVec3;
 
 use crate::scene::limits::{MAX_LENGTH, MIN_LENGTH};
 use crate::scene::source::SceneError;
+use crate::scene::sun_position::{UtcInstant, parse_date, parse_time, sun_angles};
 use crate::scene::table_reader::TableReader;
 use crate::scene::{DisplayLight, Photometry, Sky, Sun};
 use crate::util::color::srgb_to_linear3;
@@ -31,6 +32,71 @@ pub fn sun_direction(elevation_deg: f64, azimuth_deg: f64) -> DVec3 {
     DVec3::new(az.sin() * el.cos(), el.sin(), -az.cos() * el.cos())
 }
 
+/// The three ways `[sun]` places the sun, each a set of keys that go together.
+const SUN_PLACEMENTS: [&[&str]; 3] = [
+    &["direction"],
+    &["elevation_deg", "azimuth_deg"],
+    &["date", "time_utc", "latitude_deg", "longitude_deg"],
+];
+
+/// The direction towards the sun: `direction`, or its elevation and azimuth, or the date, the
+/// time and the place (`scene/sun_position.rs`; north is −z); `default` without any.
+fn read_sun_direction(t: &TableReader, default: DVec3) -> Result<DVec3, SceneError> {
+    let given: Vec<&[&str]> = (SUN_PLACEMENTS.iter().copied())
+        .filter(|keys| keys.iter().any(|k| t.has(k)))
+        .collect();
+    let keys = match given[..] {
+        [] => return Ok(default),
+        [keys] => keys,
+        [a, b, ..] => {
+            return Err(t.error(
+                b.iter().find(|k| t.has(k)).expect("one is given"),
+                format!(
+                    "places the sun as `{}` does: give one of `direction`, `elevation_deg` with                      `azimuth_deg`, or `date`, `time_utc`, `latitude_deg` and `longitude_deg`",
+                    a.iter().find(|k| t.has(k)).expect("one is given")
+                ),
+            ));
+        }
+    };
+    if let Some(missing) = keys.iter().find(|k| !t.has(k)) {
+        return Err(t.error(
+            missing,
+            format!(
+                "is required with {}",
+                keys.iter()
+                    .filter(|k| t.has(k))
+                    .map(|k| format!("`{k}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        ));
+    }
+    match keys.len() {
+        1 => t.direction("direction", default.to_array()),
+        2 => {
+            let elevation = t.f64_in("elevation_deg", 0.0, -90.0, 90.0)?;
+            let azimuth = t.f64_in("azimuth_deg", 0.0, 0.0, 360.0)?;
+            Ok(sun_direction(elevation, azimuth))
+        }
+        _ => {
+            let (year, month, day) =
+                parse_date(t.required_str("date")?).map_err(|e| t.error("date", e))?;
+            let seconds =
+                parse_time(t.required_str("time_utc")?).map_err(|e| t.error("time_utc", e))?;
+            let latitude = t.f64_in("latitude_deg", 0.0, -90.0, 90.0)?;
+            let longitude = t.f64_in("longitude_deg", 0.0, -180.0, 180.0)?;
+            let at = UtcInstant {
+                year,
+                month,
+                day,
+                seconds,
+            };
+            let (elevation, azimuth) = sun_angles(&at, latitude, longitude);
+            Ok(sun_direction(elevation, azimuth))
+        }
+    }
+}
+
 /// `[sun]`, with its illuminance in lux when the scene states it.
 pub fn read_sun(root: &TableReader) -> Result<(Sun, Option<f64>), SceneError> {
     let d = Sun::default();
@@ -48,27 +114,7 @@ pub fn read_sun(root: &TableReader) -> Result<(Sun, Option<f64>), SceneError> {
              remove one of the two",
         ));
     }
-    let angles = ["elevation_deg", "azimuth_deg"];
-    let direction = if angles.iter().any(|k| t.has(k)) {
-        if t.has("direction") {
-            return Err(t.error(
-                "direction",
-                "give either `direction` or `elevation_deg` and `azimuth_deg`, not both",
-            ));
-        }
-        if let Some(missing) = angles.iter().find(|k| !t.has(k)) {
-            return Err(t.error(
-                missing,
-                "is required with the other angle (degrees: elevation in [-90, 90], azimuth \
-                 in [0, 360] clockwise from north, −z)",
-            ));
-        }
-        let elevation = t.f64_in("elevation_deg", 0.0, -90.0, 90.0)?;
-        let azimuth = t.f64_in("azimuth_deg", 0.0, 0.0, 360.0)?;
-        sun_direction(elevation, azimuth)
-    } else {
-        t.direction("direction", d.direction.to_array())?
-    };
+    let direction = read_sun_direction(&t, d.direction)?;
     let sun = Sun {
         direction,
         color: t.color("color", d.color)?,

@@ -24,6 +24,7 @@ pub mod read;
 pub mod shapes;
 pub mod shutter_keys;
 pub mod source;
+pub mod sun_position;
 pub mod surface_grid;
 pub mod table_reader;
 pub mod texture;
