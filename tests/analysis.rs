@@ -148,6 +148,7 @@ fn paper_rig(width: f64, height: f64, theta_f: f64, res: [u32; 2]) -> (Obstacle,
         body_color: [0.0; 3],
         display_shape: seethru::scene::display_surface::DisplayShape::Flat,
         scanout: seethru::geometry::shutter::Scanout::default(),
+        display_light: None,
     };
     let camera = Camera::new(DAffine3::IDENTITY, theta_f, res[0], res[1]).unwrap();
     (obstacle, camera)

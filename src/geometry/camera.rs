@@ -35,6 +35,9 @@ pub struct Camera {
     /// When its rows and samples see the world ([`Shutter::INSTANT`]: all at the frame's
     /// instant). Only a render in time (a moving camera or world) reads it.
     pub shutter: Shutter,
+    /// `None`: the ideal sensor (the radiance as it is). Otherwise the EMVA 1288 sensor whose
+    /// codes the camera delivers (geometry/sensor.rs): a frontal or back camera's.
+    pub sensor: Option<crate::geometry::sensor::Sensor>,
 }
 
 /// Why a camera cannot be built.
@@ -93,6 +96,7 @@ impl Camera {
             height,
             lens: None,
             shutter: Shutter::INSTANT,
+            sensor: None,
         })
     }
 
@@ -112,6 +116,7 @@ impl Camera {
             height,
             lens: Some(lens),
             shutter: Shutter::INSTANT,
+            sensor: None,
         })
     }
 

@@ -7,4 +7,5 @@ pub mod homography;
 pub mod lens;
 pub mod lens_check;
 pub mod opencv;
+pub mod sensor;
 pub mod shutter;

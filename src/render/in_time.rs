@@ -168,6 +168,7 @@ pub fn render_by_instant(
             }
         }
     }
+    crate::render::sensor_image::deliver_through_sensor(&camera, frame, region);
     stats.seconds = start.elapsed().as_secs_f64();
     Ok(stats)
 }

@@ -17,6 +17,7 @@ pub mod packets;
 pub mod ray;
 pub mod render_job;
 pub mod screen;
+pub mod sensor_image;
 pub mod settings;
 pub mod shutter_rays;
 pub mod simd;

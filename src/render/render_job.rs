@@ -183,7 +183,9 @@ impl RenderContext {
         assert_eq!((frame.width, frame.height), (camera.width, camera.height));
         frame.white_cd_m2 = self.white_cd_m2();
         let region = job.region.unwrap_or_else(|| PixelRect::full(camera));
-        self.render_bands(&job, region, frame.bands_mut(BAND_ROWS))
+        let stats = self.render_bands(&job, region, frame.bands_mut(BAND_ROWS));
+        crate::render::sensor_image::deliver_through_sensor(camera, frame, region);
+        stats
     }
 
     /// Renders `job` given `base`, the same camera's frame in `base_view` with the same

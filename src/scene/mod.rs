@@ -21,6 +21,7 @@ pub mod mesh_io;
 pub mod motion;
 pub mod procedural;
 pub mod read;
+pub mod sensor_keys;
 pub mod shapes;
 pub mod shutter_keys;
 pub mod source;

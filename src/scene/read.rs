@@ -59,8 +59,8 @@ impl Scene {
         if let Some(head) = face_object(face, driver.position()) {
             objects.push(head);
         }
-        let frontal = read_frontal(&cameras, &obstacle)?;
-        let back = read_back(&cameras, &obstacle)?;
+        let frontal = read_frontal(&cameras, &obstacle, photometry.as_ref())?;
+        let back = read_back(&cameras, &obstacle, photometry.as_ref())?;
         cameras.finish()?;
         let calibration = crate::scene::lens_keys::read_calibration(&root, &frontal, &back)?;
         root.finish()?;
@@ -538,6 +538,7 @@ fn mounted_camera(
     base: DMat3,
     default_half_deg: f64,
     default_res: [u32; 2],
+    photometry: Option<&Photometry>,
 ) -> Result<Camera, SceneError> {
     let offset = dvec3(t.array_in(
         "offset",
@@ -559,13 +560,19 @@ fn mounted_camera(
         w,
         h,
     )?;
+    let shutter = crate::scene::shutter_keys::read_shutter(t)?;
     Ok(Camera {
-        shutter: crate::scene::shutter_keys::read_shutter(t)?,
+        shutter,
+        sensor: crate::scene::sensor_keys::read_sensor(t, &shutter, photometry)?,
         ..camera
     })
 }
 
-fn read_frontal(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, SceneError> {
+fn read_frontal(
+    cameras: &TableReader,
+    obstacle: &Obstacle,
+    photometry: Option<&Photometry>,
+) -> Result<Camera, SceneError> {
     let t = camera_table(cameras, "frontal")?;
     // Camera −z along obstacle −z: the identity rotation.
     let camera = mounted_camera(
@@ -575,6 +582,7 @@ fn read_frontal(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, Sc
         DMat3::IDENTITY,
         45.0,
         [1280, 720],
+        photometry,
     )?;
     let z = obstacle
         .world_from_obstacle
@@ -588,7 +596,11 @@ fn read_frontal(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, Sc
     Ok(camera)
 }
 
-fn read_back(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, SceneError> {
+fn read_back(
+    cameras: &TableReader,
+    obstacle: &Obstacle,
+    photometry: Option<&Photometry>,
+) -> Result<Camera, SceneError> {
     let t = camera_table(cameras, "back")?;
     // Camera −z along obstacle +z (towards the driver): half a turn about y.
     let base = DMat3::from_rotation_y(std::f64::consts::PI);
@@ -599,6 +611,7 @@ fn read_back(cameras: &TableReader, obstacle: &Obstacle) -> Result<Camera, Scene
         base,
         35.0,
         [640, 480],
+        photometry,
     )?;
     t.finish()?;
     Ok(camera)

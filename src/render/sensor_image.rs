@@ -1,0 +1,30 @@
+//! What a camera with a sensor delivers (geometry/sensor.rs): each pixel's rendered radiance
+//! through the sensor, its noise drawn from the pixel's index, so that the image is the same
+//! whatever renders it (a region, bands, instants, any number of threads).
+
+use rayon::prelude::*;
+
+use crate::geometry::camera::Camera;
+use crate::render::footprint::PixelRect;
+use crate::render::frame::Frame;
+
+/// Puts the pixels of `region` of `frame` (a frame of `camera`) through the camera's sensor;
+/// nothing for an ideal sensor.
+pub fn deliver_through_sensor(camera: &Camera, frame: &mut Frame, region: PixelRect) {
+    let Some(sensor) = camera.sensor else {
+        return;
+    };
+    let width = frame.width as usize;
+    let (x0, x1) = (region.x0 as usize, region.x1 as usize);
+    (frame.color.par_chunks_mut(width).enumerate())
+        .filter(|(y, _)| (region.y0 as usize..region.y1 as usize).contains(y))
+        .for_each(|(y, row)| {
+            for (x, colour) in row.iter_mut().enumerate().take(x1).skip(x0) {
+                let pixel = (y * width + x) as u32;
+                for c in 0..3 {
+                    let dn = sensor.dn(colour[c], pixel, c as u32);
+                    colour[c] = sensor.delivered(dn);
+                }
+            }
+        });
+}
