@@ -533,3 +533,249 @@ fn a_display_emits_between_its_black_and_its_peak_and_reflects_the_light_on_it()
         "{lum}"
     );
 }
+
+/// A grey floor seen from 5 m straight above, lit only by `lamps` (no sun, a black sky, the
+/// white at 10 cd/m²): per floor pixel, its world position and its luminance (cd/m²).
+fn floor_under_lamps(grey: f64, lamps: &str, extra_objects: &str) -> Vec<(glam::DVec3, f64)> {
+    let scene = format!(
+        r#"[sun]
+illuminance_lux = 0
+[sky]
+zenith_luminance_cd_m2 = 0
+cloud_cover = 0
+[photometry]
+white_cd_m2 = 10
+{lamps}
+[obstacle]
+center = [0.0, 5.0, -0.8]
+width = 0.3
+height = 0.4
+
+[camera.driver]
+position = [0.0, 5.0, 0.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, -1.0]
+half_angle_deg = 40.0
+resolution = [96, 96]
+
+[camera.frontal]
+resolution = [16, 12]
+
+[camera.back]
+resolution = [16, 12]
+
+[[material]]
+name = "grey"
+color = [{grey}, {grey}, {grey}]
+
+[[object]]
+name = "floor"
+kind = "plane"
+material = "grey"
+size = [100.0, 100.0]
+{extra_objects}"#
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("scene.toml");
+    std::fs::write(&file, scene).unwrap();
+    let out = dir.path().join("out");
+    let (ok, _, stderr) = seethru(&[
+        "render",
+        file.to_str().unwrap(),
+        "--view",
+        "truth",
+        "--spp",
+        "1",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let image = read_all_flat_layers_from_file(out.join("truth.exr")).unwrap();
+    let layer = &image.layer_data[0];
+    let channel = |name: &str| -> Vec<f64> {
+        let c = (layer.channel_data.list.iter())
+            .find(|c| c.name.to_string() == name)
+            .unwrap_or_else(|| panic!("no channel {name}"));
+        match &c.sample_data {
+            FlatSamples::F32(v) => v.iter().map(|&x| f64::from(x)).collect(),
+            FlatSamples::U32(v) => v.iter().map(|&x| f64::from(x)).collect(),
+            FlatSamples::F16(_) => panic!(),
+        }
+    };
+    let (r, g, b) = (channel("R"), channel("G"), channel("B"));
+    let (px, py, pz, id) = (
+        channel("P.X"),
+        channel("P.Y"),
+        channel("P.Z"),
+        channel("id.object"),
+    );
+    (0..r.len())
+        .filter(|&i| id[i] == 1.0)
+        .map(|i| {
+            let y = 0.2126 * r[i] + 0.7152 * g[i] + 0.0722 * b[i];
+            (glam::DVec3::new(px[i], py[i], pz[i]), y)
+        })
+        .collect()
+}
+
+#[test]
+fn a_point_lamp_lights_a_floor_by_the_inverse_square_and_cosine_laws() {
+    let (grey, intensity) = (0.5, 500.0);
+    let rho = f64::from(srgb_to_linear(grey as f32));
+    let lamp = glam::DVec3::new(1.0, 2.0, -1.0);
+    let lamps = format!(
+        "[[light]]\nkind = \"point\"\nposition = [1.0, 2.0, -1.0]\nintensity_cd = {intensity}\ncolor = [1.0, 0.8, 0.6]\n"
+    );
+    let pixels = floor_under_lamps(grey, &lamps, "");
+    assert!(pixels.len() > 5000, "{}", pixels.len());
+    for (p, y) in pixels {
+        let d = lamp - p;
+        let expected =
+            rho * intensity * (d.y / d.length()) / (std::f64::consts::PI * d.length_squared());
+        assert!(
+            relative_error(y, expected) < 0.005,
+            "at {p}: {y} vs {expected} cd/m²"
+        );
+    }
+}
+
+#[test]
+fn a_spot_lights_its_cone_and_an_object_shades_what_it_hides() {
+    let (grey, intensity) = (0.8, 2000.0);
+    let rho = f64::from(srgb_to_linear(grey as f32));
+    // Straight down from 3 m: full within 20° of the axis, nothing beyond 30°.
+    let lamp = glam::DVec3::new(1.5, 3.0, 0.0);
+    let lamps = format!(
+        "[[light]]\nkind = \"spot\"\nposition = [1.5, 3.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\n\
+         intensity_cd = {intensity}\ncone_deg = 30\nfalloff_deg = 20\n"
+    );
+    // A ball of radius 0.3 m, 1.5 m under the lamp and 0.3 m beside its axis: its shadow on
+    // the floor is a disc inside the full beam, mostly beside where the ball hides the floor
+    // from the camera.
+    let ball = "[[object]]\nname = \"ball\"\nkind = \"sphere\"\nmaterial = \"grey\"\nradius = 0.3\n\
+                translate = [1.2, 1.5, 0.0]\n";
+    let centre = glam::DVec3::new(1.2, 1.5, 0.0);
+    let (mut lit, mut dark, mut shaded) = (0, 0, 0);
+    for (p, y) in floor_under_lamps(grey, &lamps, ball) {
+        let to = lamp - p;
+        let angle = (-to.normalize())
+            .angle_between(glam::DVec3::NEG_Y)
+            .to_degrees();
+        // Does the segment from the floor point to the lamp pass through the ball?
+        let dir = to.normalize();
+        let oc = p - centre;
+        let b = oc.dot(dir);
+        let disc = b * b - (oc.length_squared() - 0.09);
+        let blocked = disc > 0.0 && -b - disc.sqrt() > 0.0 && -b - disc.sqrt() < to.length();
+        let margin = 0.02 * (p - lamp).length(); // pixels at a shadow's or a cone's edge
+        let near_edge =
+            (disc.abs() < margin) || (angle - 20.0).abs() < 0.5 || (angle - 30.0).abs() < 0.5;
+        if near_edge {
+            continue;
+        }
+        let expected = if blocked || angle > 30.0 {
+            0.0
+        } else {
+            let profile = if angle < 20.0 {
+                1.0
+            } else {
+                let (c, c0, c1) = (
+                    angle.to_radians().cos(),
+                    30f64.to_radians().cos(),
+                    20f64.to_radians().cos(),
+                );
+                let t = (c - c0) / (c1 - c0);
+                t * t * (3.0 - 2.0 * t)
+            };
+            rho * intensity * profile * (to.y / to.length())
+                / (std::f64::consts::PI * to.length_squared())
+        };
+        if expected == 0.0 {
+            assert_eq!(y, 0.0, "at {p} (angle {angle:.1}°, blocked {blocked})");
+            if blocked && angle < 30.0 {
+                shaded += 1
+            } else {
+                dark += 1
+            }
+        } else {
+            assert!(
+                relative_error(y, expected) < 0.005,
+                "at {p} (angle {angle:.1}°): {y} vs {expected}"
+            );
+            lit += 1;
+        }
+    }
+    assert!(
+        lit > 500 && dark > 1000 && shaded > 30,
+        "{lit} lit, {dark} dark, {shaded} in the shadow"
+    );
+}
+
+#[test]
+fn lamps_are_refused_where_they_cannot_shine() {
+    let spot_key = parse(&floor_scene(
+        0.5,
+        "[sun]\nilluminance_lux = 100\n[[light]]\nposition = [0, 1, 0]\ncone_deg = 10\n",
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(
+        spot_key.contains("`light[0].cone_deg`") && spot_key.contains("kind = \"spot\""),
+        "{spot_key}"
+    );
+    let relative = parse(&floor_scene(0.5, "[[light]]\nposition = [0, 1, 0]\n"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        relative.contains("light") && relative.contains("physical units"),
+        "{relative}"
+    );
+    let many: String = (0..65)
+        .map(|_| "[[light]]\nposition = [0, 1, 0]\n")
+        .collect();
+    let e = parse(&floor_scene(
+        0.5,
+        &format!("[sun]\nilluminance_lux = 100\n{many}"),
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("more than the limit of 64"), "{e}");
+}
+
+#[test]
+fn lamps_render_the_same_on_the_per_ray_and_the_packet_paths_and_on_any_thread_count() {
+    use seethru::render::integrator::RenderContext;
+    use seethru::render::render_job::{RenderJob, Tracer};
+    use seethru::render::simd::Isa;
+    use seethru::scene::world::view_bit;
+    let text = std::fs::read_to_string(common::repo_path("scenes/das_night.toml")).unwrap();
+    let scene = common::parse_in(&common::repo_path("scenes"), "das_night.toml", &text).unwrap();
+    assert!(scene.lights.len() >= 3);
+    let ctx = RenderContext::new(scene).unwrap();
+    let camera = ctx.scene.driver.with_resolution(96, 54);
+    let render = |tracer: Tracer, threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let job = RenderJob::new(&camera, view_bit::TRUTH)
+                .label("test")
+                .tracer(tracer);
+            ctx.render(job).0.color
+        })
+    };
+    let twin = render(Tracer::PerRay, 1);
+    assert!(twin.iter().any(|c| c.max_element() > 0.0), "a black night");
+    for isa in Isa::ALL.into_iter().filter(|i| i.available()) {
+        for threads in [1, 3] {
+            let colour = render(Tracer::Packets(isa), threads);
+            let same = twin
+                .iter()
+                .zip(&colour)
+                .all(|(a, b)| a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits));
+            assert!(same, "{isa:?} on {threads} threads");
+        }
+    }
+}

@@ -352,6 +352,7 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
             ..Sky::default()
         },
         photometry: None,
+        lights: Vec::new(),
         materials,
         objects,
         obstacle,

@@ -24,9 +24,11 @@ use crate::render::screen::{Screen, Shown};
 use crate::render::shutter_rays::{CameraAt, PoseAt, ShutterRays};
 use crate::render::simd::Isa;
 use crate::render::sky::SkyModel;
+use crate::scene::light_keys::luminance;
 use crate::scene::texture::Texture;
 use crate::scene::world::{SurfaceHit, SurfaceMaterial, World, view_bit};
 use crate::scene::{DisplayLight, Scene};
+use crate::util::color::srgb_to_linear3;
 use crate::util::sampling::pixel_offset;
 
 thread_local! {
@@ -42,6 +44,8 @@ struct Shading {
     light: Vec3,
     /// Cosine of the sun to the normal: a shadow ray is traced where it is positive.
     cos: f32,
+    /// The lamps' light (`[[light]]`), as the sky's: irradiance over π, shadows applied.
+    lamps: Vec3,
 }
 
 /// Everything needed to render a scene from any camera. The world, its hierarchy and the
@@ -246,7 +250,8 @@ impl RenderContext {
                         shown[lane] = Some(self.display_content(d, s, job.view, stack, shadows));
                     }
                     (Some(s), _) => {
-                        let sh = self.shade_begin(s);
+                        let mut sh = self.shade_begin(s);
+                        sh.lamps = self.lamps_at(s, job.view, stack, shadows);
                         if sh.cos > 0.0 {
                             *shadows += 1;
                             let ray = shadow_ray(s.position, s.normal, self.sky.sun_direction);
@@ -496,7 +501,8 @@ impl RenderContext {
 
     /// Lambert shading: albedo × (sun × cos × visibility + sky ambient).
     fn shade(&self, s: &SurfaceHit, view: u8, stack: &mut Stack, shadows: &mut u64) -> Vec3 {
-        let sh = self.shade_begin(s);
+        let mut sh = self.shade_begin(s);
+        sh.lamps = self.lamps_at(s, view, stack, shadows);
         let mut lit = false;
         if sh.cos > 0.0 {
             *shadows += 1;
@@ -523,13 +529,59 @@ impl RenderContext {
             albedo,
             light: self.sky.ambient(s.normal),
             cos: s.normal.dot(self.sky.sun_direction),
+            lamps: Vec3::ZERO,
         }
+    }
+
+    /// The light of the scene's lamps on the surface `s` (irradiance over π, in units of the
+    /// white; zero without lamps): each lamp's intensity towards `s` (a spot's profile) times
+    /// the cosine over the squared distance, where its shadow ray reaches it. The same
+    /// rays, one at a time, on the per-ray and the packet paths.
+    fn lamps_at(&self, s: &SurfaceHit, view: u8, stack: &mut Stack, shadows: &mut u64) -> Vec3 {
+        let (Some(photometry), false) = (&self.scene.photometry, self.scene.lights.is_empty())
+        else {
+            return Vec3::ZERO;
+        };
+        let mut sum = Vec3::ZERO;
+        for lamp in &self.scene.lights {
+            let to = lamp.position.as_vec3() - s.position;
+            let d2 = to.length_squared();
+            let cos = s.normal.dot(to);
+            if d2 <= 0.0 || cos <= 0.0 {
+                continue;
+            }
+            let d = d2.sqrt();
+            let dir = to / d;
+            let profile = lamp.spot.map_or(1.0, |spot| spot.profile(-dir.as_dvec3()));
+            if profile == 0.0 {
+                continue;
+            }
+            if lamp.casts_shadow {
+                *shadows += 1;
+                let mut ray = shadow_ray(s.position, s.normal, dir);
+                ray.tmax = d * (1.0 - 1e-4);
+                let blocked = self.accel.occluded_with(&ray, view, stack)
+                    || (self.moving.as_ref())
+                        .is_some_and(|m| m.accel.occluded_with(&ray, view, stack));
+                if blocked {
+                    continue;
+                }
+            }
+            let colour = srgb_to_linear3(lamp.color);
+            let scale = lamp.intensity_cd * profile
+                / (std::f64::consts::PI * photometry.white_cd_m2 * f64::from(luminance(colour)));
+            sum += colour * (scale as f32 * (cos / d) / d2);
+        }
+        sum
     }
 
     /// The shaded colour, with the sun where `lit` (its cosine positive, its ray unblocked).
     #[inline]
     fn shade_end(&self, sh: Shading, lit: bool) -> Vec3 {
         let mut light = sh.light;
+        if !self.scene.lights.is_empty() {
+            light += sh.lamps;
+        }
         if lit {
             light += self.sky.sun_irradiance * sh.cos;
         }

@@ -8,7 +8,7 @@ use crate::scene::limits::{MAX_LENGTH, MIN_LENGTH};
 use crate::scene::source::SceneError;
 use crate::scene::sun_position::{UtcInstant, parse_date, parse_time, sun_angles};
 use crate::scene::table_reader::TableReader;
-use crate::scene::{DisplayLight, Photometry, Sky, Sun};
+use crate::scene::{DisplayLight, Lamp, Photometry, Sky, Spot, Sun};
 use crate::util::color::srgb_to_linear3;
 
 /// Brightest sunlight at sea level (a clear zenith sun gives about 100–130 klx), lux.
@@ -269,4 +269,64 @@ pub fn read_display_light(
         black_cd_m2: black,
         reflectance: t.f64_in("display_reflectance", 0.0, 0.0, 1.0)?,
     }))
+}
+
+/// Most `[[light]]` tables a scene may have (each lit point traces a shadow ray per light).
+pub const MAX_LIGHTS: usize = 64;
+/// Brightest lamp: a high beam's axis gives some 100 000 cd.
+pub const MAX_INTENSITY_CD: f64 = 1e7;
+
+/// The `[[light]]` tables: point and spot lamps, in a scene lit in physical units.
+pub fn read_lights(
+    root: &TableReader,
+    photometry: Option<&Photometry>,
+) -> Result<Vec<Lamp>, SceneError> {
+    let tables = root.array_of_tables("light")?;
+    if let Some(t) = tables.first()
+        && photometry.is_none()
+    {
+        return Err(t.table_error(
+            "a [[light]] gives candelas: it needs a scene lit in physical units (add `illuminance_lux` to [sun])",
+        ));
+    }
+    if tables.len() > MAX_LIGHTS {
+        return Err(tables[MAX_LIGHTS].table_error(format!(
+            "the scene has {} [[light]] tables, more than the limit of {MAX_LIGHTS}",
+            tables.len()
+        )));
+    }
+    let mut lamps = Vec::with_capacity(tables.len());
+    for t in tables {
+        let kind = t.choice("kind", "point", &["point", "spot"])?;
+        let spot_keys = ["direction", "cone_deg", "falloff_deg"];
+        let spot = if kind == "spot" {
+            let cone = t.f64_in("cone_deg", 30.0, 0.01, 90.0)?;
+            let falloff = t.f64_in("falloff_deg", cone, 0.0, cone)?;
+            Some(Spot {
+                direction: t.direction("direction", [0.0, 0.0, -1.0])?,
+                cos_cone: cone.to_radians().cos(),
+                cos_falloff: falloff.to_radians().cos(),
+            })
+        } else {
+            if let Some(key) = spot_keys.iter().find(|k| t.has(k)) {
+                return Err(t.error(key, "is a key of kind = \"spot\", but the light is a point"));
+            }
+            None
+        };
+        let color = t.color("color", [1.0, 1.0, 1.0])?;
+        let intensity = t.f64_in("intensity_cd", 1000.0, 0.0, MAX_INTENSITY_CD)?;
+        if intensity > 0.0 && srgb_to_linear3(color).max_element() == 0.0 {
+            return Err(t.error("color", "is black: a lamp with intensity needs a colour"));
+        }
+        lamps.push(Lamp {
+            name: t.opt_str("name")?.unwrap_or(kind).to_string(),
+            position: t.point("position", None)?,
+            intensity_cd: intensity,
+            color,
+            spot,
+            casts_shadow: t.bool_or("casts_shadow", true)?,
+        });
+        t.finish()?;
+    }
+    Ok(lamps)
 }

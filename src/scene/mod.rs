@@ -252,6 +252,52 @@ pub struct Obstacle {
     pub display_light: Option<DisplayLight>,
 }
 
+/// A lamp: a point light, or a spot (a street light, a headlight), in a scene lit in
+/// physical units. A surface of albedo ρ at distance d, at incidence θ from it, gains the
+/// luminance ρ I cos θ / (π d²), I its intensity towards the surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lamp {
+    pub name: String,
+    /// Where it shines from, world frame, metres.
+    pub position: DVec3,
+    /// Luminous intensity, cd, in [0, 1e7]: on its axis for a spot.
+    pub intensity_cd: f64,
+    /// Its chromaticity (sRGB in [0, 1]; scaled so that its luminance is the intensity).
+    pub color: [f64; 3],
+    /// `None`: it shines the same in every direction.
+    pub spot: Option<Spot>,
+    /// Whether what stands between it and a surface shades the surface (default true).
+    pub casts_shadow: bool,
+}
+
+/// A spot's beam: full intensity within `falloff` of its axis, none beyond `cone`, a
+/// smoothstep of the cosine between.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spot {
+    /// Unit axis, world frame.
+    pub direction: DVec3,
+    /// Cosine of the half angle beyond which it gives nothing (`cone_deg`, (0, 90]).
+    pub cos_cone: f64,
+    /// Cosine of the half angle within which it gives its full intensity (`falloff_deg`,
+    /// [0, cone]).
+    pub cos_falloff: f64,
+}
+
+impl Spot {
+    /// The fraction of the axis's intensity towards the unit direction `to` (from the lamp).
+    pub fn profile(&self, to: DVec3) -> f64 {
+        let cos = self.direction.dot(to);
+        if cos >= self.cos_falloff {
+            return 1.0;
+        }
+        if cos <= self.cos_cone {
+            return 0.0;
+        }
+        let t = (cos - self.cos_cone) / (self.cos_falloff - self.cos_cone);
+        t * t * (3.0 - 2.0 * t)
+    }
+}
+
 /// A display's light: what it emits for an image, and what it reflects of the light that
 /// falls on it. Its colour channels emit `black + (peak − black) × the frontal image's
 /// linear value clamped to [0, 1]`, the image's 1.0 being the scene's white
@@ -320,6 +366,8 @@ pub struct Scene {
     /// The light in physical units: `Some` once `[sun] illuminance_lux` is given; `None`
     /// for a scene lit in relative units (`[sun] intensity`, `[sky] ambient`).
     pub photometry: Option<Photometry>,
+    /// The `[[light]]` lamps (a photometric scene's only), world frame.
+    pub lights: Vec<Lamp>,
     pub materials: Vec<Material>,
     pub objects: Vec<Object>,
     pub obstacle: Obstacle,

@@ -41,6 +41,7 @@ impl Scene {
         let (sun, sun_lux) = read_sun(&root)?;
         let (sky, zenith_cd_m2) = read_sky(&root, sun_lux)?;
         let photometry = read_photometry(&root, &sun, &sky, sun_lux, zenith_cd_m2)?;
+        let lights = crate::scene::light_keys::read_lights(&root, photometry.as_ref())?;
         let materials = read_materials(&root, file)?;
         let mut objects = read_objects(&root, &materials, file)?;
         let obstacle_table = root
@@ -70,6 +71,7 @@ impl Scene {
             sun,
             sky,
             photometry,
+            lights,
             materials,
             objects,
             obstacle,
