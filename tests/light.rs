@@ -6,8 +6,8 @@ mod common;
 
 use std::path::Path;
 
-use common::{parse, seethru};
-use exr::prelude::{FlatSamples, read_all_flat_layers_from_file};
+use common::parse;
+use common::photometric::{WALL_SUN_LUX, exr_channels, lit_wall_scene, luminance, seethru_on};
 use seethru::scene::light_keys::sun_direction;
 use seethru::util::color::srgb_to_linear;
 
@@ -48,52 +48,14 @@ size = [100000.0, 100000.0]
     )
 }
 
-/// The truth view's EXR (colour), read with the exr crate alone: per pixel the luminance
-/// Y = 0.2126 R + 0.7152 G + 0.0722 B, and whether the pixel shows the floor (its ids
-/// PNG's colour is not the sky's black).
+/// The truth view's EXR, read with the exr crate alone: per pixel the luminance and whether
+/// the pixel shows the floor (an object id that is not the sky's 0).
 fn rendered_luminance(dir: &Path, scene: &str) -> Vec<(f64, bool)> {
-    let file = dir.join("scene.toml");
-    std::fs::write(&file, scene).unwrap();
-    let out = dir.join("out");
-    let (ok, _, stderr) = seethru(&[
-        "render",
-        file.to_str().unwrap(),
-        "--view",
-        "truth",
-        "--exr",
-        "lean",
-        "--quiet",
-        "--spp",
-        "1",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(ok, "{stderr}");
-    let image = read_all_flat_layers_from_file(out.join("truth.exr")).unwrap();
-    let layer = &image.layer_data[0];
-    let channel = |name: &str| -> Vec<f32> {
-        let c = (layer.channel_data.list.iter())
-            .find(|c| c.name.to_string() == name)
-            .unwrap_or_else(|| panic!("no channel {name}"));
-        match &c.sample_data {
-            FlatSamples::F32(v) => v.clone(),
-            _ => panic!("{name} is not f32"),
-        }
-    };
-    let ids = match &(layer.channel_data.list.iter())
-        .find(|c| c.name.to_string() == "id.object")
-        .unwrap()
-        .sample_data
-    {
-        FlatSamples::U32(v) => v.clone(),
-        _ => panic!("id.object is not u32"),
-    };
-    let (r, g, b) = (channel("R"), channel("G"), channel("B"));
-    (0..r.len())
-        .map(|i| {
-            let y = 0.2126 * r[i] as f64 + 0.7152 * g[i] as f64 + 0.0722 * b[i] as f64;
-            (y, ids[i] != 0)
-        })
+    let out = seethru_on(dir, scene, "render", &["--view", "truth", "--exr", "lean"]);
+    let channels = exr_channels(&out.join("truth.exr"));
+    let ids = &channels["id.object"];
+    (luminance(&channels).into_iter().enumerate())
+        .map(|(i, y)| (y, ids[i] != 0.0))
         .collect()
 }
 
@@ -372,100 +334,17 @@ fn a_photometric_exr_reads_back_in_units_of_the_white() {
     assert_eq!(meta.headers[0].own_attributes.white_luminance, Some(1.0));
 }
 
-/// A grey wall 20 m behind the display, lit by a white sun behind the driver (elevation 60°,
-/// so that the obstacle's shadow falls below the wall), no sky and a black ground: the wall's
-/// luminance is ρE cos h/π, and the display's face receives E cos h.
-fn display_scene(white: f64, display: &str) -> String {
-    format!(
-        r#"[sun]
-illuminance_lux = 50000
-color = [1.0, 1.0, 1.0]
-elevation_deg = 60
-azimuth_deg = 180
-[sky]
-zenith_luminance_cd_m2 = 0
-ground_color = [0.0, 0.0, 0.0]
-cloud_cover = 0
-[photometry]
-white_cd_m2 = {white}
-
-[obstacle]
-center = [0.0, 1.2, -0.8]
-width = 0.3
-height = 0.4
-{display}
-
-[camera.driver]
-position = [0.0, 1.2, 0.0]
-look_at = [0.0, 1.2, -10.0]
-half_angle_deg = 20.0
-resolution = [64, 36]
-
-[camera.frontal]
-resolution = [64, 36]
-
-[camera.back]
-resolution = [16, 12]
-
-[[material]]
-name = "grey"
-color = [0.6, 0.6, 0.6]
-
-[[object]]
-name = "wall"
-kind = "quad"
-material = "grey"
-size = [200.0, 200.0]
-translate = [0.0, 0.0, -20.0]
-"#
-    )
-}
+/// The frontal camera of the display tests.
+const FRONTAL: &str = "resolution = [64, 36]";
 
 /// Per pixel of `run`'s seethru view where the driver sees the display (the occluded view's
-/// id is the obstacle's), the luminance there, and the truth's luminance.
+/// id is the obstacle's), the luminance there and the truth's; and metrics.json.
 fn display_luminance(dir: &Path, scene: &str) -> (Vec<(f64, f64)>, serde_json::Value) {
-    let file = dir.join("scene.toml");
-    std::fs::write(&file, scene).unwrap();
-    let out = dir.join("out");
-    let _ = std::fs::remove_dir_all(&out);
-    let (ok, _, stderr) = seethru(&[
-        "run",
-        file.to_str().unwrap(),
-        "--spp",
-        "1",
-        "--band",
-        "30",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(ok, "{stderr}");
-    let read = |view: &str| -> (Vec<f64>, Vec<u32>) {
-        let image = read_all_flat_layers_from_file(out.join(format!("{view}.exr"))).unwrap();
-        let layer = &image.layer_data[0];
-        let find = |name: &str| {
-            &(layer.channel_data.list.iter())
-                .find(|c| c.name.to_string() == name)
-                .unwrap()
-                .sample_data
-        };
-        let f32s = |name| match find(name) {
-            FlatSamples::F32(v) => v.clone(),
-            _ => panic!(),
-        };
-        let ids = match find("id.object") {
-            FlatSamples::U32(v) => v.clone(),
-            _ => panic!(),
-        };
-        let (r, g, b) = (f32s("R"), f32s("G"), f32s("B"));
-        let y = (0..r.len())
-            .map(|i| 0.2126 * r[i] as f64 + 0.7152 * g[i] as f64 + 0.0722 * b[i] as f64)
-            .collect();
-        (y, ids)
-    };
-    let ((seethru, _), (truth, _), (_, occluded_ids)) =
-        (read("seethru"), read("truth"), read("occluded"));
-    let obstacle = *occluded_ids.iter().max().unwrap();
+    let out = seethru_on(dir, scene, "run", &["--band", "30"]);
+    let view = |name: &str| exr_channels(&out.join(format!("{name}.exr")));
+    let (seethru, truth) = (luminance(&view("seethru")), luminance(&view("truth")));
+    let occluded_ids = view("occluded")["id.object"].clone();
+    let obstacle = occluded_ids.iter().copied().fold(0.0, f64::max);
     let pixels = (0..seethru.len())
         .filter(|&i| occluded_ids[i] == obstacle)
         .map(|i| (seethru[i], truth[i]))
@@ -477,7 +356,7 @@ fn display_luminance(dir: &Path, scene: &str) -> (Vec<(f64, f64)>, serde_json::V
 #[test]
 fn a_display_emits_between_its_black_and_its_peak_and_reflects_the_light_on_it() {
     let dir = tempfile::tempdir().unwrap();
-    let (lux, h) = (50_000.0, 60f64.to_radians());
+    let (lux, h) = (WALL_SUN_LUX, 60f64.to_radians());
     let rho = f64::from(srgb_to_linear(0.6));
     let wall = rho * lux * h.cos() / std::f64::consts::PI;
     let face = lux * h.cos() / std::f64::consts::PI;
@@ -496,7 +375,8 @@ fn a_display_emits_between_its_black_and_its_peak_and_reflects_the_light_on_it()
             "display_peak_cd_m2 = {peak}\ndisplay_black_cd_m2 = {black}\n\
              display_reflectance = {reflectance}\n"
         );
-        let (pixels, metrics) = display_luminance(dir.path(), &display_scene(white, &display));
+        let (pixels, metrics) =
+            display_luminance(dir.path(), &lit_wall_scene(white, &display, FRONTAL));
         assert!(pixels.len() > 20, "{} display pixels", pixels.len());
         // metrics.json: every display pixel's ratio is the analytic one, and a visible step.
         let lum = &metrics["luminance"]["display"];
@@ -522,7 +402,7 @@ fn a_display_emits_between_its_black_and_its_peak_and_reflects_the_light_on_it()
     }
     // Without the keys, an ideal display: the wall's luminance, whatever the white, and no
     // visible step.
-    let (pixels, metrics) = display_luminance(dir.path(), &display_scene(wall / 4.0, ""));
+    let (pixels, metrics) = display_luminance(dir.path(), &lit_wall_scene(wall / 4.0, "", FRONTAL));
     for (seen, _) in pixels {
         assert!(relative_error(seen, wall) < 0.005, "{seen} vs {wall}");
     }
@@ -576,46 +456,12 @@ size = [100.0, 100.0]
 {extra_objects}"#
     );
     let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("scene.toml");
-    std::fs::write(&file, scene).unwrap();
-    let out = dir.path().join("out");
-    let (ok, _, stderr) = seethru(&[
-        "render",
-        file.to_str().unwrap(),
-        "--view",
-        "truth",
-        "--spp",
-        "1",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(ok, "{stderr}");
-    let image = read_all_flat_layers_from_file(out.join("truth.exr")).unwrap();
-    let layer = &image.layer_data[0];
-    let channel = |name: &str| -> Vec<f64> {
-        let c = (layer.channel_data.list.iter())
-            .find(|c| c.name.to_string() == name)
-            .unwrap_or_else(|| panic!("no channel {name}"));
-        match &c.sample_data {
-            FlatSamples::F32(v) => v.iter().map(|&x| f64::from(x)).collect(),
-            FlatSamples::U32(v) => v.iter().map(|&x| f64::from(x)).collect(),
-            FlatSamples::F16(_) => panic!(),
-        }
-    };
-    let (r, g, b) = (channel("R"), channel("G"), channel("B"));
-    let (px, py, pz, id) = (
-        channel("P.X"),
-        channel("P.Y"),
-        channel("P.Z"),
-        channel("id.object"),
-    );
-    (0..r.len())
-        .filter(|&i| id[i] == 1.0)
-        .map(|i| {
-            let y = 0.2126 * r[i] + 0.7152 * g[i] + 0.0722 * b[i];
-            (glam::DVec3::new(px[i], py[i], pz[i]), y)
-        })
+    let out = seethru_on(dir.path(), &scene, "render", &["--view", "truth"]);
+    let channels = exr_channels(&out.join("truth.exr"));
+    let [px, py, pz, id] = ["P.X", "P.Y", "P.Z", "id.object"].map(|c| &channels[c]);
+    (luminance(&channels).into_iter().enumerate())
+        .filter(|&(i, _)| id[i] == 1.0)
+        .map(|(i, y)| (glam::DVec3::new(px[i], py[i], pz[i]), y))
         .collect()
 }
 

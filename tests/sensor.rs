@@ -4,93 +4,30 @@
 
 mod common;
 
-use common::seethru;
-use exr::prelude::{FlatSamples, read_all_flat_layers_from_file};
+use common::photometric::{WALL_SUN_LUX as LUX, exr_channels, lit_wall_scene, seethru_on};
 use seethru::util::color::srgb_to_linear;
 
 const WHITE: f64 = 5000.0;
-const LUX: f64 = 50_000.0;
 
-/// A grey wall 20 m ahead, lit by a white sun 60° high behind the cameras (the obstacle's
-/// shadow falls below it), no sky: a flat field of luminance ρE cos 60°/π for the frontal
-/// camera, whose sensor takes `sensor` keys.
+/// The lit wall's flat field for the frontal camera (192 × 108 pixels, 30° half angle),
+/// whose sensor takes `sensor` keys.
 fn flat_field(exposure_ms: f64, sensor: &str) -> String {
-    format!(
-        r#"[sun]
-illuminance_lux = {LUX}
-color = [1.0, 1.0, 1.0]
-elevation_deg = 60
-azimuth_deg = 180
-[sky]
-zenith_luminance_cd_m2 = 0
-ground_color = [0.0, 0.0, 0.0]
-cloud_cover = 0
-[photometry]
-white_cd_m2 = {WHITE}
-
-[obstacle]
-center = [0.0, 1.2, -0.8]
-width = 0.3
-height = 0.4
-
-[camera.driver]
-position = [0.0, 1.2, 0.0]
-look_at = [0.0, 1.2, -10.0]
-resolution = [16, 9]
-
-[camera.frontal]
-half_angle_deg = 30.0
-resolution = [192, 108]
-exposure_ms = {exposure_ms}
-sensor = "emva"
-{sensor}
-
-[camera.back]
-resolution = [16, 12]
-
-[[material]]
-name = "grey"
-color = [0.6, 0.6, 0.6]
-
-[[object]]
-name = "wall"
-kind = "quad"
-material = "grey"
-size = [200.0, 200.0]
-translate = [0.0, 0.0, -20.0]
-"#
-    )
+    let frontal = format!(
+        "half_angle_deg = 30.0\nresolution = [192, 108]\nexposure_ms = {exposure_ms}\nsensor = \"emva\"\n{sensor}"
+    );
+    lit_wall_scene(WHITE, "", &frontal)
 }
 
 /// The frontal view's green channel in cd/m², as the EXR holds it.
 fn frontal_green(scene: &str) -> Vec<f64> {
     let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("scene.toml");
-    std::fs::write(&file, scene).unwrap();
-    let out = dir.path().join("out");
-    let (ok, _, stderr) = seethru(&[
+    let out = seethru_on(
+        dir.path(),
+        scene,
         "render",
-        file.to_str().unwrap(),
-        "--view",
-        "frontal",
-        "--exr",
-        "colour",
-        "--spp",
-        "1",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(ok, "{stderr}");
-    let image = read_all_flat_layers_from_file(out.join("frontal.exr")).unwrap();
-    let layer = &image.layer_data[0];
-    let g = (layer.channel_data.list.iter())
-        .find(|c| c.name.to_string() == "G")
-        .unwrap();
-    match &g.sample_data {
-        FlatSamples::F32(v) => v.iter().map(|&x| f64::from(x)).collect(),
-        _ => panic!("G is not f32"),
-    }
+        &["--view", "frontal", "--exr", "colour"],
+    );
+    exr_channels(&out.join("frontal.exr"))["G"].clone()
 }
 
 fn mean_and_variance(values: &[f64]) -> (f64, f64) {

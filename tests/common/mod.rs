@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod golden;
+pub mod photometric;
 pub mod python_env;
 pub mod refusal;
 
