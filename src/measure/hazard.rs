@@ -7,11 +7,13 @@
 use serde_json::json;
 
 use crate::geometry::camera::Camera;
+use crate::measure::luminance::WEBER_THRESHOLD;
 use crate::measure::metrics::MetricMaps;
 use crate::render::frame::Frame;
 use crate::render::frame_over::FrameView;
 use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
+use crate::scene::light_keys::luminance;
 use crate::system::pipeline::RunResult;
 
 /// Default bound of `--hazard-bound-arcmin`: a pixel counts as showing the hazard when the
@@ -36,6 +38,26 @@ pub struct HazardFrame {
     /// pixels that show it (any misregistration), arc-minutes, at the view's central pixel
     /// pitch; NaN when either set is empty.
     pub centroid_error_arcmin: f64,
+    /// Its luminance contrast, in a scene lit in physical units (`None` in any other).
+    pub contrast: Option<HazardContrast>,
+}
+
+/// A hazard's luminance contrast against its surround where the display hides it: the
+/// surround is the display region's pixels that do not show it (in the truth and in the
+/// see-through view, each its own). Weber contrasts (Y_object − Y_surround) / Y_surround,
+/// signed: negative for a dark pedestrian on a brighter road.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct HazardContrast {
+    /// The mean over its hidden truth pixels against the truth's surround; NaN without them.
+    pub truth: f64,
+    /// The mean over the display pixels that show it against the display's surround; NaN
+    /// when the display shows none of it.
+    pub seethru: f64,
+    /// Of the shown pixels (within the bound), those whose own contrast against the
+    /// display's surround clears [`WEBER_THRESHOLD`]: a driver can tell them from it.
+    pub visible_pixels: u64,
+    /// visible / hidden pixels, [0, 1]; NaN when nothing of it is hidden.
+    pub visibility: f64,
 }
 
 /// The hazards of one frame: `truth` and `seethru` are the driver views, `maps` the metric
@@ -80,6 +102,10 @@ pub fn hazard_frame(
                 shown += 1;
             }
         }
+        let contrast = scene
+            .photometry
+            .as_ref()
+            .map(|_| hazard_contrast(id, truth, seethru, maps, bound_arcmin, hidden));
         let centroid_error_arcmin = if hidden > 0 && shown_any > 0 {
             let (h, s) = (hidden as f64, shown_any as f64);
             let dx = hidden_sum[0] / h - shown_sum[0] / s;
@@ -100,9 +126,58 @@ pub fn hazard_frame(
                 f64::NAN
             },
             centroid_error_arcmin,
+            contrast,
         });
     }
     out
+}
+
+/// [`HazardContrast`] of object `id`, `hidden` of whose truth pixels the display hides.
+fn hazard_contrast(
+    id: u32,
+    truth: &Frame,
+    seethru: FrameView<'_>,
+    maps: &MetricMaps,
+    bound_arcmin: f64,
+    hidden: u64,
+) -> HazardContrast {
+    // Sums of luminance over (object, surround) in each view, display pixels only.
+    let (mut t, mut s) = ([0.0f64; 2], [0.0f64; 2]);
+    let (mut tn, mut sn) = ([0u64; 2], [0u64; 2]);
+    for i in (0..truth.object_id.len()).filter(|&i| maps.display[i]) {
+        let k = usize::from(truth.object_id[i] != id);
+        t[k] += f64::from(luminance(truth.color[i]));
+        tn[k] += 1;
+        let k = usize::from(seethru.get(|f| &f.object_id, i) != id);
+        s[k] += f64::from(luminance(seethru.get(|f| &f.color, i)));
+        sn[k] += 1;
+    }
+    let weber = |sum: [f64; 2], n: [u64; 2]| {
+        let (object, surround) = (sum[0] / n[0] as f64, sum[1] / n[1] as f64);
+        (object - surround) / surround
+    };
+    let surround = s[1] / sn[1] as f64;
+    let visible_pixels = (0..truth.object_id.len())
+        .filter(|&i| {
+            maps.display[i]
+                && truth.object_id[i] == id
+                && seethru.get(|f| &f.object_id, i) == id
+                && maps.misregistration[i] as f64 <= bound_arcmin
+        })
+        .filter(|&i| {
+            let y = f64::from(luminance(seethru.get(|f| &f.color, i)));
+            ((y - surround) / surround).abs() >= WEBER_THRESHOLD
+        })
+        .count() as u64;
+    HazardContrast {
+        truth: weber(t, tn),
+        seethru: weber(s, sn),
+        visible_pixels,
+        visibility: match hidden {
+            0 => f64::NAN,
+            h => visible_pixels as f64 / h as f64,
+        },
+    }
 }
 
 /// The `hazards` block of metrics.json.
@@ -110,15 +185,27 @@ pub fn hazards_json(hazards: &[HazardFrame], bound_arcmin: f64) -> serde_json::V
     json!({
         "bound_arcmin": bound_arcmin,
         "definition": "per object with hazard = true: of its truth pixels where the driver sees the display (hidden by the pillar), the fraction the seethru view shows as the same object id within bound_arcmin of misregistration; visibility is null (NaN) when nothing of it is hidden",
-        "objects": hazards.iter().map(|h| json!({
-            "name": h.name,
-            "id": h.id,
-            "truth_pixels": h.truth_pixels,
-            "hidden_pixels": h.hidden_pixels,
-            "shown_pixels": h.shown_pixels,
-            "visibility": h.visibility.is_finite().then_some(h.visibility),
-            "centroid_error_arcmin": h.centroid_error_arcmin.is_finite().then_some(h.centroid_error_arcmin),
-        })).collect::<Vec<_>>(),
+        "objects": hazards.iter().map(|h| {
+            let mut object = json!({
+                "name": h.name,
+                "id": h.id,
+                "truth_pixels": h.truth_pixels,
+                "hidden_pixels": h.hidden_pixels,
+                "shown_pixels": h.shown_pixels,
+                "visibility": h.visibility.is_finite().then_some(h.visibility),
+                "centroid_error_arcmin": h.centroid_error_arcmin.is_finite().then_some(h.centroid_error_arcmin),
+            });
+            if let Some(c) = &h.contrast {
+                object["contrast"] = json!({
+                    "truth": c.truth.is_finite().then_some(c.truth),
+                    "seethru": c.seethru.is_finite().then_some(c.seethru),
+                    "visible_pixels": c.visible_pixels,
+                    "visibility": c.visibility.is_finite().then_some(c.visibility),
+                    "weber_threshold": WEBER_THRESHOLD,
+                });
+            }
+            object
+        }).collect::<Vec<_>>(),
     })
 }
 
@@ -378,6 +465,7 @@ mod tests {
                 shown_pixels: 0,
                 visibility,
                 centroid_error_arcmin: f64::NAN,
+                contrast: None,
             },
             seen_off_pixels: off,
             seen_on_pixels: on,
@@ -407,5 +495,40 @@ mod tests {
                 frames_out_of_view: 2,
             }]
         );
+    }
+
+    /// The frame of the test above, with luminance: in the truth the pedestrian is 0.2 and
+    /// the display's other pixels 1; on the display its pixels are 1, but 1.99 at (3,1), and
+    /// the rest 2.
+    #[test]
+    fn a_hazards_contrast_is_its_weber_contrast_against_the_rest_of_the_display() {
+        let (w, h) = (4u32, 3u32);
+        let at = |x: u32, y: u32| (y * w + x) as usize;
+        let p = 7;
+        let (mut truth, mut seethru) = (Frame::new(w, h), Frame::new(w, h));
+        let n = (w * h) as usize;
+        truth.color = vec![glam::Vec3::ONE; n];
+        seethru.color = vec![glam::Vec3::splat(2.0); n];
+        for (x, y) in [(0, 0), (1, 0), (1, 1), (2, 1), (3, 1), (0, 2)] {
+            truth.object_id[at(x, y)] = p;
+            truth.color[at(x, y)] = glam::Vec3::splat(0.2);
+        }
+        for (x, y) in [(0, 0), (1, 1), (2, 1), (3, 1), (2, 2)] {
+            seethru.object_id[at(x, y)] = p;
+            seethru.color[at(x, y)] = glam::Vec3::ONE;
+        }
+        seethru.color[at(3, 1)] = glam::Vec3::splat(1.99);
+        let display = (0..n).map(|i| i % w as usize >= 1).collect();
+        let mut maps = MetricMaps::of_masks([w, h], vec![0.5; n], display, vec![false; n]);
+        maps.misregistration[at(2, 1)] = 100.0;
+        let c = hazard_contrast(p, &truth, (&seethru).into(), &maps, 10.0, 4);
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-6;
+        assert!(close(c.truth, (0.2 - 1.0) / 1.0), "{}", c.truth);
+        let shown_mean = (1.0 + 1.0 + 1.99 + 1.0) / 4.0;
+        assert!(close(c.seethru, (shown_mean - 2.0) / 2.0), "{}", c.seethru);
+        // Shown within the bound: (1,1), a contrast of −0.5, and (3,1), of −0.005: one
+        // pixel a driver can tell from the road, a quarter of the hidden ones.
+        assert_eq!(c.visible_pixels, 1);
+        assert_eq!(c.visibility, 0.25);
     }
 }
