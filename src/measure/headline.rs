@@ -97,7 +97,7 @@ pub const RUN_HEADLINES: [Headline; 13] = [
     },
     Headline {
         name: "luminance.ratio_log2.median",
-        pointer: "/luminance/display/ratio_log2_median",
+        pointer: "/luminance/display/ratio_log2/median",
         tolerance: 0.01,
         about: "median of log2(display luminance / the truth's) over the display, stops (a scene lit in physical units)",
     },

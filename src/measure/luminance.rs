@@ -12,7 +12,6 @@
 
 use serde::Serialize;
 
-use crate::measure::metrics_json::Stats;
 use crate::render::frame_over::FrameView;
 use crate::scene::Photometry;
 use crate::scene::light_keys::luminance;
@@ -47,9 +46,7 @@ pub struct LuminanceRegion {
     pub seethru_mean_cd_m2: f64,
     /// log2(Y_seethru / Y_truth), stops: 0 where the display matches the world, −3 where it
     /// gives an eighth of its light.
-    pub ratio_log2: Stats,
-    /// The median of that ratio, stops.
-    pub ratio_log2_median: f64,
+    pub ratio_log2: RatioStats,
     /// Fraction of the pixels whose Weber contrast to the truth is above the threshold.
     pub visible_share: f64,
 }
@@ -87,6 +84,42 @@ pub fn luminance_metrics(
     }
 }
 
+/// The statistics of a region's log2 ratios (NaN without any).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct RatioStats {
+    pub count: usize,
+    pub mean: f64,
+    /// The smallest value with half of the values at or below it.
+    pub median: f64,
+    /// The smallest value with 95 % of the values at or below it.
+    pub p95: f64,
+    pub min: f64,
+    pub max: f64,
+}
+
+impl RatioStats {
+    /// The statistics of `values` (sorted in place).
+    fn of(values: &mut [f64]) -> RatioStats {
+        values.sort_by(f64::total_cmp);
+        let n = values.len();
+        let at = |q: f64| match n {
+            0 => f64::NAN,
+            _ => crate::util::quantile::nearest_rank(values, q),
+        };
+        RatioStats {
+            count: n,
+            mean: match n {
+                0 => f64::NAN,
+                _ => values.iter().sum::<f64>() / n as f64,
+            },
+            median: at(0.5),
+            p95: at(0.95),
+            min: values.first().copied().unwrap_or(f64::NAN),
+            max: values.last().copied().unwrap_or(f64::NAN),
+        }
+    }
+}
+
 impl LuminanceRegion {
     /// The statistics of (truth, seethru) luminance pairs, cd/m².
     pub fn of(pairs: &[(f64, f64)]) -> LuminanceRegion {
@@ -102,17 +135,13 @@ impl LuminanceRegion {
         let visible = (kept.iter())
             .filter(|(t, s)| (s - t).abs() / t > WEBER_THRESHOLD)
             .count();
-        let ratio_log2 = Stats::of(&mut ratios);
+        let ratio_log2 = RatioStats::of(&mut ratios);
         LuminanceRegion {
             pixels: n,
             pixels_left_out: pairs.len() - n,
             truth_mean_cd_m2: mean(|p| p.0),
             seethru_mean_cd_m2: mean(|p| p.1),
             ratio_log2,
-            ratio_log2_median: match n {
-                0 => f64::NAN,
-                _ => crate::util::quantile::nearest_rank(&ratios, 0.5),
-            },
             visible_share: match n {
                 0 => f64::NAN,
                 _ => visible as f64 / n as f64,
@@ -141,7 +170,8 @@ mod tests {
         assert_eq!(r.visible_share, 1.0 / 3.0);
         assert_eq!(r.truth_mean_cd_m2, 250.0 / 3.0);
         assert_eq!(r.seethru_mean_cd_m2, 254.0 / 3.0);
-        assert_eq!(r.ratio_log2_median, 1.01f64.log2());
+        assert_eq!(r.ratio_log2.median, 1.01f64.log2());
+        assert_eq!(r.ratio_log2.min, 0.0);
         assert_eq!(r.ratio_log2.max, 1.03f64.log2());
         // A step just inside the threshold is not visible; one darker beyond it is.
         let r = LuminanceRegion::of(&[(100.0, 98.5), (100.0, 97.0)]);

@@ -842,4 +842,34 @@ mod tests {
             );
         }
     }
+
+    /// The outline's candidates on one grey row: skin up to x = 100, then an S-shaped fall
+    /// over 10 px to a dark background, and a sharp step to bright at x = 127, 66.5 px (1.1
+    /// face widths) past the right pupil. The fall gives candidates from its steepest point
+    /// on (the 2-px differences sampled every half pixel come in equal pairs, so each pair's
+    /// end on the falling side that still steps by 60 levels is one), none before it; and the
+    /// scan, 1.2 face widths long, reaches the far step.
+    #[test]
+    fn a_blurred_edge_gives_candidates_from_its_steepest_point_and_the_scan_reaches_past_a_face_width()
+     {
+        let (w, h) = (220usize, 9usize);
+        let fall = [200u8, 190, 170, 140, 110, 80, 60, 48, 42, 40];
+        let grey = |x: usize| match x {
+            0..100 => 200,
+            100..110 => fall[x - 100],
+            110..127 => 40,
+            _ => 240,
+        };
+        let mut frame = Frame::new(w as u32, h as u32);
+        for (i, c) in frame.color.iter_mut().enumerate() {
+            *c = Vec3::splat(decode_srgb8(grey(i % w)));
+        }
+        let skin: Vec<bool> = (0..w * h).map(|i| i % w < 100).collect();
+        let pupils = [DVec2::new(40.5, 4.5), DVec2::new(60.5, 4.5)];
+        let [_, right] = edge_candidates(&frame, encode_srgb8, &skin, pupils, 20.0, 60.0);
+        let xs: Vec<f64> = right.iter().map(|p| p.x).collect();
+        // Steepest at 104.5 (pixels 103 and 105: 140 − 80 = 60 levels a channel, 180 summed),
+        // then the pairs' ends at 105.5 (150) and 106.5 (96); 107.5 steps by 54, under 60.
+        assert_eq!(xs, [104.5, 105.5, 106.5, 127.5], "{right:?}");
+    }
 }
