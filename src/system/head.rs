@@ -807,6 +807,24 @@ mod tests {
         // equal to green, or green to blue.
         assert!(!is_skin([36, 36, 28]) && !is_skin([40, 30, 30]));
         assert!(!is_skin([80, 80, 80]));
+        // Blue's chromaticity must exceed 0.20: 40 of 200 is not enough, 41 of 201 is.
+        assert!(!is_skin([90, 70, 40]) && is_skin([90, 70, 41]));
+    }
+
+    /// The detector's errors say what went wrong and what to look at, as the run's error
+    /// line prints them.
+    #[test]
+    fn detection_errors_say_what_is_missing() {
+        let no_face = DetectError::NoFace.to_string();
+        assert!(
+            no_face.contains("no face found") && no_face.contains("in its view"),
+            "{no_face}"
+        );
+        let pupils = DetectError::Pupils(3).to_string();
+        assert!(
+            pupils.contains("found 3 pupil candidates") && pupils.contains("need 2"),
+            "{pupils}"
+        );
     }
 
     /// A w × h image of skin at luminance `skin` (grey, plus `slope` per pixel to the
