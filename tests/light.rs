@@ -400,6 +400,36 @@ fn a_display_emits_between_its_black_and_its_peak_and_reflects_the_light_on_it()
             );
         }
     }
+    // A lamp of 100 cd half a metre in front of the display's centre: the face reflects 5 %
+    // of its I cos θ / d² besides the sun's, pixel by pixel (the display's points from the
+    // occluded view).
+    let lamp = glam::DVec3::new(0.0, 1.2, -0.3);
+    let display = format!(
+        "display_peak_cd_m2 = {peak}\ndisplay_black_cd_m2 = {black}\ndisplay_reflectance = 0.05\n"
+    );
+    let scene = lit_wall_scene(2.0 * wall, &display, FRONTAL).replace(
+        "[obstacle]",
+        "[[light]]\nposition = [0.0, 1.2, -0.3]\nintensity_cd = 100.0\n\n[obstacle]",
+    );
+    let out = seethru_on(dir.path(), &scene, "run", &["--exr", "all"]);
+    let occluded = exr_channels(&out.join("occluded.exr"));
+    let seethru = luminance(&exr_channels(&out.join("seethru.exr")));
+    let obstacle = occluded["id.object"].iter().copied().fold(0.0, f64::max);
+    let mut checked = 0;
+    for i in (0..seethru.len()).filter(|&i| occluded["id.object"][i] == obstacle) {
+        let at = glam::DVec3::new(occluded["P.X"][i], occluded["P.Y"][i], occluded["P.Z"][i]);
+        let to = lamp - at;
+        let lamp_lux = 100.0 * (to.z / to.length()) / to.length_squared();
+        let expected =
+            black + (peak - black) * 0.5 + 0.05 * (face + lamp_lux / std::f64::consts::PI);
+        assert!(
+            relative_error(seethru[i], expected) < 0.005,
+            "at {at}: {} vs {expected}",
+            seethru[i]
+        );
+        checked += 1;
+    }
+    assert!(checked > 20, "{checked}");
     // Without the keys, an ideal display: the wall's luminance, whatever the white, and no
     // visible step.
     let (pixels, metrics) = display_luminance(dir.path(), &lit_wall_scene(wall / 4.0, "", FRONTAL));

@@ -395,7 +395,7 @@ impl RenderContext {
 
     /// What a display of light `light` gives off where it shows `shown` (the frontal
     /// image's radiance) at `face`: its emission ([`DisplayLight`]) and the light its face
-    /// reflects, in the scene's units.
+    /// reflects (the sky's, the ground's, the lamps' and the sun's), in the scene's units.
     fn display_light(
         &self,
         light: &DisplayLight,
@@ -417,7 +417,8 @@ impl RenderContext {
             return emitted;
         }
         let cos = face.normal.dot(self.sky.sun_direction);
-        let mut received = self.sky.ambient(face.normal);
+        let mut received =
+            self.sky.ambient(face.normal) + self.lamps_at(face, view, stack, shadows);
         if cos > 0.0 {
             *shadows += 1;
             let ray = shadow_ray(face.position, face.normal, self.sky.sun_direction);
