@@ -13,8 +13,8 @@ use crate::render::frame::Frame;
 use crate::render::frame_over::FrameView;
 use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
-use crate::scene::light_keys::luminance;
 use crate::system::pipeline::RunResult;
+use crate::util::color::luminance;
 
 /// Default bound of `--hazard-bound-arcmin`: a pixel counts as showing the hazard when the
 /// shown point is within this angle of the true one, arc-minutes.

@@ -14,7 +14,7 @@ use serde::Serialize;
 
 use crate::render::frame_over::FrameView;
 use crate::scene::Photometry;
-use crate::scene::light_keys::luminance;
+use crate::util::color::luminance;
 
 /// Weber contrast a driver sees as a step (photopic, large targets; see the module's note).
 pub const WEBER_THRESHOLD: f64 = 0.02;

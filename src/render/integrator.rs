@@ -24,10 +24,10 @@ use crate::render::screen::{Screen, Shown};
 use crate::render::shutter_rays::{CameraAt, PoseAt, ShutterRays};
 use crate::render::simd::Isa;
 use crate::render::sky::SkyModel;
-use crate::scene::light_keys::luminance;
 use crate::scene::texture::Texture;
 use crate::scene::world::{SurfaceHit, SurfaceMaterial, World, view_bit};
 use crate::scene::{DisplayLight, Scene};
+use crate::util::color::luminance;
 use crate::util::color::srgb_to_linear3;
 use crate::util::sampling::pixel_offset;
 

@@ -349,7 +349,7 @@ mod tests {
         let error = (irradiance - ambient).abs() / ambient;
         assert!(error.max_element() < 1e-3, "{irradiance} vs {ambient}");
         // And the zenith's luminance is the stated one, in units of the white.
-        let zenith = crate::scene::light_keys::luminance(m.radiance(Vec3::Y));
+        let zenith = crate::util::color::luminance(m.radiance(Vec3::Y));
         assert!((zenith - 6.0).abs() < 1e-5, "{zenith}");
     }
 
@@ -370,9 +370,7 @@ mod tests {
                 let phi = (j as f32 + 0.5) / 32.0 * std::f32::consts::TAU;
                 let s = (1.0 - cos * cos).sqrt();
                 let dir = to_sun * cos + (axis.0 * phi.cos() + axis.1 * phi.sin()) * s;
-                sum += f64::from(crate::scene::light_keys::luminance(
-                    m.radiance(dir.normalize()),
-                ));
+                sum += f64::from(crate::util::color::luminance(m.radiance(dir.normalize())));
             }
         }
         let collected = sum * f64::from(cone) / n as f64 / 32.0 * std::f64::consts::TAU;
@@ -382,7 +380,7 @@ mod tests {
             "{collected} vs {expected}"
         );
         // And a surface facing the sun gets E/π (Lambert's albedo 1).
-        let facing = crate::scene::light_keys::luminance(m.sun_irradiance);
+        let facing = crate::util::color::luminance(m.sun_irradiance);
         assert!((f64::from(facing) - expected / std::f64::consts::PI).abs() < 1e-3 * expected);
     }
 
@@ -394,7 +392,7 @@ mod tests {
         let (m, sky, sun) = photometric(lux, zenith, white);
         let albedo = srgb_to_linear3(sky.ground_color);
         let sun_colour = srgb_to_linear3(sun.color);
-        let sun_part = sun_colour / crate::scene::light_keys::luminance(sun_colour)
+        let sun_part = sun_colour / crate::util::color::luminance(sun_colour)
             * (lux / white / std::f64::consts::PI * sun.direction.y) as f32;
         let expected = albedo * (sun_part + m.ambient(Vec3::Y));
         assert!(

@@ -18,12 +18,6 @@ pub const MAX_SKY_CD_M2: f64 = 100_000.0;
 /// The range of the luminance shown as white: from below starlight to above the sun's disc.
 pub const WHITE_CD_M2_RANGE: (f64, f64) = (1e-6, 1e10);
 
-/// The luminance Y of linear Rec. 709 / sRGB primaries (ITU-R BT.709): what "cd/m²" means of
-/// an RGB radiance.
-pub fn luminance(rgb: glam::Vec3) -> f32 {
-    0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z
-}
-
 /// The unit direction towards a sun at `elevation_deg` above the horizon and `azimuth_deg`
 /// clockwise from north seen from above, in the world frame: y up, north −z, east +x (the
 /// axes OpenDRIVE's x east, y north map onto).

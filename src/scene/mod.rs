@@ -174,7 +174,7 @@ impl Photometry {
         let zenith = crate::util::color::srgb_to_linear3(sky.zenith_color);
         match self.sky_zenith_cd_m2 {
             0.0 => 0.0,
-            l => l / f64::from(light_keys::luminance(zenith)),
+            l => l / f64::from(crate::util::color::luminance(zenith)),
         }
     }
 
@@ -183,7 +183,7 @@ impl Photometry {
         let colour = crate::util::color::srgb_to_linear3(sun.color);
         match self.sun_illuminance_lux {
             0.0 => 0.0,
-            lux => lux / f64::from(light_keys::luminance(colour)),
+            lux => lux / f64::from(crate::util::color::luminance(colour)),
         }
     }
 
@@ -193,9 +193,9 @@ impl Photometry {
     pub fn lit_white_cd_m2(&self, sun: &Sun, sky: &Sky) -> f64 {
         let sun_part = self.sun_illuminance_lux * sun.direction.y.max(0.0) / std::f64::consts::PI;
         let [zenith, horizon] = [sky.zenith_color, sky.horizon_color].map(|c| {
-            f64::from(light_keys::luminance(crate::util::color::srgb_to_linear3(
-                c,
-            )))
+            f64::from(crate::util::color::luminance(
+                crate::util::color::srgb_to_linear3(c),
+            ))
         });
         sun_part + self.sky_cd_m2_per_unit(sky) * Sky::cosine_mean(horizon, zenith)
     }

@@ -6,7 +6,7 @@
 //! largest dark holes inside it. The known feature `A` is the interpupillary distance, whose
 //! midpoint is the eye point the compensation needs, so no face-model offsets are involved.
 
-use glam::{DAffine3, DMat3, DVec2, DVec3};
+use glam::{DAffine3, DMat3, DVec2, DVec3, Vec3};
 
 use crate::analysis::paper::{head_distance, head_offset};
 use crate::geometry::camera::Camera;
@@ -102,8 +102,9 @@ pub(crate) fn is_skin([r, g, b]: [u8; 3]) -> bool {
     (0.36..0.50).contains(&rc) && (0.28..0.37).contains(&gc) && bc > 0.20
 }
 
+/// The Rec. 709 luminance of 8-bit codes, [0, 255] ([`crate::util::color::luminance`]).
 pub(crate) fn luminance([r, g, b]: [u8; 3]) -> f32 {
-    0.2126 * r as f32 + 0.7152 * g as f32 + 0.0722 * b as f32
+    crate::util::color::luminance(Vec3::new(r as f32, g as f32, b as f32))
 }
 
 /// Connected components (4-neighbour) of the pixels of `rect` where `mask` is true, as pixel

@@ -109,6 +109,13 @@ impl Srgb8Table {
     }
 }
 
+/// The luminance Y of linear Rec. 709 / sRGB primaries (ITU-R BT.709): what "cd/m²" means of
+/// an RGB radiance, and the weight of a code's channels where the head detector compares
+/// brightness.
+pub fn luminance(rgb: Vec3) -> f32 {
+    0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z
+}
+
 /// Rec. 709 luma of 8-bit sRGB code values, [0, 255]: what SSIM compares.
 pub fn luma(c: [u8; 3]) -> f64 {
     0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64
@@ -156,6 +163,14 @@ mod tests {
     }
 
     /// Rec. 709's weights: each primary's share of white, white itself 255.
+    #[test]
+    fn luminance_weighs_the_primaries_as_rec_709() {
+        assert_eq!(luminance(Vec3::X), 0.2126);
+        assert_eq!(luminance(Vec3::Y), 0.7152);
+        assert_eq!(luminance(Vec3::Z), 0.0722);
+        assert!((luminance(Vec3::splat(3.0)) - 3.0).abs() < 1e-6);
+    }
+
     #[test]
     fn luma_weighs_the_primaries_as_rec_709() {
         let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
