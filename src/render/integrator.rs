@@ -59,6 +59,40 @@ pub struct RenderContext {
     /// What moves, at one instant of a sequence: traced beside `world` (which then holds only
     /// what stands still); `None` everywhere else.
     pub moving: Option<Arc<MovingLayer>>,
+    /// The scene's lamps ready for shading ([`lamps_of`]).
+    pub lamps: Arc<[LampShading]>,
+}
+
+/// A `[[light]]` lamp as the shading reads it, computed once per context rather than per
+/// lit point.
+#[derive(Clone, Copy, Debug)]
+pub struct LampShading {
+    position: Vec3,
+    /// Linear colour × intensity / (π × white × the colour's luminance): times cos θ / d²,
+    /// the lamp's irradiance over π in units of the white.
+    per_unit: Vec3,
+    spot: Option<crate::scene::Spot>,
+    casts_shadow: bool,
+}
+
+/// The lamps of `scene` ready for shading (none outside a photometric scene).
+pub fn lamps_of(scene: &Scene) -> Arc<[LampShading]> {
+    let Some(photometry) = &scene.photometry else {
+        return Arc::from([]);
+    };
+    (scene.lights.iter())
+        .map(|lamp| {
+            let colour = srgb_to_linear3(lamp.color);
+            let scale = lamp.intensity_cd
+                / (std::f64::consts::PI * photometry.white_cd_m2 * f64::from(luminance(colour)));
+            LampShading {
+                position: lamp.position.as_vec3(),
+                per_unit: colour * scale as f32,
+                spot: lamp.spot,
+                casts_shadow: lamp.casts_shadow,
+            }
+        })
+        .collect()
 }
 
 /// What every pixel of one render shares.
@@ -109,12 +143,14 @@ impl RenderContext {
             || SkyModel::new(&scene.sky, &scene.sun, scene.photometry.as_ref()),
         );
         let (world, accel) = built?;
+        let lamps = lamps_of(&scene);
         Ok(Self {
             scene,
             world: Arc::new(world),
             accel: Arc::new(accel),
             sky: Arc::new(sky),
             moving: None,
+            lamps,
         })
     }
 
@@ -139,12 +175,14 @@ impl RenderContext {
             let accel = Accel::build(&world)?;
             (Arc::new(world), Arc::new(accel))
         };
+        let lamps = lamps_of(&scene);
         Ok(Self {
             scene,
             world,
             accel,
             sky,
             moving: None,
+            lamps,
         })
     }
 
@@ -539,13 +577,9 @@ impl RenderContext {
     /// the cosine over the squared distance, where its shadow ray reaches it. The same
     /// rays, one at a time, on the per-ray and the packet paths.
     fn lamps_at(&self, s: &SurfaceHit, view: u8, stack: &mut Stack, shadows: &mut u64) -> Vec3 {
-        let (Some(photometry), false) = (&self.scene.photometry, self.scene.lights.is_empty())
-        else {
-            return Vec3::ZERO;
-        };
         let mut sum = Vec3::ZERO;
-        for lamp in &self.scene.lights {
-            let to = lamp.position.as_vec3() - s.position;
+        for lamp in self.lamps.iter() {
+            let to = lamp.position - s.position;
             let d2 = to.length_squared();
             let cos = s.normal.dot(to);
             if d2 <= 0.0 || cos <= 0.0 {
@@ -553,7 +587,7 @@ impl RenderContext {
             }
             let d = d2.sqrt();
             let dir = to / d;
-            let profile = lamp.spot.map_or(1.0, |spot| spot.profile(-dir.as_dvec3()));
+            let profile = lamp.spot.map_or(1.0, |spot| spot.profile(-dir.as_dvec3())) as f32;
             if profile == 0.0 {
                 continue;
             }
@@ -568,10 +602,7 @@ impl RenderContext {
                     continue;
                 }
             }
-            let colour = srgb_to_linear3(lamp.color);
-            let scale = lamp.intensity_cd * profile
-                / (std::f64::consts::PI * photometry.white_cd_m2 * f64::from(luminance(colour)));
-            sum += colour * (scale as f32 * (cos / d) / d2);
+            sum += lamp.per_unit * (profile * (cos / d) / d2);
         }
         sum
     }
@@ -580,7 +611,7 @@ impl RenderContext {
     #[inline]
     fn shade_end(&self, sh: Shading, lit: bool) -> Vec3 {
         let mut light = sh.light;
-        if !self.scene.lights.is_empty() {
+        if !self.lamps.is_empty() {
             light += sh.lamps;
         }
         if lit {

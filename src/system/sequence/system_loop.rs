@@ -254,8 +254,10 @@ impl SystemLoop {
         let rig = &self.rig;
         let layer = self.parts.at(&|id| rig.object_motion(t, id))?;
         self.seconds.moving += start.elapsed().as_secs_f64();
+        let scene = self.rig.scene_at(t);
         Ok(RenderContext {
-            scene: self.rig.scene_at(t),
+            lamps: crate::render::integrator::lamps_of(&scene),
+            scene,
             world: self.world.clone(),
             accel: self.accel.clone(),
             sky: self.sky.clone(),
