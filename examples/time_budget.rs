@@ -46,7 +46,7 @@ fn time_renders(das: &Scene) -> Result<()> {
         yaw_rate_deg_s: 20.0,
         ..RunOptions::default()
     }
-    .vehicle_motion(das.eye());
+    .vehicle_motion(das)?;
     let pose_at = move |dt: f64| motion.world_from_rig(dt) * base.world_from_camera;
     let settings = |spp| RenderSettings {
         spp,

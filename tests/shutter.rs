@@ -469,7 +469,7 @@ fn carried(
     system: &seethru::system::sequence::system_loop::SystemLoop,
     t: f64,
 ) -> impl Fn(f64) -> DAffine3 + Sync + use<> {
-    let vehicle = system.rig.vehicle;
+    let vehicle = system.rig.vehicle.clone();
     let base = system.rig.base.frontal.world_from_camera;
     move |dt: f64| vehicle.world_from_rig(t + dt) * base
 }

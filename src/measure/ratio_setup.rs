@@ -362,5 +362,6 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
         calibration: Default::default(),
         eyellipse: None,
         face: crate::scene::DriverFace::Ellipsoids,
+        ego_route: None,
     })
 }

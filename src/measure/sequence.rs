@@ -283,7 +283,7 @@ impl SequenceStepper {
                 )
             },
             vehicle_position: rig.transform_point3(system.rig.vehicle.pivot),
-            vehicle_yaw_deg: (system.rig.vehicle.yaw_rate * times.display).to_degrees(),
+            vehicle_yaw_deg: system.rig.vehicle.yaw_at(times.display).to_degrees(),
             d2_used: shown.d2_used,
             metrics: None,
             hazards: Vec::new(),

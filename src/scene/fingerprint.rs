@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
-use crate::scene::mesh_io::load_mesh;
+use crate::scene::mesh_io::shape_mesh;
 use crate::scene::texture::Texture;
 use crate::scene::{Scene, Shape};
 use crate::util::hash::Fnv64;
@@ -24,13 +24,17 @@ pub fn fingerprint(scene: &Scene) -> Result<String> {
     key.path = PathBuf::new();
     let mut seen = HashSet::new();
     for object in &mut key.objects {
-        if let Shape::Mesh { path } = &mut object.shape {
-            // The mesh's content, in the order the objects place it (a second placement of
-            // the same file adds its name only).
+        let file = match &mut object.shape {
+            Shape::Mesh { path } | Shape::Road { path, .. } => Some(path),
+            _ => None,
+        };
+        if let Some(path) = file {
+            // The mesh's content (a road map's: its triangles as baked), in the order the
+            // objects place it (a second placement of the same file adds its name only).
             let first = seen.insert(path.clone());
             write!(hash, "mesh {first};").ok();
             if first {
-                let mesh = load_mesh(path)?;
+                let mesh = shape_mesh(&object.shape).expect("a file's shape")?;
                 for tri in &mesh.tris {
                     for v in tri.p.iter().flat_map(|p| p.to_array()) {
                         hash.bytes(&v.to_bits().to_le_bytes());
@@ -43,7 +47,9 @@ pub fn fingerprint(scene: &Scene) -> Result<String> {
                 }
                 write!(hash, "{:?}", mesh.materials).ok();
             }
-            *path = PathBuf::new();
+            if let Shape::Mesh { path } | Shape::Road { path, .. } = &mut object.shape {
+                *path = PathBuf::new();
+            }
         }
         if object.shape == Shape::HeadMesh {
             // The built-in head: the files built into the binary.

@@ -67,6 +67,9 @@ pub fn shape_mesh(shape: &crate::scene::Shape) -> Option<Result<LoadedMesh>> {
     match shape {
         crate::scene::Shape::Mesh { path } => Some(load_mesh(path)),
         crate::scene::Shape::HeadMesh => Some(Ok(builtin_head().clone())),
+        crate::scene::Shape::Road { path, colors } => {
+            Some(crate::scene::road_map::load_road(path, colors))
+        }
         _ => None,
     }
 }

@@ -13,6 +13,7 @@ pub mod fingerprint;
 pub mod grow;
 pub mod head_model;
 pub mod head_path;
+pub mod lane_route;
 pub mod lens_keys;
 pub mod light_keys;
 pub mod limits;
@@ -21,6 +22,8 @@ pub mod mesh_io;
 pub mod motion;
 pub mod procedural;
 pub mod read;
+pub mod road_keys;
+pub mod road_map;
 pub mod sensor_keys;
 pub mod shapes;
 pub mod shutter_keys;
@@ -51,6 +54,8 @@ pub enum CameraKind {
 
 impl CameraKind {
     pub const NAMES: [&'static str; 3] = ["driver", "frontal", "back"];
+    /// The bits of every camera: an object all of them see.
+    pub const ALL: u8 = 0b111;
 
     pub fn bit(self) -> u8 {
         1 << self as u8
@@ -102,6 +107,12 @@ pub enum Shape {
     Quad { size: [f64; 2] },
     /// Triangle mesh from an OBJ or glTF/GLB file.
     Mesh { path: PathBuf },
+    /// The road of `[road] xodr`: an OpenDRIVE map's lanes, marks, kerb faces and objects,
+    /// in the map's frame (`scene/road_map.rs`); the object's transform places the map.
+    Road {
+        path: PathBuf,
+        colors: road_map::RoadColors,
+    },
     /// The built-in head mesh (`scene/head_model.rs`, the triangles of `assets/head.obj`,
     /// built into the binary): the driver's face of `[camera.driver] face = "mesh"`.
     HeadMesh,
@@ -118,6 +129,7 @@ impl Shape {
             Shape::Cone { .. } => "cone",
             Shape::Quad { .. } => "quad",
             Shape::Mesh { .. } | Shape::HeadMesh => "mesh",
+            Shape::Road { .. } => "road",
         }
     }
 }
@@ -386,6 +398,11 @@ pub struct Scene {
     /// The driver's face the back camera films (`[camera.driver] face`); it chooses the head
     /// tracker of `--head estimated`.
     pub face: DriverFace,
+    /// The lane route the vehicle drives in a `sequence` (and during a run's frontal
+    /// exposure) at option `speed`, where `[road]` places it in a lane of a map: world frame,
+    /// from the lane's centre at t = 0. `None`: the vehicle drives straight along −z, turning
+    /// at option `yaw_rate`.
+    pub ego_route: Option<lane_route::LaneRoute>,
 }
 
 /// The driver's face (`[camera.driver] face`), and with it the head tracker `--head

@@ -6,6 +6,7 @@
 
 use glam::{DAffine3, DQuat, DVec3, EulerRot};
 
+use crate::scene::lane_route::LaneRoute;
 use crate::scene::limits::out_of_world;
 use crate::scene::source::SceneError;
 use crate::scene::table_reader::TableReader;
@@ -227,25 +228,37 @@ pub fn check_keyframed_mesh(
     Ok(())
 }
 
-/// The vehicle's motion: constant speed along its heading, constant yaw rate, on flat ground
-/// (+y up). The rig — obstacle, cameras, driver, and every object that moves with the vehicle —
-/// is rigid; its pivot is the driver's eye at t = 0 (so a pure yaw turns the view about the
-/// eye), and at t = 0 the rig is where the scene file puts it.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The vehicle's motion: constant speed along its heading, on flat ground (+y up) turning at
+/// a constant yaw rate, or along a lane of a map (`route`). The rig — obstacle, cameras,
+/// driver, and every object that moves with the vehicle — is rigid; at t = 0 it is where the
+/// scene file puts it.
+#[derive(Clone, Debug, PartialEq)]
 pub struct VehicleMotion {
     /// Speed along the heading, m/s.
     pub speed: f64,
-    /// Yaw rate, rad/s, positive turning left (counter-clockwise seen from above, about +y).
+    /// Yaw rate, rad/s, positive turning left (counter-clockwise seen from above, about +y);
+    /// 0 with a route.
     pub yaw_rate: f64,
     /// Unit heading at t = 0, horizontal, world frame.
     pub forward: DVec3,
-    /// The pivot (the eye at t = 0), world frame.
+    /// The pivot of the yaw rate's turn (the eye at t = 0), world frame.
     pub pivot: DVec3,
+    /// The lane the vehicle follows, if the scene places it in one: the lane's centre point
+    /// under the vehicle moves along it at `speed`, the vehicle turning with the lane's
+    /// heading and rising with its elevation (it does not pitch or roll with grade and
+    /// bank).
+    pub route: Option<std::sync::Arc<LaneRoute>>,
 }
 
 impl VehicleMotion {
     /// world_from_rig at time `t` (s), where the rig frame is the world frame at t = 0.
     pub fn world_from_rig(&self, t: f64) -> DAffine3 {
+        if let Some(route) = &self.route {
+            let (start, now) = (route.pose_at(0.0), route.pose_at(self.speed * t));
+            return DAffine3::from_translation(now.position)
+                * DAffine3::from_rotation_y(yaw_between(start.heading, now.heading))
+                * DAffine3::from_translation(-start.position);
+        }
         let (w, v, f) = (self.yaw_rate, self.speed, self.forward);
         let left = DVec3::Y.cross(f);
         // ∫₀ᵗ v (cos ωs f + sin ωs left) ds, with its limit ω → 0.
@@ -258,6 +271,22 @@ impl VehicleMotion {
             * DAffine3::from_rotation_y(w * t)
             * DAffine3::from_translation(-self.pivot)
     }
+
+    /// How far the vehicle has turned at `t`, radians, positive to the left.
+    pub fn yaw_at(&self, t: f64) -> f64 {
+        match &self.route {
+            Some(route) => yaw_between(
+                route.pose_at(0.0).heading,
+                route.pose_at(self.speed * t).heading,
+            ),
+            None => self.yaw_rate * t,
+        }
+    }
+}
+
+/// The angle about +y that turns horizontal `from` onto horizontal `to`, in (−π, π].
+fn yaw_between(from: DVec3, to: DVec3) -> f64 {
+    from.cross(to).y.atan2(from.dot(to))
 }
 
 #[cfg(test)]
@@ -271,6 +300,7 @@ mod tests {
             yaw_rate: 0.5,
             forward: DVec3::NEG_Z,
             pivot: DVec3::new(1.0, 1.2, 0.0),
+            route: None,
         };
         // Numerical integration of the pivot's velocity against the closed form.
         let (mut p, steps, t) = (m.pivot, 20_000, 3.0);
@@ -286,7 +316,10 @@ mod tests {
         assert!((heading.x + (1.5f64).sin()).abs() < 1e-12 && heading.x < 0.0);
         // Straight and still: identity at t = 0, a pure translation without yaw.
         assert!(m.world_from_rig(0.0).abs_diff_eq(DAffine3::IDENTITY, 1e-12));
-        let straight = VehicleMotion { yaw_rate: 0.0, ..m };
+        let straight = VehicleMotion {
+            yaw_rate: 0.0,
+            ..m.clone()
+        };
         let moved = straight.world_from_rig(2.0).transform_point3(DVec3::ZERO);
         assert!((moved - DVec3::new(0.0, 0.0, -20.0)).length() < 1e-12);
     }

@@ -2,7 +2,7 @@
 //! defaulted as `scenes/reference.toml` documents.
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::{DAffine3, DMat3, DQuat, DVec3, EulerRot};
 
@@ -42,8 +42,13 @@ impl Scene {
         let (sky, zenith_cd_m2) = read_sky(&root, sun_lux)?;
         let photometry = read_photometry(&root, &sun, &sky, sun_lux, zenith_cd_m2)?;
         let lights = crate::scene::light_keys::read_lights(&root, photometry.as_ref())?;
-        let materials = read_materials(&root, file)?;
-        let mut objects = read_objects(&root, &materials, file)?;
+        let materials = read_materials(&root)?;
+        let mut objects = read_objects(&root, &materials)?;
+        let road = crate::scene::road_keys::read_road(&root, &objects)?;
+        let ego_route = road.and_then(|road| {
+            objects.push(road.object);
+            road.route
+        });
         let obstacle_table = root
             .table("obstacle")?
             .ok_or_else(|| root.error("obstacle", "the scene needs an [obstacle] table"))?;
@@ -81,6 +86,7 @@ impl Scene {
             calibration,
             eyellipse,
             face,
+            ego_route,
         })
     }
 }
@@ -110,7 +116,7 @@ fn bounded_tables<'a>(
     Ok(tables)
 }
 
-fn read_materials(root: &TableReader, file: &SourceFile) -> Result<Vec<Material>, SceneError> {
+fn read_materials(root: &TableReader) -> Result<Vec<Material>, SceneError> {
     let mut materials: Vec<Material> = Vec::new();
     let mut first_line: HashMap<String, Option<usize>> = HashMap::new();
     for (i, t) in bounded_tables(root, "material", MAX_MATERIALS)?
@@ -127,7 +133,7 @@ fn read_materials(root: &TableReader, file: &SourceFile) -> Result<Vec<Material>
             ));
         }
         let texture = match t.opt_str("texture")? {
-            Some(rel) => Some(existing_asset(&t, "texture", rel, file)?),
+            Some(rel) => Some(t.existing_asset("texture", rel)?),
             None => None,
         };
         materials.push(Material {
@@ -142,25 +148,6 @@ fn read_materials(root: &TableReader, file: &SourceFile) -> Result<Vec<Material>
 }
 
 /// Resolves an asset path relative to the scene file and checks that it exists.
-fn existing_asset(
-    t: &TableReader,
-    key: &str,
-    rel: &str,
-    file: &SourceFile,
-) -> Result<PathBuf, SceneError> {
-    let path = file.dir().join(rel);
-    if let Some(why) = crate::util::input_file::not_a_file(&path) {
-        return Err(t.error(
-            key,
-            format!(
-                "cannot read `{rel}` (resolved against the scene's folder: {}): {why}",
-                path.display()
-            ),
-        ));
-    }
-    Ok(path)
-}
-
 fn read_transform(t: &TableReader) -> Result<DAffine3, SceneError> {
     let (translate, [rx, ry, rz], scale) = read_placement(t)?;
     // Rotations apply about x, then y, then z (world axes).
@@ -191,11 +178,7 @@ fn read_placement(t: &TableReader) -> Result<(DVec3, [f64; 3], [f64; 3]), SceneE
 }
 
 /// Reads every `[[object]]`, within the limits on objects and triangles.
-fn read_objects(
-    root: &TableReader,
-    materials: &[Material],
-    file: &SourceFile,
-) -> Result<Vec<Object>, SceneError> {
+fn read_objects(root: &TableReader, materials: &[Material]) -> Result<Vec<Object>, SceneError> {
     let by_name: HashMap<&str, usize> = materials
         .iter()
         .enumerate()
@@ -210,7 +193,7 @@ fn read_objects(
         .into_iter()
         .enumerate()
     {
-        let object = read_object(&t, materials, &by_name, file)?;
+        let object = read_object(&t, materials, &by_name)?;
         if let Some(name) = t.opt_str("name")?
             && let Some(first) = named.insert(name.to_string(), t.error("name", "").line)
         {
@@ -247,7 +230,7 @@ fn triangle_count(shape: &Shape) -> usize {
     match shape {
         Shape::Plane { .. } | Shape::Quad { .. } => 2,
         Shape::Box { .. } => 12,
-        Shape::Sphere { .. } | Shape::Mesh { .. } | Shape::HeadMesh => 0,
+        Shape::Sphere { .. } | Shape::Mesh { .. } | Shape::HeadMesh | Shape::Road { .. } => 0,
         Shape::Cylinder { segments, .. } => 4 * segments,
         Shape::Cone { segments, .. } => 2 * segments,
     }
@@ -269,7 +252,7 @@ fn object_bounds(shape: &Shape) -> Vec<DVec3> {
         Shape::Quad { size: [x, y] } => {
             (DVec3::new(-x, -y, 0.0) / 2.0, DVec3::new(x, y, 0.0) / 2.0)
         }
-        Shape::Mesh { .. } | Shape::HeadMesh => return Vec::new(),
+        Shape::Mesh { .. } | Shape::HeadMesh | Shape::Road { .. } => return Vec::new(),
     };
     (0..8)
         .map(|i| {
@@ -286,7 +269,6 @@ fn read_object(
     t: &TableReader,
     materials: &[Material],
     by_name: &HashMap<&str, usize>,
-    file: &SourceFile,
 ) -> Result<Object, SceneError> {
     let kind = t.choice("kind", "", &OBJECT_KINDS).map_err(|e| {
         if t.has("kind") {
@@ -340,7 +322,7 @@ fn read_object(
                 ));
             }
             Shape::Mesh {
-                path: existing_asset(t, "path", rel, file)?,
+                path: t.existing_asset("path", rel)?,
             }
         }
     };
@@ -364,9 +346,9 @@ fn read_object(
         }
     };
     let hidden = t.str_list("hidden_from", &CameraKind::NAMES)?;
-    let visible_to = hidden
-        .iter()
-        .fold(0b111u8, |mask, name| mask & !CameraKind::parse(name).bit());
+    let visible_to = hidden.iter().fold(CameraKind::ALL, |mask, name| {
+        mask & !CameraKind::parse(name).bit()
+    });
     let shape_for_bounds = shape.clone();
     Ok(Object {
         name,
@@ -519,7 +501,7 @@ pub fn face_object(face: DriverFace, eye: DVec3) -> Option<Object> {
         material: None,
         world_from_object: DAffine3::from_translation(eye)
             * DAffine3::from_rotation_y(yaw_deg.to_radians()),
-        visible_to: 0b111 & !CameraKind::Driver.bit(),
+        visible_to: CameraKind::ALL & !CameraKind::Driver.bit(),
         casts_shadow: true,
         hazard: false,
         motion: crate::scene::motion::ObjectMotion {

@@ -220,6 +220,13 @@ impl<'a> TableReader<'a> {
         min: usize,
         max: usize,
     ) -> Result<Option<usize>, SceneError> {
+        Ok(self
+            .opt_i64(key, min as i64, max as i64)?
+            .map(|v| v as usize))
+    }
+
+    /// An integer in [`min`, `max`], if given.
+    pub fn opt_i64(&self, key: &str, min: i64, max: i64) -> Result<Option<i64>, SceneError> {
         let Some(item) = self.item(key) else {
             return Ok(None);
         };
@@ -229,13 +236,29 @@ impl<'a> TableReader<'a> {
                 format!("expected an integer, found {}", item.type_name()),
             )
         })?;
-        if value < min as i64 || value > max as i64 {
+        if value < min || value > max {
             return Err(self.error(
                 key,
                 format!("must be an integer in [{min}, {max}], got {value}"),
             ));
         }
-        Ok(Some(value as usize))
+        Ok(Some(value))
+    }
+
+    /// The file a path key names, resolved against the scene's folder; an error if it is not
+    /// a readable file.
+    pub fn existing_asset(&self, key: &str, rel: &str) -> Result<std::path::PathBuf, SceneError> {
+        let path = self.file.dir().join(rel);
+        if let Some(why) = crate::util::input_file::not_a_file(&path) {
+            return Err(self.error(
+                key,
+                format!(
+                    "cannot read `{rel}` (resolved against the scene's folder: {}): {why}",
+                    path.display()
+                ),
+            ));
+        }
+        Ok(path)
     }
 
     pub fn usize_in(

@@ -155,7 +155,7 @@ impl World {
         // texture's error comes first, then a file's when its first object is reached, as if
         // read in turn.
         let mesh_path = |shape: &Shape| match shape {
-            Shape::Mesh { path } => Some(path.clone()),
+            Shape::Mesh { path } | Shape::Road { path, .. } => Some(path.clone()),
             Shape::HeadMesh => Some(PathBuf::from("(built-in head mesh)")),
             _ => None,
         };
@@ -240,7 +240,7 @@ impl World {
                     segments,
                 } => frustum(*radius as f32, 0.0, *height as f32, *segments),
                 Shape::Quad { size } => quad_xy(size2(*size), 0),
-                Shape::Mesh { .. } | Shape::HeadMesh => {
+                Shape::Mesh { .. } | Shape::HeadMesh | Shape::Road { .. } => {
                     let path = &mesh_path(&object.shape).expect("a mesh shape");
                     let mesh = match meshes.get(path).expect("read above") {
                         Ok(mesh) => mesh,

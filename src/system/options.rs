@@ -3,6 +3,7 @@
 
 use crate::geometry::camera::Camera;
 use crate::render::settings::resized;
+use crate::scene::Scene;
 use crate::scene::limits::{MAX_COORDINATE, MIN_LENGTH};
 use crate::scene::motion::VehicleMotion;
 use crate::system::display::{DisplayModel, Filter};
@@ -170,15 +171,23 @@ pub struct RunOptions {
 }
 
 impl RunOptions {
-    /// The vehicle's motion at `speed_kmh` and `yaw_rate_deg_s` along world −z, about
-    /// `pivot` (the driver's eye at t = 0, world frame).
-    pub fn vehicle_motion(&self, pivot: DVec3) -> VehicleMotion {
-        VehicleMotion {
+    /// The vehicle's motion at `speed_kmh`: along the scene's lane route where `[road]`
+    /// places the vehicle in a lane (a yaw rate is then refused: the lane turns it), else
+    /// along world −z turning at `yaw_rate_deg_s` about the driver's eye.
+    pub fn vehicle_motion(&self, scene: &Scene) -> anyhow::Result<VehicleMotion> {
+        if scene.ego_route.is_some() && self.yaw_rate_deg_s != 0.0 {
+            anyhow::bail!(
+                "option `yaw_rate` ({} °/s) would turn the vehicle off its lane: the scene's [road] places it in a lane, which it follows at option `speed`; leave the yaw rate out, or choose the way at junctions with [road] turns",
+                short(self.yaw_rate_deg_s)
+            );
+        }
+        Ok(VehicleMotion {
             speed: self.speed_kmh / 3.6,
             yaw_rate: self.yaw_rate_deg_s.to_radians(),
             forward: DVec3::NEG_Z,
-            pivot,
-        }
+            pivot: scene.eye(),
+            route: scene.ego_route.clone().map(std::sync::Arc::new),
+        })
     }
 
     /// The driver's camera (as given, before the eye is chosen) at `--width`/`--height`.

@@ -389,6 +389,7 @@ pub fn frontal_pose_at(
     if options.speed_kmh == 0.0 && options.yaw_rate_deg_s == 0.0 {
         return Ok(None);
     }
+    let motion = options.vehicle_motion(scene)?;
     if scene.frontal.shutter.is_instant() {
         let given = if options.speed_kmh != 0.0 {
             "speed"
@@ -399,7 +400,6 @@ pub fn frontal_pose_at(
             "option `{given}` moves the frontal camera during its readout and exposure, but its shutter is an instant (a global shutter, exposure_ms 0): set shutter = \"rolling\" or exposure_ms in [camera.frontal], or leave the option out"
         );
     }
-    let motion = options.vehicle_motion(scene.eye());
     let base = scene.frontal.world_from_camera;
     Ok(Some(move |dt: f64| motion.world_from_rig(dt) * base))
 }

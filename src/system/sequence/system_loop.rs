@@ -185,7 +185,7 @@ impl SystemLoop {
         base.frontal = run.sized_frontal(base.frontal)?;
         base.back = run.sized_back(base.back)?;
         base.driver = driver_camera(&base, run)?;
-        let vehicle = options.run.vehicle_motion(base.eye());
+        let vehicle = options.run.vehicle_motion(&base)?;
         let rig = Rig::new(base, vehicle, options.head.clone());
         let tl = options.timeline;
         let before = scene
@@ -576,7 +576,7 @@ impl SystemLoop {
         job: RenderJob,
         frame: &mut Frame,
     ) -> Result<()> {
-        let vehicle = self.rig.vehicle;
+        let vehicle = self.rig.vehicle.clone();
         let pose_at = move |dt: f64| vehicle.world_from_rig(t + dt) * base.world_from_camera;
         let job = job.moving(&pose_at);
         render_in_time(ctx, &mut |at| self.context_at(at), t, job, frame)?;
