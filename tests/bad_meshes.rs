@@ -671,7 +671,7 @@ fn gltf_files_tobj_or_the_gltf_crate_misread_are_refused_naming_what_is_wrong() 
                 "1 nodes",
             ],
         ),
-        // Mesh textures are not read: refused rather than dropped without a word.
+        // A texture whose image is missing: named, with where it was looked for.
         (
             base.replace(
                 r#""pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}"#,
@@ -681,14 +681,19 @@ fn gltf_files_tobj_or_the_gltf_crate_misread_are_refused_naming_what_is_wrong() 
                 r#""meshes""#,
                 r#""textures": [{"source": 0}], "images": [{"uri": "paint.png"}], "meshes""#,
             ),
-            &[
-                "material `paint`",
-                "baseColorTexture",
-                "`paint.png`",
-                "mesh textures are not read",
-                "baseColorFactor",
-                "[[material]]",
-            ],
+            &["image 0", "cannot read `paint.png`", "glTF file's folder"],
+        ),
+        // Another texture coordinate set than TEXCOORD_0.
+        (
+            base.replace(
+                r#""pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}"#,
+                r#""pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}}"#,
+            )
+            .replace(
+                r#""meshes""#,
+                r#""textures": [{"source": 0}], "images": [{"uri": "paint.png"}], "meshes""#,
+            ),
+            &["material `paint`", "TEXCOORD_1", "only TEXCOORD_0"],
         ),
         (String::new(), &["not a GLB/glTF", "empty"]),
         ("PK\u{3}\u{4}zip".into(), &["not a GLB/glTF", "`PK"]),

@@ -46,6 +46,12 @@ pub fn fingerprint(scene: &Scene) -> Result<String> {
                     hash.bytes(&tri.file_material.map_or(u64::MAX, u64::from).to_le_bytes());
                 }
                 write!(hash, "{:?}", mesh.materials).ok();
+                for texture in &mesh.textures {
+                    write!(hash, "texture {}×{};", texture.width, texture.height).ok();
+                    for v in texture.texels.iter().flat_map(|t| t.to_array()) {
+                        hash.bytes(&v.to_bits().to_le_bytes());
+                    }
+                }
             }
             if let Shape::Mesh { path } | Shape::Road { path, .. } = &mut object.shape {
                 *path = PathBuf::new();

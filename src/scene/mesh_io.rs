@@ -16,6 +16,7 @@ use std::io::{BufReader, Cursor};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
+use base64::Engine;
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::scene::limits::{MAX_MESH_BYTES, MAX_TRIANGLES, first_bad_vertex};
@@ -23,14 +24,18 @@ use crate::scene::mesh_checks::{
     check_glb_header, check_mtl_lines, check_usemtl_names, clipped, obj_error_line, validated,
 };
 use crate::scene::shapes::Tri;
+use crate::scene::texture::Texture;
 use crate::util::number::{short, short_list};
 
 /// A material that a mesh file defines.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FileMaterial {
     pub name: String,
-    /// Base colour, linear RGB in [0, 1].
+    /// Base colour, linear RGB in [0, 1]; multiplied with the texture where there is one.
     pub linear_color: [f32; 3],
+    /// Its base-colour texture: an index into [`LoadedMesh::textures`], sampled at the
+    /// triangles' uv (a glTF `baseColorTexture`, repeating).
+    pub texture: Option<usize>,
 }
 
 /// Triangles of a mesh file, in the file's own frame (glTF node transforms applied).
@@ -38,6 +43,8 @@ pub struct FileMaterial {
 pub struct LoadedMesh {
     pub tris: Vec<Tri>,
     pub materials: Vec<FileMaterial>,
+    /// The images its materials' textures use, each decoded once.
+    pub textures: Vec<Texture>,
 }
 
 /// Reads a file that a mesh refers to, within [`MAX_MESH_BYTES`].
@@ -228,6 +235,7 @@ pub fn parse_obj(
             .map(|m| FileMaterial {
                 name: m.name.clone(),
                 linear_color: m.diffuse.unwrap_or([0.8; 3]),
+                texture: None,
             })
             .collect(),
         ..Default::default()
@@ -309,15 +317,13 @@ pub fn parse_gltf(
                 short(f64::from(alpha))
             );
         }
-        if let Some(t) = pbr.base_color_texture() {
-            let image = match t.texture().source().source() {
-                gltf::image::Source::Uri { uri, .. } => format!("`{}`", clipped(uri)),
-                gltf::image::Source::View { view, .. } => format!("bufferView {}", view.index()),
-            };
+        if let Some(t) = pbr.base_color_texture()
+            && t.tex_coord() != 0
+        {
             bail!(
-                "material `{}` has a baseColorTexture (texture {}, image {image}): mesh textures are not read; bake the colour into baseColorFactor, or give the object a scene [[material]] with `texture`",
+                "material `{}` samples its baseColorTexture at TEXCOORD_{}: only TEXCOORD_0 is read",
                 clipped(&name),
-                t.texture().index()
+                t.tex_coord()
             );
         }
     }
@@ -335,21 +341,32 @@ pub fn parse_gltf(
         }
     }
     let buffers = load_buffers(&doc, blob, path, read)?;
-    let mut out = LoadedMesh {
-        materials: doc
-            .materials()
-            .map(|m| {
-                let c = m.pbr_metallic_roughness().base_color_factor();
-                FileMaterial {
-                    name: m
-                        .name()
-                        .map_or_else(|| format!("#{}", m.index().unwrap_or(0)), String::from),
-                    linear_color: [c[0], c[1], c[2]],
+    let mut out = LoadedMesh::default();
+    // Each image decoded once, however many materials use it.
+    let mut decoded: Vec<Option<usize>> = vec![None; doc.images().len()];
+    for m in doc.materials() {
+        let pbr = m.pbr_metallic_roughness();
+        let c = pbr.base_color_factor();
+        let texture = match pbr.base_color_texture() {
+            Some(t) => {
+                let image = t.texture().source();
+                let i = image.index();
+                if decoded[i].is_none() {
+                    out.textures.push(gltf_image(&image, &buffers, path, read)?);
+                    decoded[i] = Some(out.textures.len() - 1);
                 }
-            })
-            .collect(),
-        ..Default::default()
-    };
+                decoded[i]
+            }
+            None => None,
+        };
+        out.materials.push(FileMaterial {
+            name: m
+                .name()
+                .map_or_else(|| format!("#{}", m.index().unwrap_or(0)), String::from),
+            linear_color: [c[0], c[1], c[2]],
+            texture,
+        });
+    }
     let scene = doc.default_scene().or_else(|| doc.scenes().next());
     let Some(scene) = scene else {
         bail!("the file has no scene")
@@ -430,6 +447,59 @@ fn load_buffers(
         out.push(data);
     }
     Ok(out)
+}
+
+/// The texture of glTF image `image`: a bufferView, a base64 `data:` URI or a file beside the
+/// glTF; PNG only.
+fn gltf_image(
+    image: &gltf::Image,
+    buffers: &[Vec<u8>],
+    path: &Path,
+    read: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
+) -> Result<Texture> {
+    let i = image.index();
+    let bytes = match image.source() {
+        gltf::image::Source::View { view, .. } => {
+            let buffer = &buffers[view.buffer().index()];
+            let range = view.offset()..view.offset().saturating_add(view.length());
+            buffer
+                .get(range)
+                .with_context(|| {
+                    format!(
+                        "image {i}: bufferView {} reaches past the end of buffer {} ({} bytes)",
+                        view.index(),
+                        view.buffer().index(),
+                        buffer.len()
+                    )
+                })?
+                .to_vec()
+        }
+        gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => {
+            let (_, payload) = uri.split_once(";base64,").with_context(|| {
+                format!("image {i}: its data URI is not base64 (`data:…;base64,…`)")
+            })?;
+            base64::engine::general_purpose::STANDARD
+                .decode(payload)
+                .map_err(|e| anyhow!("image {i}: its data URI is not valid base64: {e}"))?
+        }
+        gltf::image::Source::Uri { uri, .. } => {
+            let dir = path.parent().unwrap_or(Path::new(""));
+            let resolved = resolve_uri(dir, uri).with_context(|| {
+                format!(
+                    "image {i}: unsupported URI `{}` (use a relative path, a data: URI or a bufferView)",
+                    clipped(uri)
+                )
+            })?;
+            read(&resolved).with_context(|| {
+                format!(
+                    "image {i}: cannot read `{}` (resolved against the glTF file's folder: {})",
+                    clipped(uri),
+                    resolved.display()
+                )
+            })?
+        }
+    };
+    Texture::decode(&bytes).with_context(|| format!("image {i}"))
 }
 
 /// A relative URI (percent-encoded) resolved against `dir`; `None` for schemes and absolute

@@ -16,6 +16,7 @@ use xodr::{LaneType, RoadNetwork, RoadPosition};
 use crate::scene::limits::MAX_MESH_BYTES;
 use crate::scene::mesh_io::{FileMaterial, LoadedMesh};
 use crate::scene::shapes::Tri;
+use crate::scene::source::one_line;
 use crate::util::color::srgb_to_linear3;
 use crate::util::input_file::read_input_text;
 
@@ -70,11 +71,18 @@ impl Default for RoadColors {
 pub fn read_network(path: &Path) -> Result<RoadNetwork> {
     let xml = read_input_text(path, MAX_MESH_BYTES).context("cannot read it")?;
     let folder = path.parent().unwrap_or(Path::new("")).to_path_buf();
-    let read_include = |name: &str| {
+    parse_network(&xml, |name: &str| {
         read_input_text(&folder.join(name), MAX_MESH_BYTES).map_err(|e| format!("{name}: {e}"))
-    };
-    let (network, _) = xodr::load_str_with(&xml, read_include)
-        .map_err(|e| anyhow!("not a usable OpenDRIVE map: {e}"))?;
+    })
+}
+
+/// Bakes a map's text, `read_include` giving the text of each file an `<include>` names.
+pub fn parse_network(
+    xml: &str,
+    read_include: impl FnMut(&str) -> Result<String, String>,
+) -> Result<RoadNetwork> {
+    let (network, _) = xodr::load_str_with(xml, read_include)
+        .map_err(|e| anyhow!("not a usable OpenDRIVE map: {}", one_line(&e.to_string())))?;
     if network.lanes().is_empty() {
         bail!("the map has no lanes to draw");
     }
@@ -127,6 +135,7 @@ pub fn road_triangles(network: &RoadNetwork, colors: &RoadColors) -> LoadedMesh 
         mesh.materials.push(FileMaterial {
             name,
             linear_color: srgb_to_linear3(srgb).to_array(),
+            texture: None,
         });
         mesh.materials.len() as u32 - 1
     };

@@ -47,44 +47,65 @@ impl Texture {
     /// Loads an sRGB PNG of at most [`MAX_RESOLUTION`] pixels per side.
     pub fn load(path: &Path) -> Result<Texture> {
         crate::util::input_file::note_input(path);
-        let decode = || -> Result<image::DynamicImage> {
-            // The image crate's errors repeat their text as their source ("Invalid PNG
-            // signature.: Invalid PNG signature."): shown once, as text.
-            let text = |e: image::ImageError| anyhow::anyhow!("{e}");
-            let open =
-                || -> Result<_> { Ok(image::ImageReader::open(path)?.with_guessed_format()?) };
-            // The size first: the crate's "Image size exceeds limit" names neither.
-            let (width, height) = open()?.into_dimensions().map_err(text)?;
-            if width > MAX_RESOLUTION
-                || height > MAX_RESOLUTION
-                || u64::from(width) * u64::from(height) > MAX_PIXELS
-            {
-                anyhow::bail!(
-                    "the image is {width}×{height} px; a texture is at most {MAX_RESOLUTION} px a side and {MAX_RESOLUTION}×{} px in all",
-                    MAX_PIXELS / u64::from(MAX_RESOLUTION)
-                );
-            }
-            let mut reader = open()?;
-            let mut limits = image::Limits::default();
-            limits.max_image_width = Some(MAX_RESOLUTION);
-            limits.max_image_height = Some(MAX_RESOLUTION);
-            limits.max_alloc = Some(4 * MAX_PIXELS);
-            reader.limits(limits);
-            reader.decode().map_err(text)
-        };
-        let img = decode()
-            .with_context(|| format!("cannot load texture {}", path.display()))?
-            .to_rgb8();
-        Ok(Texture {
-            width: img.width(),
-            height: img.height(),
-            // By table (das's street: 4–9 ms of its start with a `powf` per channel, then 1.5–3).
-            texels: img
-                .pixels()
-                .map(|p| Vec3::from(p.0.map(decode_srgb8)))
-                .collect(),
-        })
+        let open = || -> Result<_> { Ok(image::ImageReader::open(path)?.with_guessed_format()?) };
+        decode_with(open).with_context(|| format!("cannot load texture {}", path.display()))
     }
+
+    /// Decodes an sRGB PNG held in memory (a glTF's embedded image), within the same limits.
+    pub fn decode(bytes: &[u8]) -> Result<Texture> {
+        if !bytes.starts_with(b"\x89PNG") {
+            let start: String = bytes
+                .iter()
+                .take(4)
+                .map(|b| format!("{b:02x}"))
+                .collect::<Vec<_>>()
+                .join(" ");
+            anyhow::bail!(
+                "only PNG images are read, and this one starts with the bytes {start}, not a PNG's 89 50 4e 47: convert it to PNG"
+            );
+        }
+        let open = || -> Result<_> {
+            Ok(image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format()?)
+        };
+        decode_with(open)
+    }
+}
+
+/// Decodes the image `open` gives (twice: the size is checked before the pixels are read)
+/// into linear texels.
+fn decode_with<R: std::io::BufRead + std::io::Seek>(
+    open: impl Fn() -> Result<image::ImageReader<R>>,
+) -> Result<Texture> {
+    // The image crate's errors repeat their text as their source ("Invalid PNG
+    // signature.: Invalid PNG signature."): shown once, as text.
+    let text = |e: image::ImageError| anyhow::anyhow!("{e}");
+    // The size first: the crate's "Image size exceeds limit" names neither.
+    let (width, height) = open()?.into_dimensions().map_err(text)?;
+    if width > MAX_RESOLUTION
+        || height > MAX_RESOLUTION
+        || u64::from(width) * u64::from(height) > MAX_PIXELS
+    {
+        anyhow::bail!(
+            "the image is {width}×{height} px; a texture is at most {MAX_RESOLUTION} px a side and {MAX_RESOLUTION}×{} px in all",
+            MAX_PIXELS / u64::from(MAX_RESOLUTION)
+        );
+    }
+    let mut reader = open()?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_RESOLUTION);
+    limits.max_image_height = Some(MAX_RESOLUTION);
+    limits.max_alloc = Some(4 * MAX_PIXELS);
+    reader.limits(limits);
+    let img = reader.decode().map_err(text)?.to_rgb8();
+    Ok(Texture {
+        width: img.width(),
+        height: img.height(),
+        // By table (das's street: 4–9 ms of its start with a `powf` per channel, then 1.5–3).
+        texels: img
+            .pixels()
+            .map(|p| Vec3::from(p.0.map(decode_srgb8)))
+            .collect(),
+    })
 }
 
 impl<T: Texel> Texels<T> {

@@ -205,6 +205,7 @@ impl World {
             .map(|(path, _)| path)
             .zip(loaded)
             .collect();
+        let mut texture_base: HashMap<PathBuf, usize> = HashMap::new();
         for (index, object) in scene.objects.iter().enumerate() {
             world.objects.push(ObjectInfo {
                 name: object.name.clone(),
@@ -257,11 +258,16 @@ impl World {
                     )?;
                     check_keyframed_mesh(path, &object.name, &mesh.tris, &object.motion)?;
                     let first = world.materials.len() as u32;
+                    // A file's textures once, however many objects place it.
+                    let first_texture = *texture_base.entry(path.clone()).or_insert_with(|| {
+                        world.textures.extend(mesh.textures.iter().cloned());
+                        world.textures.len() - mesh.textures.len()
+                    });
                     world
                         .materials
                         .extend(mesh.materials.iter().map(|m| SurfaceMaterial {
                             albedo: Vec3::from_array(m.linear_color),
-                            texture: None,
+                            texture: m.texture.map(|t| first_texture + t),
                             uv_repeat: Vec2::ONE,
                         }));
                     if mesh.materials.is_empty() && material.is_none() {
