@@ -5,6 +5,7 @@
 use glam::DVec3;
 
 use crate::scene::limits::{MAX_LENGTH, MIN_LENGTH};
+use crate::scene::motion::MovesWith;
 use crate::scene::source::SceneError;
 use crate::scene::sun_position::{UtcInstant, parse_date, parse_time, sun_angles};
 use crate::scene::table_reader::TableReader;
@@ -319,6 +320,10 @@ pub fn read_lights(
             color,
             spot,
             casts_shadow: t.bool_or("casts_shadow", true)?,
+            moves_with: match t.choice("moves_with", "world", &["world", "vehicle"])? {
+                "vehicle" => MovesWith::Vehicle,
+                _ => MovesWith::World,
+            },
         });
         t.finish()?;
     }

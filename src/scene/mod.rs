@@ -280,6 +280,10 @@ pub struct Lamp {
     pub spot: Option<Spot>,
     /// Whether what stands between it and a surface shades the surface (default true).
     pub casts_shadow: bool,
+    /// Whether it stands in the world (a street lamp) or rides with the vehicle (its
+    /// headlights, its instrument cluster) in a `sequence`; `position` and the spot's
+    /// `direction` are where it is at t = 0. Never [`motion::MovesWith::Head`].
+    pub moves_with: motion::MovesWith,
 }
 
 /// A spot's beam: full intensity within `falloff` of its axis, none beyond `cone`, a

@@ -163,6 +163,14 @@ impl Rig {
         s.back.world_from_camera = rig * s.back.world_from_camera;
         s.driver.world_from_camera =
             rig * DAffine3::from_translation(self.head_offset(t)) * s.driver.world_from_camera;
+        for lamp in s.lights.iter_mut() {
+            if lamp.moves_with == MovesWith::Vehicle {
+                lamp.position = rig.transform_point3(lamp.position);
+                if let Some(spot) = &mut lamp.spot {
+                    spot.direction = rig.transform_vector3(spot.direction).normalize();
+                }
+            }
+        }
         s
     }
 
@@ -205,6 +213,49 @@ impl Rig {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lamps_on_the_vehicle_ride_with_it_and_street_lamps_stay() {
+        let base = Scene::bundled("das_night.toml");
+        let vehicle = VehicleMotion {
+            speed: 50.0 / 3.6,
+            yaw_rate: 0.3,
+            forward: DVec3::NEG_Z,
+            pivot: base.eye(),
+            route: None,
+        };
+        let rig = Rig::new(base.clone(), vehicle, HeadMotion::Still);
+        let (start, later) = (rig.scene_at(0.0), rig.scene_at(2.0));
+        let in_vehicle =
+            |s: &Scene, p: DVec3| s.obstacle.world_from_obstacle.inverse().transform_point3(p);
+        let mut riding = 0;
+        for ((lamp, a), b) in base.lights.iter().zip(&start.lights).zip(&later.lights) {
+            assert_eq!(
+                a.position, lamp.position,
+                "{}: where the file puts it at t = 0",
+                lamp.name
+            );
+            if lamp.moves_with == MovesWith::Vehicle {
+                riding += 1;
+                // The same place and aim in the vehicle's frame, 27.8 m on in the world's.
+                let (pa, pb) = (
+                    in_vehicle(&start, a.position),
+                    in_vehicle(&later, b.position),
+                );
+                assert!(pa.distance(pb) < 1e-9, "{}", lamp.name);
+                assert!(a.position.distance(b.position) > 20.0, "{}", lamp.name);
+                if let (Some(sa), Some(sb)) = (a.spot, b.spot) {
+                    let frame = |s: &Scene| s.obstacle.world_from_obstacle.matrix3.inverse();
+                    let (da, db) = (frame(&start) * sa.direction, frame(&later) * sb.direction);
+                    assert!(da.distance(db) < 1e-9 && (sb.direction.length() - 1.0).abs() < 1e-12);
+                }
+            } else {
+                assert_eq!(b.position, lamp.position, "{} stays", lamp.name);
+            }
+        }
+        // das_night's low beams and its instrument cluster ride; its street lamps stay.
+        assert_eq!((riding, base.lights.len()), (3, 6));
+    }
 
     #[test]
     fn frames_refreshes_and_latencies() {
