@@ -589,6 +589,53 @@ fn a_spot_lights_its_cone_and_an_object_shades_what_it_hides() {
 }
 
 #[test]
+fn a_low_beams_cut_off_line_darkens_everything_above_it() {
+    let (grey, intensity) = (0.8, 2000.0);
+    let rho = f64::from(srgb_to_linear(grey as f32));
+    // A spot 3 m up aimed 40° from straight down towards +x, its cone wide (60°); the cut-off
+    // at −60° elevation: the floor is lit only within 3 m / tan 60° = 1.73 m of the lamp's foot.
+    let lamp = glam::DVec3::new(0.0, 3.0, 0.0);
+    let axis = glam::DVec3::new(40f64.to_radians().sin(), -40f64.to_radians().cos(), 0.0);
+    let lamps = format!(
+        "[[light]]\nkind = \"spot\"\nposition = [0.0, 3.0, 0.0]\ndirection = [{}, {}, 0.0]\n\
+         intensity_cd = {intensity}\ncone_deg = 60\nfalloff_deg = 60\ncutoff_deg = -60\n",
+        axis.x, axis.y
+    );
+    let (mut lit, mut cut) = (0, 0);
+    for (p, y) in floor_under_lamps(grey, &lamps, "") {
+        let to = (p - lamp).normalize();
+        let elevation = to.y.asin().to_degrees();
+        let off_axis = to.angle_between(axis).to_degrees();
+        // Pixels straddling the cut-off line or the cone's edge hold both sides.
+        if (elevation + 60.0).abs() < 1.0 || (off_axis - 60.0).abs() < 1.0 {
+            continue;
+        }
+        let from = lamp - p;
+        let expected = if elevation > -60.0 || off_axis > 60.0 {
+            0.0
+        } else {
+            rho * intensity * (from.y / from.length())
+                / (std::f64::consts::PI * from.length_squared())
+        };
+        if expected == 0.0 {
+            assert_eq!(y, 0.0, "at {p} (elevation {elevation:.1}°)");
+            cut += usize::from(off_axis < 60.0);
+        } else {
+            assert!(
+                relative_error(y, expected) < 0.005,
+                "at {p}: {y} vs {expected}"
+            );
+            lit += 1;
+        }
+    }
+    // Both sides of the line inside the cone.
+    assert!(
+        lit > 300 && cut > 300,
+        "{lit} lit, {cut} cut off inside the cone"
+    );
+}
+
+#[test]
 fn lamps_are_refused_where_they_cannot_shine() {
     let spot_key = parse(&floor_scene(
         0.5,

@@ -293,14 +293,22 @@ pub fn read_lights(
     let mut lamps = Vec::with_capacity(tables.len());
     for t in tables {
         let kind = t.choice("kind", "point", &["point", "spot"])?;
-        let spot_keys = ["direction", "cone_deg", "falloff_deg"];
+        let spot_keys = ["direction", "cone_deg", "falloff_deg", "cutoff_deg"];
         let spot = if kind == "spot" {
             let cone = t.f64_in("cone_deg", 30.0, 0.01, 90.0)?;
             let falloff = t.f64_in("falloff_deg", cone, 0.0, cone)?;
+            let cutoff = t.opt_f64("cutoff_deg")?;
+            if let Some(c) = cutoff.filter(|c| !(-90.0..=90.0).contains(c)) {
+                return Err(t.error(
+                    "cutoff_deg",
+                    crate::scene::table_reader::range_message(c, -90.0, 90.0),
+                ));
+            }
             Some(Spot {
                 direction: t.direction("direction", [0.0, 0.0, -1.0])?,
                 cos_cone: cone.to_radians().cos(),
                 cos_falloff: falloff.to_radians().cos(),
+                cutoff_sin: cutoff.map(|c| c.to_radians().sin()),
             })
         } else {
             if let Some(key) = spot_keys.iter().find(|k| t.has(k)) {

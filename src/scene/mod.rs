@@ -297,11 +297,17 @@ pub struct Spot {
     /// Cosine of the half angle within which it gives its full intensity (`falloff_deg`,
     /// [0, cone]).
     pub cos_falloff: f64,
+    /// A low beam's cut-off line: the sine of the elevation (above the horizontal, world +y)
+    /// above which the beam gives nothing (`cutoff_deg`, [−90, 90]); `None`: no cut-off.
+    pub cutoff_sin: Option<f64>,
 }
 
 impl Spot {
     /// The fraction of the axis's intensity towards the unit direction `to` (from the lamp).
     pub fn profile(&self, to: DVec3) -> f64 {
+        if self.cutoff_sin.is_some_and(|limit| to.y > limit) {
+            return 0.0;
+        }
         let cos = self.direction.dot(to);
         if cos >= self.cos_falloff {
             return 1.0;
