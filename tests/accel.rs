@@ -320,6 +320,29 @@ fn closest_and_occluded_equal_brute_force() {
 }
 
 #[test]
+fn a_big_hierarchy_collapsed_side_by_side_equals_brute_force_on_any_thread_count() {
+    // das grown eightfold: well over the boxes from which the root's subtrees are collapsed
+    // into wide nodes in parallel and appended.
+    let scene = seethru::scene::grow::grow(&common::das(), 8.0).unwrap();
+    let world = World::build(&scene).unwrap();
+    assert!(world.triangles.len() > 1 << 16, "{}", world.triangles.len());
+    let build_on = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| Accel::build(&world).unwrap())
+    };
+    let (one, two) = (build_on(1), build_on(2));
+    // The same hierarchy whatever the threads: the same size and the same summed areas.
+    assert_eq!(one.bytes(), two.bytes());
+    assert_eq!(one.area().to_bits(), two.area().to_bits());
+    let rays = random_rays(scene.eye().as_vec3(), 1500);
+    let hits = compare(&world, &two, &rays, &ALL_VIEWS);
+    assert!(hits > rays.len() / 3, "{hits} hits of {}", rays.len());
+}
+
+#[test]
 fn the_das_scene_is_built_by_ploc() {
     // The top-down build is the fallback for arrangements PLOC degenerates on; das is not one
     // (its goldens and `bench` figures are PLOC's).

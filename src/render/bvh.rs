@@ -18,6 +18,7 @@ use anyhow::{Result, bail};
 use glam::Vec4;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
+use rayon::prelude::*;
 
 use crate::render::bvh_build;
 use crate::render::packets::{EllipsoidLeaf, TRI_LANES, Triangles4};
@@ -50,6 +51,8 @@ const _: () = assert!(bvh_build::MAX_DEPTH * WIDTH <= STACK);
 /// Box exits are scaled by this before comparison: 8 ulps of headroom for the rounding of
 /// the slab distances against the exact primitive tests.
 pub(crate) const EXIT_ROUND_UP: f32 = 1.0 + 8.0 * f32::EPSILON;
+/// Boxes from which the root's subtrees are collapsed into wide nodes side by side.
+const PARALLEL_BOXES: usize = 1 << 16;
 pub use crate::render::packets::NO_PRIM;
 
 /// What the box test needs of a ray: computed once per traversal.
@@ -213,13 +216,17 @@ pub struct Bvh {
 impl Bvh {
     /// Builds the hierarchy over primitives of `world` with boxes `boxes`, referred to by
     /// `prims` (a primitive may have several boxes: spatial splits).
-    pub fn build(world: &World, boxes: &[Aabb], prims: Vec<u32>) -> Result<Self> {
-        let mut bvh = Bvh {
+    fn empty() -> Bvh {
+        Bvh {
             builder: None,
             nodes: Vec::new(),
             triangles: Vec::new(),
             ellipsoids: Vec::new(),
-        };
+        }
+    }
+
+    pub fn build(world: &World, boxes: &[Aabb], prims: Vec<u32>) -> Result<Self> {
+        let mut bvh = Bvh::empty();
         if boxes.is_empty() {
             return Ok(bvh);
         }
@@ -564,20 +571,94 @@ impl Builder<'_> {
                 node.bounds[2 * axis][slot] = aabb.min[axis] - pad[axis];
                 node.bounds[2 * axis + 1][slot] = aabb.max[axis] + pad[axis];
             }
-            node.children[slot] = if self.is_leaf(c) {
-                self.leaf(c)?
+            if self.is_leaf(c) {
+                node.children[slot] = self.leaf(c)?;
             } else {
-                let index = self.reserve();
-                inner.push((index, c));
-                index as u32
-            };
+                inner.push((slot, c));
+            }
+        }
+        let boxes: u32 = start.iter().map(|&c| self.summaries[c].count).sum();
+        if depth == 1 && boxes as usize >= PARALLEL_BOXES {
+            // A big hierarchy: the root's subtrees are made side by side, each into its own
+            // arrays, then appended in slot order. The layout differs from the one-thread
+            // order below, not the answers: a query's hit never depends on the order it
+            // visits the leaves in (`closer`), and the layout is the same on any thread count.
+            let (bvh2, summaries, world) = (self.bvh2, self.summaries, self.world);
+            let parts: Vec<Result<Bvh>> = inner
+                .par_iter()
+                .map(|&(_, c)| {
+                    let mut part = Bvh::empty();
+                    let mut builder = Builder {
+                        bvh2,
+                        summaries,
+                        world,
+                        out: &mut part,
+                    };
+                    let root = builder.reserve();
+                    let first = bvh2.nodes[c].first_index as usize;
+                    builder.fill(root, &[first, first + 1], depth + 1)?;
+                    Ok(part)
+                })
+                .collect();
+            for ((slot, _), part) in inner.iter().zip(parts) {
+                node.children[*slot] = self.append(part?)?;
+            }
+            self.out.nodes[at] = node;
+            return Ok(());
+        }
+        let mut reserved = Vec::with_capacity(inner.len());
+        for &(slot, c) in &inner {
+            let index = self.reserve();
+            node.children[slot] = index as u32;
+            reserved.push((index, c));
         }
         self.out.nodes[at] = node;
-        for (index, c) in inner {
+        for (index, c) in reserved {
             let first = self.bvh2.nodes[c].first_index as usize;
             self.fill(index, &[first, first + 1], depth + 1)?;
         }
         Ok(())
+    }
+
+    /// Appends a hierarchy made apart (its root first) to the output, its references moved
+    /// by the output's node, packet and ellipsoid counts; returns the reference of its root.
+    fn append(&mut self, part: Bvh) -> Result<u32> {
+        let (nodes, triangles, ellipsoids) = (
+            self.out.nodes.len() as u32,
+            self.out.triangles.len(),
+            self.out.ellipsoids.len(),
+        );
+        if triangles + part.triangles.len() > FIRST_MASK as usize
+            || ellipsoids + part.ellipsoids.len() > FIRST_MASK as usize
+        {
+            bail!(
+                "the scene has more than {} triangle packets or ellipsoids in one hierarchy, the most its leaf references hold: use fewer or coarser meshes",
+                FIRST_MASK
+            );
+        }
+        let moved = |child: u32| -> u32 {
+            if child == EMPTY {
+                child
+            } else if child & LEAF == 0 {
+                child + nodes
+            } else {
+                let offset = if child & ELLIPSOIDS != 0 {
+                    ellipsoids
+                } else {
+                    triangles
+                };
+                child + offset as u32
+            }
+        };
+        self.out
+            .nodes
+            .extend(part.nodes.into_iter().map(|mut node| {
+                node.children = node.children.map(moved);
+                node
+            }));
+        self.out.triangles.extend(part.triangles);
+        self.out.ellipsoids.extend(part.ellipsoids);
+        Ok(nodes)
     }
 
     /// Packs the primitives under BVH2 node `node` into a leaf and returns its reference.

@@ -21,6 +21,7 @@ use obvhs::bvh2::node::Bvh2Node;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::bvh2::{Bvh2, DEFAULT_MAX_STACK_DEPTH};
 use obvhs::ploc::PlocBuilder;
+use rayon::prelude::*;
 
 /// Deepest binary hierarchy handed on: the wide hierarchy is at most as deep.
 pub const MAX_DEPTH: usize = 120;
@@ -104,19 +105,20 @@ fn object_boxes(boxes: &[Aabb], owners: &[u32]) -> Vec<Aabb> {
 /// Whether PLOC degenerates on some probe window of `boxes`.
 fn degenerate(boxes: &[Aabb]) -> bool {
     let order = morton_order(boxes);
-    let mut window = Vec::with_capacity(WINDOW);
+    // The windows are independent: probed side by side (the answer is the same whichever
+    // finds a degenerate one first).
+    let window_degenerates = |chunk: &[u32]| {
+        let window: Vec<Aabb> = chunk.iter().map(|&i| boxes[i as usize]).collect();
+        let indices = (0..window.len() as u32).collect();
+        passes(&ploc(&window, indices, false)) > MAX_PASSES
+    };
     for stride in STRIDES {
         let sampled: Vec<u32> = order.iter().copied().step_by(stride).collect();
         if sampled.len() < WINDOW {
             break;
         }
-        for chunk in sampled.chunks(WINDOW) {
-            window.clear();
-            window.extend(chunk.iter().map(|&i| boxes[i as usize]));
-            let indices = (0..window.len() as u32).collect();
-            if passes(&ploc(&window, indices, false)) > MAX_PASSES {
-                return true;
-            }
+        if sampled.par_chunks(WINDOW).any(window_degenerates) {
+            return true;
         }
     }
     false
@@ -136,7 +138,7 @@ fn morton_order(boxes: &[Aabb]) -> Vec<u32> {
         Vec3A::ZERO,
     );
     let mut keyed: Vec<(u64, u32)> = boxes
-        .iter()
+        .par_iter()
         .enumerate()
         .map(|(i, b)| {
             let q = ((b.center() - bounds.min) * scale).max(Vec3A::ZERO);
@@ -144,7 +146,7 @@ fn morton_order(boxes: &[Aabb]) -> Vec<u32> {
             (code, i as u32)
         })
         .collect();
-    keyed.sort_unstable();
+    keyed.par_sort_unstable();
     keyed.into_iter().map(|(_, i)| i).collect()
 }
 
