@@ -76,12 +76,13 @@ fn data_uri(mime: &str, bytes: &[u8]) -> String {
 
 /// das's cameras over nothing but the mesh at `mesh` (relative to the scene in `dir`).
 fn scene_with_mesh(dir: &std::path::Path, mesh: &str) -> std::path::PathBuf {
-    let das = std::fs::read_to_string(common::repo_path("scenes/das.toml")).unwrap();
-    let head = &das[..das.find("[[material]]").unwrap()];
     let path = dir.join("scene.toml");
     std::fs::write(
         &path,
-        format!("{head}\n[[object]]\nname = \"square\"\nkind = \"mesh\"\npath = \"{mesh}\"\n"),
+        format!(
+            "{}\n[[object]]\nname = \"square\"\nkind = \"mesh\"\npath = \"{mesh}\"\n",
+            common::das_without_objects()
+        ),
     )
     .unwrap();
     path
@@ -219,23 +220,9 @@ fn a_texture_that_cannot_be_read_is_one_error_line_naming_its_image() {
     for (image, words) in cases {
         let json = gltf_json(r#"{"byteLength":92,"uri":"square.bin"}"#, &image, "");
         std::fs::write(dir.path().join("square.gltf"), json).unwrap();
-        let scene = scene_with_mesh(dir.path(), "square.gltf");
+        scene_with_mesh(dir.path(), "square.gltf");
         let mut words = words;
         words.push("square.gltf");
-        common::refusal::refused(
-            dir.path(),
-            &[
-                "render",
-                scene.to_str().unwrap(),
-                "--view",
-                "truth",
-                "--width",
-                "8",
-                "--out",
-                "o",
-            ],
-            1,
-            &words,
-        );
+        common::refusal::render_refused(dir.path(), &words);
     }
 }

@@ -49,10 +49,11 @@ fn road(id: &str, geometry: &str, length: f64, left: &str, right: &str, elevatio
 /// written with its map into `dir`.
 fn scene_with_road(dir: &Path, xodr: &str, keys: &str) -> std::path::PathBuf {
     std::fs::write(dir.join("map.xodr"), xodr).unwrap();
-    let das = std::fs::read_to_string(common::repo_path("scenes/das.toml")).unwrap();
     // das without its objects: the road is the only thing to hit.
-    let head = &das[..das.find("[[material]]").unwrap()];
-    let text = format!("{head}\n[road]\nxodr = \"map.xodr\"\n{keys}\n");
+    let text = format!(
+        "{}\n[road]\nxodr = \"map.xodr\"\n{keys}\n",
+        common::das_without_objects()
+    );
     let path = dir.join("scene.toml");
     std::fs::write(&path, text).unwrap();
     path
@@ -492,42 +493,17 @@ fn bad_maps_and_bad_keys_are_refused_in_one_line() {
         ),
     ];
     for (xodr, keys, words) in cases {
-        let path = scene_with_road(dir.path(), &xodr, &keys);
+        scene_with_road(dir.path(), &xodr, &keys);
         let mut words = words;
         words.push("scene.toml");
-        common::refusal::refused(
-            dir.path(),
-            &[
-                "render",
-                path.to_str().unwrap(),
-                "--view",
-                "truth",
-                "--width",
-                "8",
-                "--out",
-                "o",
-            ],
-            1,
-            &words,
-        );
+        common::refusal::render_refused(dir.path(), &words);
     }
     // A map named by another extension, and one that is not there.
-    let text = std::fs::read_to_string(dir.path().join("scene.toml")).unwrap();
-    for (swap, word) in [("map.xodr", ".xodr"), ("map.xodr", "cannot read")] {
-        let replaced = if word == ".xodr" {
-            text.replace(swap, "map.xml")
-        } else {
-            text.replace(swap, "gone.xodr")
-        };
-        std::fs::write(dir.path().join("bad.toml"), replaced).unwrap();
-        common::refusal::refused(
-            dir.path(),
-            &[
-                "render", "bad.toml", "--view", "truth", "--width", "8", "--out", "o",
-            ],
-            1,
-            &["xodr", word],
-        );
+    let path = dir.path().join("scene.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    for (name, word) in [("map.xml", ".xodr"), ("gone.xodr", "cannot read")] {
+        std::fs::write(&path, text.replace("map.xodr", name)).unwrap();
+        common::refusal::render_refused(dir.path(), &["xodr", word]);
     }
 }
 

@@ -101,6 +101,14 @@ pub fn das_with_mesh_head_text() -> String {
 }
 
 /// A small valid scene: a ground plane, a sphere and the obstacle with its cameras.
+/// das's light, obstacle and cameras without its materials and objects: a scene to add
+/// one thing to and trace it alone.
+#[allow(dead_code)]
+pub fn das_without_objects() -> String {
+    let das = std::fs::read_to_string(repo_path("scenes/das.toml")).unwrap();
+    das[..das.find("[[material]]").unwrap()].to_string()
+}
+
 pub const MINIMAL: &str = r#"
 [obstacle]
 center = [0.0, 1.2, -0.8]
