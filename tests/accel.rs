@@ -343,6 +343,26 @@ fn a_big_hierarchy_collapsed_side_by_side_equals_brute_force_on_any_thread_count
 }
 
 #[test]
+fn a_hierarchy_of_half_a_million_triangles_is_the_same_on_one_two_and_three_threads() {
+    // Over obvhs' thresholds for its parallel PLOC (500 000 boxes) and radix sort: the tree
+    // must not depend on how the work is split.
+    let scene = seethru::scene::grow::grow(&common::das(), 40.0).unwrap();
+    let world = World::build(&scene).unwrap();
+    assert!(world.triangles.len() > 500_000, "{}", world.triangles.len());
+    let build_on = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let accel = pool.install(|| Accel::build(&world).unwrap());
+        (accel.bytes(), accel.area().to_bits())
+    };
+    let one = build_on(1);
+    assert_eq!(build_on(2), one);
+    assert_eq!(build_on(3), one);
+}
+
+#[test]
 fn the_das_scene_is_built_by_ploc() {
     // The top-down build is the fallback for arrangements PLOC degenerates on; das is not one
     // (its goldens and `bench` figures are PLOC's).
