@@ -66,6 +66,25 @@ fn sweep_csv_inputs_found_by_fuzzing_give_one_line_errors() {
 }
 
 #[test]
+fn gltf_inputs_found_by_fuzzing_are_refused_in_one_line() {
+    // An image with neither a uri nor a bufferView: the gltf crate's `Image::source`
+    // unwrapped the uri (a panic), as it does a bufferView's missing mimeType.
+    for (path, bytes) in inputs("gltf") {
+        let read = |_: &Path| Err(std::io::ErrorKind::NotFound.into());
+        let shown = format!(
+            "{:#}",
+            seethru::scene::mesh_io::parse_gltf(&bytes, Path::new("mesh.gltf"), &read)
+                .expect_err("refused")
+        );
+        assert!(
+            !shown.contains('\n') && shown.starts_with("image 0 "),
+            "{}: {shown}",
+            path.display()
+        );
+    }
+}
+
+#[test]
 fn obj_inputs_found_by_fuzzing_are_refused_naming_the_line_and_in_time() {
     // As the fuzz target splits them: the OBJ, a NUL byte, the MTL its `mtllib` reads. Each
     // kept input is broken at a line of the OBJ or of its MTL, which the error names (tobj's

@@ -212,6 +212,15 @@ fn a_texture_that_cannot_be_read_is_one_error_line_naming_its_image() {
             r#"{"uri":"data:image/png,abc"}"#.to_string(),
             vec!["image 0", "base64"],
         ),
+        // Found by fuzzing: the gltf crate unwrapped these.
+        (
+            r#"{"name":"none"}"#.to_string(),
+            vec!["image 0", "neither a uri nor a bufferView"],
+        ),
+        (
+            r#"{"bufferView":0}"#.to_string(),
+            vec!["image 0", "without its mimeType"],
+        ),
         (
             format!(r#"{{"uri":"{}"}}"#, data_uri("image/png", &png()[..20])),
             vec!["image 0"],

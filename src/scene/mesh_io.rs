@@ -352,7 +352,9 @@ pub fn parse_gltf(
                 let image = t.texture().source();
                 let i = image.index();
                 if decoded[i].is_none() {
-                    out.textures.push(gltf_image(&image, &buffers, path, read)?);
+                    let json = &doc.as_json().images[i];
+                    out.textures
+                        .push(gltf_image(&image, json, &buffers, path, read)?);
                     decoded[i] = Some(out.textures.len() - 1);
                 }
                 decoded[i]
@@ -453,11 +455,20 @@ fn load_buffers(
 /// glTF; PNG only.
 fn gltf_image(
     image: &gltf::Image,
+    json: &gltf::json::Image,
     buffers: &[Vec<u8>],
     path: &Path,
     read: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
 ) -> Result<Texture> {
     let i = image.index();
+    // What the gltf crate's `source` unwraps unchecked (found by fuzzing): an image names a
+    // uri or a bufferView, and a bufferView comes with its mimeType.
+    match (&json.uri, &json.buffer_view, &json.mime_type) {
+        (None, None, _) => bail!("image {i} has neither a uri nor a bufferView"),
+        (Some(_), Some(_), _) => bail!("image {i} has both a uri and a bufferView"),
+        (None, Some(_), None) => bail!("image {i} is a bufferView without its mimeType"),
+        _ => {}
+    }
     let bytes = match image.source() {
         gltf::image::Source::View { view, .. } => {
             let buffer = &buffers[view.buffer().index()];
