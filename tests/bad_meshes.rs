@@ -618,17 +618,19 @@ fn mtl_lines_tobj_reads_wrongly_or_without_a_line_are_refused_naming_the_mtl_and
             "newmtl paint\n\0\0",
             &["line 2", "a NUL byte: not a text MTL"],
         ),
-        // Mesh textures are not read: refused rather than dropped without a word.
+        // A texture that is not there, and one with options: named with the material.
         (
             "newmtl paint\nKd 1 1 1\nmap_Kd tex/paint.png\n",
             &[
-                "line 3",
                 "material `paint`",
-                "`tex/paint.png`",
-                "mesh textures are not read",
-                "Kd",
-                "[[material]]",
+                "`map_Kd tex/paint.png`",
+                "cannot read it",
+                "library's folder",
             ],
+        ),
+        (
+            "newmtl paint\nKd 1 1 1\nmap_Kd -s 2 2 1 paint.png\n",
+            &["material `paint`", "options", "file name alone"],
         ),
     ] {
         let dir = scratch(

@@ -68,8 +68,7 @@ fn finite_numbers(words: &[&str]) -> std::result::Result<Vec<f32>, String> {
 /// What tobj does not check in an MTL file: text that is not (NUL bytes, not UTF-8, CR line
 /// ends), colour lines without exactly three numbers (tobj unwraps fewer and panics, ignores
 /// more), `Kd` outside [0, 1], a material name defined twice or missing, a value missing
-/// after `Ns`, `map_Kd` and the like ("material parse error"), and textures (`map_Kd`), which
-/// are not read. Errors give the line.
+/// after `Ns`, `map_Kd` and the like ("material parse error"). Errors give the line.
 pub(crate) fn check_mtl_lines(mtl: &[u8]) -> std::result::Result<(), String> {
     if let Some(why) = text_error(mtl, "MTL") {
         return Err(why);
@@ -121,13 +120,6 @@ pub(crate) fn check_mtl_lines(mtl: &[u8]) -> std::result::Result<(), String> {
                 | "map_ns" | "map_NS" | "bump" | "map_d"),
             ) if rest.is_empty() => {
                 return at(format!("`{key}` needs a texture file name"));
-            }
-            Some("map_Kd") => {
-                return at(format!(
-                    "material `{}` has the texture `{}` (`map_Kd`): mesh textures are not read; bake the colour into `Kd`, or give the object a scene [[material]] with `texture`",
-                    clipped(&current),
-                    clipped(&rest.join(" "))
-                ));
             }
             Some("newmtl") => {
                 let name = line.trim().split_once(' ').unwrap_or_default().1.trim();

@@ -178,6 +178,8 @@ pub fn parse_obj(
     // name that two libraries define (tobj would let the later one win without a word).
     let loaded: RefCell<Vec<PathBuf>> = RefCell::new(Vec::new());
     let defined_by: RefCell<HashMap<String, String>> = RefCell::new(HashMap::new());
+    // The folder of the library that defines each material: its `map_Kd` is relative to it.
+    let library_dir: RefCell<HashMap<String, PathBuf>> = RefCell::new(HashMap::new());
     let load_mtl = |written: &Path| -> tobj::MTLLoadResult {
         let resolved = dir.join(written);
         let nothing = || Ok((Vec::new(), Default::default()));
@@ -215,6 +217,8 @@ pub fn parse_obj(
         }
         for m in &materials {
             defined_by.insert(m.name.clone(), written.display().to_string());
+            let folder = resolved.parent().unwrap_or(Path::new("")).to_path_buf();
+            library_dir.borrow_mut().insert(m.name.clone(), folder);
         }
         Ok((materials, names))
     };
@@ -229,17 +233,34 @@ pub fn parse_obj(
         (Err(e), None) => bail!("material library: {e}"),
         (Ok(m), None) => m,
     };
-    let mut out = LoadedMesh {
-        materials: materials
-            .iter()
-            .map(|m| FileMaterial {
-                name: m.name.clone(),
-                linear_color: m.diffuse.unwrap_or([0.8; 3]),
-                texture: None,
-            })
-            .collect(),
-        ..Default::default()
-    };
+    let mut out = LoadedMesh::default();
+    // Each texture file decoded once, however many materials name it.
+    let mut decoded: HashMap<PathBuf, usize> = HashMap::new();
+    for m in &materials {
+        let texture = match &m.diffuse_texture {
+            Some(name) => {
+                let folder = library_dir
+                    .borrow()
+                    .get(&m.name)
+                    .cloned()
+                    .unwrap_or_default();
+                let library = defined_by
+                    .borrow()
+                    .get(&m.name)
+                    .cloned()
+                    .unwrap_or_default();
+                let material = format!("material `{}` of `{library}`", clipped(&m.name));
+                let file = obj_texture(&material, name, &folder, read, &mut decoded, &mut out)?;
+                Some(file)
+            }
+            None => None,
+        };
+        out.materials.push(FileMaterial {
+            name: m.name.clone(),
+            linear_color: m.diffuse.unwrap_or([0.8; 3]),
+            texture,
+        });
+    }
     let names: Vec<&str> = out.materials.iter().map(|m| m.name.as_str()).collect();
     check_usemtl_names(bytes, &names)?;
     let mut triangles = 0usize;
@@ -449,6 +470,41 @@ fn load_buffers(
         out.push(data);
     }
     Ok(out)
+}
+
+/// The texture a material's `map_Kd` names (relative to its library's folder), decoded into
+/// `out.textures` once per file: its index there. `material` names the material and its
+/// library for errors.
+fn obj_texture(
+    material: &str,
+    name: &str,
+    folder: &Path,
+    read: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
+    decoded: &mut HashMap<PathBuf, usize>,
+    out: &mut LoadedMesh,
+) -> Result<usize> {
+    let what = || format!("{material}: `map_Kd {}`", clipped(name));
+    if name.starts_with('-') {
+        bail!(
+            "{}: its options (`-s`, `-o`, `-clamp`, …) are not read; give the file name alone",
+            what()
+        );
+    }
+    let path = folder.join(name);
+    if let Some(&index) = decoded.get(&path) {
+        return Ok(index);
+    }
+    let bytes = read(&path).with_context(|| {
+        format!(
+            "{}: cannot read it (resolved against its library's folder: {})",
+            what(),
+            path.display()
+        )
+    })?;
+    out.textures
+        .push(Texture::decode(&bytes).with_context(what)?);
+    decoded.insert(path, out.textures.len() - 1);
+    Ok(out.textures.len() - 1)
 }
 
 /// The texture of glTF image `image`: a bufferView, a base64 `data:` URI or a file beside the

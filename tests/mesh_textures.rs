@@ -1,7 +1,7 @@
-//! glTF base-colour textures: the image (a data URI, a file beside the glTF, or a GLB
-//! bufferView) bound to its material and sampled at the primitive's TEXCOORD_0, checked by
-//! ray casts against the texels the PNG was made of; a texture that cannot be read is one
-//! `error:` line naming it.
+//! Mesh textures: a glTF base-colour texture (a data URI, a file beside the glTF, or a GLB
+//! bufferView) and an OBJ `map_Kd`, bound to their material and sampled at the triangles'
+//! uv, checked by ray casts against the texels the PNG was made of; a texture that cannot be
+//! read is one `error:` line naming it.
 
 mod common;
 
@@ -189,6 +189,25 @@ fn a_texture_file_beside_the_gltf_and_one_in_a_glb_bufferview_read_alike() {
     glb.extend(&bin);
     std::fs::write(dir.path().join("square.glb"), glb).unwrap();
     assert_colours(quarter_colours(&scene_with_mesh(dir.path(), "square.glb")));
+}
+
+#[test]
+fn an_obj_map_kd_is_read_from_its_librarys_folder_and_sampled_at_the_vts() {
+    let dir = tempfile::tempdir().unwrap();
+    // OBJ's v runs up the image: the top corners have v = 1.
+    let obj = "mtllib lib/square.mtl\n\
+               v -1 2 -5\nv 1 2 -5\nv -1 0 -5\nv 1 0 -5\n\
+               vt 0 1\nvt 1 1\nvt 0 0\nvt 1 0\n\
+               usemtl paint\nf 1/1 3/3 2/2\nf 2/2 3/3 4/4\n";
+    std::fs::create_dir_all(dir.path().join("lib/tex")).unwrap();
+    std::fs::write(dir.path().join("square.obj"), obj).unwrap();
+    std::fs::write(
+        dir.path().join("lib/square.mtl"),
+        "newmtl paint\nKd 1 0.5 1\nmap_Kd tex/square.png\n",
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("lib/tex/square.png"), png()).unwrap();
+    assert_colours(quarter_colours(&scene_with_mesh(dir.path(), "square.obj")));
 }
 
 #[test]
