@@ -253,7 +253,15 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
         a.extend(words(extra));
         groups.push(vec![case(format!("run {}", extra.join(" ")), a)]);
     }
-    let moving = words(&[
+    // A scene that places the vehicle in a lane of a map drives it along the lane, and
+    // refuses a yaw rate (tests/road.rs): it moves without one.
+    let follows_lane = seethru::scene::Scene::load(scene).is_ok_and(|s| s.ego_route.is_some());
+    let turn: &[&str] = if follows_lane {
+        &[]
+    } else {
+        &["--yaw-rate", "10"]
+    };
+    let mut moving = words(&[
         "sequence",
         &s,
         "--width",
@@ -264,8 +272,9 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
         "10",
         "--speed",
         "50",
-        "--yaw-rate",
-        "10",
+    ]);
+    moving.extend(words(turn));
+    moving.extend(words(&[
         "--head",
         "sway",
         "--latency-camera",
@@ -273,7 +282,7 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
         "--quiet",
         "--out",
         &out("seq_moving"),
-    ]);
+    ]));
     groups.push(vec![sure("sequence moving".into(), moving)]);
     for param in sweep_params() {
         let mut a = words(&["sweep", &s, "--param", &param]);

@@ -92,7 +92,8 @@ const MAX_ARCMIN: f64 = 10_800.0;
 /// no pixel to take it over) or a number in `[low, high]` (to rounding, 1e-9 relative).
 /// `coverage` (the fraction of display pixels that show the scene, over which the
 /// misregistration means are taken) comes last, so that the columns before it keep their
-/// places. PSNR is of 8-bit colours: at most 135 dB even for the largest image.
+/// places. PSNR is of 8-bit colours: at most 135 dB even for the largest image, or +∞ where
+/// the two images are identical over the display ([`UNBOUNDED_ABOVE`]).
 pub const METRIC_COLUMNS: [(&str, f64, f64); 12] = [
     ("misregistration_mean_arcmin", 0.0, MAX_ARCMIN),
     ("misregistration_p95_arcmin", 0.0, MAX_ARCMIN),
@@ -107,6 +108,10 @@ pub const METRIC_COLUMNS: [(&str, f64, f64); 12] = [
     ("R2", -f64::MAX, f64::MAX),
     ("coverage", 0.0, 1.0),
 ];
+
+/// The metric columns that may also be +∞: a PSNR of identical images (`sweep` writes
+/// `inf`; its own rows must resume and merge).
+pub const UNBOUNDED_ABOVE: [&str; 1] = ["psnr_db"];
 
 /// The column after the metrics: how many configurations the row's grid has (so that
 /// `sweep-merge` knows when a part is missing).
@@ -227,13 +232,24 @@ pub fn check_row(
     }
     for (cell, (name, low, high)) in fields[1 + params..].iter().zip(METRIC_COLUMNS) {
         let tolerance = 1e-9 * high.abs().max(1.0);
+        let unbounded = UNBOUNDED_ABOVE.contains(&name);
         let admissible = match cell.parse::<f64>() {
-            Ok(x) => x.is_nan() || (x.is_finite() && x >= low - tolerance && x <= high + tolerance),
+            Ok(x) => {
+                x.is_nan()
+                    || (unbounded && x == f64::INFINITY)
+                    || (x.is_finite() && x >= low - tolerance && x <= high + tolerance)
+            }
             Err(_) => false,
         };
         if !admissible {
             let range = if high == f64::MAX {
                 "a finite number".to_string()
+            } else if unbounded {
+                format!(
+                    "a number in [{}, {}], or inf where the images are identical",
+                    short(low),
+                    short(high)
+                )
             } else {
                 format!("a number in [{}, {}]", short(low), short(high))
             };
@@ -469,6 +485,34 @@ mod tests {
         // The same row from a grid of 3 where θ_F = 40 was index 2: now index 1 of 2.
         let rows = resume(&file(&[row(2, "40", &[], 3)])).unwrap();
         assert_eq!(rows, vec![(1, row(1, "40", &[], 2))]);
+    }
+
+    #[test]
+    fn a_psnr_of_identical_images_is_a_row_of_the_sweep() {
+        // `sweep` writes a PSNR of +∞ where the display shows exactly the truth; its own
+        // row must resume (and merge), as NaN and finite values do; −∞ must not.
+        let fields = |psnr: &str| -> Vec<String> {
+            let mut f = vec!["0".to_string(), "20".to_string()];
+            for (column, _, _) in METRIC_COLUMNS {
+                f.push(if column == "psnr_db" {
+                    psnr.into()
+                } else {
+                    "0.5".into()
+                });
+            }
+            f.push("2".into());
+            f.extend(settings());
+            f
+        };
+        let text = |psnr: &str| {
+            format!(
+                "{}\n{}\n",
+                encode(&header(&params())),
+                encode(&fields(psnr))
+            )
+        };
+        assert_eq!(resume(&text("inf")).unwrap().len(), 1);
+        assert!(resume(&text("-inf")).is_err());
     }
 
     #[test]
