@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
-use crate::scene::mesh_io::shape_mesh;
+use crate::scene::shape_mesh::shape_mesh;
 use crate::scene::texture::Texture;
 use crate::scene::{Scene, Shape};
 use crate::util::hash::Fnv64;

@@ -68,19 +68,6 @@ pub fn load_mesh(path: &Path) -> Result<LoadedMesh> {
     mesh.with_context(|| format!("mesh {}", path.display()))
 }
 
-/// The triangles a shape places from a mesh: its file's ([`load_mesh`]) or the built-in head's
-/// ([`builtin_head`]); `None` for the analytic shapes.
-pub fn shape_mesh(shape: &crate::scene::Shape) -> Option<Result<LoadedMesh>> {
-    match shape {
-        crate::scene::Shape::Mesh { path } => Some(load_mesh(path)),
-        crate::scene::Shape::HeadMesh => Some(Ok(builtin_head().clone())),
-        crate::scene::Shape::Road { path, colors } => {
-            Some(crate::scene::road_map::load_road(path, colors))
-        }
-        _ => None,
-    }
-}
-
 /// The built-in head mesh: `assets/head.obj` and `head.mtl` as built into the binary (the
 /// text `scene::head_model::head_obj` generates; `tests/assets.rs` checks they agree), parsed
 /// once per process.

@@ -25,6 +25,7 @@ pub mod read;
 pub mod road_keys;
 pub mod road_map;
 pub mod sensor_keys;
+pub mod shape_mesh;
 pub mod shapes;
 pub mod shutter_keys;
 pub mod source;

@@ -12,8 +12,9 @@ use obvhs::rt_triangle::RtTriangle;
 use rayon::prelude::*;
 
 use crate::scene::limits::check_placed_mesh;
-use crate::scene::mesh_io::{LoadedMesh, shape_mesh};
+use crate::scene::mesh_io::LoadedMesh;
 use crate::scene::motion::check_keyframed_mesh;
+use crate::scene::shape_mesh::shape_mesh;
 use crate::scene::shapes::{Tri, box_face, cuboid, frustum, plane_xz, quad_xy};
 use crate::scene::texture::Texture;
 use crate::scene::{CameraKind, Obstacle, Scene, Shape};

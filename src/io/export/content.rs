@@ -14,7 +14,7 @@ use serde_json::json;
 use crate::geometry::camera::Camera;
 use crate::io::atomic::write_atomically;
 use crate::render::sky::SkyModel;
-use crate::scene::mesh_io::shape_mesh;
+use crate::scene::shape_mesh::shape_mesh;
 use crate::scene::texture::Texture;
 use crate::scene::world::{Ellipsoid, TriAttr, World, view_bit};
 use crate::scene::{Scene, Shape};
