@@ -319,6 +319,15 @@ fn closest_and_occluded_equal_brute_force() {
     assert!(hits > rays.len() / 4, "{hits} hits of {}", rays.len());
 }
 
+/// The hierarchy of `world` built by a pool of `threads` threads.
+fn built_on(world: &World, threads: usize) -> Accel {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| Accel::build(world).unwrap())
+}
+
 #[test]
 fn a_big_hierarchy_collapsed_side_by_side_equals_brute_force_on_any_thread_count() {
     // das grown eightfold: well over the boxes from which the root's subtrees are collapsed
@@ -326,14 +335,7 @@ fn a_big_hierarchy_collapsed_side_by_side_equals_brute_force_on_any_thread_count
     let scene = seethru::scene::grow::grow(&common::das(), 8.0).unwrap();
     let world = World::build(&scene).unwrap();
     assert!(world.triangles.len() > 1 << 16, "{}", world.triangles.len());
-    let build_on = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| Accel::build(&world).unwrap())
-    };
-    let (one, two) = (build_on(1), build_on(2));
+    let (one, two) = (built_on(&world, 1), built_on(&world, 2));
     // The same hierarchy whatever the threads: the same size and the same summed areas.
     assert_eq!(one.bytes(), two.bytes());
     assert_eq!(one.area().to_bits(), two.area().to_bits());
@@ -350,11 +352,7 @@ fn a_hierarchy_of_half_a_million_triangles_is_the_same_on_one_two_and_three_thre
     let world = World::build(&scene).unwrap();
     assert!(world.triangles.len() > 500_000, "{}", world.triangles.len());
     let build_on = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        let accel = pool.install(|| Accel::build(&world).unwrap());
+        let accel = built_on(&world, threads);
         (accel.bytes(), accel.area().to_bits())
     };
     let one = build_on(1);
