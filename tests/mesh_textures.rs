@@ -74,14 +74,21 @@ fn data_uri(mime: &str, bytes: &[u8]) -> String {
     )
 }
 
-/// das's cameras over nothing but the mesh at `mesh` (relative to the scene in `dir`).
+/// das's cameras over nothing but the mesh at `mesh` (relative to the scene in `dir`), and,
+/// out of the way, a sign textured by a scene material: the world's first texture, so that
+/// the mesh's must be found past it.
 fn scene_with_mesh(dir: &std::path::Path, mesh: &str) -> std::path::PathBuf {
     let path = dir.join("scene.toml");
+    let street = common::repo_path("assets/street.png");
     std::fs::write(
         &path,
         format!(
-            "{}\n[[object]]\nname = \"square\"\nkind = \"mesh\"\npath = \"{mesh}\"\n",
-            common::das_without_objects()
+            "{}\n[[material]]\nname = \"street\"\ntexture = \"{}\"\n\
+             [[object]]\nname = \"sign\"\nkind = \"quad\"\nmaterial = \"street\"\n\
+             translate = [30.0, 2.0, -40.0]\n\
+             [[object]]\nname = \"square\"\nkind = \"mesh\"\npath = \"{mesh}\"\n",
+            common::das_without_objects(),
+            street.display()
         ),
     )
     .unwrap();
