@@ -283,7 +283,13 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
         "--out",
         &out("seq_moving"),
     ]));
-    groups.push(vec![sure("sequence moving".into(), moving)]);
+    groups.push(vec![
+        sure("sequence moving".into(), moving),
+        sure(
+            "view sequence".into(),
+            words(&["view", &out("seq_moving"), "--quiet"]),
+        ),
+    ]);
     for param in sweep_params() {
         let mut a = words(&["sweep", &s, "--param", &param]);
         if param == "eye=eyellipse" {
@@ -341,6 +347,7 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
         sure("run --exr all".into(), run_a),
         sure("run --method none".into(), run_b),
         sure("measure".into(), words(&["measure", &out("ra"), "--quiet"])),
+        sure("view run".into(), words(&["view", &out("ra"), "--quiet"])),
         // A run folder against itself: `diff` exits 1 where a metric moved (a verdict).
         sure(
             "diff runs".into(),
@@ -404,20 +411,26 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
             ]),
         ),
     ]);
-    groups.push(vec![sure(
-        "compare".into(),
-        words(&[
-            "compare",
-            &s,
-            "--width",
-            "32",
-            "--spp",
-            "1",
-            "--quiet",
-            "--out",
-            &out("cmp"),
-        ]),
-    )]);
+    groups.push(vec![
+        sure(
+            "compare".into(),
+            words(&[
+                "compare",
+                &s,
+                "--width",
+                "32",
+                "--spp",
+                "1",
+                "--quiet",
+                "--out",
+                &out("cmp"),
+            ]),
+        ),
+        sure(
+            "view compare".into(),
+            words(&["view", &out("cmp"), "--quiet"]),
+        ),
+    ]);
     groups.push(vec![case(
         "head-poses".into(),
         words(&[
@@ -481,6 +494,7 @@ fn every_command_on_every_bundled_scene_exits_cleanly_or_with_one_error_line() {
         "capture",
         "score",
         "spec",
+        "view",
     ];
     for command in commands() {
         assert!(

@@ -135,9 +135,10 @@ impl Compare {
             &out.join("compare.json"),
             &serde_json::to_string_pretty(&with_flags(&json))?,
         )?;
+        seethru::measure::viewer::write_compare_view(out)?;
         staged.commit()?;
         seethru::util::progress::summary(format!(
-            "compared {} methods; compare.md, compare.json, compare.html and the strips in {}",
+            "compared {} methods; compare.md, compare.json, compare.html, the strips and view.html in {}",
             rows.len(),
             self.out.display()
         ));

@@ -12,6 +12,7 @@ use seethru::measure::holes::{hole_metrics, read_hole_mask};
 use seethru::measure::maps::write_metrics;
 use seethru::measure::metrics::measure;
 use seethru::measure::metrics_json::Metrics;
+use seethru::measure::viewer::{RunPixels, write_run_view};
 use seethru::render::frame_over::FrameView;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
@@ -98,6 +99,8 @@ fn measure_command(dir: &Path, band: u32) -> Result<Metrics> {
         &truth,
         &with_flags(&metrics.to_json()),
     )?;
+    let pixels = RunPixels::of_run(&maps, &truth, FrameView::from(&seethru));
+    write_run_view(staged.path(), dir, &pixels)?;
     staged.commit()?;
     Ok(metrics)
 }

@@ -28,6 +28,7 @@ mod sequence_byo;
 mod spec;
 mod sweep;
 pub mod verdict;
+mod view;
 
 use anyhow::Result;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
@@ -98,6 +99,9 @@ pub enum Command {
     /// every option checked, nothing rendered: the option table's values and defaults.
     #[command(subcommand)]
     Spec(spec::Spec),
+    /// Write the viewer of an output folder (run, score, measure, sequence, compare): one
+    /// self-contained view.html to flick, wipe and read pixels in a browser.
+    View(view::View),
 }
 
 /// The command line with every negative number that follows an option joined to it
@@ -239,6 +243,7 @@ impl Command {
             Command::Sequence(c) => c.run(),
             Command::Diff(c) => c.run(),
             Command::Check(c) => c.run(),
+            Command::View(c) => c.run(),
         }
     }
 

@@ -16,6 +16,8 @@ use seethru::measure::headline::{read_results, summary_text};
 use seethru::measure::holes::write_hole_mask;
 use seethru::measure::maps::write_metrics_scaled;
 use seethru::measure::measured_run::{DriverViews, hazards_of, measure_views, view_eye};
+use seethru::measure::viewer::{RunPixels, write_run_view};
+use seethru::render::frame_over::FrameView;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
 use seethru::scene::lens_keys::read_calibration_file;
@@ -131,7 +133,7 @@ fn run_command(
         let files = writes.exr.files();
         let (kind, metrics) = read_results(staged.path())?;
         format!(
-            "{}; wrote the six views ({files}), run.json and the metrics to {}",
+            "{}; wrote the six views ({files}), run.json, the metrics and view.html to {}",
             summary_text(kind, &metrics),
             out.display()
         )
@@ -254,11 +256,17 @@ fn write_run(
         &out.join("hazards.json"),
         &serde_json::to_string_pretty(&hazards)?,
     )?;
-    // Last: a directory with run.json holds a finished run.
+    let mut report = with_flags(&result.report);
+    if let Some(top) = heatmap_max {
+        report["options"]["heatmap_max_arcmin"] = serde_json::json!(top);
+    }
     write_text(
         &out.join("run.json"),
-        &serde_json::to_string_pretty(&with_flags(&result.report))?,
+        &serde_json::to_string_pretty(&report)?,
     )?;
+    // Last, as it reads run.json and metrics.json: the viewer.
+    let pixels = RunPixels::of_run(&maps, &result.truth, FrameView::from(&result.seethru));
+    write_run_view(out, out, &pixels)?;
     let seen = &result.report["display_seen"];
     if let Some(share) = seen["share"].as_f64()
         && share < seethru::system::obstruction::SLIVER_SHARE

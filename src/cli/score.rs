@@ -16,6 +16,7 @@ use seethru::measure::capture_files::recapture;
 use seethru::measure::hazard::HAZARD_BOUND_ARCMIN;
 use seethru::measure::maps::write_metrics;
 use seethru::measure::measured_run::{MeasureSettings, MeasuredRun, measure_run};
+use seethru::measure::viewer::{RunPixels, write_run_view};
 use seethru::render::frame_over::FrameView;
 use seethru::system::capture::{DisplayImage, DisplayMap, score};
 use seethru::system::display::Filter;
@@ -153,6 +154,8 @@ impl Score {
             &out.join("run.json"),
             &serde_json::to_string_pretty(&with_flags(&result.report))?,
         )?;
+        let pixels = RunPixels::of_run(&maps, &result.truth, FrameView::from(&result.seethru));
+        write_run_view(out, out, &pixels)?;
         staged.commit()?;
         let (d, b) = (&metrics.display, &metrics.border);
         let misregistration = match scored.has_map {

@@ -414,9 +414,10 @@ impl Sequence {
             crate::cli::sequence_byo::write_index(c.path(), std::mem::take(&mut index))?;
             c.commit()?;
         }
+        seethru::measure::viewer::write_sequence_view(&out)?;
         staged.commit()?;
         say(format!(
-            "{}; wrote {} sequence(s) of {} frames (frames.csv, summary.json, plots, preview.png) to {}",
+            "{}; wrote {} sequence(s) of {} frames (frames.csv, summary.json, plots, preview.png, view.html) to {}",
             headlines.join("; "),
             runs.len(),
             runs.first().map_or(0, |r| r.1.records.len()),

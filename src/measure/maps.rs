@@ -90,7 +90,8 @@ pub fn heatmap_rgb(
 
 /// Writes `metrics.json` (`metrics`: the record's JSON, in the front end's words),
 /// `misregistration.exr` (`Y`: misregistration, arcmin, NaN outside the display and on blank
-/// pixels; `missing.mask`: 1 where missing — `Y` so that grey-image readers open it),
+/// pixels; `missing.mask`: 1 where missing; `display.mask`: 1 where the driver sees the
+/// display — `Y` so that grey-image readers open it),
 /// `misregistration.png` (heatmap with colour bar) and `missing.png` into `dir`.
 pub fn write_metrics(
     dir: &Path,
@@ -121,6 +122,10 @@ pub fn write_metrics_scaled(
             AnyChannel::new(
                 "missing.mask",
                 FlatSamples::F32(maps.missing.iter().map(|&m| m as u8 as f32).collect()),
+            ),
+            AnyChannel::new(
+                "display.mask",
+                FlatSamples::F32(maps.display.iter().map(|&d| d as u8 as f32).collect()),
             ),
         ];
         write_exr_channels(

@@ -35,3 +35,4 @@ pub mod sweep;
 pub mod sweep_csv;
 pub mod sweep_grid;
 pub mod sweep_shard;
+pub mod viewer;

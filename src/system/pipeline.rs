@@ -690,6 +690,14 @@ pub fn run_staged(
     let seen = crate::system::obstruction::obstruction_json(ctx, &driver, options.eyes.ipd);
     report["obstruction_deg"] = seen["obstruction_deg"].clone();
     report["display_seen"] = seen["display_seen"].clone();
+    // What the ids in the views name: `id.object` i + 1 is object i (0 is sky).
+    report["object_names"] = json!(
+        ctx.world
+            .objects
+            .iter()
+            .map(|o| &o.name)
+            .collect::<Vec<_>>()
+    );
     Ok(RunRest {
         crop,
         eye_used,
