@@ -411,6 +411,30 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
             ]),
         ),
     ]);
+    // A dataset of the scene: two samples whose frontal camera's angle is drawn, resumed
+    // once (nothing left to make), then its grid viewer rewritten.
+    let spec = dir.join("dataset.toml");
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(
+        &spec,
+        format!("scene = {s:?}\nsamples = 2\n[options]\nwidth = 24\nspp = 1\n[draw]\ntheta_f = {{ uniform = [40, 60] }}\n"),
+    )
+    .unwrap();
+    let dataset = words(&[
+        "dataset",
+        spec.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        &out("dataset"),
+    ]);
+    groups.push(vec![
+        sure("dataset".into(), dataset.clone()),
+        sure("dataset resumed".into(), dataset),
+        sure(
+            "view dataset".into(),
+            words(&["view", &out("dataset"), "--quiet"]),
+        ),
+    ]);
     groups.push(vec![
         sure(
             "compare".into(),
@@ -495,6 +519,7 @@ fn every_command_on_every_bundled_scene_exits_cleanly_or_with_one_error_line() {
         "score",
         "spec",
         "view",
+        "dataset",
     ];
     for command in commands() {
         assert!(

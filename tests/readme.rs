@@ -193,7 +193,7 @@ fn every_command_in_the_docs_runs_as_written() {
         let name = shown(&page);
         // Each page in a folder of its own: what one page writes cannot make another pass.
         let scratch = tempfile::tempdir().unwrap();
-        for folder in ["scenes", "assets"] {
+        for folder in ["scenes", "assets", "examples"] {
             copy_tree(&repo.join(folder), &scratch.path().join(folder));
         }
         for (number, args) in commands {

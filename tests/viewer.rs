@@ -243,8 +243,8 @@ fn a_run_without_depth_or_ids_says_so_and_a_folder_without_outputs_is_refused() 
     );
 }
 
-/// The browser check: a run, a sequence of two latencies with frame images and a compare,
-/// then the Python script drives Chromium over their pages.
+/// The browser check: a run, a sequence of two latencies with frame images, a compare and a
+/// dataset, then the Python script drives Chromium over their pages.
 #[test]
 fn in_chromium_the_pointer_reads_the_exr_and_the_slider_reads_frames_csv() {
     let chromium = std::env::var("SEETHRU_CHROMIUM").unwrap_or("/usr/bin/chromium".into());
@@ -301,12 +301,30 @@ fn in_chromium_the_pointer_reads_the_exr_and_the_slider_reads_frames_csv() {
         cmp.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
+    let data = dir.path().join("data");
+    let spec = dir.path().join("spec.toml");
+    std::fs::write(
+        &spec,
+        format!(
+            "scene = {:?}\nsamples = 4\n[options]\nwidth = 48\nspp = 1\n[draw]\ntheta_f = {{ uniform = [40, 60] }}\n",
+            das()
+        ),
+    )
+    .unwrap();
+    let (ok, _, err) = seethru(&[
+        "dataset",
+        spec.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
     let python = common::python_env::python_with(&["numpy", "OpenEXR", "selenium"]);
     let shots = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("browser-screenshots");
     let script = common::repo_path("tests/browser/viewer_in_chromium.py");
     let out = Command::new(python)
         .arg(script)
-        .args([&run, &seq, &cmp, &shots])
+        .args([&run, &seq, &cmp, &data, &shots])
         .env("SEETHRU_CHROMIUM", &chromium)
         .env("SEETHRU_CHROMEDRIVER", &driver)
         .output()

@@ -82,7 +82,7 @@ def test_the_docs_have_python_blocks_to_run():
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.relative_to(REPO).as_posix())
 def test_every_python_block_of_the_page_runs(page, tmp_path, monkeypatch):
-    for folder in ("scenes", "assets"):
+    for folder in ("scenes", "assets", "examples"):
         shutil.copytree(REPO / folder, tmp_path / folder)
     for args in seethru_commands(page):
         done = subprocess.run(

@@ -10,6 +10,7 @@ mod capture;
 mod check;
 mod compare;
 mod compare_methods;
+mod dataset;
 mod diff;
 mod export;
 mod figures;
@@ -99,6 +100,9 @@ pub enum Command {
     /// every option checked, nothing rendered: the option table's values and defaults.
     #[command(subcommand)]
     Spec(spec::Spec),
+    /// Ground-truth / see-through pairs by the thousand: one run per sample of a spec's draws,
+    /// resumable and sharded (--shard K/N), with a manifest (CSV) and a grid viewer.
+    Dataset(dataset::Dataset),
     /// Write the viewer of an output folder (run, score, measure, sequence, compare): one
     /// self-contained view.html to flick, wipe and read pixels in a browser.
     View(view::View),
@@ -244,6 +248,7 @@ impl Command {
             Command::Diff(c) => c.run(),
             Command::Check(c) => c.run(),
             Command::View(c) => c.run(),
+            Command::Dataset(c) => c.run(),
         }
     }
 

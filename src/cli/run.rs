@@ -79,6 +79,7 @@ impl Run {
             exr: self.exr,
             hazard_bound_arcmin: spec.measure.hazard_bound_arcmin,
             heatmap_max_arcmin: self.heatmap_max.map(|v| v as f32),
+            timings: true,
         };
         let calibration = self.calibration.as_deref();
         with_threads(self.threads, || {
@@ -90,15 +91,18 @@ impl Run {
 /// What one run writes beside its views, and how: the flags that shape the files, not the
 /// system.
 #[derive(Clone, Copy)]
-struct RunWrites {
+pub(crate) struct RunWrites {
     /// Border band of the mismatch metrics, display pixels in [1, 1000].
-    band: u32,
+    pub band: u32,
     /// Which EXRs each view gets.
-    exr: ExrContent,
+    pub exr: ExrContent,
     /// Hazard visibility's bound, arc-minutes.
-    hazard_bound_arcmin: f64,
+    pub hazard_bound_arcmin: f64,
     /// Top of misregistration.png's scale, arc-minutes (`None`: the p99, labelled).
-    heatmap_max_arcmin: Option<f32>,
+    pub heatmap_max_arcmin: Option<f32>,
+    /// Whether run.json keeps the timings and the peak memory (a dataset's samples leave them
+    /// out: its files are the same bytes however often they are made).
+    pub timings: bool,
 }
 
 /// `seethru run`: renders the six views into `out` with `run.json` and the metrics.
@@ -150,7 +154,7 @@ fn in_scope<'s, F: Fn(&rayon::Scope<'s>) + Sync + Send + Copy>(f: F) -> F {
 
 /// One run into `out` (inside the staging folder): every view, the metrics and run.json;
 /// `band`: the border band's width and the heatmap's fixed top, if any.
-fn write_run(
+pub(crate) fn write_run(
     ctx: &RenderContext,
     out: &Path,
     options: &RunOptions,
@@ -161,6 +165,7 @@ fn write_run(
         exr,
         hazard_bound_arcmin: hazard_bound,
         heatmap_max_arcmin: heatmap_max,
+        timings,
     } = writes;
     let views = RunViews::default();
     // The first error of the writes running beside the run.
@@ -259,6 +264,10 @@ fn write_run(
     let mut report = with_flags(&result.report);
     if let Some(top) = heatmap_max {
         report["options"]["heatmap_max_arcmin"] = serde_json::json!(top);
+    }
+    if !timings && let Some(fields) = report.as_object_mut() {
+        fields.remove("timings_s");
+        fields.remove("peak_rss_bytes");
     }
     write_text(
         &out.join("run.json"),

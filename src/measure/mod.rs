@@ -5,6 +5,8 @@ pub mod binocular;
 pub mod capture_files;
 pub mod compare;
 pub mod compare_external;
+pub mod dataset;
+pub mod dataset_spec;
 pub mod diff_thresholds;
 pub mod driver_share;
 pub mod expectations;

@@ -290,7 +290,10 @@ pub fn write_run_view(out: &Path, inputs: &Path, pixels: &RunPixels) -> Result<P
     }
     let bbox = display_box(pixels);
     let (top, heat_title) = match heat_max {
-        Some(t) => (t, "arc-minutes; top fixed by --heatmap-max".to_string()),
+        Some(t) => (
+            t,
+            "arc-minutes; top fixed when the run was made".to_string(),
+        ),
         None => (
             p99_top(pixels.misregistration.iter().copied()),
             "arc-minutes; top at the display's 99th percentile, like misregistration.png".into(),
@@ -305,7 +308,7 @@ pub fn write_run_view(out: &Path, inputs: &Path, pixels: &RunPixels) -> Result<P
     let per_pixel = |values: Option<String>| values.map_or(Value::Null, Value::String);
     let mut notes = Vec::new();
     if pixels.truth_depth.is_none() || pixels.truth_ids.is_none() {
-        notes.push("The readout has no depth or ids: the run wrote no truth EXR with them (--exr colour or none).");
+        notes.push("The readout has no depth or ids: the run's EXRs do not hold them (written with colour only, or none).");
     }
     if pixels.display.is_none() {
         notes.push("This misregistration.exr records no display mask (written before the viewer): the display is taken as its pixels with a value or missing.");
@@ -486,9 +489,39 @@ pub fn write_compare_view(dir: &Path) -> Result<PathBuf> {
     Ok(path)
 }
 
+/// Writes `dir/view.html` for a dataset folder: a grid of its samples (each sample's seethru
+/// view, linking to the sample's own viewer), sortable by any column of `manifest.csv`.
+pub fn write_dataset_view(dir: &Path) -> Result<PathBuf> {
+    let manifest = read_input_text(&dir.join("manifest.csv"), MAX_TEXT_BYTES)?;
+    let record_path = dir.join("dataset.json");
+    let record = record_path
+        .is_file()
+        .then(|| read_json(&record_path))
+        .transpose()?;
+    let samples = manifest
+        .lines()
+        .filter(|l| !l.is_empty())
+        .count()
+        .saturating_sub(1);
+    let data = json!({
+        "kind": "dataset",
+        "title": match record.as_ref().and_then(|r| r["spec"].as_str()) {
+            Some(spec) => format!("seethru dataset: {spec}"),
+            None => "seethru dataset".to_string(),
+        },
+        "subtitle": format!("{samples} samples; sort by any column; a sample opens its own viewer"),
+        "manifest_csv": manifest,
+        "heat_lut": heat_lut(),
+    });
+    let path = dir.join(VIEW_FILE);
+    write_text(&path, &page(&data))?;
+    Ok(path)
+}
+
 /// What an output folder holds, as the viewer sees it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Outputs {
+    Dataset,
     Run,
     Sequence,
     Compare,
@@ -499,7 +532,9 @@ pub fn outputs_in(dir: &Path) -> Result<Outputs> {
     if !dir.is_dir() {
         bail!("cannot show {}: not a folder", dir.display());
     }
-    if dir.join("misregistration.exr").is_file() {
+    if dir.join("manifest.csv").is_file() && dir.join("dataset.json").is_file() {
+        Ok(Outputs::Dataset)
+    } else if dir.join("misregistration.exr").is_file() {
         Ok(Outputs::Run)
     } else if dir.join("compare.json").is_file() {
         Ok(Outputs::Compare)
@@ -507,7 +542,7 @@ pub fn outputs_in(dir: &Path) -> Result<Outputs> {
         Ok(Outputs::Sequence)
     } else {
         bail!(
-            "cannot show {}: it holds no seethru outputs (misregistration.exr of run/score/measure, summary.json or frames.csv of sequence, compare.json of compare)",
+            "cannot show {}: it holds no seethru outputs (misregistration.exr of run/score/measure, summary.json or frames.csv of sequence, compare.json of compare, manifest.csv of a finished dataset)",
             dir.display()
         )
     }
@@ -519,6 +554,7 @@ pub fn write_view(dir: &Path) -> Result<PathBuf> {
         Outputs::Run => write_run_view(dir, dir, &RunPixels::read(dir)?),
         Outputs::Sequence => write_sequence_view(dir),
         Outputs::Compare => write_compare_view(dir),
+        Outputs::Dataset => write_dataset_view(dir),
     }
 }
 

@@ -152,6 +152,50 @@ impl<'a> TableReader<'a> {
         ))
     }
 
+    /// The keys of this table in the file's order (none is marked read: each is read by name
+    /// afterwards, as the keys of a table keyed by names of their own, such as options).
+    pub fn keys(&self) -> Vec<&'a str> {
+        self.table.iter().map(|(k, _)| k).collect()
+    }
+
+    /// A string, number or boolean as text (numbers as TOML wrote them): for values that a
+    /// typed parser of their own reads, such as the option table's.
+    pub fn scalar_text(&self, key: &str) -> Result<String, SceneError> {
+        let item = self.item(key).ok_or_else(|| self.missing(key))?;
+        let value = item.as_value().ok_or_else(|| {
+            self.error(key, format!("expected a value, found {}", item.type_name()))
+        })?;
+        scalar_text(value).ok_or_else(|| {
+            self.error(
+                key,
+                format!(
+                    "expected a string, number or boolean, found {}",
+                    value.type_name()
+                ),
+            )
+        })
+    }
+
+    /// A non-empty array of strings, numbers or booleans, each as text.
+    pub fn scalar_texts(&self, key: &str) -> Result<Vec<String>, SceneError> {
+        let item = self.item(key).ok_or_else(|| self.missing(key))?;
+        let array = item.as_array().ok_or_else(|| {
+            self.error(
+                key,
+                format!("expected an array, found {}", item.type_name()),
+            )
+        })?;
+        let texts: Option<Vec<String>> = array.iter().map(scalar_text).collect();
+        match texts {
+            Some(t) if !t.is_empty() => Ok(t),
+            Some(_) => Err(self.error(key, "expected at least one value, found none")),
+            None => Err(self.error(
+                key,
+                "expected strings, numbers or booleans, found an array or table inside",
+            )),
+        }
+    }
+
     /// Rejects every key that was not read: scene files have no ignored keys.
     pub fn finish(self) -> Result<(), SceneError> {
         let read = self.read.borrow();
@@ -513,4 +557,15 @@ pub fn range_message(value: f64, min: f64, max: f64) -> String {
         short(max),
         short(value)
     )
+}
+
+/// A TOML string, integer, float or boolean as text (a float as Rust writes the f64).
+fn scalar_text(value: &toml_edit::Value) -> Option<String> {
+    match value {
+        toml_edit::Value::String(s) => Some(s.value().clone()),
+        toml_edit::Value::Integer(i) => Some(i.value().to_string()),
+        toml_edit::Value::Float(f) => Some(f.value().to_string()),
+        toml_edit::Value::Boolean(b) => Some(b.value().to_string()),
+        _ => None,
+    }
 }

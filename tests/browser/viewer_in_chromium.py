@@ -3,7 +3,7 @@ Selenium through Debian's chromedriver, opens the view.html of a run, a sequence
 that the Rust test made, moves the pointer over display pixels and reads what the page says
 against the files beside it (the EXRs read here with OpenEXR, frames.csv as text).
 
-usage: viewer_in_chromium.py RUN_DIR SEQUENCE_DIR COMPARE_DIR SCREENSHOT_DIR
+usage: viewer_in_chromium.py RUN_DIR SEQUENCE_DIR COMPARE_DIR DATASET_DIR SCREENSHOT_DIR
 Prints one line per check; exits non-zero on the first failure.
 """
 
@@ -178,14 +178,37 @@ def check_compare(driver, folder, shots):
     print(f"ok: compare shows {len(rows)} methods with their strips and means")
 
 
+def check_dataset(driver, folder, shots):
+    open_page(driver, folder)
+    with open(os.path.join(folder, "manifest.csv"), newline="") as f:
+        rows = list(csv.DictReader(f))
+    from selenium.webdriver.support.ui import Select
+
+    for column, order in [("misregistration_mean_arcmin", "asc"), ("theta_f", "desc"), ("sample", "asc")]:
+        Select(driver.find_element(By.ID, "sort-by")).select_by_value(column)
+        Select(driver.find_element(By.ID, "sort-order")).select_by_value(order)
+        shown = [f.get_attribute("data-sample") for f in driver.find_elements(By.CSS_SELECTOR, "#samples figure")]
+        want = sorted(rows, key=lambda r: (float(r[column]) * (1 if order == "asc" else -1), int(r["sample"])))
+        assert shown == [r["sample"] for r in want], f"sorted by {column} {order}: {shown}"
+        print(f"ok: dataset grid sorted by {column} ({order}): {' '.join(shown)}")
+    driver.save_screenshot(os.path.join(shots, "dataset.png"))
+    # A sample opens its own viewer.
+    driver.find_element(By.CSS_SELECTOR, "#samples figure a").click()
+    WebDriverWait(driver, 20).until(lambda d: d.execute_script("return document.body.dataset.ready === '1'"))
+    assert driver.current_url.endswith("/view.html") and "/samples/" in driver.current_url, driver.current_url
+    assert driver.find_element(By.ID, "stage").is_displayed()
+    print("ok: a dataset sample opens its run viewer")
+
+
 def main():
-    run_dir, sequence_dir, compare_dir, shots = sys.argv[1:5]
+    run_dir, sequence_dir, compare_dir, dataset_dir, shots = sys.argv[1:6]
     os.makedirs(shots, exist_ok=True)
     driver = browser(os.path.join(shots, "profile"))
     try:
         check_run(driver, run_dir, shots)
         check_sequence(driver, sequence_dir, shots)
         check_compare(driver, compare_dir, shots)
+        check_dataset(driver, dataset_dir, shots)
     finally:
         driver.quit()
 

@@ -1,0 +1,48 @@
+"""examples/dataset/loaders.py on a dataset that `seethru dataset` makes: the samples' arrays
+are the files' (PNG and EXR), the draws and metrics the manifest's."""
+
+import importlib.util
+import os
+import subprocess
+
+import numpy as np
+import OpenEXR
+
+from conftest import REPO
+
+BIN = os.environ.get("SEETHRU_BIN", "seethru")
+
+
+def loaders():
+    spec = importlib.util.spec_from_file_location("loaders", REPO / "examples/dataset/loaders.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_seethru_pairs_reads_each_sample_as_its_files_say(tmp_path):
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        f'scene = "{REPO / "scenes/das.toml"}"\nsamples = 3\nseed = 5\n'
+        '[options]\nwidth = 48\nspp = 1\n[draw]\nmethod = { one_of = ["planar", "plane-fit"] }\n'
+    )
+    out = tmp_path / "d"
+    done = subprocess.run([BIN, "dataset", str(spec), "--out", str(out), "--quiet"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    pairs = loaders().SeethruPairs(str(out))
+    assert len(pairs) == 3 and pairs.draws == ["method"]
+    import cv2
+
+    for i in range(3):
+        s = pairs[i]
+        folder = out / "samples" / f"{i:06d}"
+        truth = cv2.imread(str(folder / "truth.png"))[:, :, ::-1]
+        assert s["truth"].shape == truth.shape and s["truth"].dtype == np.float32
+        assert np.array_equal(np.round(s["truth"] * 255).astype(np.uint8), truth)
+        with OpenEXR.File(str(folder / "misregistration.exr")) as f:
+            y = f.channels()["Y"].pixels
+        assert np.array_equal(np.isnan(s["misregistration"]), np.isnan(y))
+        assert np.nanmean(s["misregistration"]) == np.nanmean(y)
+        # The manifest's mean is metrics.json's, which is the map's mean over its values.
+        assert abs(s["metrics"]["misregistration_mean_arcmin"] - float(np.nanmean(y.astype(np.float64)))) < 1e-3
+        assert s["draws"]["method"] in ("planar", "plane-fit")
