@@ -4,7 +4,8 @@
 //! render and that bad input raises with the command line's message.
 //!
 //! Needs `python3` (≥ 3.10, with `venv`) and PyPI or a pip wheel cache: the environment
-//! (numpy, pytest, maturin, OpenEXR; tests/common/python_env.rs) is made once and reused.
+//! (numpy, pytest, maturin, OpenEXR, OpenCV, Ray, distributed; tests/common/python_env.rs) is
+//! made once and reused.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -13,13 +14,16 @@ use std::time::Instant;
 mod common;
 
 /// What the tests import (common::python_env's entries); OpenCV for the docs' EXR-reading
-/// blocks (python/tests/test_docs.py), pinned below 5, whose wheels have no EXR codec.
-const PACKAGES: [&str; 5] = [
+/// blocks (python/tests/test_docs.py), pinned below 5, whose wheels have no EXR codec; Ray and
+/// Dask's distributed for the dataset recipes (python/tests/test_dataset_engines.py).
+const PACKAGES: [&str; 7] = [
     "numpy",
     "pytest",
     "maturin",
     "OpenEXR",
     "cv2=opencv-python-headless<5",
+    "ray",
+    "distributed",
 ];
 
 fn repo() -> PathBuf {

@@ -430,14 +430,18 @@ pub fn write_sequence_view(dir: &Path) -> Result<PathBuf> {
             "preview": preview,
         }));
     }
-    let summary = dir.join("summary.json");
-    let summary = summary.is_file().then(|| read_json(&summary)).transpose()?;
+    // Linked, not embedded: its timings would make the page differ from run to run.
+    let summary_path = dir.join("summary.json");
+    let summary = summary_path
+        .is_file()
+        .then(|| read_json(&summary_path))
+        .transpose()?;
     let data = json!({
         "kind": "sequence",
         "title": title_of(summary.as_ref(), "sequence"),
         "subtitle": format!("{} run(s) of frames; the slider and the plot pick a frame", latencies.len()),
         "latencies": latencies,
-        "summary": summary,
+        "summary_file": summary.is_some().then_some("summary.json"),
         "heat_lut": heat_lut(),
     });
     let path = dir.join(VIEW_FILE);

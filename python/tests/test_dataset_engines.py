@@ -1,0 +1,55 @@
+"""examples/dataset/engines.py: a dataset made by Ray tasks (ray.init(num_cpus=2)) and by a
+Dask LocalCluster of two workers, a task per shard, is the single process's, file for file."""
+
+import importlib.util
+import os
+import subprocess
+
+import pytest
+
+from conftest import REPO
+
+BIN = os.environ.get("SEETHRU_BIN", "seethru")
+
+
+def engines():
+    spec = importlib.util.spec_from_file_location("engines", REPO / "examples/dataset/engines.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def files(folder):
+    out = {}
+    for root, _, names in os.walk(folder):
+        for name in names:
+            path = os.path.join(root, name)
+            with open(path, "rb") as f:
+                out[os.path.relpath(path, folder)] = f.read()
+    return out
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    base = tmp_path_factory.mktemp("engines")
+    spec = base / "spec.toml"
+    spec.write_text(
+        f'scene = "{REPO / "scenes/das.toml"}"\nsamples = 4\nseed = 3\n'
+        '[options]\nwidth = 48\nspp = 1\n[draw]\ntheta_f = { uniform = [40, 60] }\n'
+    )
+    one = base / "one"
+    done = subprocess.run([BIN, "dataset", str(spec), "--out", str(one), "--quiet"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return base, str(spec), files(one)
+
+
+@pytest.mark.parametrize("engine", ["ray", "dask"])
+def test_an_engine_makes_the_files_one_process_makes(reference, engine):
+    base, spec, want = reference
+    out = str(base / engine)
+    run = getattr(engines(), f"on_{engine}")
+    lines = run(spec, out, 2, 2, BIN)
+    assert len(lines) == 2 and all("made 2 samples" in line for line in lines), lines
+    got = files(out)
+    assert sorted(got) == sorted(want)
+    assert all(got[k] == want[k] for k in want), [k for k in want if got[k] != want[k]]
