@@ -54,26 +54,14 @@ fn json(path: &Path) -> Value {
 
 /// The `Y` channel of a misregistration.exr (arcmin per driver pixel, NaN off the display).
 fn misregistration_map(dir: &Path) -> Vec<f32> {
-    use exr::prelude::*;
-    let channel = "Y";
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(dir.join("misregistration.exr"))
-        .unwrap();
-    let y = image
-        .layer_data
-        .channel_data
-        .list
-        .iter()
-        .find(|c| c.name.to_string() == channel)
-        .unwrap();
-    match &y.sample_data {
-        FlatSamples::F32(v) => v.clone(),
-        _ => panic!("Y is f32"),
+    let channels = common::exr_channels(&dir.join("misregistration.exr"));
+    match channels
+        .into_iter()
+        .find(|(name, _)| name == "Y")
+        .map(|(_, v)| v)
+    {
+        Some(exr::prelude::FlatSamples::F32(v)) => v,
+        _ => panic!("misregistration.exr has no f32 channel Y"),
     }
 }
 

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use base64::Engine;
-use common::seethru;
+use common::{exr_channels, seethru};
 use serde_json::Value;
 
 fn das() -> String {
@@ -52,25 +52,6 @@ fn decoded(v: &Value) -> Vec<u8> {
     base64::engine::general_purpose::STANDARD
         .decode(v.as_str().expect("base64 text"))
         .unwrap()
-}
-
-fn exr_channels(path: &Path) -> Vec<(String, exr::prelude::FlatSamples)> {
-    use exr::prelude::*;
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .unwrap();
-    image
-        .layer_data
-        .channel_data
-        .list
-        .into_iter()
-        .map(|c| (c.name.to_string(), c.sample_data))
-        .collect()
 }
 
 fn f32s(channels: &[(String, exr::prelude::FlatSamples)], name: &str) -> Vec<f32> {

@@ -4,6 +4,7 @@ SEETHRU_BIN names the `seethru` binary (tests/python.rs passes cargo's); SEETHRU
 repository root (default: two folders above this one).
 """
 
+import importlib.util
 import os
 import pathlib
 import subprocess
@@ -12,6 +13,16 @@ import pytest
 
 REPO = pathlib.Path(os.environ.get("SEETHRU_REPO", pathlib.Path(__file__).resolve().parents[2]))
 SCENE = REPO / "scenes" / "das.toml"
+
+
+def example_module(relative):
+    """A Python file of examples/ (`dataset/loaders.py`) imported as a module, as a reader
+    who copies it would use it."""
+    path = REPO / "examples" / relative
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 # A small valid scene (tests/common/mod.rs's MINIMAL): a ground plane, a sphere, the obstacle.
 MINIMAL = """
 [obstacle]

@@ -1,22 +1,14 @@
 """examples/dataset/engines.py: a dataset made by Ray tasks (ray.init(num_cpus=2)) and by a
 Dask LocalCluster of two workers, a task per shard, is the single process's, file for file."""
 
-import importlib.util
 import os
 import subprocess
 
 import pytest
 
-from conftest import REPO
+from conftest import REPO, example_module
 
 BIN = os.environ.get("SEETHRU_BIN", "seethru")
-
-
-def engines():
-    spec = importlib.util.spec_from_file_location("engines", REPO / "examples/dataset/engines.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def files(folder):
@@ -47,7 +39,7 @@ def reference(tmp_path_factory):
 def test_an_engine_makes_the_files_one_process_makes(reference, engine):
     base, spec, want = reference
     out = str(base / engine)
-    run = getattr(engines(), f"on_{engine}")
+    run = getattr(example_module("dataset/engines.py"), f"on_{engine}")
     lines = run(spec, out, 2, 2, BIN)
     assert len(lines) == 2 and all("made 2 samples" in line for line in lines), lines
     got = files(out)

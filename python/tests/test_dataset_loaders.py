@@ -1,23 +1,15 @@
 """examples/dataset/loaders.py on a dataset that `seethru dataset` makes: the samples' arrays
 are the files' (PNG and EXR), the draws and metrics the manifest's."""
 
-import importlib.util
 import os
 import subprocess
 
 import numpy as np
 import OpenEXR
 
-from conftest import REPO
+from conftest import REPO, example_module
 
 BIN = os.environ.get("SEETHRU_BIN", "seethru")
-
-
-def loaders():
-    spec = importlib.util.spec_from_file_location("loaders", REPO / "examples/dataset/loaders.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def test_seethru_pairs_reads_each_sample_as_its_files_say(tmp_path):
@@ -29,7 +21,7 @@ def test_seethru_pairs_reads_each_sample_as_its_files_say(tmp_path):
     out = tmp_path / "d"
     done = subprocess.run([BIN, "dataset", str(spec), "--out", str(out), "--quiet"], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
-    pairs = loaders().SeethruPairs(str(out))
+    pairs = example_module("dataset/loaders.py").SeethruPairs(str(out))
     assert len(pairs) == 3 and pairs.draws == ["method"]
     import cv2
 

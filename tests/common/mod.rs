@@ -367,3 +367,23 @@ pub fn still_sequence(
         byo: Default::default(),
     }
 }
+
+/// Every channel of an EXR's first layer, by name, read with the `exr` crate's own reader
+/// (not seethru's): the tests' independent view of a file.
+pub fn exr_channels(path: &Path) -> Vec<(String, exr::prelude::FlatSamples)> {
+    use exr::prelude::*;
+    read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .layer_data
+        .channel_data
+        .list
+        .into_iter()
+        .map(|c| (c.name.to_string(), c.sample_data))
+        .collect()
+}
