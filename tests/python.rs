@@ -4,8 +4,8 @@
 //! render and that bad input raises with the command line's message.
 //!
 //! Needs `python3` (≥ 3.10, with `venv`) and PyPI or a pip wheel cache: the environment
-//! (numpy, pytest, maturin, OpenEXR, OpenCV, Ray, distributed; tests/common/python_env.rs) is
-//! made once and reused.
+//! (numpy, pytest, maturin, OpenEXR, OpenCV, Ray, distributed, PyArrow;
+//! tests/common/python_env.rs) is made once and reused.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -15,8 +15,9 @@ mod common;
 
 /// What the tests import (common::python_env's entries); OpenCV for the docs' EXR-reading
 /// blocks (python/tests/test_docs.py), pinned below 5, whose wheels have no EXR codec; Ray and
-/// Dask's distributed for the dataset recipes (python/tests/test_dataset_engines.py).
-const PACKAGES: [&str; 7] = [
+/// Dask's distributed for the dataset recipes (python/tests/test_dataset_engines.py), PyArrow
+/// for its Parquet manifest.
+const PACKAGES: [&str; 8] = [
     "numpy",
     "pytest",
     "maturin",
@@ -24,6 +25,7 @@ const PACKAGES: [&str; 7] = [
     "cv2=opencv-python-headless<5",
     "ray",
     "distributed",
+    "pyarrow",
 ];
 
 fn repo() -> PathBuf {

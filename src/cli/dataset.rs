@@ -14,10 +14,11 @@ use seethru::io::frame_files::ExrContent;
 use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
 use seethru::measure::dataset::{
-    MANIFEST, RECORD, SAMPLE_RECORD, check_record, is_done, manifest, record, sample_dir,
+    MANIFEST, Manifest, RECORD, SAMPLE_RECORD, check_record, is_done, record, sample_dir,
     sample_draws,
 };
 use seethru::measure::dataset_spec::{DatasetSpec, SCENE_DRAWS};
+use seethru::measure::manifest_parquet::{MANIFEST_PARQUET, write_manifest_parquet};
 use seethru::measure::option_table::{Command, Value};
 use seethru::measure::run_spec::{RunSpec, SpecError};
 use seethru::measure::sweep_grid::configure;
@@ -109,9 +110,14 @@ impl Dataset {
             spec.samples
         );
         if done == spec.samples {
-            write_text(&out.join(MANIFEST), &manifest(out, spec)?)?;
+            let manifest = Manifest::read(out, spec)?;
+            write_text(&out.join(MANIFEST), &manifest.csv())?;
+            write_manifest_parquet(&out.join(MANIFEST_PARQUET), &manifest)?;
             write_dataset_view(out)?;
-            line += &format!("; wrote {} and view.html", out.join(MANIFEST).display());
+            line += &format!(
+                "; wrote {}, {MANIFEST_PARQUET} and view.html",
+                out.join(MANIFEST).display()
+            );
         } else {
             line += " (the manifest is written when every sample is done)";
         }

@@ -122,7 +122,7 @@ pub fn check_record(dataset: &Path, spec: &DatasetSpec) -> Result<bool> {
 }
 
 /// The manifest's metric columns: (column, where in metrics.json or run.json).
-const METRIC_COLUMNS: [(&str, &str, &[&str]); 8] = [
+pub const METRIC_COLUMNS: [(&str, &str, &[&str]); 8] = [
     (
         "misregistration_mean_arcmin",
         "metrics",
@@ -146,7 +146,7 @@ const METRIC_COLUMNS: [(&str, &str, &[&str]); 8] = [
 ];
 
 /// The files of a sample, relative to the dataset folder, as the manifest's last columns.
-const FILE_COLUMNS: [(&str, &str); 7] = [
+pub const FILE_COLUMNS: [(&str, &str); 7] = [
     ("truth_png", "truth.png"),
     ("seethru_png", "seethru.png"),
     ("frontal_png", "frontal.png"),
@@ -171,49 +171,100 @@ fn field(text: &str) -> String {
     }
 }
 
-/// The manifest of a finished dataset (every sample done), from its sample folders: one row
-/// per sample with its draws, its headline metrics (empty where a metric has no value) and
-/// its files' paths relative to the dataset folder.
-pub fn manifest(dataset: &Path, spec: &DatasetSpec) -> Result<String> {
-    let mut header = vec!["sample".to_string()];
-    header.extend(spec.draws.iter().map(|d| d.name.clone()));
-    header.extend(METRIC_COLUMNS.iter().map(|c| c.0.to_string()));
-    header.extend(FILE_COLUMNS.iter().map(|c| c.0.to_string()));
-    let mut csv = header.join(",") + "\n";
-    for index in 0..spec.samples {
-        let dir = sample_dir(dataset, index);
-        let sample = read_json(&dir.join(SAMPLE_RECORD))?;
-        let metrics = read_json(&dir.join("metrics.json"))?;
-        let run = read_json(&dir.join("run.json"))?;
-        let mut row = vec![index.to_string()];
-        for d in &spec.draws {
-            let v = sample["draws"][&d.name].as_str().with_context(|| {
-                format!(
-                    "{}: no draw `{}`",
-                    dir.join(SAMPLE_RECORD).display(),
-                    d.name
-                )
-            })?;
-            row.push(field(v));
-        }
-        for (_, from, path) in METRIC_COLUMNS {
-            let mut v = if from == "metrics" { &metrics } else { &run };
-            for key in path {
-                v = &v[*key];
+/// A finished dataset's manifest: one row per sample with its draws, its headline metrics
+/// (`None` where a metric has no value) and its files' paths relative to the dataset folder
+/// (`None` where the sample has no such file), read from the sample folders.
+pub struct Manifest {
+    /// The draws' names, in the spec's order.
+    pub draws: Vec<String>,
+    pub rows: Vec<ManifestRow>,
+}
+
+pub struct ManifestRow {
+    pub sample: usize,
+    /// Each draw as drawn (text), in [`Manifest::draws`]' order.
+    pub draws: Vec<String>,
+    /// [`METRIC_COLUMNS`]' values.
+    pub metrics: Vec<Option<f64>>,
+    /// [`FILE_COLUMNS`]' paths.
+    pub files: Vec<Option<String>>,
+}
+
+impl Manifest {
+    /// Reads every sample folder of a finished dataset.
+    pub fn read(dataset: &Path, spec: &DatasetSpec) -> Result<Manifest> {
+        let mut rows = Vec::new();
+        for index in 0..spec.samples {
+            let dir = sample_dir(dataset, index);
+            let sample = read_json(&dir.join(SAMPLE_RECORD))?;
+            let metrics = read_json(&dir.join("metrics.json"))?;
+            let run = read_json(&dir.join("run.json"))?;
+            let mut draws = Vec::new();
+            for d in &spec.draws {
+                let v = sample["draws"][&d.name].as_str().with_context(|| {
+                    format!(
+                        "{}: no draw `{}`",
+                        dir.join(SAMPLE_RECORD).display(),
+                        d.name
+                    )
+                })?;
+                draws.push(v.to_string());
             }
-            row.push(v.as_f64().map_or(String::new(), |x| format!("{x}")));
-        }
-        for (_, file) in FILE_COLUMNS {
-            let rel = format!("samples/{index:06}/{file}");
-            row.push(if dataset.join(&rel).is_file() {
-                rel
-            } else {
-                String::new()
+            let metrics = METRIC_COLUMNS
+                .iter()
+                .map(|(_, from, path)| {
+                    let mut v = if *from == "metrics" { &metrics } else { &run };
+                    for key in *path {
+                        v = &v[*key];
+                    }
+                    v.as_f64()
+                })
+                .collect();
+            let files = FILE_COLUMNS
+                .iter()
+                .map(|(_, file)| {
+                    let rel = format!("samples/{index:06}/{file}");
+                    dataset.join(&rel).is_file().then_some(rel)
+                })
+                .collect();
+            rows.push(ManifestRow {
+                sample: index,
+                draws,
+                metrics,
+                files,
             });
         }
-        csv += &(row.join(",") + "\n");
+        Ok(Manifest {
+            draws: spec.draws.iter().map(|d| d.name.clone()).collect(),
+            rows,
+        })
     }
-    Ok(csv)
+
+    /// The column names: `sample`, the draws, the metrics, the files.
+    pub fn header(&self) -> Vec<String> {
+        let mut header = vec!["sample".to_string()];
+        header.extend(self.draws.iter().cloned());
+        header.extend(METRIC_COLUMNS.iter().map(|c| c.0.to_string()));
+        header.extend(FILE_COLUMNS.iter().map(|c| c.0.to_string()));
+        header
+    }
+
+    /// `manifest.csv`: numbers as Rust writes the f64, an absent value as an empty field.
+    pub fn csv(&self) -> String {
+        let mut csv = self.header().join(",") + "\n";
+        for r in &self.rows {
+            let mut row = vec![r.sample.to_string()];
+            row.extend(r.draws.iter().map(|d| field(d)));
+            row.extend(
+                r.metrics
+                    .iter()
+                    .map(|m| m.map_or(String::new(), |x| format!("{x}"))),
+            );
+            row.extend(r.files.iter().map(|f| f.clone().unwrap_or_default()));
+            csv += &(row.join(",") + "\n");
+        }
+        csv
+    }
 }
 
 #[cfg(test)]

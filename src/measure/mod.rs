@@ -17,6 +17,7 @@ pub mod holes;
 pub mod image_diff;
 pub mod image_metrics;
 pub mod luminance;
+pub mod manifest_parquet;
 pub mod maps;
 pub mod measured_run;
 pub mod metrics;
