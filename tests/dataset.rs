@@ -280,6 +280,28 @@ fn bad_specs_are_refused_in_one_line_naming_file_line_and_key() {
         );
         assert!(!out.exists(), "case {i} wrote {}", out.display());
     }
+    // Both eyes, and a sample over its memory bound.
+    for (options, says) in [
+        ("eyes = \"both\"", "one eye's run"),
+        ("max_memory = 0.001", "GiB"),
+        ("[draw]\neye_z = { uniform = [-3, -2] }", "behind the display"),
+    ] {
+        let spec = dir.path().join("options.toml");
+        let table = if options.starts_with('[') { "" } else { "[options]\n" };
+        std::fs::write(&spec, format!("{head}{table}{options}\n")).unwrap();
+        let out = dir.path().join("options_out");
+        let (ok, _, err) = seethru(&[
+            "dataset",
+            spec.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(
+            !ok && err.starts_with("error: ") && err.contains(says),
+            "{options}: {err}"
+        );
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
     // A draw that a run refuses names the sample and the value.
     let spec = spec_in(dir.path(), 2, "head_jitter_cm = { normal = [-50, 0] }\n");
     let out = dir.path().join("refused");

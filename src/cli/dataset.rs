@@ -26,6 +26,7 @@ use seethru::measure::sweep_shard::Shard;
 use seethru::measure::viewer::write_dataset_view;
 use seethru::render::integrator::RenderContext;
 use seethru::scene::Scene;
+use seethru::system::memory::{check_memory, run_estimate};
 use seethru::system::options::RunOptions;
 use seethru::util::progress::Progress;
 use serde_json::json;
@@ -69,9 +70,10 @@ impl Dataset {
     fn make(&self, spec: &DatasetSpec, base: Scene) -> Result<()> {
         let start = Instant::now();
         let out = &self.out;
-        // Every sample's draws checked before anything is written (cheap: no scene moves).
+        // Every sample checked before anything is written: its draws, the run they make, the
+        // scene they move and the memory it needs.
         for index in 0..spec.samples {
-            sample_run(spec, index)?;
+            prepared(spec, &base, index)?;
         }
         if !check_record(out, spec)? {
             write_text(
@@ -133,16 +135,12 @@ impl Dataset {
         first: &RenderContext,
         index: usize,
     ) -> Result<()> {
-        let SampleRun {
+        let Prepared {
             draws,
             run,
-            scene_draws,
-        } = sample_run(spec, index)?;
-        let options = RunOptions {
-            progress: false,
-            ..run.options
-        };
-        let (scene, options) = configure(base, &options, &scene_draws)?;
+            scene,
+            options,
+        } = prepared(spec, base, index)?;
         let ctx = first.with_scene(scene)?;
         let writes = RunWrites {
             band: run.measure.band,
@@ -201,10 +199,51 @@ fn sample_run(spec: &DatasetSpec, index: usize) -> Result<SampleRun> {
         }
     }
     let run = RunSpec::build(Command::Run, &given).map_err(|e| in_spec(spec, e))?;
+    if run.both_eyes {
+        anyhow::bail!(
+            "{}: `eyes` = both: a sample is one eye's run (draw eyes = {{ one_of = [\"left\", \"right\"] }} instead)",
+            spec.path.display()
+        );
+    }
     Ok(SampleRun {
         draws,
         run,
         scene_draws,
+    })
+}
+
+/// A sample ready to render: its draws, its run, its moved scene and options.
+struct Prepared {
+    draws: Vec<(String, String)>,
+    run: RunSpec,
+    scene: Scene,
+    options: RunOptions,
+}
+
+fn prepared(spec: &DatasetSpec, base: &Scene, index: usize) -> Result<Prepared> {
+    let SampleRun {
+        draws,
+        run,
+        scene_draws,
+    } = sample_run(spec, index)?;
+    let options = RunOptions {
+        progress: false,
+        ..run.options.clone()
+    };
+    let (scene, options) = configure(base, &options, &scene_draws).with_context(|| {
+        format!(
+            "{}: sample {index} of {}",
+            spec.path.display(),
+            spec.samples
+        )
+    })?;
+    // As `run` does, per sample (its draws may size it).
+    check_memory(&run_estimate(&scene, &options)?, run.max_memory_gib)?;
+    Ok(Prepared {
+        draws,
+        run,
+        scene,
+        options,
     })
 }
 
