@@ -284,10 +284,17 @@ fn bad_specs_are_refused_in_one_line_naming_file_line_and_key() {
     for (options, says) in [
         ("eyes = \"both\"", "one eye's run"),
         ("max_memory = 0.001", "GiB"),
-        ("[draw]\neye_z = { uniform = [-3, -2] }", "behind the display"),
+        (
+            "[draw]\neye_z = { uniform = [-3, -2] }",
+            "behind the display",
+        ),
     ] {
         let spec = dir.path().join("options.toml");
-        let table = if options.starts_with('[') { "" } else { "[options]\n" };
+        let table = if options.starts_with('[') {
+            ""
+        } else {
+            "[options]\n"
+        };
         std::fs::write(&spec, format!("{head}{table}{options}\n")).unwrap();
         let out = dir.path().join("options_out");
         let (ok, _, err) = seethru(&[
