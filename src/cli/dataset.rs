@@ -2,7 +2,7 @@
 //! the thousand. Each sample is a `run` of the spec's scene with the sample's draws, written
 //! whole into `DIR/samples/NNNNNN/` (every view, the system's inputs, the maps, run.json,
 //! sample.json); samples already there are kept (a killed run resumes); the process that
-//! finds every sample done writes `manifest.csv` and the grid `view.html`.
+//! finds every sample done writes `manifest.csv`, `manifest.parquet` and the grid `view.html`.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -40,7 +40,7 @@ pub struct Dataset {
     /// (docs/guide/datasets.md).
     spec: PathBuf,
     /// The dataset's folder: samples/NNNNNN/ per sample, dataset.json, and, once every sample
-    /// is done, manifest.csv and view.html. Samples already in it are kept (a killed run
+    /// is done, manifest.csv, manifest.parquet and view.html. Samples already in it are kept (a killed run
     /// resumes); it must hold the same spec's samples.
     #[arg(long)]
     out: PathBuf,
