@@ -3,14 +3,15 @@
 //! like a scene file: typed, unknown keys refused, every error naming the file, line and key.
 //!
 //! ```toml
-//! scene = "../../scenes/das.toml"   # relative to this file
+//! scene = "../../scenes/cabin.toml" # relative to this file
 //! samples = 8
 //! seed = 2026
 //! [options]                         # every sample: the option table's names and values
 //! width = 160
 //! [draw]                            # per sample, each with the sample's own draw
 //! eye = "eyellipse"                 # the scene's [eyellipse]
-//! method = { one_of = ["planar-inf", "planar-auto"] }
+//! method = { one_of = ["planar", "plane-fit"] }
+//! d2 = { one_of = ["inf", "auto"] }
 //! theta_f = { uniform = [40, 60] }
 //! head_jitter_cm = { normal = [0.5, 0.1] }
 //! ```
