@@ -183,7 +183,7 @@ fn the_laws_are_those_the_spec_names() {
     let spec = spec_in(
         dir.path(),
         4000,
-        "method = { one_of = [\"none\", \"planar\", \"ground\", \"plane-fit\"] }\ntheta_f = { uniform = [40, 60] }\nhead_jitter_cm = { normal = [2, 0.5] }\nfrontal_width = { uniform = [100, 103] }\n",
+        "method = { one_of = [\"none\", \"planar\", \"ground\", \"plane-fit\"] }\ntheta_f = { uniform = [40, 60] }\nhead_jitter_cm = { normal = [2, 0.5] }\nfrontal_width = { uniform = [100, 103] }\n[draw.scene]\n\"object.car.translate\" = { uniform = [[0, 10, -5], [1, 20, -5]] }\nsky.zenith_color = { normal = [[0.2, 0.5, 0.8], [0.01, 0.02, 0]] }\n",
     );
     let spec = DatasetSpec::load(&spec).unwrap();
     let rows: Vec<Vec<(String, String)>> = (0..4000).map(|i| sample_draws(&spec, i)).collect();
@@ -214,6 +214,65 @@ fn the_laws_are_those_the_spec_names() {
             .iter()
             .all(|v| ["100", "101", "102", "103"].contains(&v.as_str()))
     );
+    // A vector law draws each component by its own bounds, independently of the others.
+    let vectors = |k: usize| -> Vec<Vec<f64>> {
+        column(k)
+            .iter()
+            .map(|v| serde_json::from_str(v).unwrap())
+            .collect()
+    };
+    let (translate, zenith) = (vectors(4), vectors(5));
+    let stats = |rows: &[Vec<f64>], c: usize| {
+        let x: Vec<f64> = rows.iter().map(|r| r[c]).collect();
+        let m = x.iter().sum::<f64>() / x.len() as f64;
+        let sd = (x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (x.len() - 1) as f64).sqrt();
+        (m, sd)
+    };
+    for (c, (low, high)) in [(0.0, 1.0), (10.0, 20.0), (-5.0, -5.0)]
+        .into_iter()
+        .enumerate()
+    {
+        assert!(
+            translate
+                .iter()
+                .all(|t| t.len() == 3 && (low..=high).contains(&t[c]))
+        );
+        let (m, sd) = stats(&translate, c);
+        let width = high - low;
+        // A uniform's mean and deviation: (low + high) / 2 and width / √12; σ of the mean
+        // width / 219.
+        assert!(
+            (m - (low + high) / 2.0).abs() <= width * 0.025,
+            "component {c}: mean {m}"
+        );
+        assert!(
+            (sd - width / 12f64.sqrt()).abs() <= width * 0.02,
+            "component {c}: sd {sd}"
+        );
+    }
+    for (c, (mean, sd_want)) in [(0.2, 0.01), (0.5, 0.02), (0.8, 0.0)]
+        .into_iter()
+        .enumerate()
+    {
+        let (m, sd) = stats(&zenith, c);
+        assert!(
+            (m - mean).abs() <= 5.0 * sd_want / 63.0 + 1e-12,
+            "component {c}: mean {m}"
+        );
+        assert!(
+            (sd - sd_want).abs() <= 0.06 * sd_want + 1e-12,
+            "component {c}: sd {sd}"
+        );
+    }
+    // Components from streams of their own: uncorrelated (|r| of 4000 pairs ≲ 0.016 per σ).
+    let (mx, sx) = stats(&translate, 0);
+    let (my, sy) = stats(&translate, 1);
+    let r = translate
+        .iter()
+        .map(|t| (t[0] - mx) * (t[1] - my))
+        .sum::<f64>()
+        / (3999.0 * sx * sy);
+    assert!(r.abs() < 0.08, "the components are correlated: r = {r}");
     // The same draws however often they are asked for, and per sample, not per call order.
     assert_eq!(sample_draws(&spec, 17), rows[17]);
 }
@@ -223,7 +282,7 @@ fn bad_specs_are_refused_in_one_line_naming_file_line_and_key() {
     let dir = tempfile::tempdir().unwrap();
     let das = common::repo_path("scenes/das.toml");
     let head = format!("scene = {das:?}\nsamples = 2\n");
-    let cases: [(&str, &str); 12] = [
+    let cases: [(&str, &str); 18] = [
         ("scene = \"missing.toml\"\nsamples = 2\n", "missing.toml"),
         (&format!("scene = {das:?}\n"), "samples"),
         (&format!("{head}samples_x = 3\n"), "unknown key"),
@@ -256,6 +315,33 @@ fn bad_specs_are_refused_in_one_line_naming_file_line_and_key() {
         (
             &format!("{head}[options]\nspp = 2\n[draw]\nspp = {{ one_of = [1, 2] }}\n"),
             "also in [options]",
+        ),
+        (
+            &format!("{head}[draw.scene]\nsun.intensity = {{ uniform = [[1, 2], [3]] }}\n"),
+            "of one length",
+        ),
+        (&format!("{head}[draw.scene]\nsun = {{}}\n"), "found none"),
+        (
+            &format!(
+                "{head}[draw.scene]\n\"object.bus.translate\" = {{ one_of = [[0, 0, -9]] }}\n"
+            ),
+            "no [[object]] is named `bus`",
+        ),
+        (
+            &format!("{head}[draw.scene]\nsun.intensity = {{ uniform = [2000, 3000] }}\n"),
+            "sun.intensity",
+        ),
+        (
+            &format!(
+                "{head}[draw]\ntheta_f = {{ uniform = [40, 50] }}\n[draw.scene]\ncamera.frontal.half_angle_deg = {{ one_of = [45] }}\n"
+            ),
+            "set the same thing",
+        ),
+        (
+            &format!(
+                "{head}[draw.scene]\nsun.intensity = {{ one_of = [1] }}\n\"sun.intensity\" = {{ one_of = [2] }}\n"
+            ),
+            "drawn twice",
         ),
     ];
     for (i, (text, says)) in cases.iter().enumerate() {
@@ -322,6 +408,78 @@ fn bad_specs_are_refused_in_one_line_naming_file_line_and_key() {
         !ok && err.contains("sample 0 of 2") && err.contains("head_jitter_cm = -50"),
         "{err}"
     );
+}
+
+#[test]
+fn scene_key_draws_make_the_scene_an_edit_of_its_file_by_hand_makes() {
+    let dir = tempfile::tempdir().unwrap();
+    let das_path = common::repo_path("scenes/das.toml");
+    let das = std::fs::read_to_string(&das_path).unwrap();
+    let (car, sun) = ("translate = [-1.75, 0.0, -8.5]", "intensity = 2.6");
+    for line in [car, sun, "cloud_seed = 3\n"] {
+        assert_eq!(das.matches(line).count(), 1, "{line}");
+    }
+    let spec = spec_in(
+        dir.path(),
+        2,
+        "[draw.scene]\n\"object.car.translate\" = { uniform = [[-2.5, 0, -12], [-1, 0.01, -7]] }\nsun.intensity = { normal = [2, 0.5] }\nsky.ground_color = { one_of = [[0.3, 0.3, 0.3], [0.5, 0.4, 0.3]] }\n",
+    );
+    let out = dir.path().join("d");
+    make(&spec, &out, &["--quiet"]);
+    let base = dir.path().join("base");
+    for i in 0..2 {
+        let folder = out.join(format!("samples/{i:06}"));
+        let draws = &json(&folder.join("sample.json"))["draws"];
+        let text = |k: &str| draws[k].as_str().unwrap().to_string();
+        let translate: Vec<f64> =
+            serde_json::from_str(&text("scene.object.car.translate")).unwrap();
+        for (c, (low, high)) in translate
+            .iter()
+            .zip([(-2.5, -1.0), (0.0, 0.01), (-12.0, -7.0)])
+        {
+            assert!((low..=high).contains(c), "{translate:?}");
+        }
+        // The same scene, edited as a person would, at another place (its assets absolute).
+        let edited = das
+            .replace(
+                car,
+                &format!("translate = {}", text("scene.object.car.translate")),
+            )
+            .replace(sun, &format!("intensity = {}", text("scene.sun.intensity")))
+            .replace(
+                "\"../assets/",
+                &format!("\"{}/", common::repo_path("assets").display()),
+            );
+        // A key the file lacks is added to its table.
+        assert!(!das.contains("ground_color"));
+        let ground = text("scene.sky.ground_color");
+        let edited = edited.replace(
+            "cloud_seed = 3\n",
+            &format!("cloud_seed = 3\nground_color = {ground}\n"),
+        );
+        let scene = dir.path().join(format!("edited{i}.toml"));
+        std::fs::write(&scene, edited).unwrap();
+        let (ok, _, err) = seethru(&[
+            "run",
+            scene.to_str().unwrap(),
+            "--width",
+            "48",
+            "--spp",
+            "1",
+            "--quiet",
+            "--out",
+            base.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+        for file in ["truth.png", "seethru.png", "frontal.png", "metrics.json"] {
+            assert!(
+                std::fs::read(folder.join(file)).unwrap()
+                    == std::fs::read(base.join(file)).unwrap(),
+                "sample {i}: {file} differs from the hand-edited scene's"
+            );
+        }
+        std::fs::remove_dir_all(&base).unwrap();
+    }
 }
 
 /// The number after `key` on the line of `text` that has it (`completions: 4` → 4).

@@ -12,6 +12,7 @@ Errors raise :class:`ValueError` (bad input: a scene key, an option's range) or
 
 from ._native import Capture, Frame, Run, Scene, __version__, analyze, capture, compare, frame_pool, load_capture, options, ratio, read_frame, spec
 from ._native import run as _run
+from ._native import dataset as _dataset
 from ._native import score as _score
 from ._native import Sequence, Step
 from ._native import sequence as _sequence
@@ -19,7 +20,7 @@ from ._native import sequence as _sequence
 import numpy as _np
 
 __all__ = [
-    "Capture", "Frame", "Run", "Scene", "analyze", "capture", "compare", "frame_pool", "load_capture", "options", "ratio", "read_frame", "run", "spec",
+    "Capture", "Frame", "Run", "Scene", "analyze", "capture", "compare", "dataset", "frame_pool", "load_capture", "options", "ratio", "read_frame", "run", "spec",
     "score", "sequence", "Sequence", "Step", "__version__",
 ]
 
@@ -91,3 +92,27 @@ def sequence(scene: Scene, predictor=None, **options) -> Sequence:
     and ``misregistration`` ((h, w) float32, arcmin).
     """
     return _sequence(scene, predictor, **options)
+
+
+def dataset(spec, out, shard=None, exr: str = "lean", threads=None) -> dict:
+    """Makes a dataset as ``seethru dataset SPEC --out OUT`` does, to the same bytes.
+
+    ``spec``: the dataset's specification (TOML: the scene, ``samples``, ``seed``,
+    ``[options]``, ``[draw]``; docs/guide/datasets.md). ``out``: its folder; samples already
+    in it are kept (a killed call resumes), and it must hold the same spec's samples.
+    ``shard``: ``"K/N"`` or ``(K, N)``, only the samples i with i mod N = K (so that N
+    processes, Ray tasks or machines share a dataset; whichever finds every sample done writes
+    the manifest). ``exr``: what each view's EXR holds ("none", "colour", "lean", "all").
+    ``threads``: worker threads in [1, 1024] (default: all cores, or ``RAYON_NUM_THREADS``).
+
+    Files are the same bytes whichever front end, shard split or thread count made them. The
+    GIL is released while samples are made; Ctrl-C stops between bands of rows, keeping the
+    samples already whole. A sample's warnings (a doubtful head estimate) are issued with
+    :func:`warnings.warn` and listed in the result.
+
+    Returns a dict: ``made``, ``kept`` (samples of this call's share already there),
+    ``done`` and ``samples`` (of the whole dataset), ``seconds``, ``samples_per_second``
+    (None when none was made), ``manifest`` (manifest.csv's :class:`pathlib.Path` once every sample
+    is done, else None) and ``warnings``.
+    """
+    return _dataset(spec, out, shard, exr, threads)

@@ -269,6 +269,16 @@ def score(
 ) -> Run:
     """`seethru score`: a method's display map (h, w, 2) and/or image (h, w, 3) measured."""
 
+def dataset(
+    spec: str | PathLike[str],
+    out: str | PathLike[str],
+    shard: str | tuple[int, int] | None = None,
+    exr: Literal["none", "colour", "lean", "all"] = "lean",
+    threads: int | None = None,
+) -> dict[str, Any]:
+    """`seethru dataset SPEC --out OUT [--shard K/N]`: the same files; what it did as a dict
+    (made, kept, done, samples, seconds, samples_per_second, manifest, warnings)."""
+
 class Step:
     """One displayed frame of a :class:`Sequence` (a row of frames.csv, and its views)."""
     latency_camera: float  # ms, of this frame's sequence

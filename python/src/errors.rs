@@ -24,3 +24,13 @@ pub fn to_py(error: anyhow::Error) -> PyErr {
 pub fn bad_value(message: impl Into<String>) -> PyErr {
     PyValueError::new_err(as_keywords(&message.into()))
 }
+
+/// An error reading the input file `path`: an `OSError` when the file could not be read at all
+/// (absent, a folder, no permission), else as [`to_py`] (a bad key: `ValueError`).
+pub fn input_error(path: &std::path::Path, error: anyhow::Error) -> PyErr {
+    let unreadable = std::fs::File::open(path).is_err() || !path.is_file();
+    match unreadable {
+        true => PyOSError::new_err(printable(&as_keywords(&error_text(&error)))),
+        false => to_py(error),
+    }
+}

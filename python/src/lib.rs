@@ -7,6 +7,7 @@
 
 mod borrowed;
 mod capture;
+mod dataset;
 mod errors;
 mod frame;
 mod frame_pool;
@@ -33,6 +34,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(capture::score, m)?)?;
     m.add_function(wrap_pyfunction!(capture::load_capture, m)?)?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::dataset, m)?)?;
     m.add_function(wrap_pyfunction!(option_table::options, m)?)?;
     m.add_function(wrap_pyfunction!(option_table::spec, m)?)?;
     m.add_class::<sequence::PySequence>()?;

@@ -114,15 +114,9 @@ impl PyScene {
     /// Reads and validates a scene file (TOML), exactly as the command line does.
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyScene> {
-        let scene = py.detach(|| Scene::load(&path)).map_err(|e| {
-            // The file could not be read (absent, a folder, no permission): an OSError.
-            let unreadable = std::fs::File::open(&path).is_err() || !path.is_file();
-            let e = to_py(e.into());
-            match unreadable {
-                true => pyo3::exceptions::PyOSError::new_err(e.value(py).to_string()),
-                false => e,
-            }
-        })?;
+        let scene = py
+            .detach(|| Scene::load(&path))
+            .map_err(|e| crate::errors::input_error(&path, e.into()))?;
         Ok(PyScene {
             scene,
             context: None,

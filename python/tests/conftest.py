@@ -15,6 +15,17 @@ REPO = pathlib.Path(os.environ.get("SEETHRU_REPO", pathlib.Path(__file__).resolv
 SCENE = REPO / "scenes" / "das.toml"
 
 
+def folder_files(folder):
+    """Every file under `folder`: its path relative to `folder` → its bytes."""
+    out = {}
+    for root, _, names in os.walk(folder):
+        for name in names:
+            path = os.path.join(root, name)
+            with open(path, "rb") as f:
+                out[os.path.relpath(path, folder)] = f.read()
+    return out
+
+
 def example_module(relative):
     """A Python file of examples/ (`dataset/loaders.py`) imported as a module, as a reader
     who copies it would use it."""

@@ -46,6 +46,17 @@ fn unit(seed: u64, index: usize, name: &str, k: u64) -> f64 {
     ((state >> 11) as f64 + 1.0) / (1u64 << 53) as f64
 }
 
+/// Box–Muller with two uniforms in (0, 1]: finite for every draw.
+fn standard_normal(u0: f64, u1: f64) -> f64 {
+    (-2.0 * u0.ln()).sqrt() * (std::f64::consts::TAU * u1).cos()
+}
+
+/// A drawn vector as text, as TOML writes an array: `[1.5, 0, -12]`.
+fn vector(components: impl Iterator<Item = f64>) -> String {
+    let parts: Vec<String> = components.map(|c| format!("{c}")).collect();
+    format!("[{}]", parts.join(", "))
+}
+
 /// Sample `index`'s drawn values: (name, value as text), in the spec's order. Numbers are
 /// written as Rust writes the `f64` (shortest round trip); an integer option's uniform draw
 /// is uniform over the integers of its range, its normal draw rounded.
@@ -76,10 +87,20 @@ pub fn sample_draws(spec: &DatasetSpec, index: usize) -> Vec<(String, String)> {
                     }
                     _ => number(low + (high - low) * (1.0 - u(0))),
                 },
-                Law::Normal(mean, sd) => {
-                    // Box–Muller with two uniforms in (0, 1]: finite for every draw.
-                    let z = (-2.0 * u(0).ln()).sqrt() * (std::f64::consts::TAU * u(1)).cos();
-                    number(mean + sd * z)
+                Law::Normal(mean, sd) => number(mean + sd * standard_normal(u(0), u(1))),
+                // Component i from the draw's uniforms 2i and 2i + 1: the first component is
+                // the scalar law's draw.
+                Law::UniformVector(low, high) => vector(
+                    low.iter()
+                        .zip(high)
+                        .enumerate()
+                        .map(|(i, (low, high))| low + (high - low) * (1.0 - u(2 * i as u64))),
+                ),
+                Law::NormalVector(mean, sd) => {
+                    vector(mean.iter().zip(sd).enumerate().map(|(i, (mean, sd))| {
+                        let k = 2 * i as u64;
+                        mean + sd * standard_normal(u(k), u(k + 1))
+                    }))
                 }
             };
             (draw.name.clone(), text)

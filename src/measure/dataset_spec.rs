@@ -14,6 +14,9 @@
 //! d2 = { one_of = ["inf", "auto"] }
 //! theta_f = { uniform = [40, 60] }
 //! head_jitter_cm = { normal = [0.5, 0.1] }
+//! [draw.scene]                      # keys of the scene file (scene/key_override.rs)
+//! sky.cloud_cover = { uniform = [0, 0.8] }
+//! object.car.translate = { uniform = [[-2.5, 0, -14], [-1, 0, -7]] }
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -47,16 +50,36 @@ pub enum Law {
     Uniform(f64, f64),
     /// Normal with a mean and a standard deviation (≥ 0).
     Normal(f64, f64),
+    /// A vector, each component uniform in its [low, high] (a scene key's array).
+    UniformVector(Vec<f64>, Vec<f64>),
+    /// A vector, each component normal with its mean and standard deviation.
+    NormalVector(Vec<f64>, Vec<f64>),
 }
 
-/// One drawn value: a scene draw ([`SCENE_DRAWS`]) or a run option, and its law.
+/// One drawn value: a scene draw ([`SCENE_DRAWS`]), a key of the scene file or a run option,
+/// and its law.
 #[derive(Clone, Debug)]
 pub struct Draw {
+    /// The manifest's column: the option's or scene draw's name, `scene.PATH` for a key.
     pub name: String,
     pub law: Law,
-    /// The option drawn, `None` for a scene draw.
+    /// The option drawn, `None` for a scene draw or key.
     pub option: Option<&'static OptionSpec>,
+    /// The scene file's key drawn (`[draw.scene]`), `None` otherwise.
+    pub scene_key: Option<SceneKey>,
 }
+
+/// A key of the scene file a draw sets (`scene/key_override.rs`).
+#[derive(Clone, Debug)]
+pub struct SceneKey {
+    /// Its dotted path: `sun.time_utc`, `object.car.translate` (an element by its name).
+    pub path: String,
+    /// `one_of`'s values as written (strings stay strings, arrays arrays); empty otherwise.
+    pub values: Vec<toml_edit::Value>,
+}
+
+/// The table of `[draw]` whose keys are the scene file's.
+pub const SCENE_KEYS: &str = "scene";
 
 /// A dataset specification, checked.
 #[derive(Clone, Debug)]
@@ -110,8 +133,16 @@ impl DatasetSpec {
                 if options.iter().any(|(o, _)| o.name == key) {
                     return Err(table.error(key, "is also in [options]: give it in one of them"));
                 }
-                draws.push(read_draw(&table, key)?);
+                match key {
+                    SCENE_KEYS => {
+                        let keys = table.table(key)?.expect("a key of the table");
+                        read_scene_keys(&keys, "", &mut draws)?;
+                        keys.finish()?;
+                    }
+                    _ => draws.push(read_draw(&table, key)?),
+                }
             }
+            check_overlaps(&table, &draws)?;
             table.finish()?;
         }
         root.finish()?;
@@ -160,6 +191,7 @@ fn read_draw(table: &TableReader, key: &str) -> Result<Draw, SceneError> {
             name: key.into(),
             law: Law::Eyellipse,
             option,
+            scene_key: None,
         });
     }
     let law_table = table.table(key)?.ok_or_else(|| {
@@ -214,7 +246,122 @@ fn read_draw(table: &TableReader, key: &str) -> Result<Draw, SceneError> {
         name: key.into(),
         law,
         option,
+        scene_key: None,
     })
+}
+
+/// The scene file's key each scene draw sets: drawing both would let one silently undo the
+/// other.
+const SCENE_DRAW_KEYS: [(&str, &str); 5] = [
+    ("theta_f", "camera.frontal.half_angle_deg"),
+    ("display_width", "obstacle.width"),
+    ("eye", "camera.driver.position"),
+    ("eye_x", "camera.driver.position"),
+    ("eye_z", "camera.driver.position"),
+];
+
+/// Refuses a scene key drawn twice (`sun.x` and `"sun.x"`) or with the scene draw that sets it.
+fn check_overlaps(table: &TableReader, draws: &[Draw]) -> Result<(), SceneError> {
+    for (i, draw) in draws.iter().enumerate() {
+        let Some(key) = &draw.scene_key else { continue };
+        if draws[..i].iter().any(|d| d.name == draw.name) {
+            return Err(table.error(
+                SCENE_KEYS,
+                format!("`{}` is drawn twice: give one law", key.path),
+            ));
+        }
+        for (sweep, path) in SCENE_DRAW_KEYS {
+            if key.path == path && draws.iter().any(|d| d.name == sweep) {
+                return Err(table.error(
+                    SCENE_KEYS,
+                    format!("`{path}` and the draw {sweep} set the same thing: draw one of them"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The laws' keys: a table with exactly one of them is a law, any other a table of keys.
+const LAWS: [&str; 3] = ["one_of", "uniform", "normal"];
+
+/// `[draw.scene]`'s draws, its nested tables flattened into dotted paths (`sun.time_utc =
+/// {…}` and `"sun.time_utc" = {…}` are one key).
+fn read_scene_keys(
+    table: &TableReader,
+    prefix: &str,
+    draws: &mut Vec<Draw>,
+) -> Result<(), SceneError> {
+    for key in table.keys() {
+        let path = match prefix {
+            "" => key.to_string(),
+            _ => format!("{prefix}.{key}"),
+        };
+        let inner = table.table(key)?.ok_or_else(|| {
+            table.error(
+                key,
+                "expected a law for the scene key: { one_of = [...] }, { uniform = [low, high] } or { normal = [mean, sd] } (arrays of numbers for an array key)",
+            )
+        })?;
+        let given = inner.keys();
+        if !given.is_empty() && !given.iter().any(|k| LAWS.contains(k)) {
+            read_scene_keys(&inner, &path, draws)?;
+            inner.finish()?;
+            continue;
+        }
+        let (law, values) = match given[..] {
+            ["one_of"] => {
+                let values = inner.values("one_of")?;
+                let texts = values.iter().map(value_text).collect();
+                (Law::OneOf(texts), values)
+            }
+            [law @ ("uniform" | "normal")] => {
+                let ([a, b], length) = inner.number_pair_or_vectors(law)?;
+                match (law, length) {
+                    ("uniform", _) if a.iter().zip(&b).any(|(low, high)| low > high) => {
+                        return Err(inner.error(law, "a low bound is above its high bound"));
+                    }
+                    ("normal", _) if b.iter().any(|&sd| sd < 0.0) => {
+                        return Err(inner.error(law, "a standard deviation is negative"));
+                    }
+                    ("uniform", None) => (Law::Uniform(a[0], b[0]), Vec::new()),
+                    ("normal", None) => (Law::Normal(a[0], b[0]), Vec::new()),
+                    ("uniform", Some(_)) => (Law::UniformVector(a, b), Vec::new()),
+                    _ => (Law::NormalVector(a, b), Vec::new()),
+                }
+            }
+            _ => {
+                return Err(table.error(
+                    key,
+                    format!(
+                        "expected exactly one of one_of, uniform or normal, found {}",
+                        if given.is_empty() {
+                            "none".to_string()
+                        } else {
+                            given.join(", ")
+                        }
+                    ),
+                ));
+            }
+        };
+        inner.finish()?;
+        draws.push(Draw {
+            name: format!("{SCENE_KEYS}.{path}"),
+            law,
+            option: None,
+            scene_key: Some(SceneKey { path, values }),
+        });
+    }
+    Ok(())
+}
+
+/// A scene key's value as the manifest shows it: a string without its quotes, anything else
+/// as TOML writes it.
+pub fn value_text(value: &toml_edit::Value) -> String {
+    match value {
+        toml_edit::Value::String(s) => s.value().clone(),
+        other => other.clone().decorated("", "").to_string(),
+    }
 }
 
 /// A scene draw takes a number; an option's value must parse as the option's.

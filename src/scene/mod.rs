@@ -13,6 +13,7 @@ pub mod fingerprint;
 pub mod grow;
 pub mod head_model;
 pub mod head_path;
+pub mod key_override;
 pub mod lane_route;
 pub mod lens_keys;
 pub mod light_keys;

@@ -507,6 +507,66 @@ impl<'a> TableReader<'a> {
         self.opt_array(key)?.ok_or_else(|| self.missing(key))
     }
 
+    /// A law's two parameters: two finite numbers, or two arrays of finite numbers of one
+    /// length (component by component); `None` for numbers, the arrays' length for arrays.
+    pub fn number_pair_or_vectors(
+        &self,
+        key: &str,
+    ) -> Result<([Vec<f64>; 2], Option<usize>), SceneError> {
+        let item = self.item(key).ok_or_else(|| self.missing(key))?;
+        let wrong = || {
+            self.error(
+                key,
+                "expected two finite numbers, or two arrays of finite numbers of one length",
+            )
+        };
+        let pair = item.as_array().filter(|a| a.len() == 2).ok_or_else(wrong)?;
+        let finite = |v: &toml_edit::Value| {
+            v.as_float()
+                .or_else(|| v.as_integer().map(|i| i as f64))
+                .filter(|x| x.is_finite())
+        };
+        let mut out = [Vec::new(), Vec::new()];
+        let mut length = None;
+        for (slot, value) in out.iter_mut().zip(pair.iter()) {
+            match value.as_array() {
+                Some(inner) => {
+                    *slot = inner
+                        .iter()
+                        .map(finite)
+                        .collect::<Option<_>>()
+                        .ok_or_else(wrong)?;
+                    length = Some(inner.len());
+                }
+                None => *slot = vec![finite(value).ok_or_else(wrong)?],
+            }
+        }
+        let [a, b] = &out;
+        let scalars = pair.iter().all(|v| v.as_array().is_none());
+        let vectors = pair.iter().all(|v| v.as_array().is_some()) && a.len() == b.len();
+        match (scalars, vectors && !a.is_empty()) {
+            (true, _) => Ok((out, None)),
+            (false, true) => Ok((out, length)),
+            _ => Err(wrong()),
+        }
+    }
+
+    /// A non-empty array of TOML values as written (strings, numbers, booleans, arrays): what
+    /// a scene key drawn with `one_of` may be set to.
+    pub fn values(&self, key: &str) -> Result<Vec<toml_edit::Value>, SceneError> {
+        let item = self.item(key).ok_or_else(|| self.missing(key))?;
+        let array = item.as_array().ok_or_else(|| {
+            self.error(
+                key,
+                format!("expected an array, found {}", item.type_name()),
+            )
+        })?;
+        if array.is_empty() {
+            return Err(self.error(key, "expected at least one value, found none"));
+        }
+        Ok(array.iter().cloned().collect())
+    }
+
     /// A colour: three components in [0, 1].
     pub fn color(&self, key: &str, default: [f64; 3]) -> Result<[f64; 3], SceneError> {
         let value = self.raw_array(key)?.unwrap_or(default);
