@@ -57,6 +57,22 @@ fn files(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
     out
 }
 
+/// `seethru run` of `scene` with [`spec_in`]'s options, into `out`.
+fn run_as_the_spec(scene: &Path, out: &Path) {
+    let (ok, _, err) = seethru(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--width",
+        "48",
+        "--spp",
+        "1",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+}
+
 fn json(path: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
@@ -121,18 +137,7 @@ fn the_draws_configure_each_run_and_the_manifest_is_its_metrics() {
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
     // The base eye, from a run of the scene itself.
     let base = dir.path().join("base");
-    let (ok, _, err) = seethru(&[
-        "run",
-        common::repo_path("scenes/das.toml").to_str().unwrap(),
-        "--width",
-        "48",
-        "--spp",
-        "1",
-        "--quiet",
-        "--out",
-        base.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    run_as_the_spec(&common::repo_path("scenes/das.toml"), &base);
     let base_eye_x = json(&base.join("run.json"))["eye_true"]["obstacle_m"][0]
         .as_f64()
         .unwrap();
@@ -459,18 +464,7 @@ fn scene_key_draws_make_the_scene_an_edit_of_its_file_by_hand_makes() {
         );
         let scene = dir.path().join(format!("edited{i}.toml"));
         std::fs::write(&scene, edited).unwrap();
-        let (ok, _, err) = seethru(&[
-            "run",
-            scene.to_str().unwrap(),
-            "--width",
-            "48",
-            "--spp",
-            "1",
-            "--quiet",
-            "--out",
-            base.to_str().unwrap(),
-        ]);
-        assert!(ok, "{err}");
+        run_as_the_spec(&scene, &base);
         for file in ["truth.png", "seethru.png", "frontal.png", "metrics.json"] {
             assert!(
                 std::fs::read(folder.join(file)).unwrap()

@@ -1,6 +1,7 @@
 //! The Python package as a user installs it: `maturin build --release` makes one abi3
-//! manylinux wheel, which installs into a fresh virtual environment (numpy from PyPI or the
-//! pip cache) and runs the Python guide's quick start there with no cargo or rustc on PATH.
+//! manylinux wheel, stripped, which installs into a fresh virtual environment (numpy from PyPI
+//! or the pip cache) and runs the Python guide's quick start and the datasets guide's Python
+//! there with no cargo or rustc on PATH.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -59,6 +60,12 @@ fn the_abi3_wheel_installs_without_a_toolchain_and_runs_the_quick_start() {
         name.starts_with("seethru-") && name.contains("-cp310-abi3-manylinux_"),
         "{name}"
     );
+    // Stripped: line tables would more than double it (19.5 MB).
+    let bytes = std::fs::metadata(&built[0]).unwrap().len();
+    assert!(
+        bytes < 12 << 20,
+        "the wheel is {bytes} bytes: is it stripped?"
+    );
 
     // A fresh environment, and a PATH with the system's Python but no Rust toolchain.
     let fresh = dir.path().join("venv");
@@ -70,7 +77,7 @@ fn the_abi3_wheel_installs_without_a_toolchain_and_runs_the_quick_start() {
     let path = format!("{}:/usr/bin:/bin", fresh.join("bin").display());
     let scratch = dir.path().join("user");
     std::fs::create_dir_all(&scratch).unwrap();
-    for folder in ["scenes", "assets"] {
+    for folder in ["scenes", "assets", "examples"] {
         ok(Command::new("cp")
             .arg("-r")
             .arg(repo().join(folder))
@@ -95,8 +102,10 @@ fn the_abi3_wheel_installs_without_a_toolchain_and_runs_the_quick_start() {
     );
     assert!(written, "{err}");
     let quick = python_block_after(&repo().join("docs/guide/python.md"), "## Quick start");
+    // And a dataset, as a cluster's worker with the wheel alone makes one.
+    let dataset = python_block_after(&repo().join("docs/guide/datasets.md"), "## From Python");
     let script = format!(
-        "import shutil, sys\nassert shutil.which('cargo') is None and shutil.which('rustc') is None, 'a toolchain on PATH'\n{quick}\nimport seethru._native as native\nassert 'site-packages' in native.__file__, native.__file__\nprint('quick start ran', np.nanmean(result.misregistration))\n"
+        "import shutil, sys\nassert shutil.which('cargo') is None and shutil.which('rustc') is None, 'a toolchain on PATH'\n{quick}\nimport seethru._native as native\nassert 'site-packages' in native.__file__, native.__file__\nprint('quick start ran', np.nanmean(result.misregistration))\n{dataset}\nassert made['done'] == made['samples'] and made['manifest'].is_file(), made\nprint('dataset made')\n"
     );
     let said = ok(Command::new(fresh.join("bin/python"))
         .args(["-c", &script])
@@ -104,5 +113,8 @@ fn the_abi3_wheel_installs_without_a_toolchain_and_runs_the_quick_start() {
         .env_clear()
         .env("PATH", &path)
         .env("HOME", dir.path()));
-    assert!(said.contains("quick start ran"), "{said}");
+    assert!(
+        said.contains("quick start ran") && said.contains("dataset made"),
+        "{said}"
+    );
 }

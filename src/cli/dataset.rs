@@ -20,8 +20,8 @@ use crate::cli::args::{choice, threads, with_threads};
 
 #[derive(clap::Args)]
 pub struct Dataset {
-    /// The dataset's specification (TOML): the scene, samples, seed, [options] and [draw]
-    /// (docs/guide/datasets.md).
+    /// The dataset's specification (TOML): the scene, samples, seed, [options], [draw] and
+    /// [draw.scene] (the scene file's keys; docs/guide/datasets.md).
     spec: PathBuf,
     /// The dataset's folder: samples/NNNNNN/ per sample, dataset.json, and, once every sample
     /// is done, manifest.csv, manifest.parquet and view.html. Samples already in it are kept (a killed run

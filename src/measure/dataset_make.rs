@@ -3,6 +3,7 @@
 //! Parquet) and the grid viewer. The command line's `seethru dataset` and Python's
 //! `seethru.dataset` both call [`make_dataset`]; their files are the same bytes.
 
+use std::borrow::Cow;
 use std::path::Path;
 use std::time::Instant;
 
@@ -254,14 +255,14 @@ impl BaseScene {
     }
 
     /// The scene with `keys` set in its file (the base itself when there are none).
-    fn with_keys(&self, keys: &[(String, toml_edit::Value)]) -> Result<Scene> {
+    fn with_keys(&self, keys: &[(String, toml_edit::Value)]) -> Result<Cow<'_, Scene>> {
         if keys.is_empty() {
-            return Ok(self.scene.clone());
+            return Ok(Cow::Borrowed(&self.scene));
         }
         let keys: Vec<(&str, toml_edit::Value)> =
             keys.iter().map(|(p, v)| (p.as_str(), v.clone())).collect();
         let file = with_keys(&self.source, &keys).map_err(anyhow::Error::msg)?;
-        Ok(Scene::from_source(&file)?)
+        Ok(Cow::Owned(Scene::from_source(&file)?))
     }
 }
 

@@ -227,19 +227,7 @@ fn read_draw(table: &TableReader, key: &str) -> Result<Draw, SceneError> {
             numeric(&law_table, "normal", key, option)?;
             Law::Normal(mean, sd)
         }
-        _ => {
-            return Err(table.error(
-                key,
-                format!(
-                    "expected exactly one of one_of, uniform or normal, found {}",
-                    if given.is_empty() {
-                        "none".to_string()
-                    } else {
-                        given.join(", ")
-                    }
-                ),
-            ));
-        }
+        _ => return Err(not_one_law(table, key, &given)),
     };
     law_table.finish()?;
     Ok(Draw {
@@ -280,6 +268,18 @@ fn check_overlaps(table: &TableReader, draws: &[Draw]) -> Result<(), SceneError>
         }
     }
     Ok(())
+}
+
+/// A law table with none or several of the laws.
+fn not_one_law(table: &TableReader, key: &str, given: &[&str]) -> SceneError {
+    let found = match given {
+        [] => "none".to_string(),
+        _ => given.join(", "),
+    };
+    table.error(
+        key,
+        format!("expected exactly one of {}, found {found}", LAWS.join(", ")),
+    )
 }
 
 /// The laws' keys: a table with exactly one of them is a law, any other a table of keys.
@@ -330,19 +330,7 @@ fn read_scene_keys(
                     _ => (Law::NormalVector(a, b), Vec::new()),
                 }
             }
-            _ => {
-                return Err(table.error(
-                    key,
-                    format!(
-                        "expected exactly one of one_of, uniform or normal, found {}",
-                        if given.is_empty() {
-                            "none".to_string()
-                        } else {
-                            given.join(", ")
-                        }
-                    ),
-                ));
-            }
+            _ => return Err(not_one_law(table, key, &given)),
         };
         inner.finish()?;
         draws.push(Draw {

@@ -178,22 +178,13 @@ impl<'a> TableReader<'a> {
 
     /// A non-empty array of strings, numbers or booleans, each as text.
     pub fn scalar_texts(&self, key: &str) -> Result<Vec<String>, SceneError> {
-        let item = self.item(key).ok_or_else(|| self.missing(key))?;
-        let array = item.as_array().ok_or_else(|| {
+        let texts: Option<Vec<String>> = self.values(key)?.iter().map(scalar_text).collect();
+        texts.ok_or_else(|| {
             self.error(
                 key,
-                format!("expected an array, found {}", item.type_name()),
-            )
-        })?;
-        let texts: Option<Vec<String>> = array.iter().map(scalar_text).collect();
-        match texts {
-            Some(t) if !t.is_empty() => Ok(t),
-            Some(_) => Err(self.error(key, "expected at least one value, found none")),
-            None => Err(self.error(
-                key,
                 "expected strings, numbers or booleans, found an array or table inside",
-            )),
-        }
+            )
+        })
     }
 
     /// Rejects every key that was not read: scene files have no ignored keys.
