@@ -391,6 +391,107 @@ fn a_run_on_a_turning_vehicle_sees_its_rolling_rows_as_old_as_they_are() {
     );
 }
 
+/// `run` with a camera latency L (option `latency_camera`): the frontal image is L older than
+/// the instant the driver looks, so on the wall 6 m ahead (the model plane on it) the vehicle
+/// yawing at ω shows a mean misregistration of ω L with a global shutter, and ω (L + the mean
+/// readout age) with a rolling one: the two ages add. A latency with a still vehicle would
+/// change nothing: refused.
+#[test]
+fn a_run_with_a_camera_latency_sees_the_world_as_old_as_the_latency() {
+    use seethru::analysis::physical::ARCMIN_PER_RAD;
+    use seethru::measure::image_metrics::Flip;
+    use seethru::measure::metrics::measure_with;
+    use seethru::system::options::{RunOptions, WorkingDistance};
+    use seethru::system::pipeline::run;
+    let mean_of = |ctx: &RenderContext, options: &RunOptions| {
+        let r = run(ctx, options).unwrap();
+        let eye = ctx.scene.eye();
+        measure_with(ctx, &ctx.scene, eye, r.measured_views(), 5, Flip::Skipped)
+            .1
+            .display
+            .misregistration_arcmin
+            .mean
+    };
+    let (omega, latency) = (20f64.to_radians(), 0.05);
+    let options = RunOptions {
+        d2: WorkingDistance::Metres(6.0),
+        spp: 1,
+        yaw_rate_deg_s: omega.to_degrees(),
+        latency_camera_ms: latency * 1e3,
+        ..RunOptions::default()
+    };
+    let global = common::WallScene::default().context();
+    let mean = mean_of(&global, &options);
+    let predicted = omega * latency * ARCMIN_PER_RAD;
+    assert!(
+        (mean / predicted - 1.0).abs() < 0.03,
+        "global shutter: measured {mean:.2}′, ω L {predicted:.2}′"
+    );
+    let text = common::WallScene::default().text().replace(
+        "[camera.frontal]",
+        "[camera.frontal]\nshutter = \"rolling\"\nreadout_ms = 60.0",
+    );
+    let scene = common::parse_in(&common::repo_path("scenes"), "wall.toml", &text).unwrap();
+    let rolling = RenderContext::new(scene.clone()).unwrap();
+    let mean = mean_of(&rolling, &options);
+    let predicted = omega * (latency + common::readout_age(&scene, 0.06, 6.0)) * ARCMIN_PER_RAD;
+    assert!(
+        (mean / predicted - 1.0).abs() < 0.03,
+        "rolling shutter: measured {mean:.2}′, ω (L + readout age) {predicted:.2}′"
+    );
+    let still = RunOptions {
+        yaw_rate_deg_s: 0.0,
+        ..options
+    };
+    let error = run(&global, &still).err().unwrap().to_string();
+    assert!(
+        error.contains("option `latency_camera`") && error.contains("still"),
+        "{error}"
+    );
+}
+
+/// The frontal image of a run with a latency L is the frontal camera's render where the
+/// vehicle had it L before, placed by hand (driving back v L along +z, turning back ω L about
+/// the eye), bit for bit; the compensation keeps the camera where it is mounted.
+#[test]
+fn a_latency_renders_the_frontal_camera_where_the_vehicle_had_it() {
+    use seethru::system::options::RunOptions;
+    use seethru::system::pipeline::run;
+    let ctx = common::WallScene::default().context();
+    let (speed, omega, latency) = (0.0, 15f64.to_radians(), 0.08);
+    for (speed_kmh, yaw_rate) in [(36.0, 0.0), (speed, omega.to_degrees())] {
+        let options = RunOptions {
+            spp: 1,
+            speed_kmh,
+            yaw_rate_deg_s: yaw_rate,
+            latency_camera_ms: latency * 1e3,
+            ..RunOptions::default()
+        };
+        let frontal = run(&ctx, &options).unwrap().frontal;
+        let camera = ctx.scene.frontal;
+        let eye = ctx.scene.eye();
+        // Straight on (−z) at v, or turning about the eye at ω: L earlier.
+        let world_from_rig = if yaw_rate == 0.0 {
+            DAffine3::from_translation(glam::DVec3::Z * (speed_kmh / 3.6) * latency)
+        } else {
+            DAffine3::from_translation(eye)
+                * DAffine3::from_rotation_y(-omega * latency)
+                * DAffine3::from_translation(-eye)
+        };
+        let by_hand = Camera {
+            world_from_camera: world_from_rig * camera.world_from_camera,
+            ..camera
+        };
+        let (want, _) = ctx.render(RenderJob::new(&by_hand, FRONTAL).settings(settings(1)));
+        let moved = (by_hand.position() - camera.position()).length();
+        assert!(moved > 0.005, "the camera moved {moved} m");
+        assert!(
+            frontal.bit_identical(&want),
+            "speed {speed_kmh} km/h, yaw rate {yaw_rate}°/s: the frontal image is not the moved camera's"
+        );
+    }
+}
+
 /// A sequence on the textured wall 6 m ahead (the model plane on it), the vehicle yawing at
 /// ω, the image `latency` s old when complete, the frontal camera's shutter `shutter`: each
 /// display pixel shows a frontal row read `T (H − 1 − r) / (H − 1)` before the last, so its

@@ -72,7 +72,8 @@ pub fn method_costs(ctx: &RenderContext, repeat: usize, quiet: bool) -> Result<s
                 ..RunOptions::default()
             };
             options.scene_model.sensor.kind = kind;
-            scene_model_display(&ctx, scene, eye, &frontal, &crop, &options).map(|_| ())
+            scene_model_display(&ctx, scene, eye, &frontal, &crop, &options, &scene.frontal)
+                .map(|_| ())
         };
         let mut at_size = serde_json::Map::new();
         for (name, job) in jobs {

@@ -322,6 +322,18 @@ pub static OPTIONS: &[OptionSpec] = &[
         commands: RUNS,
     },
     OptionSpec {
+        name: "latency_camera",
+        kind: Kind::Real {
+            min: 0.0,
+            max: 10000.0,
+        },
+        unit: "ms",
+        default: Default::Value("0"),
+        help: "Time from the frontal camera's capture to the instant the driver sees the display: the vehicle's motion (speed, yaw_rate) carries the camera on meanwhile. A sequence takes a list of them as its own flag.",
+        read_with: &[],
+        commands: SINGLE_FRAMES,
+    },
+    OptionSpec {
         name: "outside",
         kind: Kind::Choice(choice_values::<Outside>),
         unit: "",

@@ -148,6 +148,7 @@ impl RunSpec {
             "head_jitter_cm" => o.head_jitter_cm = value.real(),
             "speed" => o.speed_kmh = value.real(),
             "yaw_rate" => o.yaw_rate_deg_s = value.real(),
+            "latency_camera" => o.latency_camera_ms = value.real(),
             "seed" => o.seed = value.integer() as u32,
             "feature_width" => o.feature_width = value.real(),
             "require_confident_head" => o.require_confident_head = value.switch(),

@@ -23,7 +23,7 @@ use crate::render::render_job::RenderJob;
 use crate::render::settings::{RenderSettings, check_spp};
 use crate::render::views::View;
 use crate::system::calibration_json::calibration_json;
-use crate::system::depth_sensor::{DepthMap, SensorModel, sense};
+use crate::system::depth_sensor::{DepthMap, SensorModel, sense_from};
 use crate::system::display::{MISSING_ID, sample};
 use crate::system::head::FaceDetection;
 use crate::system::options::{HeadSource, RunOptions};
@@ -93,22 +93,22 @@ pub fn capture(ctx: &RenderContext, options: &RunOptions, with_depth: bool) -> R
         spp: options.spp,
         progress: options.progress,
     };
-    let frontal_pose = crate::system::pipeline::frontal_pose_at(scene, options)?;
-    let render = |camera, view: View| {
-        let mut job = RenderJob::new(camera, view.bit())
-            .settings(settings)
-            .label(view.name());
-        if let (View::Frontal, Some(pose)) = (view, &frontal_pose) {
-            job = job.moving(pose);
-        }
-        ctx.render(job).0
-    };
-    let back = render(&scene.back, View::Back);
-    let frontal = render(&scene.frontal, View::Frontal);
+    let captured = crate::system::pipeline::frontal_capture(scene, options)?;
+    let render =
+        |job: RenderJob, view: View| ctx.render(job.settings(settings).label(view.name())).0;
+    let back = render(RenderJob::new(&scene.back, View::Back.bit()), View::Back);
+    let frontal = render(captured.job(View::Frontal.bit()), View::Frontal);
     let (eye, fix) = eye_for_compensation(scene, &back, options)?;
     let depth = if with_depth {
         let model = SensorModel::resolve(&options.scene_model.sensor, &scene.frontal)?;
-        Some(sense(ctx, &scene.frontal, &frontal, model, options.seed))
+        Some(sense_from(
+            ctx,
+            &captured.camera,
+            &scene.frontal,
+            &frontal,
+            model,
+            options.seed,
+        ))
     } else {
         None
     };
@@ -132,7 +132,7 @@ pub fn capture(ctx: &RenderContext, options: &RunOptions, with_depth: bool) -> R
         );
         calibration["depth_sensor"] = sensor;
     }
-    let truth = render(&driver, View::Truth);
+    let truth = render(RenderJob::new(&driver, View::Truth.bit()), View::Truth);
     let true_cameras = json!({
         "frontal": camera_json(&scene.frontal),
         "back": camera_json(&scene.back),

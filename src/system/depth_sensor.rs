@@ -205,6 +205,23 @@ pub fn sensor_camera(frontal_camera: &Camera, model: &SensorModel) -> Camera {
         .with_resolution(model.width, model.height)
 }
 
+/// [`sense`] from where the frontal camera captured its image (`captured`: carried on by the
+/// vehicle, option `latency_camera`), its depths read as from where the camera is mounted
+/// (`mounted`): the system does not know the vehicle moved since. With a still vehicle the two
+/// are one camera and this is [`sense`].
+pub fn sense_from(
+    ctx: &RenderContext,
+    captured: &Camera,
+    mounted: &Camera,
+    frontal: &Frame,
+    model: SensorModel,
+    seed: u32,
+) -> DepthMap {
+    let mut map = sense(ctx, captured, frontal, model, seed);
+    map.camera.world_from_camera = mounted.world_from_camera;
+    map
+}
+
 /// The sensor's depth image of the scene. `frontal` is the frontal render (the ideal
 /// sensor's depth); other sensors are ray cast at their own resolution. Noise is seeded by
 /// `seed` and the pixel index: the same for any thread count.

@@ -165,6 +165,12 @@ pub struct RunOptions {
     /// The vehicle's yaw rate about the driver's eye, °/s, [−180, 180], positive turning left.
     #[serde(default)]
     pub yaw_rate_deg_s: f64,
+    /// A single frame's camera latency, ms, [0, 10000]: the frontal image was captured this long
+    /// before the instant the driver sees the display, where the vehicle's motion had not yet
+    /// carried the camera (a sequence has its own, per refresh). Capture folders written
+    /// before it existed hold none: 0.
+    #[serde(default)]
+    pub latency_camera_ms: f64,
     /// Progress bars on stderr: the front end's, never written.
     #[serde(skip)]
     pub progress: bool,
@@ -235,6 +241,7 @@ impl Default for RunOptions {
             scene_model: SceneModelOptions::default(),
             speed_kmh: 0.0,
             yaw_rate_deg_s: 0.0,
+            latency_camera_ms: 0.0,
             progress: false,
         }
     }

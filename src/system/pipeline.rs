@@ -377,31 +377,67 @@ pub fn check_display_seen<'a>(
     Ok(())
 }
 
-/// The frontal camera's pose `dt` seconds after a run's instant, carried by the vehicle's
-/// motion (option `speed`, option `yaw_rate`, about the driver's eye), or `None` where the
-/// vehicle stands still. A moving vehicle with a frontal camera whose shutter is an instant
-/// changes nothing: refused. (The back camera and the head ride the vehicle together: it
-/// films them still.)
-pub fn frontal_pose_at(
-    scene: &Scene,
-    options: &RunOptions,
-) -> Result<Option<impl Fn(f64) -> glam::DAffine3 + Sync + use<>>> {
+/// The frontal camera as it captures a run's image: where the vehicle's motion (option
+/// `speed`, option `yaw_rate`, about the driver's eye) had carried it option `latency_camera`
+/// before the run's instant, moving on through its readout and exposure. The system does not
+/// know of the motion: it compensates with the camera where it is mounted (the scene's, through
+/// its calibration). (The back camera and the head ride the vehicle together: it films them
+/// still.)
+pub struct FrontalCapture {
+    /// The camera at the capture's instant.
+    pub camera: Camera,
+    /// Its pose `dt` seconds after that instant while the vehicle moves (`None`: still).
+    pub pose_at: Option<Box<dyn Fn(f64) -> glam::DAffine3 + Sync>>,
+}
+
+impl FrontalCapture {
+    /// A render job of the frontal view as captured.
+    pub fn job<'a>(&'a self, mask: u8) -> RenderJob<'a> {
+        let job = RenderJob::new(&self.camera, mask);
+        match &self.pose_at {
+            Some(pose) => job.moving(pose.as_ref()),
+            None => job,
+        }
+    }
+}
+
+/// [`FrontalCapture`] of `scene`'s frontal camera under `options`. A motion nothing would see
+/// (a frontal shutter that is an instant, no latency) and a latency with a still vehicle are
+/// refused: the option would change nothing.
+pub fn frontal_capture(scene: &Scene, options: &RunOptions) -> Result<FrontalCapture> {
+    let latency = options.latency_camera_ms / 1e3;
     if options.speed_kmh == 0.0 && options.yaw_rate_deg_s == 0.0 {
-        return Ok(None);
+        if latency > 0.0 {
+            bail!(
+                "option `latency_camera` ({} ms) changes nothing while the vehicle stands still: give option `speed` or option `yaw_rate`, or leave it out",
+                short(options.latency_camera_ms)
+            );
+        }
+        return Ok(FrontalCapture {
+            camera: scene.frontal,
+            pose_at: None,
+        });
     }
     let motion = options.vehicle_motion(scene)?;
-    if scene.frontal.shutter.is_instant() {
+    if scene.frontal.shutter.is_instant() && latency == 0.0 {
         let given = if options.speed_kmh != 0.0 {
             "speed"
         } else {
             "yaw_rate"
         };
         bail!(
-            "option `{given}` moves the frontal camera during its readout and exposure, but its shutter is an instant (a global shutter, exposure_ms 0): set shutter = \"rolling\" or exposure_ms in [camera.frontal], or leave the option out"
+            "option `{given}` moves the frontal camera during its readout and exposure, but its shutter is an instant (a global shutter, exposure_ms 0) and option `latency_camera` is 0: set shutter = \"rolling\" or exposure_ms in [camera.frontal], give a latency, or leave the option out"
         );
     }
     let base = scene.frontal.world_from_camera;
-    Ok(Some(move |dt: f64| motion.world_from_rig(dt) * base))
+    let pose_at = move |dt: f64| motion.world_from_rig(dt - latency) * base;
+    Ok(FrontalCapture {
+        camera: Camera {
+            world_from_camera: pose_at(0.0),
+            ..scene.frontal
+        },
+        pose_at: Some(Box::new(pose_at)),
+    })
 }
 
 /// The driver's camera a run renders at: the scene's, resized by the options.
@@ -564,28 +600,26 @@ pub fn run_staged(
         spp: options.spp,
         progress: options.progress,
     };
-    let frontal_pose = frontal_pose_at(scene, options)?;
+    let capture = frontal_capture(scene, options)?;
     let mut timings = serde_json::Map::new();
-    let timed =
-        |timings: &mut serde_json::Map<String, serde_json::Value>, camera: &Camera, view: View| {
-            let mut job = RenderJob::new(camera, view.bit())
-                .settings(settings)
-                .label(view.name());
-            if let (View::Frontal, Some(pose)) = (view, &frontal_pose) {
-                job = job.moving(pose);
-            }
-            let (frame, stats) = ctx.render(job);
-            timings.insert(view.name().into(), json!(stats.seconds));
-            frame
+    let timed = |timings: &mut serde_json::Map<String, serde_json::Value>, view: View| {
+        let job = match view {
+            View::Frontal => capture.job(view.bit()),
+            View::Back => RenderJob::new(&scene.back, view.bit()),
+            _ => RenderJob::new(&driver, view.bit()),
         };
+        let (frame, stats) = ctx.render(job.settings(settings).label(view.name()));
+        timings.insert(view.name().into(), json!(stats.seconds));
+        frame
+    };
     let back = match given.back {
         Some(b) => b.clone(),
-        None => timed(&mut timings, &scene.back, View::Back),
+        None => timed(&mut timings, View::Back),
     };
     let back = RunViews::set("back", &views.back, back, ready);
     let frontal = match given.frontal {
         Some(f) => f.clone(),
-        None => timed(&mut timings, &scene.frontal, View::Frontal),
+        None => timed(&mut timings, View::Frontal),
     };
     let frontal = RunViews::set("frontal", &views.frontal, frontal, ready);
     let (eye_used, head_fix) = eye_for_compensation(scene, back, options)?;
@@ -605,7 +639,15 @@ pub fn run_staged(
     let (display, scene_model) = if let Some(d) = given.display {
         (d, None)
     } else if options.method.models_the_scene() {
-        let m = scene_model_display(ctx, scene, eye_used, frontal, &crop, options)?;
+        let m = scene_model_display(
+            ctx,
+            scene,
+            eye_used,
+            frontal,
+            &crop,
+            options,
+            &capture.camera,
+        )?;
         (m.display.clone(), Some(m))
     } else if curved {
         (
@@ -630,7 +672,7 @@ pub fn run_staged(
             assert_eq!((t.width, t.height), (driver.width, driver.height));
             Arc::new(t.clone())
         }
-        None => Arc::new(timed(&mut timings, &driver, View::Truth)),
+        None => Arc::new(timed(&mut timings, View::Truth)),
     };
     let truth = RunViews::set("truth", &views.truth, truth, ready);
     let (occluded, stats) = ctx.render_over(

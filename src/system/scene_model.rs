@@ -9,12 +9,13 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use serde_json::json;
 
+use crate::geometry::camera::Camera;
 use crate::render::frame::{Frame, Pixel};
 use crate::render::integrator::RenderContext;
 use crate::scene::Scene;
 use crate::system::compensation::Crop;
 use crate::system::depth_search::{Found, search};
-use crate::system::depth_sensor::{DepthMap, SensorModel, sense};
+use crate::system::depth_sensor::{DepthMap, SensorModel, sense_from};
 use crate::system::display::{DisplayModel, MISSING_ID, sample};
 use crate::system::options::{Method, RunOptions};
 pub use crate::system::scene_model_options::{Fill, SceneModelOptions};
@@ -91,7 +92,8 @@ fn blank() -> Pixel {
 
 /// The display image for `run.method` (one of [`Method::models_the_scene`]) at the eye
 /// `eye`; `crop` is the d2 → ∞ crop (its region is where the plane is fitted). The sensor,
-/// fill, filter and seed are the run's.
+/// fill, filter and seed are the run's; the sensor senses from `captured_from`, the frontal
+/// camera where it captured `frontal` ([`crate::system::pipeline::FrontalCapture`]).
 pub fn scene_model_display(
     ctx: &RenderContext,
     scene: &Scene,
@@ -99,12 +101,13 @@ pub fn scene_model_display(
     frontal: &Frame,
     crop: &Crop,
     run: &RunOptions,
+    captured_from: &Camera,
 ) -> Result<SceneModelDisplay> {
     let (method, options, filter, seed) = (run.method, &run.scene_model, run.filter, run.seed);
     let camera = &scene.frontal;
     let sensor = || -> Result<DepthMap> {
         let model = SensorModel::resolve(&options.sensor, camera)?;
-        Ok(sense(ctx, camera, frontal, model, seed))
+        Ok(sense_from(ctx, captured_from, camera, frontal, model, seed))
     };
     let mut report = serde_json::Map::new();
     let found: Box<dyn Fn(DVec3) -> Found + Sync> = match method {
