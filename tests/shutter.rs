@@ -450,9 +450,10 @@ fn a_run_with_a_camera_latency_sees_the_world_as_old_as_the_latency() {
     );
 }
 
-/// The frontal image of a run with a latency L is the frontal camera's render where the
-/// vehicle had it L before, placed by hand (driving back v L along +z, turning back ω L about
-/// the eye), bit for bit; the compensation keeps the camera where it is mounted.
+/// The frontal image of a run (and of a capture) with a latency L is the frontal camera's
+/// render where the vehicle had it L before, placed by hand (driving back v L along +z,
+/// turning back ω L about the eye), bit for bit; the depth sensor's map keeps the camera where
+/// it is mounted.
 #[test]
 fn a_latency_renders_the_frontal_camera_where_the_vehicle_had_it() {
     use seethru::system::options::RunOptions;
@@ -489,6 +490,14 @@ fn a_latency_renders_the_frontal_camera_where_the_vehicle_had_it() {
             frontal.bit_identical(&want),
             "speed {speed_kmh} km/h, yaw rate {yaw_rate}°/s: the frontal image is not the moved camera's"
         );
+        // A capture sees the same; its depth sensor sensed from there too (the ideal sensor's
+        // depths are the frontal render's), read as from the mount: the system's belief.
+        let captured = seethru::system::capture::capture(&ctx, &options, true).unwrap();
+        assert!(captured.frontal.bit_identical(&want));
+        let depth = captured.depth.unwrap();
+        assert_eq!(depth.camera.world_from_camera, camera.world_from_camera);
+        let nearest = want.camera_z.iter().copied().fold(f32::INFINITY, f32::min);
+        assert!((depth.max_inverse_depth() - 1.0 / nearest).abs() < 1e-6);
     }
 }
 
