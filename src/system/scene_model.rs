@@ -93,7 +93,7 @@ fn blank() -> Pixel {
 /// The display image for `run.method` (one of [`Method::models_the_scene`]) at the eye
 /// `eye`; `crop` is the d2 → ∞ crop (its region is where the plane is fitted). The sensor,
 /// fill, filter and seed are the run's; the sensor senses from `captured_from`, the frontal
-/// camera where it captured `frontal` ([`crate::system::pipeline::FrontalCapture`]).
+/// camera where it captured `frontal` (pipeline.rs's `FrontalCapture`).
 pub fn scene_model_display(
     ctx: &RenderContext,
     scene: &Scene,
