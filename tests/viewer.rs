@@ -287,7 +287,7 @@ fn in_chromium_the_pointer_reads_the_exr_and_the_slider_reads_frames_csv() {
     std::fs::write(
         &spec,
         format!(
-            "scene = {:?}\nsamples = 4\n[options]\nwidth = 48\nspp = 1\n[draw]\ntheta_f = {{ uniform = [40, 60] }}\n",
+            "scene = {:?}\nsamples = 4\n[options]\nwidth = 48\nspp = 1\n[draw]\ntheta_f = {{ uniform = [40, 60] }}\n[draw.scene]\n\"object.car.translate\" = {{ uniform = [[-2.5, 0, -14], [-1, 0, -7]] }}\n",
             das()
         ),
     )

@@ -191,6 +191,16 @@ def check_dataset(driver, folder, shots):
         want = sorted(rows, key=lambda r: (float(r[column]) * (1 if order == "asc" else -1), int(r["sample"])))
         assert shown == [r["sample"] for r in want], f"sorted by {column} {order}: {shown}"
         print(f"ok: dataset grid sorted by {column} ({order}): {' '.join(shown)}")
+    # Each sample's caption and image are its own row's, a drawn vector (a quoted CSV field
+    # with commas) included: a naive split would shift every later column.
+    by_sample = {r["sample"]: r for r in rows}
+    for figure in driver.find_elements(By.CSS_SELECTOR, "#samples figure"):
+        row = by_sample[figure.get_attribute("data-sample")]
+        src = figure.find_element(By.TAG_NAME, "img").get_attribute("src")
+        assert src.endswith("/" + row["seethru_png"]), (src, row["seethru_png"])
+        vector = row["scene.object.car.translate"]
+        assert "," in vector and f"scene.object.car.translate = {vector}" in figure.text, figure.text
+    print("ok: each sample shows its own row, its drawn vector whole")
     driver.save_screenshot(os.path.join(shots, "dataset.png"))
     # A sample opens its own viewer.
     driver.find_element(By.CSS_SELECTOR, "#samples figure a").click()
