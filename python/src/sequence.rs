@@ -19,6 +19,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use seethru::geometry::shutter::Shutter;
 use seethru::measure::image_metrics::Flip;
+use seethru::measure::option_table::MAX_LATENCY_MS;
 use seethru::measure::sequence::{Measuring, SequenceStepper};
 use seethru::measure::sequence_records::FrameRecord;
 use seethru::render::frame::Frame;
@@ -42,7 +43,6 @@ use crate::scene::PyScene;
 use seethru::measure::option_table::Command;
 
 /// Longest latency, ms; most camera latencies in one sequence (as `seethru sequence`).
-const MAX_LATENCY_MS: f64 = 10_000.0;
 const MAX_LATENCIES: usize = 64;
 
 /// A sequence being stepped through; iterating yields one [`PyStep`] per displayed frame,

@@ -184,8 +184,11 @@ def sequence_keywords() -> set[str]:
 
 
 # The options a sequence shares with a run: the table's, but `head` (a sequence's `head` is
-# the head's motion; its source is `head_source`).
-SHARED = [o for o in OPTIONS if o["name"] in sequence_keywords() and o["name"] != "head"]
+# the head's motion; its source is `head_source`) and `latency_camera` (a run's is one
+# instant's latency; a sequence takes a list of them, one sequence each, with its own parser
+# over the table's range, MAX_LATENCY_MS).
+NOT_SHARED = {"head", "latency_camera"}
+SHARED = [o for o in OPTIONS if o["name"] in sequence_keywords() and o["name"] not in NOT_SHARED]
 REFUSED = [(o, v) for o in SHARED for v, taken in cases(o) if taken is False]
 
 

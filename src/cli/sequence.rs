@@ -12,6 +12,7 @@ use seethru::io::output_paths::{Input, Output, check_paths};
 use seethru::io::staged::StagedDir;
 use seethru::measure::headline::{RunKind, summary_text};
 use seethru::measure::image_metrics::Flip;
+use seethru::measure::option_table::MAX_LATENCY_MS;
 use seethru::measure::run_spec::RunSpec;
 use seethru::measure::sequence::{Measuring, SequenceRun, run_sequence_hazards};
 use seethru::measure::sequence_budget::{has_effects_of_time, run_budget};
@@ -36,7 +37,6 @@ use crate::cli::args::{ReadWhen, choice, positive, real, refuse_ignored, threads
 use crate::cli::option_args::{self, OptionArgs};
 
 /// Longest latency, ms.
-const MAX_LATENCY_MS: f64 = 10_000.0;
 /// Most latencies in one `--latency-camera` list.
 const MAX_LATENCIES: usize = 64;
 

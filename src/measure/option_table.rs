@@ -143,6 +143,10 @@ const PIXELS: Kind = Kind::Integer {
     max: MAX_RESOLUTION as u64,
 };
 /// The commands that run the system: each but `render`.
+/// Longest camera latency, ms: a run's, and each of a sequence's (which takes a list of
+/// them with its own parser: one sequence per latency).
+pub const MAX_LATENCY_MS: f64 = 10_000.0;
+
 const RUNS: &[Command] = &[
     Command::Run,
     Command::Capture,
@@ -325,7 +329,7 @@ pub static OPTIONS: &[OptionSpec] = &[
         name: "latency_camera",
         kind: Kind::Real {
             min: 0.0,
-            max: 10000.0,
+            max: MAX_LATENCY_MS,
         },
         unit: "ms",
         default: Default::Value("0"),
