@@ -11,7 +11,7 @@ use serde_json::{Value, json};
 use crate::measure::dataset_spec::{DatasetSpec, Law};
 use crate::measure::option_table::Kind;
 use crate::util::hash::Fnv64;
-use crate::util::input_file::read_input_text;
+use crate::util::input_file::read_input_json;
 
 /// The dataset's record in its folder: which spec its samples follow.
 pub const RECORD: &str = "dataset.json";
@@ -127,9 +127,7 @@ pub fn check_record(dataset: &Path, spec: &DatasetSpec) -> Result<bool> {
     if !path.is_file() {
         return Ok(false);
     }
-    let text = read_input_text(&path, 1 << 20)?;
-    let old: Value = serde_json::from_str(&text)
-        .with_context(|| format!("cannot read {}: invalid JSON", path.display()))?;
+    let old = read_input_json(&path, 1 << 20)?;
     if old["spec_hash"] != json!(spec.source_hash) {
         bail!(
             "{} holds the samples of another spec ({}, hash {}; this one {}): write it into another folder, or give the spec that began it",
@@ -177,12 +175,6 @@ pub const FILE_COLUMNS: [(&str, &str); 7] = [
     ("run_json", "run.json"),
 ];
 
-fn read_json(path: &Path) -> Result<Value> {
-    let text = read_input_text(path, 64 << 20)?;
-    serde_json::from_str(&text)
-        .with_context(|| format!("cannot read {}: invalid JSON", path.display()))
-}
-
 /// A CSV field: quoted when it holds a comma, a quote or a line break.
 fn field(text: &str) -> String {
     if text.contains([',', '"', '\n', '\r']) {
@@ -217,9 +209,10 @@ impl Manifest {
         let mut rows = Vec::new();
         for index in 0..spec.samples {
             let dir = sample_dir(dataset, index);
-            let sample = read_json(&dir.join(SAMPLE_RECORD))?;
-            let metrics = read_json(&dir.join("metrics.json"))?;
-            let run = read_json(&dir.join("run.json"))?;
+            let read_json = |name: &str| read_input_json(&dir.join(name), 64 << 20);
+            let sample = read_json(SAMPLE_RECORD)?;
+            let metrics = read_json("metrics.json")?;
+            let run = read_json("run.json")?;
             let mut draws = Vec::new();
             for d in &spec.draws {
                 let v = sample["draws"][&d.name].as_str().with_context(|| {

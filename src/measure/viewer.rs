@@ -19,7 +19,7 @@ use crate::measure::maps::{heat_color, p99_top};
 use crate::measure::metrics::MetricMaps;
 use crate::render::frame::Frame;
 use crate::render::frame_over::{Field, FrameView};
-use crate::util::input_file::read_input_text;
+use crate::util::input_file::{read_input_json, read_input_text};
 
 /// The page's file name in the folder it shows.
 pub const VIEW_FILE: &str = "view.html";
@@ -368,9 +368,7 @@ fn headline(metrics: Option<&Value>) -> String {
 const MAX_TEXT_BYTES: u64 = 64 << 20;
 
 fn read_json(path: &Path) -> Result<Value> {
-    let text = read_input_text(path, MAX_TEXT_BYTES)?;
-    serde_json::from_str(&text)
-        .with_context(|| format!("cannot read {}: invalid JSON", path.display()))
+    read_input_json(path, MAX_TEXT_BYTES)
 }
 
 /// Writes `dir/view.html` for a sequence folder: per latency folder (`latency_*` with a

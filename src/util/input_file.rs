@@ -99,6 +99,14 @@ pub fn read_input(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
     Ok(bytes)
 }
 
+/// [`read_input_text`] parsed as JSON; the error names the file.
+pub fn read_input_json(path: &Path, limit: u64) -> anyhow::Result<serde_json::Value> {
+    use anyhow::Context;
+    let text = read_input_text(path, limit)?;
+    serde_json::from_str(&text)
+        .with_context(|| format!("cannot read {}: invalid JSON", path.display()))
+}
+
 /// [`read_input`] as UTF-8 text; the error names the first byte that is not.
 pub fn read_input_text(path: &Path, limit: u64) -> std::io::Result<String> {
     String::from_utf8(read_input(path, limit)?).map_err(|e| {
