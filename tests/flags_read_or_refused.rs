@@ -938,6 +938,22 @@ fn score_refuses_a_filter_it_would_not_read() {
         );
         assert!(!dir.path().join("refused").exists());
     }
+    // --display-codes says what a display image holds: without one it is refused.
+    common::refusal::refused(
+        dir.path(),
+        &[
+            "score",
+            inputs.as_str(),
+            "--out",
+            "refused",
+            "--map",
+            "map.npy",
+            "--display-codes",
+        ],
+        1,
+        &["--display-codes is read only with --display-image"],
+    );
+    assert!(!dir.path().join("refused").exists());
 }
 
 #[test]

@@ -702,3 +702,174 @@ fn lamps_render_the_same_on_the_per_ray_and_the_packet_paths_and_on_any_thread_c
         }
     }
 }
+
+#[test]
+fn a_display_turns_a_coded_cameras_codes_into_light_by_its_transfer_curve() {
+    let dir = tempfile::tempdir().unwrap();
+    let (peak, black) = (500.0, 1.0);
+    // A camera whose automatic exposure puts the wall at 0.3 of full scale, its codes
+    // noise-free enough to be one code in every channel: no read noise or dark current, and
+    // 3·10⁶ electrons (a shot noise of 0.06 %, a code's step 1.6 %).
+    let camera = "resolution = [64, 36]\nexposure_ms = 300\nsensor = \"emva\"\n\
+                  full_well_e = 10000000\nread_noise_e = 0\ndark_current_e_s = 0\n\
+                  auto_exposure = \"average\"\nauto_target = 0.3\n";
+    let srgb = |x: f64| {
+        if x <= 0.0031308 {
+            12.92 * x
+        } else {
+            1.055 * x.powf(1.0 / 2.4) - 0.055
+        }
+    };
+    let srgb_decode = |v: f64| {
+        if v <= 0.04045 {
+            v / 12.92
+        } else {
+            ((v + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    // (camera curve and bits, display transfer, the share of the range the display gives)
+    let code8 = |x: f64| (srgb(x) * 255.0).round() / 255.0;
+    let code12 = |x: f64| (x.powf(1.0 / 2.2) * 4095.0).round() / 4095.0;
+    let cases: [(&str, &str, f64); 4] = [
+        // Matched curves: linear again, within the 8-bit code.
+        (
+            "tone_curve = \"srgb\"\noutput_bits = 8",
+            "srgb",
+            srgb_decode(code8(0.3)),
+        ),
+        // An sRGB camera on a 2.4-gamma display: the mid-tones darker.
+        (
+            "tone_curve = \"srgb\"\noutput_bits = 8",
+            "gamma2.4",
+            code8(0.3).powf(2.4),
+        ),
+        // A 2.2-gamma camera at 12 bits on a 2.2-gamma display.
+        (
+            "tone_curve = \"gamma2.2\"\noutput_bits = 12",
+            "gamma2.2",
+            code12(0.3).powf(2.2),
+        ),
+        // Codes shown as linear light: brighter.
+        (
+            "tone_curve = \"srgb\"\noutput_bits = 8",
+            "linear",
+            code8(0.3),
+        ),
+    ];
+    for (coding, transfer, share) in cases {
+        let display = format!(
+            "display_peak_cd_m2 = {peak}\ndisplay_black_cd_m2 = {black}\ndisplay_transfer = \"{transfer}\"\n"
+        );
+        let scene = lit_wall_scene(5000.0, &display, &format!("{camera}{coding}\n"));
+        let (pixels, _) = display_luminance(dir.path(), &scene);
+        assert!(pixels.len() > 20, "{} display pixels", pixels.len());
+        let expected = black + (peak - black) * share;
+        for (seen, _) in pixels {
+            assert!(
+                relative_error(seen, expected) < 0.005,
+                "{coding} on {transfer}: {seen} vs {expected} cd/m²"
+            );
+        }
+    }
+    // A coded camera needs a display that makes light of codes.
+    let e = common::parse(&lit_wall_scene(
+        5000.0,
+        "",
+        &format!("{camera}tone_curve = \"srgb\"\n"),
+    ))
+    .map(|_| ())
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("`camera.frontal.tone_curve`") && e.contains("display_peak_cd_m2"),
+        "{e}"
+    );
+}
+
+#[test]
+fn score_shows_a_methods_display_image_as_linear_light_or_as_the_displays_codes() {
+    let dir = tempfile::tempdir().unwrap();
+    let (peak, black) = (500.0, 1.0);
+    let display = format!(
+        "display_peak_cd_m2 = {peak}\ndisplay_black_cd_m2 = {black}\ndisplay_transfer = \"gamma2.2\"\n"
+    );
+    let scene = lit_wall_scene(5000.0, &display, FRONTAL);
+    let capture = seethru_on(dir.path(), &scene, "capture", &[]);
+    let calibration: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(capture.join("calibration.json")).unwrap())
+            .unwrap();
+    let size = &calibration["display"]["resolution_px"];
+    let (w, h) = (
+        size[0].as_u64().unwrap() as u32,
+        size[1].as_u64().unwrap() as u32,
+    );
+    // One flat image: 8-bit value 128 everywhere.
+    let png = dir.path().join("flat.png");
+    image::RgbImage::from_pixel(w, h, image::Rgb([128, 128, 128]))
+        .save(&png)
+        .unwrap();
+    let shown = |codes: bool| {
+        let out = dir.path().join(if codes { "codes" } else { "linear" });
+        let mut args = vec![
+            "score".to_string(),
+            capture.display().to_string(),
+            "--display-image".into(),
+            png.display().to_string(),
+            "--quiet".into(),
+            "--out".into(),
+            out.display().to_string(),
+        ];
+        if codes {
+            args.push("--display-codes".into());
+        }
+        let (ok, _, err) = common::seethru(&args);
+        assert!(ok, "{err}");
+        let occluded = exr_channels(&out.join("occluded.exr"))["id.object"].clone();
+        let obstacle = occluded.iter().copied().fold(0.0, f64::max);
+        let seen = luminance(&exr_channels(&out.join("seethru.exr")));
+        let pixels: Vec<f64> = (0..seen.len())
+            .filter(|&i| occluded[i] == obstacle)
+            .map(|i| seen[i])
+            .collect();
+        assert!(pixels.len() > 20);
+        pixels
+    };
+    // Linear light (the PNG's sRGB decoded): the display gives off that share of its range,
+    // whatever its transfer curve.
+    let linear = f64::from(srgb_to_linear(128.0 / 255.0));
+    for seen in shown(false) {
+        let expected = black + (peak - black) * linear;
+        assert!(
+            relative_error(seen, expected) < 0.005,
+            "{seen} vs {expected}"
+        );
+    }
+    // Codes: the display's 2.2 gamma of code 128.
+    for seen in shown(true) {
+        let expected = black + (peak - black) * (128.0f64 / 255.0).powf(2.2);
+        assert!(
+            relative_error(seen, expected) < 0.005,
+            "{seen} vs {expected}"
+        );
+    }
+    // Codes for a display that makes no light of codes: one line naming it.
+    let ideal = seethru_on(
+        dir.path(),
+        &lit_wall_scene(5000.0, "", FRONTAL),
+        "capture",
+        &[],
+    );
+    let (ok, _, err) = common::seethru(&[
+        "score",
+        ideal.to_str().unwrap(),
+        "--display-image",
+        png.to_str().unwrap(),
+        "--display-codes",
+        "--out",
+        dir.path().join("refused").to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.starts_with("error:") && err.contains("display_peak_cd_m2"),
+        "{err}"
+    );
+}

@@ -41,17 +41,26 @@ def run(scene: Scene, **options) -> Run:
     return _run(scene, **options)
 
 
-def score(capture: Capture, map=None, display_image=None, filter: str = "bilinear", band: int = 5) -> Run:
+def score(
+    capture: Capture,
+    map=None,
+    display_image=None,
+    filter: str = "bilinear",
+    band: int = 5,
+    display_codes: bool = False,
+) -> Run:
     """Measures a method's display as ``seethru score`` does, without files.
 
     ``map``: (display height, display width, 2), per display pixel the frontal pixel it shows
     ([..., 0] = x, [..., 1] = y, OpenCV's ``remap`` convention; NaN shows nothing).
     ``display_image``: (display height, display width, 3) linear RGB shown instead of the
-    map's colours (alone: image metrics only). Any float array (or torch tensor via
-    ``.numpy()``); it is read as float32. Returns a :class:`Run` like :func:`run`.
+    map's colours (alone: image metrics only); with ``display_codes=True``, the display's
+    codes in [0, 1], which its transfer curve (the scene's ``display_transfer``) turns into
+    light. Any float array (or torch tensor via ``.numpy()``); it is read as float32. Returns
+    a :class:`Run` like :func:`run`.
     """
     as_f32 = lambda a: None if a is None else _np.ascontiguousarray(a, dtype=_np.float32)
-    return _score(capture, as_f32(map), as_f32(display_image), filter, band)
+    return _score(capture, as_f32(map), as_f32(display_image), filter, band, display_codes)
 
 
 def sequence(scene: Scene, predictor=None, **options) -> Sequence:

@@ -269,6 +269,7 @@ def score(
     display_image: npt.ArrayLike | None = None,
     filter: str = "bilinear",
     band: int = 5,
+    display_codes: bool = False,
 ) -> Run:
     """`seethru score`: a method's display map (h, w, 2) and/or image (h, w, 3) measured."""
 

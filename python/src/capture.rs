@@ -200,9 +200,11 @@ fn pixels_of(
 }
 
 /// Measures a method's display map (frontal pixel per display pixel, OpenCV's remap
-/// convention, NaN shows nothing) and/or display image (linear RGB) as `seethru score`.
+/// convention, NaN shows nothing) and/or display image (linear RGB, or the display's codes
+/// with `display_codes`) as `seethru score`.
 #[pyfunction]
-#[pyo3(signature = (capture, map=None, display_image=None, filter="bilinear", band=5))]
+#[pyo3(signature = (capture, map=None, display_image=None, filter="bilinear", band=5, display_codes=false))]
+#[allow(clippy::too_many_arguments)]
 pub fn score(
     py: Python<'_>,
     capture: &Bound<'_, PyCapture>,
@@ -210,6 +212,7 @@ pub fn score(
     display_image: Option<PyReadonlyArray3<'_, f32>>,
     filter: &str,
     band: i64,
+    display_codes: bool,
 ) -> PyResult<PyRun> {
     let filter: Filter = choice_of("filter", filter)?;
     let band = int_in("band", band, 1, 1000)? as u32;
@@ -240,9 +243,15 @@ pub fn score(
                     .chunks_exact(3)
                     .map(|c| Vec3::new(c[0], c[1], c[2]))
                     .collect(),
+                codes: display_codes,
             })
         })
         .transpose()?;
+    if display_codes && image.is_none() {
+        return Err(bad_value(
+            "display_codes says what display_image= holds: it needs display_image=",
+        ));
+    }
     let c = capture.get();
     let (inner, context) = (c.inner.clone(), c.context.clone());
     let shutters = [context.scene.frontal.shutter, context.scene.back.shutter];

@@ -86,6 +86,7 @@ fn zeroed(width: u32, height: u32) -> Frame {
         height,
         color: vectors(),
         white_cd_m2: None,
+        exposure: None,
         depth: vec![0.0; n],
         camera_z: vec![0.0; n],
         position: vectors(),

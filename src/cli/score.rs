@@ -36,6 +36,11 @@ pub struct Score {
     /// resolution): shown instead of the map's colours; alone, only image metrics.
     #[arg(long = "display-image", value_name = "FILE")]
     display_image: Option<PathBuf>,
+    /// The display image holds the display's codes, not linear light: what its transfer curve
+    /// (`display_transfer`) turns into light, as a coded camera's image is shown (a PNG's 8 or
+    /// 16 bits as code / top code, an EXR's values as they are).
+    #[arg(long = "display-codes")]
+    display_codes: bool,
     /// Output directory: the views, metrics.json, the heatmaps and run.json, as `run` writes.
     #[arg(long)]
     out: PathBuf,
@@ -65,12 +70,13 @@ pub fn load_map(path: &Path) -> Result<DisplayMap> {
     })
 }
 
-fn load_image(path: &Path) -> Result<DisplayImage> {
-    let i = read_display_image(path)?;
+fn load_image(path: &Path, codes: bool) -> Result<DisplayImage> {
+    let i = read_display_image(path, codes)?;
     Ok(DisplayImage {
         width: i.width,
         height: i.height,
         color: i.color.into_iter().map(Vec3::from_array).collect(),
+        codes,
     })
 }
 
@@ -88,18 +94,29 @@ impl Score {
             bail!("score needs --map FILE, --display-image FILE or both");
         }
         // Given even at its default, --filter without a map would be ignored.
-        crate::cli::args::refuse_ignored(&[crate::cli::args::ReadWhen {
-            option: "filter",
-            read: self.map.is_some() && self.display_image.is_none(),
-            when: "with --map and no --display-image (it resamples the frontal image's colours at the map's points; a display image replaces them)",
-        }])?;
+        crate::cli::args::refuse_ignored(&[
+            crate::cli::args::ReadWhen {
+                option: "filter",
+                read: self.map.is_some() && self.display_image.is_none(),
+                when: "with --map and no --display-image (it resamples the frontal image's colours at the map's points; a display image replaces them)",
+            },
+            crate::cli::args::ReadWhen {
+                option: "display_codes",
+                read: self.display_image.is_some(),
+                when: "with --display-image (it says what the image holds)",
+            },
+        ])?;
         crate::cli::args::with_threads(self.threads, || self.write())?
     }
 
     fn write(&self) -> Result<()> {
         // The files first: a bad map fails before anything is rendered.
         let map = self.map.as_deref().map(load_map).transpose()?;
-        let image = self.display_image.as_deref().map(load_image).transpose()?;
+        let image = self
+            .display_image
+            .as_deref()
+            .map(|p| load_image(p, self.display_codes))
+            .transpose()?;
         let mut r = recapture(&self.inputs)?;
         r.options.filter = self.filter;
         let name = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());

@@ -6,6 +6,15 @@
 //! white at 1.0 (what a camera's image is everywhere else in seethru), after subtracting the
 //! mean dark signal (a black-level correction).
 //!
+//! A camera with a tone curve ([`Coding`]) delivers what a real camera's output is: its
+//! signal as a share of the ADC's full scale, through the curve (sRGB, BT.709, a 2.2 gamma or
+//! linear), quantised to 8, 10 or 12 bits. seethru keeps that image in linear light, each
+//! code decoded by the same curve and scaled back to the scene's white ([`Sensor::delivered`]),
+//! so that every consumer reads it as any other camera image; the codes themselves are
+//! [`Exposure::code`] of it, exactly. Automatic exposure ([`AutoExposure`]) sets the gain
+//! that puts the metered signal at its target: the camera's codes, and so a display's light,
+//! then follow the world's brightness no longer.
+//!
 //! The lens follows the camera equation for a distant object on the axis: the sensor's
 //! illuminance is π L / (4 N²) for a radiance L (transmittance 1, the cos⁴ fall-off left out).
 //! Light is counted as photons of 555 nm: 1 lx·s on 1 µm² is [`PHOTONS_PER_LUX_S_UM2`].
@@ -37,10 +46,156 @@ pub struct Sensor {
     pub gain_dn_per_e: f64,
     /// Seed of the noise: the same seed, the same noise in every pixel.
     pub noise_seed: u32,
-    /// Exposure time, s, > 0 (the camera's `exposure_ms`).
+    /// Exposure time, s, > 0 (the camera's `exposure_ms`; with an automatic exposure, set
+    /// for each frame by its metering, at most that).
     pub exposure_s: f64,
     /// The luminance of a linear 1.0 the sensor is given, cd/m² (the scene's white).
     pub white_cd_m2: f64,
+    /// The tone curve and the bits of the delivered codes; `None`: linear light, unquantised
+    /// beyond the ADC (`tone_curve = "none"`).
+    pub coding: Option<Coding>,
+    /// Automatic exposure; `None`: manual (the gain is K).
+    pub auto_exposure: Option<AutoExposure>,
+    /// The gain applied on top of K, [1, the automatic exposure's `max_gain`]: 1 for a manual
+    /// exposure; for an automatic one, set with the exposure time for each frame by its
+    /// metering (render/exposure.rs), `None` until then.
+    pub exposure_gain: Option<f64>,
+}
+
+/// The camera's output curve: what it applies to its linear signal before quantising.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ToneCurve {
+    /// The codes linear in the signal.
+    Linear,
+    /// IEC 61966-2-1's sRGB curve.
+    Srgb,
+    /// ITU-R BT.709's (and BT.2020's) camera curve.
+    Bt709,
+    /// A pure power of 1/2.2.
+    Gamma22,
+}
+
+impl ToneCurve {
+    /// The scene-file names, in the order of [`ToneCurve::ALL`].
+    pub const NAMES: [&'static str; 4] = ["linear", "srgb", "bt709", "gamma2.2"];
+    pub const ALL: [ToneCurve; 4] = [
+        ToneCurve::Linear,
+        ToneCurve::Srgb,
+        ToneCurve::Bt709,
+        ToneCurve::Gamma22,
+    ];
+
+    pub fn from_name(name: &str) -> Option<ToneCurve> {
+        let i = Self::NAMES.iter().position(|n| *n == name)?;
+        Some(Self::ALL[i])
+    }
+
+    pub fn name(self) -> &'static str {
+        Self::NAMES[Self::ALL.iter().position(|c| *c == self).expect("listed")]
+    }
+
+    /// The curve: a signal in [0, 1] (a share of full scale) to a code in [0, 1].
+    pub fn encode(self, x: f64) -> f64 {
+        let x = x.clamp(0.0, 1.0);
+        match self {
+            ToneCurve::Linear => x,
+            ToneCurve::Srgb if x <= 0.003_130_8 => 12.92 * x,
+            ToneCurve::Srgb => 1.055 * x.powf(1.0 / 2.4) - 0.055,
+            ToneCurve::Bt709 if x < 0.018 => 4.5 * x,
+            ToneCurve::Bt709 => 1.099 * x.powf(0.45) - 0.099,
+            ToneCurve::Gamma22 => x.powf(1.0 / 2.2),
+        }
+    }
+
+    /// Its inverse: a code in [0, 1] back to the signal.
+    pub fn decode(self, code: f64) -> f64 {
+        let v = code.clamp(0.0, 1.0);
+        match self {
+            ToneCurve::Linear => v,
+            ToneCurve::Srgb if v <= 0.040_45 => v / 12.92,
+            ToneCurve::Srgb => ((v + 0.055) / 1.055).powf(2.4),
+            ToneCurve::Bt709 if v < 0.081 => v / 4.5,
+            ToneCurve::Bt709 => ((v + 0.099) / 1.099).powf(1.0 / 0.45),
+            ToneCurve::Gamma22 => v.powf(2.2),
+        }
+    }
+}
+
+/// How a camera codes its delivered image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Coding {
+    pub curve: ToneCurve,
+    /// Bits of a delivered code: 8, 10 or 12.
+    pub bits: u32,
+}
+
+impl Coding {
+    /// The top code, 2^bits − 1.
+    pub fn top(self) -> f64 {
+        f64::from((1u32 << self.bits) - 1)
+    }
+}
+
+/// How the automatic exposure meters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Metering {
+    /// Every zone alike.
+    Average,
+    /// Zones weighted by a Gaussian about the image's centre, σ a quarter of the width.
+    Center,
+}
+
+/// Automatic exposure: it sets the exposure time (up to the shutter's, which sets the motion
+/// blur) and then the gain, as an automotive camera does within its time limit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AutoExposure {
+    pub metering: Metering,
+    /// The shortest exposure time, s, (0, max_exposure_s].
+    pub min_exposure_s: f64,
+    /// The longest exposure time, s: the shutter's `exposure_ms`.
+    pub max_exposure_s: f64,
+    /// The metered mean signal it aims at, as a share of the ADC's full scale, (0, 1).
+    pub target: f64,
+    /// Most gain on top of K, [1, 1e4]; the least is 1.
+    pub max_gain: f64,
+    /// How fast a sequence's exposure follows, stops per second, (0, 1e3]; a single frame's
+    /// is the settled one.
+    pub adaptation_ev_s: f64,
+}
+
+/// What a frame from a camera with a sensor records of its exposure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Exposure {
+    /// The exposure time, s.
+    pub exposure_s: f64,
+    /// The gain on top of K the frame was taken with, ≥ 1.
+    pub gain: f64,
+    /// The metered mean signal at that gain, as a share of the ADC's full scale, [0, 1]
+    /// (`None`: a manual exposure, which meters nothing).
+    pub metered: Option<f64>,
+    /// The automatic exposure's target, as a share of full scale (`None`: manual).
+    pub target: Option<f64>,
+    /// Whether the automatic exposure wanted a gain beyond [1, max_gain] (so missed its
+    /// target).
+    pub at_limit: bool,
+    /// The tone curve and bits of the codes (`None`: linear light).
+    pub coding: Option<Coding>,
+    /// The linear value (units of the scene's white) at the ADC's full scale.
+    pub full_scale: f64,
+}
+
+impl Exposure {
+    /// The code in [0, 1] (code / top code) of a delivered linear value, exact for what
+    /// a coded camera delivers; for a camera in linear light, the value clamped to [0, 1].
+    pub fn code(&self, value: f32) -> f32 {
+        match self.coding {
+            None => value.clamp(0.0, 1.0),
+            Some(c) => {
+                let code = (c.curve.encode(f64::from(value) / self.full_scale) * c.top()).round();
+                (code / c.top()) as f32
+            }
+        }
+    }
 }
 
 impl Sensor {
@@ -78,16 +233,55 @@ impl Sensor {
         };
         let electrons = poisson(mean, &mut draws) + self.read_noise_e * draws.normal();
         let charge = electrons.clamp(0.0, self.full_well_e);
-        (self.gain_dn_per_e * charge)
-            .round()
-            .clamp(0.0, self.max_dn())
+        (self.gain() * charge).round().clamp(0.0, self.max_dn())
+    }
+
+    /// A manual exposure's gain set (1); an automatic one's left to its metering.
+    pub fn with_manual_gain(self) -> Sensor {
+        Sensor {
+            exposure_gain: self.auto_exposure.is_none().then_some(1.0),
+            ..self
+        }
+    }
+
+    /// The system gain the frame is taken with: K times the exposure's gain, DN per
+    /// electron.
+    pub fn gain(&self) -> f64 {
+        self.gain_dn_per_e * self.exposure_gain.unwrap_or(1.0)
+    }
+
+    /// The linear value (units of the scene's white) whose signal fills the ADC.
+    pub fn full_scale(&self) -> f64 {
+        self.max_dn() / (self.gain() * self.mean_electrons(self.white_cd_m2))
     }
 
     /// What the camera delivers for a code: back in linear light, the mean dark signal
-    /// subtracted, the white at 1.0.
+    /// subtracted, the white at 1.0. With a tone curve, the signal's share of full scale
+    /// through the curve, quantised to the coding's bits, and decoded back.
     pub fn delivered(&self, dn: f64) -> f32 {
-        let white = self.gain_dn_per_e * self.mean_electrons(self.white_cd_m2);
-        ((dn - self.gain_dn_per_e * self.dark_electrons()) / white) as f32
+        let white = self.gain() * self.mean_electrons(self.white_cd_m2);
+        let signal = dn - self.gain() * self.dark_electrons();
+        match self.coding {
+            None => (signal / white) as f32,
+            Some(c) => {
+                let code = (c.curve.encode(signal / self.max_dn()) * c.top()).round();
+                (c.curve.decode(code / c.top()) * self.max_dn() / white) as f32
+            }
+        }
+    }
+
+    /// What a frame taken with this sensor records of its exposure (`metered` and
+    /// `at_limit` from the automatic exposure's metering).
+    pub fn exposure(&self, metered: Option<f64>, at_limit: bool) -> Exposure {
+        Exposure {
+            exposure_s: self.exposure_s,
+            gain: self.exposure_gain.unwrap_or(1.0),
+            metered,
+            target: self.auto_exposure.map(|a| a.target),
+            at_limit,
+            coding: self.coding,
+            full_scale: self.full_scale(),
+        }
     }
 }
 
@@ -147,6 +341,9 @@ mod tests {
             noise_seed: 7,
             exposure_s: 0.001,
             white_cd_m2: 1000.0,
+            coding: None,
+            auto_exposure: None,
+            exposure_gain: Some(1.0),
         }
     }
 

@@ -339,8 +339,9 @@ pub struct ImageFile {
 }
 
 /// Reads a method's display image: an 8-bit sRGB PNG (decoded to linear) or an EXR with
-/// linear `R`, `G`, `B` channels.
-pub fn read_display_image(path: &Path) -> Result<ImageFile> {
+/// linear `R`, `G`, `B` channels; or, with `codes`, the display's codes: a PNG's (8 or 16
+/// bits) as code / top code, an EXR's as they are.
+pub fn read_display_image(path: &Path, codes: bool) -> Result<ImageFile> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -350,12 +351,16 @@ pub fn read_display_image(path: &Path) -> Result<ImageFile> {
         Some("png") => {
             let bytes = read_bytes(path)?;
             let image = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
-                .with_context(|| format!("{shown}: not a readable PNG"))?
-                .to_rgb8();
-            let color = image
-                .pixels()
-                .map(|p| p.0.map(crate::util::color::decode_srgb8))
-                .collect();
+                .with_context(|| format!("{shown}: not a readable PNG"))?;
+            let color = if codes {
+                (image.to_rgb16().pixels())
+                    .map(|p| p.0.map(|c| f32::from(c) / 65535.0))
+                    .collect()
+            } else {
+                (image.to_rgb8().pixels())
+                    .map(|p| p.0.map(crate::util::color::decode_srgb8))
+                    .collect()
+            };
             Ok(ImageFile {
                 width: image.width(),
                 height: image.height(),

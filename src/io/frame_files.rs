@@ -28,8 +28,16 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<(
 }
 
 /// The colour AOV as an 8-bit sRGB PNG (clamped to [0, 1]; [`encode_srgb8`]).
+/// A frame from a camera that codes its image ([`crate::geometry::sensor::Coding`]) is its
+/// codes instead: 8 bits as they are, 10 or 12 bits in a 16-bit PNG, each code scaled by
+/// 65535 / its top code (rounded: exact both ways).
 pub fn write_color_png<'a>(frame: impl Into<FrameView<'a>>, path: &Path) -> Result<()> {
     let frame = frame.into();
+    if let FrameView::Whole(whole) = frame
+        && let Some(exposure) = whole.exposure.filter(|e| e.coding.is_some())
+    {
+        return write_codes_png(whole, &exposure, path);
+    }
     let (w, h) = (frame.width(), frame.height());
     let mut rgb = vec![0; 3 * w as usize * h as usize];
     let mut out = rgb.chunks_exact_mut(3);
@@ -41,6 +49,36 @@ pub fn write_color_png<'a>(frame: impl Into<FrameView<'a>>, path: &Path) -> Resu
         }
     }
     write_png(path, w, h, rgb)
+}
+
+/// A coded camera's frame as its codes ([`write_color_png`]).
+fn write_codes_png(
+    frame: &Frame,
+    exposure: &crate::geometry::sensor::Exposure,
+    path: &Path,
+) -> Result<()> {
+    let coding = exposure.coding.expect("a coded frame");
+    let codes = frame
+        .color
+        .iter()
+        .flat_map(|c| c.to_array())
+        .map(|v| f64::from(exposure.code(v)));
+    if coding.bits == 8 {
+        return write_png(
+            path,
+            frame.width,
+            frame.height,
+            codes.map(|v| (v * 255.0).round() as u8).collect(),
+        );
+    }
+    let samples: Vec<u16> = codes.map(|v| (v * 65535.0).round() as u16).collect();
+    let img =
+        image::ImageBuffer::<image::Rgb<u16>, _>::from_raw(frame.width, frame.height, samples)
+            .context("image buffer has the wrong size")?;
+    write_atomically(
+        path,
+        |file| Ok(img.write_to(file, image::ImageFormat::Png)?),
+    )
 }
 
 /// A stable, well-separated colour for an id; black for 0 (sky).
@@ -540,6 +578,7 @@ pub fn read_exr_from<R: std::io::Read + std::io::Seek + Send>(
         height,
         color,
         white_cd_m2,
+        exposure: None,
         depth: f32s(channel::Z)?,
         camera_z: f32s(channel::CAMERA_Z)?,
         position: vec3s(channel::P)?,

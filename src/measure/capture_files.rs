@@ -197,6 +197,8 @@ pub fn write_capture_folder(
             "back_size_px": [c.back.width, c.back.height],
             "depth": c.depth.as_ref().map(|d| json!({"file": "depth.npy", "size_px": [d.camera.width, d.camera.height], "sensor": d.model, "units": "axial depth along the frontal camera's axis, metres, float32, shape (height, width); NaN: no return"})),
             "files": files,
+            "exposure": {"frontal": crate::system::report::exposure_json(&c.frontal), "back": crate::system::report::exposure_json(&c.back)},
+            "images": "frontal.png and back.png: a camera's image as sRGB of its linear light, or, for a camera with a tone curve, its codes (8 bits; 10 and 12 bits in 16-bit PNGs, each code × 65535 / its top code); the EXRs: cd/m² in a photometric scene, decoded from the codes where there are codes",
             "map_format": "a display map: .npy float32 of shape (display height, display width, 2), [..., 0] = x and [..., 1] = y frontal pixels in OpenCV's remap convention (pixel centres at integers), NaN shows nothing; or EXR with channels x, y. State the capture it was made for in <map>.json: {\"capture_fingerprint\": \"...\"}",
             "truth": "truth/ holds the truth view and the true eye: a method must not read it",
         }))?,

@@ -272,6 +272,7 @@ impl SequenceStepper {
             eye_estimated: shown.eye_estimated,
             eye_used: shown.eye_used,
             head_confidence: shown.head_confidence,
+            frontal_exposure: shown.frontal_exposure,
             head_pose: shown.head_pose,
             head_yaw_true_deg: {
                 let base = &system.rig.base;

@@ -19,7 +19,7 @@ use crate::system::sequence::timeline::Timeline;
 use crate::util::color::encode_srgb8;
 
 /// The columns of `frames.csv`.
-pub const FRAME_COLUMNS: [&str; 42] = [
+pub const FRAME_COLUMNS: [&str; 45] = [
     "frame",
     "t_s",
     "refresh_s",
@@ -62,6 +62,9 @@ pub const FRAME_COLUMNS: [&str; 42] = [
     "head_yaw_deg",
     "head_fit_margin",
     "head_yaw_true_deg",
+    "frontal_exposure_ms",
+    "frontal_gain",
+    "frontal_metered",
 ];
 
 /// The columns of `frames.csv` for each hazard object, after [`FRAME_COLUMNS`], each named
@@ -153,6 +156,9 @@ pub fn frames_csv(records: &[FrameRecord], timeline: &Timeline) -> Result<String
             r.head_pose.map_or(f64::NAN, |p| p.yaw_deg),
             r.head_pose.map_or(f64::NAN, |p| p.margin),
             r.head_yaw_true_deg.unwrap_or(f64::NAN),
+            r.frontal_exposure.map_or(f64::NAN, |e| e.exposure_s * 1e3),
+            r.frontal_exposure.map_or(f64::NAN, |e| e.gain),
+            (r.frontal_exposure.and_then(|e| e.metered)).unwrap_or(f64::NAN),
         ]
         .iter()
         .map(|v| format!("{v}"))

@@ -63,6 +63,8 @@ pub struct FrameRecord {
     pub eye_used: DVec3,
     /// The image-based head estimate's confidence, [0, 1] (`None`: another head source).
     pub head_confidence: Option<f64>,
+    /// The exposure of the frontal image shown (`None`: a camera without a sensor).
+    pub frontal_exposure: Option<crate::geometry::sensor::Exposure>,
     /// The yaw fit of the image-based estimate on the mesh face: the fitted yaw from facing
     /// the back camera (degrees, positive towards the driver's left) and its margin, [0, 0.05]
     /// (`None`: the ellipsoid face or another head source).
@@ -117,6 +119,7 @@ mod tests {
             eye_estimated: DVec3::ZERO,
             eye_used: DVec3::ZERO,
             head_confidence: confidence,
+            frontal_exposure: None,
             head_pose: None,
             head_yaw_true_deg: None,
             vehicle_position: DVec3::ZERO,

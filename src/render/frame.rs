@@ -15,6 +15,9 @@ pub struct Frame {
     /// scene's [`crate::scene::Photometry::white_cd_m2`]; its EXRs hold `color` × this);
     /// `None` in a scene lit in relative units.
     pub white_cd_m2: Option<f32>,
+    /// The exposure of a frame from a camera with a sensor: its gain, what its automatic
+    /// exposure metered, its tone curve and codes (`None`: no sensor, the radiance as it is).
+    pub exposure: Option<crate::geometry::sensor::Exposure>,
     /// Distance from the camera centre along the pixel-centre ray, metres; +∞ for sky.
     pub depth: Vec<f32>,
     /// Depth along the camera's viewing axis (−z in camera space), metres; +∞ for sky.
@@ -114,6 +117,7 @@ impl Frame {
             height,
             color: vec![p.color; n],
             white_cd_m2: None,
+            exposure: None,
             depth: vec![p.depth; n],
             camera_z: vec![p.camera_z; n],
             position: vec![p.position; n],
@@ -173,6 +177,7 @@ impl Frame {
             height,
             color: Vec::with_capacity(n),
             white_cd_m2: None,
+            exposure: None,
             depth: Vec::with_capacity(n),
             camera_z: Vec::with_capacity(n),
             position: Vec::with_capacity(n),

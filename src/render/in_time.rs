@@ -63,12 +63,18 @@ pub fn render_in_time(
     job: RenderJob,
     frame: &mut Frame,
 ) -> Result<RenderStats> {
-    if needs_instants(context, &job) {
+    // The automatic exposure meters the world of the frame's instant.
+    let (camera, metered) = context.exposed(&job);
+    let job = job.of_camera(&camera);
+    let stats = if needs_instants(context, &job) {
         frame.white_cd_m2 = context.white_cd_m2();
-        render_by_instant(context_at, t, job, frame)
+        frame.exposure = None;
+        render_by_instant(context_at, t, job, frame)?
     } else {
-        Ok(context.render_into(job, frame))
-    }
+        context.render_into(job, frame)
+    };
+    crate::render::sensor_image::record_metering(frame, metered);
+    Ok(stats)
 }
 
 /// The instant, seconds after the frame's, at which the world of the band of rows starting at
@@ -168,7 +174,7 @@ pub fn render_by_instant(
             }
         }
     }
-    crate::render::sensor_image::deliver_through_sensor(&camera, frame, region);
+    crate::render::sensor_image::deliver_through_sensor(&camera, frame, region, None);
     stats.seconds = start.elapsed().as_secs_f64();
     Ok(stats)
 }

@@ -450,7 +450,10 @@ impl RenderContext {
             .map_or(1.0, |p| p.white_cd_m2);
         let black = (light.black_cd_m2 / white) as f32;
         let range = ((light.peak_cd_m2 - light.black_cd_m2) / white) as f32;
-        let emitted = Vec3::splat(black) + shown.clamp(Vec3::ZERO, Vec3::ONE) * range;
+        // `shown` is the display's code: a coded camera's (system/display.rs), or linear light.
+        let share = |code: f32| light.transfer.light(code);
+        let emitted =
+            Vec3::splat(black) + Vec3::new(share(shown.x), share(shown.y), share(shown.z)) * range;
         if light.reflectance == 0.0 {
             return emitted;
         }

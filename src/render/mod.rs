@@ -7,6 +7,7 @@ pub mod bvh_build;
 pub mod bvh_packet;
 pub mod camera_rays;
 pub mod cancel;
+pub mod exposure;
 pub mod footprint;
 pub mod frame;
 pub mod frame_over;

@@ -13,9 +13,13 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::geometry::camera::Camera;
+use crate::geometry::sensor::Metering;
 use crate::render::accel::Difference;
 use crate::render::bvh::Stack;
 use crate::render::bvh_packet::{PACKET, PacketStack};
+use crate::render::exposure::{
+    Metered, Zones, metering_camera, settled, with_exposure, zone_weight,
+};
 use crate::render::footprint::{PixelRect, footprint};
 use crate::render::frame::{Frame, Rows};
 use crate::render::frame_over::FrameOver;
@@ -143,6 +147,32 @@ impl<'a> RenderJob<'a> {
         }
     }
 
+    /// The job's camera.
+    pub fn camera(&self) -> &'a Camera {
+        self.camera
+    }
+
+    /// The [`view_bit`] of the primitives the job shows.
+    pub fn view(&self) -> u8 {
+        self.view
+    }
+
+    /// The same job of `camera` (the job's camera exposed, say).
+    pub fn of_camera(self, camera: &'a Camera) -> RenderJob<'a> {
+        RenderJob { camera, ..self }
+    }
+
+    /// The same job of `camera` (another size of the job's camera: its metering image, say),
+    /// every pixel and every sample.
+    pub fn whole_frame_of(self, camera: &'a Camera) -> RenderJob<'a> {
+        RenderJob {
+            region: None,
+            sample: None,
+            label: "",
+            ..self.of_camera(camera)
+        }
+    }
+
     /// What every pixel of the job shares: its camera at each instant of its shutter.
     pub(super) fn pixels(&self) -> PixelJob<'a> {
         let spp = self.settings.spp;
@@ -171,6 +201,44 @@ impl RenderContext {
         (frame, stats)
     }
 
+    /// The metering image of `job`'s camera (render/exposure.rs), as `job` renders it (its
+    /// view, pose and motion) at one sample per zone.
+    pub fn meter(&self, job: &RenderJob, metering: Metering) -> Zones {
+        let camera = metering_camera(job.camera);
+        let settings = RenderSettings {
+            spp: 1,
+            progress: false,
+        };
+        let (frame, _) = self.render(job.whole_frame_of(&camera).settings(settings));
+        let (w, h) = (camera.width, camera.height);
+        let weight = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| zone_weight(metering, x, y, w, h))
+            .collect();
+        Zones {
+            weight,
+            colour: frame.color,
+        }
+    }
+
+    /// `job`'s camera with its exposure set: an automatic exposure that has none yet meters
+    /// `job`'s view over this context and settles (with what it metered); any other camera as
+    /// it is.
+    pub fn exposed(&self, job: &RenderJob) -> (Camera, Option<Metered>) {
+        let camera = *job.camera;
+        let Some(sensor) = camera.sensor else {
+            return (camera, None);
+        };
+        let Some(auto) = sensor
+            .auto_exposure
+            .filter(|_| sensor.exposure_gain.is_none())
+        else {
+            return (camera, None);
+        };
+        let metered = settled(&sensor, &auto, &self.meter(job, auto.metering));
+        (with_exposure(&camera, &metered), Some(metered))
+    }
+
     /// What a frame's 1.0 is in cd/m² in a scene lit in physical units ([`Frame::white_cd_m2`]).
     pub fn white_cd_m2(&self) -> Option<f32> {
         (self.scene.photometry.as_ref()).map(|p| p.white_cd_m2 as f32)
@@ -179,12 +247,15 @@ impl RenderContext {
     /// Renders `job` into `frame`, a frame of the camera's size, so that a sequence of renders
     /// reuses its buffers: the pixels outside the job's region keep what they held.
     pub fn render_into(&self, job: RenderJob, frame: &mut Frame) -> RenderStats {
-        let camera = job.camera;
+        let (camera, metered) = self.exposed(&job);
+        let job = job.of_camera(&camera);
         assert_eq!((frame.width, frame.height), (camera.width, camera.height));
         frame.white_cd_m2 = self.white_cd_m2();
-        let region = job.region.unwrap_or_else(|| PixelRect::full(camera));
+        // A frame reused from a camera with a sensor: its exposure is this render's.
+        frame.exposure = None;
+        let region = job.region.unwrap_or_else(|| PixelRect::full(&camera));
         let stats = self.render_bands(&job, region, frame.bands_mut(BAND_ROWS));
-        crate::render::sensor_image::deliver_through_sensor(camera, frame, region);
+        crate::render::sensor_image::deliver_through_sensor(&camera, frame, region, metered);
         stats
     }
 

@@ -5,15 +5,26 @@
 use rayon::prelude::*;
 
 use crate::geometry::camera::Camera;
+use crate::render::exposure::Metered;
 use crate::render::footprint::PixelRect;
 use crate::render::frame::Frame;
 
-/// Puts the pixels of `region` of `frame` (a frame of `camera`) through the camera's sensor;
-/// nothing for an ideal sensor.
-pub fn deliver_through_sensor(camera: &Camera, frame: &mut Frame, region: PixelRect) {
+/// Puts the pixels of `region` of `frame` (a frame of `camera`, whose exposure's gain is set)
+/// through the camera's sensor, and records the exposure in the frame (with `metered`, what
+/// an automatic exposure metered); nothing for an ideal sensor.
+pub fn deliver_through_sensor(
+    camera: &Camera,
+    frame: &mut Frame,
+    region: PixelRect,
+    metered: Option<Metered>,
+) {
     let Some(sensor) = camera.sensor else {
         return;
     };
+    assert!(
+        sensor.exposure_gain.is_some(),
+        "an automatic exposure is metered before its frame is delivered"
+    );
     let width = frame.width as usize;
     let (x0, x1) = (region.x0 as usize, region.x1 as usize);
     (frame.color.par_chunks_mut(width).enumerate())
@@ -27,4 +38,14 @@ pub fn deliver_through_sensor(camera: &Camera, frame: &mut Frame, region: PixelR
                 }
             }
         });
+    frame.exposure = Some(sensor.exposure(None, false));
+    record_metering(frame, metered);
+}
+
+/// Records in `frame`'s exposure what its automatic exposure metered.
+pub fn record_metering(frame: &mut Frame, metered: Option<Metered>) {
+    if let (Some(exposure), Some(m)) = (frame.exposure.as_mut(), metered) {
+        exposure.metered = Some(m.share);
+        exposure.at_limit = m.at_limit;
+    }
 }

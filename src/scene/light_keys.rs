@@ -240,6 +240,7 @@ pub fn read_display_light(
         "display_peak_cd_m2",
         "display_black_cd_m2",
         "display_reflectance",
+        "display_transfer",
     ];
     let Some(first) = keys.iter().find(|k| t.has(k)) else {
         return Ok(None);
@@ -263,6 +264,12 @@ pub fn read_display_light(
         peak_cd_m2: peak,
         black_cd_m2: black,
         reflectance: t.f64_in("display_reflectance", 0.0, 0.0, 1.0)?,
+        transfer: crate::scene::DisplayTransfer::from_name(t.choice(
+            "display_transfer",
+            "linear",
+            &crate::scene::DisplayTransfer::NAMES,
+        )?)
+        .expect("a listed name"),
     }))
 }
 

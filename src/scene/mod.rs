@@ -337,6 +337,55 @@ pub struct DisplayLight {
     /// adds reflectance × the illuminance on the face / π (the sky, the ground, the sun
     /// where it reaches the face).
     pub reflectance: f64,
+    /// How a code becomes light (default linear: a frontal image in linear light, shown as
+    /// it is).
+    pub transfer: DisplayTransfer,
+}
+
+/// A display's electro-optical transfer: the share of its range a code in [0, 1] gives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DisplayTransfer {
+    /// The code's value.
+    Linear,
+    /// IEC 61966-2-1's sRGB curve.
+    Srgb,
+    /// A power of 2.2.
+    Gamma22,
+    /// A power of 2.4 (ITU-R BT.1886 with a black of zero: the black is `black_cd_m2`'s).
+    Gamma24,
+}
+
+impl DisplayTransfer {
+    pub const NAMES: [&'static str; 4] = ["linear", "srgb", "gamma2.2", "gamma2.4"];
+
+    pub fn from_name(name: &str) -> Option<DisplayTransfer> {
+        let all = [Self::Linear, Self::Srgb, Self::Gamma22, Self::Gamma24];
+        Some(all[Self::NAMES.iter().position(|n| *n == name)?])
+    }
+
+    /// The code in [0, 1] that gives `share` of the display's range: the inverse of
+    /// [`DisplayTransfer::light`]; a share beyond [0, 1] is clamped.
+    pub fn code(self, share: f32) -> f32 {
+        let v = share.clamp(0.0, 1.0);
+        match self {
+            DisplayTransfer::Linear => v,
+            DisplayTransfer::Srgb => crate::util::color::linear_to_srgb(v),
+            DisplayTransfer::Gamma22 => v.powf(1.0 / 2.2),
+            DisplayTransfer::Gamma24 => v.powf(1.0 / 2.4),
+        }
+    }
+
+    /// The share of the display's range (peak − black) a code in [0, 1] gives; a code
+    /// beyond is clamped.
+    pub fn light(self, code: f32) -> f32 {
+        let v = code.clamp(0.0, 1.0);
+        match self {
+            DisplayTransfer::Linear => v,
+            DisplayTransfer::Srgb => crate::util::color::srgb_to_linear(v),
+            DisplayTransfer::Gamma22 => v.powf(2.2),
+            DisplayTransfer::Gamma24 => v.powf(2.4),
+        }
+    }
 }
 
 impl Obstacle {

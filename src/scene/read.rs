@@ -576,6 +576,12 @@ fn read_frontal(
     if z > 1e-9 {
         return Err(t.error("offset", format!("the frontal camera must be on the scene side of the display (z ≤ 0 in the obstacle frame), got z = {} m", crate::util::number::short(z))));
     }
+    if camera.sensor.is_some_and(|s| s.coding.is_some()) && obstacle.display_light.is_none() {
+        return Err(t.error(
+            "tone_curve",
+            "makes the frontal camera deliver codes, which only a display with a light turns into light: give [obstacle] display_peak_cd_m2 (and display_transfer)",
+        ));
+    }
     t.finish()?;
     Ok(camera)
 }

@@ -201,8 +201,32 @@ pub struct DisplayMap {
 pub struct DisplayImage {
     pub width: u32,
     pub height: u32,
-    /// Row-major linear RGB, ≥ 0 (1.0 is display white).
+    /// Row-major linear RGB, ≥ 0 (1.0 is display white); with `codes`, the display's codes
+    /// in [0, 1].
     pub color: Vec<Vec3>,
+    /// Whether `color` holds the display's codes (what its transfer curve turns into light,
+    /// as a coded camera's image is shown) rather than linear light.
+    pub codes: bool,
+}
+
+impl DisplayImage {
+    /// The values the display is driven with ([`crate::scene::DisplayTransfer`]): codes as
+    /// they are; linear light through the inverse of the display's transfer, so that it gives
+    /// off that light. Refused: codes for a display that makes no light of codes (an ideal
+    /// display, which shows radiance).
+    pub fn drive(&self, display: Option<&crate::scene::DisplayLight>) -> Result<Vec<Vec3>> {
+        match (display, self.codes) {
+            (None, true) => bail!(
+                "a display image of codes needs a display that turns codes into light: the scene's [obstacle] has no display_peak_cd_m2 (its display is ideal and shows linear light)"
+            ),
+            (Some(d), false) => Ok(self
+                .color
+                .iter()
+                .map(|c| c.map(|v| d.transfer.code(v)))
+                .collect()),
+            _ => Ok(self.color.clone()),
+        }
+    }
 }
 
 /// A method's display with how it was made: the frames of `run` and a note for the metrics.
@@ -347,7 +371,25 @@ pub fn score(
     let display_size = ctx.scene.obstacle.display_resolution;
     let frontal_size = Some([capture.frontal.width, capture.frontal.height]);
     check_display_input(display_size, frontal_size, &capture.fingerprint, map, image)?;
-    let display = display_from(&capture.frontal, display_size, options, map, image);
+    let driven = image
+        .map(|i| -> Result<DisplayImage> {
+            Ok(DisplayImage {
+                color: i.drive(ctx.scene.obstacle.display_light.as_ref())?,
+                ..i.clone()
+            })
+        })
+        .transpose()?;
+    let mut display = display_from(
+        &capture.frontal,
+        display_size,
+        options,
+        map,
+        driven.as_ref(),
+    );
+    if image.is_none() {
+        // The frontal image's colours: shown by their codes, as `run` shows them.
+        display.exposure = capture.frontal.exposure;
+    }
     let blank_map_pixels = match map {
         Some(_) => display
             .object_id

@@ -54,6 +54,7 @@ fn resample_with(
     // threads, written in place.
     let mut frame = Frame::new(w, h);
     frame.white_cd_m2 = frontal.white_cd_m2;
+    frame.exposure = frontal.exposure;
     frame.bands_mut(8).into_par_iter().for_each(|mut band| {
         for row in 0..band.len() {
             let y = band.y + row;
@@ -244,7 +245,13 @@ impl Screen for DisplaySurface {
                         }
                     },
                 };
-                Shown::Pixel(shown.pixel(x, y))
+                let mut pixel = shown.pixel(x, y);
+                // A coded camera's image is shown by its codes (the display's light turns them
+                // into light, render/integrator.rs); linear light as it is.
+                if let Some(exposure) = shown.exposure.filter(|e| e.coding.is_some()) {
+                    pixel.color = pixel.color.map(|c| exposure.code(c));
+                }
+                Shown::Pixel(pixel)
             }
             DisplaySurface::Ideal {
                 map,

@@ -657,6 +657,11 @@ pub fn run_staged(
     } else {
         (resample_through(frontal, &map, options.filter), None)
     };
+    let mut display = display;
+    if !given_display {
+        // Made from the frontal image: the display shows it by its codes.
+        display.exposure = frontal.exposure;
+    }
     timings.insert("display".into(), json!(start.elapsed().as_secs_f64()));
     let missing = display
         .object_id
@@ -726,6 +731,10 @@ pub fn run_staged(
     }
     // The renders are the run's memory peak.
     report["peak_rss_bytes"] = json!(peak_rss_bytes());
+    report["exposure"] = json!({
+        "frontal": crate::system::report::exposure_json(frontal),
+        "back": crate::system::report::exposure_json(back),
+    });
     report["eyes"] = json!({"options": options.eyes, "view_world_m": driver.position().to_array()});
     report["lenses"] = crate::system::frontal_map::lenses_json(scene)?;
     report["calibration"] = crate::system::calibration_json::calibration_json(scene)?;

@@ -71,6 +71,27 @@ pub fn report(
     })
 }
 
+/// The `exposure` of a frame from a camera with a sensor (run.json's, capture.json's):
+/// its time and gain, what its automatic exposure metered against its target, and its codes;
+/// `null` for a camera without a sensor.
+pub fn exposure_json(frame: &crate::render::frame::Frame) -> serde_json::Value {
+    let Some(e) = frame.exposure else {
+        return serde_json::Value::Null;
+    };
+    let white = f64::from(frame.white_cd_m2.unwrap_or(f32::NAN));
+    json!({
+        "exposure_ms": e.exposure_s * 1e3,
+        "gain": e.gain,
+        "metered": e.metered,
+        "target": e.target,
+        "at_limit": e.at_limit,
+        "tone_curve": e.coding.map_or("none", |c| c.curve.name()),
+        "output_bits": e.coding.map(|c| c.bits),
+        "full_scale_cd_m2": e.full_scale * white,
+        "note": "metered, target: the automatic exposure's mean signal and its aim, shares of the ADC's full scale (null: a manual exposure); at_limit: it could not reach its target; full_scale_cd_m2: the luminance that fills the ADC",
+    })
+}
+
 /// The `[camera.driver] face` value of a face.
 pub fn face_name(face: DriverFace) -> &'static str {
     match face {

@@ -19,12 +19,14 @@ use crate::geometry::camera::Camera;
 use crate::geometry::lens::Lens;
 use crate::geometry::shutter::Scanout;
 use crate::render::accel::Accel;
+use crate::render::exposure::Adapting;
 use crate::render::footprint::PixelRect;
 use crate::render::frame::Frame;
 use crate::render::in_time::render_in_time;
 use crate::render::integrator::RenderContext;
 use crate::render::moving::MovingParts;
 use crate::render::render_job::RenderJob;
+use crate::render::sensor_image::record_metering;
 use crate::render::settings::{RenderSettings, check_spp};
 use crate::render::sky::SkyModel;
 use crate::scene::Scene;
@@ -87,6 +89,8 @@ pub struct Shown {
     pub d2_used: Option<f64>,
     /// The frontal camera at the capture time.
     pub frontal: Camera,
+    /// The frontal image's exposure (`None`: a camera without a sensor).
+    pub frontal_exposure: Option<crate::geometry::sensor::Exposure>,
     /// The believed frontal lens the display image went through (`None`: a pinhole).
     pub lens: Option<Lens>,
     /// How the ideal display maps its points: through `crop` and `lens` on a flat display,
@@ -143,6 +147,8 @@ pub struct SystemLoop {
     pub track_face: bool,
     /// Back camera pixels rendered for the head estimates, summed over the refreshes.
     pub back_pixels: u64,
+    /// The frontal and the back camera's automatic exposures.
+    exposures: [Adapting; 2],
 }
 
 impl SystemLoop {
@@ -237,6 +243,7 @@ impl SystemLoop {
             back_tracker: BackTracker::new(&rig_back),
             track_face: true,
             back_pixels: 0,
+            exposures: [Adapting::default(); 2],
         })
     }
 
@@ -457,11 +464,16 @@ impl SystemLoop {
                 spp: run.spp.max(BACK_MIN_SPP),
                 progress: false,
             };
-            let (back, _) = b.render(
-                RenderJob::new(&back_true, view_bit::BACK)
-                    .settings(back_settings)
-                    .label("back"),
+            let job = RenderJob::new(&back_true, view_bit::BACK)
+                .settings(back_settings)
+                .label("back");
+            let (camera, metered) = self.exposure_of(view_bit::BACK).exposed(
+                &back_true,
+                |m| b.meter(&job, m),
+                times.head,
             );
+            let (mut back, _) = b.render(job.of_camera(&camera));
+            record_metering(&mut back, metered);
             let head = HeadEstimate {
                 source: run.head,
                 eye_world_m: eye_world.to_array(),
@@ -482,7 +494,7 @@ impl SystemLoop {
             });
         }
         let external = byo.maps.as_ref().map(|maps| maps.get(&times.refresh));
-        let display = if let Some(named) = external {
+        let mut display = if let Some(named) = external {
             let named = named.with_context(|| {
                 format!(
                     "option `maps`: no map for refresh {} (at t = {} s)",
@@ -513,6 +525,8 @@ impl SystemLoop {
         } else {
             resample_through(&self.frontal, &map, run.filter)
         };
+        // Made from the frontal image: the display shows it by its codes.
+        display.exposure = self.frontal.exposure;
         self.seconds.frontal += frontal_seconds;
         self.seconds.compensation += start.elapsed().as_secs_f64() - frontal_seconds;
         self.inputs = inputs;
@@ -537,6 +551,7 @@ impl SystemLoop {
             crop,
             d2_used,
             frontal: frontal_camera,
+            frontal_exposure: self.frontal.exposure,
             lens: map.lens,
             ideal,
         });
@@ -579,8 +594,18 @@ impl SystemLoop {
         let vehicle = self.rig.vehicle.clone();
         let pose_at = move |dt: f64| vehicle.world_from_rig(t + dt) * base.world_from_camera;
         let job = job.moving(&pose_at);
+        let (camera, metered) =
+            self.exposure_of(job.view())
+                .exposed(job.camera(), |m| ctx.meter(&job, m), t);
+        let job = job.of_camera(&camera);
         render_in_time(ctx, &mut |at| self.context_at(at), t, job, frame)?;
+        record_metering(frame, metered);
         Ok(())
+    }
+
+    /// The automatic exposure of the camera of `view` (a [`view_bit`]: frontal or back).
+    fn exposure_of(&mut self, view: u8) -> &mut Adapting {
+        &mut self.exposures[usize::from(view != view_bit::FRONTAL)]
     }
 
     /// The inputs of the refresh [`SystemLoop::show`] last made, once (`None` after, or
