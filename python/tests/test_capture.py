@@ -117,3 +117,20 @@ def test_an_image_alone_says_misregistration_needs_a_map():
     with_map = seethru.score(cap, map=m, display_image=image).metrics
     assert "misregistration_needs_a_map" not in with_map
     assert with_map["external_method"]["display_from"] == "map and image"
+
+
+def test_a_display_image_of_codes_is_shown_through_the_displays_transfer():
+    # das_dusk: a coded camera and an sRGB display of 1000 cd/m² (black 0.5).
+    scene = seethru.Scene.load(REPO / "scenes" / "das_dusk.toml")
+    cap = seethru.capture(scene, width=48, frontal_width=160, spp=1)
+    w, h = cap.display_resolution
+    image = np.full((h, w, 3), 0.5, np.float32)
+    linear = seethru.score(cap, display_image=image).metrics["luminance"]["display"]
+    codes = seethru.score(cap, display_image=image, display_codes=True).metrics["luminance"]["display"]
+    # The display's sRGB curve of code 0.5 is 0.214 of its range: codes give less light than
+    # linear 0.5, by the curve (and the light its face reflects, the same in both).
+    srgb = ((0.5 + 0.055) / 1.055) ** 2.4
+    step = 999.5 * (0.5 - srgb)
+    assert abs((linear["seethru_mean_cd_m2"] - codes["seethru_mean_cd_m2"]) - step) < 0.01 * step
+    with pytest.raises(ValueError, match="display_codes says what display_image= holds"):
+        seethru.score(cap, map=planar_map(cap.calibration, {"head": cap.head}), display_codes=True)
