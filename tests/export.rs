@@ -693,3 +693,90 @@ fn the_format_and_the_file_name_must_agree() {
     assert!(ok, "{err}");
     assert!(dir.path().join("new/scene.mtl").is_file());
 }
+
+#[test]
+fn lamps_export_as_mitsuba_emitters_and_gltf_lights_of_their_intensity() {
+    // das_night's lamps, white 10 cd/m²: a Lambertian surface of albedo ρ at d, θ gets
+    // ρ/π · I·cos θ/d² cd/m² from a lamp of I cd, so a physical renderer in units of the
+    // white needs a radiant intensity of I / white (per channel, for a white lamp; a colour
+    // is scaled so its luminance is I).
+    let path = common::repo_path("scenes/das_night.toml");
+    let scene = seethru::scene::Scene::load(&path).unwrap();
+    let white = scene.photometry.as_ref().unwrap().white_cd_m2;
+    let dir = tempfile::tempdir().unwrap();
+    let world = World::build(&scene).unwrap();
+    let xml = dir.path().join("night.xml");
+    export(&scene, &world, &xml, Some(ExportFormat::Mitsuba)).unwrap();
+    let text = std::fs::read_to_string(&xml).unwrap();
+    let doc = roxmltree::Document::parse(&text).unwrap();
+    let emitters: Vec<roxmltree::Node> = doc
+        .descendants()
+        .filter(|n| {
+            n.has_tag_name("emitter") && matches!(n.attribute("type"), Some("point" | "spot"))
+        })
+        .collect();
+    assert_eq!(emitters.len(), scene.lights.len());
+    let value = |n: roxmltree::Node, tag: &str, name: &str| -> String {
+        n.descendants()
+            .find(|c| c.has_tag_name(tag) && c.attribute("name") == Some(name))
+            .unwrap()
+            .attribute("value")
+            .unwrap()
+            .to_string()
+    };
+    let luminance = |v: DVec3| 0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z;
+    for (lamp, e) in scene.lights.iter().zip(&emitters) {
+        let intensity = triple(&value(*e, "rgb", "intensity"));
+        assert!(
+            (luminance(intensity) / (lamp.intensity_cd / white) - 1.0).abs() < 1e-5,
+            "{}: {intensity}",
+            lamp.name
+        );
+        match &lamp.spot {
+            None => {
+                assert_eq!(e.attribute("type"), Some("point"));
+                let p = e.descendants().find(|n| n.has_tag_name("point")).unwrap();
+                let at: Vec<f64> = ["x", "y", "z"]
+                    .map(|k| p.attribute(k).unwrap().parse().unwrap())
+                    .to_vec();
+                assert_eq!(DVec3::from_slice(&at), lamp.position);
+            }
+            Some(spot) => {
+                assert_eq!(e.attribute("type"), Some("spot"));
+                let cone: f64 = value(*e, "float", "cutoff_angle").parse().unwrap();
+                let beam: f64 = value(*e, "float", "beam_width").parse().unwrap();
+                assert!((cone.to_radians().cos() - spot.cos_cone).abs() < 1e-9);
+                assert!((beam.to_radians().cos() - spot.cos_falloff).abs() < 1e-9);
+                let lookat = e.descendants().find(|n| n.has_tag_name("lookat")).unwrap();
+                let (origin, target) = (
+                    triple(lookat.attribute("origin").unwrap()),
+                    triple(lookat.attribute("target").unwrap()),
+                );
+                assert!((origin - lamp.position).length() < 1e-9);
+                assert!(((target - origin).normalize() - spot.direction).length() < 1e-9);
+            }
+        }
+    }
+    // What Mitsuba cannot state is said beside the emitter.
+    assert!(text.contains("cut-off line (cutoff_deg) is not exported"));
+    // glTF: a light per lamp after the sun, the spots' cones in radians.
+    let glb = dir.path().join("night.glb");
+    export(&scene, &world, &glb, Some(ExportFormat::Gltf)).unwrap();
+    let gltf = gltf::Gltf::open(&glb).unwrap();
+    let lights: Vec<_> = gltf.document.lights().unwrap().collect();
+    assert_eq!(lights.len(), 1 + scene.lights.len());
+    for (lamp, light) in scene.lights.iter().zip(&lights[1..]) {
+        let c = light.color().map(f64::from);
+        let radiant = DVec3::from(c) * f64::from(light.intensity());
+        assert!((luminance(radiant) / (lamp.intensity_cd / white) - 1.0).abs() < 1e-5);
+        if let (
+            Some(spot),
+            gltf::khr_lights_punctual::Kind::Spot {
+                outer_cone_angle, ..
+            },
+        ) = (&lamp.spot, light.kind())
+        {
+            assert!((f64::from(outer_cone_angle).cos() - spot.cos_cone).abs() < 1e-6);
+        }
+    }
+}

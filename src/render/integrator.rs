@@ -75,6 +75,13 @@ pub struct LampShading {
     casts_shadow: bool,
 }
 
+impl LampShading {
+    /// Linear colour × intensity / (π × white × the colour's luminance).
+    pub fn per_unit(&self) -> Vec3 {
+        self.per_unit
+    }
+}
+
 /// The lamps of `scene` ready for shading (none outside a photometric scene).
 pub fn lamps_of(scene: &Scene) -> Arc<[LampShading]> {
     let Some(photometry) = &scene.photometry else {

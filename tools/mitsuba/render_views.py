@@ -26,14 +26,22 @@ def srgb8(linear):
 
 
 def seethru_frame(path):
-    """Colour (linear RGB) and object ids of a seethru EXR, whatever its layer names."""
-    layers = {name: np.array(b) for name, b in mi.Bitmap(path).split()}
-    names = {name.lower(): name for name in layers}
-    color = layers[names.get("color", names.get("<root>"))][..., :3]
-    ids = layers[names.get("id", names.get("object_id"))]
-    # `id` holds `id.object` and `id.part` (in that order); older files had `object_id.id`.
-    ids = (ids[..., 0] if ids.ndim == 3 else ids).reshape(color.shape[:2])
-    return color, ids
+    """Colour (linear RGB, in units of the scene's white) and object ids of a seethru EXR,
+    each channel found by its name (a layer's channels are stored in no fixed order)."""
+    bitmap = mi.Bitmap(path)
+    channels = {}
+    for layer, b in bitmap.split():
+        values = np.array(b)
+        values = values.reshape(values.shape[0], values.shape[1], -1)
+        for k, field in enumerate(b.struct_()):
+            name = field.name if layer == "<root>" else f"{layer}.{field.name}"
+            channels[name] = values[..., k]
+    color = np.stack([channels["R"], channels["G"], channels["B"]], axis=-1)
+    # A photometric scene's EXR holds cd/m²; the export's light is in units of its white.
+    metadata = bitmap.metadata()
+    white = metadata.get("seethru_white_cd_m2") if "seethru_white_cd_m2" in metadata.keys() else 1.0
+    ids = channels.get("id.object", channels.get("object_id.id"))
+    return color / white, ids
 
 
 def main():

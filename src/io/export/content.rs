@@ -144,6 +144,37 @@ pub struct ExportScene<'a> {
     pub materials: Vec<ExportMaterial>,
     /// The lighting in physical terms (see [`Lighting`]).
     pub lighting: Lighting,
+    /// The scene's `[[light]]` lamps, as a physical renderer states them.
+    pub lamps: Vec<ExportLamp>,
+}
+
+/// A `[[light]]` lamp as a physically based renderer states it: a point of radiant
+/// intensity `intensity` (linear RGB in the units of the export's sun, π × seethru's
+/// per-unit term: a Lambertian surface of albedo ρ at distance d and incidence θ gets
+/// ρ / π × intensity × cos θ / d²), a spot where `spot` says so.
+#[derive(Clone, Debug)]
+pub struct ExportLamp {
+    pub name: String,
+    /// World frame, metres.
+    pub position: DVec3,
+    pub intensity: Vec3,
+    pub spot: Option<ExportSpot>,
+    /// Whether objects shade what it lights (a physical renderer's lamps always do).
+    pub casts_shadow: bool,
+}
+
+/// A spot's beam as the exporters can state it: its axis and two half angles. seethru's
+/// smoothstep between them and a low beam's cut-off line are not (the writers say so).
+#[derive(Clone, Copy, Debug)]
+pub struct ExportSpot {
+    /// Unit axis, world frame.
+    pub direction: DVec3,
+    /// Half angle of the full intensity, degrees.
+    pub falloff_deg: f64,
+    /// Half angle beyond which it gives nothing, degrees.
+    pub cone_deg: f64,
+    /// A low beam's cut-off line, degrees above the horizontal (`None`: none).
+    pub cutoff_deg: Option<f64>,
 }
 
 /// seethru's light as a physically based renderer states it. seethru shades Lambertian
@@ -243,11 +274,27 @@ impl<'a> ExportScene<'a> {
             sky_up: sky.ambient(Vec3::Y),
             sky_down: sky.ambient(-Vec3::Y),
         };
+        let lamps = (scene.lights.iter())
+            .zip(crate::render::integrator::lamps_of(scene).iter())
+            .map(|(lamp, shading)| ExportLamp {
+                name: lamp.name.clone(),
+                position: lamp.position,
+                intensity: shading.per_unit() * std::f32::consts::PI,
+                spot: lamp.spot.map(|s| ExportSpot {
+                    direction: s.direction,
+                    falloff_deg: s.cos_falloff.clamp(-1.0, 1.0).acos().to_degrees(),
+                    cone_deg: s.cos_cone.clamp(-1.0, 1.0).acos().to_degrees(),
+                    cutoff_deg: s.cutoff_sin.map(|v| v.clamp(-1.0, 1.0).asin().to_degrees()),
+                }),
+                casts_shadow: lamp.casts_shadow,
+            })
+            .collect();
         Ok(Self {
             scene,
             objects,
             materials,
             lighting,
+            lamps,
         })
     }
 

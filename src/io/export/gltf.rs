@@ -222,16 +222,53 @@ fn document(content: &ExportScene) -> Result<(Value, Vec<u8>)> {
         "rotation": pose(DVec3::ZERO, rotation).1,
         "extensions": {"KHR_lights_punctual": {"light": 0}},
     }));
+    // The lamps: a point or spot light each, in the sun's units (its radiant intensity over
+    // its colour's largest channel); a spot shines down its node's −z.
+    let mut lights = vec![json!({
+        "name": "sun",
+        "type": "directional",
+        "color": color.to_array(),
+        "intensity": light.sun_irradiance.max_element(),
+    })];
+    for lamp in &content.lamps {
+        let peak = lamp.intensity.max_element().max(f32::MIN_POSITIVE);
+        let mut entry = json!({
+            "name": lamp.name,
+            "type": "point",
+            "color": (lamp.intensity / peak).to_array(),
+            "intensity": lamp.intensity.max_element(),
+        });
+        let mut rotation = json!([0.0, 0.0, 0.0, 1.0]);
+        if let Some(spot) = &lamp.spot {
+            let up = if spot.direction.cross(DVec3::Y).length() > 1e-6 {
+                DVec3::Y
+            } else {
+                DVec3::Z
+            };
+            rotation = pose(DVec3::ZERO, world_from_camera_rotation(spot.direction, up)?).1;
+            // glTF needs the inner cone strictly inside the outer one.
+            let outer = spot.cone_deg.to_radians();
+            entry["type"] = json!("spot");
+            entry["spot"] = json!({
+                "innerConeAngle": spot.falloff_deg.to_radians().min(outer * (1.0 - 1e-6)),
+                "outerConeAngle": outer,
+            });
+        }
+        entry["extras"] = json!({"seethru_casts_shadow": lamp.casts_shadow, "seethru_cutoff_deg": lamp.spot.and_then(|s| s.cutoff_deg)});
+        roots.push(nodes.len());
+        nodes.push(json!({
+            "name": lamp.name,
+            "translation": lamp.position.to_array(),
+            "rotation": rotation,
+            "extensions": {"KHR_lights_punctual": {"light": lights.len()}},
+        }));
+        lights.push(entry);
+    }
 
     let doc = json!({
         "asset": {"version": "2.0", "generator": concat!("seethru ", env!("CARGO_PKG_VERSION"))},
         "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_specular"],
-        "extensions": {"KHR_lights_punctual": {"lights": [{
-            "name": "sun",
-            "type": "directional",
-            "color": color.to_array(),
-            "intensity": light.sun_irradiance.max_element(),
-        }]}},
+        "extensions": {"KHR_lights_punctual": {"lights": lights}},
         "scene": 0,
         "scenes": [{
             "name": scene.path.file_stem().unwrap_or_default().to_string_lossy(),

@@ -20,7 +20,7 @@ use glam::{DVec3, Vec3};
 use crate::geometry::camera::Camera;
 use crate::io::atomic::{write_atomically, write_text};
 use crate::io::export::content::{
-    CAMERA_ZNEAR, ExportScene, Primitive, VIEWS, assets_dir, sanitize, write_asset,
+    CAMERA_ZNEAR, ExportLamp, ExportScene, Primitive, VIEWS, assets_dir, sanitize, write_asset,
 };
 
 /// Samples per pixel the scenes ask for by default (`mi.load_file(path, spp=…)` changes it).
@@ -201,6 +201,9 @@ fn lights_and_materials(
         rgb(-light.sun_direction),
         rgb(light.sun_irradiance),
     );
+    for lamp in &content.lamps {
+        lamp_xml(&mut s, lamp);
+    }
     for (i, m) in content.materials.iter().enumerate() {
         let id = bsdf_id(i, &m.name);
         let reflectance = match &m.texture {
@@ -238,6 +241,78 @@ fn lights_and_materials(
         );
     }
     Ok(s)
+}
+
+/// A `[[light]]` lamp: Mitsuba's `point` or `spot` emitter of the same radiant intensity.
+/// Mitsuba's spot falls off linearly in angle between `beam_width` and `cutoff_angle`
+/// (seethru's by a smoothstep of the cosine), and knows no cut-off line or lamp without
+/// shadows: the comment says where the export differs.
+fn lamp_xml(s: &mut String, lamp: &ExportLamp) {
+    let name = xml_escape(&lamp.name).replace("--", "- -");
+    let mut notes = Vec::new();
+    if !lamp.casts_shadow {
+        notes.push("casts_shadow = false in seethru: Mitsuba's lamps always cast shadows");
+    }
+    let p = lamp.position;
+    match &lamp.spot {
+        None => {
+            let _ = write!(
+                s,
+                r#"
+    <!-- lamp {name}{} -->
+    <emitter type="point">
+        <point name="position" x="{}" y="{}" z="{}"/>
+        <rgb name="intensity" value="{}"/>
+    </emitter>
+"#,
+                notes.iter().map(|n| format!(": {n}")).collect::<String>(),
+                p.x,
+                p.y,
+                p.z,
+                rgb(lamp.intensity)
+            );
+        }
+        Some(spot) => {
+            notes.push("Mitsuba's spot falls off linearly in angle between beam_width and cutoff_angle, seethru's by a smoothstep of the cosine");
+            if spot.cutoff_deg.is_some() {
+                notes
+                    .push("its cut-off line (cutoff_deg) is not exported: Mitsuba's spot has none");
+            }
+            let target = p + spot.direction;
+            let up = if spot.direction.cross(DVec3::Y).length() > 1e-6 {
+                DVec3::Y
+            } else {
+                DVec3::Z
+            };
+            let _ = write!(
+                s,
+                r#"
+    <!-- lamp {name}: {} -->
+    <emitter type="spot">
+        <transform name="to_world">
+            <lookat origin="{}, {}, {}" target="{}, {}, {}" up="{}, {}, {}"/>
+        </transform>
+        <rgb name="intensity" value="{}"/>
+        <float name="cutoff_angle" value="{}"/>
+        <float name="beam_width" value="{}"/>
+    </emitter>
+"#,
+                notes.join("; "),
+                p.x,
+                p.y,
+                p.z,
+                target.x,
+                target.y,
+                target.z,
+                up.x,
+                up.y,
+                up.z,
+                rgb(lamp.intensity),
+                spot.cone_deg,
+                spot.falloff_deg,
+            );
+        }
+    }
 }
 
 fn scene_xml(
