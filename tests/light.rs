@@ -873,3 +873,67 @@ fn score_shows_a_methods_display_image_as_linear_light_or_as_the_displays_codes(
         "{err}"
     );
 }
+
+#[test]
+fn a_low_beams_kerb_side_cut_off_rises_at_fifteen_degrees() {
+    let (grey, intensity) = (0.8, 2000.0);
+    let rho = f64::from(srgb_to_linear(grey as f32));
+    // A beam 0.7 m up at z = 6 aimed along −z, its cone wide (80°), cut off at −10°, its kerb
+    // to the right (+x). Below the flat line (elevation ≤ −10°) it lights everywhere; on the
+    // kerb side (l > 0) also below the rising line, which on a screen across the axis
+    // (forward f, height v) is v / f ≤ tan(−10°) + (l / f) tan 15°, as ECE R112 draws it.
+    let lamp = glam::DVec3::new(0.0, 0.7, 6.0);
+    let beam = |kerb: &str| {
+        format!(
+            "[[light]]\nkind = \"spot\"\nposition = [0.0, 0.7, 6.0]\ndirection = [0.0, 0.0, -1.0]\n\
+             intensity_cd = {intensity}\ncone_deg = 80\nfalloff_deg = 80\ncutoff_deg = -10\n{kerb}"
+        )
+    };
+    let (tan_c, tan_15) = ((-10f64).to_radians().tan(), 15f64.to_radians().tan());
+    let mut stepped = 0;
+    for (kerb, rises) in [("cutoff_kerb = \"right\"\n", 1.0), ("", 0.0)] {
+        for (p, y) in floor_under_lamps(grey, &beam(kerb), "") {
+            let to = p - lamp;
+            let (f, l, v) = (-to.z, to.x, to.y);
+            let sin_c = (-10f64).to_radians().sin();
+            let flat = v / to.length() <= sin_c;
+            let line = tan_c + (l / f) * tan_15;
+            let step = rises > 0.0 && l > 0.0 && v / f <= line;
+            // Pixels straddling either line, or the cone's edge, hold both sides.
+            let near_line = (v / to.length() - sin_c).abs() * to.length() < 0.05
+                || (rises > 0.0 && l > 0.0 && (v / f - line).abs() * f < 0.05);
+            let off_axis = to.angle_between(glam::DVec3::NEG_Z).to_degrees();
+            if f <= 0.0 || near_line || (off_axis - 80.0).abs() < 1.0 {
+                continue;
+            }
+            let lit = off_axis < 80.0 && (flat || step);
+            if lit {
+                let from = -to;
+                let expected = rho * intensity * (from.y / from.length())
+                    / (std::f64::consts::PI * from.length_squared());
+                assert!(
+                    relative_error(y, expected) < 0.005,
+                    "at {p}: {y} vs {expected}"
+                );
+                stepped += usize::from(rises > 0.0 && !flat);
+            } else {
+                assert_eq!(y, 0.0, "at {p} ({kerb:?})");
+            }
+        }
+    }
+    // The step-up lights a region of its own, beyond the flat line on the kerb side.
+    assert!(stepped > 200, "{stepped} pixels lit by the step-up");
+    // A step-up needs a cut-off line to raise.
+    let e = parse(&floor_scene(
+        0.5,
+        "[sun]\nilluminance_lux = 0\n[sky]\nzenith_luminance_cd_m2 = 0\n[photometry]\nwhite_cd_m2 = 10\n\
+         [[light]]\nkind = \"spot\"\nposition = [0.0, 1.0, 0.0]\ncutoff_kerb = \"right\"\n",
+    ))
+    .map(|_| ())
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("`light[0].cutoff_kerb`") && e.contains("cutoff_deg"),
+        "{e}"
+    );
+}

@@ -273,6 +273,40 @@ pub fn read_display_light(
     }))
 }
 
+/// `cutoff_kerb` of a spot of axis `direction` and cut-off `cutoff` (degrees): the side whose
+/// cut-off line rises at [`crate::scene::KERB_STEP_DEG`].
+fn read_kerb_step(
+    t: &TableReader,
+    direction: glam::DVec3,
+    cutoff: Option<f64>,
+) -> Result<Option<crate::scene::KerbStep>, SceneError> {
+    let side = t.choice("cutoff_kerb", "none", &["none", "right", "left"])?;
+    if side == "none" {
+        return Ok(None);
+    }
+    let Some(cutoff) = cutoff else {
+        return Err(t.error(
+            "cutoff_kerb",
+            "raises the cut-off line on the kerb side: it needs cutoff_deg",
+        ));
+    };
+    let forward = glam::DVec3::new(direction.x, 0.0, direction.z);
+    if forward.length() < 1e-6 || cutoff.abs() >= 45.0 {
+        return Err(t.error(
+            "cutoff_kerb",
+            "needs a beam aimed near the horizontal (cutoff_deg within ±45° and a direction not straight up or down)",
+        ));
+    }
+    let forward = forward.normalize();
+    // Right of the axis, seen from above with +y up: forward × up.
+    let right = forward.cross(glam::DVec3::Y);
+    Ok(Some(crate::scene::KerbStep {
+        forward,
+        kerb: if side == "right" { right } else { -right },
+        cutoff_tan: cutoff.to_radians().tan(),
+    }))
+}
+
 /// Most `[[light]]` tables a scene may have (each lit point traces a shadow ray per light).
 pub const MAX_LIGHTS: usize = 64;
 /// Brightest lamp: a high beam's axis gives some 100 000 cd.
@@ -300,7 +334,13 @@ pub fn read_lights(
     let mut lamps = Vec::with_capacity(tables.len());
     for t in tables {
         let kind = t.choice("kind", "point", &["point", "spot"])?;
-        let spot_keys = ["direction", "cone_deg", "falloff_deg", "cutoff_deg"];
+        let spot_keys = [
+            "direction",
+            "cone_deg",
+            "falloff_deg",
+            "cutoff_deg",
+            "cutoff_kerb",
+        ];
         let spot = if kind == "spot" {
             let cone = t.f64_in("cone_deg", 30.0, 0.01, 90.0)?;
             let falloff = t.f64_in("falloff_deg", cone, 0.0, cone)?;
@@ -311,11 +351,13 @@ pub fn read_lights(
                     crate::scene::table_reader::range_message(c, -90.0, 90.0),
                 ));
             }
+            let direction = t.direction("direction", [0.0, 0.0, -1.0])?;
             Some(Spot {
-                direction: t.direction("direction", [0.0, 0.0, -1.0])?,
+                direction,
                 cos_cone: cone.to_radians().cos(),
                 cos_falloff: falloff.to_radians().cos(),
                 cutoff_sin: cutoff.map(|c| c.to_radians().sin()),
+                kerb_step: read_kerb_step(&t, direction, cutoff)?,
             })
         } else {
             if let Some(key) = spot_keys.iter().find(|k| t.has(k)) {

@@ -302,12 +302,30 @@ pub struct Spot {
     /// A low beam's cut-off line: the sine of the elevation (above the horizontal, world +y)
     /// above which the beam gives nothing (`cutoff_deg`, [−90, 90]); `None`: no cut-off.
     pub cutoff_sin: Option<f64>,
+    /// An asymmetric low beam's step-up (`cutoff_kerb`): on the kerb side of its axis the
+    /// cut-off line rises at 15° (ECE R112), as a screen across the axis shows it; `None`:
+    /// the line is flat.
+    pub kerb_step: Option<KerbStep>,
 }
+
+/// The kerb side's rising cut-off line of a low beam ([`Spot::kerb_step`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KerbStep {
+    /// The axis's horizontal direction, unit, world frame.
+    pub forward: DVec3,
+    /// Towards the kerb, horizontal and across `forward`, unit, world frame.
+    pub kerb: DVec3,
+    /// Tangent of the cut-off's elevation (`cutoff_deg`).
+    pub cutoff_tan: f64,
+}
+
+/// The slope of the kerb side's cut-off line: 15° (ECE R112's asymmetric low beam).
+pub const KERB_STEP_DEG: f64 = 15.0;
 
 impl Spot {
     /// The fraction of the axis's intensity towards the unit direction `to` (from the lamp).
     pub fn profile(&self, to: DVec3) -> f64 {
-        if self.cutoff_sin.is_some_and(|limit| to.y > limit) {
+        if self.cutoff_sin.is_some_and(|limit| to.y > limit) && !self.under_kerb_step(to) {
             return 0.0;
         }
         let cos = self.direction.dot(to);
@@ -319,6 +337,17 @@ impl Spot {
         }
         let t = (cos - self.cos_cone) / (self.cos_falloff - self.cos_cone);
         t * t * (3.0 - 2.0 * t)
+    }
+
+    /// Whether `to` is under the kerb side's rising line: on a screen across the axis (at
+    /// forward distance f, kerb-side offset l > 0, height v), v / f ≤ tan(cutoff) +
+    /// (l / f) tan 15°. At l = 0 the line meets the flat one.
+    fn under_kerb_step(&self, to: DVec3) -> bool {
+        let Some(step) = self.kerb_step else {
+            return false;
+        };
+        let (f, l) = (to.dot(step.forward), to.dot(step.kerb));
+        f > 0.0 && l > 0.0 && to.y <= f * step.cutoff_tan + l * KERB_STEP_DEG.to_radians().tan()
     }
 }
 
