@@ -325,10 +325,11 @@ fn poisson(mean: f64, draws: &mut Draws) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn sensor() -> Sensor {
+    /// A sensor of a 12-bit ADC, 20 000 e⁻ well and 1 ms exposure, manual, linear light.
+    pub(crate) fn sensor() -> Sensor {
         Sensor {
             f_number: 2.0,
             pixel_um: 3.0,

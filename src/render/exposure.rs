@@ -205,23 +205,17 @@ mod tests {
 
     fn sensor() -> Sensor {
         Sensor {
-            f_number: 2.0,
-            pixel_um: 3.0,
-            quantum_efficiency: 0.6,
             full_well_e: 10_000.0,
-            read_noise_e: 3.0,
             dark_current_e_s: 0.0,
-            adc_bits: 12,
             gain_dn_per_e: 4095.0 / 10_000.0,
-            noise_seed: 0,
             exposure_s: 0.004,
-            white_cd_m2: 1000.0,
             coding: Some(Coding {
                 curve: ToneCurve::Srgb,
                 bits: 8,
             }),
             auto_exposure: Some(AUTO),
             exposure_gain: None,
+            ..crate::geometry::sensor::tests::sensor()
         }
     }
 
