@@ -349,6 +349,34 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn small_poisson_draws_follow_the_probability_mass_function() {
+        // Each count's frequency against e^−μ μ^k / k!, within 5 standard errors.
+        for mean in [0.3, 4.0, 12.0, 29.0] {
+            let n = 200_000u32;
+            let mut counts = vec![0u32; 100];
+            for i in 0..n {
+                let mut draws = Draws {
+                    key: hash_u32(i ^ 0x5eed),
+                    n: 0,
+                };
+                counts[poisson(mean, &mut draws) as usize] += 1;
+            }
+            let mut pmf = f64::exp(-mean);
+            for (k, &count) in counts.iter().enumerate().take(60) {
+                if k > 0 {
+                    pmf *= mean / k as f64;
+                }
+                let expected = pmf * f64::from(n);
+                let error = 5.0 * expected.sqrt() + 1.0;
+                assert!(
+                    (f64::from(count) - expected).abs() <= error,
+                    "mean {mean}, k {k}: {count} vs {expected:.1}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn poisson_draws_have_the_mean_and_the_variance_of_their_mean() {
         // Below and above the switch to the normal.
         for mean in [0.3, 4.0, 29.0, 31.0, 500.0] {
