@@ -103,7 +103,7 @@ fn estimates_grow_with_what_they_count() {
     assert!((growth - 4.0).abs() < 0.1, "{growth}");
     // bench: its batches scale with the batch's pixels, the scene part with --grow.
     let scene = das();
-    let bench = |w, h, grow| bench_estimate(&scene, w, h, grow).unwrap().bytes;
+    let bench = |w, h, grow| bench_estimate(&scene, w, h, grow, false).unwrap().bytes;
     let per_pixel = (bench(2000, 1000, 1.0) - bench(1000, 1000, 1.0)) as f64 / 1e6;
     let frame = seethru::render::frame::Frame::BYTES_PER_PIXEL as f64;
     assert!(per_pixel > frame + 64.0, "{per_pixel} bytes per pixel");
@@ -147,7 +147,7 @@ fn the_bench_estimate_counts_its_batches_at_their_size() {
     let pixels = (w * h) as f64;
     let held = held as f64 / pixels;
     let scene = das();
-    let bench = |w, h| bench_estimate(&scene, w, h, 1.0).unwrap().bytes;
+    let bench = |w, h| bench_estimate(&scene, w, h, 1.0, false).unwrap().bytes;
     let frame = seethru::render::frame::Frame::BYTES_PER_PIXEL as f64;
     let counted = (bench(2000, 1000) - bench(1000, 1000)) as f64 / 1e6 - frame;
     // An upper bound (a shadow or incoherent ray at every pixel), and not a loose one: das's

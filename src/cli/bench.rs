@@ -48,6 +48,10 @@ pub struct Bench {
     /// trees, buildings), in [1, 1000], to see how the cost scales with scene size.
     #[arg(long, default_value_t = 1.0, value_parser = real(1.0, 1000.0))]
     grow: f64,
+    /// Trace the scene's instanced meshes flattened (every placement its own triangles in
+    /// one hierarchy): the same images, to time the two-level hierarchy against the flat one.
+    #[arg(long)]
+    flatten: bool,
     /// Print only the JSON line.
     #[arg(long)]
     json: bool,
@@ -67,6 +71,7 @@ impl Bench {
             self.width,
             self.height,
             self.grow,
+            self.flatten,
         )?;
         check_memory(&estimate, self.memory.max_memory)?;
         with_threads(self.threads, || bench(&self).map(|_| ()))?
@@ -164,14 +169,24 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
     };
     let load = Instant::now();
     let scene = grow(&Scene::load(&options.scene)?, options.grow)?;
-    let ctx = RenderContext::new(scene)?;
+    let mut ctx = RenderContext::new(scene)?;
+    if options.flatten {
+        ctx = ctx.flattened()?;
+    }
     let load_s = load.elapsed().as_secs_f64();
     let world = &ctx.world;
+    let placements: usize = world
+        .instanced
+        .iter()
+        .map(|s| s.world_from_object.len())
+        .sum();
     say(format!(
-        "scene        {} (grown {}×): {} triangles, {} ellipsoids; loaded and built in {load_s:.3} s",
+        "scene        {} (grown {}×{}): {} triangles, {} instanced ({placements} placements), {} ellipsoids; loaded and built in {load_s:.3} s",
         options.scene.display(),
         options.grow,
+        if options.flatten { ", flattened" } else { "" },
         world.triangles.len(),
+        world.instanced_count(),
         world.ellipsoids.len()
     ));
     let builds: Vec<f64> = (0..options.repeat)
@@ -334,6 +349,9 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         "scene": options.scene.display().to_string(),
         "grow": options.grow,
         "triangles": world.triangles.len(),
+        "instanced_triangles": world.instanced_count(),
+        "placements": placements,
+        "flattened": options.flatten,
         "ellipsoids": world.ellipsoids.len(),
         "bvh_build_ms": build.json(),
         "bvh_bytes": ctx.accel.bytes(),

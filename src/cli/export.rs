@@ -36,6 +36,16 @@ impl Export {
 fn export_scene(scene_path: &Path, out: &Path, format: Option<ExportFormat>) -> Result<()> {
     let scene = Scene::load(scene_path)?;
     let world = World::build(&scene)?;
+    // The formats are written flat: every placement of an instanced mesh its own triangles.
+    let flat = world.triangles.len() + world.instanced_count();
+    if flat > seethru::scene::limits::MAX_TRIANGLES {
+        anyhow::bail!(
+            "{}: its instanced meshes flatten to {flat} triangles, more than export's limit of {}",
+            scene_path.display(),
+            seethru::scene::limits::MAX_TRIANGLES
+        );
+    }
+    let world = world.flattened();
     let exported = seethru::io::export::export(&scene, &world, out, format)?;
     let assets = seethru::io::export::content::assets_dir(out);
     let (in_assets, beside): (Vec<_>, Vec<_>) =

@@ -179,6 +179,7 @@ fn object(name: &str, shape: Shape, material: usize, world_from_object: DAffine3
         casts_shadow: true,
         hazard: false,
         motion: Default::default(),
+        instances: Vec::new(),
     }
 }
 

@@ -13,13 +13,12 @@ use std::time::{Duration, Instant};
 use anyhow::Result;
 use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
-use obvhs::splits::split_aabbs_preset;
-use obvhs::triangle::Triangle;
 
 use std::cell::RefCell;
 
-use crate::render::bvh::{Bvh, NO_PRIM, Stack};
-use crate::render::bvh_packet::{PacketStack, RayPacket};
+use crate::render::bvh::{Bvh, NO_PRIM, Stack, primitive_boxes};
+use crate::render::bvh_packet::{PACKET, PacketStack, RayPacket};
+use crate::render::instances::{InstanceLevel, placed_bounds};
 use crate::render::ray::TraceRay;
 use crate::render::simd::{self, Isa};
 use crate::scene::world::World;
@@ -37,6 +36,8 @@ struct Group {
     /// Boxes the hierarchy was built over.
     boxes: usize,
     bvh: Bvh,
+    /// The group's instanced meshes and their placements.
+    instances: InstanceLevel,
 }
 
 /// Where the images of two views of one camera can differ.
@@ -75,40 +76,6 @@ pub struct Accel {
     pub build_time: Duration,
 }
 
-/// Boxes to build a hierarchy over `prims`, and the primitive each belongs to. Large
-/// triangles (the ground, the street, long kerbs) get several tight boxes instead of one that
-/// overlaps everything (obvhs' spatial pre-splits); a primitive may then be in several leaves.
-/// Ellipsoids keep one box: it is tight enough.
-fn primitive_boxes(world: &World, prims: &[u32]) -> (Vec<Aabb>, Vec<u32>) {
-    let (triangles, ellipsoids): (Vec<u32>, Vec<u32>) = prims
-        .iter()
-        .partition(|&&p| (p as usize) < world.triangles.len());
-    let tris: Vec<Triangle> = triangles
-        .iter()
-        .map(|&p| {
-            let t = &world.triangles[p as usize];
-            Triangle {
-                v0: t.v0,
-                v1: t.v0 - t.e1,
-                v2: t.v0 + t.e2,
-            }
-        })
-        .collect();
-    let mut aabbs: Vec<Aabb> = tris.iter().map(Triangle::aabb).collect();
-    // Indices into `tris` while splitting (the preset reads the triangles through them).
-    let mut indices: Vec<u32> = (0..tris.len() as u32).collect();
-    if !tris.is_empty() {
-        let areas: Vec<f32> = aabbs.iter().map(Aabb::half_area).collect();
-        let average = areas.iter().sum::<f32>() / areas.len() as f32;
-        let largest = areas.iter().copied().fold(0.0, f32::max);
-        split_aabbs_preset(&mut aabbs, &mut indices, &tris, average, largest);
-    }
-    let mut indices: Vec<u32> = indices.iter().map(|&i| triangles[i as usize]).collect();
-    aabbs.extend(ellipsoids.iter().map(|&p| world.aabb(p as usize)));
-    indices.extend(ellipsoids);
-    (aabbs, indices)
-}
-
 pub fn make_ray(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> TraceRay {
     TraceRay::new(Vec3A::from(origin), Vec3A::from(dir), tmin, tmax)
 }
@@ -116,30 +83,53 @@ pub fn make_ray(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> TraceRay {
 impl Accel {
     pub fn build(world: &World) -> Result<Accel> {
         let start = Instant::now();
-        // Primitives of each visibility class, in world order.
-        let mut classes: BTreeMap<(u8, bool), Vec<u32>> = BTreeMap::new();
-        for prim in 0..world.primitive_count() {
-            classes
-                .entry(world.visibility(prim))
-                .or_default()
-                .push(prim as u32);
+        // Primitives of each visibility class, in world order; the instanced ones by set.
+        let mut classes: BTreeMap<(u8, bool), (Vec<u32>, Vec<usize>)> = BTreeMap::new();
+        let flat =
+            (0..world.triangles.len()).chain(world.ellipsoid_base()..world.primitive_count());
+        for prim in flat {
+            let class = classes.entry(world.visibility(prim)).or_default();
+            class.0.push(prim as u32);
         }
-        let mut groups = Vec::new();
-        for ((views, casts_shadow), prims) in classes {
+        for (s, set) in world.instanced.iter().enumerate() {
+            if !set.is_empty() {
+                let class = classes
+                    .entry(world.visibility(set.first_prim as usize))
+                    .or_default();
+                class.1.push(s);
+            }
+        }
+        let mut built = Vec::new();
+        let mut world_box = placed_bounds(world);
+        for ((views, casts_shadow), (prims, sets)) in classes {
             let (boxes, indices) = primitive_boxes(world, &prims);
             let mut bounds = Aabb::empty();
             for b in &boxes {
                 bounds = bounds.union(b);
             }
-            groups.push(Group {
+            world_box = world_box.union(&bounds);
+            built.push((
                 views,
                 casts_shadow,
                 bounds,
-                boxes: boxes.len(),
-                bvh: Bvh::build(world, &boxes, indices)?,
+                boxes.len(),
+                Bvh::build(world, &boxes, indices)?,
+                sets,
+            ));
+        }
+        let mut groups = Vec::new();
+        for (views, casts_shadow, bounds, boxes, bvh, sets) in built {
+            let instances = InstanceLevel::build(world, &sets, &world_box)?;
+            groups.push(Group {
+                views,
+                casts_shadow,
+                bounds: bounds.union(&instances.bounds()),
+                boxes,
+                bvh,
+                instances,
             });
         }
-        groups.sort_by_key(|g| std::cmp::Reverse(g.bvh.bytes()));
+        groups.sort_by_key(|g| std::cmp::Reverse(g.bvh.bytes() + g.instances.bytes()));
         Ok(Accel {
             groups,
             build_time: start.elapsed(),
@@ -178,6 +168,9 @@ impl Accel {
         let mut best = NO_PRIM;
         for group in self.groups.iter().filter(|g| g.views & view != 0) {
             group.bvh.closest(&mut ray, &mut best, stack);
+            if !group.instances.is_empty() {
+                group.instances.closest(&mut ray, &mut best, stack);
+            }
         }
         (best != NO_PRIM).then_some(Hit {
             prim: best as usize,
@@ -198,6 +191,18 @@ impl Accel {
     ) {
         for group in self.groups.iter().filter(|g| g.views & view != 0) {
             simd::closest(isa, &group.bvh, packet, stack);
+            if !group.instances.is_empty() {
+                // Lane by lane: the instance level has no packet traversal.
+                Stack::with_thread_stack(|stack| {
+                    for lane in (0..PACKET).filter(|l| packet.active & (1 << l) != 0) {
+                        let mut ray = packet.ray(lane);
+                        group
+                            .instances
+                            .closest(&mut ray, &mut packet.prim[lane], stack);
+                        packet.tmax[lane] = ray.tmax;
+                    }
+                });
+            }
         }
     }
 
@@ -219,6 +224,16 @@ impl Accel {
             .filter(|g| g.views & view != 0 && g.casts_shadow)
         {
             blocked |= simd::any(isa, &g.bvh, &rest, stack);
+            if !g.instances.is_empty() {
+                Stack::with_thread_stack(|stack| {
+                    let open = packet.active & !blocked;
+                    for lane in (0..PACKET).filter(|l| open & (1 << l) != 0) {
+                        if g.instances.any(&packet.ray(lane), stack) {
+                            blocked |= 1 << lane;
+                        }
+                    }
+                });
+            }
             rest.active = packet.active & !blocked;
             if rest.active == 0 {
                 break;
@@ -239,7 +254,9 @@ impl Accel {
         self.groups
             .iter()
             .filter(|g| g.views & view != 0 && g.casts_shadow)
-            .any(|g| g.bvh.any(ray, stack))
+            .any(|g| {
+                g.bvh.any(ray, stack) || (!g.instances.is_empty() && g.instances.any(ray, stack))
+            })
     }
 
     /// Whether view `view` shows any primitive of the hierarchy (as a surface, or as the
@@ -276,7 +293,10 @@ impl Accel {
 
     /// Bytes held by the hierarchies.
     pub fn bytes(&self) -> usize {
-        self.groups.iter().map(|g| g.bvh.bytes()).sum()
+        self.groups
+            .iter()
+            .map(|g| g.bvh.bytes() + g.instances.bytes())
+            .sum()
     }
 }
 

@@ -15,9 +15,11 @@
 //! query to the same distance, bit for bit.
 
 use anyhow::{Result, bail};
-use glam::Vec4;
+use glam::{Affine3A, Vec4};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
+use obvhs::splits::split_aabbs_preset;
+use obvhs::triangle::Triangle;
 use rayon::prelude::*;
 
 use crate::render::bvh_build;
@@ -203,6 +205,50 @@ fn key_entry(key: u64) -> f32 {
     f32::from_bits((key >> 32) as u32)
 }
 
+/// Boxes to build a hierarchy over `prims`, and the primitive each belongs to. Large
+/// triangles (the ground, the street, long kerbs) get several tight boxes instead of one that
+/// overlaps everything (obvhs' spatial pre-splits); a primitive may then be in several leaves.
+/// Ellipsoids keep one box: it is tight enough.
+pub fn primitive_boxes(world: &World, prims: &[u32]) -> (Vec<Aabb>, Vec<u32>) {
+    let (triangles, ellipsoids): (Vec<u32>, Vec<u32>) = prims
+        .iter()
+        .partition(|&&p| (p as usize) < world.triangles.len());
+    let tris: Vec<Triangle> = triangles
+        .iter()
+        .map(|&p| {
+            let t = &world.triangles[p as usize];
+            Triangle {
+                v0: t.v0,
+                v1: t.v0 - t.e1,
+                v2: t.v0 + t.e2,
+            }
+        })
+        .collect();
+    let mut aabbs: Vec<Aabb> = tris.iter().map(Triangle::aabb).collect();
+    // Indices into `tris` while splitting (the preset reads the triangles through them).
+    let mut indices: Vec<u32> = (0..tris.len() as u32).collect();
+    if !tris.is_empty() {
+        let areas: Vec<f32> = aabbs.iter().map(Aabb::half_area).collect();
+        let average = areas.iter().sum::<f32>() / areas.len() as f32;
+        let largest = areas.iter().copied().fold(0.0, f32::max);
+        split_aabbs_preset(&mut aabbs, &mut indices, &tris, average, largest);
+    }
+    let mut indices: Vec<u32> = indices.iter().map(|&i| triangles[i as usize]).collect();
+    aabbs.extend(ellipsoids.iter().map(|&p| world.aabb(p as usize)));
+    indices.extend(ellipsoids);
+    (aabbs, indices)
+}
+
+/// First packet and packet count of a triangle leaf reference.
+#[inline(always)]
+fn packets_of(leaf: u32) -> (usize, usize) {
+    debug_assert!(leaf & ELLIPSOIDS == 0);
+    (
+        (leaf & FIRST_MASK) as usize,
+        ((leaf >> COUNT_SHIFT) & COUNT_MASK) as usize + 1,
+    )
+}
+
 /// A wide BVH over the triangles and ellipsoids of a world.
 #[derive(Clone)]
 pub struct Bvh {
@@ -257,7 +303,7 @@ impl Bvh {
         for packet in &mut self.triangles {
             *packet = Triangles4::new(&world.triangles, &packet.prim);
         }
-        let offset = world.triangles.len();
+        let offset = world.ellipsoid_base();
         for leaf in &mut self.ellipsoids {
             leaf.ellipsoid = world.ellipsoids[leaf.prim as usize - offset];
         }
@@ -363,17 +409,54 @@ impl Bvh {
     /// [`NO_PRIM`] where nothing was found yet).
     #[inline]
     pub fn closest(&self, ray: &mut TraceRay, best: &mut u32, stack: &mut Stack) {
+        let lanes = RayLanes::new(ray);
+        self.walk_closest(&lanes, ray, stack, |bvh, leaf, ray| {
+            bvh.leaf_closest(leaf, ray, best)
+        });
+    }
+
+    /// [`Bvh::closest`] of a hierarchy built in an object frame, placed by `m`: its boxes
+    /// are tested with `object_ray` (`ray` in the object frame: the same `t`), its triangles
+    /// are placed by `m` ([`crate::scene::instances::placed`]) and tested with `ray`, as the
+    /// flattened world's would be, under primitive indices `base` + their own.
+    #[inline]
+    pub fn closest_placed(
+        &self,
+        object_ray: &TraceRay,
+        ray: &mut TraceRay,
+        best: &mut u32,
+        stack: &mut Stack,
+        (m, base): (&Affine3A, u32),
+    ) {
+        let lanes = RayLanes::new(object_ray);
+        self.walk_closest(&lanes, ray, stack, |bvh, leaf, ray| {
+            let (first, count) = packets_of(leaf);
+            for packet in &bvh.triangles[first..first + count] {
+                packet.placed(m, base).closest(ray, best);
+            }
+        });
+    }
+
+    /// The near-to-far walk of [`Bvh::closest`]: boxes tested with `lanes` in `ray`'s
+    /// interval, each leaf handed to `leaf`, which shrinks `ray.tmax`.
+    #[inline(always)]
+    fn walk_closest(
+        &self,
+        lanes: &RayLanes,
+        ray: &mut TraceRay,
+        stack: &mut Stack,
+        mut leaf: impl FnMut(&Bvh, u32, &mut TraceRay),
+    ) {
         if self.nodes.is_empty() {
             return;
         }
-        let lanes = RayLanes::new(ray);
         stack.len = 0;
         let mut current = 0u32;
         'visit: loop {
             // Down the tree, near child first, until a leaf or nothing is hit.
             while current & LEAF == 0 {
                 let node = &self.nodes[current as usize];
-                let (mut mask, entry) = node.intersect(&lanes, ray.tmin, ray.tmax);
+                let (mut mask, entry) = node.intersect(lanes, ray.tmin, ray.tmax);
                 if mask == 0 {
                     break;
                 }
@@ -412,7 +495,7 @@ impl Bvh {
                 current = keys[0] as u32;
             }
             if current & LEAF != 0 {
-                self.leaf_closest(current, ray, best);
+                leaf(self, current, ray);
             }
             // The next stacked subtree that starts before the closest hit so far.
             while let Some(k) = stack.pop() {
@@ -428,27 +511,73 @@ impl Bvh {
     /// Whether any primitive is hit in [tmin, tmax].
     #[inline]
     pub fn any(&self, ray: &TraceRay, stack: &mut Stack) -> bool {
+        let lanes = RayLanes::new(ray);
+        self.walk_any(&lanes, ray, stack, |bvh, leaf| bvh.leaf_any(leaf, ray))
+    }
+
+    /// [`Bvh::any`] of a hierarchy placed by `m`, as [`Bvh::closest_placed`].
+    #[inline]
+    pub fn any_placed(
+        &self,
+        object_ray: &TraceRay,
+        ray: &TraceRay,
+        stack: &mut Stack,
+        (m, base): (&Affine3A, u32),
+    ) -> bool {
+        let lanes = RayLanes::new(object_ray);
+        self.walk_any(&lanes, ray, stack, |bvh, leaf| {
+            let (first, count) = packets_of(leaf);
+            bvh.triangles[first..first + count]
+                .iter()
+                .any(|p| p.placed(m, base).any(ray))
+        })
+    }
+
+    /// The walk of [`Bvh::any`]: until `leaf` finds a hit.
+    #[inline(always)]
+    fn walk_any(
+        &self,
+        lanes: &RayLanes,
+        ray: &TraceRay,
+        stack: &mut Stack,
+        leaf: impl Fn(&Bvh, u32) -> bool,
+    ) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
-        let lanes = RayLanes::new(ray);
         stack.len = 0;
         let mut current = 0u32;
         loop {
             if current & LEAF == 0 {
                 let node = &self.nodes[current as usize];
-                let (mut mask, _) = node.intersect(&lanes, ray.tmin, ray.tmax);
+                let (mut mask, _) = node.intersect(lanes, ray.tmin, ray.tmax);
                 while mask != 0 {
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
                     stack.push(u64::from(node.children[i]));
                 }
-            } else if self.leaf_any(current, ray) {
+            } else if leaf(self, current) {
                 return true;
             }
             match stack.pop() {
                 Some(k) => current = k as u32,
                 None => return false,
+            }
+        }
+    }
+
+    /// Widens every child box by `pad` (metres of the frame the hierarchy was built in) on
+    /// each side: the slack an instance's boxes need for the rounding between its object
+    /// frame and the world's (the instance level, `render/instances.rs`).
+    pub(crate) fn pad(&mut self, pad: f32) {
+        for node in &mut self.nodes {
+            for slot in 0..WIDTH {
+                if node.children[slot] != EMPTY {
+                    for axis in 0..3 {
+                        node.bounds[2 * axis][slot] -= pad;
+                        node.bounds[2 * axis + 1][slot] += pad;
+                    }
+                }
             }
         }
     }
@@ -688,7 +817,7 @@ impl Builder<'_> {
             (first, prims.len().div_ceil(TRI_LANES), 0)
         } else {
             let first = self.out.ellipsoids.len();
-            let offset = world.triangles.len();
+            let offset = world.ellipsoid_base();
             self.out
                 .ellipsoids
                 .extend(prims.iter().map(|&p| EllipsoidLeaf {

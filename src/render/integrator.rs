@@ -161,6 +161,18 @@ impl RenderContext {
         })
     }
 
+    /// This context with its world flattened ([`World::flattened`]) and its hierarchy built
+    /// anew: the same images, from one flat hierarchy instead of two levels.
+    pub fn flattened(self) -> Result<Self> {
+        let world = World::build(&self.scene)?.flattened();
+        let accel = Accel::build(&world)?;
+        Ok(Self {
+            world: Arc::new(world),
+            accel: Arc::new(accel),
+            ..self
+        })
+    }
+
     /// A context for `scene`, reusing this one's world and hierarchy when `scene` differs
     /// from this context's only in its cameras, and its sky when sky and sun are the same.
     pub fn with_scene(&self, scene: Scene) -> Result<Self> {

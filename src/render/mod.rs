@@ -12,6 +12,7 @@ pub mod footprint;
 pub mod frame;
 pub mod frame_over;
 pub mod in_time;
+pub mod instances;
 pub mod integrator;
 pub mod moving;
 pub mod packets;

@@ -116,6 +116,8 @@ impl MovingParts {
         World {
             triangles,
             tri_attrs,
+            // Instanced objects are static: never in a moving part.
+            instanced: Vec::new(),
             ellipsoids,
             objects: r.objects.clone(),
             materials: r.materials.clone(),

@@ -9,8 +9,10 @@
 //! ([`closer`]): the per-ray and the packet traversals (`render/bvh_packet.rs`) visit
 //! them in different orders and give the same primitive.
 
-use glam::Vec4;
+use glam::{Affine3A, Vec4};
 use obvhs::rt_triangle::RtTriangle;
+
+use crate::scene::instances::placed;
 
 use crate::render::ray::TraceRay;
 
@@ -100,6 +102,20 @@ impl Triangles4 {
 }
 
 impl Triangles4 {
+    /// The four triangles placed by `m` ([`placed`]: as the flattened world's), under
+    /// primitive indices `base` + their own.
+    #[inline(always)]
+    pub fn placed(&self, m: &Affine3A, base: u32) -> Triangles4 {
+        let [v0, e1, e2, ng] = placed(m, self.v0, self.e1, self.e2);
+        Triangles4 {
+            v0,
+            e1,
+            e2,
+            ng,
+            prim: self.prim.map(|p| base + p),
+        }
+    }
+
     /// Where a lane's triangle is hit [`closer`] than `best` at `ray.tmax`, shrinks
     /// `ray.tmax` to that hit and sets `best` to its primitive index.
     #[inline(always)]

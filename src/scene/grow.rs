@@ -77,6 +77,7 @@ pub fn grow(base: &Scene, factor: f64) -> Result<Scene> {
             casts_shadow: true,
             hazard: false,
             motion: Default::default(),
+            instances: Vec::new(),
         })
     };
     for lot in 0..lots as u32 {

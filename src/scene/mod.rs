@@ -13,6 +13,7 @@ pub mod fingerprint;
 pub mod grow;
 pub mod head_model;
 pub mod head_path;
+pub mod instances;
 pub mod key_override;
 pub mod lane_route;
 pub mod lens_keys;
@@ -154,6 +155,10 @@ pub struct Object {
     pub hazard: bool,
     /// How it moves during a `sequence` (nothing else reads it).
     pub motion: motion::ObjectMotion,
+    /// Placements of a mesh object (`instances`): rows x, y, z (metres, world frame),
+    /// yaw (degrees about +y), each placing the object as `world_from_object` leaves it.
+    /// Empty: the object once, at `world_from_object`.
+    pub instances: Vec<[f64; 4]>,
 }
 
 /// The sun: a directional light that casts hard shadows.

@@ -350,6 +350,18 @@ fn read_object(
         mask & !CameraKind::parse(name).bit()
     });
     let shape_for_bounds = shape.clone();
+    let instances = read_instances(t, &shape)?;
+    let motion = {
+        let (translate, rotate_deg, scale) = read_placement(t)?;
+        let corners = object_bounds(&shape_for_bounds);
+        read_object_motion(t, translate, dvec3(rotate_deg), dvec3(scale), &corners)?
+    };
+    if !instances.is_empty() && motion.moves() {
+        return Err(t.error(
+            "instances",
+            "an instanced object cannot move (keyframes, moves_with): instances are static",
+        ));
+    }
     Ok(Object {
         name,
         shape,
@@ -358,12 +370,25 @@ fn read_object(
         visible_to,
         casts_shadow: t.bool_or("casts_shadow", true)?,
         hazard: t.bool_or("hazard", false)?,
-        motion: {
-            let (translate, rotate_deg, scale) = read_placement(t)?;
-            let corners = object_bounds(&shape_for_bounds);
-            read_object_motion(t, translate, dvec3(rotate_deg), dvec3(scale), &corners)?
-        },
+        motion,
+        instances,
     })
+}
+
+/// `instances`: the placements file of a mesh object ([`crate::scene::instances`]).
+fn read_instances(t: &TableReader, shape: &Shape) -> Result<Vec<[f64; 4]>, SceneError> {
+    let Some(rel) = t.opt_str("instances")? else {
+        return Ok(Vec::new());
+    };
+    if !matches!(shape, Shape::Mesh { .. }) {
+        return Err(t.error(
+            "instances",
+            "only a mesh object (kind = \"mesh\") can be instanced",
+        ));
+    }
+    let path = t.existing_asset("instances", rel)?;
+    crate::scene::instances::read_placements(&path, rel)
+        .map_err(|e| t.error("instances", format!("{e:#}")))
 }
 
 fn read_obstacle(
@@ -510,6 +535,7 @@ pub fn face_object(face: DriverFace, eye: DVec3) -> Option<Object> {
             scale: DVec3::ONE,
             places: Vec::new(),
         },
+        instances: Vec::new(),
     })
 }
 

@@ -140,6 +140,7 @@ pub fn read_road(root: &TableReader, objects: &[Object]) -> Result<Option<Road>,
             scale: DVec3::ONE,
             places: Vec::new(),
         },
+        instances: Vec::new(),
     };
     Ok(Some(Road { object, route }))
 }

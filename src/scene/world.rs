@@ -1,5 +1,10 @@
 //! The renderable world: every object of a scene flattened into world-space primitives
-//! (triangles and analytic ellipsoids) with their materials, textures and ids.
+//! (triangles and analytic ellipsoids) with their materials, textures and ids, but for
+//! instanced meshes, kept once with their placements ([`InstanceSet`]).
+//!
+//! Primitive indices run over the triangles, then the instanced triangles (set by set,
+//! placement by placement), then the ellipsoids: the order of the same world
+//! [`World::flattened`], so that both break ties between equally near hits alike.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -11,7 +16,8 @@ use obvhs::ray::Ray;
 use obvhs::rt_triangle::RtTriangle;
 use rayon::prelude::*;
 
-use crate::scene::limits::check_placed_mesh;
+use crate::scene::instances::{self, MAX_INSTANCED_TRIANGLES, placed_triangle};
+use crate::scene::limits::{check_placed_mesh, out_of_world};
 use crate::scene::mesh_io::LoadedMesh;
 use crate::scene::motion::check_keyframed_mesh;
 use crate::scene::shape_mesh::shape_mesh;
@@ -61,6 +67,45 @@ pub struct TriAttr {
     pub material: u32,
 }
 
+/// One mesh and its placements.
+pub struct InstanceSet {
+    /// The mesh's triangles in its object frame (metres), degenerate ones dropped.
+    pub triangles: Vec<RtTriangle>,
+    /// Per triangle: texture coordinates, part, object id and material (`normal` unused: the
+    /// placed triangle's own is used).
+    pub attrs: Vec<TriAttr>,
+    /// World from object of each placement, f32: the transform [`placed`] applies.
+    pub world_from_object: Vec<Affine3A>,
+    /// Primitive index of the first placement's first triangle; placement `i`'s triangle `j`
+    /// is `first_prim + i × triangles + j`.
+    pub first_prim: u32,
+}
+
+impl InstanceSet {
+    /// Triangles of all placements together.
+    pub fn len(&self) -> usize {
+        self.triangles.len() * self.world_from_object.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Placement and triangle of the set's `k`-th triangle (0-based within the set).
+    pub fn split(&self, k: usize) -> (usize, usize) {
+        (k / self.triangles.len(), k % self.triangles.len())
+    }
+
+    /// The set's `k`-th triangle in the world frame, and its attributes.
+    pub fn triangle(&self, k: usize) -> (RtTriangle, &TriAttr) {
+        let (instance, tri) = self.split(k);
+        (
+            placed_triangle(&self.world_from_object[instance], &self.triangles[tri]),
+            &self.attrs[tri],
+        )
+    }
+}
+
 /// A unit sphere under an affine transform.
 #[derive(Clone, Copy, Debug)]
 pub struct Ellipsoid {
@@ -91,6 +136,8 @@ pub struct SurfaceHit {
 pub struct World {
     pub triangles: Vec<RtTriangle>,
     pub tri_attrs: Vec<TriAttr>,
+    /// Meshes placed many times; their triangles' indices follow [`World::triangles`].
+    pub instanced: Vec<InstanceSet>,
     pub ellipsoids: Vec<Ellipsoid>,
     pub objects: Vec<ObjectInfo>,
     pub materials: Vec<SurfaceMaterial>,
@@ -136,6 +183,7 @@ impl World {
         let mut world = World {
             triangles: Vec::new(),
             tri_attrs: Vec::new(),
+            instanced: Vec::new(),
             ellipsoids: Vec::new(),
             objects: Vec::new(),
             materials: Vec::new(),
@@ -250,13 +298,15 @@ impl World {
                             return Err(meshes.remove(path).expect("read above").unwrap_err());
                         }
                     };
-                    check_placed_mesh(
-                        path,
-                        &object.name,
-                        &mesh.tris,
-                        &object.world_from_object,
-                        world.triangles.len(),
-                    )?;
+                    if object.instances.is_empty() {
+                        check_placed_mesh(
+                            path,
+                            &object.name,
+                            &mesh.tris,
+                            &object.world_from_object,
+                            world.triangles.len(),
+                        )?;
+                    }
                     check_keyframed_mesh(path, &object.name, &mesh.tris, &object.motion)?;
                     let first = world.materials.len() as u32;
                     // A file's textures once, however many objects place it.
@@ -279,11 +329,16 @@ impl World {
                         });
                     }
                     let fallback = world.materials.len() as u32 - 1;
-                    world.add_tris(&mesh.tris, object.world_from_object, id, |t| {
+                    let material_of = |t: &Tri| {
                         material
                             .or(t.file_material.map(|m| first + m))
                             .unwrap_or(fallback)
-                    });
+                    };
+                    if object.instances.is_empty() {
+                        world.add_tris(&mesh.tris, object.world_from_object, id, material_of);
+                    } else {
+                        world.add_instances(path, object, &mesh.tris, id, material_of)?;
+                    }
                     continue;
                 }
             };
@@ -292,7 +347,140 @@ impl World {
             });
         }
         world.add_obstacle(&scene.obstacle, obstacle);
+        let mut first = world.triangles.len();
+        for set in &mut world.instanced {
+            set.first_prim = first as u32;
+            first += set.len();
+        }
         Ok(world)
+    }
+
+    /// One set of `object`'s placements of a mesh's triangles `tris` (object frame); each
+    /// placement must stay inside the world.
+    fn add_instances(
+        &mut self,
+        path: &std::path::Path,
+        object: &crate::scene::Object,
+        tris: &[Tri],
+        id: u32,
+        material: impl Fn(&Tri) -> u32,
+    ) -> Result<()> {
+        let mut set = InstanceSet {
+            triangles: Vec::new(),
+            attrs: Vec::new(),
+            world_from_object: Vec::with_capacity(object.instances.len()),
+            first_prim: 0,
+        };
+        let mut lo = Vec3::INFINITY;
+        let mut hi = Vec3::NEG_INFINITY;
+        for tri in tris {
+            let [a, b, c] = tri.p;
+            if (b - a).cross(c - a).length_squared() == 0.0 {
+                continue;
+            }
+            for p in tri.p {
+                (lo, hi) = (lo.min(p), hi.max(p));
+            }
+            set.triangles
+                .push(RtTriangle::new(a.into(), b.into(), c.into()));
+            set.attrs.push(TriAttr {
+                uv: tri.uv,
+                normal: Vec3::ZERO,
+                part: tri.part,
+                object: id,
+                material: material(tri),
+            });
+        }
+        let before: u64 = self.instanced.iter().map(|s| s.len() as u64).sum();
+        let total = before + (set.triangles.len() * object.instances.len()) as u64;
+        if total > MAX_INSTANCED_TRIANGLES {
+            anyhow::bail!(
+                "object `{}`: {} placements of mesh {} bring the world's instances to {total} triangles, more than the limit of {MAX_INSTANCED_TRIANGLES}",
+                object.name,
+                object.instances.len(),
+                path.display()
+            );
+        }
+        for (row, place) in object.instances.iter().enumerate() {
+            let m = instances::world_from_object(*place, &object.world_from_object);
+            for corner in 0..8 {
+                let pick = |bit: usize, a: f32, b: f32| if corner & bit == 0 { a } else { b };
+                let p = Vec3::new(
+                    pick(1, lo.x, hi.x),
+                    pick(2, lo.y, hi.y),
+                    pick(4, lo.z, hi.z),
+                );
+                if let Some(why) = out_of_world(m.transform_point3(p).as_dvec3()) {
+                    anyhow::bail!(
+                        "object `{}`: placement {} (data row {} of its instances file) puts mesh {} outside the world: {why}",
+                        object.name,
+                        row,
+                        row + 1,
+                        path.display()
+                    );
+                }
+            }
+            set.world_from_object.push(m);
+        }
+        self.instanced.push(set);
+        Ok(())
+    }
+
+    /// The same world with every instanced triangle a triangle of its own, at the same
+    /// index: what tracing the instances must equal, bit for bit.
+    pub fn flattened(mut self) -> World {
+        for set in std::mem::take(&mut self.instanced) {
+            for k in 0..set.len() {
+                let (rt, attr) = set.triangle(k);
+                self.triangles.push(rt);
+                self.tri_attrs.push(TriAttr {
+                    normal: geometric_normal(&rt),
+                    ..*attr
+                });
+            }
+        }
+        self
+    }
+
+    /// A world of these triangles alone (an instanced mesh in its object frame, for its
+    /// hierarchy): no objects, materials or textures.
+    pub fn of_triangles(triangles: Vec<RtTriangle>, tri_attrs: Vec<TriAttr>) -> World {
+        World {
+            triangles,
+            tri_attrs,
+            instanced: Vec::new(),
+            ellipsoids: Vec::new(),
+            objects: Vec::new(),
+            materials: Vec::new(),
+            textures: Vec::new(),
+            obstacle_id: 0,
+        }
+    }
+
+    /// Instanced triangles of all sets together.
+    pub fn instanced_count(&self) -> usize {
+        self.instanced.iter().map(InstanceSet::len).sum()
+    }
+
+    /// Index of the first ellipsoid: past the triangles and the instanced triangles.
+    pub fn ellipsoid_base(&self) -> usize {
+        self.triangles.len() + self.instanced_count()
+    }
+
+    /// What primitive index `prim` names.
+    #[inline]
+    fn primitive(&self, prim: usize) -> Primitive {
+        if prim < self.triangles.len() {
+            return Primitive::Triangle(prim);
+        }
+        let mut k = prim - self.triangles.len();
+        for (s, set) in self.instanced.iter().enumerate() {
+            if k < set.len() {
+                return Primitive::Instanced(s, k);
+            }
+            k -= set.len();
+        }
+        Primitive::Ellipsoid(k)
     }
 
     fn add_tris(
@@ -385,13 +573,17 @@ impl World {
     }
 
     pub fn primitive_count(&self) -> usize {
-        self.triangles.len() + self.ellipsoids.len()
+        self.ellipsoid_base() + self.ellipsoids.len()
     }
 
     pub fn object_of(&self, prim: usize) -> u32 {
-        match prim.checked_sub(self.triangles.len()) {
-            None => self.tri_attrs[prim].object,
-            Some(e) => self.ellipsoids[e].object,
+        match self.primitive(prim) {
+            Primitive::Triangle(t) => self.tri_attrs[t].object,
+            Primitive::Instanced(s, k) => {
+                let set = &self.instanced[s];
+                set.attrs[set.split(k).1].object
+            }
+            Primitive::Ellipsoid(e) => self.ellipsoids[e].object,
         }
     }
 
@@ -402,9 +594,10 @@ impl World {
     }
 
     pub fn aabb(&self, prim: usize) -> Aabb {
-        match prim.checked_sub(self.triangles.len()) {
-            None => self.triangles[prim].aabb(),
-            Some(e) => {
+        match self.primitive(prim) {
+            Primitive::Triangle(t) => self.triangles[t].aabb(),
+            Primitive::Instanced(s, k) => self.instanced[s].triangle(k).0.aabb(),
+            Primitive::Ellipsoid(e) => {
                 // The unit sphere's box under an affine map: centre ± the rows' absolute sums.
                 let m = &self.ellipsoids[e].world_from_object;
                 let c = m.translation;
@@ -423,9 +616,12 @@ impl World {
     /// [tmin, tmax], or infinity.
     #[inline(always)]
     pub fn intersect(&self, prim: usize, ray: &Ray) -> f32 {
-        match prim.checked_sub(self.triangles.len()) {
-            None => self.triangles[prim].intersect(ray),
-            Some(e) => self.ellipsoids[e].intersect(ray.origin, ray.direction, ray.tmin, ray.tmax),
+        match self.primitive(prim) {
+            Primitive::Triangle(t) => self.triangles[t].intersect(ray),
+            Primitive::Instanced(s, k) => self.instanced[s].triangle(k).0.intersect(ray),
+            Primitive::Ellipsoid(e) => {
+                self.ellipsoids[e].intersect(ray.origin, ray.direction, ray.tmin, ray.tmax)
+            }
         }
     }
 
@@ -433,19 +629,26 @@ impl World {
     pub fn surface(&self, prim: usize, origin: Vec3, dir: Vec3, t: f32) -> SurfaceHit {
         let position = origin + dir * t;
         let textured = |material: u32| self.materials[material as usize].texture.is_some();
-        let (normal, uv, object, part, material) = match prim.checked_sub(self.triangles.len()) {
-            None => {
-                let attr = &self.tri_attrs[prim];
-                let uv = if textured(attr.material) {
-                    let [v0, v1, v2] = vertices(&self.triangles[prim]);
-                    let [b0, b1, b2] = barycentric(position, v0, v1, v2);
-                    attr.uv[0] * b0 + attr.uv[1] * b1 + attr.uv[2] * b2
-                } else {
-                    Vec2::ZERO
-                };
-                (attr.normal, uv, attr.object, attr.part, attr.material)
+        let triangle = |tri: &RtTriangle, attr: &TriAttr, normal: Vec3| {
+            let uv = if textured(attr.material) {
+                let [v0, v1, v2] = vertices(tri);
+                let [b0, b1, b2] = barycentric(position, v0, v1, v2);
+                attr.uv[0] * b0 + attr.uv[1] * b1 + attr.uv[2] * b2
+            } else {
+                Vec2::ZERO
+            };
+            (normal, uv, attr.object, attr.part, attr.material)
+        };
+        let (normal, uv, object, part, material) = match self.primitive(prim) {
+            Primitive::Triangle(t) => {
+                let attr = &self.tri_attrs[t];
+                triangle(&self.triangles[t], attr, attr.normal)
             }
-            Some(e) => {
+            Primitive::Instanced(s, k) => {
+                let (tri, attr) = self.instanced[s].triangle(k);
+                triangle(&tri, attr, geometric_normal(&tri))
+            }
+            Primitive::Ellipsoid(e) => {
                 let el = &self.ellipsoids[e];
                 let local = el.object_from_world.transform_point3(position);
                 let n = Vec3::from(el.normal_from_object * Vec3A::from(local)).normalize();
@@ -475,6 +678,14 @@ impl World {
             material,
         }
     }
+}
+
+/// What a primitive index names: a triangle, an instanced triangle (set, index within the
+/// set) or an ellipsoid.
+enum Primitive {
+    Triangle(usize),
+    Instanced(usize, usize),
+    Ellipsoid(usize),
 }
 
 /// The corners of a triangle as the intersection test's edges give them back.

@@ -153,13 +153,22 @@ const GROWN_TRIANGLE_BYTES: u64 = 640;
 /// incoherent hits; the packet and per-ray shadow flags and the incoherent ones) and one shaded frame, all held while the scene grown
 /// `grow`× is traced; then the `run` it times at the scene's own sizes, with the batches
 /// still held.
-pub fn bench_estimate(scene: &Scene, width: u32, height: u32, grow: f64) -> Result<MemoryEstimate> {
+/// With `flatten`, the instanced meshes count as the triangles they flatten to.
+pub fn bench_estimate(
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    grow: f64,
+    flatten: bool,
+) -> Result<MemoryEstimate> {
     let pixels = width as u64 * height as u64;
     let per_pixel = 3 * size_of::<BatchRay>() as u64
         + 3 * size_of::<Option<Hit>>() as u64
         + 3 * size_of::<bool>() as u64
         + FRAME_BYTES_PER_PIXEL;
-    let triangles = World::build(scene)?.triangles.len() as u64;
+    let world = World::build(scene)?;
+    let flattened = if flatten { world.instanced_count() } else { 0 };
+    let triangles = (world.triangles.len() + flattened) as u64;
     let grown = (triangles as f64 * grow).ceil() as u64;
     let run = run_estimate(scene, &RunOptions::default())?;
     Ok(MemoryEstimate {

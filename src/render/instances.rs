@@ -1,0 +1,276 @@
+//! The instance level of the two-level hierarchy: each instanced mesh
+//! ([`crate::scene::instances`]) gets one wide hierarchy in its object frame, shared by all
+//! its placements, and a binary hierarchy over the placements' world boxes finds which
+//! placements a ray may hit.
+//!
+//! A placement is entered with the ray in its object frame (the same `t`: the direction is
+//! transformed, not normalised), but its triangles are tested in the world frame, placed as
+//! the flattened world places them ([`crate::scene::instances::placed`]), so a hit has the
+//! distance and index the flattened world gives, bit for bit. Only the boxes are tested in
+//! the object frame, so they are widened by a bound on the rounding between the two frames
+//! ([`PAD_ULPS`]); `tests/instances.rs` holds every query to the flattened world's and to the
+//! brute force.
+
+use anyhow::Result;
+use glam::{Affine3A, Vec3A};
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::Bvh2;
+
+use crate::render::bvh::{Bvh, EXIT_ROUND_UP, Stack};
+use crate::render::bvh_build;
+use crate::render::ray::TraceRay;
+use crate::scene::world::InstanceSet;
+use crate::scene::world::World;
+
+/// Slack of an instance's object-frame boxes, in units of f32's epsilon × the largest world
+/// coordinate (over the scale): the rounding of the ray into the object frame and of the
+/// placed vertices is a few such units.
+const PAD_ULPS: f32 = 64.0;
+/// Deepest the binary hierarchy over placements can be ([`bvh_build::MAX_DEPTH`]), plus one.
+const TLAS_STACK: usize = bvh_build::MAX_DEPTH + 1;
+
+/// One placement: its mesh's hierarchy, its transforms and its first primitive index.
+#[derive(Clone, Copy)]
+struct Placement {
+    mesh: u32,
+    world_from_object: Affine3A,
+    object_from_world: Affine3A,
+    base: u32,
+}
+
+/// The placements of one visibility group and their meshes' hierarchies.
+#[derive(Clone, Default)]
+pub struct InstanceLevel {
+    /// One per instanced mesh, in its object frame, boxes widened.
+    meshes: Vec<Bvh>,
+    placements: Vec<Placement>,
+    /// Over the placements' world boxes; each leaf holds one placement's index.
+    tlas: Option<Bvh2>,
+}
+
+impl InstanceLevel {
+    /// The level of the sets `sets` (indices into `world.instanced`), all of one visibility
+    /// group. `world_box` bounds every primitive of the world, placed ones too (the slack of
+    /// the boxes grows with its reach; rays are assumed to start within it).
+    pub fn build(world: &World, sets: &[usize], world_box: &Aabb) -> Result<InstanceLevel> {
+        let mut level = InstanceLevel::default();
+        if sets.is_empty() {
+            return Ok(level);
+        }
+        let reach = world_box
+            .min
+            .abs()
+            .max(world_box.max.abs())
+            .max_element()
+            .max(1.0);
+        let mut boxes = Vec::new();
+        for &s in sets {
+            let set = &world.instanced[s];
+            let Some(first) = set.world_from_object.first() else {
+                continue;
+            };
+            // Placements are rigid: every one has the object's scale.
+            let m = first.matrix3;
+            let scale = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.length());
+            let smallest = scale.iter().copied().fold(f32::INFINITY, f32::min);
+            let pad = PAD_ULPS * f32::EPSILON * reach / smallest;
+            let mesh = mesh_hierarchy(set, pad)?;
+            let Some(object_box) = mesh_box(set, pad) else {
+                continue;
+            };
+            let index = level.meshes.len() as u32;
+            level.meshes.push(mesh);
+            let n = set.triangles.len() as u32;
+            for (i, m) in set.world_from_object.iter().enumerate() {
+                boxes.push(placed_box(m, &object_box));
+                level.placements.push(Placement {
+                    mesh: index,
+                    world_from_object: *m,
+                    object_from_world: m.inverse(),
+                    base: set.first_prim + i as u32 * n,
+                });
+            }
+        }
+        let prims: Vec<u32> = (0..boxes.len() as u32).collect();
+        let owners = prims.clone();
+        level.tlas = (!boxes.is_empty()).then(|| bvh_build::build(&boxes, prims, &owners).0);
+        Ok(level)
+    }
+
+    /// World box of every placement.
+    pub fn bounds(&self) -> Aabb {
+        self.tlas
+            .as_ref()
+            .map_or_else(Aabb::empty, |t| t.nodes[0].aabb)
+    }
+
+    /// Bytes held: the meshes' hierarchies, the placements and their hierarchy.
+    pub fn bytes(&self) -> usize {
+        self.meshes.iter().map(Bvh::bytes).sum::<usize>()
+            + self.placements.len() * size_of::<Placement>()
+            + self.tlas.as_ref().map_or(0, |t| {
+                t.nodes.len() * size_of::<obvhs::bvh2::node::Bvh2Node>()
+            })
+    }
+
+    /// Placements in the level.
+    pub fn len(&self) -> usize {
+        self.placements.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.placements.is_empty()
+    }
+
+    /// [`Bvh::closest`] over the placements.
+    #[inline]
+    pub fn closest(&self, ray: &mut TraceRay, best: &mut u32, stack: &mut Stack) {
+        self.walk(ray, |m, object_ray, ray| {
+            self.meshes[m.mesh as usize].closest_placed(
+                object_ray,
+                ray,
+                best,
+                stack,
+                (&m.world_from_object, m.base),
+            );
+            false
+        });
+    }
+
+    /// [`Bvh::any`] over the placements.
+    #[inline]
+    pub fn any(&self, ray: &TraceRay, stack: &mut Stack) -> bool {
+        let mut blocked = false;
+        self.walk(&mut ray.clone(), |m, object_ray, ray| {
+            blocked = self.meshes[m.mesh as usize].any_placed(
+                object_ray,
+                ray,
+                stack,
+                (&m.world_from_object, m.base),
+            );
+            blocked
+        });
+        blocked
+    }
+
+    /// Visits the placements whose boxes `ray` enters in its [tmin, tmax], near first, with
+    /// the ray in each one's object frame, until `visit` returns true; `visit` may shrink
+    /// `ray.tmax`, which prunes what is left.
+    #[inline(always)]
+    fn walk(
+        &self,
+        ray: &mut TraceRay,
+        mut visit: impl FnMut(&Placement, &TraceRay, &mut TraceRay) -> bool,
+    ) {
+        let Some(tlas) = &self.tlas else {
+            return;
+        };
+        let enters = |b: &Aabb, ray: &TraceRay| -> Option<f32> {
+            let t0 = (b.min - ray.origin) * ray.inv_dir;
+            let t1 = (b.max - ray.origin) * ray.inv_dir;
+            let entry = t0.min(t1).max_element().max(ray.tmin);
+            let exit = t0.max(t1).min_element().min(ray.tmax);
+            (entry <= exit * EXIT_ROUND_UP).then_some(entry)
+        };
+        let mut stack = [(0u32, 0f32); TLAS_STACK];
+        let mut len = 0;
+        let mut current = enters(&tlas.nodes[0].aabb, ray).map(|_| 0u32);
+        loop {
+            let i = match current.take() {
+                Some(i) => i,
+                None => {
+                    // The next stacked node that starts before the closest hit so far.
+                    let mut next = None;
+                    while len > 0 {
+                        len -= 1;
+                        let (node, entry) = stack[len];
+                        if entry <= ray.tmax * EXIT_ROUND_UP {
+                            next = Some(node);
+                            break;
+                        }
+                    }
+                    match next {
+                        Some(i) => i,
+                        None => return,
+                    }
+                }
+            };
+            let node = &tlas.nodes[i as usize];
+            if node.is_leaf() {
+                let m = &self.placements[node.first_index as usize];
+                let object_ray = TraceRay::new(
+                    m.object_from_world.transform_point3a(ray.origin),
+                    m.object_from_world.transform_vector3a(ray.dir),
+                    ray.tmin,
+                    ray.tmax,
+                );
+                if visit(m, &object_ray, ray) {
+                    return;
+                }
+                continue;
+            }
+            let (a, b) = (node.first_index, node.first_index + 1);
+            match [a, b].map(|c| enters(&tlas.nodes[c as usize].aabb, ray)) {
+                [Some(ea), Some(eb)] => {
+                    let (near, far) = if ea <= eb { (a, (b, eb)) } else { (b, (a, ea)) };
+                    stack[len] = far;
+                    len += 1;
+                    current = Some(near);
+                }
+                [Some(_), None] => current = Some(a),
+                [None, Some(_)] => current = Some(b),
+                [None, None] => {}
+            }
+        }
+    }
+}
+
+/// World box of every placement of every instanced mesh of `world` (unwidened).
+pub fn placed_bounds(world: &World) -> Aabb {
+    let mut bounds = Aabb::empty();
+    for set in &world.instanced {
+        if let Some(b) = mesh_box(set, 0.0) {
+            for m in &set.world_from_object {
+                bounds = bounds.union(&placed_box(m, &b));
+            }
+        }
+    }
+    bounds
+}
+
+/// The mesh's hierarchy in its object frame, every box widened by `pad`.
+fn mesh_hierarchy(set: &InstanceSet, pad: f32) -> Result<Bvh> {
+    let mesh = World::of_triangles(set.triangles.clone(), set.attrs.clone());
+    let prims: Vec<u32> = (0..set.triangles.len() as u32).collect();
+    let (boxes, indices) = crate::render::bvh::primitive_boxes(&mesh, &prims);
+    let mut bvh = Bvh::build(&mesh, &boxes, indices)?;
+    bvh.pad(pad);
+    Ok(bvh)
+}
+
+/// The mesh's box in its object frame, widened by `pad`; `None` without triangles.
+fn mesh_box(set: &InstanceSet, pad: f32) -> Option<Aabb> {
+    let mut b = Aabb::empty();
+    for t in &set.triangles {
+        b = b.union(&t.aabb());
+    }
+    (!set.triangles.is_empty())
+        .then(|| Aabb::new(b.min - Vec3A::splat(pad), b.max + Vec3A::splat(pad)))
+}
+
+/// The world box of an object-frame box under `m`, widened by a few ulps of its coordinates.
+fn placed_box(m: &Affine3A, b: &Aabb) -> Aabb {
+    let mut out = Aabb::empty();
+    for corner in 0..8 {
+        let pick = |bit: usize, lo: f32, hi: f32| if corner & bit == 0 { lo } else { hi };
+        let p = Vec3A::new(
+            pick(1, b.min.x, b.max.x),
+            pick(2, b.min.y, b.max.y),
+            pick(4, b.min.z, b.max.z),
+        );
+        let q = m.transform_point3a(p);
+        out = out.union(&Aabb::new(q, q));
+    }
+    let pad = out.min.abs().max(out.max.abs()) * (8.0 * f32::EPSILON);
+    Aabb::new(out.min - pad, out.max + pad)
+}
