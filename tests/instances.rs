@@ -262,3 +262,99 @@ fn bad_placements_are_refused_in_one_line_naming_the_file_the_line_and_the_key()
         assert!(!out.exists());
     }
 }
+
+/// A glTF of one box mesh (12 triangles) placed by three nodes: a parent moved and turned
+/// with two children (one turned and stretched unevenly, one moved), and a second root.
+fn three_boxes_gltf() -> String {
+    use base64::Engine;
+    let c = |i: usize| -> [f32; 3] { [0, 1, 2].map(|a| if i >> a & 1 == 1 { 0.5 } else { -0.5 }) };
+    let faces = [
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+    ];
+    let mut bytes = Vec::new();
+    for f in faces {
+        for i in [f[0], f[1], f[2], f[0], f[2], f[3]] {
+            bytes.extend(c(i).iter().flat_map(|v| v.to_le_bytes()));
+        }
+    }
+    let uri = base64::engine::general_purpose::STANDARD.encode(&bytes);
+    format!(
+        r#"{{"asset": {{"version": "2.0"}},
+  "buffers": [{{"byteLength": {n}, "uri": "data:application/octet-stream;base64,{uri}"}}],
+  "bufferViews": [{{"buffer": 0, "byteLength": {n}}}],
+  "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 36, "type": "VEC3",
+                  "min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]}}],
+  "materials": [{{"name": "paint", "pbrMetallicRoughness": {{"baseColorFactor": [0.8, 0.3, 0.1, 1]}}}}],
+  "meshes": [{{"name": "box", "primitives": [{{"attributes": {{"POSITION": 0}}, "material": 0}}]}}],
+  "nodes": [
+    {{"translation": [-2.0, 0.5, -9.0], "rotation": [0, 0.38268343, 0, 0.92387953], "children": [1, 2]}},
+    {{"mesh": 0, "rotation": [0.25881905, 0, 0, 0.96592583], "scale": [1.0, 2.0, 0.5]}},
+    {{"mesh": 0, "translation": [1.5, 0.0, 0.0]}},
+    {{"mesh": 0, "translation": [2.5, 0.75, -14.0], "scale": [1.5, 1.5, 1.5]}}
+  ],
+  "scenes": [{{"nodes": [0, 3]}}], "scene": 0}}"#,
+        n = bytes.len()
+    )
+}
+
+#[test]
+fn a_gltf_mesh_that_several_nodes_place_is_instanced_and_traced_as_its_flattened_copies() {
+    use seethru::scene::mesh_io::{load_mesh, load_mesh_sharing};
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("boxes.gltf"), three_boxes_gltf()).unwrap();
+    let file = dir.path().join("boxes.gltf");
+    // Loaded for the world: the mesh once, at the three nodes' placements; elsewhere flat.
+    let shared = load_mesh_sharing(&file).unwrap();
+    assert!(shared.tris.is_empty());
+    assert_eq!(shared.shared.len(), 1);
+    assert_eq!(shared.shared[0].file_from_mesh.len(), 3);
+    let flat = load_mesh(&file).unwrap();
+    assert!(flat.shared.is_empty());
+    assert_eq!(flat.tris.len(), 36);
+    // Both place the same corners (the node hierarchy composed either way), to f32 rounding.
+    let corners = |tris: &[seethru::scene::shapes::Tri]| {
+        let mut v: Vec<[i64; 3]> = tris
+            .iter()
+            .flat_map(|t| t.p)
+            .map(|p| p.to_array().map(|c| (c as f64 * 1e4).round() as i64))
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(corners(&shared.flat_tris()), corners(&flat.tris));
+    // In a scene: one instanced set of three placements, traced as the world flattened.
+    let extra = "\n[[object]]\nname = \"boxes\"\nkind = \"mesh\"\npath = \"boxes.gltf\"\n";
+    let path = das_with(dir.path(), extra, &[]);
+    let (instanced, flattened) = both_contexts(Scene::load(&path).unwrap());
+    let set = &instanced.world.instanced[0];
+    assert_eq!((set.triangles.len(), set.world_from_object.len()), (12, 3));
+    for view in View::ALL {
+        let camera = view.camera(&instanced.scene).with_resolution(96, 54);
+        let job = || {
+            RenderJob::new(&camera, view.bit()).settings(RenderSettings {
+                spp: 1,
+                progress: false,
+            })
+        };
+        let (a, _) = instanced.render(job());
+        let (b, _) = flattened.render(job());
+        let bits = |f: &seethru::render::frame::Frame| -> Vec<u32> {
+            f.color
+                .iter()
+                .flat_map(|c| c.to_array().map(f32::to_bits))
+                .chain(f.object_id.iter().copied())
+                .collect()
+        };
+        assert!(bits(&a) == bits(&b), "{view:?}: the images differ");
+        let boxes = instanced.scene.objects.len() as u32; // the last object's id
+        let shown = a.object_id.iter().filter(|&&id| id == boxes).count();
+        if view == View::Truth {
+            assert!(shown > 40, "{shown} pixels of the boxes");
+        }
+    }
+}

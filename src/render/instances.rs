@@ -66,14 +66,20 @@ impl InstanceLevel {
         let mut boxes = Vec::new();
         for &s in sets {
             let set = &world.instanced[s];
-            let Some(first) = set.world_from_object.first() else {
-                continue;
-            };
-            // Placements are rigid: every one has the object's scale.
-            let m = first.matrix3;
-            let scale = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.length());
-            let smallest = scale.iter().copied().fold(f32::INFINITY, f32::min);
-            let pad = PAD_ULPS * f32::EPSILON * reach / smallest;
+            // A world length ℓ is at most ‖object_from_world‖ ℓ in the object frame (the
+            // Frobenius norm bounds the largest stretch, whatever the shear).
+            let stretch = set
+                .world_from_object
+                .iter()
+                .map(|m| {
+                    let inv = m.matrix3.inverse();
+                    (inv.x_axis.length_squared()
+                        + inv.y_axis.length_squared()
+                        + inv.z_axis.length_squared())
+                    .sqrt()
+                })
+                .fold(0.0f32, f32::max);
+            let pad = PAD_ULPS * f32::EPSILON * reach * stretch;
             let mesh = mesh_hierarchy(set, pad)?;
             let Some(object_box) = mesh_box(set, pad) else {
                 continue;

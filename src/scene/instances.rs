@@ -77,13 +77,17 @@ pub fn placed_triangle(m: &Affine3A, t: &RtTriangle) -> RtTriangle {
     RtTriangle { v0, e1, e2, ng }
 }
 
-/// The f32 transform of a placement: translation(x, y, z) · rotation about y(yaw) ·
-/// `object` (composed in f64).
-pub fn world_from_object(row: [f64; 4], object: &DAffine3) -> Affine3A {
+/// The transform of a placements row: translation(x, y, z) · rotation about y(yaw) ·
+/// `object`.
+pub fn world_from_object(row: [f64; 4], object: &DAffine3) -> DAffine3 {
     let [x, y, z, yaw_deg] = row;
-    let m = DAffine3::from_translation(DVec3::new(x, y, z))
+    DAffine3::from_translation(DVec3::new(x, y, z))
         * DAffine3::from_rotation_y(yaw_deg.to_radians())
-        * *object;
+        * *object
+}
+
+/// A placement as [`placed`] applies it: the transform rounded to f32.
+pub fn in_f32(m: &DAffine3) -> Affine3A {
     Affine3A::from_cols_array(&m.to_cols_array().map(|v| v as f32))
 }
 
@@ -170,7 +174,10 @@ mod tests {
     /// turned 90° lies 1 m along −z (counter-clockwise seen from above).
     #[test]
     fn a_placement_turns_then_moves() {
-        let m = world_from_object([10.0, 0.0, 5.0, 90.0], &DAffine3::IDENTITY);
+        let m = in_f32(&world_from_object(
+            [10.0, 0.0, 5.0, 90.0],
+            &DAffine3::IDENTITY,
+        ));
         let p = m.transform_point3(glam::Vec3::X);
         assert!((p - glam::Vec3::new(10.0, 0.0, 4.0)).length() < 1e-6, "{p}");
     }
@@ -179,10 +186,10 @@ mod tests {
     /// form gives the single form's bits in every lane.
     #[test]
     fn placing_one_triangle_or_four_gives_the_same_bits() {
-        let m = world_from_object(
+        let m = in_f32(&world_from_object(
             [3.25, -0.5, 17.0, 33.0],
             &DAffine3::from_scale(DVec3::splat(1.7)),
-        );
+        ));
         let tris: Vec<RtTriangle> = (0..4)
             .map(|i| {
                 let f = i as f32;

@@ -93,8 +93,8 @@ pub fn check_placed_mesh(
 }
 
 /// The first vertex of `tris` that is not finite or not within ±[`MAX_COORDINATE`], if any.
-pub fn first_bad_vertex(tris: &[Tri]) -> Option<(usize, Vec3)> {
-    tris.iter().enumerate().find_map(|(i, t)| {
+pub fn first_bad_vertex<'a>(tris: impl IntoIterator<Item = &'a Tri>) -> Option<(usize, Vec3)> {
+    tris.into_iter().enumerate().find_map(|(i, t)| {
         t.p.iter()
             .find(|p| out_of_world(p.as_dvec3()).is_some())
             .map(|&p| (i, p))

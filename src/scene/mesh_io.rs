@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
 use base64::Engine;
-use glam::{Mat4, Vec2, Vec3};
+use glam::{DAffine3, Mat4, Vec2, Vec3};
 
 use crate::scene::limits::{MAX_MESH_BYTES, MAX_TRIANGLES, first_bad_vertex};
 use crate::scene::mesh_checks::{
@@ -45,6 +45,37 @@ pub struct LoadedMesh {
     pub materials: Vec<FileMaterial>,
     /// The images its materials' textures use, each decoded once.
     pub textures: Vec<Texture>,
+    /// glTF meshes that several nodes place, kept once (only [`load_mesh_sharing`] fills it;
+    /// elsewhere they are in `tris`, placed at each node).
+    pub shared: Vec<SharedMesh>,
+}
+
+/// A glTF mesh several nodes place: its triangles in its own frame and each node's placement.
+#[derive(Clone, Debug)]
+pub struct SharedMesh {
+    pub tris: Vec<Tri>,
+    /// File frame from the mesh's frame, per node that places it (the node hierarchy's
+    /// transforms), in the order the nodes are reached.
+    pub file_from_mesh: Vec<DAffine3>,
+}
+
+impl LoadedMesh {
+    /// Every triangle in the file's frame: `tris`, then each shared mesh at each placement.
+    pub fn flat_tris(&self) -> std::borrow::Cow<'_, [Tri]> {
+        if self.shared.is_empty() {
+            return std::borrow::Cow::Borrowed(&self.tris);
+        }
+        let mut all = self.tris.clone();
+        for shared in &self.shared {
+            for m in &shared.file_from_mesh {
+                all.extend(shared.tris.iter().map(|t| Tri {
+                    p: t.p.map(|p| m.transform_point3(p.as_dvec3()).as_vec3()),
+                    ..*t
+                }));
+            }
+        }
+        std::borrow::Cow::Owned(all)
+    }
 }
 
 /// Reads a file that a mesh refers to, within [`MAX_MESH_BYTES`].
@@ -54,13 +85,23 @@ pub fn read_limited(path: &Path) -> std::io::Result<Vec<u8>> {
 
 /// Loads an OBJ (with its MTL files) or a glTF/GLB (with its buffers). Errors name the file.
 pub fn load_mesh(path: &Path) -> Result<LoadedMesh> {
+    load(path, false)
+}
+
+/// [`load_mesh`], keeping a glTF mesh that several nodes place once, with its placements
+/// ([`LoadedMesh::shared`]): what the world instances.
+pub fn load_mesh_sharing(path: &Path) -> Result<LoadedMesh> {
+    load(path, true)
+}
+
+fn load(path: &Path, share: bool) -> Result<LoadedMesh> {
     let lower = path.to_string_lossy().to_ascii_lowercase();
     let bytes = read_limited(path).context("cannot read it");
     let mesh = bytes.and_then(|bytes| {
         if lower.ends_with(".obj") {
             parse_obj(&bytes, path, &read_limited)
         } else if lower.ends_with(".gltf") || lower.ends_with(".glb") {
-            parse_gltf(&bytes, path, &read_limited)
+            parse_gltf_with(&bytes, path, &read_limited, share)
         } else {
             bail!("unsupported mesh format (use .obj, .gltf or .glb)")
         }
@@ -95,33 +136,47 @@ pub const BUILTIN_HEAD: [&[u8]; 2] = [
 /// Checks what every loader must deliver: some triangles with an area, within the limits,
 /// finite vertices inside the world, colours in [0, 1].
 fn checked(mesh: LoadedMesh) -> Result<LoadedMesh> {
-    if mesh.tris.len() > MAX_TRIANGLES {
+    // Triangles are numbered as read: the file's own, then each shared mesh's once.
+    let all: Vec<&Tri> = mesh
+        .tris
+        .iter()
+        .chain(mesh.shared.iter().flat_map(|s| &s.tris))
+        .collect();
+    if all.len() > MAX_TRIANGLES {
         bail!(
             "{} triangles, more than the limit of {MAX_TRIANGLES}",
-            mesh.tris.len()
+            all.len()
         );
     }
-    if let Some((i, p)) = first_bad_vertex(&mesh.tris) {
+    if let Some((i, p)) = first_bad_vertex(all.iter().copied()) {
         bail!(
             "triangle {i} has a vertex at {}: coordinates must be finite and within the world, [-1e6, 1e6] m",
             short_list(&p.to_array().map(f64::from))
         );
     }
-    if let Some(i) = mesh
-        .tris
+    if let Some(i) = all
         .iter()
         .position(|t| t.uv.iter().any(|uv| !uv.is_finite()))
     {
         bail!("triangle {i} has a texture coordinate that is not finite");
     }
-    if !mesh.tris.iter().any(|t| {
+    if !all.iter().any(|t| {
         let [a, b, c] = t.p;
         (b - a).cross(c - a).length_squared() > 0.0
     }) {
         bail!(
             "no faces with an area ({} triangles, all degenerate or none: points and lines are not drawn)",
-            mesh.tris.len()
+            all.len()
         );
+    }
+    for shared in &mesh.shared {
+        if let Some(m) = shared
+            .file_from_mesh
+            .iter()
+            .find(|m| !m.to_cols_array().iter().all(|v| v.is_finite()))
+        {
+            bail!("a node places a mesh by a transform that is not finite: {m:?}");
+        }
     }
     for m in &mesh.materials {
         if m.linear_color.iter().any(|c| !(0.0..=1.0).contains(c)) {
@@ -299,6 +354,17 @@ pub fn parse_gltf(
     path: &Path,
     read: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
 ) -> Result<LoadedMesh> {
+    parse_gltf_with(bytes, path, read, false)
+}
+
+/// [`parse_gltf`]; with `share`, a mesh several nodes place is kept once
+/// ([`LoadedMesh::shared`]).
+fn parse_gltf_with(
+    bytes: &[u8],
+    path: &Path,
+    read: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
+    share: bool,
+) -> Result<LoadedMesh> {
     let start = bytes.iter().position(|b| !b.is_ascii_whitespace());
     match start.map(|i| &bytes[i..]) {
         None => bail!("not a GLB/glTF: the file is empty (or only white space)"),
@@ -385,7 +451,7 @@ pub fn parse_gltf(
     // parents, and following it would loop forever or duplicate geometry.
     let mut reached = vec![false; doc.nodes().len()];
     let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
-    let mut part = 0u32;
+    let mut placed: Vec<(gltf::Mesh, Mat4)> = Vec::new();
     while let Some((node, parent)) = stack.pop() {
         if std::mem::replace(&mut reached[node.index()], true) {
             bail!(
@@ -396,6 +462,19 @@ pub fn parse_gltf(
         }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(mesh) = node.mesh() {
+            placed.push((mesh, world));
+        }
+        stack.extend(node.children().map(|c| (c, world)));
+    }
+    let mut uses = vec![0usize; doc.meshes().len()];
+    for (mesh, _) in &placed {
+        uses[mesh.index()] += 1;
+    }
+    // Where each shared mesh is in `out.shared`.
+    let mut shared_at: Vec<Option<usize>> = vec![None; doc.meshes().len()];
+    let mut part = 0u32;
+    for (mesh, world) in placed {
+        let read_all = |world: Mat4, part: &mut u32, tris: &mut Vec<Tri>| -> Result<()> {
             for primitive in mesh.primitives() {
                 let name = format!(
                     "mesh {} (`{}`) primitive {}",
@@ -403,12 +482,30 @@ pub fn parse_gltf(
                     mesh.name().unwrap_or(""),
                     primitive.index()
                 );
-                read_primitive(&primitive, &buffers, world, part, &mut out.tris)
-                    .with_context(|| name)?;
-                part += 1;
+                read_primitive(&primitive, &buffers, world, *part, tris).with_context(|| name)?;
+                *part += 1;
             }
+            Ok(())
+        };
+        if !(share && uses[mesh.index()] > 1) {
+            read_all(world, &mut part, &mut out.tris)?;
+            continue;
         }
-        stack.extend(node.children().map(|c| (c, world)));
+        let at = match shared_at[mesh.index()] {
+            Some(at) => at,
+            None => {
+                let mut tris = Vec::new();
+                read_all(Mat4::IDENTITY, &mut part, &mut tris)?;
+                out.shared.push(SharedMesh {
+                    tris,
+                    file_from_mesh: Vec::new(),
+                });
+                shared_at[mesh.index()] = Some(out.shared.len() - 1);
+                out.shared.len() - 1
+            }
+        };
+        let m = world.as_dmat4();
+        out.shared[at].file_from_mesh.push(DAffine3::from_mat4(m));
     }
     checked(out)
 }

@@ -18,7 +18,7 @@ use rayon::prelude::*;
 
 use crate::scene::instances::{self, MAX_INSTANCED_TRIANGLES, placed_triangle};
 use crate::scene::limits::{check_placed_mesh, out_of_world};
-use crate::scene::mesh_io::LoadedMesh;
+use crate::scene::mesh_io::{LoadedMesh, SharedMesh, load_mesh_sharing};
 use crate::scene::motion::check_keyframed_mesh;
 use crate::scene::shape_mesh::shape_mesh;
 use crate::scene::shapes::{Tri, box_face, cuboid, frustum, plane_xz, quad_xy};
@@ -222,7 +222,11 @@ impl World {
             || -> Vec<Result<LoadedMesh>> {
                 firsts
                     .par_iter()
-                    .map(|(_, shape)| shape_mesh(shape).expect("a mesh shape"))
+                    .map(|(_, shape)| match shape {
+                        // A glTF mesh several nodes place is instanced, not flattened.
+                        Shape::Mesh { path } => load_mesh_sharing(path),
+                        _ => shape_mesh(shape).expect("a mesh shape"),
+                    })
                     .collect()
             },
             || -> Vec<Option<Result<Texture>>> {
@@ -298,16 +302,25 @@ impl World {
                             return Err(meshes.remove(path).expect("read above").unwrap_err());
                         }
                     };
+                    // A moving object stays flat: the moving layer is refitted triangle by
+                    // triangle.
+                    let flat;
+                    let (tris, shared): (&[Tri], &[SharedMesh]) = if object.motion.moves() {
+                        flat = mesh.flat_tris();
+                        (&flat, &[])
+                    } else {
+                        (&mesh.tris, &mesh.shared)
+                    };
                     if object.instances.is_empty() {
                         check_placed_mesh(
                             path,
                             &object.name,
-                            &mesh.tris,
+                            tris,
                             &object.world_from_object,
                             world.triangles.len(),
                         )?;
                     }
-                    check_keyframed_mesh(path, &object.name, &mesh.tris, &object.motion)?;
+                    check_keyframed_mesh(path, &object.name, tris, &object.motion)?;
                     let first = world.materials.len() as u32;
                     // A file's textures once, however many objects place it.
                     let first_texture = *texture_base.entry(path.clone()).or_insert_with(|| {
@@ -334,10 +347,40 @@ impl World {
                             .or(t.file_material.map(|m| first + m))
                             .unwrap_or(fallback)
                     };
-                    if object.instances.is_empty() {
-                        world.add_tris(&mesh.tris, object.world_from_object, id, material_of);
+                    // The object's placements: its instances rows, or its own transform.
+                    let rows = &object.instances;
+                    let placements: Vec<DAffine3> = if rows.is_empty() {
+                        world.add_tris(tris, object.world_from_object, id, material_of);
+                        vec![object.world_from_object]
                     } else {
-                        world.add_instances(path, object, &mesh.tris, id, material_of)?;
+                        let placements: Vec<DAffine3> = rows
+                            .iter()
+                            .map(|r| instances::world_from_object(*r, &object.world_from_object))
+                            .collect();
+                        world.add_instances(
+                            path,
+                            object,
+                            tris,
+                            &placements,
+                            (id, 1),
+                            material_of,
+                        )?;
+                        placements
+                    };
+                    for s in shared {
+                        let nodes = &s.file_from_mesh;
+                        let each: Vec<DAffine3> = placements
+                            .iter()
+                            .flat_map(|p| nodes.iter().map(move |m| *p * *m))
+                            .collect();
+                        world.add_instances(
+                            path,
+                            object,
+                            &s.tris,
+                            &each,
+                            (id, nodes.len()),
+                            material_of,
+                        )?;
                     }
                     continue;
                 }
@@ -355,20 +398,22 @@ impl World {
         Ok(world)
     }
 
-    /// One set of `object`'s placements of a mesh's triangles `tris` (object frame); each
+    /// One set of triangles `tris` (a mesh's frame) at `placements` (world from that frame),
+    /// `per_row` of them for each of `object`'s instances rows (for messages); each
     /// placement must stay inside the world.
     fn add_instances(
         &mut self,
         path: &std::path::Path,
         object: &crate::scene::Object,
         tris: &[Tri],
-        id: u32,
+        placements: &[DAffine3],
+        (id, per_row): (u32, usize),
         material: impl Fn(&Tri) -> u32,
     ) -> Result<()> {
         let mut set = InstanceSet {
             triangles: Vec::new(),
             attrs: Vec::new(),
-            world_from_object: Vec::with_capacity(object.instances.len()),
+            world_from_object: Vec::with_capacity(placements.len()),
             first_prim: 0,
         };
         let mut lo = Vec3::INFINITY;
@@ -392,17 +437,17 @@ impl World {
             });
         }
         let before: u64 = self.instanced.iter().map(|s| s.len() as u64).sum();
-        let total = before + (set.triangles.len() * object.instances.len()) as u64;
+        let total = before + (set.triangles.len() * placements.len()) as u64;
         if total > MAX_INSTANCED_TRIANGLES {
             anyhow::bail!(
                 "object `{}`: {} placements of mesh {} bring the world's instances to {total} triangles, more than the limit of {MAX_INSTANCED_TRIANGLES}",
                 object.name,
-                object.instances.len(),
+                placements.len(),
                 path.display()
             );
         }
-        for (row, place) in object.instances.iter().enumerate() {
-            let m = instances::world_from_object(*place, &object.world_from_object);
+        for (k, place) in placements.iter().enumerate() {
+            let m = instances::in_f32(place);
             for corner in 0..8 {
                 let pick = |bit: usize, a: f32, b: f32| if corner & bit == 0 { a } else { b };
                 let p = Vec3::new(
@@ -411,11 +456,14 @@ impl World {
                     pick(4, lo.z, hi.z),
                 );
                 if let Some(why) = out_of_world(m.transform_point3(p).as_dvec3()) {
+                    let row = if object.instances.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" (data row {} of its instances file)", k / per_row + 1)
+                    };
                     anyhow::bail!(
-                        "object `{}`: placement {} (data row {} of its instances file) puts mesh {} outside the world: {why}",
+                        "object `{}`: placement {k}{row} puts mesh {} outside the world: {why}",
                         object.name,
-                        row,
-                        row + 1,
                         path.display()
                     );
                 }
