@@ -137,6 +137,9 @@ impl Node {
 pub struct Stack {
     entries: Vec<u64>,
     len: usize,
+    /// The instance level's own stack of (node, entry distance), beside this one (its walk
+    /// runs mesh walks on `entries` at its leaves).
+    pub(crate) placements: Vec<(u32, f32)>,
 }
 
 impl Stack {
@@ -144,6 +147,7 @@ impl Stack {
         Stack {
             entries: vec![0; STACK],
             len: 0,
+            placements: Vec::with_capacity(64),
         }
     }
 

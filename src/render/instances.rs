@@ -26,8 +26,6 @@ use crate::scene::world::World;
 /// coordinate (over the scale): the rounding of the ray into the object frame and of the
 /// placed vertices is a few such units.
 const PAD_ULPS: f32 = 64.0;
-/// Deepest the binary hierarchy over placements can be ([`bvh_build::MAX_DEPTH`]), plus one.
-const TLAS_STACK: usize = bvh_build::MAX_DEPTH + 1;
 
 /// One placement: its mesh's hierarchy, its transforms and its first primitive index.
 #[derive(Clone, Copy)]
@@ -131,7 +129,7 @@ impl InstanceLevel {
     /// [`Bvh::closest`] over the placements.
     #[inline]
     pub fn closest(&self, ray: &mut TraceRay, best: &mut u32, stack: &mut Stack) {
-        self.walk(ray, |m, object_ray, ray| {
+        self.walk(ray, stack, |m, object_ray, ray, stack| {
             self.meshes[m.mesh as usize].closest_placed(
                 object_ray,
                 ray,
@@ -147,7 +145,7 @@ impl InstanceLevel {
     #[inline]
     pub fn any(&self, ray: &TraceRay, stack: &mut Stack) -> bool {
         let mut blocked = false;
-        self.walk(&mut ray.clone(), |m, object_ray, ray| {
+        self.walk(&mut ray.clone(), stack, |m, object_ray, ray, stack| {
             blocked = self.meshes[m.mesh as usize].any_placed(
                 object_ray,
                 ray,
@@ -166,7 +164,8 @@ impl InstanceLevel {
     fn walk(
         &self,
         ray: &mut TraceRay,
-        mut visit: impl FnMut(&Placement, &TraceRay, &mut TraceRay) -> bool,
+        stack: &mut Stack,
+        mut visit: impl FnMut(&Placement, &TraceRay, &mut TraceRay, &mut Stack) -> bool,
     ) {
         let Some(tlas) = &self.tlas else {
             return;
@@ -178,28 +177,20 @@ impl InstanceLevel {
             let exit = t0.max(t1).min_element().min(ray.tmax);
             (entry <= exit * EXIT_ROUND_UP).then_some(entry)
         };
-        let mut stack = [(0u32, 0f32); TLAS_STACK];
-        let mut len = 0;
+        // Its own stack, taken from the thread's for the walk (the mesh walks use the rest).
+        let mut todo = std::mem::take(&mut stack.placements);
+        todo.clear();
         let mut current = enters(&tlas.nodes[0].aabb, ray).map(|_| 0u32);
         loop {
             let i = match current.take() {
                 Some(i) => i,
-                None => {
-                    // The next stacked node that starts before the closest hit so far.
-                    let mut next = None;
-                    while len > 0 {
-                        len -= 1;
-                        let (node, entry) = stack[len];
-                        if entry <= ray.tmax * EXIT_ROUND_UP {
-                            next = Some(node);
-                            break;
-                        }
-                    }
-                    match next {
-                        Some(i) => i,
-                        None => return,
-                    }
-                }
+                // The next stacked node that starts before the closest hit so far.
+                None => match std::iter::from_fn(|| todo.pop())
+                    .find(|&(_, entry)| entry <= ray.tmax * EXIT_ROUND_UP)
+                {
+                    Some((i, _)) => i,
+                    None => break,
+                },
             };
             let node = &tlas.nodes[i as usize];
             if node.is_leaf() {
@@ -210,8 +201,8 @@ impl InstanceLevel {
                     ray.tmin,
                     ray.tmax,
                 );
-                if visit(m, &object_ray, ray) {
-                    return;
+                if visit(m, &object_ray, ray, stack) {
+                    break;
                 }
                 continue;
             }
@@ -219,8 +210,7 @@ impl InstanceLevel {
             match [a, b].map(|c| enters(&tlas.nodes[c as usize].aabb, ray)) {
                 [Some(ea), Some(eb)] => {
                     let (near, far) = if ea <= eb { (a, (b, eb)) } else { (b, (a, ea)) };
-                    stack[len] = far;
-                    len += 1;
+                    todo.push(far);
                     current = Some(near);
                 }
                 [Some(_), None] => current = Some(a),
@@ -228,6 +218,7 @@ impl InstanceLevel {
                 [None, None] => {}
             }
         }
+        stack.placements = todo;
     }
 }
 
