@@ -358,3 +358,19 @@ fn a_gltf_mesh_that_several_nodes_place_is_instanced_and_traced_as_its_flattened
         }
     }
 }
+
+/// A scene's fingerprint (what captures and datasets match scenes by) holds its placements:
+/// the same scene text with one car moved 1 cm in its placements file differs; the same files
+/// in another folder do not (das's keyframes once carried their file's path into it).
+#[test]
+fn the_fingerprint_holds_the_placements_and_not_the_folder() {
+    use seethru::scene::fingerprint::fingerprint;
+    let of = |csv: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        let path = das_with(dir.path(), &instanced_cars(), &[("cars.csv", csv)]);
+        fingerprint(&Scene::load(&path).unwrap()).unwrap()
+    };
+    let base = of(CARS);
+    assert_eq!(base, of(CARS));
+    assert_ne!(base, of(&CARS.replace("-4.2,0,-9,0", "-4.21,0,-9,0")));
+}

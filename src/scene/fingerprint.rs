@@ -24,6 +24,8 @@ pub fn fingerprint(scene: &Scene) -> Result<String> {
     key.path = PathBuf::new();
     let mut seen = HashSet::new();
     for object in &mut key.objects {
+        // Where the keyframes are written (for messages) is not what they hold.
+        object.motion.places.clear();
         let file = match &mut object.shape {
             Shape::Mesh { path } | Shape::Road { path, .. } => Some(path),
             _ => None,
@@ -47,10 +49,7 @@ pub fn fingerprint(scene: &Scene) -> Result<String> {
                 }
                 write!(hash, "{:?}", mesh.materials).ok();
                 for texture in &mesh.textures {
-                    write!(hash, "texture {}×{};", texture.width, texture.height).ok();
-                    for v in texture.texels.iter().flat_map(|t| t.to_array()) {
-                        hash.bytes(&v.to_bits().to_le_bytes());
-                    }
+                    hash_texture(&mut hash, texture);
                 }
             }
             if let Shape::Mesh { path } | Shape::Road { path, .. } = &mut object.shape {
@@ -68,13 +67,18 @@ pub fn fingerprint(scene: &Scene) -> Result<String> {
         if let Some(path) = &mut material.texture {
             let texture =
                 Texture::load(path).with_context(|| format!("material `{}`", material.name))?;
-            write!(hash, "texture {}×{};", texture.width, texture.height).ok();
-            for v in texture.texels.iter().flat_map(|t| t.to_array()) {
-                hash.bytes(&v.to_bits().to_le_bytes());
-            }
+            hash_texture(&mut hash, &texture);
             *path = PathBuf::new();
         }
     }
     write!(hash, "{key:?}").ok();
     Ok(format!("{:016x}", hash.finish()))
+}
+
+/// A texture's size and every texel's bits.
+fn hash_texture(hash: &mut Fnv64, texture: &Texture) {
+    write!(hash, "texture {}×{};", texture.width, texture.height).ok();
+    for v in texture.texels.iter().flat_map(|t| t.to_array()) {
+        hash.bytes(&v.to_bits().to_le_bytes());
+    }
 }
