@@ -1,11 +1,14 @@
 //! A recorded head path for `seethru sequence --head-path`: a CSV of `t,x,y,z` rows — time in
 //! seconds, the eye in the obstacle frame in metres — read with the `csv` crate. Times must
-//! increase; every value must be a finite number; a first line `t,x,y,z` is a header.
+//! increase; every value must be a finite number; a first line of names (`t,x,y,z`) is a
+//! header, and `#` starts a comment.
 
 use std::path::Path;
 
 use anyhow::{Result, bail};
 use glam::DVec3;
+
+use crate::util::number_rows::number_rows;
 
 /// Most rows of a head path.
 pub const MAX_ROWS: usize = 1_000_000;
@@ -32,48 +35,20 @@ impl HeadPath {
 
     /// Parses CSV `text`; errors name `name` and the line.
     pub fn parse(text: &[u8], name: &str) -> Result<HeadPath> {
-        let mut reader = csv::ReaderBuilder::new()
-            .has_headers(false)
-            .flexible(true)
-            .trim(csv::Trim::All)
-            .from_reader(text);
+        let rows = number_rows(
+            text,
+            name,
+            ["t", "x", "y", "z"],
+            "seconds, metres in the obstacle frame",
+            MAX_ROWS,
+        )?;
         let mut samples: Vec<(f64, DVec3)> = Vec::new();
         let mut lines = Vec::new();
-        for (i, record) in reader.records().enumerate() {
-            let record = record.map_err(|e| {
-                let line = e.position().map_or(i as u64 + 1, |p| p.line());
-                anyhow::anyhow!("{name}:{line}: not CSV: {e}")
-            })?;
-            let line = record.position().map_or(i as u64 + 1, |p| p.line());
-            if i == 0 && record.get(0) == Some("t") {
-                continue;
-            }
-            if record.len() != 4 {
-                bail!(
-                    "{name}:{line}: expected 4 values t,x,y,z (seconds, metres in the obstacle frame), got {}",
-                    record.len()
-                );
-            }
-            let mut values = [0.0; 4];
-            for (k, column) in ["t", "x", "y", "z"].iter().enumerate() {
-                let field = &record[k];
-                values[k] = match field.parse::<f64>() {
-                    Ok(v) if v.is_finite() && v.abs() <= 1e6 => v,
-                    // A quoted field may hold line breaks and escapes: shown, not obeyed.
-                    _ => bail!(
-                        "{name}:{line}: `{column}` must be a finite number in [-1000000, 1000000], got `{}`",
-                        crate::util::message::printable(field)
-                    ),
-                };
-            }
-            let [t, x, y, z] = values;
+        for (line, [t, x, y, z]) in rows {
             if let Some(&(previous, _)) = samples.last()
                 && t <= previous
             {
                 bail!("{name}:{line}: times must increase: t = {t} s follows t = {previous} s");
-            }
-            if samples.len() == MAX_ROWS {
-                bail!("{name}:{line}: more than {MAX_ROWS} rows");
             }
             samples.push((t, DVec3::new(x, y, z)));
             lines.push(line);

@@ -21,6 +21,8 @@ use anyhow::{Result, bail};
 use glam::{Affine3A, DAffine3, DVec3, Vec3A, Vec4};
 use obvhs::rt_triangle::RtTriangle;
 
+use crate::util::number_rows::number_rows;
+
 /// Most rows of one placements file.
 pub const MAX_INSTANCES: usize = 1_000_000;
 /// Most triangles of a world's instances together, counted once per placement (primitive
@@ -104,47 +106,17 @@ const MAX_PLACEMENTS_BYTES: u64 = 64 << 20;
 
 /// [`read_placements`] of `text`, named `name` in errors.
 pub fn parse_placements(text: &[u8], name: &str) -> Result<Vec<[f64; 4]>> {
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .flexible(true)
-        .from_reader(text);
-    let mut rows = Vec::new();
-    for (i, record) in reader.records().enumerate() {
-        let record = record.map_err(|e| {
-            let line = e.position().map_or(i as u64 + 1, |p| p.line());
-            anyhow::anyhow!("{name}:{line}: not CSV: {e}")
-        })?;
-        let line = record.position().map_or(i as u64 + 1, |p| p.line());
-        if i == 0 && record.iter().all(|f| f.parse::<f64>().is_err()) {
-            continue; // a header
-        }
-        if record.len() != 4 {
-            bail!(
-                "{name}:{line}: expected 4 values x,y,z,yaw_deg (metres, world frame; degrees about +y), got {}",
-                record.len()
-            );
-        }
-        let mut row = [0.0; 4];
-        for (k, (field, column)) in record.iter().zip(["x", "y", "z", "yaw_deg"]).enumerate() {
-            row[k] = match field.parse::<f64>() {
-                Ok(v) if v.is_finite() && v.abs() <= 1e6 => v,
-                _ => bail!(
-                    "{name}:{line}: `{column}` must be a finite number in [-1000000, 1000000], got `{}`",
-                    field.escape_debug()
-                ),
-            };
-        }
-        if rows.len() == MAX_INSTANCES {
-            bail!("{name}:{line}: more than {MAX_INSTANCES} placements");
-        }
-        rows.push(row);
-    }
+    let rows = number_rows(
+        text,
+        name,
+        ["x", "y", "z", "yaw_deg"],
+        "metres, world frame; degrees about +y",
+        MAX_INSTANCES,
+    )?;
     if rows.is_empty() {
         bail!("{name}: no placements (expected x,y,z,yaw_deg rows)");
     }
-    Ok(rows)
+    Ok(rows.into_iter().map(|(_, row)| row).collect())
 }
 
 #[cfg(test)]

@@ -180,16 +180,7 @@ impl World {
         keep: &dyn Fn(usize) -> bool,
         obstacle: bool,
     ) -> Result<World> {
-        let mut world = World {
-            triangles: Vec::new(),
-            tri_attrs: Vec::new(),
-            instanced: Vec::new(),
-            ellipsoids: Vec::new(),
-            objects: Vec::new(),
-            materials: Vec::new(),
-            textures: Vec::new(),
-            obstacle_id: 0,
-        };
+        let mut world = World::of_triangles(Vec::new(), Vec::new());
         // A part loads only the textures its objects use (the whole world loads them all, so
         // that a broken texture is an error whether or not an object uses it).
         let whole = (0..scene.objects.len()).all(keep);

@@ -12,6 +12,7 @@ pub mod json;
 pub mod memory;
 pub mod message;
 pub mod number;
+pub mod number_rows;
 pub mod option_words;
 pub mod progress;
 pub mod quantile;
