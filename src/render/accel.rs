@@ -2,7 +2,8 @@
 //! BVHs ([`crate::render::bvh`]), with brute-force twins that the tests hold them to.
 //!
 //! Primitives are grouped by visibility — which views show them, whether they cast shadows —
-//! and each group gets its own hierarchies (one over triangle packets, one over ellipsoids).
+//! and each group gets its own hierarchy (over triangle packets and ellipsoids), and an
+//! instance level for its instanced meshes ([`crate::render::instances`]).
 //! A query traverses only the groups its view shows, so no leaf test asks "is this visible
 //! here?": in das the big shared group holds everything but the obstacle (driver views only,
 //! no shadow) and the head (hidden from the driver), which are tiny groups of their own.
