@@ -117,7 +117,7 @@ def tree():
     for i in range(seg):
         j = (i + 1) % seg
         m.quad("bark", lo[i], lo[j], hi[j], hi[i])
-    v, f = icosphere(4)
+    v, f = icosphere(3)
     for k, (cx, cy, cz, rad) in enumerate([(0.0, 3.6, 0.0, 1.7), (0.5, 4.6, 0.3, 1.3), (-0.4, 5.3, -0.2, 1.0)]):
         base = len(m.v)
         for p in v:
