@@ -263,8 +263,9 @@ fn bad_placements_are_refused_in_one_line_naming_the_file_the_line_and_the_key()
     }
 }
 
-/// A glTF of one box mesh (12 triangles) placed by three nodes: a parent moved and turned
-/// with two children (one turned and stretched unevenly, one moved), and a second root.
+/// A glTF of one box mesh (12 triangles) placed by four nodes: a parent moved and turned
+/// with three children (one turned and stretched unevenly, one moved, one scaled to nothing,
+/// as files hide a node), and a second root.
 fn three_boxes_gltf() -> String {
     use base64::Engine;
     let c = |i: usize| -> [f32; 3] { [0, 1, 2].map(|a| if i >> a & 1 == 1 { 0.5 } else { -0.5 }) };
@@ -292,10 +293,11 @@ fn three_boxes_gltf() -> String {
   "materials": [{{"name": "paint", "pbrMetallicRoughness": {{"baseColorFactor": [0.8, 0.3, 0.1, 1]}}}}],
   "meshes": [{{"name": "box", "primitives": [{{"attributes": {{"POSITION": 0}}, "material": 0}}]}}],
   "nodes": [
-    {{"translation": [-2.0, 0.5, -9.0], "rotation": [0, 0.38268343, 0, 0.92387953], "children": [1, 2]}},
+    {{"translation": [-2.0, 0.5, -9.0], "rotation": [0, 0.38268343, 0, 0.92387953], "children": [1, 2, 4]}},
     {{"mesh": 0, "rotation": [0.25881905, 0, 0, 0.96592583], "scale": [1.0, 2.0, 0.5]}},
     {{"mesh": 0, "translation": [1.5, 0.0, 0.0]}},
-    {{"mesh": 0, "translation": [2.5, 0.75, -14.0], "scale": [1.5, 1.5, 1.5]}}
+    {{"mesh": 0, "translation": [2.5, 0.75, -14.0], "scale": [1.5, 1.5, 1.5]}},
+    {{"mesh": 0, "translation": [0.0, 1.0, 0.0], "scale": [0.0, 0.0, 0.0]}}
   ],
   "scenes": [{{"nodes": [0, 3]}}], "scene": 0}}"#,
         n = bytes.len()
@@ -312,10 +314,10 @@ fn a_gltf_mesh_that_several_nodes_place_is_instanced_and_traced_as_its_flattened
     let shared = load_mesh_sharing(&file).unwrap();
     assert!(shared.tris.is_empty());
     assert_eq!(shared.shared.len(), 1);
-    assert_eq!(shared.shared[0].file_from_mesh.len(), 3);
+    assert_eq!(shared.shared[0].file_from_mesh.len(), 4);
     let flat = load_mesh(&file).unwrap();
     assert!(flat.shared.is_empty());
-    assert_eq!(flat.tris.len(), 36);
+    assert_eq!(flat.tris.len(), 48);
     // Both place the same corners (the node hierarchy composed either way), to f32 rounding.
     let corners = |tris: &[seethru::scene::shapes::Tri]| {
         let mut v: Vec<[i64; 3]> = tris
@@ -327,7 +329,8 @@ fn a_gltf_mesh_that_several_nodes_place_is_instanced_and_traced_as_its_flattened
         v
     };
     assert_eq!(corners(&shared.flat_tris()), corners(&flat.tris));
-    // In a scene: one instanced set of three placements, traced as the world flattened.
+    // In a scene: one instanced set of the three placements that show something (the one
+    // scaled to nothing is left out), traced as the world flattened.
     let extra = "\n[[object]]\nname = \"boxes\"\nkind = \"mesh\"\npath = \"boxes.gltf\"\n";
     let path = das_with(dir.path(), extra, &[]);
     let (instanced, flattened) = both_contexts(Scene::load(&path).unwrap());

@@ -439,6 +439,11 @@ impl World {
         }
         for (k, place) in placements.iter().enumerate() {
             let m = instances::in_f32(place);
+            // A placement that flattens its mesh (a glTF node scaled by 0, to hide it) shows
+            // nothing, and has no object frame for a ray to enter: left out.
+            if !m.matrix3.determinant().is_normal() {
+                continue;
+            }
             for corner in 0..8 {
                 let pick = |bit: usize, a: f32, b: f32| if corner & bit == 0 { a } else { b };
                 let p = Vec3::new(
