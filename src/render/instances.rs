@@ -19,6 +19,7 @@ use obvhs::bvh2::Bvh2;
 use crate::render::bvh::{Bvh, EXIT_ROUND_UP, Stack};
 use crate::render::bvh_build;
 use crate::render::ray::TraceRay;
+use crate::scene::instances::box_corners;
 use crate::scene::world::InstanceSet;
 use crate::scene::world::World;
 
@@ -258,14 +259,8 @@ fn mesh_box(set: &InstanceSet, pad: f32) -> Option<Aabb> {
 /// The world box of an object-frame box under `m`, widened by a few ulps of its coordinates.
 fn placed_box(m: &Affine3A, b: &Aabb) -> Aabb {
     let mut out = Aabb::empty();
-    for corner in 0..8 {
-        let pick = |bit: usize, lo: f32, hi: f32| if corner & bit == 0 { lo } else { hi };
-        let p = Vec3A::new(
-            pick(1, b.min.x, b.max.x),
-            pick(2, b.min.y, b.max.y),
-            pick(4, b.min.z, b.max.z),
-        );
-        let q = m.transform_point3a(p);
+    for p in box_corners(b.min.into(), b.max.into()) {
+        let q = m.transform_point3a(p.into());
         out = out.union(&Aabb::new(q, q));
     }
     let pad = out.min.abs().max(out.max.abs()) * (8.0 * f32::EPSILON);

@@ -18,7 +18,7 @@ use std::ops::{Add, Mul, Sub};
 use std::path::Path;
 
 use anyhow::{Result, bail};
-use glam::{Affine3A, DAffine3, DVec3, Vec3A, Vec4};
+use glam::{Affine3A, DAffine3, DVec3, Vec3, Vec3A, Vec4};
 use obvhs::rt_triangle::RtTriangle;
 
 use crate::util::number_rows::number_rows;
@@ -86,6 +86,18 @@ pub fn world_from_object(row: [f64; 4], object: &DAffine3) -> DAffine3 {
     DAffine3::from_translation(DVec3::new(x, y, z))
         * DAffine3::from_rotation_y(yaw_deg.to_radians())
         * *object
+}
+
+/// The eight corners of the box [lo, hi] (corner i takes hi on axis k where bit k of i is set).
+pub fn box_corners(lo: Vec3, hi: Vec3) -> [Vec3; 8] {
+    std::array::from_fn(|i| {
+        let pick = |bit: usize, a: f32, b: f32| if i & bit == 0 { a } else { b };
+        Vec3::new(
+            pick(1, lo.x, hi.x),
+            pick(2, lo.y, hi.y),
+            pick(4, lo.z, hi.z),
+        )
+    })
 }
 
 /// A placement as [`placed`] applies it: the transform rounded to f32.

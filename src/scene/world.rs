@@ -444,13 +444,7 @@ impl World {
             if !m.matrix3.determinant().is_normal() {
                 continue;
             }
-            for corner in 0..8 {
-                let pick = |bit: usize, a: f32, b: f32| if corner & bit == 0 { a } else { b };
-                let p = Vec3::new(
-                    pick(1, lo.x, hi.x),
-                    pick(2, lo.y, hi.y),
-                    pick(4, lo.z, hi.z),
-                );
+            for p in instances::box_corners(lo, hi) {
                 if let Some(why) = out_of_world(m.transform_point3(p).as_dvec3()) {
                     let row = if object.instances.is_empty() {
                         String::new()
