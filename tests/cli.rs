@@ -568,6 +568,45 @@ fn temporaries_of_killed_processes_are_removed_by_the_next_write() {
 }
 
 #[test]
+fn bench_times_only_the_parts_asked_for() {
+    let json = |parts: &str| -> serde_json::Value {
+        let (ok, out, err) = seethru(&[
+            "bench",
+            "scenes/das.toml",
+            "--width",
+            "16",
+            "--height",
+            "9",
+            "--repeat",
+            "1",
+            "--parts",
+            parts,
+            "--json",
+        ]);
+        assert!(ok, "--parts {parts}: {err}");
+        serde_json::from_str(out.lines().last().unwrap()).unwrap()
+    };
+    let has = |v: &serde_json::Value, key: &str| v.get(key).is_some_and(|x| !x.is_null());
+    let trace = json("trace");
+    assert!(has(&trace, "bvh_build_ms") && has(&trace, "rays") && has(&trace, "frame"));
+    for absent in ["methods", "sequence", "run"] {
+        assert!(
+            !has(&trace, absent),
+            "--parts trace timed `{absent}`: {trace}"
+        );
+    }
+    // Every report names its scene and memory, whatever it timed.
+    let sequence = json(" sequence");
+    assert!(has(&sequence, "sequence") && has(&sequence, "peak_rss_bytes"));
+    for absent in ["bvh_build_ms", "rays", "frame", "methods", "run"] {
+        assert!(
+            !has(&sequence, absent),
+            "--parts sequence timed `{absent}`: {sequence}"
+        );
+    }
+}
+
+#[test]
 fn bench_measures_its_repeats_and_how_busy_the_frame_kept_its_workers() {
     let (ok, out, err) = seethru(&[
         "bench",

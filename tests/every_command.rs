@@ -481,12 +481,16 @@ fn scene_cases(scene: &Path, dir: &Path, run_choices: &Choices) -> Vec<Vec<Case>
             ]),
         )]);
     }
-    groups.push(vec![sure(
-        "bench".into(),
-        words(&[
-            "bench", &s, "--width", "32", "--height", "18", "--repeat", "1", "--quiet",
-        ]),
-    )]);
+    // The tracer's part on every scene; the other parts time fixed-size work (the methods,
+    // a sequence, full-size runs) that the cases above cover at tiny sizes, so they run on
+    // das alone: they took 15–30 s a scene, half the matrix's time.
+    let mut bench = words(&[
+        "bench", &s, "--width", "32", "--height", "18", "--repeat", "1", "--quiet",
+    ]);
+    if name != "das" {
+        bench.extend(words(&["--parts", "trace"]));
+    }
+    groups.push(vec![sure("bench".into(), bench)]);
     groups
 }
 
@@ -628,6 +632,8 @@ fn every_command_on_every_bundled_scene_exits_cleanly_or_with_one_error_line() {
     let total: usize = groups.iter().map(Vec::len).sum();
     let queue = Mutex::new(groups.into_iter());
     let failures = Mutex::new(Vec::new());
+    // Each case's wall time, so the slowest (what sets CI's length) are printed at the end.
+    let timings = Mutex::new(Vec::new());
     let workers = std::thread::available_parallelism().map_or(2, |n| n.get());
     std::thread::scope(|scope| {
         for _ in 0..workers {
@@ -637,7 +643,13 @@ fn every_command_on_every_bundled_scene_exits_cleanly_or_with_one_error_line() {
                         return;
                     };
                     for case in group {
-                        if let Some(why) = failure(&case.args, case.must_succeed) {
+                        let start = Instant::now();
+                        let failed = failure(&case.args, case.must_succeed);
+                        timings
+                            .lock()
+                            .unwrap()
+                            .push((start.elapsed(), case.label.clone()));
+                        if let Some(why) = failed {
                             failures.lock().unwrap().push(format!(
                                 "{}: seethru {}\n    {why}",
                                 case.label,
@@ -650,6 +662,13 @@ fn every_command_on_every_bundled_scene_exits_cleanly_or_with_one_error_line() {
         }
     });
     let failures = failures.into_inner().unwrap();
+    let mut timings = timings.into_inner().unwrap();
+    timings.sort_by(|a, b| b.0.cmp(&a.0));
+    let all: Duration = timings.iter().map(|t| t.0).sum();
+    eprintln!("every command: {all:.1?} of case time in all; the slowest cases:");
+    for (took, label) in timings.iter().take(25) {
+        eprintln!("  {took:>10.2?}  {label}");
+    }
     assert!(
         failures.is_empty(),
         "{} of {total} cases failed:\n{}",

@@ -25,7 +25,20 @@ use serde_json::json;
 
 use seethru::system::memory::{bench_estimate, check_memory};
 
-use crate::cli::args::{MemoryLimit, integer, pixels, real, threads, with_threads};
+use crate::cli::args::{MemoryLimit, choice, integer, pixels, real, threads, with_threads};
+
+/// A part of the benchmark, for `--parts`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Part {
+    /// The hierarchy's build, the ray throughputs and the shaded frames: the tracer.
+    Trace,
+    /// The compensation methods' display maps, at two fixed frontal sizes.
+    Methods,
+    /// The system loop of `sequence` at 640×360.
+    Sequence,
+    /// `seethru run SCENE` as a user calls it, with each `--exr` choice.
+    Run,
+}
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -52,6 +65,15 @@ pub struct Bench {
     /// one hierarchy): the same images, to time the two-level hierarchy against the flat one.
     #[arg(long)]
     flatten: bool,
+    /// Parts to time, comma-separated (the JSON leaves the others out): `trace` alone times
+    /// the tracer on a big scene in seconds rather than minutes.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_parser = choice::<Part>(),
+        default_value = "trace,methods,sequence,run"
+    )]
+    parts: Vec<Part>,
     /// Print only the JSON line.
     #[arg(long)]
     json: bool,
@@ -189,6 +211,68 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         world.instanced_count(),
         world.ellipsoids.len()
     ));
+    let threads = rayon::current_num_threads();
+    let isa = Isa::best();
+    let mut report = json!({
+        "scene": options.scene.display().to_string(),
+        "grow": options.grow,
+        "triangles": world.triangles.len(),
+        "instanced_triangles": world.instanced_count(),
+        "placements": placements,
+        "flattened": options.flatten,
+        "ellipsoids": world.ellipsoids.len(),
+        "bvh_bytes": ctx.accel.bytes(),
+        "threads": threads,
+        "isa": isa.name(),
+        "repeat": options.repeat,
+        "width": options.width,
+        "height": options.height,
+    });
+    let mut add = |key: &str, value: serde_json::Value| report[key] = value;
+    if options.parts.contains(&Part::Trace) {
+        let (lines, trace) = bench_trace(options, &ctx, threads, isa)?;
+        lines.into_iter().for_each(say);
+        for (key, value) in trace {
+            add(&key, value);
+        }
+    }
+    if options.parts.contains(&Part::Methods) {
+        add(
+            "methods",
+            crate::cli::bench_methods::method_costs(&ctx, options.repeat, options.json)?,
+        );
+    }
+    if options.parts.contains(&Part::Sequence) {
+        let (lines, sequence) = crate::cli::bench_sequence::bench_sequence(&ctx.scene)?;
+        lines.into_iter().for_each(say);
+        add("sequence", sequence);
+    }
+    if options.parts.contains(&Part::Run) {
+        let (lines, run) = crate::cli::bench_run::bench_run(&options.scene, options.repeat)?;
+        lines.into_iter().for_each(say);
+        add("run", run);
+    }
+    let peak = peak_rss_bytes();
+    say(format!(
+        "peak RSS     {}",
+        peak.map_or("unknown".into(), |b| format!("{:.0} MB", b as f64 / 1e6))
+    ));
+    add("peak_rss_bytes", json!(peak));
+    println!("{report}");
+    Ok(report)
+}
+
+/// The tracer's part: the hierarchy's build, the ray batches and the shaded frames; its
+/// report lines and JSON entries.
+fn bench_trace(
+    options: &Bench,
+    ctx: &RenderContext,
+    threads: usize,
+    isa: Isa,
+) -> Result<(Vec<String>, serde_json::Map<String, serde_json::Value>)> {
+    let mut lines = Vec::new();
+    let mut say = |line: String| lines.push(line);
+    let world = &ctx.world;
     let builds: Vec<f64> = (0..options.repeat)
         .map(|_| Accel::build(world).map(|a| a.build_time.as_secs_f64() * 1e3))
         .collect::<Result<_>>()?;
@@ -197,8 +281,6 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         "bvh          build {build} ms (min / median / max), {:.1} MB",
         ctx.accel.bytes() as f64 / 1e6
     ));
-    let threads = rayon::current_num_threads();
-    let isa = Isa::best();
     say(format!(
         "threads      {threads}; packets of 16 rays on {} ({} lanes)",
         isa.name(),
@@ -335,38 +417,9 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
             json!({"ms": spread.json(), "workers_busy": busy}),
         );
     }
-    let methods = crate::cli::bench_methods::method_costs(&ctx, options.repeat, options.json)?;
-    let (lines, sequence) = crate::cli::bench_sequence::bench_sequence(&ctx.scene)?;
-    lines.into_iter().for_each(say);
-    let (lines, run) = crate::cli::bench_run::bench_run(&options.scene, options.repeat)?;
-    lines.into_iter().for_each(say);
-    let peak = peak_rss_bytes();
-    say(format!(
-        "peak RSS     {}",
-        peak.map_or("unknown".into(), |b| format!("{:.0} MB", b as f64 / 1e6))
-    ));
-    let report = json!({
-        "scene": options.scene.display().to_string(),
-        "grow": options.grow,
-        "triangles": world.triangles.len(),
-        "instanced_triangles": world.instanced_count(),
-        "placements": placements,
-        "flattened": options.flatten,
-        "ellipsoids": world.ellipsoids.len(),
-        "bvh_build_ms": build.json(),
-        "bvh_bytes": ctx.accel.bytes(),
-        "threads": threads,
-        "isa": isa.name(),
-        "repeat": options.repeat,
-        "width": options.width,
-        "height": options.height,
-        "rays": rays_json,
-        "frame": frames,
-        "methods": methods,
-        "sequence": sequence,
-        "run": run,
-        "peak_rss_bytes": peak,
-    });
-    println!("{report}");
-    Ok(report)
+    let mut out = serde_json::Map::new();
+    out.insert("bvh_build_ms".into(), build.json());
+    out.insert("rays".into(), rays_json.into());
+    out.insert("frame".into(), frames.into());
+    Ok((lines, out))
 }
