@@ -663,7 +663,7 @@ fn every_command_on_every_bundled_scene_exits_cleanly_or_with_one_error_line() {
     });
     let failures = failures.into_inner().unwrap();
     let mut timings = timings.into_inner().unwrap();
-    timings.sort_by(|a, b| b.0.cmp(&a.0));
+    timings.sort_by_key(|t| std::cmp::Reverse(t.0));
     let all: Duration = timings.iter().map(|t| t.0).sum();
     eprintln!("every command: {all:.1?} of case time in all; the slowest cases:");
     for (took, label) in timings.iter().take(25) {
