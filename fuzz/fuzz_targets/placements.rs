@@ -13,7 +13,10 @@ fuzz_target!(|data: &[u8]| {
         Ok(rows) => {
             assert!(!rows.is_empty() && rows.len() <= MAX_INSTANCES);
             for row in rows {
-                assert!(row.iter().all(|v| v.is_finite() && v.abs() <= 1e6), "{row:?}");
+                assert!(
+                    row.iter().all(|v| v.is_finite() && v.abs() <= 1e6),
+                    "{row:?}"
+                );
                 let m = world_from_object(row, &DAffine3::from_scale(glam::DVec3::splat(2.0)));
                 assert!(m.is_finite(), "{row:?}");
             }
