@@ -595,9 +595,11 @@ fn bench_times_only_the_parts_asked_for() {
             "--parts trace timed `{absent}`: {trace}"
         );
     }
-    // Every report names its scene and memory, whatever it timed.
+    // Every report names its scene and memory, whatever it timed (and a choice may have
+    // spaces around it).
     let sequence = json(" sequence");
     assert!(has(&sequence, "sequence") && has(&sequence, "peak_rss_bytes"));
+    assert!(has(&sequence, "scene") && has(&sequence, "triangles"));
     for absent in ["bvh_build_ms", "rays", "frame", "methods", "run"] {
         assert!(
             !has(&sequence, absent),
