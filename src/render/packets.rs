@@ -12,7 +12,7 @@
 use glam::{Affine3A, Vec4};
 use obvhs::rt_triangle::RtTriangle;
 
-use crate::scene::instances::placed;
+use crate::scene::instances::{Lane, placed};
 
 use crate::render::ray::TraceRay;
 
@@ -34,14 +34,14 @@ pub fn closer(t: f32, prim: u32, tmax: f32, best: u32) -> bool {
 /// Triangles per packet.
 pub const TRI_LANES: usize = 4;
 
-/// Four triangles, structure of arrays: per axis and lane the base vertex, the two edges and
-/// the unnormalised normal of [`RtTriangle`]; and each lane's primitive index.
+/// Four triangles, structure of arrays: per axis and lane the base vertex and the two edges
+/// of [`RtTriangle`] (its normal is computed where needed, [`normal`]); and each lane's
+/// primitive index.
 #[derive(Clone, Copy, Debug)]
 pub struct Triangles4 {
     pub(crate) v0: [Vec4; 3],
     pub(crate) e1: [Vec4; 3],
     pub(crate) e2: [Vec4; 3],
-    pub(crate) ng: [Vec4; 3],
     /// Primitive index of each lane; unused lanes repeat lane 0's.
     pub(crate) prim: [u32; TRI_LANES],
 }
@@ -54,7 +54,6 @@ impl Triangles4 {
             v0: [Vec4::ZERO; 3],
             e1: [Vec4::ZERO; 3],
             e2: [Vec4::ZERO; 3],
-            ng: [Vec4::ZERO; 3],
             prim: [0; TRI_LANES],
         };
         for lane in 0..TRI_LANES {
@@ -64,7 +63,6 @@ impl Triangles4 {
                 packet.v0[axis][lane] = t.v0[axis];
                 packet.e1[axis][lane] = t.e1[axis];
                 packet.e2[axis][lane] = t.e2[axis];
-                packet.ng[axis][lane] = t.ng[axis];
             }
             packet.prim[lane] = prim;
         }
@@ -79,7 +77,7 @@ impl Triangles4 {
         let [v0x, v0y, v0z] = self.v0;
         let [e1x, e1y, e1z] = self.e1;
         let [e2x, e2y, e2z] = self.e2;
-        let [ngx, ngy, ngz] = self.ng;
+        let [ngx, ngy, ngz] = normal(self.e1, self.e2);
         let (cx, cy, cz) = (v0x - ox, v0y - oy, v0z - oz);
         // r = d × c
         let rx = dy * cz - dz * cy;
@@ -101,17 +99,30 @@ impl Triangles4 {
     }
 }
 
+/// `e1 × e2` per lane, in the order of operations of `RtTriangle`'s stored normal (glam's
+/// `Vec3A::cross`: x = e1.y·e2.z − e1.z·e2.y, and so on) and of [`placed`]'s, so the hits are
+/// those of the brute force bit for bit. Computed where it is used rather than stored: a
+/// packet takes 160 bytes, not 208 (the hierarchy of a million triangles 16 % less memory,
+/// its rays within 0–4 % of the stored normal's speed).
+#[inline(always)]
+pub fn normal<L: Lane>(e1: [L; 3], e2: [L; 3]) -> [L; 3] {
+    [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ]
+}
+
 impl Triangles4 {
     /// The four triangles placed by `m` ([`placed`]: as the flattened world's), under
     /// primitive indices `base` + their own.
     #[inline(always)]
     pub fn placed(&self, m: &Affine3A, base: u32) -> Triangles4 {
-        let [v0, e1, e2, ng] = placed(m, self.v0, self.e1, self.e2);
+        let [v0, e1, e2, _] = placed(m, self.v0, self.e1, self.e2);
         Triangles4 {
             v0,
             e1,
             e2,
-            ng,
             prim: self.prim.map(|p| base + p),
         }
     }
