@@ -300,7 +300,7 @@ fn triangle_hits<const N: usize>(
     let [v0x, v0y, v0z] = packet.v0.map(|v| v[j]);
     let [e1x, e1y, e1z] = packet.e1.map(|v| v[j]);
     let [e2x, e2y, e2z] = packet.e2.map(|v| v[j]);
-    let [ngx, ngy, ngz] = crate::render::packets::normal([e1x, e1y, e1z], [e2x, e2y, e2z]);
+    let [ngx, ngy, ngz] = crate::scene::instances::normal([e1x, e1y, e1z], [e2x, e2y, e2z]);
     let mut valid = [false; N];
     for i in 0..N {
         let (dx, dy, dz) = (l.d[0][i], l.d[1][i], l.d[2][i]);

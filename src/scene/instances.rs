@@ -64,12 +64,19 @@ pub fn placed<L: Lane>(m: &Affine3A, v0: [L; 3], e1: [L; 3], e2: [L; 3]) -> [[L;
     let moved = linear(v0);
     let v0 = [0, 1, 2].map(|row| moved[row] + L::splat(t[row]));
     let (e1, e2) = (linear(e1), linear(e2));
-    let ng = [
+    [v0, e1, e2, normal(e1, e2)]
+}
+
+/// `e1 × e2`, in the order of operations of `RtTriangle`'s stored normal (glam's
+/// `Vec3A::cross`: x = e1.y·e2.z − e1.z·e2.y, and so on), so that a normal computed here (a
+/// placed triangle's, a packet's lane) is the world's bit for bit.
+#[inline(always)]
+pub fn normal<L: Lane>(e1: [L; 3], e2: [L; 3]) -> [L; 3] {
+    [
         e1[1] * e2[2] - e1[2] * e2[1],
         e1[2] * e2[0] - e1[0] * e2[2],
         e1[0] * e2[1] - e1[1] * e2[0],
-    ];
-    [v0, e1, e2, ng]
+    ]
 }
 
 /// [`placed`] of one triangle.
