@@ -780,3 +780,116 @@ fn lamps_export_as_mitsuba_emitters_and_gltf_lights_of_their_intensity() {
         }
     }
 }
+
+#[test]
+fn glossy_materials_export_as_a_coat_of_their_f0_and_roughness_in_every_format() {
+    // left_turn_night's wet streets (F0 0.02, α 0.15) beside Lambertian materials: Mitsuba's
+    // roughplastic, glTF's metallic-roughness with an index of refraction and OBJ's
+    // Blinn–Phong each state the same lobe; the Lambertian ones stay diffuse.
+    let path = common::repo_path("scenes/left_turn_night.toml");
+    let scene = seethru::scene::Scene::load(&path).unwrap();
+    let world = World::build(&scene).unwrap();
+    let glossy: Vec<_> = (scene.materials.iter())
+        .filter(|m| m.specular > 0.0)
+        .collect();
+    assert!(glossy.len() >= 2 && glossy.len() < scene.materials.len());
+    let f0_of_ior = |n: f64| ((n - 1.0) / (n + 1.0)).powi(2);
+    let dir = tempfile::tempdir().unwrap();
+
+    let xml = dir.path().join("wet.xml");
+    export(&scene, &world, &xml, Some(ExportFormat::Mitsuba)).unwrap();
+    let text = std::fs::read_to_string(&xml).unwrap();
+    let doc = roxmltree::Document::parse(&text).unwrap();
+    for m in &scene.materials {
+        let outer = (doc.descendants())
+            .find(|n| {
+                n.has_tag_name("bsdf")
+                    && n.attribute("id")
+                        .is_some_and(|id| id.ends_with(&format!("_{}", m.name)))
+            })
+            .unwrap_or_else(|| panic!("no bsdf for {}", m.name));
+        let inner = outer.children().find(|n| n.has_tag_name("bsdf")).unwrap();
+        let value = |name: &str| -> f64 {
+            let n = (inner.children())
+                .find(|c| c.attribute("name") == Some(name))
+                .unwrap_or_else(|| panic!("{}: no {name}", m.name));
+            n.attribute("value").unwrap().parse().unwrap()
+        };
+        let named = |name: &str| inner.children().any(|c| c.attribute("name") == Some(name));
+        if m.specular > 0.0 {
+            assert_eq!(inner.attribute("type"), Some("roughplastic"), "{}", m.name);
+            assert!((value("alpha") - m.roughness).abs() < 1e-6, "{}", m.name);
+            let f0 = f0_of_ior(value("int_ior") / value("ext_ior"));
+            assert!((f0 - m.specular).abs() < 1e-6, "{}: F0 {f0}", m.name);
+            assert!(
+                named("diffuse_reflectance") && !named("reflectance"),
+                "{}",
+                m.name
+            );
+        } else {
+            assert_eq!(inner.attribute("type"), Some("diffuse"), "{}", m.name);
+            assert!(named("reflectance"), "{}", m.name);
+        }
+    }
+
+    let glb = dir.path().join("wet.glb");
+    export(&scene, &world, &glb, Some(ExportFormat::Gltf)).unwrap();
+    // The JSON chunk as written (the gltf crate drops extensions it does not model): after
+    // the 12-byte header, the chunk's length and type.
+    let bytes = std::fs::read(&glb).unwrap();
+    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    assert_eq!(&bytes[16..20], b"JSON");
+    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + length]).unwrap();
+    for m in &scene.materials {
+        let got = (json["materials"].as_array().unwrap().iter())
+            .find(|g| g["name"] == m.name.as_str())
+            .unwrap_or_else(|| panic!("no glTF material {}", m.name));
+        let pbr = &got["pbrMetallicRoughness"];
+        assert_eq!(pbr["metallicFactor"].as_f64(), Some(0.0));
+        let ext = &got["extensions"];
+        let specular = ext["KHR_materials_specular"]["specularFactor"]
+            .as_f64()
+            .unwrap();
+        if m.specular > 0.0 {
+            let alpha = pbr["roughnessFactor"].as_f64().unwrap().powi(2);
+            assert!((alpha - m.roughness).abs() < 1e-6, "{}: α {alpha}", m.name);
+            let f0 = f0_of_ior(ext["KHR_materials_ior"]["ior"].as_f64().unwrap());
+            assert!(
+                (f0 - m.specular).abs() < 1e-6 && specular == 1.0,
+                "{}",
+                m.name
+            );
+        } else {
+            assert!(
+                specular == 0.0 && ext.get("KHR_materials_ior").is_none(),
+                "{}",
+                m.name
+            );
+        }
+    }
+    let used = json["extensionsUsed"].to_string();
+    assert!(used.contains("KHR_materials_ior"), "{used}");
+
+    let obj = dir.path().join("wet.obj");
+    export(&scene, &world, &obj, Some(ExportFormat::Obj)).unwrap();
+    let (_, materials) = tobj::load_obj(&obj, &tobj::GPU_LOAD_OPTIONS).unwrap();
+    for m in &scene.materials {
+        let got = (materials.as_ref().unwrap().iter())
+            .find(|g| g.name.ends_with(&format!("_{}", m.name)))
+            .unwrap_or_else(|| panic!("no OBJ material {}", m.name));
+        let ks = got.specular.unwrap();
+        if m.specular > 0.0 {
+            let ns = f64::from(got.shininess.unwrap());
+            let alpha = (2.0 / (ns + 2.0)).sqrt();
+            assert!((alpha - m.roughness).abs() < 1e-5, "{}: α {alpha}", m.name);
+            assert!(
+                ks.iter().all(|&k| (f64::from(k) - m.specular).abs() < 1e-6),
+                "{}",
+                m.name
+            );
+            assert_eq!(got.illumination_model, Some(2));
+        } else {
+            assert_eq!(ks, [0.0; 3], "{}", m.name);
+        }
+    }
+}

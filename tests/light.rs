@@ -447,7 +447,12 @@ fn a_display_emits_between_its_black_and_its_peak_and_reflects_the_light_on_it()
 /// A grey floor seen from 5 m straight above, lit only by `lamps` (no sun, a black sky, the
 /// white at 10 cd/m²): per floor pixel, its world position and its luminance (cd/m²).
 fn floor_under_lamps(grey: f64, lamps: &str, extra_objects: &str) -> Vec<(glam::DVec3, f64)> {
-    let scene = format!(
+    floor_pixels(&floor_under_lamps_scene(grey, lamps, extra_objects))
+}
+
+/// The scene of [`floor_under_lamps`].
+fn floor_under_lamps_scene(grey: f64, lamps: &str, extra_objects: &str) -> String {
+    format!(
         r#"[sun]
 illuminance_lux = 0
 [sky]
@@ -484,9 +489,14 @@ kind = "plane"
 material = "grey"
 size = [100.0, 100.0]
 {extra_objects}"#
-    );
+    )
+}
+
+/// The floor's pixels (object 1) of `scene`'s truth view: per pixel, its world position and
+/// its luminance (cd/m²).
+fn floor_pixels(scene: &str) -> Vec<(glam::DVec3, f64)> {
     let dir = tempfile::tempdir().unwrap();
-    let out = seethru_on(dir.path(), &scene, "render", &["--view", "truth"]);
+    let out = seethru_on(dir.path(), scene, "render", &["--view", "truth"]);
     let channels = exr_channels(&out.join("truth.exr"));
     let [px, py, pz, id] = ["P.X", "P.Y", "P.Z", "id.object"].map(|c| &channels[c]);
     (luminance(&channels).into_iter().enumerate())
@@ -667,13 +677,21 @@ fn lamps_are_refused_where_they_cannot_shine() {
 }
 
 #[test]
-fn lamps_render_the_same_on_the_per_ray_and_the_packet_paths_and_on_any_thread_count() {
+fn lamps_and_glossy_coats_render_the_same_on_the_per_ray_and_the_packet_paths_and_on_any_thread_count()
+ {
+    // das_night's lamps; left_turn_night's lamps on its wet streets.
+    for name in ["das_night.toml", "left_turn_night.toml"] {
+        lamps_render_the_same_on_every_path(name);
+    }
+}
+
+fn lamps_render_the_same_on_every_path(name: &str) {
     use seethru::render::integrator::RenderContext;
     use seethru::render::render_job::{RenderJob, Tracer};
     use seethru::render::simd::Isa;
     use seethru::scene::world::view_bit;
-    let text = std::fs::read_to_string(common::repo_path("scenes/das_night.toml")).unwrap();
-    let scene = common::parse_in(&common::repo_path("scenes"), "das_night.toml", &text).unwrap();
+    let text = std::fs::read_to_string(common::repo_path("scenes").join(name)).unwrap();
+    let scene = common::parse_in(&common::repo_path("scenes"), name, &text).unwrap();
     assert!(scene.lights.len() >= 3);
     let ctx = RenderContext::new(scene).unwrap();
     let camera = ctx.scene.driver.with_resolution(96, 54);
@@ -698,7 +716,7 @@ fn lamps_render_the_same_on_the_per_ray_and_the_packet_paths_and_on_any_thread_c
                 .iter()
                 .zip(&colour)
                 .all(|(a, b)| a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits));
-            assert!(same, "{isa:?} on {threads} threads");
+            assert!(same, "{name}: {isa:?} on {threads} threads");
         }
     }
 }
@@ -936,4 +954,108 @@ fn a_low_beams_kerb_side_cut_off_rises_at_fifteen_degrees() {
         e.contains("`light[0].cutoff_kerb`") && e.contains("cutoff_deg"),
         "{e}"
     );
+}
+
+/// The GGX lobe's BRDF with Schlick's Fresnel and the height-correlated Smith term, as pbrt-v4
+/// and Heitz (2014) write it, in f64: for light from `wi` seen from `wo` (unit vectors from a
+/// surface of normal `n`).
+fn ggx_brdf(f0: f64, alpha: f64, n: glam::DVec3, wi: glam::DVec3, wo: glam::DVec3) -> f64 {
+    let h = (wi + wo).normalize();
+    let a2 = alpha * alpha;
+    let d = a2 / (std::f64::consts::PI * (n.dot(h).powi(2) * (a2 - 1.0) + 1.0).powi(2));
+    let f = f0 + (1.0 - f0) * (1.0 - wo.dot(h)).powi(5);
+    let lambda = |w: glam::DVec3| {
+        let c = n.dot(w);
+        ((1.0 + a2 * (1.0 - c * c) / (c * c)).sqrt() - 1.0) / 2.0
+    };
+    let g = 1.0 / (1.0 + lambda(wi) + lambda(wo));
+    d * f * g / (4.0 * n.dot(wi) * n.dot(wo))
+}
+
+/// `scene` with keys added to its material `grey`.
+fn grey_with(scene: &str, keys: &str) -> String {
+    let named = "name = \"grey\"\n";
+    assert!(scene.contains(named));
+    scene.replacen(named, &format!("{named}{keys}\n"), 1)
+}
+
+#[test]
+fn a_glossy_floor_under_a_lamp_adds_the_ggx_lobe_to_what_its_albedo_diffuses() {
+    // A damp grey floor (F0 0.04, α 0.3) under a point lamp: per pixel, (1 − F0) ρ I cos/πd²
+    // diffused and f I cos/d² reflected by the lobe, toward the camera 5 m above the origin.
+    let (grey, intensity, f0, alpha) = (0.5, 500.0, 0.04, 0.3);
+    let rho = f64::from(srgb_to_linear(grey as f32));
+    let (lamp, eye) = (
+        glam::DVec3::new(1.0, 2.0, -1.0),
+        glam::DVec3::new(0.0, 5.0, 0.0),
+    );
+    let lamps = format!("[[light]]\nposition = [1.0, 2.0, -1.0]\nintensity_cd = {intensity}\n");
+    let scene = grey_with(
+        &floor_under_lamps_scene(grey, &lamps, ""),
+        &format!("specular = {f0}\nroughness = {alpha}"),
+    );
+    let pixels = floor_pixels(&scene);
+    assert!(pixels.len() > 5000, "{}", pixels.len());
+    let mut glossiest: f64 = 0.0;
+    for (p, y) in pixels {
+        let (to_lamp, to_eye) = ((lamp - p).normalize(), (eye - p).normalize());
+        let irradiance = intensity * to_lamp.y / (lamp - p).length_squared();
+        let lobe = ggx_brdf(f0, alpha, glam::DVec3::Y, to_lamp, to_eye) * irradiance;
+        let expected = (1.0 - f0) * rho * irradiance / std::f64::consts::PI + lobe;
+        glossiest = glossiest.max(lobe / expected);
+        assert!(
+            relative_error(y, expected) < 0.005,
+            "at {p}: {y} vs {expected} cd/m²"
+        );
+    }
+    // The highlight is in the picture: somewhere the lobe gives a third of the light.
+    assert!(glossiest > 0.3, "{glossiest}");
+}
+
+#[test]
+fn a_wet_black_floor_mirrors_the_low_sun_where_the_angles_of_incidence_and_reflection_meet() {
+    // A black floor with a smooth coat (F0 0.5, α 0.05) under a sun 15° high in the south
+    // (+z), filmed from 1.2 m looking south: the only light is the lobe's, f E cos θ, and it
+    // peaks where the view's ray meets the floor 15° below the horizon, at z = 1.2 / tan 15°.
+    let (lux, elevation, f0, alpha) = (100_000.0, 15.0, 0.5, 0.05);
+    let light = format!(
+        "[sun]\nilluminance_lux = {lux}\nelevation_deg = {elevation}\nazimuth_deg = 180\n\
+         [sky]\nzenith_luminance_cd_m2 = 0\ncloud_cover = 0\n\
+         [photometry]\nwhite_cd_m2 = 5000\n"
+    );
+    let scene = grey_with(
+        &floor_scene(0.0, &light),
+        &format!("specular = {f0}\nroughness = {alpha}"),
+    );
+    let sun = sun_direction(elevation, 180.0);
+    let eye = glam::DVec3::new(0.0, 1.2, 0.0);
+    let pixels = floor_pixels(&scene);
+    assert!(pixels.len() > 300, "{}", pixels.len());
+    for &(p, y) in &pixels {
+        let expected =
+            ggx_brdf(f0, alpha, glam::DVec3::Y, sun, (eye - p).normalize()) * lux * sun.y;
+        assert!(
+            (y - expected).abs() < 0.005 * expected + 1e-9 * lux,
+            "at {p}: {y} vs {expected} cd/m²"
+        );
+    }
+    let (peak, _) = (pixels.iter()).fold((glam::DVec3::ZERO, 0.0), |best, &(p, y)| {
+        if y > best.1 { (p, y) } else { best }
+    });
+    let mirror = glam::DVec3::new(0.0, 0.0, 1.2 / elevation.to_radians().tan());
+    // A pixel here spans some 0.1 m across and 0.4 m along the view.
+    assert!(
+        (peak.x - mirror.x).abs() < 0.15 && (peak.z - mirror.z).abs() < 0.5,
+        "the highlight at {peak}, the mirror point at {mirror}"
+    );
+    // A wall 2 m high and 1 m wide at z = 8 m shades the floor up to 2 m / tan 15° = 7.5 m
+    // before it, the mirror point too: there the lobe gets no sun.
+    let wall = "[[object]]\nname = \"wall\"\nkind = \"box\"\nmaterial = \"grey\"\n\
+                size = [1.0, 2.0, 0.2]\ntranslate = [0.0, 1.0, 8.0]\n";
+    let shaded: Vec<(glam::DVec3, f64)> = floor_pixels(&format!("{scene}{wall}"))
+        .into_iter()
+        .filter(|(p, _)| p.x.abs() < 0.4 && p.z > 1.0 && p.z < 7.4)
+        .collect();
+    assert!(shaded.len() > 20, "{}", shaded.len());
+    assert!(shaded.iter().all(|&(_, y)| y == 0.0), "{shaded:?}");
 }

@@ -160,15 +160,6 @@ fn p_depth(setup: &Setup) -> f64 {
     }
 }
 
-fn material(name: &str, color: [f64; 3]) -> Material {
-    Material {
-        name: name.into(),
-        color,
-        texture: None,
-        uv_repeat: [1.0, 1.0],
-    }
-}
-
 fn object(name: &str, shape: Shape, material: usize, world_from_object: DAffine3) -> Object {
     Object {
         name: name.into(),
@@ -279,8 +270,8 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
     let driver = aim.with_resolution(width, rows.min(4 * width).max((width / 4).max(8)));
     let back = Camera::new(DAffine3::from_rotation_y(std::f64::consts::PI), 0.6, 8, 6)?;
     let materials = vec![
-        material("background", [0.6, 0.6, 0.6]),
-        material("object", [0.8, 0.2, 0.1]),
+        Material::matte("background", [0.6, 0.6, 0.6]),
+        Material::matte("object", [0.8, 0.2, 0.1]),
     ];
     // Tall enough that every display row sees the setup, from the eye and from the camera.
     let tall = 4.0 * height * (d1 + d2) / d1 + 2.0 * tan_needed * (d2 + p_depth(setup)) + 2.0;

@@ -24,6 +24,7 @@ use crate::render::screen::{Screen, Shown};
 use crate::render::shutter_rays::{CameraAt, PoseAt, ShutterRays};
 use crate::render::simd::Isa;
 use crate::render::sky::SkyModel;
+use crate::render::specular;
 use crate::scene::texture::Texture;
 use crate::scene::world::{SurfaceHit, SurfaceMaterial, World, view_bit};
 use crate::scene::{DisplayLight, Scene};
@@ -36,9 +37,10 @@ thread_local! {
     static STACK: std::cell::RefCell<Stack> = std::cell::RefCell::new(Stack::new());
 }
 
-/// The parts of Lambert shading known before the shadow ray is traced.
+/// The parts of the shading known before the sun's shadow ray is traced.
 #[derive(Clone, Copy)]
 struct Shading {
+    /// The diffuse albedo: the material's (textured), × (1 − F0) under a glossy lobe.
     albedo: Vec3,
     /// Sky ambient.
     light: Vec3,
@@ -46,6 +48,30 @@ struct Shading {
     cos: f32,
     /// The lamps' light (`[[light]]`), as the sky's: irradiance over π, shadows applied.
     lamps: Vec3,
+    /// The material's glossy lobe, if it has one.
+    lobe: Option<Lobe>,
+}
+
+/// A glossy lobe ([`specular`]) at one surface point, seen from one direction.
+#[derive(Clone, Copy)]
+struct Lobe {
+    f0: f32,
+    alpha: f32,
+    normal: Vec3,
+    /// Unit vector from the surface toward the eye (the ray's origin).
+    to_eye: Vec3,
+    /// The lamps' highlights (radiance, in units of the white; shadows applied).
+    lamps: Vec3,
+    /// π × the lobe's BRDF toward the sun (0 where the sun is below the surface).
+    sun: f32,
+}
+
+impl Lobe {
+    /// π × the lobe's BRDF for light from `to_light`.
+    #[inline]
+    fn pi_brdf(&self, to_light: Vec3) -> f32 {
+        specular::pi_brdf(self.f0, self.alpha, self.normal, to_light, self.to_eye)
+    }
 }
 
 /// Everything needed to render a scene from any camera. The world, its hierarchy and the
@@ -231,7 +257,7 @@ impl RenderContext {
             // A display emits its image: no shading.
             sum += match (&hit, &shown) {
                 (_, Some(d)) => d.color,
-                (Some(s), None) => self.shade(s, job.view, stack, shadows),
+                (Some(s), None) => self.shade(s, dir, job.view, stack, shadows),
                 (None, None) => self.sky.radiance(dir),
             };
             if sample == job.samples.start {
@@ -307,8 +333,8 @@ impl RenderContext {
                         shown[lane] = Some(self.display_content(d, s, job.view, stack, shadows));
                     }
                     (Some(s), _) => {
-                        let mut sh = self.shade_begin(s);
-                        sh.lamps = self.lamps_at(s, job.view, stack, shadows);
+                        let mut sh = self.shade_begin(s, dirs[lane]);
+                        sh.lamps = self.lamps_at(s, sh.lobe.as_mut(), job.view, stack, shadows);
                         if sh.cos > 0.0 {
                             *shadows += 1;
                             let ray = shadow_ray(s.position, s.normal, self.sky.sun_direction);
@@ -428,7 +454,7 @@ impl RenderContext {
             Shown::FrontalRay(origin, dir) => {
                 match self.trace_with(origin, dir, view_bit::FRONTAL, stack) {
                     Some(s) => Pixel {
-                        color: self.shade(&s, view_bit::FRONTAL, stack, shadows),
+                        color: self.shade(&s, dir, view_bit::FRONTAL, stack, shadows),
                         depth: s.t,
                         camera_z: s.t,
                         position: s.position,
@@ -478,7 +504,7 @@ impl RenderContext {
         }
         let cos = face.normal.dot(self.sky.sun_direction);
         let mut received =
-            self.sky.ambient(face.normal) + self.lamps_at(face, view, stack, shadows);
+            self.sky.ambient(face.normal) + self.lamps_at(face, None, view, stack, shadows);
         if cos > 0.0 {
             *shadows += 1;
             let ray = shadow_ray(face.position, face.normal, self.sky.sun_direction);
@@ -560,10 +586,19 @@ impl RenderContext {
         }
     }
 
-    /// Lambert shading: albedo × (sun × cos × visibility + sky ambient).
-    fn shade(&self, s: &SurfaceHit, view: u8, stack: &mut Stack, shadows: &mut u64) -> Vec3 {
-        let mut sh = self.shade_begin(s);
-        sh.lamps = self.lamps_at(s, view, stack, shadows);
+    /// The radiance toward a ray of direction `dir` from the surface `s` it meets: Lambert
+    /// shading, albedo × (sun × cos × visibility + sky ambient + lamps), and the highlights
+    /// of a glossy material's lobe.
+    fn shade(
+        &self,
+        s: &SurfaceHit,
+        dir: Vec3,
+        view: u8,
+        stack: &mut Stack,
+        shadows: &mut u64,
+    ) -> Vec3 {
+        let mut sh = self.shade_begin(s, dir);
+        sh.lamps = self.lamps_at(s, sh.lobe.as_mut(), view, stack, shadows);
         let mut lit = false;
         if sh.cos > 0.0 {
             *shadows += 1;
@@ -578,27 +613,53 @@ impl RenderContext {
         self.shade_end(sh, lit)
     }
 
-    /// The albedo, the ambient light and the sun's cosine at `s`.
+    /// The albedo, the ambient light, the sun's cosine and the glossy lobe at `s`, seen along
+    /// `dir`.
     #[inline]
-    fn shade_begin(&self, s: &SurfaceHit) -> Shading {
+    fn shade_begin(&self, s: &SurfaceHit, dir: Vec3) -> Shading {
         let (material, textures) = self.material(s.material);
         let mut albedo = material.albedo;
         if let Some(t) = material.texture {
             albedo *= textures[t].sample(s.uv * material.uv_repeat);
         }
+        let cos = s.normal.dot(self.sky.sun_direction);
+        let lobe = (material.specular > 0.0).then(|| {
+            albedo *= 1.0 - material.specular;
+            let mut lobe = Lobe {
+                f0: material.specular,
+                alpha: material.roughness,
+                normal: s.normal,
+                to_eye: -dir,
+                lamps: Vec3::ZERO,
+                sun: 0.0,
+            };
+            if cos > 0.0 {
+                lobe.sun = lobe.pi_brdf(self.sky.sun_direction);
+            }
+            lobe
+        });
         Shading {
             albedo,
             light: self.sky.ambient(s.normal),
-            cos: s.normal.dot(self.sky.sun_direction),
+            cos,
             lamps: Vec3::ZERO,
+            lobe,
         }
     }
 
     /// The light of the scene's lamps on the surface `s` (irradiance over π, in units of the
     /// white; zero without lamps): each lamp's intensity towards `s` (a spot's profile) times
-    /// the cosine over the squared distance, where its shadow ray reaches it. The same
-    /// rays, one at a time, on the per-ray and the packet paths.
-    fn lamps_at(&self, s: &SurfaceHit, view: u8, stack: &mut Stack, shadows: &mut u64) -> Vec3 {
+    /// the cosine over the squared distance, where its shadow ray reaches it; and, into the
+    /// surface's glossy `lobe`, their highlights. The same rays, one at a time, on the per-ray
+    /// and the packet paths.
+    fn lamps_at(
+        &self,
+        s: &SurfaceHit,
+        mut lobe: Option<&mut Lobe>,
+        view: u8,
+        stack: &mut Stack,
+        shadows: &mut u64,
+    ) -> Vec3 {
         let mut sum = Vec3::ZERO;
         for lamp in self.lamps.iter() {
             let to = lamp.position - s.position;
@@ -624,7 +685,11 @@ impl RenderContext {
                     continue;
                 }
             }
-            sum += lamp.per_unit * (profile * (cos / d) / d2);
+            let light = lamp.per_unit * (profile * (cos / d) / d2);
+            sum += light;
+            if let Some(lobe) = &mut lobe {
+                lobe.lamps += light * lobe.pi_brdf(dir);
+            }
         }
         sum
     }
@@ -639,7 +704,14 @@ impl RenderContext {
         if lit {
             light += self.sky.sun_irradiance * sh.cos;
         }
-        sh.albedo * light
+        let mut colour = sh.albedo * light;
+        if let Some(lobe) = sh.lobe {
+            colour += lobe.lamps;
+            if lit {
+                colour += self.sky.sun_irradiance * (sh.cos * lobe.sun);
+            }
+        }
+        colour
     }
 }
 

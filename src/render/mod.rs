@@ -24,5 +24,6 @@ pub mod settings;
 pub mod shutter_rays;
 pub mod simd;
 pub mod sky;
+pub mod specular;
 pub mod throughput;
 pub mod views;

@@ -37,12 +37,7 @@ pub fn grow(base: &Scene, factor: f64) -> Result<Scene> {
     let base_triangles = World::build(base)?.triangles.len();
     let target = (base_triangles as f64 * factor).round() as usize;
     let material = |scene: &mut Scene, name: &str, color: [f64; 3]| {
-        scene.materials.push(Material {
-            name: format!("grown_{name}"),
-            color,
-            texture: None,
-            uv_repeat: [1.0, 1.0],
-        });
+        (scene.materials).push(Material::matte(format!("grown_{name}"), color));
         scene.materials.len() - 1
     };
     let bark = material(&mut scene, "bark", [0.36, 0.25, 0.16]);

@@ -28,6 +28,11 @@ pub const MAX_ROTATION_DEG: f64 = 360.0;
 pub const MAX_MOUNT_OFFSET: f64 = 100.0;
 /// Largest texture repetition factor.
 pub const MAX_UV_REPEAT: f64 = 1e6;
+/// The smallest GGX roughness α of a material's glossy lobe: below it a highlight of a point
+/// lamp shrinks under a pixel and flickers from sample to sample.
+pub const MIN_ROUGHNESS: f64 = 0.01;
+/// A material's GGX roughness α by default: a satin clear coat, a damp road.
+pub const DEFAULT_ROUGHNESS: f64 = 0.2;
 /// Largest image side accepted anywhere (renders, textures, EXRs), pixels.
 pub const MAX_RESOLUTION: u32 = 16384;
 /// Largest image accepted anywhere, pixels (16k × 8k).

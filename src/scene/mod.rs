@@ -83,6 +83,26 @@ pub struct Material {
     pub texture: Option<PathBuf>,
     /// How often the texture repeats across the surface's [0, 1]² UV range, per axis, > 0.
     pub uv_repeat: [f64; 2],
+    /// The glossy lobe's reflectance at normal incidence F0, [0, 1] (0: no lobe, the
+    /// surface is Lambertian; water 0.02, glass and car clear coat 0.04).
+    pub specular: f64,
+    /// The glossy lobe's GGX roughness α (Mitsuba's `alpha`: the microfacets' slope width),
+    /// [`MIN_ROUGHNESS`](limits::MIN_ROUGHNESS), 1]; read only where `specular` > 0.
+    pub roughness: f64,
+}
+
+impl Material {
+    /// An untextured Lambertian material of sRGB colour `color`.
+    pub fn matte(name: impl Into<String>, color: [f64; 3]) -> Material {
+        Material {
+            name: name.into(),
+            color,
+            texture: None,
+            uv_repeat: [1.0, 1.0],
+            specular: 0.0,
+            roughness: limits::DEFAULT_ROUGHNESS,
+        }
+    }
 }
 
 /// A primitive's shape in its object space.

@@ -9,8 +9,8 @@ use glam::{DAffine3, DMat3, DQuat, DVec3, EulerRot};
 use crate::geometry::camera::{Camera, world_from_camera_rotation};
 use crate::scene::light_keys::{read_photometry, read_sky, read_sun};
 use crate::scene::limits::{
-    MAX_DISPLAY_SIZE, MAX_LENGTH, MAX_MATERIALS, MAX_MOUNT_OFFSET, MAX_OBJECTS, MAX_ROTATION_DEG,
-    MAX_TRIANGLES, MAX_UV_REPEAT, MIN_LENGTH, out_of_world,
+    DEFAULT_ROUGHNESS, MAX_DISPLAY_SIZE, MAX_LENGTH, MAX_MATERIALS, MAX_MOUNT_OFFSET, MAX_OBJECTS,
+    MAX_ROTATION_DEG, MAX_TRIANGLES, MAX_UV_REPEAT, MIN_LENGTH, MIN_ROUGHNESS, out_of_world,
 };
 use crate::scene::motion::read_object_motion;
 use crate::scene::source::{SceneError, SourceFile};
@@ -141,6 +141,8 @@ fn read_materials(root: &TableReader) -> Result<Vec<Material>, SceneError> {
             color: t.color("color", [0.8, 0.8, 0.8])?,
             texture,
             uv_repeat: t.array_in("uv_repeat", [1.0, 1.0], MIN_LENGTH, MAX_UV_REPEAT)?,
+            specular: t.f64_in("specular", 0.0, 0.0, 1.0)?,
+            roughness: t.f64_in("roughness", DEFAULT_ROUGHNESS, MIN_ROUGHNESS, 1.0)?,
         });
         t.finish()?;
     }

@@ -45,6 +45,23 @@ pub struct SurfaceMaterial {
     pub albedo: Vec3,
     pub texture: Option<usize>,
     pub uv_repeat: Vec2,
+    /// The glossy lobe's reflectance at normal incidence, [0, 1]; 0: Lambertian only.
+    pub specular: f32,
+    /// The glossy lobe's GGX roughness α, (0, 1].
+    pub roughness: f32,
+}
+
+impl SurfaceMaterial {
+    /// A Lambertian material of linear colour `albedo`, untextured.
+    pub fn matte(albedo: Vec3) -> SurfaceMaterial {
+        SurfaceMaterial {
+            albedo,
+            texture: None,
+            uv_repeat: Vec2::ONE,
+            specular: 0.0,
+            roughness: 1.0,
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -242,6 +259,8 @@ impl World {
                 albedo: srgb_to_linear3(m.color),
                 texture,
                 uv_repeat: Vec2::new(m.uv_repeat[0] as f32, m.uv_repeat[1] as f32),
+                specular: m.specular as f32,
+                roughness: m.roughness as f32,
             });
         }
         let mut meshes: HashMap<PathBuf, Result<LoadedMesh>> = firsts
@@ -321,16 +340,11 @@ impl World {
                     world
                         .materials
                         .extend(mesh.materials.iter().map(|m| SurfaceMaterial {
-                            albedo: Vec3::from_array(m.linear_color),
                             texture: m.texture.map(|t| first_texture + t),
-                            uv_repeat: Vec2::ONE,
+                            ..SurfaceMaterial::matte(Vec3::from_array(m.linear_color))
                         }));
                     if mesh.materials.is_empty() && material.is_none() {
-                        world.materials.push(SurfaceMaterial {
-                            albedo: Vec3::splat(0.6),
-                            texture: None,
-                            uv_repeat: Vec2::ONE,
-                        });
+                        (world.materials).push(SurfaceMaterial::matte(Vec3::splat(0.6)));
                     }
                     let fallback = world.materials.len() as u32 - 1;
                     let material_of = |t: &Tri| {
@@ -576,11 +590,7 @@ impl World {
         let body = self.materials.len() as u32;
         // Two materials: the body, then the switched-off display.
         for color in [obstacle.body_color, obstacle.display_off_color] {
-            self.materials.push(SurfaceMaterial {
-                albedo: srgb_to_linear3(color),
-                texture: None,
-                uv_repeat: Vec2::ONE,
-            });
+            (self.materials).push(SurfaceMaterial::matte(srgb_to_linear3(color)));
         }
         let (tris, obstacle_from_box) = match obstacle.display_shape.curved() {
             Some(surface) => (

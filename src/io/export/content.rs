@@ -134,6 +134,19 @@ pub struct ExportMaterial {
     pub texture: Option<Texture>,
     /// Texture repetitions per unit of the surface's own UVs; exported UVs include it.
     pub uv_repeat: Vec2,
+    /// The glossy lobe's reflectance at normal incidence, [0, 1]; 0: Lambertian.
+    pub specular: f32,
+    /// The glossy lobe's GGX roughness α, (0, 1].
+    pub roughness: f32,
+}
+
+impl ExportMaterial {
+    /// The refractive index of a dielectric coat that reflects `specular` at normal
+    /// incidence, ((n − 1)/(n + 1))² = F0, held below 2 000 (F0 → 1 has none).
+    pub fn coat_ior(&self) -> f32 {
+        let r = self.specular.sqrt().min(0.999);
+        (1.0 + r) / (1.0 - r)
+    }
 }
 
 /// Everything an export writes, gathered from the scene and its world.
@@ -205,6 +218,8 @@ impl<'a> ExportScene<'a> {
                 linear_color: m.albedo,
                 texture: m.texture.map(|t| world.textures[t].clone()),
                 uv_repeat: m.uv_repeat,
+                specular: m.specular,
+                roughness: m.roughness,
             })
             .collect::<Vec<_>>();
 

@@ -119,10 +119,11 @@ fn document(content: &ExportScene) -> Result<(Value, Vec<u8>)> {
     let (mut images, mut textures, mut materials) = (vec![], vec![], vec![]);
     for m in &content.materials {
         let c = m.linear_color;
+        // glTF's roughness is the square root of GGX's α.
         let mut pbr = json!({
             "baseColorFactor": [c.x, c.y, c.z, 1.0],
             "metallicFactor": 0.0,
-            "roughnessFactor": 1.0,
+            "roughnessFactor": if m.specular > 0.0 { m.roughness.sqrt() } else { 1.0 },
         });
         if let Some(t) = &m.texture {
             let view = bin.view(&texture_png(t)?, None);
@@ -133,8 +134,14 @@ fn document(content: &ExportScene) -> Result<(Value, Vec<u8>)> {
         materials.push(json!({
             "name": m.name,
             "pbrMetallicRoughness": pbr,
-            // seethru's surfaces are Lambertian and seen from both sides.
-            "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}},
+            // A Lambertian surface has no specular reflection; a glossy one a dielectric
+            // coat of the index that reflects its F0. Every surface is seen from both sides.
+            "extensions": if m.specular > 0.0 {
+                json!({"KHR_materials_specular": {"specularFactor": 1.0},
+                       "KHR_materials_ior": {"ior": m.coat_ior()}})
+            } else {
+                json!({"KHR_materials_specular": {"specularFactor": 0.0}})
+            },
             "doubleSided": true,
             "extras": {
                 "uv_repeat": m.uv_repeat.to_array(),
@@ -267,7 +274,7 @@ fn document(content: &ExportScene) -> Result<(Value, Vec<u8>)> {
 
     let doc = json!({
         "asset": {"version": "2.0", "generator": concat!("seethru ", env!("CARGO_PKG_VERSION"))},
-        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_specular"],
+        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_specular", "KHR_materials_ior"],
         "extensions": {"KHR_lights_punctual": {"lights": lights}},
         "scene": 0,
         "scenes": [{

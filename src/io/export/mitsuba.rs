@@ -229,13 +229,34 @@ fn lights_and_materials(
                 rgb(m.linear_color)
             ),
         };
+        let inner = if m.specular > 0.0 {
+            // seethru's diffuse part is (1 − F0) ρ/π; roughplastic's also loses what the
+            // coat reflects on the way in and out (a few per cent at F0 0.04).
+            format!(
+                r#"<bsdf type="roughplastic">
+            <string name="distribution" value="ggx"/>
+            <float name="alpha" value="{}"/>
+            <float name="int_ior" value="{}"/>
+            <float name="ext_ior" value="1"/>
+            <boolean name="nonlinear" value="false"/>
+            {}
+        </bsdf>"#,
+                m.roughness,
+                m.coat_ior(),
+                reflectance.replacen("\"reflectance\"", "\"diffuse_reflectance\"", 1),
+            )
+        } else {
+            format!(
+                r#"<bsdf type="diffuse">
+            {reflectance}
+        </bsdf>"#
+            )
+        };
         let _ = write!(
             s,
             r#"
     <bsdf type="twosided" id="{id}">
-        <bsdf type="diffuse">
-            {reflectance}
-        </bsdf>
+        {inner}
     </bsdf>
 "#
         );

@@ -69,11 +69,16 @@ pub fn write_obj(content: &ExportScene, path: &Path) -> Result<Vec<PathBuf>> {
     for (i, m) in content.materials.iter().enumerate() {
         let name = material_name(i, &m.name);
         let c = m.linear_color;
-        let _ = writeln!(
-            mtl,
-            "\nnewmtl {name}\nKd {} {} {}\nKs 0 0 0\nillum 1",
-            c.x, c.y, c.z
-        );
+        let _ = writeln!(mtl, "\nnewmtl {name}\nKd {} {} {}", c.x, c.y, c.z);
+        if m.specular > 0.0 {
+            // A glossy lobe as Blinn–Phong's: the exponent of the same slope width (Walter
+            // et al. 2007: α = √(2 / (Ns + 2))).
+            let (f0, alpha) = (m.specular, m.roughness);
+            let ns = 2.0 / (alpha * alpha) - 2.0;
+            let _ = writeln!(mtl, "Ks {f0} {f0} {f0}\nNs {ns}\nillum 2");
+        } else {
+            let _ = writeln!(mtl, "Ks 0 0 0\nillum 1");
+        }
         if let Some(t) = &m.texture {
             let file = format!("{name}.png");
             files.push(write_asset(&assets, &file, &texture_png(t)?)?);
