@@ -781,18 +781,29 @@ fn lamps_export_as_mitsuba_emitters_and_gltf_lights_of_their_intensity() {
     }
 }
 
+/// The `bsdf` elements directly inside `n`.
+fn child_bsdfs<'a, 'input>(n: roxmltree::Node<'a, 'input>) -> Vec<roxmltree::Node<'a, 'input>> {
+    n.children().filter(|c| c.has_tag_name("bsdf")).collect()
+}
+
 #[test]
 fn glossy_materials_export_as_a_coat_of_their_f0_and_roughness_in_every_format() {
     // left_turn_night's wet streets (F0 0.02, α 0.15) beside Lambertian materials: Mitsuba's
-    // roughplastic, glTF's metallic-roughness with an index of refraction and OBJ's
-    // Blinn–Phong each state the same lobe; the Lambertian ones stay diffuse.
+    // blend of a diffuse and a rough conductor, glTF's metallic-roughness with an index of
+    // refraction and OBJ's Blinn–Phong each state the same lobe; the Lambertian ones stay
+    // diffuse.
     let path = common::repo_path("scenes/left_turn_night.toml");
-    let scene = seethru::scene::Scene::load(&path).unwrap();
+    let mut scene = seethru::scene::Scene::load(&path).unwrap();
+    // Two untextured coats besides: a bright yellow one (its diffuse part near 1) and paint.
+    for (name, f0) in [("cyclist", 0.04), ("paint", 0.5)] {
+        let m = scene.materials.iter_mut().find(|m| m.name == name).unwrap();
+        (m.specular, m.roughness) = (f0, 0.3);
+    }
     let world = World::build(&scene).unwrap();
     let glossy: Vec<_> = (scene.materials.iter())
         .filter(|m| m.specular > 0.0)
         .collect();
-    assert!(glossy.len() >= 2 && glossy.len() < scene.materials.len());
+    assert!(glossy.len() >= 4 && glossy.len() < scene.materials.len());
     let f0_of_ior = |n: f64| ((n - 1.0) / (n + 1.0)).powi(2);
     let dir = tempfile::tempdir().unwrap();
 
@@ -800,7 +811,14 @@ fn glossy_materials_export_as_a_coat_of_their_f0_and_roughness_in_every_format()
     export(&scene, &world, &xml, Some(ExportFormat::Mitsuba)).unwrap();
     let text = std::fs::read_to_string(&xml).unwrap();
     let doc = roxmltree::Document::parse(&text).unwrap();
-    for m in &scene.materials {
+    let value_of = |n: roxmltree::Node, name: &str| -> String {
+        let c = (n.children())
+            .find(|c| c.attribute("name") == Some(name))
+            .unwrap_or_else(|| panic!("no {name} in {:?}", n.attribute("type")));
+        c.attribute("value").unwrap().to_string()
+    };
+    let number = |n: roxmltree::Node, name: &str| -> f64 { value_of(n, name).parse().unwrap() };
+    for (i, m) in scene.materials.iter().enumerate() {
         let outer = (doc.descendants())
             .find(|n| {
                 n.has_tag_name("bsdf")
@@ -808,27 +826,48 @@ fn glossy_materials_export_as_a_coat_of_their_f0_and_roughness_in_every_format()
                         .is_some_and(|id| id.ends_with(&format!("_{}", m.name)))
             })
             .unwrap_or_else(|| panic!("no bsdf for {}", m.name));
-        let inner = outer.children().find(|n| n.has_tag_name("bsdf")).unwrap();
-        let value = |name: &str| -> f64 {
-            let n = (inner.children())
-                .find(|c| c.attribute("name") == Some(name))
-                .unwrap_or_else(|| panic!("{}: no {name}", m.name));
-            n.attribute("value").unwrap().parse().unwrap()
-        };
-        let named = |name: &str| inner.children().any(|c| c.attribute("name") == Some(name));
+        let inner = child_bsdfs(outer)[0];
+        let albedo = world.materials[i].albedo.as_dvec3();
         if m.specular > 0.0 {
-            assert_eq!(inner.attribute("type"), Some("roughplastic"), "{}", m.name);
-            assert!((value("alpha") - m.roughness).abs() < 1e-6, "{}", m.name);
-            let f0 = f0_of_ior(value("int_ior") / value("ext_ior"));
-            assert!((f0 - m.specular).abs() < 1e-6, "{}: F0 {f0}", m.name);
+            // (1 − w) × diffuse(ρ') + w × conductor(s): ρ'(1 − w) = (1 − F0) ρ, w s = 1, the
+            // conductor's index that of the coat (k = 0: a dielectric's Fresnel), its α.
+            assert_eq!(inner.attribute("type"), Some("blendbsdf"), "{}", m.name);
+            let w = number(inner, "weight");
+            let [diffuse, coat] = child_bsdfs(inner)[..] else {
+                panic!("{}", m.name)
+            };
+            assert_eq!(diffuse.attribute("type"), Some("diffuse"));
+            assert_eq!(coat.attribute("type"), Some("roughconductor"));
+            assert_eq!(value_of(coat, "distribution"), "ggx");
             assert!(
-                named("diffuse_reflectance") && !named("reflectance"),
+                (number(coat, "alpha") - m.roughness).abs() < 1e-6,
                 "{}",
                 m.name
             );
+            assert!((w * number(coat, "specular_reflectance") - 1.0).abs() < 1e-5);
+            let eta = triple(&value_of(coat, "eta"));
+            assert_eq!(triple(&value_of(coat, "k")), DVec3::ZERO);
+            let f0 = f0_of_ior(eta.x);
+            assert!(
+                eta.x == eta.y && eta.y == eta.z && (f0 - m.specular).abs() < 1e-6,
+                "{f0}"
+            );
+            if m.texture.is_none() {
+                let rho = triple(&value_of(diffuse, "reflectance"));
+                assert!(rho.max_element() <= 1.0, "{}: {rho}", m.name);
+                let want = albedo * (1.0 - m.specular);
+                assert!(
+                    (rho * (1.0 - w) - want).length() < 1e-5,
+                    "{}: {rho}",
+                    m.name
+                );
+            }
         } else {
             assert_eq!(inner.attribute("type"), Some("diffuse"), "{}", m.name);
-            assert!(named("reflectance"), "{}", m.name);
+            if m.texture.is_none() {
+                let rho = triple(&value_of(inner, "reflectance"));
+                assert!((rho - albedo).length() < 1e-6, "{}: {rho}", m.name);
+            }
         }
     }
 

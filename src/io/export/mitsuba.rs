@@ -8,7 +8,8 @@
 //! Lighting (see [`crate::io::export::content::Lighting`]): the sun is a `directional` emitter with π ×
 //! seethru's irradiance; seethru's ambient term is an `envmap` of two uniform hemispheres,
 //! which gives an unoccluded surface exactly seethru's ambient light. Surfaces are `diffuse`
-//! inside `twosided`; the `direct` integrator, like seethru, adds no interreflections.
+//! inside `twosided`, a glossy one a blend of a diffuse and a coat (`Coat`); the `direct`
+//! integrator, like seethru, adds no interreflections.
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -20,7 +21,8 @@ use glam::{DVec3, Vec3};
 use crate::geometry::camera::Camera;
 use crate::io::atomic::{write_atomically, write_text};
 use crate::io::export::content::{
-    CAMERA_ZNEAR, ExportLamp, ExportScene, Primitive, VIEWS, assets_dir, sanitize, write_asset,
+    CAMERA_ZNEAR, ExportLamp, ExportMaterial, ExportScene, Primitive, VIEWS, assets_dir, sanitize,
+    write_asset,
 };
 
 /// Samples per pixel the scenes ask for by default (`mi.load_file(path, spp=…)` changes it).
@@ -42,6 +44,34 @@ fn xml_escape(s: &str) -> String {
 
 fn triple(v: DVec3) -> String {
     format!("{}, {}, {}", v.x, v.y, v.z)
+}
+
+/// How a glossy material is written as Mitsuba's `blendbsdf` of a diffuse and a coat:
+/// (1 − w) × diffuse(ρ') + w × coat(1/w) = (1 − F0) ρ/π + the lobe, with ρ' ≤ 1 (Mitsuba
+/// refuses brighter reflectances).
+#[derive(Clone, Copy)]
+struct Coat {
+    /// The coat's weight w in the blend, (0, 0.5].
+    weight: f32,
+    /// ρ'/ρ = (1 − F0)/(1 − w).
+    diffuse_scale: f32,
+}
+
+impl Coat {
+    fn of(m: &ExportMaterial) -> Coat {
+        let brightest = match &m.texture {
+            Some(t) => {
+                (t.texels.iter()).fold(0.0f32, |a, &c| a.max((c * m.linear_color).max_element()))
+            }
+            None => m.linear_color.max_element(),
+        };
+        let diffuse = (1.0 - m.specular) * brightest;
+        let weight = (1.0 - diffuse).min(0.5);
+        Coat {
+            weight,
+            diffuse_scale: (1.0 - m.specular) / (1.0 - weight),
+        }
+    }
 }
 
 fn rgb(v: Vec3) -> String {
@@ -206,6 +236,8 @@ fn lights_and_materials(
     }
     for (i, m) in content.materials.iter().enumerate() {
         let id = bsdf_id(i, &m.name);
+        let coat = (m.specular > 0.0).then(|| Coat::of(m));
+        let scale = coat.map_or(1.0, |c| c.diffuse_scale);
         let reflectance = match &m.texture {
             // Colour × texture, linear, as the renderer multiplies them.
             Some(t) => {
@@ -213,7 +245,7 @@ fn lights_and_materials(
                 let path = assets.join(&file);
                 let w = t.width as usize;
                 write_exr(&path, w, t.height as usize, |x, y| {
-                    t.texels[y * w + x] * m.linear_color
+                    t.texels[y * w + x] * m.linear_color * scale
                 })?;
                 files.push(path);
                 format!(
@@ -226,31 +258,37 @@ fn lights_and_materials(
             }
             None => format!(
                 r#"<rgb name="reflectance" value="{}"/>"#,
-                rgb(m.linear_color)
+                rgb(m.linear_color * scale)
             ),
         };
-        let inner = if m.specular > 0.0 {
-            // seethru's diffuse part is (1 − F0) ρ/π; roughplastic's also loses what the
-            // coat reflects on the way in and out (a few per cent at F0 0.04).
-            format!(
-                r#"<bsdf type="roughplastic">
-            <string name="distribution" value="ggx"/>
-            <float name="alpha" value="{}"/>
-            <float name="int_ior" value="{}"/>
-            <float name="ext_ior" value="1"/>
-            <boolean name="nonlinear" value="false"/>
-            {}
+        let inner = match coat {
+            // seethru's glossy material is a sum, (1 − F0) ρ/π + the coat's GGX lobe: a blend
+            // of a diffuse and a conductor of the coat's real index (k = 0, whose Fresnel term
+            // is a dielectric's), each scaled up by its weight's inverse.
+            Some(coat) => format!(
+                r#"<bsdf type="blendbsdf">
+            <float name="weight" value="{w}"/>
+            <bsdf type="diffuse">
+            {reflectance}
+            </bsdf>
+            <bsdf type="roughconductor">
+                <string name="distribution" value="ggx"/>
+                <float name="alpha" value="{alpha}"/>
+                <rgb name="eta" value="{n}, {n}, {n}"/>
+                <rgb name="k" value="0, 0, 0"/>
+                <float name="specular_reflectance" value="{s}"/>
+            </bsdf>
         </bsdf>"#,
-                m.roughness,
-                m.coat_ior(),
-                reflectance.replacen("\"reflectance\"", "\"diffuse_reflectance\"", 1),
-            )
-        } else {
-            format!(
+                w = coat.weight,
+                alpha = m.roughness,
+                n = m.coat_ior(),
+                s = 1.0 / coat.weight,
+            ),
+            None => format!(
                 r#"<bsdf type="diffuse">
             {reflectance}
         </bsdf>"#
-            )
+            ),
         };
         let _ = write!(
             s,
