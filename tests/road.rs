@@ -367,6 +367,49 @@ fn a_raised_sidewalk_has_a_kerb_face_towards_the_road() {
     );
 }
 
+#[test]
+fn a_wet_map_coats_its_lanes_sidewalks_kerbs_and_marks_but_not_its_verges() {
+    let dir = tempfile::tempdir().unwrap();
+    let geometry = "<geometry s=\"0\" x=\"-20\" y=\"0\" hdg=\"0\" length=\"60\"><line/></geometry>";
+    let height = "<height sOffset=\"0\" inner=\"0.15\" outer=\"0.15\"/>";
+    let right = lane(-1, "driving", &width(3.5, 0.0), "solid", "")
+        + &lane(-2, "sidewalk", &width(2.0, 0.0), "none", height)
+        + &lane(-3, "border", &width(1.0, 0.0), "none", "");
+    let xodr = map(&[road("1", geometry, 60.0, "", &right, "")]);
+    for (keys, f0, alpha) in [
+        ("", 0.0, 0.2),
+        ("specular = 0.02\nroughness = 0.15", 0.02, 0.15),
+    ] {
+        let world = world_of(&scene_with_road(dir.path(), &xodr, keys));
+        let road = 1 + world.objects.iter().position(|o| o.name == "road").unwrap() as u32;
+        let mut parts = std::collections::BTreeSet::new();
+        for attr in world.tri_attrs.iter().filter(|a| a.object == road) {
+            let m = &world.materials[attr.material as usize];
+            let paved = attr.part != road_part::VERGE;
+            let (want_f0, want_alpha) = if paved { (f0, alpha) } else { (0.0, 0.2) };
+            assert_eq!(
+                (m.specular, m.roughness),
+                (want_f0 as f32, want_alpha as f32),
+                "part {} with `{keys}`",
+                attr.part
+            );
+            parts.insert(attr.part);
+        }
+        let all = [
+            road_part::ASPHALT,
+            road_part::SIDEWALK,
+            road_part::KERB,
+            road_part::MARKING,
+        ];
+        assert!(
+            all.iter()
+                .chain([&road_part::VERGE])
+                .all(|p| parts.contains(p)),
+            "{parts:?}"
+        );
+    }
+}
+
 /// The vehicle's lane centre and heading at `t` for the scene at `path` at 10 km/h.
 fn driven(scene: &Scene, t: f64) -> (DVec3, f64) {
     let options = RunOptions {
@@ -485,6 +528,16 @@ fn bad_maps_and_bad_keys_are_refused_in_one_line() {
             good.clone(),
             format!("{ego}\nasphalt_color = [2.0, 0.0, 0.0]"),
             vec!["asphalt_color"],
+        ),
+        (
+            good.clone(),
+            format!("{ego}\nspecular = 1.5"),
+            vec!["specular", "1.5", "[0, 1]"],
+        ),
+        (
+            good.clone(),
+            format!("{ego}\nroughness = 0.001"),
+            vec!["roughness", "0.001", "[0.01, 1]"],
         ),
         (
             good.clone(),

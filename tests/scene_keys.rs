@@ -102,8 +102,8 @@ fn documented(key: &str) -> Documented {
         "object.rotate_deg" => closed(-360.0, 360.0),
         "object.segments" => closed(3.0, 4096.0),
         "material.uv_repeat" => left_open(0.0, 1e6),
-        "material.specular" => closed(0.0, 1.0),
-        "material.roughness" => closed(0.01, 1.0),
+        "material.specular" | "road.specular" => closed(0.0, 1.0),
+        "material.roughness" | "road.roughness" => closed(0.01, 1.0),
         k if k.ends_with(".resolution") || k == "obstacle.display_resolution" => {
             closed(1.0, 16384.0)
         }

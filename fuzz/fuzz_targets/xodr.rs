@@ -4,7 +4,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use seethru::scene::road_map::{
-    RoadColors, Turn, lane_pose, parse_network, road_triangles, route_points,
+    RoadLook, Turn, lane_pose, parse_network, road_triangles, route_points,
 };
 
 fuzz_target!(|data: &[u8]| {
@@ -18,7 +18,7 @@ fuzz_target!(|data: &[u8]| {
             return;
         }
     };
-    let mesh = road_triangles(&network, &RoadColors::default());
+    let mesh = road_triangles(&network, &RoadLook::default());
     assert!(mesh.tris.iter().all(|t| t.p.iter().all(|p| p.is_finite())));
     for road in network.roads().iter().take(4) {
         let length = road.length();

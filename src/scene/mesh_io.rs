@@ -36,6 +36,24 @@ pub struct FileMaterial {
     /// Its base-colour texture: an index into [`LoadedMesh::textures`], sampled at the
     /// triangles' uv (a glTF `baseColorTexture`, repeating).
     pub texture: Option<usize>,
+    /// A glossy coat's reflectance at normal incidence, [0, 1]: 0 (Lambertian) for every
+    /// mesh file (their `Ks` and roughness are not a coat's); a road map's wet surfaces.
+    pub specular: f32,
+    /// The coat's GGX roughness α, [0.01, 1].
+    pub roughness: f32,
+}
+
+impl FileMaterial {
+    /// A Lambertian, untextured material of linear colour `linear_color`.
+    pub fn matte(name: String, linear_color: [f32; 3]) -> FileMaterial {
+        FileMaterial {
+            name,
+            linear_color,
+            texture: None,
+            specular: 0.0,
+            roughness: crate::scene::limits::DEFAULT_ROUGHNESS as f32,
+        }
+    }
 }
 
 /// Triangles of a mesh file, in the file's own frame (glTF node transforms applied).
@@ -298,9 +316,8 @@ pub fn parse_obj(
             None => None,
         };
         out.materials.push(FileMaterial {
-            name: m.name.clone(),
-            linear_color: m.diffuse.unwrap_or([0.8; 3]),
             texture,
+            ..FileMaterial::matte(m.name.clone(), m.diffuse.unwrap_or([0.8; 3]))
         });
     }
     let names: Vec<&str> = out.materials.iter().map(|m| m.name.as_str()).collect();
@@ -435,12 +452,10 @@ fn parse_gltf_with(
             }
             None => None,
         };
+        let name = (m.name()).map_or_else(|| format!("#{}", m.index().unwrap_or(0)), String::from);
         out.materials.push(FileMaterial {
-            name: m
-                .name()
-                .map_or_else(|| format!("#{}", m.index().unwrap_or(0)), String::from),
-            linear_color: [c[0], c[1], c[2]],
             texture,
+            ..FileMaterial::matte(name, [c[0], c[1], c[2]])
         });
     }
     let scene = doc.default_scene().or_else(|| doc.scenes().next());

@@ -134,7 +134,7 @@ pub enum Shape {
     /// in the map's frame (`scene/road_map.rs`); the object's transform places the map.
     Road {
         path: PathBuf,
-        colors: road_map::RoadColors,
+        look: road_map::RoadLook,
     },
     /// The built-in head mesh (`scene/head_model.rs`, the triangles of `assets/head.obj`,
     /// built into the binary): the driver's face of `[camera.driver] face = "mesh"`.

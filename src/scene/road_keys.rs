@@ -4,9 +4,9 @@
 use glam::{DAffine3, DMat3, DVec3};
 
 use crate::scene::lane_route::LaneRoute;
-use crate::scene::limits::MAX_LENGTH;
+use crate::scene::limits::{DEFAULT_ROUGHNESS, MAX_LENGTH, MIN_ROUGHNESS};
 use crate::scene::motion::{MovesWith, ObjectMotion};
-use crate::scene::road_map::{PoseInput, RoadColors, Turn, lane_pose, read_network, route_points};
+use crate::scene::road_map::{PoseInput, RoadLook, Turn, lane_pose, read_network, route_points};
 use crate::scene::source::SceneError;
 use crate::scene::table_reader::TableReader;
 use crate::scene::{CameraKind, Object, Shape};
@@ -113,12 +113,14 @@ pub fn read_road(root: &TableReader, objects: &[Object]) -> Result<Option<Road>,
             ));
         }
     };
-    let defaults = RoadColors::default();
-    let colors = RoadColors {
+    let defaults = RoadLook::default();
+    let look = RoadLook {
         asphalt: t.color("asphalt_color", defaults.asphalt)?,
         sidewalk: t.color("sidewalk_color", defaults.sidewalk)?,
         verge: t.color("verge_color", defaults.verge)?,
         object: t.color("object_color", defaults.object)?,
+        specular: t.f64_in("specular", 0.0, 0.0, 1.0)?,
+        roughness: t.f64_in("roughness", DEFAULT_ROUGHNESS, MIN_ROUGHNESS, 1.0)?,
     };
     if objects.iter().any(|o| o.name == ROAD_OBJECT_NAME) {
         return Err(t.table_error(format!(
@@ -128,7 +130,7 @@ pub fn read_road(root: &TableReader, objects: &[Object]) -> Result<Option<Road>,
     t.finish()?;
     let object = Object {
         name: ROAD_OBJECT_NAME.to_string(),
-        shape: Shape::Road { path, colors },
+        shape: Shape::Road { path, look },
         material: None,
         world_from_object: world_from_map,
         visible_to: CameraKind::ALL,

@@ -46,22 +46,30 @@ pub const KERB_FACE_DEPTH_M: f32 = 0.25;
 /// the asphalt under it first, far less than any pixel of a driver's view.
 pub const PAINT_LIFT_M: f32 = 0.005;
 
-/// The colours of a map's surfaces (sRGB, [0, 1]); paint takes the colour the map names.
+/// How a map's surfaces look: their colours (sRGB, [0, 1]; paint takes the colour the map
+/// names) and the glossy coat of the paved ones.
 #[derive(Clone, Debug, PartialEq)]
-pub struct RoadColors {
+pub struct RoadLook {
     pub asphalt: [f64; 3],
     pub sidewalk: [f64; 3],
     pub verge: [f64; 3],
     pub object: [f64; 3],
+    /// The coat's reflectance at normal incidence F0 on the lanes, sidewalks, kerb faces and
+    /// marks, [0, 1]: 0 dry, 0.02 wet (water); the verges and objects have none.
+    pub specular: f64,
+    /// The coat's GGX roughness α, [0.01, 1].
+    pub roughness: f64,
 }
 
-impl Default for RoadColors {
+impl Default for RoadLook {
     fn default() -> Self {
-        RoadColors {
+        RoadLook {
             asphalt: [0.32, 0.32, 0.33],
             sidewalk: [0.62, 0.6, 0.56],
             verge: [0.36, 0.52, 0.22],
             object: [0.55, 0.55, 0.55],
+            specular: 0.0,
+            roughness: crate::scene::limits::DEFAULT_ROUGHNESS,
         }
     }
 }
@@ -90,9 +98,9 @@ pub fn parse_network(
 }
 
 /// The map at `path` as a mesh in its own frame: [`road_triangles`] of [`read_network`].
-pub fn load_road(path: &Path, colors: &RoadColors) -> Result<LoadedMesh> {
+pub fn load_road(path: &Path, look: &RoadLook) -> Result<LoadedMesh> {
     let network = read_network(path).with_context(|| format!("road map {}", path.display()))?;
-    Ok(road_triangles(&network, colors))
+    Ok(road_triangles(&network, look))
 }
 
 /// What each lane type is drawn as.
@@ -126,17 +134,19 @@ fn vec3(p: xodr::Point) -> Vec3 {
 /// The triangles of a baked map, in its frame, with one material per colour: the permanent
 /// lanes' surface (each lane coloured by what it is for), a vertical face along both edges
 /// of every sidewalk, the painted marks, and the map's objects.
-pub fn road_triangles(network: &RoadNetwork, colors: &RoadColors) -> LoadedMesh {
+pub fn road_triangles(network: &RoadNetwork, look: &RoadLook) -> LoadedMesh {
     let mut mesh = LoadedMesh::default();
-    let mut material_of = |name: String, srgb: [f64; 3]| -> u32 {
+    // A material by name; `paved` ones carry the look's coat.
+    let mut material_of = |name: String, srgb: [f64; 3], paved: bool| -> u32 {
         if let Some(i) = mesh.materials.iter().position(|m| m.name == name) {
             return i as u32;
         }
-        mesh.materials.push(FileMaterial {
-            name,
-            linear_color: srgb_to_linear3(srgb).to_array(),
-            texture: None,
-        });
+        let mut material = FileMaterial::matte(name, srgb_to_linear3(srgb).to_array());
+        if paved {
+            material.specular = look.specular as f32;
+            material.roughness = look.roughness as f32;
+        }
+        mesh.materials.push(material);
         mesh.materials.len() as u32 - 1
     };
     let mut tris = Vec::new();
@@ -153,11 +163,11 @@ pub fn road_triangles(network: &RoadNetwork, colors: &RoadColors) -> LoadedMesh 
         let kind = network.lane(span.lane).map_or(LaneType::None, |l| l.kind);
         let part = lane_part(kind);
         let (name, color) = match part {
-            road_part::SIDEWALK => ("sidewalk", colors.sidewalk),
-            road_part::VERGE => ("verge", colors.verge),
-            _ => ("asphalt", colors.asphalt),
+            road_part::SIDEWALK => ("sidewalk", look.sidewalk),
+            road_part::VERGE => ("verge", look.verge),
+            _ => ("asphalt", look.asphalt),
         };
-        let material = material_of(name.to_string(), color);
+        let material = material_of(name.to_string(), color, part != road_part::VERGE);
         let vertex = |i: u32| vec3(surface.vertices[i as usize]);
         for k in span.indices.clone().step_by(3) {
             let i = &surface.indices[k as usize..k as usize + 3];
@@ -187,7 +197,7 @@ pub fn road_triangles(network: &RoadNetwork, colors: &RoadColors) -> LoadedMesh 
             } else {
                 &line.color
             };
-            let material = material_of(format!("paint {color}"), paint_color(color));
+            let material = material_of(format!("paint {color}"), paint_color(color), true);
             for piece in &line.pieces {
                 let [a, b, c, d] = piece.map(|p| vec3(p) + lift);
                 push([a, b, c], road_part::MARKING, material);
@@ -197,7 +207,7 @@ pub fn road_triangles(network: &RoadNetwork, colors: &RoadColors) -> LoadedMesh 
     }
     let objects = network.object_mesh();
     if !objects.indices.is_empty() {
-        let material = material_of("roadside object".to_string(), colors.object);
+        let material = material_of("roadside object".to_string(), look.object, false);
         for i in objects.indices.chunks_exact(3) {
             let p = [0, 1, 2].map(|k| vec3(objects.vertices[i[k] as usize]));
             push(p, road_part::OBJECT, material);

@@ -14,7 +14,7 @@ pub fn shape_mesh(shape: &Shape) -> Option<Result<LoadedMesh>> {
     match shape {
         Shape::Mesh { path } => Some(load_mesh(path)),
         Shape::HeadMesh => Some(Ok(builtin_head().clone())),
-        Shape::Road { path, colors } => Some(load_road(path, colors)),
+        Shape::Road { path, look } => Some(load_road(path, look)),
         _ => None,
     }
 }

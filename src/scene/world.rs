@@ -341,6 +341,8 @@ impl World {
                         .materials
                         .extend(mesh.materials.iter().map(|m| SurfaceMaterial {
                             texture: m.texture.map(|t| first_texture + t),
+                            specular: m.specular,
+                            roughness: m.roughness,
                             ..SurfaceMaterial::matte(Vec3::from_array(m.linear_color))
                         }));
                     if mesh.materials.is_empty() && material.is_none() {
