@@ -261,3 +261,72 @@ fn a_texture_that_cannot_be_read_is_one_error_line_naming_its_image() {
         common::refusal::render_refused(dir.path(), &words);
     }
 }
+
+#[test]
+fn a_scene_material_replaces_one_of_a_meshs_own_materials_by_name() {
+    // car.mtl's body, glass and wheels: the body takes the scene's glossy `paint`, the others
+    // stay the file's.
+    let car = common::repo_path("assets/car.obj");
+    let object = |keys: &str| {
+        format!(
+            "[[material]]\nname = \"paint\"\ncolor = [0.1, 0.2, 0.6]\nspecular = 0.04\nroughness = 0.1\n\n\
+             [[object]]\nname = \"car\"\nkind = \"mesh\"\npath = \"{}\"\ntranslate = [0.0, 0.0, -8.0]\n{keys}\n",
+            car.display()
+        )
+    };
+    let load = |keys: &str| {
+        let dir = common::refusal::scratch(&object(keys), &[]);
+        seethru::scene::world::World::build(&Scene::load(&dir.path().join("scene.toml")).unwrap())
+    };
+    let world = load("materials = { body = \"paint\" }").unwrap();
+    let plain = load("").unwrap();
+    let car_id = 1 + world.objects.iter().position(|o| o.name == "car").unwrap() as u32;
+    let file = seethru::scene::mesh_io::load_mesh(&car).unwrap();
+    let body = file
+        .materials
+        .iter()
+        .position(|m| m.name == "body")
+        .unwrap();
+    let (mut bodies, mut others) = (0, 0);
+    for (attr, plain_attr) in
+        (world.tri_attrs.iter().zip(&plain.tri_attrs)).filter(|(a, _)| a.object == car_id)
+    {
+        let m = &world.materials[attr.material as usize];
+        let was = &plain.materials[plain_attr.material as usize];
+        if was.albedo == Vec3::from_array(file.materials[body].linear_color) {
+            assert_eq!((m.specular, m.roughness), (0.04, 0.1));
+            assert_eq!(m.albedo, Vec3::new(0.1, 0.2, 0.6).map(srgb_to_linear));
+            bodies += 1;
+        } else {
+            assert_eq!((m.specular, m.albedo), (0.0, was.albedo));
+            others += 1;
+        }
+    }
+    assert!(
+        bodies > 100 && others > 100,
+        "{bodies} body, {others} other triangles"
+    );
+
+    // Names the file does not define, or the scene does not, and keys that contradict.
+    let refused = |keys: &str, words: &[&str]| {
+        let scratch = common::refusal::scratch(&object(keys), &[]);
+        common::refusal::render_refused(scratch.path(), words);
+    };
+    refused(
+        "materials = { bonnet = \"paint\" }",
+        &["car", "bonnet", "car.obj", "body, glass, wheels"],
+    );
+    refused(
+        "materials = { body = \"chrome\" }",
+        &["materials.body", "chrome", "paint"],
+    );
+    refused(
+        "material = \"paint\"\nmaterials = { body = \"paint\" }",
+        &["materials", "one of the two"],
+    );
+    refused("materials = \"paint\"", &["materials", "table"]);
+    let not_a_mesh = "[[object]]\nname = \"box\"\nkind = \"box\"\nmaterial = \"grey\"\n\
+                      materials = { body = \"grey\" }\n";
+    let scratch = common::refusal::scratch(not_a_mesh, &[]);
+    common::refusal::render_refused(scratch.path(), &["materials", "only a `mesh` object"]);
+}

@@ -165,6 +165,7 @@ fn object(name: &str, shape: Shape, material: usize, world_from_object: DAffine3
         name: name.into(),
         shape,
         material: Some(material),
+        file_materials: Vec::new(),
         world_from_object,
         visible_to: 0b111,
         casts_shadow: true,

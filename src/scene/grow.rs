@@ -67,6 +67,7 @@ pub fn grow(base: &Scene, factor: f64) -> Result<Scene> {
             name,
             shape,
             material,
+            file_materials: Vec::new(),
             world_from_object: at,
             visible_to: all_cameras,
             casts_shadow: true,

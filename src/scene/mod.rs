@@ -164,6 +164,9 @@ pub struct Object {
     pub shape: Shape,
     /// Index into [`Scene::materials`]; `None` for meshes that bring their own materials.
     pub material: Option<usize>,
+    /// A mesh's own materials replaced by name: (the file's material name, index into
+    /// [`Scene::materials`]); empty for every other object.
+    pub file_materials: Vec<(String, usize)>,
     /// Object space to world space: translate · rotate · scale.
     pub world_from_object: DAffine3,
     /// Bit set of [`CameraKind::bit`]s of the cameras that see the object.

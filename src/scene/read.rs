@@ -328,17 +328,45 @@ fn read_object(
             }
         }
     };
-    let material = match t.opt_str("material")? {
-        Some(m) => Some(*by_name.get(m).ok_or_else(|| {
+    // A scene material by name, or an error at `key` that lists the defined ones.
+    let scene_material = |t: &TableReader, key: &str, m: &str| {
+        by_name.get(m).copied().ok_or_else(|| {
             let mut names: Vec<&str> = materials.iter().map(|x| x.name.as_str()).take(20).collect();
             if materials.len() > names.len() {
                 names.push("…");
             }
             t.error(
-                "material",
+                key,
                 format!("no material named `{m}` (defined: {})", names.join(", ")),
             )
-        })?),
+        })
+    };
+    let file_materials = match t.table("materials")? {
+        None => Vec::new(),
+        Some(_) if !matches!(shape, Shape::Mesh { .. }) => {
+            return Err(t.error(
+                "materials",
+                "replaces a mesh file's materials by name: only a `mesh` object has them",
+            ));
+        }
+        Some(_) if t.has("material") => {
+            return Err(t.error(
+                "materials",
+                "`material` already replaces every material of the file: give one of the two",
+            ));
+        }
+        Some(table) => {
+            let mut pairs = Vec::new();
+            for file_name in table.keys() {
+                let m = table.required_str(file_name)?;
+                pairs.push((file_name.to_string(), scene_material(&table, file_name, m)?));
+            }
+            table.finish()?;
+            pairs
+        }
+    };
+    let material = match t.opt_str("material")? {
+        Some(m) => Some(scene_material(t, "material", m)?),
         None if matches!(shape, Shape::Mesh { .. }) => None,
         None => {
             return Err(t.error(
@@ -368,6 +396,7 @@ fn read_object(
         name,
         shape,
         material,
+        file_materials,
         world_from_object: read_transform(t)?,
         visible_to,
         casts_shadow: t.bool_or("casts_shadow", true)?,
@@ -526,6 +555,7 @@ pub fn face_object(face: DriverFace, eye: DVec3) -> Option<Object> {
         name: FACE_MESH_NAME.to_string(),
         shape: Shape::HeadMesh,
         material: None,
+        file_materials: Vec::new(),
         world_from_object: DAffine3::from_translation(eye)
             * DAffine3::from_rotation_y(yaw_deg.to_radians()),
         visible_to: CameraKind::ALL & !CameraKind::Driver.bit(),

@@ -7,7 +7,7 @@
 //! [`World::flattened`], so that both break ties between equally near hits alike.
 
 use std::collections::HashMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use glam::{Affine3A, DAffine3, DVec3, Mat3A, Vec2, Vec3, Vec3A};
@@ -23,7 +23,7 @@ use crate::scene::motion::check_keyframed_mesh;
 use crate::scene::shape_mesh::shape_mesh;
 use crate::scene::shapes::{Tri, box_face, cuboid, frustum, plane_xz, quad_xy};
 use crate::scene::texture::Texture;
-use crate::scene::{CameraKind, Obstacle, Scene, Shape};
+use crate::scene::{CameraKind, Object, Obstacle, Scene, Shape};
 use crate::util::color::srgb_to_linear3;
 
 /// The views a primitive can be visible in, as bits of a mask.
@@ -161,6 +161,30 @@ pub struct World {
     pub textures: Vec<Texture>,
     /// Object id of the obstacle; its `box_face::POS_Z` part is the display.
     pub obstacle_id: u32,
+}
+
+/// Per material of the mesh file at `path` that `object` places, the scene material that
+/// replaces it (`materials = { name = "scene material" }`), if any; an error names a file
+/// material the file does not define.
+fn replaced_materials(object: &Object, path: &Path, mesh: &LoadedMesh) -> Result<Vec<Option<u32>>> {
+    let mut replaced = vec![None; mesh.materials.len()];
+    for (name, scene_material) in &object.file_materials {
+        let Some(i) = mesh.materials.iter().position(|m| &m.name == name) else {
+            let defined: Vec<&str> = mesh.materials.iter().map(|m| m.name.as_str()).collect();
+            anyhow::bail!(
+                "object `{}`: `materials` replaces `{name}`, which {} does not define (its materials: {})",
+                object.name,
+                path.display(),
+                if defined.is_empty() {
+                    "none".to_string()
+                } else {
+                    defined.join(", ")
+                }
+            );
+        };
+        replaced[i] = Some(*scene_material as u32);
+    }
+    Ok(replaced)
 }
 
 fn views_of(visible_to: u8) -> u8 {
@@ -349,9 +373,12 @@ impl World {
                         (world.materials).push(SurfaceMaterial::matte(Vec3::splat(0.6)));
                     }
                     let fallback = world.materials.len() as u32 - 1;
+                    let replaced = replaced_materials(object, path, mesh)?;
                     let material_of = |t: &Tri| {
                         material
-                            .or(t.file_material.map(|m| first + m))
+                            .or(t
+                                .file_material
+                                .map(|m| replaced[m as usize].unwrap_or(first + m)))
                             .unwrap_or(fallback)
                     };
                     // The object's placements: its instances rows, or its own transform.
