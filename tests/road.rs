@@ -410,6 +410,49 @@ fn a_wet_map_coats_its_lanes_sidewalks_kerbs_and_marks_but_not_its_verges() {
     }
 }
 
+#[test]
+fn what_the_importer_skips_in_a_map_is_a_warning_naming_the_map() {
+    // A road with a `<geometry>` of no length (which xodr drops, and says so) renders, with
+    // one `warning:` line naming the map and the geometry; the bundled map has none.
+    let dir = tempfile::tempdir().unwrap();
+    let geometry = "<geometry s=\"0\" x=\"-20\" y=\"0\" hdg=\"0\" length=\"60\"><line/></geometry>";
+    let right = lane(-1, "driving", &width(3.5, 0.0), "none", "");
+    let plain = road("1", geometry, 60.0, "", &right, "");
+    let dropped = "<geometry s=\"60\" x=\"40\" y=\"0\" hdg=\"0\" length=\"0\"><line/></geometry>";
+    let with_dropped = plain.replacen("</planView>", &format!("{dropped}</planView>"), 1);
+    for (xodr, warned) in [(map(&[plain]), false), (map(&[with_dropped]), true)] {
+        let scene = scene_with_road(dir.path(), &xodr, "");
+        let out = dir.path().join("out");
+        let (ok, _, stderr) = common::seethru(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--view",
+            "truth",
+            "--width",
+            "16",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(ok, "{stderr}");
+        let warnings: Vec<&str> = stderr
+            .lines()
+            .filter(|l| l.starts_with("warning: "))
+            .collect();
+        if warned {
+            assert_eq!(warnings.len(), 1, "{stderr}");
+            assert!(
+                warnings[0].contains("map.xodr") && warnings[0].contains("<geometry> at s 60"),
+                "{stderr}"
+            );
+        } else {
+            assert!(warnings.is_empty(), "{stderr}");
+        }
+    }
+    let bundled = Scene::load(&common::repo_path("scenes/intersection.toml")).unwrap();
+    assert!(bundled.warnings.is_empty(), "{:?}", bundled.warnings);
+}
+
 /// The vehicle's lane centre and heading at `t` for the scene at `path` at 10 km/h.
 fn driven(scene: &Scene, t: f64) -> (DVec3, f64) {
     let options = RunOptions {

@@ -12,7 +12,10 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let network = match parse_network(xml, |_| Err("no includes here".to_string())) {
-        Ok(network) => network,
+        Ok((network, warnings)) => {
+            assert!(warnings.iter().all(|w| !w.contains('\n')), "{warnings:?}");
+            network
+        }
         Err(e) => {
             assert!(!format!("{e:#}").contains('\n'), "{e:#}");
             return;

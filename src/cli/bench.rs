@@ -1,6 +1,7 @@
 //! `seethru bench`: BVH build time, trace-only ray throughput (coherent and incoherent,
 //! closest and any hit), shaded frame times and peak memory on a scene.
 
+use crate::cli::load_scene;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -17,7 +18,6 @@ use seethru::render::throughput::{
     trace_closest_per_ray,
 };
 use seethru::render::views::View;
-use seethru::scene::Scene;
 use seethru::scene::grow::grow;
 use seethru::util::cpu_time::threads_cpu_ns;
 use seethru::util::memory::peak_rss_bytes;
@@ -89,7 +89,7 @@ impl Bench {
             anyhow::bail!("--repeat {} is out of range [1, 1000]", self.repeat);
         }
         let estimate = bench_estimate(
-            &Scene::load(&self.scene)?,
+            &load_scene(&self.scene)?,
             self.width,
             self.height,
             self.grow,
@@ -190,7 +190,7 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         }
     };
     let load = Instant::now();
-    let scene = grow(&Scene::load(&options.scene)?, options.grow)?;
+    let scene = grow(&load_scene(&options.scene)?, options.grow)?;
     let mut ctx = RenderContext::new(scene)?;
     if options.flatten {
         ctx = ctx.flattened()?;

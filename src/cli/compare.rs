@@ -1,6 +1,7 @@
 //! `seethru compare`: compensation methods side by side on one scene — one table (Markdown,
 //! JSON, HTML) and one image strip per method.
 
+use crate::cli::load_scene;
 use crate::cli::with_flags;
 use std::path::{Path, PathBuf};
 
@@ -14,7 +15,6 @@ use seethru::measure::compare::{
 };
 use seethru::measure::run_spec::RunSpec;
 use seethru::render::integrator::RenderContext;
-use seethru::scene::Scene;
 use seethru::system::memory::{check_memory, run_estimate};
 use seethru::system::options::RunOptions;
 use seethru::system::reads::hazard_bound_reads;
@@ -80,7 +80,7 @@ impl Compare {
 
     fn write(&self, spec: &RunSpec, base: &RunOptions) -> Result<()> {
         let (band, hazard_bound_arcmin) = (spec.measure.band, spec.measure.hazard_bound_arcmin);
-        let scene = Scene::load(&self.scene)?;
+        let scene = load_scene(&self.scene)?;
         refuse_ignored(&[hazard_bound_reads(&scene)])?;
         check_memory(&run_estimate(&scene, base)?, spec.max_memory_gib)?;
         let ctx = RenderContext::new(scene)?;

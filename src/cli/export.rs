@@ -2,12 +2,12 @@
 //! scenes — and its cameras as JSON.
 
 use crate::cli::args::choice;
+use crate::cli::load_scene;
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use seethru::io::export::ExportFormat;
 use seethru::io::output_paths::{Input, Output, check_paths};
-use seethru::scene::Scene;
 use seethru::scene::world::World;
 
 #[derive(clap::Args)]
@@ -34,7 +34,7 @@ impl Export {
 }
 
 fn export_scene(scene_path: &Path, out: &Path, format: Option<ExportFormat>) -> Result<()> {
-    let scene = Scene::load(scene_path)?;
+    let scene = load_scene(scene_path)?;
     let world = World::build(&scene)?;
     // The formats are written flat: every placement of an instanced mesh its own triangles.
     let flat = world.triangles.len() + world.instanced_count();

@@ -2,12 +2,12 @@
 //! (yaw, pitch, distance), the error distribution of the frontal equations and of the yaw
 //! fit as one Markdown table on stdout, and the fit's time per frame on stderr.
 
+use crate::cli::load_scene;
 use std::path::PathBuf;
 
 use anyhow::Result;
 use seethru::io::output_paths::{Input, check_paths};
 use seethru::measure::head_poses::{fit_time_line, pose_grid, pose_table};
-use seethru::scene::Scene;
 use seethru::system::head_pose::prepare_fit;
 
 use crate::cli::args::{pixels, real, threads, with_threads};
@@ -40,7 +40,7 @@ pub struct HeadPoses {
 impl HeadPoses {
     pub fn run(self) -> Result<()> {
         check_paths(&[Input::file("SCENE", &self.scene)], &[])?;
-        let scene = Scene::load(&self.scene)?;
+        let scene = load_scene(&self.scene)?;
         let started = std::time::Instant::now();
         prepare_fit();
         let setup_s = started.elapsed().as_secs_f64();

@@ -1,5 +1,6 @@
 //! `seethru measure`: the metrics of a `run` directory recomputed from its EXRs.
 
+use crate::cli::load_scene;
 use crate::cli::with_flags;
 use std::path::{Path, PathBuf};
 
@@ -15,7 +16,6 @@ use seethru::measure::metrics_json::Metrics;
 use seethru::measure::viewer::{RunPixels, write_run_view};
 use seethru::render::frame_over::FrameView;
 use seethru::render::integrator::RenderContext;
-use seethru::scene::Scene;
 use seethru::util::input_file::read_input_text;
 
 use crate::cli::args::band;
@@ -52,7 +52,7 @@ fn measure_command(dir: &Path, band: u32) -> Result<Metrics> {
         .scene_absolute
         .clone()
         .unwrap_or(record.scene.clone());
-    let scene = Scene::load(&scene_path).with_context(|| {
+    let scene = load_scene(&scene_path).with_context(|| {
         format!(
             "the scene {} that {} names (`scene` = {})",
             shown_absolute(&scene_path),

@@ -108,6 +108,16 @@ pub enum Command {
     View(view::View),
 }
 
+/// The scene at `path`, what reading it doubted (an OpenDRIVE map's skipped features)
+/// printed as `warning:` lines on stderr.
+pub fn load_scene(path: &std::path::Path) -> Result<seethru::scene::Scene> {
+    let scene = seethru::scene::Scene::load(path)?;
+    for warning in &scene.warnings {
+        eprintln!("warning: {warning}");
+    }
+    Ok(scene)
+}
+
 /// The command line with every negative number that follows an option joined to it
 /// (`--b1 -0.35` → `--b1=-0.35`, `--width -inf` → `--width=-inf`): clap takes `-0.35` or
 /// `-inf` for an option of its own and says "unexpected argument '-i'", naming neither the

@@ -1,5 +1,6 @@
 //! `seethru render`: views of a scene as colour PNG, id PNG and an EXR with every AOV.
 
+use crate::cli::load_scene;
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
@@ -11,7 +12,6 @@ use seethru::render::integrator::RenderContext;
 use seethru::render::render_job::RenderJob;
 use seethru::render::settings::{RenderSettings, resized};
 use seethru::render::views::View;
-use seethru::scene::Scene;
 use seethru::system::memory::{check_memory, render_estimate};
 
 use crate::cli::args::{choice, threads, with_threads};
@@ -67,7 +67,7 @@ fn render_views(
     exr: ExrContent,
 ) -> Result<()> {
     let options = &spec.options;
-    let scene = Scene::load(scene_path)?;
+    let scene = load_scene(scene_path)?;
     // Check every camera before the first (possibly long) render.
     let cameras = views
         .iter()

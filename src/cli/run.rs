@@ -1,6 +1,7 @@
 //! `seethru run`: the see-through system end to end on a scene, with every view, run.json and
 //! the metrics written to a directory.
 
+use crate::cli::load_scene;
 use seethru::util::option_words::as_flags;
 use std::path::{Path, PathBuf};
 
@@ -11,7 +12,6 @@ use seethru::io::staged::StagedDir;
 use seethru::measure::headline::{read_results, summary_text};
 use seethru::measure::run_files::{RunWrites, write_run};
 use seethru::render::integrator::RenderContext;
-use seethru::scene::Scene;
 use seethru::scene::lens_keys::read_calibration_file;
 use seethru::system::memory::{both_eyes_estimate, check_memory, run_estimate};
 use seethru::system::options::RunOptions;
@@ -90,7 +90,7 @@ fn run_command(
     max_memory: f64,
     both: bool,
 ) -> Result<()> {
-    let mut scene = Scene::load(scene_path)?;
+    let mut scene = load_scene(scene_path)?;
     refuse_ignored(&[hazard_bound_reads(&scene)])?;
     if let Some(path) = calibration {
         scene.calibration = read_calibration_file(path, &scene.frontal, &scene.back)?;

@@ -1,6 +1,7 @@
 //! `seethru sequence`: the see-through system over time — vehicle motion, head motion and
 //! latency — measured frame by frame against the truth at the same instant.
 
+use crate::cli::load_scene;
 use crate::cli::with_flags;
 use seethru::util::option_words::as_flags;
 use std::path::{Path, PathBuf};
@@ -21,7 +22,6 @@ use seethru::measure::sequence_files::{
     summary,
 };
 use seethru::measure::sequence_records::head_warning;
-use seethru::scene::Scene;
 use seethru::scene::head_path::HeadPath;
 use seethru::system::memory::{check_memory, sequence_estimate};
 use seethru::system::options::{HeadSource, RunOptions};
@@ -265,7 +265,7 @@ impl Sequence {
         let spec = self.run_options.spec()?;
         self.refuse_ignored(&spec)?;
         let head = self.head_motion()?;
-        let scene = Scene::load(&self.scene)?;
+        let scene = load_scene(&self.scene)?;
         refuse_ignored(&[hazard_bound_reads(&scene)])?;
         if let HeadMotion::Path(path) = &head {
             path.check_in_world(&scene.obstacle.world_from_obstacle)?;

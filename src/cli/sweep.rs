@@ -1,5 +1,6 @@
 //! `seethru sweep`: metrics for every combination of parameter values, as CSV and a plot.
 
+use crate::cli::load_scene;
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -10,7 +11,6 @@ use seethru::measure::sweep::{
 };
 use seethru::measure::sweep_grid::{EYELLIPSE, MAX_VALUES, eyellipse_param, parse_param};
 use seethru::measure::sweep_shard::Shard;
-use seethru::scene::Scene;
 use seethru::system::memory::{DEFAULT_MAX_MEMORY_GIB, MemoryEstimate, check_memory, run_estimate};
 use seethru::system::options::{HeadSource, RunOptions};
 
@@ -159,7 +159,7 @@ impl Sweep {
         };
         let computed = with_threads(self.threads, || -> Result<usize> {
             // Every worker thread runs a configuration at a time, each holding its frames.
-            let scene = Scene::load(&self.scene)?;
+            let scene = load_scene(&self.scene)?;
             let one = run_estimate(
                 &scene,
                 &RunOptions {

@@ -356,5 +356,6 @@ pub fn build_scene(setup: &Setup, width: u32, compensation: &Compensation) -> Re
         eyellipse: None,
         face: crate::scene::DriverFace::Ellipsoids,
         ego_route: None,
+        warnings: Vec::new(),
     })
 }

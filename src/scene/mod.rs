@@ -521,6 +521,9 @@ pub struct Scene {
     /// from the lane's centre at t = 0. `None`: the vehicle drives straight along −z, turning
     /// at option `yaw_rate`.
     pub ego_route: Option<lane_route::LaneRoute>,
+    /// What reading the scene dropped or doubted, one line each (without `warning:`): the
+    /// features of an OpenDRIVE map its importer skips. Commands print them on stderr.
+    pub warnings: Vec<String>,
 }
 
 /// The driver's face (`[camera.driver] face`), and with it the head tracker `--head

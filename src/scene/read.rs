@@ -45,8 +45,10 @@ impl Scene {
         let materials = read_materials(&root)?;
         let mut objects = read_objects(&root, &materials)?;
         let road = crate::scene::road_keys::read_road(&root, &objects)?;
+        let mut warnings = Vec::new();
         let ego_route = road.and_then(|road| {
             objects.push(road.object);
+            warnings = road.warnings;
             road.route
         });
         let obstacle_table = root
@@ -87,6 +89,7 @@ impl Scene {
             eyellipse,
             face,
             ego_route,
+            warnings,
         })
     }
 }

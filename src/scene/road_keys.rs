@@ -43,6 +43,8 @@ pub fn world_from_map_at(center: DVec3, travel: DVec3, at: DVec3) -> DAffine3 {
 pub struct Road {
     pub object: Object,
     pub route: Option<LaneRoute>,
+    /// What the importer dropped or doubted in the map, one line each, the file named.
+    pub warnings: Vec<String>,
 }
 
 /// The scene's `[road]` table, if it has one.
@@ -58,7 +60,11 @@ pub fn read_road(root: &TableReader, objects: &[Object]) -> Result<Option<Road>,
         ));
     }
     let path = t.existing_asset("xodr", rel)?;
-    let network = read_network(&path).map_err(|e| t.error("xodr", format!("`{rel}`: {e:#}")))?;
+    let (network, warnings) =
+        read_network(&path).map_err(|e| t.error("xodr", format!("`{rel}`: {e:#}")))?;
+    let warnings = (warnings.into_iter())
+        .map(|w| format!("{}: {w}", path.display()))
+        .collect();
     let given: Vec<&str> = EGO_KEYS.into_iter().filter(|k| t.has(k)).collect();
     let (world_from_map, route) = match given.len() {
         0 => {
@@ -145,7 +151,11 @@ pub fn read_road(root: &TableReader, objects: &[Object]) -> Result<Option<Road>,
         },
         instances: Vec::new(),
     };
-    Ok(Some(Road { object, route }))
+    Ok(Some(Road {
+        object,
+        route,
+        warnings,
+    }))
 }
 
 #[cfg(test)]

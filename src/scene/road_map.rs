@@ -75,8 +75,10 @@ impl Default for RoadLook {
 }
 
 /// Reads and bakes a map, its `<include>`s read from its folder, each within the mesh size
-/// limit. Errors name the problem; the caller names the file.
-pub fn read_network(path: &Path) -> Result<RoadNetwork> {
+/// limit; with it, one line per thing the importer dropped or doubted (xodr's warnings: a
+/// feature it skips, a road it could not bake). Errors name the problem; the caller names
+/// the file.
+pub fn read_network(path: &Path) -> Result<(RoadNetwork, Vec<String>)> {
     let xml = read_input_text(path, MAX_MESH_BYTES).context("cannot read it")?;
     let folder = path.parent().unwrap_or(Path::new("")).to_path_buf();
     parse_network(&xml, |name: &str| {
@@ -84,22 +86,27 @@ pub fn read_network(path: &Path) -> Result<RoadNetwork> {
     })
 }
 
-/// Bakes a map's text, `read_include` giving the text of each file an `<include>` names.
+/// Bakes a map's text, `read_include` giving the text of each file an `<include>` names;
+/// with it, the importer's warnings, one line each.
 pub fn parse_network(
     xml: &str,
     read_include: impl FnMut(&str) -> Result<String, String>,
-) -> Result<RoadNetwork> {
-    let (network, _) = xodr::load_str_with(xml, read_include)
+) -> Result<(RoadNetwork, Vec<String>)> {
+    let (network, provenance) = xodr::load_str_with(xml, read_include)
         .map_err(|e| anyhow!("not a usable OpenDRIVE map: {}", one_line(&e.to_string())))?;
     if network.lanes().is_empty() {
         bail!("the map has no lanes to draw");
     }
-    Ok(network)
+    let warnings = (provenance.warnings.iter())
+        .map(|w| one_line(&w.to_string()))
+        .collect();
+    Ok((network, warnings))
 }
 
 /// The map at `path` as a mesh in its own frame: [`road_triangles`] of [`read_network`].
 pub fn load_road(path: &Path, look: &RoadLook) -> Result<LoadedMesh> {
-    let network = read_network(path).with_context(|| format!("road map {}", path.display()))?;
+    let (network, _) =
+        read_network(path).with_context(|| format!("road map {}", path.display()))?;
     Ok(road_triangles(&network, look))
 }
 
