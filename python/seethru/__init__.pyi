@@ -55,6 +55,9 @@ class Scene:
         """An independent copy sharing the built world while the geometry is the same."""
     @property
     def path(self) -> str: ...
+    @property
+    def warnings(self) -> list[str]:
+        """What reading the scene doubted, a line each (an OpenDRIVE map's dropped parts)."""
     eye: tuple[float, float, float]
     """The driver's eye, world metres; setting it moves the driver camera (same orientation)."""
     driver_pose: Pose

@@ -138,6 +138,13 @@ impl PyScene {
         self.scene.path.clone()
     }
 
+    /// What reading the scene dropped or doubted, one line each: the features of an
+    /// OpenDRIVE map its importer skips (the command line prints them as `warning:` lines).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.scene.warnings.clone()
+    }
+
     /// The driver's eye, world frame, metres: the driver camera's centre. Setting it moves
     /// the driver camera, keeping its orientation, and the driver's head (the objects riding
     /// with it, the face the back camera films) with it.

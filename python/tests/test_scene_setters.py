@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import seethru
-from conftest import SCENE
+from conftest import REPO, SCENE
 
 
 def test_bad_setter_values_are_refused_with_the_range():
@@ -51,3 +51,17 @@ def test_moving_and_resizing_the_obstacle_changes_the_run():
     assert seethru.run(smaller, width=64, spp=1).metrics["display_pixels"] < base
     # The copy's changes leave the original as it was.
     assert seethru.run(scene, width=64, spp=1).metrics["display_pixels"] == base
+
+
+def test_a_maps_dropped_parts_are_the_scenes_warnings(tmp_path):
+    # intersection.toml's map with a <geometry> of no length added, which the importer
+    # drops and says so; the bundled map itself has no warning.
+    bundled = REPO / "scenes" / "intersection.toml"
+    assert seethru.Scene.load(bundled).warnings == []
+    xodr = (REPO / "assets" / "roads" / "intersection.xodr").read_text()
+    dropped = '<geometry s="0" x="0" y="0" hdg="0" length="0"><line/></geometry>'
+    (tmp_path / "map.xodr").write_text(xodr.replace("</planView>", dropped + "</planView>", 1))
+    text = bundled.read_text().replace('xodr = "../assets/roads/intersection.xodr"', 'xodr = "map.xodr"')
+    (tmp_path / "scene.toml").write_text(text)
+    warnings = seethru.Scene.load(tmp_path / "scene.toml").warnings
+    assert len(warnings) == 1 and "map.xodr" in warnings[0] and "<geometry>" in warnings[0], warnings
