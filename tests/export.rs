@@ -908,6 +908,16 @@ fn glossy_materials_export_as_a_coat_of_their_f0_and_roughness_in_every_format()
     }
     let used = json["extensionsUsed"].to_string();
     assert!(used.contains("KHR_materials_ior"), "{used}");
+    // A Lambertian scene does not use it.
+    let das = export_das("das.glb", Some(ExportFormat::Gltf));
+    let bytes = std::fs::read(&das.path).unwrap();
+    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + length]).unwrap();
+    assert!(
+        !json["extensionsUsed"]
+            .to_string()
+            .contains("KHR_materials_ior")
+    );
 
     let obj = dir.path().join("wet.obj");
     export(&scene, &world, &obj, Some(ExportFormat::Obj)).unwrap();
@@ -917,6 +927,20 @@ fn glossy_materials_export_as_a_coat_of_their_f0_and_roughness_in_every_format()
             .find(|g| g.name.ends_with(&format!("_{}", m.name)))
             .unwrap_or_else(|| panic!("no OBJ material {}", m.name));
         let ks = got.specular.unwrap();
+        // Blinn–Phong adds the two: the diffuse part is (1 − F0) ρ, as seethru's.
+        let kd = DVec3::from_array(got.diffuse.unwrap().map(f64::from));
+        let rho = world.materials[scene
+            .materials
+            .iter()
+            .position(|x| x.name == m.name)
+            .unwrap()]
+        .albedo
+        .as_dvec3();
+        assert!(
+            (kd - rho * (1.0 - m.specular)).length() < 1e-6,
+            "{}: Kd {kd}",
+            m.name
+        );
         if m.specular > 0.0 {
             let ns = f64::from(got.shininess.unwrap());
             let alpha = (2.0 / (ns + 2.0)).sqrt();

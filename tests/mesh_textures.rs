@@ -314,7 +314,12 @@ fn a_scene_material_replaces_one_of_a_meshs_own_materials_by_name() {
     };
     refused(
         "materials = { bonnet = \"paint\" }",
-        &["car", "bonnet", "car.obj", "body, glass, wheels"],
+        &[
+            "scene.toml",
+            "materials.bonnet",
+            "car.obj",
+            "body, glass, wheels",
+        ],
     );
     refused(
         "materials = { body = \"chrome\" }",
@@ -329,4 +334,8 @@ fn a_scene_material_replaces_one_of_a_meshs_own_materials_by_name() {
                       materials = { body = \"grey\" }\n";
     let scratch = common::refusal::scratch(not_a_mesh, &[]);
     common::refusal::render_refused(scratch.path(), &["materials", "only a `mesh` object"]);
+    // A roughness with no coat to shape.
+    let matte = "[[material]]\nname = \"matte\"\ncolor = [0.5, 0.5, 0.5]\nroughness = 0.3\n";
+    let scratch = common::refusal::scratch(matte, &[]);
+    common::refusal::render_refused(scratch.path(), &["material[1].roughness", "specular"]);
 }

@@ -13,6 +13,7 @@ use seethru::scene::Scene;
 use seethru::scene::road_map::road_part;
 use seethru::scene::world::{World, view_bit};
 use seethru::system::options::RunOptions;
+use seethru::util::color::srgb_to_linear;
 
 /// A map of one road, `id`, starting at (x, y) with heading `hdg`.
 fn map(roads: &[String]) -> String {
@@ -451,6 +452,66 @@ fn what_the_importer_skips_in_a_map_is_a_warning_naming_the_map() {
     }
     let bundled = Scene::load(&common::repo_path("scenes/intersection.toml")).unwrap();
     assert!(bundled.warnings.is_empty(), "{:?}", bundled.warnings);
+}
+
+#[test]
+fn signals_are_boards_of_their_size_at_their_place_facing_their_heading() {
+    // A sign 3 m right of the reference line at s = 20 (x = 0), 2 m up, 0.8 × 0.5 m, facing
+    // the traffic; a traffic light at s = 30 (x = 10) turned a quarter turn by its hOffset,
+    // of the default size.
+    let dir = tempfile::tempdir().unwrap();
+    let geometry = "<geometry s=\"0\" x=\"-20\" y=\"0\" hdg=\"0\" length=\"60\"><line/></geometry>";
+    let right = lane(-1, "driving", &width(3.5, 0.0), "none", "");
+    let signals = "<signals>\
+        <signal s=\"20\" t=\"-3\" id=\"1\" dynamic=\"no\" orientation=\"+\" zOffset=\"2\" \
+         type=\"274\" subtype=\"-1\" country=\"DE\" width=\"0.8\" height=\"0.5\" hOffset=\"0\"/>\
+        <signal s=\"30\" t=\"-3\" id=\"2\" dynamic=\"yes\" orientation=\"+\" zOffset=\"2\" \
+         type=\"1000001\" subtype=\"-1\" country=\"OpenDRIVE\" hOffset=\"1.5707963\"/></signals>";
+    let xodr =
+        map(&[road("1", geometry, 60.0, "", &right, "")
+            .replace("</road>", &format!("{signals}</road>"))]);
+    let world = world_of(&scene_with_road(
+        dir.path(),
+        &xodr,
+        "signal_color = [0.9, 0.1, 0.1]",
+    ));
+    let boards = map_vertices(&world, road_part::SIGNAL);
+    let bounds = |near_x: f64| {
+        let corners: Vec<DVec3> = boards
+            .iter()
+            .copied()
+            .filter(|p| (p.x - near_x).abs() < 2.0)
+            .collect();
+        assert_eq!(corners.len(), 8, "{corners:?}");
+        let lo = corners.iter().fold(DVec3::INFINITY, |a, &p| a.min(p));
+        let hi = corners.iter().fold(DVec3::NEG_INFINITY, |a, &p| a.max(p));
+        (lo, hi)
+    };
+    let close = |a: DVec3, b: [f64; 3]| (a - DVec3::from_array(b)).abs().max_element() < 1e-4;
+    let (lo, hi) = bounds(0.0);
+    assert!(
+        close(lo, [-0.025, -3.4, 2.0]) && close(hi, [0.025, -2.6, 2.5]),
+        "{lo} {hi}"
+    );
+    let (lo, hi) = bounds(10.0);
+    assert!(
+        close(lo, [9.7, -3.025, 2.0]) && close(hi, [10.3, -2.975, 2.6]),
+        "{lo} {hi}"
+    );
+    // Each takes its colour.
+    let road = 1 + world.objects.iter().position(|o| o.name == "road").unwrap() as u32;
+    let colours: std::collections::BTreeSet<[u32; 3]> = (world.tri_attrs.iter())
+        .filter(|a| a.object == road && a.part == road_part::SIGNAL)
+        .map(|a| {
+            world.materials[a.material as usize]
+                .albedo
+                .to_array()
+                .map(f32::to_bits)
+        })
+        .collect();
+    let want = |srgb: f32| srgb_to_linear(srgb).to_bits();
+    let expected = [[want(0.9), want(0.1), want(0.1)], [want(0.08); 3]];
+    assert_eq!(colours, expected.into_iter().collect());
 }
 
 /// The vehicle's lane centre and heading at `t` for the scene at `path` at 10 km/h.

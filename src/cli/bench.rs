@@ -190,7 +190,8 @@ fn bench(options: &Bench) -> Result<serde_json::Value> {
         }
     };
     let load = Instant::now();
-    let scene = grow(&load_scene(&options.scene)?, options.grow)?;
+    // `run` read the scene once already and printed its warnings.
+    let scene = grow(&seethru::scene::Scene::load(&options.scene)?, options.grow)?;
     let mut ctx = RenderContext::new(scene)?;
     if options.flatten {
         ctx = ctx.flattened()?;

@@ -1,7 +1,8 @@
 //! A material's glossy lobe: the GGX (Trowbridge–Reitz) microfacet reflection of a dielectric
-//! coat, with Schlick's Fresnel and the height-correlated Smith masking–shadowing term (Heitz
-//! 2014, "Understanding the masking-shadowing function in microfacet-based BRDFs"), the model of
-//! pbrt-v4's and Mitsuba 3's rough dielectrics and of glTF's metallic-roughness materials.
+//! coat, with Schlick's approximation of the Fresnel term and the height-correlated Smith
+//! masking–shadowing term (Heitz 2014, "Understanding the masking-shadowing function in
+//! microfacet-based BRDFs"), as glTF's reference BRDF has them (pbrt-v4 and Mitsuba 3 use
+//! GGX too, with the exact Fresnel term; Mitsuba with separable Smith masking).
 //!
 //! The lobe reflects the sun and the lamps (delta lights), not the sky or other objects: there
 //! are no reflection rays. Under it the diffuse albedo is scaled by (1 − F0), the light the coat
@@ -90,6 +91,24 @@ mod tests {
             assert!(
                 a <= bound + 1e-3 && a > 0.85 * bound,
                 "α {alpha}: {a} vs {bound}"
+            );
+            // The same integral over the half vectors: ∫ D G (n·h) dωh for θh < 45°, the
+            // light at 2θh, G = 1/(1 + Λ(2θh)) (Λ = 0 for the eye on the normal).
+            let n = 20_000;
+            let step = std::f64::consts::FRAC_PI_4 / n as f64;
+            let twin: f64 = (0..n)
+                .map(|k| {
+                    let theta = (k as f64 + 0.5) * step;
+                    let c = theta.cos();
+                    let d = a2 / (std::f64::consts::PI * (c * c * (a2 - 1.0) + 1.0).powi(2));
+                    let tan2 = (2.0 * theta).tan().powi(2);
+                    let g = 1.0 / (1.0 + ((1.0 + a2 * tan2).sqrt() - 1.0) / 2.0);
+                    d * g * c * theta.sin() * step * std::f64::consts::TAU
+                })
+                .sum();
+            assert!(
+                (a - twin).abs() < 2e-3,
+                "α {alpha}: {a} vs {twin} over the half vectors"
             );
         }
     }

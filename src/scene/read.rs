@@ -139,17 +139,33 @@ fn read_materials(root: &TableReader) -> Result<Vec<Material>, SceneError> {
             Some(rel) => Some(t.existing_asset("texture", rel)?),
             None => None,
         };
+        let (specular, roughness) = read_coat(&t)?;
         materials.push(Material {
             name,
             color: t.color("color", [0.8, 0.8, 0.8])?,
             texture,
             uv_repeat: t.array_in("uv_repeat", [1.0, 1.0], MIN_LENGTH, MAX_UV_REPEAT)?,
-            specular: t.f64_in("specular", 0.0, 0.0, 1.0)?,
-            roughness: t.f64_in("roughness", DEFAULT_ROUGHNESS, MIN_ROUGHNESS, 1.0)?,
+            specular,
+            roughness,
         });
         t.finish()?;
     }
     Ok(materials)
+}
+
+/// A glossy coat's keys, `specular` (F0, [0, 1], default 0: none) and `roughness` (GGX α,
+/// [`MIN_ROUGHNESS`], 1], default [`DEFAULT_ROUGHNESS`]), of a `[[material]]` or `[road]`;
+/// a roughness without a coat to shape is refused.
+pub(crate) fn read_coat(t: &TableReader) -> Result<(f64, f64), SceneError> {
+    let specular = t.f64_in("specular", 0.0, 0.0, 1.0)?;
+    let roughness = t.f64_in("roughness", DEFAULT_ROUGHNESS, MIN_ROUGHNESS, 1.0)?;
+    if t.has("roughness") && specular == 0.0 {
+        return Err(t.error(
+            "roughness",
+            "shapes the glossy coat, and there is none: give specular in (0, 1] too",
+        ));
+    }
+    Ok((specular, roughness))
 }
 
 /// Resolves an asset path relative to the scene file and checks that it exists.

@@ -4,7 +4,7 @@
 use glam::{DAffine3, DMat3, DVec3};
 
 use crate::scene::lane_route::LaneRoute;
-use crate::scene::limits::{DEFAULT_ROUGHNESS, MAX_LENGTH, MIN_ROUGHNESS};
+use crate::scene::limits::MAX_LENGTH;
 use crate::scene::motion::{MovesWith, ObjectMotion};
 use crate::scene::road_map::{PoseInput, RoadLook, Turn, lane_pose, read_network, route_points};
 use crate::scene::source::SceneError;
@@ -63,7 +63,7 @@ pub fn read_road(root: &TableReader, objects: &[Object]) -> Result<Option<Road>,
     let (network, warnings) =
         read_network(&path).map_err(|e| t.error("xodr", format!("`{rel}`: {e:#}")))?;
     let warnings = (warnings.into_iter())
-        .map(|w| format!("{}: {w}", path.display()))
+        .map(|w| crate::util::message::printable(&format!("{}: {w}", path.display())))
         .collect();
     let given: Vec<&str> = EGO_KEYS.into_iter().filter(|k| t.has(k)).collect();
     let (world_from_map, route) = match given.len() {
@@ -120,13 +120,16 @@ pub fn read_road(root: &TableReader, objects: &[Object]) -> Result<Option<Road>,
         }
     };
     let defaults = RoadLook::default();
+    let (specular, roughness) = crate::scene::read::read_coat(&t)?;
     let look = RoadLook {
         asphalt: t.color("asphalt_color", defaults.asphalt)?,
         sidewalk: t.color("sidewalk_color", defaults.sidewalk)?,
         verge: t.color("verge_color", defaults.verge)?,
         object: t.color("object_color", defaults.object)?,
-        specular: t.f64_in("specular", 0.0, 0.0, 1.0)?,
-        roughness: t.f64_in("roughness", DEFAULT_ROUGHNESS, MIN_ROUGHNESS, 1.0)?,
+        signal: t.color("signal_color", defaults.signal)?,
+        traffic_light: t.color("traffic_light_color", defaults.traffic_light)?,
+        specular,
+        roughness,
     };
     if objects.iter().any(|o| o.name == ROAD_OBJECT_NAME) {
         return Err(t.table_error(format!(

@@ -15,10 +15,11 @@ use xodr::{LaneType, RoadNetwork, RoadPosition};
 
 use crate::scene::limits::MAX_MESH_BYTES;
 use crate::scene::mesh_io::{FileMaterial, LoadedMesh};
-use crate::scene::shapes::Tri;
+use crate::scene::shapes::{Tri, cuboid};
 use crate::scene::source::one_line;
 use crate::util::color::srgb_to_linear3;
 use crate::util::input_file::read_input_text;
+use crate::util::message::printable;
 
 /// The parts of a road map's object (the `part` id of its triangles, and of the hits on
 /// them).
@@ -35,7 +36,13 @@ pub mod road_part {
     pub const KERB: u32 = 4;
     /// The map's `<object>`s (poles, barriers, buildings the map describes).
     pub const OBJECT: u32 = 5;
+    /// The boards of the map's `<signal>`s (signs, traffic lights).
+    pub const SIGNAL: u32 = 6;
 }
+
+/// A signal board's size where the map gives none, metres: thickness along its heading,
+/// width, height (a 60 cm sign).
+pub const DEFAULT_SIGNAL_SIZE: [f32; 3] = [0.05, 0.6, 0.6];
 
 /// How deep, metres, the vertical face along each edge of a sidewalk reaches below its top:
 /// deeper than any kerb, so the face meets the road beside it; what lies below the road is
@@ -54,6 +61,10 @@ pub struct RoadLook {
     pub sidewalk: [f64; 3],
     pub verge: [f64; 3],
     pub object: [f64; 3],
+    /// The boards of signs (static signals).
+    pub signal: [f64; 3],
+    /// The housings of traffic lights (dynamic signals).
+    pub traffic_light: [f64; 3],
     /// The coat's reflectance at normal incidence F0 on the lanes, sidewalks, kerb faces and
     /// marks, [0, 1]: 0 dry, 0.02 wet (water); the verges and objects have none.
     pub specular: f64,
@@ -68,6 +79,8 @@ impl Default for RoadLook {
             sidewalk: [0.62, 0.6, 0.56],
             verge: [0.36, 0.52, 0.22],
             object: [0.55, 0.55, 0.55],
+            signal: [0.85, 0.85, 0.85],
+            traffic_light: [0.08, 0.08, 0.08],
             specular: 0.0,
             roughness: crate::scene::limits::DEFAULT_ROUGHNESS,
         }
@@ -97,8 +110,9 @@ pub fn parse_network(
     if network.lanes().is_empty() {
         bail!("the map has no lanes to draw");
     }
+    // A map's ids and names reach the terminal: made inert as errors are.
     let warnings = (provenance.warnings.iter())
-        .map(|w| one_line(&w.to_string()))
+        .map(|w| printable(&one_line(&w.to_string())))
         .collect();
     Ok((network, warnings))
 }
@@ -220,8 +234,43 @@ pub fn road_triangles(network: &RoadNetwork, look: &RoadLook) -> LoadedMesh {
             push(p, road_part::OBJECT, material);
         }
     }
+    for signal in network.signals() {
+        let (name, color) = if signal.dynamic {
+            ("traffic light", look.traffic_light)
+        } else {
+            ("sign", look.signal)
+        };
+        let material = material_of(name.to_string(), color, false);
+        for p in signal_board(signal) {
+            push(p, road_part::SIGNAL, material);
+        }
+    }
     mesh.tris = tris;
     mesh
+}
+
+/// A signal's board as triangles in the map's frame: a box of the map's size (or
+/// [`DEFAULT_SIGNAL_SIZE`]) whose bottom edge's middle is the signal's position, its face
+/// toward its heading, turned by its heading about +z, then its pitch and roll. No pole:
+/// the map gives the board's height above the road, not where a pole would stand.
+fn signal_board(signal: &xodr::Signal) -> Vec<[Vec3; 3]> {
+    let [t, w, h] = DEFAULT_SIGNAL_SIZE;
+    let size = [
+        signal.length.filter(|l| *l > 0.0).unwrap_or(t),
+        signal.width.filter(|l| *l > 0.0).unwrap_or(w),
+        signal.height.filter(|l| *l > 0.0).unwrap_or(h),
+    ];
+    // Pitch about the turned y, nose (+x) down for a positive angle; roll about the turned
+    // x, left side (+y) up for a positive angle.
+    let rotation = glam::Quat::from_rotation_z(signal.heading)
+        * glam::Quat::from_rotation_y(signal.pitch)
+        * glam::Quat::from_rotation_x(signal.roll);
+    let lift = Vec3::new(0.0, 0.0, size[2] / 2.0);
+    let at = vec3(signal.position);
+    cuboid(size)
+        .into_iter()
+        .map(|tri| tri.p.map(|p| at + rotation * (p + lift)))
+        .collect()
 }
 
 /// Where a lane's centre lies at `s` metres along its road's reference line, and which way

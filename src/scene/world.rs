@@ -163,23 +163,32 @@ pub struct World {
     pub obstacle_id: u32,
 }
 
-/// Per material of the mesh file at `path` that `object` places, the scene material that
-/// replaces it (`materials = { name = "scene material" }`), if any; an error names a file
-/// material the file does not define.
-fn replaced_materials(object: &Object, path: &Path, mesh: &LoadedMesh) -> Result<Vec<Option<u32>>> {
+/// Per material of the mesh file at `path` that `object` (of the scene file `scene`) places,
+/// the scene material that replaces it (`materials = { name = "scene material" }`), if any;
+/// an error names the scene, the key and the materials the file does define.
+fn replaced_materials(
+    scene: &Path,
+    object: &Object,
+    path: &Path,
+    mesh: &LoadedMesh,
+) -> Result<Vec<Option<u32>>> {
     let mut replaced = vec![None; mesh.materials.len()];
     for (name, scene_material) in &object.file_materials {
         let Some(i) = mesh.materials.iter().position(|m| &m.name == name) else {
             let defined: Vec<&str> = mesh.materials.iter().map(|m| m.name.as_str()).collect();
+            let defined = if defined.is_empty() {
+                "none".to_string()
+            } else {
+                defined.join(", ")
+            };
             anyhow::bail!(
-                "object `{}`: `materials` replaces `{name}`, which {} does not define (its materials: {})",
-                object.name,
-                path.display(),
-                if defined.is_empty() {
-                    "none".to_string()
-                } else {
-                    defined.join(", ")
-                }
+                "{}",
+                crate::util::message::printable(&format!(
+                    "{}: object `{}`: materials.{name}: {} defines no material `{name}` (it defines: {defined})",
+                    scene.display(),
+                    object.name,
+                    path.display(),
+                ))
             );
         };
         replaced[i] = Some(*scene_material as u32);
@@ -226,8 +235,9 @@ impl World {
         // that a broken texture is an error whether or not an object uses it).
         let whole = (0..scene.objects.len()).all(keep);
         let mut used = vec![whole; scene.materials.len()];
-        for (i, o) in scene.objects.iter().enumerate() {
-            if let Some(m) = o.material.filter(|_| keep(i)) {
+        for (_, o) in scene.objects.iter().enumerate().filter(|&(i, _)| keep(i)) {
+            let replacing = o.file_materials.iter().map(|(_, m)| *m);
+            for m in o.material.into_iter().chain(replacing) {
                 used[m] = true;
             }
         }
@@ -373,7 +383,7 @@ impl World {
                         (world.materials).push(SurfaceMaterial::matte(Vec3::splat(0.6)));
                     }
                     let fallback = world.materials.len() as u32 - 1;
-                    let replaced = replaced_materials(object, path, mesh)?;
+                    let replaced = replaced_materials(&scene.path, object, path, mesh)?;
                     let material_of = |t: &Tri| {
                         material
                             .or(t
@@ -839,5 +849,21 @@ mod tests {
         assert_eq!(counts(&|_| true), (1, 1));
         assert_eq!(counts(&uses), (1, 1));
         assert_eq!(counts(&|i| !uses(i)), (0, 0));
+
+        // A textured scene material that replaces one of a mesh's own (`materials`): a part
+        // of that mesh alone loads its texture.
+        let mut scene = scene.clone();
+        let street = (scene.materials.iter())
+            .position(|m| m.texture.is_some())
+            .unwrap();
+        let car = scene.objects.iter().position(|o| o.name == "car").unwrap();
+        scene.objects[car].file_materials = vec![("body".to_string(), street)];
+        let world = World::build_part(&scene, &|i| i == car, false).expect("the part builds");
+        let textured = world
+            .materials
+            .iter()
+            .filter(|m| m.texture.is_some())
+            .count();
+        assert_eq!((world.textures.len(), textured), (1, 1));
     }
 }

@@ -272,9 +272,13 @@ fn document(content: &ExportScene) -> Result<(Value, Vec<u8>)> {
         lights.push(entry);
     }
 
+    let mut extensions_used = vec!["KHR_lights_punctual", "KHR_materials_specular"];
+    if content.materials.iter().any(|m| m.specular > 0.0) {
+        extensions_used.push("KHR_materials_ior");
+    }
     let doc = json!({
         "asset": {"version": "2.0", "generator": concat!("seethru ", env!("CARGO_PKG_VERSION"))},
-        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_specular", "KHR_materials_ior"],
+        "extensionsUsed": extensions_used,
         "extensions": {"KHR_lights_punctual": {"lights": lights}},
         "scene": 0,
         "scenes": [{

@@ -68,7 +68,8 @@ pub fn write_obj(content: &ExportScene, path: &Path) -> Result<Vec<PathBuf>> {
     );
     for (i, m) in content.materials.iter().enumerate() {
         let name = material_name(i, &m.name);
-        let c = m.linear_color;
+        // Blinn–Phong adds Kd and Ks: a coat's diffuse part is (1 − F0) ρ, as seethru's.
+        let c = m.linear_color * (1.0 - m.specular);
         let _ = writeln!(mtl, "\nnewmtl {name}\nKd {} {} {}", c.x, c.y, c.z);
         if m.specular > 0.0 {
             // A glossy lobe as Blinn–Phong's: the exponent of the same slope width (Walter
