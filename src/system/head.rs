@@ -785,6 +785,16 @@ mod tests {
         }
         let r = face_region(&rgb, &big, w, h, Rect::whole(w, h)).unwrap();
         assert_eq!((r.face_box, r.search), ([10, 3, 20, 27], [7, 0, 23, 30]));
+        // The same face further right and down: the margin is the face's size's, not its
+        // place's (3 again).
+        let mut moved = vec![false; w * h];
+        for y in 5..29 {
+            for x in 24..34 {
+                moved[y * w + x] = true;
+            }
+        }
+        let r = face_region(&rgb, &moved, w, h, Rect::whole(w, h)).unwrap();
+        assert_eq!((r.face_box, r.search), ([24, 5, 34, 29], [21, 2, 37, 30]));
         // 19 pixels are no face; 20 are.
         let mut few = vec![false; w * h];
         for i in 0..19 {
