@@ -4,6 +4,7 @@
 //! parameter table of every object kind; the defaults below are the ones documented there.
 
 pub mod builtin;
+pub mod coat_keys;
 pub mod curved_body;
 pub mod display_keys;
 pub mod display_surface;

@@ -7,10 +7,11 @@ use std::path::Path;
 use glam::{DAffine3, DMat3, DQuat, DVec3, EulerRot};
 
 use crate::geometry::camera::{Camera, world_from_camera_rotation};
+use crate::scene::coat_keys::read_coat;
 use crate::scene::light_keys::{read_photometry, read_sky, read_sun};
 use crate::scene::limits::{
-    DEFAULT_ROUGHNESS, MAX_DISPLAY_SIZE, MAX_LENGTH, MAX_MATERIALS, MAX_MOUNT_OFFSET, MAX_OBJECTS,
-    MAX_ROTATION_DEG, MAX_TRIANGLES, MAX_UV_REPEAT, MIN_LENGTH, MIN_ROUGHNESS, out_of_world,
+    MAX_DISPLAY_SIZE, MAX_LENGTH, MAX_MATERIALS, MAX_MOUNT_OFFSET, MAX_OBJECTS, MAX_ROTATION_DEG,
+    MAX_TRIANGLES, MAX_UV_REPEAT, MIN_LENGTH, out_of_world,
 };
 use crate::scene::motion::read_object_motion;
 use crate::scene::source::{SceneError, SourceFile};
@@ -151,21 +152,6 @@ fn read_materials(root: &TableReader) -> Result<Vec<Material>, SceneError> {
         t.finish()?;
     }
     Ok(materials)
-}
-
-/// A glossy coat's keys, `specular` (F0, [0, 1], default 0: none) and `roughness` (GGX α,
-/// [`MIN_ROUGHNESS`], 1], default [`DEFAULT_ROUGHNESS`]), of a `[[material]]` or `[road]`;
-/// a roughness without a coat to shape is refused.
-pub(crate) fn read_coat(t: &TableReader) -> Result<(f64, f64), SceneError> {
-    let specular = t.f64_in("specular", 0.0, 0.0, 1.0)?;
-    let roughness = t.f64_in("roughness", DEFAULT_ROUGHNESS, MIN_ROUGHNESS, 1.0)?;
-    if t.has("roughness") && specular == 0.0 {
-        return Err(t.error(
-            "roughness",
-            "shapes the glossy coat, and there is none: give specular in (0, 1] too",
-        ));
-    }
-    Ok((specular, roughness))
 }
 
 /// Resolves an asset path relative to the scene file and checks that it exists.

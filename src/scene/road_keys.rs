@@ -3,6 +3,7 @@
 
 use glam::{DAffine3, DMat3, DVec3};
 
+use crate::scene::coat_keys::read_coat;
 use crate::scene::lane_route::LaneRoute;
 use crate::scene::limits::MAX_LENGTH;
 use crate::scene::motion::{MovesWith, ObjectMotion};
@@ -120,7 +121,7 @@ pub fn read_road(root: &TableReader, objects: &[Object]) -> Result<Option<Road>,
         }
     };
     let defaults = RoadLook::default();
-    let (specular, roughness) = crate::scene::read::read_coat(&t)?;
+    let (specular, roughness) = read_coat(&t)?;
     let look = RoadLook {
         asphalt: t.color("asphalt_color", defaults.asphalt)?,
         sidewalk: t.color("sidewalk_color", defaults.sidewalk)?,
