@@ -781,6 +781,15 @@ fn lamps_export_as_mitsuba_emitters_and_gltf_lights_of_their_intensity() {
     }
 }
 
+/// A GLB's JSON chunk as written (the gltf crate drops extensions it does not model): after
+/// the 12-byte header, the chunk's length and type.
+fn glb_json(path: &Path) -> serde_json::Value {
+    let bytes = std::fs::read(path).unwrap();
+    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    assert_eq!(&bytes[16..20], b"JSON");
+    serde_json::from_slice(&bytes[20..20 + length]).unwrap()
+}
+
 /// The `bsdf` elements directly inside `n`.
 fn child_bsdfs<'a, 'input>(n: roxmltree::Node<'a, 'input>) -> Vec<roxmltree::Node<'a, 'input>> {
     n.children().filter(|c| c.has_tag_name("bsdf")).collect()
@@ -873,12 +882,7 @@ fn glossy_materials_export_as_a_coat_of_their_f0_and_roughness_in_every_format()
 
     let glb = dir.path().join("wet.glb");
     export(&scene, &world, &glb, Some(ExportFormat::Gltf)).unwrap();
-    // The JSON chunk as written (the gltf crate drops extensions it does not model): after
-    // the 12-byte header, the chunk's length and type.
-    let bytes = std::fs::read(&glb).unwrap();
-    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    assert_eq!(&bytes[16..20], b"JSON");
-    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + length]).unwrap();
+    let json = glb_json(&glb);
     for m in &scene.materials {
         let got = (json["materials"].as_array().unwrap().iter())
             .find(|g| g["name"] == m.name.as_str())
@@ -910,9 +914,7 @@ fn glossy_materials_export_as_a_coat_of_their_f0_and_roughness_in_every_format()
     assert!(used.contains("KHR_materials_ior"), "{used}");
     // A Lambertian scene does not use it.
     let das = export_das("das.glb", Some(ExportFormat::Gltf));
-    let bytes = std::fs::read(&das.path).unwrap();
-    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + length]).unwrap();
+    let json = glb_json(&das.path);
     assert!(
         !json["extensionsUsed"]
             .to_string()
