@@ -13,6 +13,7 @@ use seethru::analysis::examples::paper_occlusion;
 use seethru::measure::ratio::ratio_estimate;
 use seethru::measure::ratio_setup::{Compensation, Setup};
 use seethru::paper::reproduce::reproduce_estimate;
+use seethru::scene::Scene;
 use seethru::system::memory::bench_estimate;
 
 /// The paper's occlusion case as `seethru ratio` arguments, and as a setup.
@@ -82,7 +83,8 @@ fn estimates_bound_the_memory_each_command_uses() {
             estimate.bytes
         );
     }
-    let estimate = reproduce_estimate(&repo_path("scenes/das.toml"), true).unwrap();
+    let estimate =
+        reproduce_estimate(&Scene::load(&repo_path("scenes/das.toml")).unwrap(), true).unwrap();
     let peak = peak_bytes(&["reproduce", "--quick", "--out", out.to_str().unwrap()]);
     assert!(
         peak <= estimate.bytes + PROCESS_BYTES,
@@ -114,8 +116,12 @@ fn estimates_grow_with_what_they_count() {
     );
     // reproduce: the full size renders 1280-wide driver views where --quick renders 256.
     let das_path = repo_path("scenes/das.toml");
-    let full = reproduce_estimate(&das_path, false).unwrap().bytes;
-    let quick = reproduce_estimate(&das_path, true).unwrap().bytes;
+    let full = reproduce_estimate(&Scene::load(&das_path).unwrap(), false)
+        .unwrap()
+        .bytes;
+    let quick = reproduce_estimate(&Scene::load(&das_path).unwrap(), true)
+        .unwrap()
+        .bytes;
     // Every case's width grows at least 4× (the ratio cases 480 → 1920): 16× the pixels.
     assert!(full > 8 * quick, "{full} against {quick}");
 }

@@ -414,7 +414,9 @@ fn a_wet_map_coats_its_lanes_sidewalks_kerbs_and_marks_but_not_its_verges() {
 #[test]
 fn what_the_importer_skips_in_a_map_is_a_warning_naming_the_map() {
     // A road with a `<geometry>` of no length (which xodr drops, and says so) renders, with
-    // one `warning:` line naming the map and the geometry; the bundled map has none.
+    // one `warning:` line naming the map and the geometry; the bundled map has none. So do
+    // `capture` and `dataset`, which read the scene their own way, and `reproduce`, which
+    // says it before it refuses a scene without das's car.
     let dir = tempfile::tempdir().unwrap();
     let geometry = "<geometry s=\"0\" x=\"-20\" y=\"0\" hdg=\"0\" length=\"60\"><line/></geometry>";
     let right = lane(-1, "driving", &width(3.5, 0.0), "none", "");
@@ -423,31 +425,62 @@ fn what_the_importer_skips_in_a_map_is_a_warning_naming_the_map() {
     let with_dropped = plain.replacen("</planView>", &format!("{dropped}</planView>"), 1);
     for (xodr, warned) in [(map(&[plain]), false), (map(&[with_dropped]), true)] {
         let scene = scene_with_road(dir.path(), &xodr, "");
-        let out = dir.path().join("out");
-        let (ok, _, stderr) = common::seethru(&[
-            "render",
-            scene.to_str().unwrap(),
-            "--view",
-            "truth",
-            "--width",
-            "16",
-            "--quiet",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert!(ok, "{stderr}");
-        let warnings: Vec<&str> = stderr
-            .lines()
-            .filter(|l| l.starts_with("warning: "))
-            .collect();
-        if warned {
-            assert_eq!(warnings.len(), 1, "{stderr}");
-            assert!(
-                warnings[0].contains("map.xodr") && warnings[0].contains("<geometry> at s 60"),
-                "{stderr}"
-            );
-        } else {
-            assert!(warnings.is_empty(), "{stderr}");
+        let scene = scene.to_str().unwrap();
+        let spec = dir.path().join("spec.toml");
+        std::fs::write(
+            &spec,
+            format!("scene = {scene:?}\nsamples = 1\nseed = 1\n[options]\nwidth = 16\nspp = 1\n"),
+        )
+        .unwrap();
+        let spec = spec.to_str().unwrap();
+        let out = dir.path().join(format!("out_{warned}"));
+        let at = |name: &str| out.join(name).to_str().unwrap().to_string();
+        let small = ["--width", "16", "--frontal-width", "16", "--quiet"];
+        let commands: Vec<(Vec<String>, bool)> = [
+            (
+                vec![
+                    "render", scene, "--view", "truth", "--width", "16", "--quiet", "--out",
+                ],
+                "render",
+                true,
+            ),
+            (
+                [&["capture", scene][..], &small, &["--out"]].concat(),
+                "capture",
+                true,
+            ),
+            (vec!["dataset", spec, "--quiet", "--out"], "dataset", true),
+            (
+                vec!["reproduce", "--quick", "--scene", scene, "--out"],
+                "reproduce",
+                false,
+            ),
+        ]
+        .into_iter()
+        .map(|(args, folder, succeeds)| {
+            let mut args: Vec<String> = args.into_iter().map(String::from).collect();
+            args.push(at(folder));
+            (args, succeeds)
+        })
+        .collect();
+        for (args, succeeds) in commands {
+            let words: Vec<&str> = args.iter().map(String::as_str).collect();
+            let (ok, _, stderr) = common::seethru(&words);
+            assert_eq!(ok, succeeds, "{}: {stderr}", args[0]);
+            let warnings: Vec<&str> = stderr
+                .lines()
+                .filter(|l| l.starts_with("warning: "))
+                .collect();
+            if warned {
+                assert_eq!(warnings.len(), 1, "{}: {stderr}", args[0]);
+                assert!(
+                    warnings[0].contains("map.xodr") && warnings[0].contains("<geometry> at s 60"),
+                    "{}: {stderr}",
+                    args[0]
+                );
+            } else {
+                assert!(warnings.is_empty(), "{}: {stderr}", args[0]);
+            }
         }
     }
     let bundled = Scene::load(&common::repo_path("scenes/intersection.toml")).unwrap();

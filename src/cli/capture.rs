@@ -17,6 +17,7 @@ use seethru::system::options::RunOptions;
 
 use crate::cli::args::{choice, threads, with_threads};
 use crate::cli::option_args::{self, OptionArgs};
+use crate::cli::print_warnings;
 
 /// The flags of a capture (run's flags that decide what the system receives).
 #[derive(clap::Args)]
@@ -67,6 +68,7 @@ impl CaptureArgs {
         )?;
         with_threads(self.threads, || {
             let scene = spec_scene(&spec)?;
+            print_warnings(&scene);
             check_memory(&run_estimate(&scene, &options)?, run.max_memory_gib)?;
             let ctx = RenderContext::new(scene)?;
             let captured = capture(&ctx, &options, run.depth)?;

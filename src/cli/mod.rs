@@ -112,10 +112,15 @@ pub enum Command {
 /// printed as `warning:` lines on stderr.
 pub fn load_scene(path: &std::path::Path) -> Result<seethru::scene::Scene> {
     let scene = seethru::scene::Scene::load(path)?;
+    print_warnings(&scene);
+    Ok(scene)
+}
+
+/// What reading `scene` doubted, one `warning:` line each on stderr.
+pub fn print_warnings(scene: &seethru::scene::Scene) {
     for warning in &scene.warnings {
         eprintln!("warning: {warning}");
     }
-    Ok(scene)
 }
 
 /// The command line with every negative number that follows an option joined to it

@@ -10,6 +10,7 @@ use seethru::paper::reproduce::reproduce_estimate;
 use seethru::system::memory::check_memory;
 
 use crate::cli::args::{MemoryLimit, threads, with_threads};
+use crate::cli::load_scene;
 
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
@@ -60,13 +61,14 @@ impl Reproduce {
                 (builtin.scene(), label, Some(builtin))
             }
         };
+        let base = load_scene(&scene)?;
         check_memory(
-            &reproduce_estimate(&scene, self.quick)?,
+            &reproduce_estimate(&base, self.quick)?,
             self.memory.max_memory,
         )?;
         let staged = seethru::io::staged::StagedDir::new(&self.out)?;
         with_threads(self.threads, || {
-            seethru::paper::reproduce::reproduce_named(&scene, &label, staged.path(), self.quick)
+            seethru::paper::reproduce::reproduce_named(&base, &label, staged.path(), self.quick)
         })??;
         staged.commit()?;
         seethru::util::progress::summary(format!(

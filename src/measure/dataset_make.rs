@@ -59,7 +59,8 @@ pub struct DatasetMade {
     pub seconds: f64,
     /// Whether every sample is done and the manifest and view.html were written.
     pub manifest: bool,
-    /// Each made sample's warnings, as "sample N: …" in the library's words.
+    /// What reading the base scene doubted (an OpenDRIVE map's skipped features), then each
+    /// made sample's warnings, as "sample N: …", in the library's words.
     pub warnings: Vec<String>,
 }
 
@@ -124,7 +125,9 @@ pub fn make_dataset(job: &DatasetJob) -> Result<DatasetMade> {
         samples: spec.samples,
         seconds: start.elapsed().as_secs_f64(),
         manifest,
-        warnings: warnings.into_iter().flatten().collect(),
+        warnings: (base.scene.warnings.iter().cloned())
+            .chain(warnings.into_iter().flatten())
+            .collect(),
     })
 }
 

@@ -109,16 +109,15 @@ fn ratio_setups() -> [(&'static str, &'static str, Setup); 2] {
     ]
 }
 
-/// Memory a reproduction of the scene at `scene_path` needs: its largest case, one after
-/// another, with the metric maps of the car's two θ_F cases kept for their comparison.
-pub fn reproduce_estimate(scene_path: &Path, quick: bool) -> Result<MemoryEstimate> {
+/// Memory a reproduction of scene `base` needs: its largest case, one after another, with
+/// the metric maps of the car's two θ_F cases kept for their comparison.
+pub fn reproduce_estimate(base: &Scene, quick: bool) -> Result<MemoryEstimate> {
     let sizes = sizes(quick);
-    let base = Scene::load(scene_path)?;
     let options = case_options(&sizes);
     let mut estimates = Vec::new();
     for (_, distance) in CARS {
         for theta in THETAS_DEG {
-            let scene = das_case(&base, distance, 1.0, theta)?;
+            let scene = das_case(base, distance, 1.0, theta)?;
             let mut estimate = run_estimate(&scene, &options)?;
             let driver = options.sized_driver(scene.driver)?;
             let kept = THETAS_DEG.len() as u64
@@ -141,19 +140,19 @@ pub fn reproduce_estimate(scene_path: &Path, quick: bool) -> Result<MemoryEstima
 
 /// Runs the reproduction into `out`; returns `report.json`'s content.
 pub fn reproduce(scene_path: &Path, out: &Path, quick: bool) -> Result<serde_json::Value> {
-    reproduce_named(scene_path, &scene_path.display().to_string(), out, quick)
+    let base = Scene::load(scene_path)?;
+    reproduce_named(&base, &scene_path.display().to_string(), out, quick)
 }
 
-/// As [`reproduce`], the report naming the scene `scene_name` (the built-in copy's
-/// temporary path would mean nothing to a reader).
+/// As [`reproduce`] on scene `base`, read from the file the report names `scene_name` (the
+/// built-in copy's temporary path would mean nothing to a reader).
 pub fn reproduce_named(
-    scene_path: &Path,
+    base: &Scene,
     scene_name: &str,
     out: &Path,
     quick: bool,
 ) -> Result<serde_json::Value> {
     let sizes = sizes(quick);
-    let base = Scene::load(scene_path)?;
     let mut cases = Vec::new();
     let mut equal = Vec::new();
     // Four display cases, then the two ratio setups.
@@ -164,7 +163,7 @@ pub fn reproduce_named(
         for theta in THETAS_DEG {
             let name = format!("car {car_label} (≈{distance} m), θ_F = {theta}°, D = 1 m");
             let dir = format!("car_{car_label}_theta{}", theta as u32);
-            let scene = das_case(&base, distance, 1.0, theta)?;
+            let scene = das_case(base, distance, 1.0, theta)?;
             let ctx = RenderContext::new(scene)?;
             let result = run(&ctx, &case_options(&sizes))?;
             let (maps, metrics) = measure(
