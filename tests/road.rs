@@ -488,6 +488,42 @@ fn what_the_importer_skips_in_a_map_is_a_warning_naming_the_map() {
 }
 
 #[test]
+fn the_map_is_read_once_with_the_scene() {
+    // The world is built from the map the scene read: a map file changed (here spoiled)
+    // after the scene was read does not reach it, and the road is the one read.
+    let dir = tempfile::tempdir().unwrap();
+    let geometry = "<geometry s=\"0\" x=\"-20\" y=\"0\" hdg=\"0\" length=\"60\"><line/></geometry>";
+    let right = lane(-1, "driving", &width(3.5, 0.0), "none", "");
+    let path = scene_with_road(
+        dir.path(),
+        &map(&[road("1", geometry, 60.0, "", &right, "")]),
+        "",
+    );
+    let scene = Scene::load(&path).unwrap();
+    let before = World::build(&scene).unwrap();
+    std::fs::write(dir.path().join("map.xodr"), "not a map").unwrap();
+    let after = World::build(&scene).unwrap();
+    let asphalt = map_vertices(&before, road_part::ASPHALT);
+    assert!(!asphalt.is_empty());
+    assert_eq!(map_vertices(&after, road_part::ASPHALT), asphalt);
+    assert_eq!(after.triangles.len(), before.triangles.len());
+    // Two reads of one text are equal scenes; a different text is not.
+    let again = scene_with_road(
+        dir.path(),
+        &map(&[road("1", geometry, 60.0, "", &right, "")]),
+        "",
+    );
+    assert_eq!(Scene::load(&again).unwrap(), scene);
+    let wider = lane(-1, "driving", &width(3.6, 0.0), "none", "");
+    let other = scene_with_road(
+        dir.path(),
+        &map(&[road("1", geometry, 60.0, "", &wider, "")]),
+        "",
+    );
+    assert_ne!(Scene::load(&other).unwrap(), scene);
+}
+
+#[test]
 fn signals_are_boards_of_their_size_at_their_place_facing_their_heading() {
     // A sign 3 m right of the reference line at s = 20 (x = 0), 2 m up, 0.8 × 0.5 m, facing
     // the traffic; a traffic light at s = 30 (x = 10) turned a quarter turn by its hOffset,

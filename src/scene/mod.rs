@@ -136,6 +136,8 @@ pub enum Shape {
     Road {
         path: PathBuf,
         look: road_map::RoadLook,
+        /// The map as read with the scene (not read again to build the world).
+        map: road_map::ParsedMap,
     },
     /// The built-in head mesh (`scene/head_model.rs`, the triangles of `assets/head.obj`,
     /// built into the binary): the driver's face of `[camera.driver] face = "mesh"`.

@@ -61,7 +61,7 @@ pub fn read_road(root: &TableReader, objects: &[Object]) -> Result<Option<Road>,
         ));
     }
     let path = t.existing_asset("xodr", rel)?;
-    let (network, warnings) =
+    let (map, warnings) =
         read_network(&path).map_err(|e| t.error("xodr", format!("`{rel}`: {e:#}")))?;
     let warnings = (warnings.into_iter())
         .map(|w| crate::util::message::printable(&format!("{}: {w}", path.display())))
@@ -87,7 +87,7 @@ pub fn read_road(root: &TableReader, objects: &[Object]) -> Result<Option<Road>,
                 ));
             }
             let s = t.f64_in("ego_s", 0.0, 0.0, MAX_LENGTH)?;
-            let pose = lane_pose(&network, road, lane, s).map_err(|e| {
+            let pose = lane_pose(&map.network, road, lane, s).map_err(|e| {
                 let key = match e.about {
                     PoseInput::Road => "ego_road",
                     PoseInput::Lane => "ego_lane",
@@ -103,7 +103,7 @@ pub fn read_road(root: &TableReader, objects: &[Object]) -> Result<Option<Road>,
                 .filter_map(Turn::parse)
                 .collect();
             let route = LaneRoute::new(
-                route_points(&network, &pose, &turns)
+                route_points(&map.network, &pose, &turns)
                     .into_iter()
                     .map(|p| world_from_map.transform_point3(p)),
             );
@@ -140,7 +140,7 @@ pub fn read_road(root: &TableReader, objects: &[Object]) -> Result<Option<Road>,
     t.finish()?;
     let object = Object {
         name: ROAD_OBJECT_NAME.to_string(),
-        shape: Shape::Road { path, look },
+        shape: Shape::Road { path, look, map },
         material: None,
         file_materials: Vec::new(),
         world_from_object: world_from_map,

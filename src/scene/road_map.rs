@@ -8,6 +8,7 @@
 //! z (up), metres. `scene/road_keys.rs` places it in the world.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use anyhow::{Context, Result, anyhow, bail};
 use glam::{DVec3, Vec2, Vec3};
@@ -18,6 +19,7 @@ use crate::scene::mesh_io::{FileMaterial, LoadedMesh};
 use crate::scene::shapes::{Tri, cuboid};
 use crate::scene::source::one_line;
 use crate::util::color::srgb_to_linear3;
+use crate::util::hash::Fnv64;
 use crate::util::input_file::read_input_text;
 use crate::util::message::printable;
 
@@ -87,16 +89,48 @@ impl Default for RoadLook {
     }
 }
 
+/// A map as the scene read it: baked once, when the scene file is read, and turned into
+/// triangles from that when the world is built.
+#[derive(Clone)]
+pub struct ParsedMap {
+    pub network: Arc<RoadNetwork>,
+    /// FNV-1a of the texts read (the map's, then each `<include>`'s in the order read): the
+    /// parse is a function of them, so two maps of equal texts are equal.
+    pub texts_hash: u64,
+}
+
+impl PartialEq for ParsedMap {
+    fn eq(&self, other: &Self) -> bool {
+        self.texts_hash == other.texts_hash
+    }
+}
+
+impl std::fmt::Debug for ParsedMap {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "ParsedMap({:016x})", self.texts_hash)
+    }
+}
+
 /// Reads and bakes a map, its `<include>`s read from its folder, each within the mesh size
 /// limit; with it, one line per thing the importer dropped or doubted (xodr's warnings: a
 /// feature it skips, a road it could not bake). Errors name the problem; the caller names
 /// the file.
-pub fn read_network(path: &Path) -> Result<(RoadNetwork, Vec<String>)> {
+pub fn read_network(path: &Path) -> Result<(ParsedMap, Vec<String>)> {
     let xml = read_input_text(path, MAX_MESH_BYTES).context("cannot read it")?;
     let folder = path.parent().unwrap_or(Path::new("")).to_path_buf();
-    parse_network(&xml, |name: &str| {
-        read_input_text(&folder.join(name), MAX_MESH_BYTES).map_err(|e| format!("{name}: {e}"))
-    })
+    let mut hash = Fnv64::default();
+    hash.bytes(xml.as_bytes());
+    let (network, warnings) = parse_network(&xml, |name: &str| {
+        let text = read_input_text(&folder.join(name), MAX_MESH_BYTES)
+            .map_err(|e| format!("{name}: {e}"))?;
+        hash.bytes(text.as_bytes());
+        Ok(text)
+    })?;
+    let map = ParsedMap {
+        network: Arc::new(network),
+        texts_hash: hash.finish(),
+    };
+    Ok((map, warnings))
 }
 
 /// Bakes a map's text, `read_include` giving the text of each file an `<include>` names;
@@ -115,13 +149,6 @@ pub fn parse_network(
         .map(|w| printable(&one_line(&w.to_string())))
         .collect();
     Ok((network, warnings))
-}
-
-/// The map at `path` as a mesh in its own frame: [`road_triangles`] of [`read_network`].
-pub fn load_road(path: &Path, look: &RoadLook) -> Result<LoadedMesh> {
-    let (network, _) =
-        read_network(path).with_context(|| format!("road map {}", path.display()))?;
-    Ok(road_triangles(&network, look))
 }
 
 /// What each lane type is drawn as.
