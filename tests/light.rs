@@ -1059,3 +1059,74 @@ fn a_wet_black_floor_mirrors_the_low_sun_where_the_angles_of_incidence_and_refle
     assert!(shaded.len() > 20, "{}", shaded.len());
     assert!(shaded.iter().all(|&(_, y)| y == 0.0), "{shaded:?}");
 }
+
+#[test]
+fn a_mirror_floor_shows_the_lit_wall_before_it_and_the_black_sky_around_it() {
+    // A black floor under a perfect, smooth coat (F0 1, α 0.01) before a white wall 4 m wide
+    // and 3 m high whose face is at z = 7.9 m, lit by a sun 30° high behind the camera,
+    // under a black sky; 16 samples a pixel. Where a floor point's mirror ray (the view's
+    // ray reflected about the floor) meets the wall at least 0.4 m inside its edges, the
+    // floor shows the wall's luminance, less what GGX's long tail sends past the wall (0.4 %
+    // on average here) and never more (the weight G2/G1 is at most 1, and the sun's disc,
+    // behind the camera, is not gathered); where it passes the wall by 0.4 m, the sky's black
+    // but for that tail. Without reflection rays the whole floor would be black; a reflection
+    // mirrored the wrong way across or along the view would swap the two sets.
+    let light = "[sun]\nilluminance_lux = 100000\nelevation_deg = 30\nazimuth_deg = 0\n\
+                 [sky]\nzenith_luminance_cd_m2 = 0\ncloud_cover = 0\n\
+                 [photometry]\nwhite_cd_m2 = 5000\n";
+    let wall = "[[material]]\nname = \"white\"\ncolor = [0.8, 0.8, 0.8]\n\
+                [[object]]\nname = \"wall\"\nkind = \"box\"\nmaterial = \"white\"\n\
+                size = [4.0, 3.0, 0.2]\ntranslate = [0.0, 1.5, 8.0]\n";
+    let scene = grey_with(&floor_scene(0.0, light), "specular = 1\nroughness = 0.01");
+    let dir = tempfile::tempdir().unwrap();
+    let out = seethru_on(
+        dir.path(),
+        &format!("{scene}{wall}"),
+        "render",
+        &["--view", "truth", "--width", "160", "--spp", "16"],
+    );
+    let channels = exr_channels(&out.join("truth.exr"));
+    let [px, py, pz, id] = ["P.X", "P.Y", "P.Z", "id.object"].map(|c| &channels[c]);
+    let y = luminance(&channels);
+    let mut wall: Vec<f64> = (0..y.len())
+        .filter(|&i| id[i] == 2.0)
+        .map(|i| y[i])
+        .collect();
+    assert!(wall.len() > 500, "{}", wall.len());
+    wall.sort_by(f64::total_cmp);
+    let lw = wall[wall.len() / 2];
+    assert!(lw > 1000.0, "{lw}");
+    let eye = glam::DVec3::new(0.0, 1.2, 0.0);
+    let (mut inside, mut outside) = (Vec::new(), Vec::new());
+    for i in (0..y.len()).filter(|&i| id[i] == 1.0) {
+        let p = glam::DVec3::new(px[i], py[i], pz[i]);
+        let view = (p - eye).normalize();
+        let mirror = glam::DVec3::new(view.x, -view.y, view.z);
+        let t = (7.9 - p.z) / mirror.z;
+        let q = p + mirror * t;
+        assert!(
+            y[i] <= 1.01 * lw,
+            "at {p}: {} brighter than the wall's {lw}",
+            y[i]
+        );
+        if t > 0.0 && q.x.abs() < 1.6 && q.y > 0.4 && q.y < 2.6 {
+            inside.push(y[i] / lw);
+        } else if t <= 0.0 || q.x.abs() > 2.4 || q.y > 3.4 {
+            outside.push(y[i] / lw);
+        }
+    }
+    assert!(
+        inside.len() > 100 && outside.len() > 100,
+        "{} inside, {} outside",
+        inside.len(),
+        outside.len()
+    );
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let bright = inside.iter().filter(|&&r| r > 0.8).count() as f64 / inside.len() as f64;
+    assert!(
+        mean(&inside) > 0.97 && bright > 0.95,
+        "inside: mean {}, {bright} above 0.8",
+        mean(&inside)
+    );
+    assert!(mean(&outside) < 0.05, "outside: mean {}", mean(&outside));
+}

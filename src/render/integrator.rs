@@ -30,7 +30,7 @@ use crate::scene::world::{SurfaceHit, SurfaceMaterial, World, view_bit};
 use crate::scene::{DisplayLight, Scene};
 use crate::util::color::luminance;
 use crate::util::color::srgb_to_linear3;
-use crate::util::sampling::pixel_offset;
+use crate::util::sampling::{hash_u32, hash_words, pixel_offset, unit_float};
 
 thread_local! {
     /// The traversal stack of [`RenderContext::trace`].
@@ -64,6 +64,9 @@ struct Lobe {
     lamps: Vec3,
     /// π × the lobe's BRDF toward the sun (0 where the sun is below the surface).
     sun: f32,
+    /// What the sample's reflection ray gathered (the sky, or the surface it met, lit
+    /// directly), times its weight: radiance in units of the white.
+    reflected: Vec3,
 }
 
 impl Lobe {
@@ -335,6 +338,9 @@ impl RenderContext {
                     (Some(s), _) => {
                         let mut sh = self.shade_begin(s, dirs[lane]);
                         sh.lamps = self.lamps_at(s, sh.lobe.as_mut(), job.view, stack, shadows);
+                        if let Some(lobe) = sh.lobe.as_mut() {
+                            self.reflection_at(s, lobe, job.view, stack, shadows);
+                        }
                         if sh.cos > 0.0 {
                             *shadows += 1;
                             let ray = shadow_ray(s.position, s.normal, self.sky.sun_direction);
@@ -597,8 +603,25 @@ impl RenderContext {
         stack: &mut Stack,
         shadows: &mut u64,
     ) -> Vec3 {
+        self.shade_lit(s, dir, view, stack, shadows, true)
+    }
+
+    /// [`RenderContext::shade`], a glossy lobe's reflection ray traced where `reflect`
+    /// (not for the surface a reflection ray meets: one bounce).
+    fn shade_lit(
+        &self,
+        s: &SurfaceHit,
+        dir: Vec3,
+        view: u8,
+        stack: &mut Stack,
+        shadows: &mut u64,
+        reflect: bool,
+    ) -> Vec3 {
         let mut sh = self.shade_begin(s, dir);
         sh.lamps = self.lamps_at(s, sh.lobe.as_mut(), view, stack, shadows);
+        if let (Some(lobe), true) = (sh.lobe.as_mut(), reflect) {
+            self.reflection_at(s, lobe, view, stack, shadows);
+        }
         let mut lit = false;
         if sh.cos > 0.0 {
             *shadows += 1;
@@ -632,6 +655,7 @@ impl RenderContext {
                 to_eye: -dir,
                 lamps: Vec3::ZERO,
                 sun: 0.0,
+                reflected: Vec3::ZERO,
             };
             if cos > 0.0 {
                 lobe.sun = lobe.pi_brdf(self.sky.sun_direction);
@@ -694,6 +718,32 @@ impl RenderContext {
         sum
     }
 
+    /// Traces the reflection ray of `lobe` at `s` ([`specular::sample_reflection`], its two
+    /// numbers hashed from the point, so the per-ray and the packet paths draw the same) and
+    /// keeps what it gathers: the sky without the sun's disc, or the surface it meets, shaded
+    /// by the sun, the sky and the lamps (no second reflection).
+    fn reflection_at(
+        &self,
+        s: &SurfaceHit,
+        lobe: &mut Lobe,
+        view: u8,
+        stack: &mut Stack,
+        shadows: &mut u64,
+    ) {
+        let h = hash_words(&s.position.to_array().map(f32::to_bits));
+        let (u, v) = (unit_float(h), unit_float(hash_u32(h)));
+        let Some((dir, weight)) =
+            specular::sample_reflection(lobe.f0, lobe.alpha, lobe.normal, lobe.to_eye, u, v)
+        else {
+            return;
+        };
+        let radiance = match self.trace_with(off_surface(s.position, s.normal), dir, view, stack) {
+            Some(hit) => self.shade_lit(&hit, dir, view, stack, shadows, false),
+            None => self.sky.radiance_without_sun(dir),
+        };
+        lobe.reflected = radiance * weight;
+    }
+
     /// The shaded colour, with the sun where `lit` (its cosine positive, its ray unblocked).
     #[inline]
     fn shade_end(&self, sh: Shading, lit: bool) -> Vec3 {
@@ -706,7 +756,7 @@ impl RenderContext {
         }
         let mut colour = sh.albedo * light;
         if let Some(lobe) = sh.lobe {
-            colour += lobe.lamps;
+            colour += lobe.lamps + lobe.reflected;
             if lit {
                 colour += self.sky.sun_irradiance * (sh.cos * lobe.sun);
             }
@@ -787,10 +837,16 @@ fn axial_depth(camera_from_world: &DAffine3, p: Vec3) -> f32 {
     -(z + camera_from_world.translation.z) as f32
 }
 
-/// A ray leaving a surface point `position` (unit normal `normal`) in direction `dir`: its
-/// origin is offset along the normal, scaled with the coordinates' magnitude to stay above
-/// the f32 rounding of the hit point.
+/// A ray leaving a surface point `position` (unit normal `normal`) in direction `dir`, from
+/// [`off_surface`].
 pub fn shadow_ray(position: Vec3, normal: Vec3, dir: Vec3) -> TraceRay {
+    make_ray(off_surface(position, normal), dir, 0.0, f32::INFINITY)
+}
+
+/// Where a ray leaving the surface at `position` (unit `normal`) starts: lifted along the
+/// normal by a distance that grows with the coordinates' magnitude, to stay above the f32
+/// rounding of the hit point.
+fn off_surface(position: Vec3, normal: Vec3) -> Vec3 {
     let eps = 2e-4 * (1.0 + position.abs().max_element());
-    make_ray(position + normal * eps, dir, 0.0, f32::INFINITY)
+    position + normal * eps
 }

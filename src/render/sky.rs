@@ -122,12 +122,22 @@ impl SkyModel {
 
     /// Radiance seen along a ray that leaves the scene in direction `dir` (unit).
     pub fn radiance(&self, dir: Vec3) -> Vec3 {
+        self.radiance_of(dir, true)
+    }
+
+    /// [`SkyModel::radiance`] without the sun's disc: what a glossy coat's reflection rays
+    /// gather (the coat reflects the sun already, as the delta light it is to the shading).
+    pub fn radiance_without_sun(&self, dir: Vec3) -> Vec3 {
+        self.radiance_of(dir, false)
+    }
+
+    fn radiance_of(&self, dir: Vec3, sun: bool) -> Vec3 {
         let base = self.gradient(dir);
         let cloud = self.cloud_density(dir);
         let cloud_color =
             Vec3::splat(0.9) * (0.55 + 0.45 * self.sun_direction.y.max(0.0)) * self.cloud_scale;
         let mut c = base.lerp(cloud_color, cloud);
-        if dir.dot(self.sun_direction) > SUN_DISC_COS && cloud < 0.5 {
+        if sun && dir.dot(self.sun_direction) > SUN_DISC_COS && cloud < 0.5 {
             c += self.sun_disc;
         }
         c

@@ -59,7 +59,7 @@ translate = [0.0, 0.0, -20.0]
 }
 
 /// Runs `seethru <command> scene.toml <flags> --spp 1 --quiet --out out` on `scene` (text)
-/// in `dir`, and returns `out`.
+/// in `dir` (`--spp 1` unless `flags` give one), and returns `out`.
 pub fn seethru_on(dir: &Path, scene: &str, command: &str, flags: &[&str]) -> std::path::PathBuf {
     let file = dir.join("scene.toml");
     std::fs::write(&file, scene).unwrap();
@@ -67,7 +67,10 @@ pub fn seethru_on(dir: &Path, scene: &str, command: &str, flags: &[&str]) -> std
     let _ = std::fs::remove_dir_all(&out);
     let mut args = vec![command, file.to_str().unwrap()];
     args.extend_from_slice(flags);
-    args.extend(["--spp", "1", "--quiet", "--out", out.to_str().unwrap()]);
+    if !flags.contains(&"--spp") {
+        args.extend(["--spp", "1"]);
+    }
+    args.extend(["--quiet", "--out", out.to_str().unwrap()]);
     let (ok, _, stderr) = super::seethru(&args);
     assert!(ok, "{stderr}");
     out
