@@ -260,7 +260,7 @@ impl RenderContext {
             // A display emits its image: no shading.
             sum += match (&hit, &shown) {
                 (_, Some(d)) => d.color,
-                (Some(s), None) => self.shade(s, dir, job.view, stack, shadows),
+                (Some(s), None) => self.shade(s, dir, job.view, stack, shadows, true),
                 (None, None) => self.sky.radiance(dir),
             };
             if sample == job.samples.start {
@@ -460,7 +460,7 @@ impl RenderContext {
             Shown::FrontalRay(origin, dir) => {
                 match self.trace_with(origin, dir, view_bit::FRONTAL, stack) {
                     Some(s) => Pixel {
-                        color: self.shade(&s, dir, view_bit::FRONTAL, stack, shadows),
+                        color: self.shade(&s, dir, view_bit::FRONTAL, stack, shadows, true),
                         depth: s.t,
                         camera_z: s.t,
                         position: s.position,
@@ -594,21 +594,9 @@ impl RenderContext {
 
     /// The radiance toward a ray of direction `dir` from the surface `s` it meets: Lambert
     /// shading, albedo × (sun × cos × visibility + sky ambient + lamps), and the highlights
-    /// of a glossy material's lobe.
+    /// of a glossy material's lobe, with its reflection ray where `reflect` (not for the
+    /// surface a reflection ray meets: one bounce).
     fn shade(
-        &self,
-        s: &SurfaceHit,
-        dir: Vec3,
-        view: u8,
-        stack: &mut Stack,
-        shadows: &mut u64,
-    ) -> Vec3 {
-        self.shade_lit(s, dir, view, stack, shadows, true)
-    }
-
-    /// [`RenderContext::shade`], a glossy lobe's reflection ray traced where `reflect`
-    /// (not for the surface a reflection ray meets: one bounce).
-    fn shade_lit(
         &self,
         s: &SurfaceHit,
         dir: Vec3,
@@ -738,7 +726,7 @@ impl RenderContext {
             return;
         };
         let radiance = match self.trace_with(off_surface(s.position, s.normal), dir, view, stack) {
-            Some(hit) => self.shade_lit(&hit, dir, view, stack, shadows, false),
+            Some(hit) => self.shade(&hit, dir, view, stack, shadows, false),
             None => self.sky.radiance_without_sun(dir),
         };
         lobe.reflected = radiance * weight;

@@ -112,27 +112,10 @@ fn smith_lambda(a2: f32, cos: f32) -> f32 {
 mod tests {
     use super::*;
 
-    /// The lobe's directional albedo toward `to_eye`: ∫ f cos θi dωi over the hemisphere, by
-    /// the midpoint rule in (cos θi, φ), `n` steps a side.
+    /// The lobe's directional albedo toward `to_eye`: ∫ f cos θi dωi over the hemisphere
+    /// (its reflection of a uniform sky of radiance 1).
     fn albedo(f0: f32, alpha: f32, to_eye: Vec3, n: usize) -> f64 {
-        let mut sum = 0.0f64;
-        for i in 0..n {
-            let cos = (i as f64 + 0.5) / n as f64;
-            let sin = (1.0 - cos * cos).sqrt();
-            for j in 0..n {
-                let phi = std::f64::consts::TAU * (j as f64 + 0.5) / n as f64;
-                let to_light = Vec3::new(
-                    (sin * phi.cos()) as f32,
-                    cos as f32,
-                    (sin * phi.sin()) as f32,
-                );
-                // f cos dω = (π f / π) cos d(cos θ) dφ.
-                let f =
-                    f64::from(pi_brdf(f0, alpha, Vec3::Y, to_light, to_eye)) / std::f64::consts::PI;
-                sum += f * cos;
-            }
-        }
-        sum * std::f64::consts::TAU / (n * n) as f64
+        reflected(f0, alpha, to_eye, &|_| 1.0, n)
     }
 
     #[test]
@@ -170,8 +153,8 @@ mod tests {
         }
     }
 
-    /// The lobe's reflection of a sky of radiance `sky` toward `to_eye`, by the midpoint
-    /// rule over the hemisphere, `n` steps a side (as [`albedo`]).
+    /// The lobe's reflection of a sky of radiance `sky` toward `to_eye`, ∫ f L cos θi dωi, by
+    /// the midpoint rule in (cos θi, φ), `n` steps a side.
     fn reflected(f0: f32, alpha: f32, to_eye: Vec3, sky: &dyn Fn(Vec3) -> f64, n: usize) -> f64 {
         let mut sum = 0.0f64;
         for i in 0..n {
@@ -184,6 +167,7 @@ mod tests {
                     cos as f32,
                     (sin * phi.sin()) as f32,
                 );
+                // f cos dω = (π f / π) cos d(cos θ) dφ.
                 let f =
                     f64::from(pi_brdf(f0, alpha, Vec3::Y, to_light, to_eye)) / std::f64::consts::PI;
                 sum += f * cos * sky(to_light);
