@@ -415,8 +415,8 @@ fn a_wet_map_coats_its_lanes_sidewalks_kerbs_and_marks_but_not_its_verges() {
 fn what_the_importer_skips_in_a_map_is_a_warning_naming_the_map() {
     // A road with a `<geometry>` of no length (which xodr drops, and says so) renders, with
     // one `warning:` line naming the map and the geometry; the bundled map has none. So do
-    // `capture` and `dataset`, which read the scene their own way, and `reproduce`, which
-    // says it before it refuses a scene without das's car.
+    // `capture` and `dataset`, which read the scene their own way, `score`, which captures
+    // again, and `reproduce`, which says it before it refuses a scene without das's car.
     let dir = tempfile::tempdir().unwrap();
     let geometry = "<geometry s=\"0\" x=\"-20\" y=\"0\" hdg=\"0\" length=\"60\"><line/></geometry>";
     let right = lane(-1, "driving", &width(3.5, 0.0), "none", "");
@@ -436,6 +436,11 @@ fn what_the_importer_skips_in_a_map_is_a_warning_naming_the_map() {
         let out = dir.path().join(format!("out_{warned}"));
         let at = |name: &str| out.join(name).to_str().unwrap().to_string();
         let small = ["--width", "16", "--frontal-width", "16", "--quiet"];
+        // A display image of the wrong size: `score` captures again (and says the warning)
+        // before it finds that out.
+        let image = dir.path().join("one_pixel.png");
+        image::RgbImage::new(1, 1).save(&image).unwrap();
+        let (captured, image) = (at("capture"), image.to_str().unwrap().to_string());
         let commands: Vec<(Vec<String>, bool)> = [
             (
                 vec![
@@ -453,6 +458,11 @@ fn what_the_importer_skips_in_a_map_is_a_warning_naming_the_map() {
             (
                 vec!["reproduce", "--quick", "--scene", scene, "--out"],
                 "reproduce",
+                false,
+            ),
+            (
+                vec!["score", &captured, "--display-image", &image, "--out"],
+                "score",
                 false,
             ),
         ]

@@ -1,7 +1,7 @@
 //! `seethru score`: an outside method's display map (and/or display image) for a capture,
 //! shown on the display and measured exactly as `run` measures a built-in method.
 
-use crate::cli::with_flags;
+use crate::cli::{print_warnings, with_flags};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
@@ -118,6 +118,7 @@ impl Score {
             .map(|p| load_image(p, self.display_codes))
             .transpose()?;
         let mut r = recapture(&self.inputs)?;
+        print_warnings(&r.ctx.scene);
         r.options.filter = self.filter;
         let name = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
         let in_file = |e: anyhow::Error| {

@@ -176,24 +176,30 @@ mod tests {
         sum * std::f64::consts::TAU / (n * n) as f64
     }
 
-    /// The same by [`sample_reflection`], on an n × n grid of (u, v) cell midpoints.
+    /// The same by [`sample_reflection`], on an n × n grid of (u, v) cell midpoints, at a
+    /// surface turned by `tilt` (its normal `tilt` × +y, the eye and the sky turned with it).
     fn reflected_by_samples(
         f0: f32,
         alpha: f32,
         to_eye: Vec3,
         sky: &dyn Fn(Vec3) -> f64,
         n: usize,
+        tilt: glam::Quat,
     ) -> f64 {
+        let normal = tilt * Vec3::Y;
         let mut sum = 0.0f64;
         for i in 0..n {
             for j in 0..n {
                 let (u, v) = ((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
                 if let Some((to_light, weight)) =
-                    sample_reflection(f0, alpha, Vec3::Y, to_eye, u, v)
+                    sample_reflection(f0, alpha, normal, tilt * to_eye, u, v)
                 {
-                    assert!(to_light.is_normalized() && to_light.y > 0.0, "{to_light}");
+                    assert!(
+                        to_light.is_normalized() && to_light.dot(normal) > 0.0,
+                        "{to_light}"
+                    );
                     assert!((0.0..=1.0).contains(&weight), "{weight}");
-                    sum += f64::from(weight) * sky(to_light);
+                    sum += f64::from(weight) * sky(tilt.inverse() * to_light);
                 }
             }
         }
@@ -205,22 +211,31 @@ mod tests {
         // The sampled estimate of the reflected radiance equals the lobe's integral, for a
         // uniform sky (the directional albedo) and for one bright toward +x and the zenith
         // (which the directions' distribution, not only the weights' mean, must get right);
-        // rough and smooth, from above, at 53° and at grazing angles, across the azimuth.
+        // rough and smooth, from above, at 53° and at grazing angles, across the azimuth; on
+        // an upright and a leaning surface.
         let uniform = |_: Vec3| 1.0;
         let lopsided = |d: Vec3| f64::from((1.0 + d.x) * (1.0 + d.x) + 4.0 * d.y * d.y * d.y);
         let skies: [(&str, &dyn Fn(Vec3) -> f64); 2] =
             [("uniform", &uniform), ("lopsided", &lopsided)];
+        // Upright, and a surface whose normal leans to (0.3, 0.5, 0.8): the tangent frame
+        // built for any normal.
+        let tilts = [
+            glam::Quat::IDENTITY,
+            glam::Quat::from_rotation_arc(Vec3::Y, Vec3::new(0.3, 0.5, 0.8).normalize()),
+        ];
         for (f0, alpha) in [(0.04f32, 0.1f32), (0.5, 0.3), (1.0, 0.7)] {
             for (cos, azimuth) in [(1.0f32, 0.0f32), (0.6, 0.0), (0.6, 2.0), (0.25, 3.5)] {
                 let sin = (1.0 - cos * cos).sqrt();
                 let to_eye = Vec3::new(sin * azimuth.cos(), cos, sin * azimuth.sin());
                 for (name, sky) in skies {
                     let want = reflected(f0, alpha, to_eye, sky, 1500);
-                    let got = reflected_by_samples(f0, alpha, to_eye, sky, 700);
-                    assert!(
-                        (got - want).abs() < 0.01 * want + 2e-4,
-                        "F0 {f0}, α {alpha}, cos {cos}, azimuth {azimuth}, {name}: {got} vs {want}"
-                    );
+                    for tilt in tilts {
+                        let got = reflected_by_samples(f0, alpha, to_eye, sky, 500, tilt);
+                        assert!(
+                            (got - want).abs() < 0.01 * want + 2e-4,
+                            "F0 {f0}, α {alpha}, cos {cos}, azimuth {azimuth}, {name}, {tilt}: {got} vs {want}"
+                        );
+                    }
                 }
             }
         }

@@ -94,8 +94,9 @@ impl Default for RoadLook {
 #[derive(Clone)]
 pub struct ParsedMap {
     pub network: Arc<RoadNetwork>,
-    /// FNV-1a of the texts read (the map's, then each `<include>`'s in the order read): the
-    /// parse is a function of them, so two maps of equal texts are equal.
+    /// FNV-1a of the texts read, each after its length (the map's, then each `<include>`'s
+    /// in the order read): the parse is a function of them, so two maps of equal texts are
+    /// equal.
     pub texts_hash: u64,
 }
 
@@ -105,9 +106,11 @@ impl PartialEq for ParsedMap {
     }
 }
 
+/// Without the hash: a scene's fingerprint (`scene/fingerprint.rs`) hashes its `Debug` and
+/// the map's baked triangles, which a comment or a space in the file does not change.
 impl std::fmt::Debug for ParsedMap {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "ParsedMap({:016x})", self.texts_hash)
+        f.write_str("ParsedMap { .. }")
     }
 }
 
@@ -119,11 +122,11 @@ pub fn read_network(path: &Path) -> Result<(ParsedMap, Vec<String>)> {
     let xml = read_input_text(path, MAX_MESH_BYTES).context("cannot read it")?;
     let folder = path.parent().unwrap_or(Path::new("")).to_path_buf();
     let mut hash = Fnv64::default();
-    hash.bytes(xml.as_bytes());
+    hash.bytes(&xml.len().to_le_bytes()).bytes(xml.as_bytes());
     let (network, warnings) = parse_network(&xml, |name: &str| {
         let text = read_input_text(&folder.join(name), MAX_MESH_BYTES)
             .map_err(|e| format!("{name}: {e}"))?;
-        hash.bytes(text.as_bytes());
+        hash.bytes(&text.len().to_le_bytes()).bytes(text.as_bytes());
         Ok(text)
     })?;
     let map = ParsedMap {

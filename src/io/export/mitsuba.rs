@@ -9,7 +9,8 @@
 //! seethru's irradiance; seethru's ambient term is an `envmap` of two uniform hemispheres,
 //! which gives an unoccluded surface exactly seethru's ambient light. Surfaces are `diffuse`
 //! inside `twosided`, a glossy one a blend of a diffuse and a coat (`Coat`); the `direct`
-//! integrator, like seethru, adds no interreflections.
+//! integrator adds no interreflections, as seethru's diffuse shading (a glossy coat's
+//! reflection of other objects, one ray in seethru, has no counterpart there).
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
