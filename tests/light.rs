@@ -227,6 +227,11 @@ fn light_keys_that_contradict_each_other_are_refused_with_the_key_named() {
             "photometry.black",
             "unknown key",
         ),
+        (
+            "[sun]\nilluminance_lux = 1000\n[photometry]\nlamp_sampling = \"all\"\n",
+            "photometry.lamp_sampling",
+            "`all` is not one of: every, one",
+        ),
     ];
     for (light, key, words) in cases {
         let e = parse(&floor_scene(0.5, light)).unwrap_err().to_string();
@@ -526,6 +531,147 @@ fn a_point_lamp_lights_a_floor_by_the_inverse_square_and_cosine_laws() {
     }
 }
 
+/// Three point lamps of different colours and intensities over [`floor_under_lamps`]'s floor.
+const THREE_LAMPS: &str = "\
+[[light]]\nposition = [-1.5, 2.0, 0.0]\nintensity_cd = 500\ncolor = [1.0, 0.7, 0.4]\n
+[[light]]\nposition = [1.5, 2.5, -1.0]\nintensity_cd = 800\ncolor = [0.5, 0.7, 1.0]\n
+[[light]]\nposition = [0.0, 3.0, 1.5]\nintensity_cd = 300\n";
+
+type Shade = (f64, [f64; 3]);
+
+/// Per floor pixel of [`floor_under_lamps_scene`] under `lamps`, a sun of `sun_lux` and
+/// `extra_objects` (by pixel index): its luminance and linear RGB, with every lamp's shadow ray and with one
+/// drawn per sample, at `spp` samples each (the same sub-pixel positions).
+fn every_and_one(
+    lamps: &str,
+    sun_lux: f64,
+    extra_objects: &str,
+    spp: &str,
+) -> std::collections::BTreeMap<usize, (Shade, Shade)> {
+    let every = floor_under_lamps_scene(0.5, lamps, extra_objects).replace(
+        "illuminance_lux = 0\n",
+        &format!("illuminance_lux = {sun_lux}\nelevation_deg = 55\nazimuth_deg = 100\n"),
+    );
+    let one = one_lamp_drawn(&every);
+    let [every, one] = [every, one].map(|scene| {
+        let dir = tempfile::tempdir().unwrap();
+        let out = seethru_on(
+            dir.path(),
+            &scene,
+            "render",
+            &["--view", "truth", "--spp", spp],
+        );
+        let c = exr_channels(&out.join("truth.exr"));
+        (luminance(&c).into_iter().enumerate())
+            .filter(|&(i, _)| c["id.object"][i] == 1.0)
+            .map(|(i, y)| (i, (y, ["R", "G", "B"].map(|k| c[k][i]))))
+            .collect::<Vec<_>>()
+    });
+    assert!(every.len() > 5000, "{}", every.len());
+    assert!(every.iter().zip(&one).all(|(a, b)| a.0 == b.0));
+    (every.into_iter().zip(one))
+        .map(|((i, a), (_, b))| (i, (a, b)))
+        .collect()
+}
+
+#[test]
+fn one_lamp_drawn_per_sample_gives_the_exact_luminance_where_every_lamp_is_seen() {
+    // Unshadowed, the drawn lamp's light over its share of the luminance is the sum's
+    // luminance at every pixel; only the colour is the drawn lamp's.
+    // The sun, drawn with the lamps, too.
+    for sun_lux in [0.0, 20.0] {
+        exact_where_every_lamp_is_seen(sun_lux);
+    }
+}
+
+fn exact_where_every_lamp_is_seen(sun_lux: f64) {
+    let pixels = every_and_one(THREE_LAMPS, sun_lux, "", "1");
+    let mut recoloured = 0;
+    let (mut every_rgb, mut one_rgb) = ([0.0; 3], [0.0; 3]);
+    for ((y_every, every), (y_one, one)) in pixels.values() {
+        assert!(
+            relative_error(*y_one, *y_every) < 1e-4,
+            "{y_one} vs {y_every} cd/m²"
+        );
+        recoloured += usize::from((0..3).any(|k| relative_error(one[k], every[k]) > 0.05));
+        for k in 0..3 {
+            every_rgb[k] += every[k];
+            one_rgb[k] += one[k];
+        }
+    }
+    // Each pixel shows one lamp's colour (the draws differ), and on average the sum's.
+    assert!(
+        recoloured * 2 > pixels.len(),
+        "{recoloured} of {}",
+        pixels.len()
+    );
+    for k in 0..3 {
+        assert!(
+            relative_error(one_rgb[k], every_rgb[k]) < 0.02,
+            "channel {k}: {} vs {}",
+            one_rgb[k],
+            every_rgb[k]
+        );
+    }
+}
+
+#[test]
+fn one_lamp_drawn_per_sample_is_unbiased_in_the_shadows_of_some_lamps() {
+    // A ball over the floor casts one shadow per lamp. Where some lamps are hidden, one drawn
+    // lamp per sample averages, over many samples, to what every lamp's ray gives.
+    let ball = "[[object]]\nname = \"ball\"\nkind = \"sphere\"\nmaterial = \"grey\"\n\
+                radius = 0.4\ntranslate = [0.0, 1.0, 0.0]\n";
+    // And with each lamp split into seven of a seventh of its intensity at its place: 21
+    // lamps, weighed sixteen at a time (the draw across the chunks).
+    let split: String = (THREE_LAMPS.split("\n\n").map(|lamp| lamp.trim()))
+        .flat_map(|lamp| {
+            let cd: f64 = lamp
+                .split("intensity_cd = ")
+                .nth(1)
+                .unwrap()
+                .split('\n')
+                .next()
+                .unwrap()
+                .parse()
+                .unwrap();
+            let seventh = lamp.replace(
+                &format!("intensity_cd = {cd}"),
+                &format!("intensity_cd = {}", cd / 7.0),
+            );
+            std::iter::repeat_n(format!("{seventh}\n\n"), 7)
+        })
+        .collect();
+    assert_eq!(split.matches("[[light]]").count(), 21);
+    // The sun, drawn with them, casts one more shadow.
+    for (lamps, sun_lux) in [(THREE_LAMPS, 0.0), (&split, 0.0), (THREE_LAMPS, 20.0)] {
+        unbiased_in_the_shadows(lamps, sun_lux, ball);
+    }
+}
+
+fn unbiased_in_the_shadows(lamps: &str, sun_lux: f64, ball: &str) {
+    let unshadowed = every_and_one(lamps, sun_lux, "", "64");
+    let pixels = every_and_one(lamps, sun_lux, ball, "64");
+    let (mut every, mut one, mut n) = (0.0, 0.0, 0);
+    let mut noisy = 0;
+    for (i, ((y_every, _), (y_one, _))) in &pixels {
+        let y_free = unshadowed[i].0.0;
+        // Partly shadowed: some lamp hidden (selected on every lamp's image, not on the
+        // drawn one's, so that the noise does not pick the pixels), some still seen.
+        if *y_every < 0.95 * y_free && *y_every > 0.05 * y_free {
+            every += y_every;
+            one += y_one;
+            n += 1;
+            noisy += usize::from(relative_error(*y_one, *y_every) > 0.01);
+        }
+    }
+    assert!(n > 300, "{n} partly shadowed pixels");
+    assert!(noisy * 2 > n, "{noisy} of {n} differ: no lamp drawn?");
+    assert!(
+        relative_error(one, every) < 0.01,
+        "{one} vs {every} over {n} pixels"
+    );
+}
+
 #[test]
 fn a_spot_lights_its_cone_and_an_object_shades_what_it_hides() {
     let (grey, intensity) = (0.8, 2000.0);
@@ -679,19 +825,36 @@ fn lamps_are_refused_where_they_cannot_shine() {
 #[test]
 fn lamps_and_glossy_coats_render_the_same_on_the_per_ray_and_the_packet_paths_and_on_any_thread_count()
  {
-    // das_night's lamps; left_turn_night's lamps on its wet streets.
-    for name in ["das_night.toml", "left_turn_night.toml"] {
-        lamps_render_the_same_on_every_path(name);
+    // das_night's lamps, every lamp's shadow ray or one drawn per sample; left_turn_night's
+    // lamps on its wet streets, also drawn.
+    for (name, one) in [
+        ("das_night.toml", false),
+        ("das_night.toml", true),
+        ("left_turn_night.toml", false),
+        ("left_turn_night.toml", true),
+    ] {
+        lamps_render_the_same_on_every_path(name, one);
     }
 }
 
-fn lamps_render_the_same_on_every_path(name: &str) {
+/// `text` (a scene with a `[photometry]` table) with `lamp_sampling = "one"` in it.
+fn one_lamp_drawn(text: &str) -> String {
+    assert!(text.contains("[photometry]\n"));
+    text.replace("[photometry]\n", "[photometry]\nlamp_sampling = \"one\"\n")
+}
+
+fn lamps_render_the_same_on_every_path(name: &str, one: bool) {
     use seethru::render::integrator::RenderContext;
     use seethru::render::render_job::{RenderJob, Tracer};
     use seethru::render::simd::Isa;
     use seethru::scene::world::view_bit;
-    let text = std::fs::read_to_string(common::repo_path("scenes").join(name)).unwrap();
+    let mut text = std::fs::read_to_string(common::repo_path("scenes").join(name)).unwrap();
+    if one {
+        text = one_lamp_drawn(&text);
+    }
     let scene = common::parse_in(&common::repo_path("scenes"), name, &text).unwrap();
+    let drawn = (scene.photometry.as_ref()).map(|p| p.lamp_sampling);
+    assert_eq!(drawn == Some(seethru::scene::LampSampling::One), one);
     assert!(scene.lights.len() >= 3);
     let ctx = RenderContext::new(scene).unwrap();
     let camera = ctx.scene.driver.with_resolution(96, 54);
@@ -716,7 +879,10 @@ fn lamps_render_the_same_on_every_path(name: &str) {
                 .iter()
                 .zip(&colour)
                 .all(|(a, b)| a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits));
-            assert!(same, "{name}: {isa:?} on {threads} threads");
+            assert!(
+                same,
+                "{name} (one lamp drawn: {one}): {isa:?} on {threads} threads"
+            );
         }
     }
 }

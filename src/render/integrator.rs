@@ -27,7 +27,7 @@ use crate::render::sky::SkyModel;
 use crate::render::specular;
 use crate::scene::texture::Texture;
 use crate::scene::world::{SurfaceHit, SurfaceMaterial, World, view_bit};
-use crate::scene::{DisplayLight, Scene};
+use crate::scene::{DisplayLight, LampSampling, Scene};
 use crate::util::color::luminance;
 use crate::util::color::srgb_to_linear3;
 use crate::util::sampling::{hash_u32, hash_words, pixel_offset, unit_float};
@@ -44,7 +44,8 @@ struct Shading {
     albedo: Vec3,
     /// Sky ambient.
     light: Vec3,
-    /// Cosine of the sun to the normal: a shadow ray is traced where it is positive.
+    /// Cosine of the sun to the normal: a shadow ray is traced where it is positive (0 where
+    /// the sun is drawn with the lamps, [`LampSampling::One`]).
     cos: f32,
     /// The lamps' light (`[[light]]`), as the sky's: irradiance over π, shadows applied.
     lamps: Vec3,
@@ -90,6 +91,8 @@ pub struct RenderContext {
     pub moving: Option<Arc<MovingLayer>>,
     /// The scene's lamps ready for shading ([`lamps_of`]).
     pub lamps: Arc<[LampShading]>,
+    /// How their shadow rays are spent: the scene's `[photometry] lamp_sampling`.
+    pub lamp_sampling: LampSampling,
 }
 
 /// A `[[light]]` lamp as the shading reads it, computed once per context rather than per
@@ -109,6 +112,113 @@ impl LampShading {
     pub fn per_unit(&self) -> Vec3 {
         self.per_unit
     }
+
+    /// Its unshadowed light on `s` (irradiance over π, in units of the white), with the
+    /// direction and the distance to it; `None` where it gives `s` nothing (behind the
+    /// surface, outside a spot's beam).
+    #[inline]
+    fn light_at(&self, s: &SurfaceHit) -> Option<DrawnLamp> {
+        let to = self.position - s.position;
+        let d2 = to.length_squared();
+        let cos = s.normal.dot(to);
+        if d2 <= 0.0 || cos <= 0.0 {
+            return None;
+        }
+        let d = d2.sqrt();
+        let dir = to / d;
+        let profile = self.spot.map_or(1.0, |spot| spot.profile(-dir.as_dvec3())) as f32;
+        if profile == 0.0 {
+            return None;
+        }
+        let light = self.per_unit * (profile * (cos / d) / d2);
+        Some(DrawnLamp { light, dir, d })
+    }
+}
+
+/// A lamp's light on a surface point (irradiance over π, in units of the white) once its
+/// shadow ray reaches it, the unit direction to it and its distance.
+#[derive(Clone, Copy)]
+struct DrawnLamp {
+    light: Vec3,
+    dir: Vec3,
+    d: f32,
+}
+
+impl DrawnLamp {
+    /// The shadow ray from `s` to the lamp, stopping just short of it.
+    #[inline]
+    fn shadow_ray(&self, s: &SurfaceHit) -> TraceRay {
+        let mut ray = shadow_ray(s.position, s.normal, self.dir);
+        ray.tmax = self.d * (1.0 - 1e-4);
+        ray
+    }
+
+    /// Adds its light to `sum`, and its highlight to `lobe`.
+    #[inline]
+    fn add_to(&self, sum: &mut Vec3, lobe: Option<&mut Lobe>) {
+        *sum += self.light;
+        if let Some(lobe) = lobe {
+            lobe.lamps += self.light * lobe.pi_brdf(self.dir);
+        }
+    }
+}
+
+/// One light drawn among those offered in proportion to their weights (the luminance of
+/// their unshadowed light), in one pass: weighted reservoir sampling with a reservoir of one,
+/// its one number, hashed from the point as the reflection's are, rescaled to [0, 1) after
+/// each light.
+struct Reservoir {
+    u: f32,
+    total: f32,
+    drawn: Option<(DrawnLamp, f32)>,
+}
+
+impl Reservoir {
+    #[inline]
+    fn new(s: &SurfaceHit) -> Self {
+        let bits = s.position.to_array().map(f32::to_bits);
+        Self {
+            u: unit_float(hash_words(&[bits[0], bits[1], bits[2], LAMP_SALT])),
+            total: 0.0,
+            drawn: None,
+        }
+    }
+
+    #[inline]
+    fn offer(&mut self, light: DrawnLamp) {
+        let weight = luminance(light.light);
+        if weight <= 0.0 {
+            return;
+        }
+        self.total += weight;
+        let p = weight / self.total;
+        if self.u < p {
+            self.drawn = Some((light, weight));
+            self.u /= p;
+        } else {
+            self.u = (self.u - p) / (1.0 - p);
+        }
+        self.u = self.u.min(1.0 - f32::EPSILON);
+    }
+
+    /// The drawn light over the probability of its draw, weight / total.
+    #[inline]
+    fn drawn(self) -> Option<DrawnLamp> {
+        let total = self.total;
+        self.drawn.map(|(lamp, weight)| DrawnLamp {
+            light: lamp.light * (total / weight),
+            ..lamp
+        })
+    }
+}
+
+/// Salt of the number that draws a lamp ([`LampSampling::One`]), so that it is not the
+/// reflection ray's, hashed from the same point.
+const LAMP_SALT: u32 = 0x6c61_6d70;
+
+/// How `scene`'s lamps' shadow rays are spent (every lamp's outside a photometric scene).
+pub fn lamp_sampling_of(scene: &Scene) -> LampSampling {
+    (scene.photometry.as_ref()).map_or(LampSampling::Every, |p| p.lamp_sampling)
 }
 
 /// The lamps of `scene` ready for shading (none outside a photometric scene).
@@ -181,12 +291,13 @@ impl RenderContext {
         let (world, accel) = built?;
         let lamps = lamps_of(&scene);
         Ok(Self {
-            scene,
             world: Arc::new(world),
             accel: Arc::new(accel),
             sky: Arc::new(sky),
             moving: None,
+            lamp_sampling: lamp_sampling_of(&scene),
             lamps,
+            scene,
         })
     }
 
@@ -225,12 +336,13 @@ impl RenderContext {
         };
         let lamps = lamps_of(&scene);
         Ok(Self {
-            scene,
             world,
             accel,
             sky,
             moving: None,
+            lamp_sampling: lamp_sampling_of(&scene),
             lamps,
+            scene,
         })
     }
 
@@ -298,6 +410,8 @@ impl RenderContext {
         let mut cameras = [job.rays.at(tile.y, 0); PACKET];
         let mut camera = RayPacket::new();
         let mut shadow = RayPacket::new();
+        // The shadow rays toward the lamps drawn under `LampSampling::One`, one per lane.
+        let mut lamp_rays = RayPacket::new();
         // One instant (a still camera, an instant shutter): one camera for every lane, its
         // constants loaded once.
         let single = job.rays.single();
@@ -326,7 +440,9 @@ impl RenderContext {
             let moving_hits = self.trace_packet_hits(&mut camera, job.view, tile.isa, packet_stack);
             let mut shown = [None; PACKET];
             let mut shading = [None; PACKET];
+            let mut drawn_lamps = [None; PACKET];
             shadow.clear();
+            lamp_rays.clear();
             // Each lane's surface is shaded as soon as it is known: an array of sixteen
             // surfaces, written then read back, cost about 3 % of a run's CPU.
             for lane in 0..n {
@@ -337,7 +453,14 @@ impl RenderContext {
                     }
                     (Some(s), _) => {
                         let mut sh = self.shade_begin(s, dirs[lane]);
-                        sh.lamps = self.lamps_at(s, sh.lobe.as_mut(), job.view, stack, shadows);
+                        let (lamps, drawn) =
+                            self.lamps_but_drawn(s, sh.lobe.as_mut(), job.view, stack, shadows);
+                        sh.lamps = lamps;
+                        if let Some(lamp) = drawn {
+                            *shadows += 1;
+                            lamp_rays.set(lane, &lamp.shadow_ray(s));
+                            drawn_lamps[lane] = Some(lamp);
+                        }
                         if let Some(lobe) = sh.lobe.as_mut() {
                             self.reflection_at(s, lobe, job.view, stack, shadows);
                         }
@@ -356,6 +479,18 @@ impl RenderContext {
                 }
             }
             let blocked = self.occluded_packet(&shadow, job.view, tile.isa, packet_stack);
+            if lamp_rays.active != 0 {
+                let lamps_blocked =
+                    self.occluded_packet(&lamp_rays, job.view, tile.isa, packet_stack);
+                let reached = lamp_rays.active & !lamps_blocked;
+                for lane in 0..n {
+                    if let (Some(lamp), Some(sh)) = (drawn_lamps[lane], shading[lane].as_mut())
+                        && reached >> lane & 1 != 0
+                    {
+                        lamp.add_to(&mut sh.lamps, sh.lobe.as_mut());
+                    }
+                }
+            }
             for lane in 0..n {
                 // A display emits its image: no shading.
                 sums[lane] += match (&shown[lane], shading[lane]) {
@@ -508,15 +643,13 @@ impl RenderContext {
         if light.reflectance == 0.0 {
             return emitted;
         }
-        let cos = face.normal.dot(self.sky.sun_direction);
+        let cos = self.sun_cos(face);
         let mut received =
             self.sky.ambient(face.normal) + self.lamps_at(face, None, view, stack, shadows);
         if cos > 0.0 {
             *shadows += 1;
             let ray = shadow_ray(face.position, face.normal, self.sky.sun_direction);
-            let blocked = self.accel.occluded_with(&ray, view, stack)
-                || (self.moving.as_ref()).is_some_and(|m| m.accel.occluded_with(&ray, view, stack));
-            if !blocked {
+            if !self.occluded(&ray, view, stack) {
                 received += self.sky.sun_irradiance * cos;
             }
         }
@@ -614,14 +747,19 @@ impl RenderContext {
         if sh.cos > 0.0 {
             *shadows += 1;
             let ray = shadow_ray(s.position, s.normal, self.sky.sun_direction);
-            let blocked = self.accel.occluded_with(&ray, view, stack)
-                || self
-                    .moving
-                    .as_ref()
-                    .is_some_and(|m| m.accel.occluded_with(&ray, view, stack));
-            lit = !blocked;
+            lit = !self.occluded(&ray, view, stack);
         }
         self.shade_end(sh, lit)
+    }
+
+    /// The cosine of the sun to the normal at `s`, where the sun gets a shadow ray of its
+    /// own; 0 where it is drawn with the lamps ([`LampSampling::One`]).
+    #[inline]
+    fn sun_cos(&self, s: &SurfaceHit) -> f32 {
+        match self.lamp_sampling {
+            LampSampling::Every => s.normal.dot(self.sky.sun_direction),
+            LampSampling::One => 0.0,
+        }
     }
 
     /// The albedo, the ambient light, the sun's cosine and the glossy lobe at `s`, seen along
@@ -633,7 +771,7 @@ impl RenderContext {
         if let Some(t) = material.texture {
             albedo *= textures[t].sample(s.uv * material.uv_repeat);
         }
-        let cos = s.normal.dot(self.sky.sun_direction);
+        let cos = self.sun_cos(s);
         let lobe = (material.specular > 0.0).then(|| {
             albedo *= 1.0 - material.specular;
             let mut lobe = Lobe {
@@ -662,8 +800,9 @@ impl RenderContext {
     /// The light of the scene's lamps on the surface `s` (irradiance over π, in units of the
     /// white; zero without lamps): each lamp's intensity towards `s` (a spot's profile) times
     /// the cosine over the squared distance, where its shadow ray reaches it; and, into the
-    /// surface's glossy `lobe`, their highlights. The same rays, one at a time, on the per-ray
-    /// and the packet paths.
+    /// surface's glossy `lobe`, their highlights. The shadow rays go to every lamp, or to one
+    /// light drawn among the sun and the lamps ([`LampSampling`]); the same rays on the
+    /// per-ray and the packet paths.
     fn lamps_at(
         &self,
         s: &SurfaceHit,
@@ -672,38 +811,71 @@ impl RenderContext {
         stack: &mut Stack,
         shadows: &mut u64,
     ) -> Vec3 {
-        let mut sum = Vec3::ZERO;
-        for lamp in self.lamps.iter() {
-            let to = lamp.position - s.position;
-            let d2 = to.length_squared();
-            let cos = s.normal.dot(to);
-            if d2 <= 0.0 || cos <= 0.0 {
-                continue;
-            }
-            let d = d2.sqrt();
-            let dir = to / d;
-            let profile = lamp.spot.map_or(1.0, |spot| spot.profile(-dir.as_dvec3())) as f32;
-            if profile == 0.0 {
-                continue;
-            }
-            if lamp.casts_shadow {
-                *shadows += 1;
-                let mut ray = shadow_ray(s.position, s.normal, dir);
-                ray.tmax = d * (1.0 - 1e-4);
-                let blocked = self.accel.occluded_with(&ray, view, stack)
-                    || (self.moving.as_ref())
-                        .is_some_and(|m| m.accel.occluded_with(&ray, view, stack));
-                if blocked {
-                    continue;
-                }
-            }
-            let light = lamp.per_unit * (profile * (cos / d) / d2);
-            sum += light;
-            if let Some(lobe) = &mut lobe {
-                lobe.lamps += light * lobe.pi_brdf(dir);
+        let (mut sum, drawn) = self.lamps_but_drawn(s, lobe.as_deref_mut(), view, stack, shadows);
+        if let Some(lamp) = drawn {
+            *shadows += 1;
+            if !self.occluded(&lamp.shadow_ray(s), view, stack) {
+                lamp.add_to(&mut sum, lobe);
             }
         }
         sum
+    }
+
+    /// [`Self::lamps_at`] but for the lamp drawn under [`LampSampling::One`], returned with its
+    /// shadow ray still to trace (the packet path traces those of a tile together).
+    fn lamps_but_drawn(
+        &self,
+        s: &SurfaceHit,
+        mut lobe: Option<&mut Lobe>,
+        view: u8,
+        stack: &mut Stack,
+        shadows: &mut u64,
+    ) -> (Vec3, Option<DrawnLamp>) {
+        let mut sum = Vec3::ZERO;
+        // One loop per way: a loop that could do either spills more registers (3 % of
+        // das_night's frame).
+        if self.lamp_sampling == LampSampling::Every {
+            for lamp in self.lamps.iter() {
+                let Some(lamp_light) = lamp.light_at(s) else {
+                    continue;
+                };
+                if lamp.casts_shadow {
+                    *shadows += 1;
+                    if self.occluded(&lamp_light.shadow_ray(s), view, stack) {
+                        continue;
+                    }
+                }
+                lamp_light.add_to(&mut sum, lobe.as_deref_mut());
+            }
+            return (sum, None);
+        }
+        // "one": a single reservoir over the sun and the shadow-casting lamps.
+        let mut reservoir = Reservoir::new(s);
+        let cos = s.normal.dot(self.sky.sun_direction);
+        if cos > 0.0 {
+            reservoir.offer(DrawnLamp {
+                light: self.sky.sun_irradiance * cos,
+                dir: self.sky.sun_direction,
+                d: f32::INFINITY,
+            });
+        }
+        for lamp in self.lamps.iter() {
+            let Some(lamp_light) = lamp.light_at(s) else {
+                continue;
+            };
+            if lamp.casts_shadow {
+                reservoir.offer(lamp_light);
+            } else {
+                lamp_light.add_to(&mut sum, lobe.as_deref_mut());
+            }
+        }
+        (sum, reservoir.drawn())
+    }
+
+    /// Whether `ray` meets anything, in the static world or the moving layer.
+    fn occluded(&self, ray: &TraceRay, view: u8, stack: &mut Stack) -> bool {
+        self.accel.occluded_with(ray, view, stack)
+            || (self.moving.as_ref()).is_some_and(|m| m.accel.occluded_with(ray, view, stack))
     }
 
     /// Traces the reflection ray of `lobe` at `s` ([`specular::sample_reflection`], its two

@@ -329,6 +329,7 @@ mod tests {
             sun_illuminance_lux: sun_lux,
             sky_zenith_cd_m2: zenith_cd_m2,
             white_cd_m2: white,
+            lamp_sampling: Default::default(),
         };
         (SkyModel::new(&sky, &sun, Some(&p)), sky, sun)
     }

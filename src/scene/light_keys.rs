@@ -9,7 +9,7 @@ use crate::scene::motion::MovesWith;
 use crate::scene::source::SceneError;
 use crate::scene::sun_position::{UtcInstant, parse_date, parse_time, sun_angles};
 use crate::scene::table_reader::TableReader;
-use crate::scene::{DisplayLight, Lamp, Photometry, Sky, Spot, Sun};
+use crate::scene::{DisplayLight, Lamp, LampSampling, Photometry, Sky, Spot, Sun};
 use crate::util::color::srgb_to_linear3;
 
 /// Brightest sunlight at sea level (a clear zenith sun gives about 100–130 klx), lux.
@@ -188,6 +188,7 @@ pub fn read_photometry(
         sun_illuminance_lux: sun_lux,
         sky_zenith_cd_m2: zenith_cd_m2,
         white_cd_m2: 0.0,
+        lamp_sampling: LampSampling::Every,
     };
     let lit_white = photometry.lit_white_cd_m2(sun, sky);
     let (min, max) = WHITE_CD_M2_RANGE;
@@ -207,6 +208,7 @@ pub fn read_photometry(
                     ),
                 ));
             }
+            photometry.lamp_sampling = read_lamp_sampling(&t)?;
             t.finish()?;
             white
         }
@@ -223,6 +225,16 @@ pub fn read_photometry(
         }
     };
     Ok(Some(photometry))
+}
+
+/// `[photometry] lamp_sampling`: "every" (the default) or "one" ([`LampSampling`]).
+fn read_lamp_sampling(t: &TableReader) -> Result<LampSampling, SceneError> {
+    Ok(
+        match t.choice("lamp_sampling", "every", &["every", "one"])? {
+            "one" => LampSampling::One,
+            _ => LampSampling::Every,
+        },
+    )
 }
 
 /// The display's luminance range, cd/m²: automotive displays give some 500–1 500, HDR

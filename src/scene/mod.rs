@@ -211,6 +211,23 @@ pub struct Photometry {
     /// The luminance shown as white, cd/m², in [1e-6, 1e10]: a frame's linear 1.0. Default:
     /// [`Photometry::lit_white_cd_m2`].
     pub white_cd_m2: f64,
+    /// How the lamps' shadow rays are spent (`lamp_sampling`; default every lamp's).
+    pub lamp_sampling: LampSampling,
+}
+
+/// How a lit point gathers the shadow-casting lamps' light (`[photometry] lamp_sampling`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LampSampling {
+    /// A shadow ray to every lamp that lights the point: no noise from the lamps, a ray per
+    /// lamp (`"every"`, the default).
+    #[default]
+    Every,
+    /// One shadow ray per sample, to one light drawn among the sun and the shadow-casting
+    /// lamps in proportion to its unshadowed light's luminance at the point; that light over
+    /// the probability of its draw where the ray reaches it (`"one"`): unbiased; the
+    /// luminance exact wherever every light or none is seen (the colour is the drawn
+    /// light's), noisy only in partial shadow; one ray however many lamps.
+    One,
 }
 
 impl Photometry {

@@ -264,6 +264,7 @@ impl SystemLoop {
         let scene = self.rig.scene_at(t);
         Ok(RenderContext {
             lamps: crate::render::integrator::lamps_of(&scene),
+            lamp_sampling: crate::render::integrator::lamp_sampling_of(&scene),
             scene,
             world: self.world.clone(),
             accel: self.accel.clone(),
