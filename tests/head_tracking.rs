@@ -83,6 +83,63 @@ fn a_detection_in_the_pixels_it_used_is_the_whole_images() {
             detect_in(&frame, cut).is_ok_and(|c| !c.whole),
             "{offset}: a region one column short of the pixels used is not whole"
         );
+        // One row or column short on any side: not whole (the +2 rings of the pupils'
+        // search box, and the skin's edges, are counted).
+        for (side, short) in [
+            (
+                "left",
+                PixelRect {
+                    x0: used.x0 + 1,
+                    ..used
+                },
+            ),
+            (
+                "top",
+                PixelRect {
+                    y0: used.y0 + 1,
+                    ..used
+                },
+            ),
+            (
+                "bottom",
+                PixelRect {
+                    y1: used.y1 - 1,
+                    ..used
+                },
+            ),
+        ] {
+            assert!(
+                detect_in(&frame, short).is_ok_and(|c| !c.whole)
+                    || detect_in(&frame, short).is_err(),
+                "{offset}: a region one {side} line short of the pixels used is not whole"
+            );
+        }
+        // The pupils left to right in the image, each with its own area.
+        assert!(
+            whole.pupils[0][0] < whole.pupils[1][0],
+            "{:?}",
+            whole.pupils
+        );
+        // The pixels outside the region read as black: the region's detection is that of the
+        // image blacked outside it, here a region that cuts the face's left third away.
+        let third = PixelRect {
+            x0: used.x0 + (used.x1 - used.x0) / 3,
+            ..used
+        };
+        let mut blacked = frame.clone();
+        for y in 0..frame.height {
+            for x in 0..frame.width {
+                if !(third.x0..third.x1).contains(&x) || !(third.y0..third.y1).contains(&y) {
+                    let i = blacked.index(x, y);
+                    blacked.color[i] = glam::Vec3::ZERO;
+                }
+            }
+        }
+        assert_eq!(
+            detect_in(&frame, third).map(|c| c.detection),
+            detect(&blacked),
+            "{offset}: the face's left third cut away"
+        );
         // Below the face: no skin there.
         let away = PixelRect {
             x0: 0,
