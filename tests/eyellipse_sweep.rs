@@ -57,7 +57,16 @@ fn each_driver_is_a_row_and_the_share_is_recounted_from_them() {
         shard: None,
         bound_arcmin: bound,
     };
-    assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 6);
+    assert_eq!(
+        sweep(
+            &seethru::scene::Scene::load(&scene).unwrap(),
+            &params,
+            &csv,
+            &options
+        )
+        .unwrap(),
+        6
+    );
     let text = std::fs::read_to_string(&csv).unwrap();
     let rows: Vec<Vec<&str>> = text
         .lines()
@@ -100,7 +109,13 @@ fn each_driver_is_a_row_and_the_share_is_recounted_from_them() {
                 shard: Some(format!("{k}/2").parse().unwrap()),
                 ..options
             };
-            sweep(&scene, &params, &part, &options).unwrap();
+            sweep(
+                &seethru::scene::Scene::load(&scene).unwrap(),
+                &params,
+                &part,
+                &options,
+            )
+            .unwrap();
             part
         })
         .collect();

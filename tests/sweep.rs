@@ -9,6 +9,7 @@ use seethru::measure::{
     sweep_shard::Shard,
 };
 use seethru::render::settings::resized;
+use seethru::scene::Scene;
 use seethru::system::options::HeadSource;
 
 /// A sweep of the minimal scene in `dir`, as the command line runs it; panics on failure.
@@ -288,7 +289,10 @@ fn sweeps_write_every_row_and_resume() {
         bound_arcmin: 1.0,
     };
     let scene = common::repo_path("scenes/das.toml");
-    assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 4);
+    assert_eq!(
+        sweep(&Scene::load(&scene).unwrap(), &params, &csv, &options).unwrap(),
+        4
+    );
     let first = std::fs::read_to_string(&csv).unwrap();
     let lines: Vec<&str> = first.lines().collect();
     assert_eq!(lines.len(), 5);
@@ -352,7 +356,10 @@ fn sweeps_write_every_row_and_resume() {
         ]
     );
     // Nothing left to do: nothing recomputed, file unchanged.
-    assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 0);
+    assert_eq!(
+        sweep(&Scene::load(&scene).unwrap(), &params, &csv, &options).unwrap(),
+        0
+    );
     assert_eq!(std::fs::read_to_string(&csv).unwrap(), first);
     // An interrupted sweep (a row missing) redoes only that row, bit-identically.
     let without: String = first
@@ -361,11 +368,14 @@ fn sweeps_write_every_row_and_resume() {
         .map(|l| format!("{l}\n"))
         .collect();
     std::fs::write(&csv, without).unwrap();
-    assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 1);
+    assert_eq!(
+        sweep(&Scene::load(&scene).unwrap(), &params, &csv, &options).unwrap(),
+        1
+    );
     assert_eq!(std::fs::read_to_string(&csv).unwrap(), first);
     // Bad parameters are rejected before anything renders.
     let err = sweep(
-        &scene,
+        &Scene::load(&scene).unwrap(),
         &[parse_param("eye_z=-2").unwrap()],
         &dir.path().join("t.csv"),
         &options,
@@ -396,7 +406,10 @@ fn rows_that_share_an_eye_or_a_world_equal_rows_computed_alone() {
         bound_arcmin: 1.0,
     };
     let scene = common::repo_path("scenes/das.toml");
-    assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 8);
+    assert_eq!(
+        sweep(&Scene::load(&scene).unwrap(), &params, &csv, &options).unwrap(),
+        8
+    );
     let all = std::fs::read_to_string(&csv).unwrap();
     for row in [1, 2, 5] {
         let without: String = all
@@ -405,7 +418,10 @@ fn rows_that_share_an_eye_or_a_world_equal_rows_computed_alone() {
             .map(|l| format!("{l}\n"))
             .collect();
         std::fs::write(&csv, without).unwrap();
-        assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 1);
+        assert_eq!(
+            sweep(&Scene::load(&scene).unwrap(), &params, &csv, &options).unwrap(),
+            1
+        );
         assert_eq!(std::fs::read_to_string(&csv).unwrap(), all, "row {row}");
     }
     // The same sweep in three parts, as three machines would run it: the parts are disjoint,
@@ -417,7 +433,7 @@ fn rows_that_share_an_eye_or_a_world_equal_rows_computed_alone() {
                 shard: Some(format!("{k}/3").parse::<Shard>().unwrap()),
                 ..options
             };
-            sweep(&scene, &params, &part, &options).unwrap();
+            sweep(&Scene::load(&scene).unwrap(), &params, &part, &options).unwrap();
             part
         })
         .collect();
@@ -455,7 +471,10 @@ fn a_row_holds_the_metrics_of_run_with_the_same_settings() {
     };
     let scene = common::repo_path("scenes/das.toml");
     let params = [parse_param("d2=6").unwrap()];
-    assert_eq!(sweep(&scene, &params, &csv, &options).unwrap(), 1);
+    assert_eq!(
+        sweep(&Scene::load(&scene).unwrap(), &params, &csv, &options).unwrap(),
+        1
+    );
     let text = std::fs::read_to_string(&csv).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     let row: std::collections::HashMap<&str, &str> =

@@ -173,7 +173,7 @@ impl Sweep {
                 what: format!("{at_once} configurations at once, each with {}", one.what),
             };
             check_memory(&all, self.max_memory)?;
-            sweep(&self.scene, &params, &self.out, &options)
+            sweep(&scene, &params, &self.out, &options)
         })??;
         seethru::util::progress::summary(format!(
             "computed {computed} configurations; results in {}",

@@ -67,13 +67,9 @@ pub struct SweepOptions {
 /// The default bound of the share of drivers, arcmin: the 1′ of the plots and the paper.
 pub const DRIVER_SHARE_BOUND_ARCMIN: f64 = 1.0;
 
-/// Runs the sweep; writes `csv` (and `<csv>.png`); returns the number of rows computed now.
-pub fn sweep(
-    scene_path: &Path,
-    params: &[Param],
-    csv: &Path,
-    options: &SweepOptions,
-) -> Result<usize> {
+/// Runs the sweep over `base` (a scene as read, its map with it); writes `csv` (and
+/// `<csv>.png`); returns the number of rows computed now.
+pub fn sweep(base: &Scene, params: &[Param], csv: &Path, options: &SweepOptions) -> Result<usize> {
     check_out(csv)?;
     if params.is_empty() {
         bail!("give at least one option `param`");
@@ -87,7 +83,6 @@ pub fn sweep(
         );
     }
     check_grid_size(params)?;
-    let base = Scene::load(scene_path)?;
     let base_options = RunOptions {
         width: Some(options.width),
         spp: options.spp,
@@ -103,7 +98,7 @@ pub fn sweep(
     let configs = combinations(params);
     // Validate every configuration before rendering any.
     for c in &configs {
-        configure(&base, &base_options, c)?;
+        configure(base, &base_options, c)?;
     }
     let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
     let header_line = encode(&header(&names));
@@ -118,7 +113,7 @@ pub fn sweep(
         }
         .to_string(),
         options.band.to_string(),
-        fingerprint(&base).with_context(|| format!("scene {}", scene_path.display()))?,
+        fingerprint(base).with_context(|| format!("scene {}", base.path.display()))?,
         env!("CARGO_PKG_VERSION").to_string(),
     ];
     // Rows already done: this sweep's header, settings and grid; anything else is refused.
@@ -145,7 +140,7 @@ pub fn sweep(
     let jobs: Vec<(usize, Scene, RunOptions)> = todo
         .iter()
         .map(|&index| {
-            let (scene, options) = configure(&base, &base_options, &configs[index])?;
+            let (scene, options) = configure(base, &base_options, &configs[index])?;
             Ok((index, scene, options))
         })
         .collect::<Result<_>>()?;
