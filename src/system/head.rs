@@ -931,6 +931,47 @@ mod tests {
         assert_eq!(used, read);
     }
 
+    /// On a whole detection, the walks' allowance is a tenth of the face's width (its search
+    /// box's): the eye's white beside each pupil (7 px of non-skin from the pupil's centre,
+    /// under the 12.4 px allowance) is crossed, and a patch of skin 20 px beyond the face's
+    /// right edge (a hand) is not reached. The face stands 138 px from the image's left edge,
+    /// so a width measured from the image's edge, not the box's, moves the edges.
+    #[test]
+    fn a_whole_detections_walk_allows_a_tenth_of_the_face() {
+        let (w, h) = (320, 120);
+        let mut frame = Frame::new(w as u32, h as u32);
+        let code = |c: [u8; 3]| {
+            Vec3::from_array(c.map(|v| crate::util::color::srgb_to_linear(f32::from(v) / 255.0)))
+        };
+        let (skin, white, pupil) = ([200, 150, 120], [235, 235, 235], [20, 20, 20]);
+        let pupils = [DVec2::new(180.5, 55.5), DVec2::new(220.5, 55.5)];
+        for y in 0..h {
+            for x in 0..w {
+                let p = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                let in_face = (150..250).contains(&x) && (30..90).contains(&y);
+                let in_hand = (270..285).contains(&x) && (45..70).contains(&y);
+                let c = if pupils.iter().any(|q| q.distance(p) < 2.0) {
+                    code(pupil)
+                } else if in_face
+                    && (50..62).contains(&y)
+                    && ((173..178).contains(&x) || (223..228).contains(&x))
+                {
+                    code(white)
+                } else if in_face || in_hand {
+                    code(skin)
+                } else {
+                    Vec3::ZERO
+                };
+                frame.color[y * w + x] = c;
+            }
+        }
+        let d = detect(&frame).unwrap();
+        assert_eq!(d.face_box, [150, 30, 250, 90]);
+        let [left, right] = d.row_edges;
+        assert!((left[0] - 150.0).abs() <= 0.25, "left edge {left:?}");
+        assert!((right[0] - 250.0).abs() <= 0.25, "right edge {right:?}");
+    }
+
     #[test]
     fn skin_is_told_from_hair_grass_asphalt_and_sky() {
         assert!(is_skin([222, 173, 140]) && is_skin([120, 92, 76]));
