@@ -568,6 +568,7 @@ fn every_and_one(
             .collect::<Vec<_>>()
     });
     assert!(every.len() > 5000, "{}", every.len());
+    assert_eq!(every.len(), one.len());
     assert!(every.iter().zip(&one).all(|(a, b)| a.0 == b.0));
     (every.into_iter().zip(one))
         .map(|((i, a), (_, b))| (i, (a, b)))
@@ -578,14 +579,14 @@ fn every_and_one(
 fn one_lamp_drawn_per_sample_gives_the_exact_luminance_where_every_lamp_is_seen() {
     // Unshadowed, the drawn lamp's light over its share of the luminance is the sum's
     // luminance at every pixel; only the colour is the drawn lamp's.
-    // The sun, drawn with the lamps, too.
-    for sun_lux in [0.0, 20.0] {
-        exact_where_every_lamp_is_seen(sun_lux);
+    // The sun, drawn with the lamps, too; and the sun alone (no lamp to draw it with).
+    for (lamps, sun_lux) in [(THREE_LAMPS, 0.0), (THREE_LAMPS, 20.0), ("", 20.0)] {
+        exact_where_every_lamp_is_seen(lamps, sun_lux);
     }
 }
 
-fn exact_where_every_lamp_is_seen(sun_lux: f64) {
-    let pixels = every_and_one(THREE_LAMPS, sun_lux, "", "1");
+fn exact_where_every_lamp_is_seen(lamps: &str, sun_lux: f64) {
+    let pixels = every_and_one(lamps, sun_lux, "", "1");
     let mut recoloured = 0;
     let (mut every_rgb, mut one_rgb) = ([0.0; 3], [0.0; 3]);
     for ((y_every, every), (y_one, one)) in pixels.values() {
@@ -601,7 +602,7 @@ fn exact_where_every_lamp_is_seen(sun_lux: f64) {
     }
     // Each pixel shows one lamp's colour (the draws differ), and on average the sum's.
     assert!(
-        recoloured * 2 > pixels.len(),
+        lamps.is_empty() || recoloured * 2 > pixels.len(),
         "{recoloured} of {}",
         pixels.len()
     );
@@ -622,7 +623,7 @@ fn one_lamp_drawn_per_sample_is_unbiased_in_the_shadows_of_some_lamps() {
     let ball = "[[object]]\nname = \"ball\"\nkind = \"sphere\"\nmaterial = \"grey\"\n\
                 radius = 0.4\ntranslate = [0.0, 1.0, 0.0]\n";
     // And with each lamp split into seven of a seventh of its intensity at its place: 21
-    // lamps, weighed sixteen at a time (the draw across the chunks).
+    // lamps, a longer draw.
     let split: String = (THREE_LAMPS.split("\n\n").map(|lamp| lamp.trim()))
         .flat_map(|lamp| {
             let cd: f64 = lamp
@@ -670,6 +671,29 @@ fn unbiased_in_the_shadows(lamps: &str, sun_lux: f64, ball: &str) {
         relative_error(one, every) < 0.01,
         "{one} vs {every} over {n} pixels"
     );
+}
+
+#[test]
+fn a_dark_black_lamp_gives_nothing() {
+    // intensity 0 with a black colour is admitted; its light is 0, not 0 / 0, under either
+    // way of spending the shadow rays.
+    let lit = "[[light]]\nposition = [1.0, 2.0, -1.0]\nintensity_cd = 500\n";
+    let dark = "[[light]]\nposition = [0.0, 1.0, 0.0]\nintensity_cd = 0\ncolor = [0, 0, 0]\n";
+    let alone = floor_under_lamps(0.5, lit, "");
+    for way in ["every", "one"] {
+        let scene = floor_under_lamps_scene(0.5, &format!("{lit}\n{dark}"), "").replace(
+            "[photometry]\n",
+            &format!("[photometry]\nlamp_sampling = \"{way}\"\n"),
+        );
+        let both = floor_pixels(&scene);
+        assert_eq!(both.len(), alone.len());
+        for ((_, y), (_, y_alone)) in both.iter().zip(&alone) {
+            assert!(
+                relative_error(*y, *y_alone) < 1e-6,
+                "{way}: {y} vs {y_alone}"
+            );
+        }
+    }
 }
 
 #[test]

@@ -187,7 +187,8 @@ impl Reservoir {
     #[inline]
     fn offer(&mut self, light: DrawnLamp) {
         let weight = luminance(light.light);
-        if weight <= 0.0 {
+        // Not a NaN, not so close to a lamp that its light overflowed.
+        if !(weight > 0.0 && weight.is_finite()) {
             return;
         }
         self.total += weight;
@@ -216,9 +217,14 @@ impl Reservoir {
 /// reflection ray's, hashed from the same point.
 const LAMP_SALT: u32 = 0x6c61_6d70;
 
-/// How `scene`'s lamps' shadow rays are spent (every lamp's outside a photometric scene).
+/// How `scene`'s lamps' shadow rays are spent: its `lamp_sampling` where a lamp casts
+/// shadows; every light's otherwise (outside a photometric scene, and where the sun alone
+/// would be drawn: its own ray is then exact, for the same one ray).
 pub fn lamp_sampling_of(scene: &Scene) -> LampSampling {
-    (scene.photometry.as_ref()).map_or(LampSampling::Every, |p| p.lamp_sampling)
+    match &scene.photometry {
+        Some(p) if scene.lights.iter().any(|lamp| lamp.casts_shadow) => p.lamp_sampling,
+        _ => LampSampling::Every,
+    }
 }
 
 /// The lamps of `scene` ready for shading (none outside a photometric scene).
@@ -229,8 +235,15 @@ pub fn lamps_of(scene: &Scene) -> Arc<[LampShading]> {
     (scene.lights.iter())
         .map(|lamp| {
             let colour = srgb_to_linear3(lamp.color);
-            let scale = lamp.intensity_cd
-                / (std::f64::consts::PI * photometry.white_cd_m2 * f64::from(luminance(colour)));
+            // A dark lamp may be black (0 / 0): it gives nothing.
+            let scale = match lamp.intensity_cd {
+                0.0 => 0.0,
+                cd => {
+                    cd / (std::f64::consts::PI
+                        * photometry.white_cd_m2
+                        * f64::from(luminance(colour)))
+                }
+            };
             LampShading {
                 position: lamp.position.as_vec3(),
                 per_unit: colour * scale as f32,
@@ -385,7 +398,7 @@ impl RenderContext {
 
     /// The pixels of `tile` of `band`, as [`RenderContext::render_pixel`] gives each: its
     /// camera rays traced as one packet, then the sun's shadow rays from its lit hits as
-    /// another, sample by sample.
+    /// another (or, under [`LampSampling::One`], the drawn lights' rays), sample by sample.
     pub(super) fn render_tile(
         &self,
         job: &PixelJob,

@@ -932,9 +932,9 @@ mod tests {
     }
 
     /// On a whole detection, the walks' allowance is a tenth of the face's width (its search
-    /// box's): the eye's white beside each pupil (7 px of non-skin from the pupil's centre,
-    /// under the 12.4 px allowance) is crossed, and a patch of skin 20 px beyond the face's
-    /// right edge (a hand) is not reached. The face stands 138 px from the image's left edge,
+    /// box's, 12.4 px): the eye's white beside each pupil (about 5 px of non-skin walked from
+    /// the pupil's centre) is crossed, and a patch of skin 20 px beyond the face's right edge
+    /// (a hand) is not reached. The face stands 138 px from the image's left edge,
     /// so a width measured from the image's edge, not the box's, moves the edges.
     #[test]
     fn a_whole_detections_walk_allows_a_tenth_of_the_face() {
