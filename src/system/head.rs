@@ -972,6 +972,31 @@ mod tests {
         assert!((right[0] - 250.0).abs() <= 0.25, "right edge {right:?}");
     }
 
+    /// A pixel set grows by its 4-neighbours within the image: a pixel on the right or the
+    /// bottom edge gains no neighbour across it (not the next row's first pixel, nor a row
+    /// below the image), as the brute force over every pixel says.
+    #[test]
+    fn a_set_grows_by_its_neighbours_within_the_image() {
+        let (w, h): (usize, usize) = (7, 5);
+        for set in [
+            vec![6],
+            vec![34],
+            vec![13, 14, 20],
+            vec![0, 28, 34],
+            vec![30],
+        ] {
+            let brute: Vec<usize> = (0..w * h)
+                .filter(|&j| {
+                    set.iter().any(|&i| {
+                        let (dx, dy) = ((i % w).abs_diff(j % w), (i / w).abs_diff(j / w));
+                        dx + dy <= 1
+                    })
+                })
+                .collect();
+            assert_eq!(grow(&set, w, h), brute, "{set:?}");
+        }
+    }
+
     #[test]
     fn skin_is_told_from_hair_grass_asphalt_and_sky() {
         assert!(is_skin([222, 173, 140]) && is_skin([120, 92, 76]));
