@@ -972,6 +972,44 @@ mod tests {
         assert!((right[0] - 250.0).abs() <= 0.25, "right edge {right:?}");
     }
 
+    /// Where the face meets the image's edges, the walks stop there: skin to the left and
+    /// right borders on the pupils' row gives the edges 0 and w, and the pixels read stay
+    /// inside the image (no column read from the next row, no row below it).
+    #[test]
+    fn the_row_edges_stop_at_the_images_borders() {
+        let (w, h) = (40, 12);
+        let mut skin = vec![false; w * h];
+        for y in 6..12 {
+            for x in 0..w {
+                skin[y * w + x] = !(14..16).contains(&x) && !(24..26).contains(&x);
+            }
+        }
+        // The pupils on the bottom row, so that a walk that wandered down would leave the
+        // image.
+        let pupils = [DVec2::new(15.0, 11.5), DVec2::new(25.0, 11.5)];
+        let mut used = Rect {
+            x0: 14,
+            y0: 11,
+            x1: 26,
+            y1: 12,
+        };
+        let [left, right] = row_edges(&skin, w, h, pupils, 20.0, &mut used);
+        assert!((left.x - 0.0).abs() <= 0.25 && left.y == 11.5, "{left}");
+        assert!(
+            (right.x - w as f64).abs() <= 0.25 && right.y == 11.5,
+            "{right}"
+        );
+        assert_eq!(
+            used,
+            Rect {
+                x0: 0,
+                y0: 11,
+                x1: w,
+                y1: 12
+            }
+        );
+    }
+
     /// A pixel set grows by its 4-neighbours within the image: a pixel on the right or the
     /// bottom edge gains no neighbour across it (not the next row's first pixel, nor a row
     /// below the image), as the brute force over every pixel says.
