@@ -17,7 +17,7 @@ use obvhs::aabb::Aabb;
 
 use std::cell::RefCell;
 
-use crate::render::bvh::{Bvh, NO_PRIM, Stack, primitive_boxes};
+use crate::render::bvh::{BuildChoice, Bvh, NO_PRIM, Stack, primitive_boxes};
 use crate::render::bvh_packet::{PACKET, PacketStack, RayPacket};
 use crate::render::instances::{InstanceLevel, placed_bounds};
 use crate::render::ray::TraceRay;
@@ -83,14 +83,32 @@ pub fn make_ray(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> TraceRay {
 
 impl Accel {
     pub fn build(world: &World) -> Result<Accel> {
+        Accel::build_with(world, BuildChoice::Binned)
+    }
+
+    /// [`Accel::build`] with the builder `choice` for the world's own primitives (instanced
+    /// meshes are binned).
+    pub fn build_with(world: &World, choice: BuildChoice) -> Result<Accel> {
         let start = Instant::now();
         // Primitives of each visibility class, in world order; the instanced ones by set.
         let mut classes: BTreeMap<(u8, bool), (Vec<u32>, Vec<usize>)> = BTreeMap::new();
         let flat =
             (0..world.triangles.len()).chain(world.ellipsoid_base()..world.primitive_count());
+        // Runs of primitives of one class (an object's) go in at once.
+        let mut run: Option<((u8, bool), Vec<u32>)> = None;
         for prim in flat {
-            let class = classes.entry(world.visibility(prim)).or_default();
-            class.0.push(prim as u32);
+            let key = world.visibility(prim);
+            match &mut run {
+                Some((k, prims)) if *k == key => prims.push(prim as u32),
+                _ => {
+                    if let Some((k, prims)) = run.replace((key, vec![prim as u32])) {
+                        classes.entry(k).or_default().0.extend(prims);
+                    }
+                }
+            }
+        }
+        if let Some((k, prims)) = run {
+            classes.entry(k).or_default().0.extend(prims);
         }
         for (s, set) in world.instanced.iter().enumerate() {
             if !set.is_empty() {
@@ -114,7 +132,7 @@ impl Accel {
                 casts_shadow,
                 bounds,
                 boxes.len(),
-                Bvh::build(world, &boxes, indices)?,
+                Bvh::build_with(world, boxes, indices, choice)?,
                 sets,
             ));
         }

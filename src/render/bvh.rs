@@ -1,12 +1,12 @@
 //! A wide bounding volume hierarchy laid out for SIMD traversal of single rays.
 //!
-//! obvhs builds a binary BVH (PLOC, spatial pre-splits, reinsertion; a top-down build where
-//! PLOC would degenerate: [`crate::render::bvh_build`]); this module collapses it into nodes
-//! of [`WIDTH`] = 8 children whose boxes are stored structure-of-arrays, so that one ray is
-//! tested against four of them with a few SSE instructions (glam's `Vec4`, any x86-64), and a
-//! packet of rays against each child in vector lanes (`render/bvh_packet.rs`); and into
+//! Nodes of [`WIDTH`] = 8 children whose boxes are stored structure-of-arrays, so that one
+//! ray is tested against four of them with a few SSE instructions (glam's `Vec4`, any
+//! x86-64), and a packet of rays against each child in vector lanes (`render/bvh_packet.rs`);
 //! leaves of primitive packets — four triangles tested together, or single ellipsoids
-//! ([`crate::render::packets`]).
+//! ([`crate::render::packets`]). The nodes are binned straight from the primitives' boxes
+//! ([`crate::render::bvh_binned`]); the builder before, obvhs' binary BVH (PLOC, reinsertion;
+//! [`crate::render::bvh_build`]) collapsed here, stays as its twin in tests.
 //!
 //! Traversal keeps the ray's `tmax` at the closest hit so far, visits children near to far,
 //! and skips stacked subtrees that start beyond it. Box tests are conservative (the exit
@@ -22,9 +22,9 @@ use obvhs::splits::split_aabbs_preset;
 use obvhs::triangle::Triangle;
 use rayon::prelude::*;
 
-use crate::render::bvh_build;
 use crate::render::packets::{EllipsoidLeaf, TRI_LANES, Triangles4};
 use crate::render::ray::TraceRay;
+use crate::render::{bvh_binned, bvh_build};
 use crate::scene::world::World;
 
 /// Children per node, a multiple of four (a `Vec4` per four). 8 against 4, measured in CPU
@@ -44,6 +44,9 @@ pub(crate) const COUNT_MASK: u32 = 0b111;
 pub(crate) const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 /// Most packets in one leaf.
 const MAX_LEAF_PACKETS: usize = COUNT_MASK as usize + 1;
+/// The error of a hierarchy whose leaf references cannot hold its packets.
+const TOO_MANY_PACKETS: &str = "the scene has more than 134217727 triangle packets or ellipsoids in one hierarchy, the most its leaf references hold: use fewer or coarser meshes";
+const _: () = assert!(FIRST_MASK == 134_217_727);
 /// An unused child slot (its box is empty, so it is never entered); unused slots follow the
 /// used ones.
 pub(crate) const EMPTY: u32 = u32::MAX;
@@ -95,10 +98,21 @@ pub(crate) struct Node {
 
 impl Node {
     /// Unused slots have NaN boxes, which no ray enters.
-    const EMPTY: Node = Node {
+    pub(crate) const EMPTY: Node = Node {
         bounds: [[f32::NAN; WIDTH]; 6],
         children: [EMPTY; WIDTH],
     };
+
+    /// Sets child `slot`'s box to `aabb` padded by a few ulps of its coordinates: clipped
+    /// (spatially split) boxes can be a rounding short of their triangle, which matters to a
+    /// ray that runs exactly along a box face.
+    pub(crate) fn set_child_box(&mut self, slot: usize, aabb: &Aabb) {
+        let pad = aabb.min.abs().max(aabb.max.abs()) * (4.0 * f32::EPSILON);
+        for axis in 0..3 {
+            self.bounds[2 * axis][slot] = aabb.min[axis] - pad[axis];
+            self.bounds[2 * axis + 1][slot] = aabb.max[axis] + pad[axis];
+        }
+    }
 
     /// Which children the ray enters in [tmin, tmax] (bit i for child i), and where: four
     /// children at a time in a `Vec4` (SSE on any x86-64).
@@ -214,30 +228,53 @@ fn key_entry(key: u64) -> f32 {
 /// overlaps everything (obvhs' spatial pre-splits); a primitive may then be in several leaves.
 /// Ellipsoids keep one box: it is tight enough.
 pub fn primitive_boxes(world: &World, prims: &[u32]) -> (Vec<Aabb>, Vec<u32>) {
-    let (triangles, ellipsoids): (Vec<u32>, Vec<u32>) = prims
+    let (mut indices, ellipsoids): (Vec<u32>, Vec<u32>) = prims
         .iter()
         .partition(|&&p| (p as usize) < world.triangles.len());
-    let tris: Vec<Triangle> = triangles
-        .iter()
-        .map(|&p| {
-            let t = &world.triangles[p as usize];
-            Triangle {
-                v0: t.v0,
-                v1: t.v0 - t.e1,
-                v2: t.v0 + t.e2,
+    let triangle = |p: u32| {
+        let t = &world.triangles[p as usize];
+        Triangle {
+            v0: t.v0,
+            v1: t.v0 - t.e1,
+            v2: t.v0 + t.e2,
+        }
+    };
+    let mut aabbs: Vec<Aabb> = indices.par_iter().map(|&p| triangle(p).aabb()).collect();
+    if !aabbs.is_empty() {
+        // Summed in order (a float sum's rounding depends on its order).
+        let (sum, largest) = aabbs
+            .iter()
+            .map(Aabb::half_area)
+            .fold((0.0f32, 0.0f32), |(sum, largest), area| {
+                (sum + area, largest.max(area))
+            });
+        let average = sum / aabbs.len() as f32;
+        // The preset splits only boxes of over three times the average area, and appends
+        // the new boxes in the order it visits its candidates: run on the boxes over the
+        // average alone (in order), it splits the same boxes the same way, without a copy of
+        // every triangle.
+        let large: Vec<usize> = (0..aabbs.len())
+            .filter(|&i| aabbs[i].half_area() > average)
+            .collect();
+        let mut large_boxes: Vec<Aabb> = large.iter().map(|&i| aabbs[i]).collect();
+        let mut large_indices: Vec<u32> = (0..large.len() as u32).collect();
+        let large_triangles: Vec<Triangle> = large.iter().map(|&i| triangle(indices[i])).collect();
+        split_aabbs_preset(
+            &mut large_boxes,
+            &mut large_indices,
+            &large_triangles,
+            average,
+            largest,
+        );
+        for (k, aabb) in large_boxes.iter().enumerate() {
+            if k < large.len() {
+                aabbs[large[k]] = *aabb;
+            } else {
+                aabbs.push(*aabb);
+                indices.push(indices[large[large_indices[k] as usize]]);
             }
-        })
-        .collect();
-    let mut aabbs: Vec<Aabb> = tris.iter().map(Triangle::aabb).collect();
-    // Indices into `tris` while splitting (the preset reads the triangles through them).
-    let mut indices: Vec<u32> = (0..tris.len() as u32).collect();
-    if !tris.is_empty() {
-        let areas: Vec<f32> = aabbs.iter().map(Aabb::half_area).collect();
-        let average = areas.iter().sum::<f32>() / areas.len() as f32;
-        let largest = areas.iter().copied().fold(0.0, f32::max);
-        split_aabbs_preset(&mut aabbs, &mut indices, &tris, average, largest);
+        }
     }
-    let mut indices: Vec<u32> = indices.iter().map(|&i| triangles[i as usize]).collect();
     aabbs.extend(ellipsoids.iter().map(|&p| world.aabb(p as usize)));
     indices.extend(ellipsoids);
     (aabbs, indices)
@@ -253,6 +290,17 @@ fn packets_of(leaf: u32) -> (usize, usize) {
     )
 }
 
+/// Which builder makes a hierarchy.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BuildChoice {
+    /// Binned SAH straight into wide nodes ([`bvh_binned`]): the default, at every size.
+    Binned,
+    /// PLOC's binary tree (a top-down one where PLOC degenerates) collapsed into wide nodes:
+    /// the builder before, kept as the binned one's twin in tests (on das its trees trace
+    /// 3–10 % slower and take 20 % more memory, and it builds 2.5–4 times slower).
+    Ploc,
+}
+
 /// A wide BVH over the triangles and ellipsoids of a world.
 #[derive(Clone)]
 pub struct Bvh {
@@ -264,9 +312,7 @@ pub struct Bvh {
 }
 
 impl Bvh {
-    /// Builds the hierarchy over primitives of `world` with boxes `boxes`, referred to by
-    /// `prims` (a primitive may have several boxes: spatial splits).
-    fn empty() -> Bvh {
+    pub(crate) fn empty() -> Bvh {
         Bvh {
             builder: None,
             nodes: Vec::new(),
@@ -275,13 +321,30 @@ impl Bvh {
         }
     }
 
-    pub fn build(world: &World, boxes: &[Aabb], prims: Vec<u32>) -> Result<Self> {
-        let mut bvh = Bvh::empty();
+    /// Builds the hierarchy over primitives of `world` with boxes `boxes`, referred to by
+    /// `prims` (a primitive may have several boxes: spatial splits), binned into wide nodes.
+    pub fn build(world: &World, boxes: Vec<Aabb>, prims: Vec<u32>) -> Result<Self> {
+        Bvh::build_with(world, boxes, prims, BuildChoice::Binned)
+    }
+
+    /// [`Bvh::build`] with the builder `choice` picks.
+    pub fn build_with(
+        world: &World,
+        mut boxes: Vec<Aabb>,
+        mut prims: Vec<u32>,
+        choice: BuildChoice,
+    ) -> Result<Self> {
         if boxes.is_empty() {
+            return Ok(Bvh::empty());
+        }
+        if choice == BuildChoice::Binned {
+            let mut bvh = bvh_binned::build(world, &mut boxes, &mut prims)?;
+            bvh.builder = Some(bvh_build::Builder::Binned);
             return Ok(bvh);
         }
+        let mut bvh = Bvh::empty();
         let owners: Vec<u32> = prims.iter().map(|&p| world.object_of(p as usize)).collect();
-        let (bvh2, builder) = bvh_build::build(boxes, prims, &owners);
+        let (bvh2, builder) = bvh_build::build(&boxes, prims, &owners);
         bvh.builder = Some(builder);
         let summaries = summarise(&bvh2, world.triangles.len() as u32);
         let mut builder = Builder {
@@ -327,12 +390,7 @@ impl Bvh {
                     debug_assert!(child as usize > i);
                     node_boxes[child as usize]
                 };
-                let pad = aabb.min.abs().max(aabb.max.abs()) * (4.0 * f32::EPSILON);
-                let bounds = &mut self.nodes[i].bounds;
-                for axis in 0..3 {
-                    bounds[2 * axis][slot] = aabb.min[axis] - pad[axis];
-                    bounds[2 * axis + 1][slot] = aabb.max[axis] + pad[axis];
-                }
+                self.nodes[i].set_child_box(slot, &aabb);
                 node_box = node_box.union(&aabb);
             }
             node_boxes[i] = node_box;
@@ -586,12 +644,159 @@ impl Bvh {
         }
     }
 
+    /// Appends a hierarchy made apart (its root first), its references moved by this one's
+    /// node, packet and ellipsoid counts; returns the reference of its root.
+    pub(crate) fn append(&mut self, part: Bvh) -> Result<u32> {
+        let (nodes, triangles, ellipsoids) = (
+            self.nodes.len() as u32,
+            self.triangles.len(),
+            self.ellipsoids.len(),
+        );
+        if triangles + part.triangles.len() > FIRST_MASK as usize
+            || ellipsoids + part.ellipsoids.len() > FIRST_MASK as usize
+        {
+            bail!(TOO_MANY_PACKETS);
+        }
+        let counts = [nodes as usize, triangles, ellipsoids];
+        self.nodes.extend(part.nodes.into_iter().map(|mut node| {
+            node.children = node.children.map(|child| relocated(child, counts));
+            node
+        }));
+        self.triangles.extend(part.triangles);
+        self.ellipsoids.extend(part.ellipsoids);
+        Ok(nodes)
+    }
+
+    /// Concatenates hierarchies made apart (each its root first), each one's references moved
+    /// by the node, packet and ellipsoid counts of those before it; each link [part, node,
+    /// slot, linked part] then refers that child slot to the linked part's root.
+    pub(crate) fn concatenate(parts: &[&Bvh], links: &[[usize; 4]]) -> Result<Bvh> {
+        let starts = |len: fn(&Bvh) -> usize| -> (Vec<usize>, usize) {
+            let mut total = 0;
+            let starts = parts
+                .iter()
+                .map(|part| {
+                    total += len(part);
+                    total - len(part)
+                })
+                .collect();
+            (starts, total)
+        };
+        let (nodes, node_count) = starts(|b| b.nodes.len());
+        let (triangles, triangle_count) = starts(|b| b.triangles.len());
+        let (ellipsoids, ellipsoid_count) = starts(|b| b.ellipsoids.len());
+        if triangle_count > FIRST_MASK as usize || ellipsoid_count > FIRST_MASK as usize {
+            bail!(TOO_MANY_PACKETS);
+        }
+        let out_nodes = concatenated(
+            parts,
+            |b| &b.nodes,
+            (&nodes, node_count),
+            |i, node| {
+                let counts = [nodes[i], triangles[i], ellipsoids[i]];
+                Node {
+                    children: node.children.map(|child| relocated(child, counts)),
+                    ..*node
+                }
+            },
+        );
+        let mut out = Bvh {
+            builder: None,
+            nodes: out_nodes,
+            triangles: concatenated(
+                parts,
+                |b| &b.triangles,
+                (&triangles, triangle_count),
+                |_, p| *p,
+            ),
+            ellipsoids: concatenated(
+                parts,
+                |b| &b.ellipsoids,
+                (&ellipsoids, ellipsoid_count),
+                |_, e| *e,
+            ),
+        };
+        for &[part, node, slot, linked] in links {
+            out.nodes[nodes[part] + node].children[slot] = nodes[linked] as u32;
+        }
+        Ok(out)
+    }
+
+    /// Packs primitives `prims` of `world` (all triangles, or all ellipsoids) into a leaf and
+    /// returns its reference.
+    pub(crate) fn push_leaf(
+        &mut self,
+        world: &World,
+        prims: &mut Vec<u32>,
+        triangles: bool,
+    ) -> Result<u32> {
+        // Spatial splits can put one primitive in several boxes of the same subtree.
+        prims.sort_unstable();
+        prims.dedup();
+        let (first, count, kind) = if triangles {
+            let first = self.triangles.len();
+            self.triangles.extend(
+                prims
+                    .chunks(TRI_LANES)
+                    .map(|chunk| Triangles4::new(&world.triangles, chunk)),
+            );
+            (first, prims.len().div_ceil(TRI_LANES), 0)
+        } else {
+            let first = self.ellipsoids.len();
+            let offset = world.ellipsoid_base();
+            self.ellipsoids.extend(prims.iter().map(|&p| EllipsoidLeaf {
+                ellipsoid: world.ellipsoids[p as usize - offset],
+                prim: p,
+            }));
+            (first, prims.len(), ELLIPSOIDS)
+        };
+        if count > MAX_LEAF_PACKETS || first + count > FIRST_MASK as usize {
+            bail!(TOO_MANY_PACKETS);
+        }
+        Ok(LEAF | kind | ((count as u32 - 1) << COUNT_SHIFT) | first as u32)
+    }
+
     /// Bytes held by the hierarchy.
     pub fn bytes(&self) -> usize {
         self.nodes.len() * size_of::<Node>()
             + self.triangles.len() * size_of::<Triangles4>()
             + self.ellipsoids.len() * size_of::<EllipsoidLeaf>()
     }
+}
+
+/// Child reference `child` of a hierarchy placed after `counts` = [nodes, triangle packets,
+/// ellipsoid leaves] of another.
+fn relocated(child: u32, [nodes, triangles, ellipsoids]: [usize; 3]) -> u32 {
+    if child == EMPTY {
+        child
+    } else if child & LEAF == 0 {
+        child + nodes as u32
+    } else if child & ELLIPSOIDS != 0 {
+        child + ellipsoids as u32
+    } else {
+        child + triangles as u32
+    }
+}
+
+/// The arrays `field` of `parts` one after the other, each element mapped by `map` (given
+/// its part's index), made side by side; `(starts, total)`: where each part's elements start,
+/// and their count.
+fn concatenated<T: Send + Sync, U: Send>(
+    parts: &[&Bvh],
+    field: impl Fn(&Bvh) -> &Vec<T> + Sync,
+    (starts, total): (&[usize], usize),
+    map: impl Fn(usize, &T) -> U + Sync,
+) -> Vec<U> {
+    (0..total)
+        .into_par_iter()
+        .with_min_len(1 << 12)
+        .map(|k| {
+            // The last part that starts at or before k: the one holding it (an empty part
+            // starts where the next does).
+            let i = starts.partition_point(|&s| s <= k) - 1;
+            map(i, &field(parts[i])[k - starts[i]])
+        })
+        .collect()
 }
 
 /// What the builder needs to know of a BVH2 subtree.
@@ -695,15 +900,7 @@ impl Builder<'_> {
         let mut node = Node::EMPTY;
         let mut inner = Vec::new();
         for (slot, &c) in children.iter().enumerate() {
-            // Padded by a few ulps of the coordinates: clipped (spatially split) boxes can
-            // be a rounding short of their triangle, which matters to a ray that runs
-            // exactly along a box face.
-            let aabb = self.bvh2.nodes[c].aabb();
-            let pad = aabb.min.abs().max(aabb.max.abs()) * (4.0 * f32::EPSILON);
-            for axis in 0..3 {
-                node.bounds[2 * axis][slot] = aabb.min[axis] - pad[axis];
-                node.bounds[2 * axis + 1][slot] = aabb.max[axis] + pad[axis];
-            }
+            node.set_child_box(slot, self.bvh2.nodes[c].aabb());
             if self.is_leaf(c) {
                 node.children[slot] = self.leaf(c)?;
             } else {
@@ -734,7 +931,7 @@ impl Builder<'_> {
                 })
                 .collect();
             for ((slot, _), part) in inner.iter().zip(parts) {
-                node.children[*slot] = self.append(part?)?;
+                node.children[*slot] = self.out.append(part?)?;
             }
             self.out.nodes[at] = node;
             return Ok(());
@@ -753,47 +950,6 @@ impl Builder<'_> {
         Ok(())
     }
 
-    /// Appends a hierarchy made apart (its root first) to the output, its references moved
-    /// by the output's node, packet and ellipsoid counts; returns the reference of its root.
-    fn append(&mut self, part: Bvh) -> Result<u32> {
-        let (nodes, triangles, ellipsoids) = (
-            self.out.nodes.len() as u32,
-            self.out.triangles.len(),
-            self.out.ellipsoids.len(),
-        );
-        if triangles + part.triangles.len() > FIRST_MASK as usize
-            || ellipsoids + part.ellipsoids.len() > FIRST_MASK as usize
-        {
-            bail!(
-                "the scene has more than {} triangle packets or ellipsoids in one hierarchy, the most its leaf references hold: use fewer or coarser meshes",
-                FIRST_MASK
-            );
-        }
-        let moved = |child: u32| -> u32 {
-            if child == EMPTY {
-                child
-            } else if child & LEAF == 0 {
-                child + nodes
-            } else {
-                let offset = if child & ELLIPSOIDS != 0 {
-                    ellipsoids
-                } else {
-                    triangles
-                };
-                child + offset as u32
-            }
-        };
-        self.out
-            .nodes
-            .extend(part.nodes.into_iter().map(|mut node| {
-                node.children = node.children.map(moved);
-                node
-            }));
-        self.out.triangles.extend(part.triangles);
-        self.out.ellipsoids.extend(part.ellipsoids);
-        Ok(nodes)
-    }
-
     /// Packs the primitives under BVH2 node `node` into a leaf and returns its reference.
     fn leaf(&mut self, node: usize) -> Result<u32> {
         let mut prims = Vec::new();
@@ -807,35 +963,7 @@ impl Builder<'_> {
                 todo.push(n.first_index as usize + 1);
             }
         }
-        // Spatial splits can put one primitive in several boxes of the same subtree.
-        prims.sort_unstable();
-        prims.dedup();
-        let world = self.world;
-        let (first, count, kind) = if self.summaries[node].triangles {
-            let first = self.out.triangles.len();
-            self.out.triangles.extend(
-                prims
-                    .chunks(TRI_LANES)
-                    .map(|chunk| Triangles4::new(&world.triangles, chunk)),
-            );
-            (first, prims.len().div_ceil(TRI_LANES), 0)
-        } else {
-            let first = self.out.ellipsoids.len();
-            let offset = world.ellipsoid_base();
-            self.out
-                .ellipsoids
-                .extend(prims.iter().map(|&p| EllipsoidLeaf {
-                    ellipsoid: world.ellipsoids[p as usize - offset],
-                    prim: p,
-                }));
-            (first, prims.len(), ELLIPSOIDS)
-        };
-        if count > MAX_LEAF_PACKETS || first + count > FIRST_MASK as usize {
-            bail!(
-                "the scene has more than {} triangle packets or ellipsoids in one hierarchy, the most its leaf references hold: use fewer or coarser meshes",
-                FIRST_MASK
-            );
-        }
-        Ok(LEAF | kind | ((count as u32 - 1) << COUNT_SHIFT) | first as u32)
+        self.out
+            .push_leaf(self.world, &mut prims, self.summaries[node].triangles)
     }
 }

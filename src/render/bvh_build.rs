@@ -43,6 +43,8 @@ const BINS: usize = 16;
 pub enum Builder {
     Ploc,
     TopDown,
+    /// Binned SAH straight into wide nodes (`bvh_binned.rs`), for large inputs.
+    Binned,
 }
 
 /// Builds a binary hierarchy over `boxes` (box i refers to primitive `prims[i]`, part of

@@ -3,6 +3,7 @@
 
 pub mod accel;
 pub mod bvh;
+pub mod bvh_binned;
 pub mod bvh_build;
 pub mod bvh_packet;
 pub mod camera_rays;

@@ -1,0 +1,678 @@
+//! The builder: binned SAH straight into wide nodes, as Embree's.
+//!
+//! The builder before (`bvh_build.rs`: PLOC, reinsertion; then the collapse in `bvh.rs`)
+//! passes many times over a binary hierarchy of twice as many nodes as boxes, which
+//! reinsertion has scattered in memory: on a million triangles it took four times Embree's
+//! build. Here a wide node is filled by splitting the range of boxes it covers, the child of
+//! largest area first, until it has [`WIDTH`] children. Each split bins the boxes' centres
+//! into up to [`BINS`] slabs per axis and cuts where the surface-area cost is least, counting
+//! whole packets of [`TRI_LANES`] triangles (so leaves come out full); ranges of at most
+//! [`SMALL`] boxes are cut by the exact sweep instead. No binary hierarchy is kept: each box
+//! is touched a few times per wide level. Its trees are also tighter than PLOC's (on das:
+//! 3–10 % faster rays, 16 % less memory; docs/notebook/benchmark-history.md).
+//!
+//! Both cores from the first split, and the same tree on any thread count: ranges of
+//! [`PARALLEL_BINNING`] boxes or more are binned in chunks side by side (bins merge by
+//! minima, maxima and counts: the same in any order); a node over [`PARALLEL_SPLITS`] boxes
+//! is filled by three levels of halves, each half split side by side; subtrees of [`TASK`]
+//! boxes or more are built apart, side by side, and concatenated in preorder. The tree and
+//! its layout depend only on the boxes.
+
+use anyhow::{Result, bail};
+use glam::Vec3A;
+use obvhs::aabb::Aabb;
+use rayon::prelude::*;
+
+use crate::render::bvh::{Bvh, Node, STACK, WIDTH};
+use crate::render::packets::TRI_LANES;
+use crate::scene::world::World;
+
+/// Slabs per axis of a split's search.
+const BINS: usize = 32;
+/// Boxes from which a range is binned in chunks side by side.
+const PARALLEL_BINNING: usize = 1 << 15;
+/// Ranges of this many boxes or more fill their node by halves side by side.
+const PARALLEL_SPLITS: usize = 1 << 17;
+/// Subtrees of this many boxes or more are built apart, side by side.
+const TASK: usize = 1 << 14;
+/// Ranges of at most this many items are split by the exact sweep, not binned.
+const SMALL: usize = 16;
+/// Wide depth from which ranges split at the median (bounding the depth on any input).
+const SAH_DEPTH: usize = 24;
+
+/// The items being built over, as two arrays reordered together: each item's box (world
+/// frame, metres) and its primitive; `offset` is the index of the first among all items
+/// (ranges index all items).
+struct Items<'a> {
+    boxes: &'a mut [Aabb],
+    prims: &'a mut [u32],
+    offset: usize,
+    /// Primitives below this are triangles, the others ellipsoids.
+    triangles: usize,
+}
+
+impl<'a> Items<'a> {
+    /// The items before `at` (an index of all items) and the rest, apart.
+    fn split_off(self, at: usize) -> (Items<'a>, Items<'a>) {
+        let (boxes, boxes_tail) = self.boxes.split_at_mut(at - self.offset);
+        let (prims, prims_tail) = self.prims.split_at_mut(at - self.offset);
+        let head = Items {
+            boxes,
+            prims,
+            ..self
+        };
+        let tail = Items {
+            boxes: boxes_tail,
+            prims: prims_tail,
+            offset: at,
+            triangles: self.triangles,
+        };
+        (head, tail)
+    }
+
+    /// The items of `range`, apart from the others.
+    fn take(self, range: &Range) -> Items<'a> {
+        self.split_off(range.start).1.split_off(range.end).0
+    }
+
+    fn reborrow(&mut self) -> Items<'_> {
+        Items {
+            boxes: self.boxes,
+            prims: self.prims,
+            ..*self
+        }
+    }
+
+    fn boxes(&self, range: &Range) -> &[Aabb] {
+        &self.boxes[range.start - self.offset..range.end - self.offset]
+    }
+
+    fn prims(&self, range: &Range) -> &[u32] {
+        &self.prims[range.start - self.offset..range.end - self.offset]
+    }
+
+    fn swap(&mut self, a: usize, b: usize) {
+        self.boxes.swap(a - self.offset, b - self.offset);
+        self.prims.swap(a - self.offset, b - self.offset);
+    }
+
+    /// Reorders the items of `range` to `order` (their places in it).
+    fn reorder(&mut self, range: &Range, order: &[usize]) {
+        let boxes: Vec<Aabb> = order.iter().map(|&k| self.boxes(range)[k]).collect();
+        let prims: Vec<u32> = order.iter().map(|&k| self.prims(range)[k]).collect();
+        let (start, end) = (range.start - self.offset, range.end - self.offset);
+        self.boxes[start..end].copy_from_slice(&boxes);
+        self.prims[start..end].copy_from_slice(&prims);
+    }
+
+    /// The kind of leaf `range` becomes (triangles: true), or None if it must be split: one
+    /// packet of triangles, or one ellipsoid.
+    fn leaf_kind(&self, range: &Range) -> Option<bool> {
+        if range.len() > TRI_LANES {
+            return None;
+        }
+        let triangles = self
+            .prims(range)
+            .iter()
+            .all(|&prim| (prim as usize) < self.triangles);
+        (range.len() == 1 || triangles).then_some(triangles)
+    }
+
+    /// Splits `range` into at most 2^`levels` ranges that are not leaves, by halves side by
+    /// side, and appends them to `out` in order.
+    fn split_levels(mut self, range: Range, depth: usize, levels: u32, out: &mut Vec<Range>) {
+        if levels == 0 || self.leaf_kind(&range).is_some() {
+            out.push(range);
+            return;
+        }
+        let (left, right) = self.split(range, depth);
+        let (head, tail) = self.split_off(right.start);
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        rayon::join(
+            || head.split_levels(left, depth, levels - 1, &mut a),
+            || tail.split_levels(right, depth, levels - 1, &mut b),
+        );
+        out.extend(a);
+        out.extend(b);
+    }
+
+    /// Splits `range` (two or more items, not one leaf) into two non-empty ranges: apart by
+    /// kind where that makes leaves, else by the surface-area heuristic (below
+    /// [`SAH_DEPTH`]), else at the median.
+    fn split(&mut self, range: Range, depth: usize) -> (Range, Range) {
+        if range.len() <= TRI_LANES {
+            // A leaf but for its kinds (triangles and ellipsoids, or several ellipsoids).
+            let triangles = self.triangles;
+            let (left, right) = self.partition(range, |_, prim| (prim as usize) < triangles);
+            if left.len() > 0 && right.len() > 0 {
+                return (left, right);
+            }
+        }
+        if depth >= SAH_DEPTH {
+            return self.median_split(range);
+        }
+        if range.len() <= SMALL {
+            return self.small_split(range);
+        }
+        let extent = range.centres.diagonal();
+        if extent.cmpgt(Vec3A::ZERO).any() {
+            let map = BinMap::new(&range.centres, range.len());
+            let boxes = self.boxes(&range);
+            let best = match map.bins {
+                8 => Bins::<8>::best_split_of(boxes, &map),
+                16 => Bins::<16>::best_split_of(boxes, &map),
+                _ => Bins::<BINS>::best_split_of(boxes, &map),
+            };
+            if let Some((axis, slab)) = best {
+                return self.partition(range, |aabb, _| map.slab(axis, centre2(aabb)) <= slab);
+            }
+        }
+        self.median_split(range)
+    }
+
+    /// Splits a small range (at most [`SMALL`] items) where the surface-area cost is least
+    /// over every cut of its items sorted by centre along the axis where the centres spread
+    /// most (ties by place): the exact sweep, cheaper than binning so few.
+    fn small_split(&mut self, range: Range) -> (Range, Range) {
+        let boxes = self.boxes(&range);
+        let n = boxes.len();
+        let axis = range.centres.largest_axis();
+        // Sort keys: the centre's bits in an order that sorts as the floats do, above the
+        // item's place.
+        let mut order = [u64::MAX; SMALL];
+        for (k, o) in order[..n].iter_mut().enumerate() {
+            let bits = centre2(&boxes[k])[axis].to_bits();
+            let ordered = if bits >> 31 == 1 {
+                !bits
+            } else {
+                bits | 1 << 31
+            };
+            *o = u64::from(ordered) << 32 | k as u64;
+        }
+        order[..n].sort_unstable();
+        let place = |k: usize| order[k] as u32 as usize;
+        let packets = |count: usize| count.div_ceil(TRI_LANES) as f32;
+        let mut right = [0.0f32; SMALL];
+        let mut acc = Aabb::INVALID;
+        for k in (1..n).rev() {
+            acc = acc.union(&boxes[place(k)]);
+            right[k] = acc.half_area() * packets(n - k);
+        }
+        let (mut acc, mut best) = (Aabb::INVALID, (f32::INFINITY, 1));
+        for k in 1..n {
+            acc = acc.union(&boxes[place(k - 1)]);
+            let cost = acc.half_area() * packets(k) + right[k];
+            if cost < best.0 {
+                best = (cost, k);
+            }
+        }
+        let (mut boxes_sorted, mut prims_sorted) = ([Aabb::INVALID; SMALL], [0; SMALL]);
+        for k in 0..n {
+            boxes_sorted[k] = boxes[place(k)];
+            prims_sorted[k] = self.prims(&range)[place(k)];
+        }
+        let (start, end) = (range.start - self.offset, range.end - self.offset);
+        self.boxes[start..end].copy_from_slice(&boxes_sorted[..n]);
+        self.prims[start..end].copy_from_slice(&prims_sorted[..n]);
+        self.halves(range, range.start + best.1)
+    }
+
+    /// `range` cut at `split`, with the bounds of both parts.
+    fn halves(&self, range: Range, split: usize) -> (Range, Range) {
+        let (left, right) = (
+            Range {
+                end: split,
+                ..range
+            },
+            Range {
+                start: split,
+                ..range
+            },
+        );
+        (
+            Bounds::of(self.boxes(&left)).range(range.start, split),
+            Bounds::of(self.boxes(&right)).range(split, range.end),
+        )
+    }
+
+    /// Splits `range` at its median along the axis where its centres spread most; by order
+    /// where they coincide.
+    fn median_split(&mut self, range: Range) -> (Range, Range) {
+        let mid = range.len() / 2;
+        let axis = range.centres.largest_axis();
+        if range.centres.diagonal()[axis] > 0.0 {
+            let (boxes, prims) = (self.boxes(&range), self.prims(&range));
+            let mut order: Vec<usize> = (0..range.len()).collect();
+            order.select_nth_unstable_by(mid, |&a, &b| {
+                centre2(&boxes[a])[axis]
+                    .total_cmp(&centre2(&boxes[b])[axis])
+                    .then(prims[a].cmp(&prims[b]))
+                    .then(a.cmp(&b))
+            });
+            self.reorder(&range, &order);
+        }
+        self.halves(range, range.start + mid)
+    }
+
+    /// Reorders `range` so that the items for which `left` holds come first; returns both
+    /// parts with their bounds.
+    fn partition(&mut self, range: Range, left: impl Fn(&Aabb, u32) -> bool) -> (Range, Range) {
+        let (mut lb, mut rb) = (Bounds::EMPTY, Bounds::EMPTY);
+        let offset = self.offset;
+        let goes_left =
+            |items: &Items, k: usize| left(&items.boxes[k - offset], items.prims[k - offset]);
+        let (mut i, mut j) = (range.start, range.end);
+        loop {
+            while i < j && goes_left(self, i) {
+                lb.add(&self.boxes[i - offset]);
+                i += 1;
+            }
+            while i < j && !goes_left(self, j - 1) {
+                rb.add(&self.boxes[j - 1 - offset]);
+                j -= 1;
+            }
+            if i == j {
+                break;
+            }
+            self.swap(i, j - 1);
+        }
+        (lb.range(range.start, i), rb.range(i, range.end))
+    }
+}
+
+/// Twice the box's centre (the halving cancels in every comparison).
+#[inline(always)]
+fn centre2(aabb: &Aabb) -> Vec3A {
+    aabb.min + aabb.max
+}
+
+/// A range of items with the union of their boxes and the bounds of their centres (doubled).
+#[derive(Clone, Copy)]
+struct Range {
+    start: usize,
+    end: usize,
+    aabb: Aabb,
+    centres: Aabb,
+}
+
+impl Range {
+    fn len(&self) -> usize {
+        self.end - self.start
+    }
+}
+
+/// Box and centre bounds, grown item by item.
+#[derive(Clone, Copy)]
+struct Bounds {
+    aabb: Aabb,
+    centres: Aabb,
+}
+
+impl Bounds {
+    const EMPTY: Bounds = Bounds {
+        aabb: Aabb::INVALID,
+        centres: Aabb::INVALID,
+    };
+
+    #[inline(always)]
+    fn add(&mut self, aabb: &Aabb) {
+        self.aabb = self.aabb.union(aabb);
+        self.centres.extend(centre2(aabb));
+    }
+
+    fn of(boxes: &[Aabb]) -> Bounds {
+        let mut bounds = Bounds::EMPTY;
+        for aabb in boxes {
+            bounds.add(aabb);
+        }
+        bounds
+    }
+
+    fn union(self, other: Bounds) -> Bounds {
+        Bounds {
+            aabb: self.aabb.union(&other.aabb),
+            centres: self.centres.union(&other.centres),
+        }
+    }
+
+    fn range(self, start: usize, end: usize) -> Range {
+        Range {
+            start,
+            end,
+            aabb: self.aabb,
+            centres: self.centres,
+        }
+    }
+}
+
+/// Which slab of each axis a centre falls in.
+struct BinMap {
+    lo: Vec3A,
+    scale: Vec3A,
+    /// Slabs per axis, at most [`BINS`].
+    bins: usize,
+}
+
+impl BinMap {
+    /// The slabs of a range of `count` items with centres in `centres`: fewer for fewer
+    /// items (the sweep over them costs as much as binning a few items).
+    fn new(centres: &Aabb, count: usize) -> BinMap {
+        let bins = match count {
+            ..64 => 8,
+            64..128 => 16,
+            _ => BINS,
+        };
+        let extent = centres.diagonal();
+        let scale = Vec3A::select(
+            extent.cmpgt(Vec3A::ZERO),
+            Vec3A::splat((bins - 1) as f32) / extent,
+            Vec3A::ZERO,
+        );
+        BinMap {
+            lo: centres.min,
+            scale,
+            bins,
+        }
+    }
+
+    /// The slab of each axis: the centre's place in [0, bins − 1] rounded to the nearest
+    /// (the end slabs are half as wide), by adding 2²³, whose float has no fraction bits:
+    /// a float→integer conversion without the range checks of `as`.
+    #[inline(always)]
+    fn slabs(&self, centre2: Vec3A) -> [u32; 3] {
+        let place = ((centre2 - self.lo) * self.scale)
+            .clamp(Vec3A::ZERO, Vec3A::splat((self.bins - 1) as f32))
+            + Vec3A::splat(MAGIC);
+        place.to_array().map(|f| f.to_bits() & 0xff)
+    }
+
+    /// [`BinMap::slabs`] of one axis (the same operations: the same slab).
+    #[inline(always)]
+    fn slab(&self, axis: usize, centre2: Vec3A) -> u32 {
+        // SSE's max and min (the vector clamp's), NaN to 0 as there.
+        let place = (centre2[axis] - self.lo[axis]) * self.scale[axis];
+        let place = if place > 0.0 { place } else { 0.0 };
+        let last = (self.bins - 1) as f32;
+        let place = if place < last { place } else { last };
+        (place + MAGIC).to_bits() & 0xff
+    }
+}
+
+/// 2²³: the floats from it to 2²⁴ are the integers, in their low mantissa bits.
+const MAGIC: f32 = 8_388_608.0;
+
+/// Per axis and slab: the union of the boxes whose centres fall in it, and their count.
+/// `N` slabs: as many as the map's (their initialisation is a copy of all of them).
+#[derive(Clone, Copy)]
+struct Bins<const N: usize> {
+    boxes: [[Aabb; N]; 3],
+    counts: [[u32; N]; 3],
+}
+
+impl<const N: usize> Bins<N> {
+    const EMPTY: Bins<N> = Bins {
+        boxes: [[Aabb::INVALID; N]; 3],
+        counts: [[0; N]; 3],
+    };
+
+    /// The cheapest split of the boxes of a range, binned by `map` (of `N` slabs), side by
+    /// side in chunks where they are many.
+    fn best_split_of(boxes: &[Aabb], map: &BinMap) -> Option<(usize, u32)> {
+        debug_assert_eq!(map.bins, N);
+        let bins = if boxes.len() >= PARALLEL_BINNING {
+            boxes
+                .par_chunks(PARALLEL_BINNING / 4)
+                .map(|chunk| Bins::<N>::of(chunk, map))
+                .reduce(|| Bins::EMPTY, Bins::merged)
+        } else {
+            Bins::<N>::of(boxes, map)
+        };
+        bins.best_split()
+    }
+
+    fn of(boxes: &[Aabb], map: &BinMap) -> Bins<N> {
+        // Two sets of bins, for the even and the odd boxes: consecutive boxes often fall in
+        // the same slab, and one set would make each update wait for the last.
+        let (mut even, mut odd) = (Bins::EMPTY, Bins::EMPTY);
+        let mut pairs = boxes.chunks_exact(2);
+        for pair in &mut pairs {
+            even.add(&pair[0], map);
+            odd.add(&pair[1], map);
+        }
+        for aabb in pairs.remainder() {
+            even.add(aabb, map);
+        }
+        even.merged(odd)
+    }
+
+    #[inline(always)]
+    fn add(&mut self, aabb: &Aabb, map: &BinMap) {
+        let slabs = map.slabs(centre2(aabb));
+        for (axis, &k) in slabs.iter().enumerate() {
+            let k = k as usize;
+            self.boxes[axis][k] = self.boxes[axis][k].union(aabb);
+            self.counts[axis][k] += 1;
+        }
+    }
+
+    fn merged(mut self, other: Bins<N>) -> Bins<N> {
+        for axis in 0..3 {
+            for k in 0..N {
+                self.boxes[axis][k] = self.boxes[axis][k].union(&other.boxes[axis][k]);
+                self.counts[axis][k] += other.counts[axis][k];
+            }
+        }
+        self
+    }
+
+    /// The cheapest split, (axis, last slab of the left part), where one leaves both parts
+    /// non-empty. Cost: each part's half-area times its packets of [`TRI_LANES`].
+    fn best_split(&self) -> Option<(usize, u32)> {
+        let packets = |count: u32| count.div_ceil(TRI_LANES as u32) as f32;
+        let mut best: Option<(f32, usize, u32)> = None;
+        for axis in 0..3 {
+            let (boxes, counts) = (&self.boxes[axis], &self.counts[axis]);
+            let mut right_cost = [f32::INFINITY; N];
+            let (mut acc, mut count) = (Aabb::INVALID, 0);
+            for k in (1..N).rev() {
+                acc = acc.union(&boxes[k]);
+                count += counts[k];
+                if count > 0 {
+                    right_cost[k] = acc.half_area() * packets(count);
+                }
+            }
+            let (mut acc, mut count) = (Aabb::INVALID, 0);
+            for k in 0..N - 1 {
+                acc = acc.union(&boxes[k]);
+                count += counts[k];
+                if count == 0 {
+                    continue;
+                }
+                let cost = acc.half_area() * packets(count) + right_cost[k + 1];
+                if cost.is_finite() && best.is_none_or(|(c, _, _)| cost < c) {
+                    best = Some((cost, axis, k as u32));
+                }
+            }
+        }
+        best.map(|(_, axis, slab)| (axis, slab))
+    }
+}
+
+/// A subtree left to build apart: its range, its depth, and the child slot that will refer
+/// to it.
+struct Deferred {
+    range: Range,
+    depth: usize,
+    node: usize,
+    slot: usize,
+}
+
+struct Builder<'a> {
+    /// The items of this part; ranges index into them.
+    items: Items<'a>,
+    world: &'a World,
+    out: Bvh,
+    /// Subtrees of [`TASK`] boxes or more, left to build apart.
+    deferred: Vec<Deferred>,
+    /// A leaf's primitives (kept to spare an allocation per leaf).
+    leaf: Vec<u32>,
+}
+
+/// A subtree built apart: its hierarchy (its root first), and the subtrees built apart below
+/// it, each with the node and slot that refers to it.
+struct Part {
+    bvh: Bvh,
+    links: Vec<(usize, usize, Part)>,
+}
+
+impl Part {
+    /// Builds the subtree of `range` (all of `items`), its subtrees of [`TASK`] boxes or
+    /// more side by side.
+    fn build(items: Items, range: Range, depth: usize, world: &World) -> Result<Part> {
+        let mut out = Bvh::empty();
+        out.nodes.reserve(range.len() / 8);
+        out.triangles.reserve(range.len() / 3);
+        let mut builder = Builder {
+            items,
+            world,
+            out,
+            deferred: Vec::new(),
+            leaf: Vec::with_capacity(TRI_LANES),
+        };
+        let root = builder.reserve();
+        builder.fill(root, range, depth)?;
+        let Builder {
+            items,
+            out,
+            mut deferred,
+            ..
+        } = builder;
+        // The deferred ranges are disjoint: cut the items into their slices, in order.
+        deferred.sort_by_key(|d| d.range.start);
+        let mut slices = Vec::with_capacity(deferred.len());
+        let mut rest = items;
+        for d in &deferred {
+            let (slice, tail) = rest.split_off(d.range.start).1.split_off(d.range.end);
+            slices.push(slice);
+            rest = tail;
+        }
+        let parts: Vec<Result<Part>> = deferred
+            .par_iter()
+            .zip(slices)
+            .map(|(d, items)| Part::build(items, d.range, d.depth, world))
+            .collect();
+        let mut links = Vec::with_capacity(parts.len());
+        for (d, part) in deferred.iter().zip(parts) {
+            links.push((d.node, d.slot, part?));
+        }
+        Ok(Part { bvh: out, links })
+    }
+
+    /// This part and those below it in preorder, with each link as (its part's index, node,
+    /// slot, the linked part's index).
+    fn flatten<'a>(&'a self, parts: &mut Vec<&'a Bvh>, links: &mut Vec<[usize; 4]>) -> usize {
+        let me = parts.len();
+        parts.push(&self.bvh);
+        for (node, slot, part) in &self.links {
+            let linked = part.flatten(parts, links);
+            links.push([me, *node, *slot, linked]);
+        }
+        me
+    }
+}
+
+/// Builds the wide hierarchy over `boxes` (box i refers to primitive `prims[i]` of `world`),
+/// reordering both.
+pub fn build(world: &World, boxes: &mut [Aabb], prims: &mut [u32]) -> Result<Bvh> {
+    // Chunks side by side: minima and maxima are the same in any order.
+    let bounds = boxes
+        .par_chunks(PARALLEL_BINNING)
+        .map(Bounds::of)
+        .reduce(|| Bounds::EMPTY, Bounds::union)
+        .range(0, boxes.len());
+    let items = Items {
+        boxes,
+        prims,
+        offset: 0,
+        triangles: world.triangles.len(),
+    };
+    let root = Part::build(items, bounds, 1, world)?;
+    let (mut parts, mut links) = (Vec::new(), Vec::new());
+    root.flatten(&mut parts, &mut links);
+    Bvh::concatenate(&parts, &links)
+}
+
+impl Builder<'_> {
+    fn reserve(&mut self) -> usize {
+        self.out.nodes.push(Node::EMPTY);
+        self.out.nodes.len() - 1
+    }
+
+    /// Fills wide node `at` with the subtrees of `range`, split largest first until there
+    /// are [`WIDTH`].
+    fn fill(&mut self, at: usize, range: Range, depth: usize) -> Result<()> {
+        // A closest-hit query stacks at most WIDTH − 1 entries per level, an any-hit WIDTH.
+        // Below SAH_DEPTH every node halves its largest range at least: this cannot fail.
+        if depth * WIDTH > STACK {
+            bail!(
+                "internal error: the scene's hierarchy is deeper than {} levels",
+                STACK / WIDTH
+            );
+        }
+        // The children, each with the kind of leaf it makes (None: an inner node).
+        let mut children = [(range, self.items.leaf_kind(&range)); WIDTH];
+        let mut count = 1;
+        if range.len() >= PARALLEL_SPLITS {
+            // Big: three levels of halves, side by side (largest first would split one
+            // after the other).
+            let mut ranges = Vec::with_capacity(WIDTH);
+            let items = self.items.reborrow().take(&range);
+            items.split_levels(range, depth, WIDTH.ilog2(), &mut ranges);
+            count = ranges.len();
+            for (child, r) in children.iter_mut().zip(ranges) {
+                *child = (r, self.items.leaf_kind(&r));
+            }
+        }
+        while count < WIDTH {
+            let open = children[..count]
+                .iter()
+                .enumerate()
+                .filter(|(_, (_, kind))| kind.is_none())
+                .max_by(|a, b| a.1.0.aabb.half_area().total_cmp(&b.1.0.aabb.half_area()));
+            let Some((i, &(c, _))) = open else { break };
+            let (left, right) = self.items.split(c, depth);
+            children.copy_within(i + 1..count, i + 2);
+            children[i] = (left, self.items.leaf_kind(&left));
+            children[i + 1] = (right, self.items.leaf_kind(&right));
+            count += 1;
+        }
+        let mut node = Node::EMPTY;
+        let mut reserved = [(0, range); WIDTH];
+        let mut inner = 0;
+        for (slot, &(c, kind)) in children[..count].iter().enumerate() {
+            node.set_child_box(slot, &c.aabb);
+            if let Some(triangles) = kind {
+                self.leaf.clear();
+                self.leaf.extend_from_slice(self.items.prims(&c));
+                node.children[slot] = self.out.push_leaf(self.world, &mut self.leaf, triangles)?;
+            } else if c.len() >= TASK {
+                self.deferred.push(Deferred {
+                    range: c,
+                    depth: depth + 1,
+                    node: at,
+                    slot,
+                });
+            } else {
+                let index = self.reserve();
+                node.children[slot] = index as u32;
+                reserved[inner] = (index, c);
+                inner += 1;
+            }
+        }
+        self.out.nodes[at] = node;
+        for &(index, c) in &reserved[..inner] {
+            self.fill(index, c, depth + 1)?;
+        }
+        Ok(())
+    }
+}
