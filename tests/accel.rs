@@ -7,8 +7,9 @@ mod common;
 
 use glam::{DAffine3, DVec3, Vec3};
 use seethru::geometry::camera::Camera;
-use seethru::render::accel::{Accel, Hit, closest_brute_force, make_ray, occluded_brute_force};
-use seethru::render::bvh::BuildChoice;
+use seethru::render::accel::{
+    Accel, BuildChoice, Hit, closest_brute_force, make_ray, occluded_brute_force,
+};
 use seethru::render::bvh_build::Builder;
 use seethru::render::bvh_packet::{PACKET, PacketStack, RayPacket};
 use seethru::render::camera_rays::CameraRays;

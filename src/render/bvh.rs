@@ -5,7 +5,7 @@
 //! x86-64), and a packet of rays against each child in vector lanes (`render/bvh_packet.rs`);
 //! leaves of primitive packets — four triangles tested together, or single ellipsoids
 //! ([`crate::render::packets`]). The nodes are binned straight from the primitives' boxes
-//! ([`crate::render::bvh_binned`]); the builder before, obvhs' binary BVH (PLOC, reinsertion;
+//! (`bvh_binned.rs`); the builder before, obvhs' binary BVH (PLOC, reinsertion;
 //! [`crate::render::bvh_build`]) collapsed here, stays as its twin in tests.
 //!
 //! Traversal keeps the ray's `tmax` at the closest hit so far, visits children near to far,
@@ -22,9 +22,9 @@ use obvhs::splits::split_aabbs_preset;
 use obvhs::triangle::Triangle;
 use rayon::prelude::*;
 
+use crate::render::bvh_build;
 use crate::render::packets::{EllipsoidLeaf, TRI_LANES, Triangles4};
 use crate::render::ray::TraceRay;
-use crate::render::{bvh_binned, bvh_build};
 use crate::scene::world::World;
 
 /// Children per node, a multiple of four (a `Vec4` per four). 8 against 4, measured in CPU
@@ -290,17 +290,6 @@ fn packets_of(leaf: u32) -> (usize, usize) {
     )
 }
 
-/// Which builder makes a hierarchy.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BuildChoice {
-    /// Binned SAH straight into wide nodes ([`bvh_binned`]): the default, at every size.
-    Binned,
-    /// PLOC's binary tree (a top-down one where PLOC degenerates) collapsed into wide nodes:
-    /// the builder before, kept as the binned one's twin in tests (on das its trees trace
-    /// 3–10 % slower and take 20 % more memory, and it builds 2.5–4 times slower).
-    Ploc,
-}
-
 /// A wide BVH over the triangles and ellipsoids of a world.
 #[derive(Clone)]
 pub struct Bvh {
@@ -322,29 +311,15 @@ impl Bvh {
     }
 
     /// Builds the hierarchy over primitives of `world` with boxes `boxes`, referred to by
-    /// `prims` (a primitive may have several boxes: spatial splits), binned into wide nodes.
-    pub fn build(world: &World, boxes: Vec<Aabb>, prims: Vec<u32>) -> Result<Self> {
-        Bvh::build_with(world, boxes, prims, BuildChoice::Binned)
-    }
-
-    /// [`Bvh::build`] with the builder `choice` picks.
-    pub fn build_with(
-        world: &World,
-        mut boxes: Vec<Aabb>,
-        mut prims: Vec<u32>,
-        choice: BuildChoice,
-    ) -> Result<Self> {
+    /// `prims` (a primitive may have several boxes: spatial splits), by the builder before
+    /// the binned one: PLOC's binary tree (a top-down one where PLOC degenerates) collapsed.
+    pub fn build_ploc(world: &World, boxes: &[Aabb], prims: Vec<u32>) -> Result<Self> {
         if boxes.is_empty() {
             return Ok(Bvh::empty());
         }
-        if choice == BuildChoice::Binned {
-            let mut bvh = bvh_binned::build(world, &mut boxes, &mut prims)?;
-            bvh.builder = Some(bvh_build::Builder::Binned);
-            return Ok(bvh);
-        }
         let mut bvh = Bvh::empty();
         let owners: Vec<u32> = prims.iter().map(|&p| world.object_of(p as usize)).collect();
-        let (bvh2, builder) = bvh_build::build(&boxes, prims, &owners);
+        let (bvh2, builder) = bvh_build::build(boxes, prims, &owners);
         bvh.builder = Some(builder);
         let summaries = summarise(&bvh2, world.triangles.len() as u32);
         let mut builder = Builder {

@@ -24,6 +24,7 @@ use obvhs::aabb::Aabb;
 use rayon::prelude::*;
 
 use crate::render::bvh::{Bvh, Node, STACK, WIDTH};
+use crate::render::bvh_build::Builder as Made;
 use crate::render::packets::TRI_LANES;
 use crate::scene::world::World;
 
@@ -584,6 +585,9 @@ impl Part {
 /// Builds the wide hierarchy over `boxes` (box i refers to primitive `prims[i]` of `world`),
 /// reordering both.
 pub fn build(world: &World, boxes: &mut [Aabb], prims: &mut [u32]) -> Result<Bvh> {
+    if boxes.is_empty() {
+        return Ok(Bvh::empty());
+    }
     // Chunks side by side: minima and maxima are the same in any order.
     let bounds = boxes
         .par_chunks(PARALLEL_BINNING)
@@ -599,7 +603,9 @@ pub fn build(world: &World, boxes: &mut [Aabb], prims: &mut [u32]) -> Result<Bvh
     let root = Part::build(items, bounds, 1, world)?;
     let (mut parts, mut links) = (Vec::new(), Vec::new());
     root.flatten(&mut parts, &mut links);
-    Bvh::concatenate(&parts, &links)
+    let mut bvh = Bvh::concatenate(&parts, &links)?;
+    bvh.builder = Some(Made::Binned);
+    Ok(bvh)
 }
 
 impl Builder<'_> {

@@ -240,8 +240,8 @@ pub fn placed_bounds(world: &World) -> Aabb {
 fn mesh_hierarchy(set: &InstanceSet, pad: f32) -> Result<Bvh> {
     let mesh = World::of_triangles(set.triangles.clone(), set.attrs.clone());
     let prims: Vec<u32> = (0..set.triangles.len() as u32).collect();
-    let (boxes, indices) = crate::render::bvh::primitive_boxes(&mesh, &prims);
-    let mut bvh = Bvh::build(&mesh, boxes, indices)?;
+    let (mut boxes, mut indices) = crate::render::bvh::primitive_boxes(&mesh, &prims);
+    let mut bvh = crate::render::bvh_binned::build(&mesh, &mut boxes, &mut indices)?;
     bvh.pad(pad);
     Ok(bvh)
 }
