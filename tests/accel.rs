@@ -766,6 +766,12 @@ fn ellipsoids_among_subtrees_built_apart_equal_brute_force() {
     assert!(balls_hit > rays.len() / 3, "{balls_hit} balls hit");
 }
 
+/// The id of the object named `name` in `world` (its index in the objects plus one).
+fn object_id(world: &World, name: &str) -> u32 {
+    let i = world.objects.iter().position(|o| o.name == name);
+    i.unwrap_or_else(|| panic!("no object {name}")) as u32 + 1
+}
+
 /// The moving layer of `scenes/das_mesh_head.toml` with the head mesh, the ball (an
 /// ellipsoid) and the car; the head and the ball carried by `head` and `ball` (rigid
 /// world_from_world maps), the car left in place.
@@ -779,10 +785,7 @@ fn moved_layers(
     let mut parts =
         MovingParts::new(&scene, &|i| names.contains(&scene.objects[i].name.as_str())).unwrap();
     let still = parts.at(&|_| None).unwrap();
-    let id = |name: &str| {
-        let i = still.world.objects.iter().position(|o| o.name == name);
-        i.unwrap_or_else(|| panic!("no object {name}")) as u32 + 1
-    };
+    let id = |name| object_id(&still.world, name);
     let (head_id, ball_id, car_id) = (id("head"), id("ball"), id("car"));
     // Where the rays aim: the head's centre and the ball's, after the motion.
     let mut head_box = obvhs::aabb::Aabb::empty();
@@ -883,8 +886,7 @@ fn a_refitted_moving_layer_equals_a_rebuilt_one_and_brute_force() {
         }
     }
     // Many rays hit the moved head's triangles and the moved ball.
-    let id = |name: &str| world.objects.iter().position(|o| o.name == name).unwrap() as u32 + 1;
-    let (head_id, ball_id) = (id("head"), id("ball"));
+    let (head_id, ball_id) = (object_id(world, "head"), object_id(world, "ball"));
     let (mut on_head, mut on_ball) = (0, 0);
     for &(o, d) in &rays {
         let ray = make_ray(o, d, 0.0, f32::INFINITY);
@@ -936,13 +938,7 @@ fn the_moving_layer_refits_rigid_motion_and_rebuilds_where_its_boxes_grow() {
     let (mut parts, _, _, motion) = moved_layers(DAffine3::IDENTITY, DAffine3::IDENTITY, stretch);
     let layer = parts.at(&motion).unwrap();
     assert_eq!((parts.builds, parts.refits), (2, 0));
-    let car = layer
-        .world
-        .objects
-        .iter()
-        .position(|o| o.name == "car")
-        .unwrap() as u32
-        + 1;
+    let car = object_id(&layer.world, "car");
     let car_box = layer
         .world
         .triangles
