@@ -19,7 +19,7 @@ use std::cell::RefCell;
 
 use crate::render::bvh::{Bvh, NO_PRIM, Stack, primitive_boxes};
 use crate::render::bvh_binned;
-use crate::render::bvh_packet::{PACKET, PacketStack, RayPacket};
+use crate::render::bvh_packet::{PacketStack, RayPacket};
 use crate::render::instances::{InstanceLevel, placed_bounds};
 use crate::render::ray::TraceRay;
 use crate::render::simd::{self, Isa};
@@ -233,16 +233,7 @@ impl Accel {
         for group in self.groups.iter().filter(|g| g.views & view != 0) {
             simd::closest(isa, &group.bvh, packet, stack);
             if !group.instances.is_empty() {
-                // Lane by lane: the instance level has no packet traversal.
-                Stack::with_thread_stack(|stack| {
-                    for lane in (0..PACKET).filter(|l| packet.active & (1 << l) != 0) {
-                        let mut ray = packet.ray(lane);
-                        group
-                            .instances
-                            .closest(&mut ray, &mut packet.prim[lane], stack);
-                        packet.tmax[lane] = ray.tmax;
-                    }
-                });
+                simd::closest_instances(isa, &group.instances, packet, stack);
             }
         }
     }
@@ -266,14 +257,8 @@ impl Accel {
         {
             blocked |= simd::any(isa, &g.bvh, &rest, stack);
             if !g.instances.is_empty() {
-                Stack::with_thread_stack(|stack| {
-                    let open = packet.active & !blocked;
-                    for lane in (0..PACKET).filter(|l| open & (1 << l) != 0) {
-                        if g.instances.any(&packet.ray(lane), stack) {
-                            blocked |= 1 << lane;
-                        }
-                    }
-                });
+                rest.active = packet.active & !blocked;
+                blocked |= simd::any_instances(isa, &g.instances, &rest, stack);
             }
             rest.active = packet.active & !blocked;
             if rest.active == 0 {

@@ -282,7 +282,7 @@ pub fn primitive_boxes(world: &World, prims: &[u32]) -> (Vec<Aabb>, Vec<u32>) {
 
 /// First packet and packet count of a triangle leaf reference.
 #[inline(always)]
-fn packets_of(leaf: u32) -> (usize, usize) {
+pub(crate) fn packets_of(leaf: u32) -> (usize, usize) {
     debug_assert!(leaf & ELLIPSOIDS == 0);
     (
         (leaf & FIRST_MASK) as usize,

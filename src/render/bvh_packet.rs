@@ -16,11 +16,11 @@
 
 use std::cell::RefCell;
 
-use glam::Vec3A;
+use glam::{Affine3A, Vec3A};
 
 use crate::render::bvh::{
     Bvh, COUNT_MASK, COUNT_SHIFT, ELLIPSOIDS, EMPTY, EXIT_ROUND_UP, FIRST_MASK, LEAF, NO_PRIM,
-    Node, STACK, WIDTH, max, min,
+    Node, STACK, WIDTH, max, min, packets_of,
 };
 use crate::render::packets::{TRI_LANES, Triangles4, closer};
 use crate::render::ray::{Hit, TraceRay, reciprocal};
@@ -147,6 +147,9 @@ pub struct PacketStack {
     nodes: Vec<u32>,
     masks: Vec<[bool; PACKET]>,
     entries: Vec<[f32; PACKET]>,
+    /// The instance level's own stack of (node, lanes as bits, each lane's entry distance),
+    /// beside this one (its walk runs mesh walks on the others at its leaves).
+    pub(crate) placements: Vec<(u32, u32, [f32; PACKET])>,
 }
 
 impl Default for PacketStack {
@@ -161,6 +164,7 @@ impl PacketStack {
             nodes: Vec::with_capacity(STACK),
             masks: Vec::with_capacity(STACK),
             entries: Vec::with_capacity(STACK),
+            placements: Vec::with_capacity(64),
         }
     }
 
@@ -186,13 +190,18 @@ impl PacketStack {
     }
 }
 
-/// `N` lanes of a packet, loaded for a kernel.
-struct Lanes<const N: usize> {
+/// `N` rays of a packet, loaded for a kernel, in the frame their boxes (or triangles) are
+/// tested in.
+pub(crate) struct Rays<const N: usize> {
     o: [[f32; N]; 3],
     d: [[f32; N]; 3],
     inv: [[f32; N]; 3],
     tmin: [f32; N],
-    tmax: [f32; N],
+}
+
+/// The closest hit found so far of each of `N` rays: distance (metres) and primitive.
+pub(crate) struct Hits<const N: usize> {
+    pub(crate) tmax: [f32; N],
     prim: [u32; N],
 }
 
@@ -203,21 +212,58 @@ fn part<const N: usize, T: Copy + Default>(a: &[T; PACKET], base: usize) -> [T; 
     out
 }
 
-impl<const N: usize> Lanes<N> {
+impl<const N: usize> Rays<N> {
+    /// Lanes `base..base + N` of `p`.
     #[inline(always)]
-    fn load(p: &RayPacket, base: usize) -> Lanes<N> {
-        Lanes {
+    pub(crate) fn load(p: &RayPacket, base: usize) -> Rays<N> {
+        Rays {
             o: [0, 1, 2].map(|a| part(&p.origin[a], base)),
             d: [0, 1, 2].map(|a| part(&p.dir[a], base)),
             inv: [0, 1, 2].map(|a| part(&p.inv_dir[a], base)),
             tmin: part(&p.tmin, base),
+        }
+    }
+
+    /// These rays in the frame `frame_from_world` maps to, each as
+    /// `TraceRay::new(frame_from_world.transform_point3a(o), ….transform_vector3a(d), …)`
+    /// gives it, bit for bit (glam's order of operations, without fused multiply-adds): the
+    /// same `t` in both frames.
+    #[inline(always)]
+    pub(crate) fn transformed(&self, frame_from_world: &Affine3A) -> Rays<N> {
+        let c = [
+            frame_from_world.matrix3.x_axis,
+            frame_from_world.matrix3.y_axis,
+            frame_from_world.matrix3.z_axis,
+        ];
+        let t = frame_from_world.translation;
+        let linear = |v: &[[f32; N]; 3], row: usize, i: usize| {
+            c[0][row] * v[0][i] + c[1][row] * v[1][i] + c[2][row] * v[2][i]
+        };
+        let o = [0, 1, 2].map(|row| std::array::from_fn(|i| linear(&self.o, row, i) + t[row]));
+        let d: [[f32; N]; 3] =
+            [0, 1, 2].map(|row| std::array::from_fn(|i| linear(&self.d, row, i)));
+        let inv = d.map(|axis| axis.map(reciprocal));
+        Rays {
+            o,
+            d,
+            inv,
+            tmin: self.tmin,
+        }
+    }
+}
+
+impl<const N: usize> Hits<N> {
+    /// Lanes `base..base + N` of `p`.
+    #[inline(always)]
+    pub(crate) fn load(p: &RayPacket, base: usize) -> Hits<N> {
+        Hits {
             tmax: part(&p.tmax, base),
             prim: part(&p.prim, base),
         }
     }
 
     #[inline(always)]
-    fn store(&self, p: &mut RayPacket, base: usize) {
+    pub(crate) fn store(&self, p: &mut RayPacket, base: usize) {
         p.tmax[base..base + N].copy_from_slice(&self.tmax);
         p.prim[base..base + N].copy_from_slice(&self.prim);
     }
@@ -226,11 +272,11 @@ impl<const N: usize> Lanes<N> {
 /// Lanes of a kernel: `true` where the lane's ray takes part. Kept as one `bool` per lane, not
 /// as bits: the compiler turns these loops into vector compares and blends, where building
 /// an integer of bits cost a dozen instructions per box test.
-type Mask<const N: usize> = [bool; N];
+pub(crate) type Mask<const N: usize> = [bool; N];
 
 /// Bit i set where `c[i]` (once per packet, at the end).
 #[inline(always)]
-fn bits_of<const N: usize>(c: Mask<N>) -> u32 {
+pub(crate) fn bits_of<const N: usize>(c: Mask<N>) -> u32 {
     let mut m = 0u32;
     for (i, &b) in c.iter().enumerate() {
         m |= u32::from(b) << i;
@@ -240,52 +286,70 @@ fn bits_of<const N: usize>(c: Mask<N>) -> u32 {
 
 /// `c[i]` where bit i of `mask` is set.
 #[inline(always)]
-fn lanes_of<const N: usize>(mask: u32) -> Mask<N> {
+pub(crate) fn lanes_of<const N: usize>(mask: u32) -> Mask<N> {
     std::array::from_fn(|i| (mask >> i) & 1 != 0)
 }
 
 #[inline(always)]
-fn and<const N: usize>(a: Mask<N>, b: Mask<N>) -> Mask<N> {
+pub(crate) fn and<const N: usize>(a: Mask<N>, b: Mask<N>) -> Mask<N> {
     std::array::from_fn(|i| a[i] & b[i])
 }
 
 /// Whether any lane is set (a reduction, without early exit, so that it vectorises).
 #[inline(always)]
-fn any_set<const N: usize>(c: &Mask<N>) -> bool {
+pub(crate) fn any_set<const N: usize>(c: &Mask<N>) -> bool {
     c.iter().fold(false, |a, &b| a | b)
 }
 
-/// Which lanes enter child `c` of `node` within their [tmin, tmax], and where: the box test
-/// of `bvh.rs`'s `Node::intersect`, per lane.
+/// Which lanes of `r` enter the box [`lo`, `hi`] within their [tmin, `tmax`], and where: the
+/// box test of `bvh.rs`'s `Node::intersect`, per lane.
 #[inline(always)]
-fn child_hits<const N: usize>(
-    node: &Node,
-    c: usize,
-    l: &Lanes<N>,
+pub(crate) fn box_hits<const N: usize>(
+    lo: [f32; 3],
+    hi: [f32; 3],
+    r: &Rays<N>,
+    tmax: &[f32; N],
     entry: &mut [f32; N],
 ) -> Mask<N> {
-    let b = &node.bounds;
-    let (bx0, bx1, by0, by1, bz0, bz1) = (b[0][c], b[1][c], b[2][c], b[3][c], b[4][c], b[5][c]);
     let mut hit = [false; N];
     for i in 0..N {
         let (x0, x1) = (
-            (bx0 - l.o[0][i]) * l.inv[0][i],
-            (bx1 - l.o[0][i]) * l.inv[0][i],
+            (lo[0] - r.o[0][i]) * r.inv[0][i],
+            (hi[0] - r.o[0][i]) * r.inv[0][i],
         );
         let (y0, y1) = (
-            (by0 - l.o[1][i]) * l.inv[1][i],
-            (by1 - l.o[1][i]) * l.inv[1][i],
+            (lo[1] - r.o[1][i]) * r.inv[1][i],
+            (hi[1] - r.o[1][i]) * r.inv[1][i],
         );
         let (z0, z1) = (
-            (bz0 - l.o[2][i]) * l.inv[2][i],
-            (bz1 - l.o[2][i]) * l.inv[2][i],
+            (lo[2] - r.o[2][i]) * r.inv[2][i],
+            (hi[2] - r.o[2][i]) * r.inv[2][i],
         );
-        let e = max(max(max(l.tmin[i], min(z0, z1)), min(y0, y1)), min(x0, x1));
-        let x = min(min(min(l.tmax[i], max(z0, z1)), max(y0, y1)), max(x0, x1));
+        let e = max(max(max(r.tmin[i], min(z0, z1)), min(y0, y1)), min(x0, x1));
+        let x = min(min(min(tmax[i], max(z0, z1)), max(y0, y1)), max(x0, x1));
         entry[i] = e;
         hit[i] = e <= x * EXIT_ROUND_UP;
     }
     hit
+}
+
+/// [`box_hits`] of child `c` of `node`.
+#[inline(always)]
+fn child_hits<const N: usize>(
+    node: &Node,
+    c: usize,
+    r: &Rays<N>,
+    tmax: &[f32; N],
+    entry: &mut [f32; N],
+) -> Mask<N> {
+    let b = &node.bounds;
+    box_hits(
+        [b[0][c], b[2][c], b[4][c]],
+        [b[1][c], b[3][c], b[5][c]],
+        r,
+        tmax,
+        entry,
+    )
 }
 
 /// The triangle test of [`Triangles4`] (obvhs' `RtTriangle::intersect`) for lane `j` of
@@ -294,7 +358,8 @@ fn child_hits<const N: usize>(
 fn triangle_hits<const N: usize>(
     packet: &Triangles4,
     j: usize,
-    l: &Lanes<N>,
+    r: &Rays<N>,
+    tmax: &[f32; N],
     t_out: &mut [f32; N],
 ) -> Mask<N> {
     let [v0x, v0y, v0z] = packet.v0.map(|v| v[j]);
@@ -303,8 +368,8 @@ fn triangle_hits<const N: usize>(
     let [ngx, ngy, ngz] = crate::scene::instances::normal([e1x, e1y, e1z], [e2x, e2y, e2z]);
     let mut valid = [false; N];
     for i in 0..N {
-        let (dx, dy, dz) = (l.d[0][i], l.d[1][i], l.d[2][i]);
-        let (cx, cy, cz) = (v0x - l.o[0][i], v0y - l.o[1][i], v0z - l.o[2][i]);
+        let (dx, dy, dz) = (r.d[0][i], r.d[1][i], r.d[2][i]);
+        let (cx, cy, cz) = (v0x - r.o[0][i], v0y - r.o[1][i], v0z - r.o[2][i]);
         let rx = dy * cz - dz * cy;
         let ry = dz * cx - dx * cz;
         let rz = dx * cy - dy * cx;
@@ -316,7 +381,7 @@ fn triangle_hits<const N: usize>(
         // A -0.0 barycentric is a miss, like a negative one (the sign bit, as obvhs).
         let outside = (u.to_bits() | v.to_bits() | w.to_bits()) >> 31 != 0;
         t_out[i] = t;
-        valid[i] = inv_det != 0.0 && t >= l.tmin[i] && t <= l.tmax[i] && !outside;
+        valid[i] = inv_det != 0.0 && t >= r.tmin[i] && t <= tmax[i] && !outside;
     }
     valid
 }
@@ -330,32 +395,65 @@ fn used_lanes(packet: &Triangles4) -> usize {
         .unwrap_or(TRI_LANES)
 }
 
+/// Tests the rays of `on` against `packet`'s triangles for their closest hits.
+#[inline(always)]
+fn triangles_closest<const N: usize>(
+    packet: &Triangles4,
+    r: &Rays<N>,
+    h: &mut Hits<N>,
+    on: Mask<N>,
+) {
+    for j in 0..used_lanes(packet) {
+        let prim = packet.prim[j];
+        let mut t = [0.0; N];
+        let valid = triangle_hits(packet, j, r, &h.tmax, &mut t);
+        for i in 0..N {
+            let take = on[i] && valid[i] && closer(t[i], prim, h.tmax[i], h.prim[i]);
+            h.tmax[i] = if take { t[i] } else { h.tmax[i] };
+            h.prim[i] = if take { prim } else { h.prim[i] };
+        }
+    }
+}
+
+/// Adds to `blocked` the rays of `on` that hit a triangle of `packet` in [tmin, `tmax`].
+#[inline(always)]
+fn triangles_any<const N: usize>(
+    packet: &Triangles4,
+    r: &Rays<N>,
+    tmax: &[f32; N],
+    on: Mask<N>,
+    blocked: &mut Mask<N>,
+) {
+    // Every lane, used or not (an unused lane repeats lane 0's triangle, which gives the same
+    // answer): a loop of fixed length, unrolled whatever the code around it. Bounded by the
+    // lanes in use, it was unrolled fourfold, eightfold or not at all as that code changed,
+    // and das's shadow rays ran up to 13 % slower.
+    for j in 0..TRI_LANES {
+        let mut t = [0.0; N];
+        let hit = triangle_hits(packet, j, r, tmax, &mut t);
+        for i in 0..N {
+            blocked[i] |= hit[i] & on[i];
+        }
+    }
+}
+
 /// Tests the rays of `on` against leaf `leaf`'s primitives for their closest hits.
 #[inline(always)]
-fn leaf_closest<const N: usize>(bvh: &Bvh, leaf: u32, l: &mut Lanes<N>, on: Mask<N>) {
+fn leaf_closest<const N: usize>(bvh: &Bvh, leaf: u32, r: &Rays<N>, h: &mut Hits<N>, on: Mask<N>) {
     let first = (leaf & FIRST_MASK) as usize;
     let count = ((leaf >> COUNT_SHIFT) & COUNT_MASK) as usize + 1;
     if leaf & ELLIPSOIDS == 0 {
         for packet in &bvh.triangles[first..first + count] {
-            for j in 0..used_lanes(packet) {
-                let prim = packet.prim[j];
-                let mut t = [0.0; N];
-                let valid = triangle_hits(packet, j, l, &mut t);
-                for i in 0..N {
-                    let take = on[i] && valid[i] && closer(t[i], prim, l.tmax[i], l.prim[i]);
-                    l.tmax[i] = if take { t[i] } else { l.tmax[i] };
-                    l.prim[i] = if take { prim } else { l.prim[i] };
-                }
-            }
+            triangles_closest(packet, r, h, on);
         }
     } else {
         for e in &bvh.ellipsoids[first..first + count] {
             for i in (0..N).filter(|&i| on[i]) {
-                let (o, d) = (lane_vec(&l.o, i), lane_vec(&l.d, i));
-                let t = e.ellipsoid.intersect(o, d, l.tmin[i], l.tmax[i]);
-                if t.is_finite() && closer(t, e.prim, l.tmax[i], l.prim[i]) {
-                    l.tmax[i] = t;
-                    l.prim[i] = e.prim;
+                let (o, d) = (lane_vec(&r.o, i), lane_vec(&r.d, i));
+                let t = e.ellipsoid.intersect(o, d, r.tmin[i], h.tmax[i]);
+                if t.is_finite() && closer(t, e.prim, h.tmax[i], h.prim[i]) {
+                    h.tmax[i] = t;
+                    h.prim[i] = e.prim;
                 }
             }
         }
@@ -363,12 +461,13 @@ fn leaf_closest<const N: usize>(bvh: &Bvh, leaf: u32, l: &mut Lanes<N>, on: Mask
 }
 
 /// Adds to `blocked` the rays of `on` that hit a primitive of leaf `leaf` in their
-/// [tmin, tmax].
+/// [tmin, `tmax`].
 #[inline(always)]
 fn leaf_any<const N: usize>(
     bvh: &Bvh,
     leaf: u32,
-    l: &Lanes<N>,
+    r: &Rays<N>,
+    tmax: &[f32; N],
     on: Mask<N>,
     blocked: &mut Mask<N>,
 ) {
@@ -376,13 +475,7 @@ fn leaf_any<const N: usize>(
     let count = ((leaf >> COUNT_SHIFT) & COUNT_MASK) as usize + 1;
     if leaf & ELLIPSOIDS == 0 {
         for packet in &bvh.triangles[first..first + count] {
-            for j in 0..used_lanes(packet) {
-                let mut t = [0.0; N];
-                let hit = triangle_hits(packet, j, l, &mut t);
-                for i in 0..N {
-                    blocked[i] |= hit[i] & on[i];
-                }
-            }
+            triangles_any(packet, r, tmax, on, blocked);
         }
     } else {
         for e in &bvh.ellipsoids[first..first + count] {
@@ -390,11 +483,8 @@ fn leaf_any<const N: usize>(
                 if !on[i] || blocked[i] {
                     continue;
                 }
-                let (o, d) = (lane_vec(&l.o, i), lane_vec(&l.d, i));
-                if e.ellipsoid
-                    .intersect(o, d, l.tmin[i], l.tmax[i])
-                    .is_finite()
-                {
+                let (o, d) = (lane_vec(&r.o, i), lane_vec(&r.d, i));
+                if e.ellipsoid.intersect(o, d, r.tmin[i], tmax[i]).is_finite() {
                     blocked[i] = true;
                 }
             }
@@ -407,17 +497,24 @@ fn lane_vec<const N: usize>(a: &[[f32; N]; 3], i: usize) -> Vec3A {
     Vec3A::new(a[0][i], a[1][i], a[2][i])
 }
 
-/// Closest hits of the rays of `on` in `l`, as [`Bvh::closest`] per ray.
+/// The near-to-far walk of the rays of `on` (`r`) through `bvh` for their closest hits,
+/// which shrink their `tmax` in `h`: its boxes tested with `boxes` (the rays in the
+/// hierarchy's frame), its leaves' primitives with `r`, placed by `placed` = (world from
+/// object, primitive index base) where it is given. (The leaf test is chosen by a value, not
+/// passed as a closure: with a closure, the compiler unrolled `any_walk`'s leaf loop eightfold
+/// and das's shadow rays ran 5 % slower.)
 #[inline(always)]
-fn closest_lanes<const N: usize>(
+fn closest_walk<const N: usize>(
     bvh: &Bvh,
-    l: &mut Lanes<N>,
+    (boxes, r): (&Rays<N>, &Rays<N>),
+    placed: Option<(&Affine3A, u32)>,
+    h: &mut Hits<N>,
     on: Mask<N>,
     stack: &mut PacketStack,
 ) {
     stack.clear();
     let mut entry = [0.0; PACKET];
-    entry[..N].copy_from_slice(&l.tmin);
+    entry[..N].copy_from_slice(&boxes.tmin);
     let mut mask = [false; PACKET];
     mask[..N].copy_from_slice(&on);
     stack.nodes.push(0);
@@ -428,12 +525,20 @@ fn closest_lanes<const N: usize>(
         let entry: [f32; N] = part(&stack.entries.pop().unwrap_or([0.0; PACKET]), 0);
         // Lanes whose closest hit so far is nearer than the subtree are done with it.
         let on: Mask<N> =
-            std::array::from_fn(|i| mask[i] & (entry[i] <= l.tmax[i] * EXIT_ROUND_UP));
+            std::array::from_fn(|i| mask[i] & (entry[i] <= h.tmax[i] * EXIT_ROUND_UP));
         if !any_set(&on) {
             continue;
         }
         if current & LEAF != 0 {
-            leaf_closest(bvh, current, l, on);
+            match placed {
+                None => leaf_closest(bvh, current, r, h, on),
+                Some((world_from_object, base)) => {
+                    let (first, count) = packets_of(current);
+                    for packet in &bvh.triangles[first..first + count] {
+                        triangles_closest(&packet.placed(world_from_object, base), r, h, on);
+                    }
+                }
+            }
             continue;
         }
         let node = &bvh.nodes[current as usize];
@@ -447,19 +552,11 @@ fn closest_lanes<const N: usize>(
                 break;
             }
             let mut e = [0.0; N];
-            let m = and(child_hits(node, c, l, &mut e), on);
+            let m = and(child_hits(node, c, boxes, &h.tmax, &mut e), on);
             if !any_set(&m) {
                 continue;
             }
-            // Entries are at least tmin ≥ 0: non-negative floats order as their bits.
-            let nearest = (0..N).fold(u32::MAX, |a, i| {
-                a.min(if m[i] {
-                    e[i].to_bits() & 0x7fff_ffff
-                } else {
-                    u32::MAX
-                })
-            });
-            keys[n] = (u64::from(nearest) << 32) | c as u64;
+            keys[n] = (u64::from(nearest_entry(&m, &e)) << 32) | c as u64;
             masks[c][..N].copy_from_slice(&m);
             entries[c][..N].copy_from_slice(&e);
             n += 1;
@@ -481,11 +578,27 @@ fn closest_lanes<const N: usize>(
     }
 }
 
-/// Which rays of `on` in `l` are blocked, as [`Bvh::any`] per ray.
+/// The bits of the nearest entry of the lanes of `m` (entries are at least tmin ≥ 0, and
+/// non-negative floats order as their bits), `u32::MAX` where no lane is set.
 #[inline(always)]
-fn any_lanes<const N: usize>(
+pub(crate) fn nearest_entry<const N: usize>(m: &Mask<N>, e: &[f32; N]) -> u32 {
+    (0..N).fold(u32::MAX, |a, i| {
+        a.min(if m[i] {
+            e[i].to_bits() & 0x7fff_ffff
+        } else {
+            u32::MAX
+        })
+    })
+}
+
+/// Which rays of `on` (`r`) are blocked in `bvh` within each lane's [tmin, `tmax`], boxes and
+/// leaves tested as in [`closest_walk`].
+#[inline(always)]
+fn any_walk<const N: usize>(
     bvh: &Bvh,
-    l: &Lanes<N>,
+    (boxes, r): (&Rays<N>, &Rays<N>),
+    placed: Option<(&Affine3A, u32)>,
+    tmax: &[f32; N],
     on: Mask<N>,
     stack: &mut PacketStack,
 ) -> Mask<N> {
@@ -503,7 +616,16 @@ fn any_lanes<const N: usize>(
             continue;
         }
         if current & LEAF != 0 {
-            leaf_any(bvh, current, l, m, &mut blocked);
+            match placed {
+                None => leaf_any(bvh, current, r, tmax, m, &mut blocked),
+                Some((world_from_object, base)) => {
+                    let (first, count) = packets_of(current);
+                    for packet in &bvh.triangles[first..first + count] {
+                        let placed = packet.placed(world_from_object, base);
+                        triangles_any(&placed, r, tmax, m, &mut blocked);
+                    }
+                }
+            }
             let open: Mask<N> = std::array::from_fn(|i| on[i] & !blocked[i]);
             if !any_set(&open) {
                 return blocked;
@@ -515,7 +637,7 @@ fn any_lanes<const N: usize>(
             if node.children[c] == EMPTY {
                 break;
             }
-            let cm = and(child_hits(node, c, l, &mut scratch), m);
+            let cm = and(child_hits(node, c, boxes, tmax, &mut scratch), m);
             if any_set(&cm) {
                 let mut wide = [false; PACKET];
                 wide[..N].copy_from_slice(&cm);
@@ -525,6 +647,53 @@ fn any_lanes<const N: usize>(
         }
     }
     blocked
+}
+
+/// The closest hits of the rays of `on` (`r`, world frame) among the triangles of `bvh`, a
+/// hierarchy built in an object frame and placed by `world_from_object` under primitive
+/// indices `base` + its own: [`crate::render::bvh::Bvh::closest_placed`] per lane. Its boxes
+/// are tested with the rays moved by `object_from_world`, its triangles placed and tested
+/// with `r`.
+#[inline(always)]
+pub(crate) fn closest_placed<const N: usize>(
+    bvh: &Bvh,
+    (world_from_object, object_from_world, base): (&Affine3A, &Affine3A, u32),
+    r: &Rays<N>,
+    h: &mut Hits<N>,
+    on: Mask<N>,
+    stack: &mut PacketStack,
+) {
+    if bvh.nodes.is_empty() {
+        return;
+    }
+    let object = r.transformed(object_from_world);
+    let placed = Some((world_from_object, base));
+    closest_walk(bvh, (&object, r), placed, h, on, stack);
+}
+
+/// Which rays of `on` a triangle of `bvh` placed as in [`closest_placed`] blocks in their
+/// [tmin, `tmax`].
+#[inline(always)]
+pub(crate) fn any_placed<const N: usize>(
+    bvh: &Bvh,
+    (world_from_object, object_from_world, base): (&Affine3A, &Affine3A, u32),
+    r: &Rays<N>,
+    tmax: &[f32; N],
+    on: Mask<N>,
+    stack: &mut PacketStack,
+) -> Mask<N> {
+    if bvh.nodes.is_empty() {
+        return [false; N];
+    }
+    let object = r.transformed(object_from_world);
+    any_walk(
+        bvh,
+        (&object, r),
+        Some((world_from_object, base)),
+        tmax,
+        on,
+        stack,
+    )
 }
 
 /// The closest hits of `packet`'s active rays in `bvh`, `N` lanes at a time: shrinks each
@@ -537,9 +706,10 @@ pub(crate) fn closest<const N: usize>(bvh: &Bvh, packet: &mut RayPacket, stack: 
     for base in (0..PACKET).step_by(N) {
         let mask = (packet.active >> base) & (u32::MAX >> (32 - N));
         if mask != 0 {
-            let mut l = Lanes::<N>::load(packet, base);
-            closest_lanes(bvh, &mut l, lanes_of(mask), stack);
-            l.store(packet, base);
+            let r = Rays::<N>::load(packet, base);
+            let mut h = Hits::<N>::load(packet, base);
+            closest_walk(bvh, (&r, &r), None, &mut h, lanes_of(mask), stack);
+            h.store(packet, base);
         }
     }
 }
@@ -555,8 +725,10 @@ pub(crate) fn any<const N: usize>(bvh: &Bvh, packet: &RayPacket, stack: &mut Pac
     for base in (0..PACKET).step_by(N) {
         let mask = (packet.active >> base) & (u32::MAX >> (32 - N));
         if mask != 0 {
-            let l = Lanes::<N>::load(packet, base);
-            blocked |= bits_of(any_lanes(bvh, &l, lanes_of(mask), stack)) << base;
+            let r = Rays::<N>::load(packet, base);
+            let tmax: &[f32; N] = packet.tmax[base..base + N].try_into().expect("N lanes");
+            let hit = any_walk(bvh, (&r, &r), None, tmax, lanes_of(mask), stack);
+            blocked |= bits_of(hit) << base;
         }
     }
     blocked

@@ -18,6 +18,10 @@ use obvhs::bvh2::Bvh2;
 
 use crate::render::bvh::{Bvh, EXIT_ROUND_UP, Stack};
 use crate::render::bvh_build;
+use crate::render::bvh_packet::{
+    self, Hits, Mask, PACKET, PacketStack, RayPacket, Rays, and, any_set, bits_of, box_hits,
+    lanes_of, nearest_entry,
+};
 use crate::render::ray::TraceRay;
 use crate::scene::instances::box_corners;
 use crate::scene::world::InstanceSet;
@@ -217,6 +221,156 @@ impl InstanceLevel {
                 [Some(_), None] => current = Some(a),
                 [None, Some(_)] => current = Some(b),
                 [None, None] => {}
+            }
+        }
+        stack.placements = todo;
+    }
+}
+
+impl InstanceLevel {
+    /// [`InstanceLevel::closest`] for every active ray of `packet`, `N` lanes at a time: the
+    /// placements' boxes and each mesh's hierarchy walked by the lanes together, each leaf's
+    /// triangles placed once for all of them. Each lane gets the hit the per-ray walk gives
+    /// it, bit for bit (the same box and triangle tests, and [`closer`]'s choice, which does
+    /// not depend on the order of the tests).
+    ///
+    /// [`closer`]: crate::render::packets::closer
+    #[inline(always)]
+    pub(crate) fn closest_packet<const N: usize>(
+        &self,
+        packet: &mut RayPacket,
+        stack: &mut PacketStack,
+    ) {
+        for base in (0..PACKET).step_by(N) {
+            let lanes = (packet.active >> base) & (u32::MAX >> (32 - N));
+            if lanes == 0 {
+                continue;
+            }
+            let rays = Rays::<N>::load(packet, base);
+            let mut hits = Hits::<N>::load(packet, base);
+            let mut tmax = hits.tmax;
+            self.walk_packet(
+                &rays,
+                lanes_of(lanes),
+                &mut tmax,
+                stack,
+                |m, on, tmax, _, stack| {
+                    let mesh = &self.meshes[m.mesh as usize];
+                    let placed = (&m.world_from_object, &m.object_from_world, m.base);
+                    bvh_packet::closest_placed(mesh, placed, &rays, &mut hits, on, stack);
+                    *tmax = hits.tmax;
+                },
+            );
+            hits.store(packet, base);
+        }
+    }
+
+    /// [`InstanceLevel::any`] for every active ray of `packet`, `N` lanes at a time, as
+    /// [`InstanceLevel::closest_packet`]: bit i is set where lane i's ray is blocked.
+    #[inline(always)]
+    pub(crate) fn any_packet<const N: usize>(
+        &self,
+        packet: &RayPacket,
+        stack: &mut PacketStack,
+    ) -> u32 {
+        let mut blocked = 0;
+        for base in (0..PACKET).step_by(N) {
+            let lanes = (packet.active >> base) & (u32::MAX >> (32 - N));
+            if lanes == 0 {
+                continue;
+            }
+            let rays = Rays::<N>::load(packet, base);
+            let mut tmax = Hits::<N>::load(packet, base).tmax;
+            let mut hit = [false; N];
+            self.walk_packet(
+                &rays,
+                lanes_of(lanes),
+                &mut tmax,
+                stack,
+                |m, on, tmax, open, stack| {
+                    let mesh = &self.meshes[m.mesh as usize];
+                    let placed = (&m.world_from_object, &m.object_from_world, m.base);
+                    let now = bvh_packet::any_placed(mesh, placed, &rays, tmax, on, stack);
+                    for i in 0..N {
+                        hit[i] |= now[i];
+                        open[i] &= !now[i];
+                    }
+                },
+            );
+            blocked |= bits_of(hit) << base;
+        }
+        blocked
+    }
+
+    /// [`InstanceLevel::walk`] for the lanes `on` of `rays` together: visits the placements
+    /// whose boxes any open lane enters within its [tmin, `tmax`], nearest lane's entry first,
+    /// with the lanes that enter each, until no lane is open. `visit` may shrink `tmax`, which
+    /// prunes what is left, and close lanes (`open`).
+    #[inline(always)]
+    fn walk_packet<const N: usize>(
+        &self,
+        rays: &Rays<N>,
+        on: Mask<N>,
+        tmax: &mut [f32; N],
+        stack: &mut PacketStack,
+        mut visit: impl FnMut(&Placement, Mask<N>, &mut [f32; N], &mut Mask<N>, &mut PacketStack),
+    ) {
+        let Some(tlas) = &self.tlas else {
+            return;
+        };
+        let widen = |e: [f32; N]| {
+            let mut wide = [0.0; PACKET];
+            wide[..N].copy_from_slice(&e);
+            wide
+        };
+        let enters = |b: &Aabb, tmax: &[f32; N], lanes: Mask<N>| {
+            let mut entry = [0.0; N];
+            let hit = box_hits(b.min.into(), b.max.into(), rays, tmax, &mut entry);
+            (and(hit, lanes), entry)
+        };
+        let mut open = on;
+        // Its own stack, taken from the thread's for the walk (the mesh walks use the rest).
+        let mut todo = std::mem::take(&mut stack.placements);
+        todo.clear();
+        let (m, e) = enters(&tlas.nodes[0].aabb, tmax, open);
+        if any_set(&m) {
+            todo.push((0, bits_of(m), widen(e)));
+        }
+        while let Some((i, lanes, entry)) = todo.pop() {
+            let lanes: Mask<N> = lanes_of(lanes);
+            // Lanes closed, or whose closest hit so far is nearer than the subtree, skip it.
+            let on: Mask<N> =
+                std::array::from_fn(|l| lanes[l] & open[l] & (entry[l] <= tmax[l] * EXIT_ROUND_UP));
+            if !any_set(&on) {
+                continue;
+            }
+            let node = &tlas.nodes[i as usize];
+            if node.is_leaf() {
+                visit(
+                    &self.placements[node.first_index as usize],
+                    on,
+                    tmax,
+                    &mut open,
+                    stack,
+                );
+                if !any_set(&open) {
+                    break;
+                }
+                continue;
+            }
+            let (a, b) = (node.first_index, node.first_index + 1);
+            let (ma, ea) = enters(&tlas.nodes[a as usize].aabb, tmax, on);
+            let (mb, eb) = enters(&tlas.nodes[b as usize].aabb, tmax, on);
+            // Far first on the stack, so that the near child is popped next.
+            let far_first = if nearest_entry(&ma, &ea) <= nearest_entry(&mb, &eb) {
+                [(b, mb, eb), (a, ma, ea)]
+            } else {
+                [(a, ma, ea), (b, mb, eb)]
+            };
+            for (c, m, e) in far_first {
+                if any_set(&m) {
+                    todo.push((c, bits_of(m), widen(e)));
+                }
             }
         }
         stack.placements = todo;

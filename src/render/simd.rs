@@ -18,6 +18,7 @@ use std::sync::OnceLock;
 
 use crate::render::bvh::Bvh;
 use crate::render::bvh_packet::{self, PacketStack, RayPacket};
+use crate::render::instances::InstanceLevel;
 
 /// An instruction set the packet kernels are compiled for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -119,6 +120,46 @@ pub fn any(isa: Isa, bvh: &Bvh, packet: &RayPacket, stack: &mut PacketStack) -> 
     }
 }
 
+/// [`InstanceLevel::closest_packet`] on `isa`'s kernels (the portable ones where the CPU
+/// lacks `isa`).
+#[inline]
+pub fn closest_instances(
+    isa: Isa,
+    level: &InstanceLevel,
+    packet: &mut RayPacket,
+    stack: &mut PacketStack,
+) {
+    match isa.check() {
+        // SAFETY: `check` returned the ISA only because this CPU has its features.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { x86::closest_instances_avx512(level, packet, stack) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { x86::closest_instances_avx2(level, packet, stack) },
+        _ => level.closest_packet::<4>(packet, stack),
+    }
+}
+
+/// [`InstanceLevel::any_packet`] on `isa`'s kernels (the portable ones where the CPU lacks
+/// `isa`).
+#[inline]
+pub fn any_instances(
+    isa: Isa,
+    level: &InstanceLevel,
+    packet: &RayPacket,
+    stack: &mut PacketStack,
+) -> u32 {
+    match isa.check() {
+        // SAFETY: `check` returned the ISA only because this CPU has its features.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { x86::any_instances_avx512(level, packet, stack) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { x86::any_instances_avx2(level, packet, stack) },
+        _ => level.any_packet::<4>(packet, stack),
+    }
+}
+
 /// The kernels compiled per ISA (no fused multiply-add: `fma` is not enabled, and Rust
 /// never fuses a multiply and an add on its own, so every lane rounds as the per-ray path).
 #[cfg(target_arch = "x86_64")]
@@ -143,5 +184,41 @@ mod x86 {
     #[target_feature(enable = "avx2,avx,bmi1,bmi2,lzcnt,popcnt")]
     pub(super) fn any_avx2(bvh: &Bvh, packet: &RayPacket, stack: &mut PacketStack) -> u32 {
         bvh_packet::any::<8>(bvh, packet, stack)
+    }
+
+    #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx2,avx,bmi1,bmi2,lzcnt,popcnt")]
+    pub(super) fn closest_instances_avx512(
+        level: &InstanceLevel,
+        packet: &mut RayPacket,
+        stack: &mut PacketStack,
+    ) {
+        level.closest_packet::<16>(packet, stack)
+    }
+
+    #[target_feature(enable = "avx2,avx,bmi1,bmi2,lzcnt,popcnt")]
+    pub(super) fn closest_instances_avx2(
+        level: &InstanceLevel,
+        packet: &mut RayPacket,
+        stack: &mut PacketStack,
+    ) {
+        level.closest_packet::<8>(packet, stack)
+    }
+
+    #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx2,avx,bmi1,bmi2,lzcnt,popcnt")]
+    pub(super) fn any_instances_avx512(
+        level: &InstanceLevel,
+        packet: &RayPacket,
+        stack: &mut PacketStack,
+    ) -> u32 {
+        level.any_packet::<16>(packet, stack)
+    }
+
+    #[target_feature(enable = "avx2,avx,bmi1,bmi2,lzcnt,popcnt")]
+    pub(super) fn any_instances_avx2(
+        level: &InstanceLevel,
+        packet: &RayPacket,
+        stack: &mut PacketStack,
+    ) -> u32 {
+        level.any_packet::<8>(packet, stack)
     }
 }
