@@ -14,6 +14,7 @@ use std::time::{Duration, Instant};
 use anyhow::Result;
 use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
+use rayon::prelude::*;
 
 use std::cell::RefCell;
 
@@ -113,24 +114,20 @@ impl Accel {
     pub fn build_with(world: &World, choice: BuildChoice) -> Result<Accel> {
         let start = Instant::now();
         // Primitives of each visibility class, in world order; the instanced ones by set.
+        // Classified in chunks side by side, each chunk's runs merged in order (the same
+        // classes on any thread count): 11.5 million triangles took 70-90 ms one by one.
         let mut classes: BTreeMap<(u8, bool), (Vec<u32>, Vec<usize>)> = BTreeMap::new();
-        let flat =
-            (0..world.triangles.len()).chain(world.ellipsoid_base()..world.primitive_count());
-        // Runs of primitives of one class (an object's) go in at once.
-        let mut run: Option<((u8, bool), Vec<u32>)> = None;
-        for prim in flat {
-            let key = world.visibility(prim);
-            match &mut run {
-                Some((k, prims)) if *k == key => prims.push(prim as u32),
-                _ => {
-                    if let Some((k, prims)) = run.replace((key, vec![prim as u32])) {
-                        classes.entry(k).or_default().0.extend(prims);
-                    }
-                }
-            }
-        }
-        if let Some((k, prims)) = run {
-            classes.entry(k).or_default().0.extend(prims);
+        let triangles = world.triangles.len();
+        let chunks: Vec<Vec<ClassRun>> = (0..triangles.div_ceil(CLASS_CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let end = ((c + 1) * CLASS_CHUNK).min(triangles);
+                class_runs(world, c * CLASS_CHUNK..end)
+            })
+            .collect();
+        let ellipsoids = class_runs(world, world.ellipsoid_base()..world.primitive_count());
+        for (key, prims) in chunks.into_iter().flatten().chain(ellipsoids) {
+            classes.entry(key).or_default().0.extend(prims);
         }
         for (s, set) in world.instanced.iter().enumerate() {
             if !set.is_empty() {
@@ -349,4 +346,23 @@ pub fn occluded_brute_force(world: &World, ray: &TraceRay, view: u8) -> bool {
         let (views, casts) = world.visibility(prim);
         views & view != 0 && casts && world.intersect(prim, &ray).is_finite()
     })
+}
+
+/// A visibility class (views, casts a shadow) and primitives of it.
+type ClassRun = ((u8, bool), Vec<u32>);
+
+/// Primitives classified side by side per chunk of this many.
+const CLASS_CHUNK: usize = 1 << 16;
+
+/// The primitives `prims` of `world` as runs of one visibility class, in order.
+fn class_runs(world: &World, prims: std::ops::Range<usize>) -> Vec<ClassRun> {
+    let mut runs: Vec<ClassRun> = Vec::new();
+    for prim in prims {
+        let key = world.visibility(prim);
+        match runs.last_mut() {
+            Some((k, run)) if *k == key => run.push(prim as u32),
+            _ => runs.push((key, vec![prim as u32])),
+        }
+    }
+    runs
 }

@@ -229,7 +229,7 @@ fn key_entry(key: u64) -> f32 {
 /// Ellipsoids keep one box: it is tight enough.
 pub fn primitive_boxes(world: &World, prims: &[u32]) -> (Vec<Aabb>, Vec<u32>) {
     let (mut indices, ellipsoids): (Vec<u32>, Vec<u32>) = prims
-        .iter()
+        .par_iter()
         .partition(|&&p| (p as usize) < world.triangles.len());
     let triangle = |p: u32| {
         let t = &world.triangles[p as usize];
@@ -241,37 +241,52 @@ pub fn primitive_boxes(world: &World, prims: &[u32]) -> (Vec<Aabb>, Vec<u32>) {
     };
     let mut aabbs: Vec<Aabb> = indices.par_iter().map(|&p| triangle(p).aabb()).collect();
     if !aabbs.is_empty() {
-        // Summed in order (a float sum's rounding depends on its order).
+        // Summed per chunk of fixed size, then the chunks in order: the same rounding on any
+        // thread count.
         let (sum, largest) = aabbs
-            .iter()
-            .map(Aabb::half_area)
-            .fold((0.0f32, 0.0f32), |(sum, largest), area| {
-                (sum + area, largest.max(area))
+            .par_chunks(SPLIT_CHUNK)
+            .map(|chunk| {
+                chunk
+                    .iter()
+                    .map(Aabb::half_area)
+                    .fold((0.0f32, 0.0f32), |(sum, largest), area| {
+                        (sum + area, largest.max(area))
+                    })
+            })
+            .collect::<Vec<_>>()
+            .into_iter()
+            .fold((0.0f32, 0.0f32), |(sum, largest), (s, l)| {
+                (sum + s, largest.max(l))
             });
         let average = sum / aabbs.len() as f32;
-        // The preset splits only boxes of over three times the average area, and appends
-        // the new boxes in the order it visits its candidates: run on the boxes over the
-        // average alone (in order), it splits the same boxes the same way, without a copy of
-        // every triangle.
+        // The preset splits only boxes of over three times the average area, each on its own
+        // (whether a box is split, and into what, depends on it and its triangle alone): run
+        // on the boxes over the average alone, in chunks side by side, it splits the same
+        // boxes the same way, without a copy of every triangle. Each chunk's new boxes are
+        // appended after the previous chunk's, the same order on any thread count.
         let large: Vec<usize> = (0..aabbs.len())
+            .into_par_iter()
             .filter(|&i| aabbs[i].half_area() > average)
             .collect();
-        let mut large_boxes: Vec<Aabb> = large.iter().map(|&i| aabbs[i]).collect();
-        let mut large_indices: Vec<u32> = (0..large.len() as u32).collect();
-        let large_triangles: Vec<Triangle> = large.iter().map(|&i| triangle(indices[i])).collect();
-        split_aabbs_preset(
-            &mut large_boxes,
-            &mut large_indices,
-            &large_triangles,
-            average,
-            largest,
-        );
-        for (k, aabb) in large_boxes.iter().enumerate() {
-            if k < large.len() {
-                aabbs[large[k]] = *aabb;
-            } else {
-                aabbs.push(*aabb);
-                indices.push(indices[large[large_indices[k] as usize]]);
+        let split: Vec<(Vec<Aabb>, Vec<u32>)> = large
+            .par_chunks(SPLIT_CHUNK)
+            .map(|chunk| {
+                let mut boxes: Vec<Aabb> = chunk.iter().map(|&i| aabbs[i]).collect();
+                let mut local: Vec<u32> = (0..chunk.len() as u32).collect();
+                let triangles: Vec<Triangle> =
+                    chunk.iter().map(|&i| triangle(indices[i])).collect();
+                split_aabbs_preset(&mut boxes, &mut local, &triangles, average, largest);
+                (boxes, local)
+            })
+            .collect();
+        for (chunk, (boxes, local)) in large.chunks(SPLIT_CHUNK).zip(split) {
+            for (k, aabb) in boxes.iter().enumerate() {
+                if k < chunk.len() {
+                    aabbs[chunk[k]] = *aabb;
+                } else {
+                    aabbs.push(*aabb);
+                    indices.push(indices[chunk[local[k] as usize]]);
+                }
             }
         }
     }
@@ -279,6 +294,9 @@ pub fn primitive_boxes(world: &World, prims: &[u32]) -> (Vec<Aabb>, Vec<u32>) {
     indices.extend(ellipsoids);
     (aabbs, indices)
 }
+
+/// Boxes per chunk of [`primitive_boxes`]' sums and splits, side by side.
+const SPLIT_CHUNK: usize = 1 << 14;
 
 /// First packet and packet count of a triangle leaf reference.
 #[inline(always)]

@@ -13,7 +13,8 @@
 //!
 //! Both cores from the first split, and the same tree on any thread count: ranges of
 //! [`PARALLEL_BINNING`] boxes or more are binned in chunks side by side (bins merge by
-//! minima, maxima and counts: the same in any order); a node over [`PARALLEL_SPLITS`] boxes
+//! minima, maxima and counts: the same in any order), and those of [`PARALLEL_PARTITION`] or
+//! more partitioned in fixed blocks side by side ([`partition_blocks`]); a node over [`PARALLEL_SPLITS`] boxes
 //! is filled by three levels of halves, each half split side by side; subtrees of [`TASK`]
 //! boxes or more are built apart, side by side, and concatenated in preorder. The tree and
 //! its layout depend only on the boxes.
@@ -34,6 +35,10 @@ const BINS: usize = 32;
 const PARALLEL_BINNING: usize = 1 << 15;
 /// Ranges of this many boxes or more fill their node by halves side by side.
 const PARALLEL_SPLITS: usize = 1 << 17;
+/// Ranges of this many boxes or more are partitioned in blocks side by side.
+const PARALLEL_PARTITION: usize = 1 << 18;
+/// Items per block of a partition side by side.
+const PARTITION_BLOCK: usize = 1 << 15;
 /// Subtrees of this many boxes or more are built apart, side by side.
 const TASK: usize = 1 << 14;
 /// Ranges of at most this many items are split by the exact sweep, not binned.
@@ -90,11 +95,6 @@ impl<'a> Items<'a> {
 
     fn prims(&self, range: &Range) -> &[u32] {
         &self.prims[range.start - self.offset..range.end - self.offset]
-    }
-
-    fn swap(&mut self, a: usize, b: usize) {
-        self.boxes.swap(a - self.offset, b - self.offset);
-        self.prims.swap(a - self.offset, b - self.offset);
     }
 
     /// Reorders the items of `range` to `order` (their places in it).
@@ -256,29 +256,143 @@ impl<'a> Items<'a> {
     }
 
     /// Reorders `range` so that the items for which `left` holds come first; returns both
-    /// parts with their bounds.
-    fn partition(&mut self, range: Range, left: impl Fn(&Aabb, u32) -> bool) -> (Range, Range) {
-        let (mut lb, mut rb) = (Bounds::EMPTY, Bounds::EMPTY);
-        let offset = self.offset;
-        let goes_left =
-            |items: &Items, k: usize| left(&items.boxes[k - offset], items.prims[k - offset]);
-        let (mut i, mut j) = (range.start, range.end);
-        loop {
-            while i < j && goes_left(self, i) {
-                lb.add(&self.boxes[i - offset]);
-                i += 1;
-            }
-            while i < j && !goes_left(self, j - 1) {
-                rb.add(&self.boxes[j - 1 - offset]);
-                j -= 1;
-            }
-            if i == j {
-                break;
-            }
-            self.swap(i, j - 1);
-        }
-        (lb.range(range.start, i), rb.range(i, range.end))
+    /// parts with their bounds. Big ranges are partitioned in blocks side by side
+    /// ([`partition_blocks`]).
+    fn partition(
+        &mut self,
+        range: Range,
+        left: impl Fn(&Aabb, u32) -> bool + Sync,
+    ) -> (Range, Range) {
+        let (start, end) = (range.start - self.offset, range.end - self.offset);
+        let (boxes, prims) = (&mut self.boxes[start..end], &mut self.prims[start..end]);
+        let (count, lb, rb) = if range.len() >= PARALLEL_PARTITION {
+            partition_blocks(boxes, prims, &left)
+        } else {
+            partition_slice(boxes, prims, &left)
+        };
+        let split = range.start + count;
+        (lb.range(range.start, split), rb.range(split, range.end))
     }
+}
+
+/// Reorders `boxes` and `prims` together so that the items for which `left` holds come
+/// first (Hoare's scheme); returns how many they are, and the bounds of both parts.
+fn partition_slice(
+    boxes: &mut [Aabb],
+    prims: &mut [u32],
+    left: &impl Fn(&Aabb, u32) -> bool,
+) -> (usize, Bounds, Bounds) {
+    let (mut lb, mut rb) = (Bounds::EMPTY, Bounds::EMPTY);
+    let (mut i, mut j) = (0, boxes.len());
+    loop {
+        while i < j && left(&boxes[i], prims[i]) {
+            lb.add(&boxes[i]);
+            i += 1;
+        }
+        while i < j && !left(&boxes[j - 1], prims[j - 1]) {
+            rb.add(&boxes[j - 1]);
+            j -= 1;
+        }
+        if i == j {
+            break;
+        }
+        boxes.swap(i, j - 1);
+        prims.swap(i, j - 1);
+    }
+    (i, lb, rb)
+}
+
+/// [`partition_slice`] on both cores: each block of [`PARTITION_BLOCK`] items is partitioned
+/// on its own, side by side; then the right items that lie before the left ones' total and
+/// the left items after it, as many of each, are swapped pair by pair, in pieces side by
+/// side. The blocks are fixed, so the order is the same on any thread count.
+fn partition_blocks(
+    boxes: &mut [Aabb],
+    prims: &mut [u32],
+    left: &(impl Fn(&Aabb, u32) -> bool + Sync),
+) -> (usize, Bounds, Bounds) {
+    let n = boxes.len();
+    let blocks: Vec<(usize, Bounds, Bounds)> = boxes
+        .par_chunks_mut(PARTITION_BLOCK)
+        .zip(prims.par_chunks_mut(PARTITION_BLOCK))
+        .map(|(boxes, prims)| partition_slice(boxes, prims, left))
+        .collect();
+    let count: usize = blocks.iter().map(|b| b.0).sum();
+    let (lb, rb) = blocks
+        .iter()
+        .fold((Bounds::EMPTY, Bounds::EMPTY), |(l, r), b| {
+            (l.union(b.1), r.union(b.2))
+        });
+    // Where the misplaced items lie: right ones before `count`, left ones from it on.
+    let (mut rights, mut lefts) = (Vec::new(), Vec::new());
+    for (k, &(in_block, _, _)) in blocks.iter().enumerate() {
+        let start = k * PARTITION_BLOCK;
+        let (mid, end) = (start + in_block, (start + PARTITION_BLOCK).min(n));
+        if mid < end.min(count) {
+            rights.push((mid, end.min(count)));
+        }
+        if start.max(count) < mid {
+            lefts.push((start.max(count), mid));
+        }
+    }
+    // Paired in order, in pieces of at most PARTITION_BLOCK pairs: (right at, left at, length).
+    let mut pairs = Vec::new();
+    let (mut r, mut l) = (rights.iter().copied(), lefts.iter().copied());
+    let (mut a, mut b) = (r.next(), l.next());
+    while let (Some((a0, a1)), Some((b0, b1))) = (a, b) {
+        let len = (a1 - a0).min(b1 - b0).min(PARTITION_BLOCK);
+        pairs.push((a0, b0, len));
+        a = if a0 + len == a1 {
+            r.next()
+        } else {
+            Some((a0 + len, a1))
+        };
+        b = if b0 + len == b1 {
+            l.next()
+        } else {
+            Some((b0 + len, b1))
+        };
+    }
+    debug_assert!(
+        a.is_none() && b.is_none(),
+        "as many misplaced on either side"
+    );
+    let (box_rights, box_lefts) = boxes.split_at_mut(count);
+    let (prim_rights, prim_lefts) = prims.split_at_mut(count);
+    let segments = |pairs: &[(usize, usize, usize)]| {
+        let rights: Vec<(usize, usize)> = pairs.iter().map(|&(a, _, len)| (a, len)).collect();
+        let lefts: Vec<(usize, usize)> =
+            pairs.iter().map(|&(_, b, len)| (b - count, len)).collect();
+        (rights, lefts)
+    };
+    let (at_rights, at_lefts) = segments(&pairs);
+    cut(box_rights, &at_rights)
+        .into_par_iter()
+        .zip(cut(box_lefts, &at_lefts))
+        .zip(
+            cut(prim_rights, &at_rights)
+                .into_par_iter()
+                .zip(cut(prim_lefts, &at_lefts)),
+        )
+        .for_each(|((a, b), (pa, pb))| {
+            a.swap_with_slice(b);
+            pa.swap_with_slice(pb);
+        });
+    (count, lb, rb)
+}
+
+/// The disjoint pieces (start, length) of `items`, in ascending order, as slices apart.
+fn cut<'s, T>(mut items: &'s mut [T], pieces: &[(usize, usize)]) -> Vec<&'s mut [T]> {
+    let mut out = Vec::with_capacity(pieces.len());
+    let mut taken = 0;
+    for &(start, len) in pieces {
+        let rest = std::mem::take(&mut items);
+        let (piece, tail) = rest[start - taken..].split_at_mut(len);
+        out.push(piece);
+        items = tail;
+        taken = start + len;
+    }
+    out
 }
 
 /// Twice the box's centre (the halving cancels in every comparison).
@@ -680,5 +794,72 @@ impl Builder<'_> {
             self.fill(index, c, depth + 1)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `n` boxes of pseudo-random centres and sizes (a fixed generator), box i for prim i.
+    fn boxes(n: usize) -> Vec<Aabb> {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        (0..n)
+            .map(|_| {
+                let c = Vec3A::new(next(), next(), next()) * 100.0;
+                let h = Vec3A::new(next(), next(), next());
+                Aabb::new(c - h, c + h)
+            })
+            .collect()
+    }
+
+    /// The block partition against Hoare's on one thread: the same items on each side, each
+    /// box still with its primitive, and the same bounds.
+    #[test]
+    fn a_partition_in_blocks_side_by_side_equals_the_partition_on_one_thread() {
+        // Not a multiple of the block; predicates that leave few, half and most items on the
+        // left, and one whose blocks hold runs of uneven length on either side.
+        let n = 9 * PARTITION_BLOCK + 1234;
+        let original = boxes(n);
+        let predicates: [&(dyn Fn(&Aabb, u32) -> bool + Sync); 4] = [
+            &|b, _| b.min.x < 10.0,
+            &|b, _| centre2(b).y < 100.0,
+            &|b, _| b.max.z > 5.0,
+            &|_, p| (p as usize / 1000) % 7 < 3 || p as usize > n - 50_000,
+        ];
+        for (k, left) in predicates.iter().enumerate() {
+            let (mut boxes, mut prims) = (original.clone(), (0..n as u32).collect::<Vec<_>>());
+            let (count, lb, rb) = partition_blocks(&mut boxes, &mut prims, left);
+            let (mut twin_boxes, mut twin_prims) = (original.clone(), prims.clone());
+            twin_prims.sort_unstable();
+            assert_eq!(
+                twin_prims,
+                (0..n as u32).collect::<Vec<_>>(),
+                "{k}: a permutation"
+            );
+            let (twin_count, twin_lb, twin_rb) =
+                partition_slice(&mut twin_boxes, &mut twin_prims, left);
+            assert_eq!(count, twin_count, "{k}");
+            assert!(count > 0 && count < n, "{k}: {count} of {n} on the left");
+            for (i, (b, &p)) in boxes.iter().zip(&prims).enumerate() {
+                assert_eq!(
+                    *b, original[p as usize],
+                    "{k}: item {i} parted from its box"
+                );
+                assert_eq!(left(b, p), i < count, "{k}: item {i} on the wrong side");
+            }
+            for (bounds, twin) in [(lb, twin_lb), (rb, twin_rb)] {
+                assert_eq!(bounds.aabb, twin.aabb, "{k}");
+                assert_eq!(bounds.centres, twin.centres, "{k}");
+            }
+            let exact = Bounds::of(&boxes[count..]);
+            assert_eq!((rb.aabb, rb.centres), (exact.aabb, exact.centres), "{k}");
+        }
     }
 }
