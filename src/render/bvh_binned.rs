@@ -801,6 +801,8 @@ impl Builder<'_> {
 mod tests {
     use super::*;
 
+    type Predicate<'a> = dyn Fn(&Aabb, u32) -> bool + Sync + 'a;
+
     /// `n` boxes of pseudo-random centres and sizes (a fixed generator), box i for prim i.
     fn boxes(n: usize) -> Vec<Aabb> {
         let mut state = 0x2545_f491_4f6c_dd1du64;
@@ -827,7 +829,7 @@ mod tests {
         // left, and one whose blocks hold runs of uneven length on either side.
         let n = 9 * PARTITION_BLOCK + 1234;
         let original = boxes(n);
-        let predicates: [&(dyn Fn(&Aabb, u32) -> bool + Sync); 4] = [
+        let predicates: [&Predicate<'_>; 4] = [
             &|b, _| b.min.x < 10.0,
             &|b, _| centre2(b).y < 100.0,
             &|b, _| b.max.z > 5.0,
