@@ -113,6 +113,13 @@ impl RayPacket {
         self.active = ((1u64 << n) - 1) as u32;
     }
 
+    /// The active lanes among `base..base + N`, as bits from bit 0 (the lanes a kernel of `N`
+    /// lanes takes at `base`).
+    #[inline(always)]
+    pub(crate) fn lanes_from<const N: usize>(&self, base: usize) -> u32 {
+        (self.active >> base) & (u32::MAX >> (32 - N))
+    }
+
     /// Empties the packet (its lanes keep their old rays, inactive).
     #[inline]
     pub fn clear(&mut self) {
@@ -704,7 +711,7 @@ pub(crate) fn closest<const N: usize>(bvh: &Bvh, packet: &mut RayPacket, stack: 
         return;
     }
     for base in (0..PACKET).step_by(N) {
-        let mask = (packet.active >> base) & (u32::MAX >> (32 - N));
+        let mask = packet.lanes_from::<N>(base);
         if mask != 0 {
             let r = Rays::<N>::load(packet, base);
             let mut h = Hits::<N>::load(packet, base);
@@ -723,7 +730,7 @@ pub(crate) fn any<const N: usize>(bvh: &Bvh, packet: &RayPacket, stack: &mut Pac
     }
     let mut blocked = 0;
     for base in (0..PACKET).step_by(N) {
-        let mask = (packet.active >> base) & (u32::MAX >> (32 - N));
+        let mask = packet.lanes_from::<N>(base);
         if mask != 0 {
             let r = Rays::<N>::load(packet, base);
             let tmax: &[f32; N] = packet.tmax[base..base + N].try_into().expect("N lanes");

@@ -41,6 +41,15 @@ struct Placement {
     base: u32,
 }
 
+impl Placement {
+    /// (world from object, object from world, first primitive index): what a packet walk of
+    /// its mesh needs.
+    #[inline(always)]
+    fn placed(&self) -> (&Affine3A, &Affine3A, u32) {
+        (&self.world_from_object, &self.object_from_world, self.base)
+    }
+}
+
 /// The placements of one visibility group and their meshes' hierarchies.
 #[derive(Clone, Default)]
 pub struct InstanceLevel {
@@ -242,7 +251,7 @@ impl InstanceLevel {
         stack: &mut PacketStack,
     ) {
         for base in (0..PACKET).step_by(N) {
-            let lanes = (packet.active >> base) & (u32::MAX >> (32 - N));
+            let lanes = packet.lanes_from::<N>(base);
             if lanes == 0 {
                 continue;
             }
@@ -256,8 +265,7 @@ impl InstanceLevel {
                 stack,
                 |m, on, tmax, _, stack| {
                     let mesh = &self.meshes[m.mesh as usize];
-                    let placed = (&m.world_from_object, &m.object_from_world, m.base);
-                    bvh_packet::closest_placed(mesh, placed, &rays, &mut hits, on, stack);
+                    bvh_packet::closest_placed(mesh, m.placed(), &rays, &mut hits, on, stack);
                     *tmax = hits.tmax;
                 },
             );
@@ -275,7 +283,7 @@ impl InstanceLevel {
     ) -> u32 {
         let mut blocked = 0;
         for base in (0..PACKET).step_by(N) {
-            let lanes = (packet.active >> base) & (u32::MAX >> (32 - N));
+            let lanes = packet.lanes_from::<N>(base);
             if lanes == 0 {
                 continue;
             }
@@ -289,8 +297,7 @@ impl InstanceLevel {
                 stack,
                 |m, on, tmax, open, stack| {
                     let mesh = &self.meshes[m.mesh as usize];
-                    let placed = (&m.world_from_object, &m.object_from_world, m.base);
-                    let now = bvh_packet::any_placed(mesh, placed, &rays, tmax, on, stack);
+                    let now = bvh_packet::any_placed(mesh, m.placed(), &rays, tmax, on, stack);
                     for i in 0..N {
                         hit[i] |= now[i];
                         open[i] &= !now[i];
