@@ -931,6 +931,100 @@ mod tests {
         assert_eq!(used, read);
     }
 
+    /// On a rolled face (the pupils' line at 45°) the walks run diagonally: each stops a
+    /// quarter pixel past its last skin sample, and `used` grows down and to the right as
+    /// well as up and to the left, to the last pixel read. Skin fills the square
+    /// [10, 50)²; from the pupils at (20.5, 20.5) and (30.5, 30.5), with an allowance of 4 px
+    /// (a tenth of a 40 px face): the left walk's last skin sample is at s = 14.75 (x = y =
+    /// 20.5 − 14.75/√2 = 10.07), its last read at s = 19 (7.07); the right walk's at
+    /// s = 27.5 (49.95) and 31.75 (52.95).
+    #[test]
+    fn a_rolled_faces_walks_run_along_its_pupils_line_and_grow_what_they_read() {
+        let (w, h) = (64, 64);
+        let mut skin = vec![false; w * h];
+        for y in 10..50 {
+            for x in 10..50 {
+                skin[y * w + x] = true;
+            }
+        }
+        let pupils = [DVec2::new(20.5, 20.5), DVec2::new(30.5, 30.5)];
+        let mut used = Rect {
+            x0: 20,
+            y0: 20,
+            x1: 31,
+            y1: 31,
+        };
+        let [left, right] = row_edges(&skin, w, h, pupils, 40.0, &mut used);
+        let diagonal = DVec2::ONE / 2f64.sqrt();
+        let expected = [
+            pupils[0] - diagonal * (14.75 + 0.125),
+            pupils[1] + diagonal * (27.5 + 0.125),
+        ];
+        for (edge, want) in [left, right].iter().zip(expected) {
+            assert!(edge.distance(want) < 1e-9, "{edge} against {want}");
+        }
+        let read = Rect {
+            x0: 7,
+            y0: 7,
+            x1: 53,
+            y1: 53,
+        };
+        assert_eq!(used, read);
+
+        // Skin over the whole image, the right pupil near its bottom edge: the right walk
+        // leaves through the bottom border after s = 2 (y = 63.91; at s = 2.25, y = 64.09 is
+        // outside, not the row past the image), the left walk through the left border after
+        // s = 57.25 (x = 0.02).
+        let skin = vec![true; w * h];
+        let pupils = [DVec2::new(40.5, 52.5), DVec2::new(50.5, 62.5)];
+        let mut used = Rect {
+            x0: 40,
+            y0: 52,
+            x1: 51,
+            y1: 63,
+        };
+        let [left, right] = row_edges(&skin, w, h, pupils, 40.0, &mut used);
+        let expected = [
+            pupils[0] - diagonal * (57.25 + 0.125),
+            pupils[1] + diagonal * (2.0 + 0.125),
+        ];
+        for (edge, want) in [left, right].iter().zip(expected) {
+            assert!(edge.distance(want) < 1e-9, "{edge} against {want}");
+        }
+        let read = Rect {
+            x0: 0,
+            y0: 12,
+            x1: 52,
+            y1: 64,
+        };
+        assert_eq!(used, read);
+    }
+
+    /// Through skin that never ends, each walk stops after 1.5 face widths (15 px for a
+    /// 10 px face; the quarter-pixel steps reach 15 exactly), its edge a quarter step beyond.
+    #[test]
+    fn a_walk_through_endless_skin_stops_at_one_and_a_half_face_widths() {
+        let (w, h) = (64, 64);
+        let skin = vec![true; w * h];
+        let pupils = [DVec2::new(20.5, 30.5), DVec2::new(30.5, 30.5)];
+        let mut used = Rect {
+            x0: 20,
+            y0: 30,
+            x1: 31,
+            y1: 31,
+        };
+        let [left, right] = row_edges(&skin, w, h, pupils, 10.0, &mut used);
+        assert_eq!(left, DVec2::new(20.5 - 15.125, 30.5));
+        assert_eq!(right, DVec2::new(30.5 + 15.125, 30.5));
+        let read = Rect {
+            x0: 5,
+            y0: 30,
+            x1: 46,
+            y1: 31,
+        };
+        assert_eq!(used, read);
+    }
+
     /// On a whole detection, the walks' allowance is a tenth of the face's width (its search
     /// box's, 12.4 px): the eye's white beside each pupil (about 5 px of non-skin walked from
     /// the pupil's centre) is crossed, and a patch of skin 20 px beyond the face's right edge
