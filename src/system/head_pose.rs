@@ -224,6 +224,32 @@ impl Fit<'_> {
     }
 }
 
+/// Steps of the golden section: the bracket of two coarse steps (4°) shrinks by 0.618 a step,
+/// to 4° × 0.618^24 ≈ 4e-5°.
+const GOLDEN_STEPS: usize = 24;
+
+/// The minimum of `f` in [`a`, `b`] by golden-section search, for `f` unimodal there: each of
+/// `steps` steps keeps the part of the bracket around the lower of two inner points (at
+/// 0.382 and 0.618 of it) and evaluates `f` once, at the new inner point. Returns the final
+/// bracket's midpoint, within (b − a) · 0.618^`steps` / 2 of the minimum.
+fn golden_section_min(mut a: f64, mut b: f64, steps: usize, mut f: impl FnMut(f64) -> f64) -> f64 {
+    let g = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..steps {
+        if fc < fd {
+            (b, d, fd) = (d, c, fc);
+            c = b - g * (b - a);
+            fc = f(c);
+        } else {
+            (a, c, fc) = (c, d, fd);
+            d = a + g * (b - a);
+            fd = f(d);
+        }
+    }
+    (a + b) / 2.0
+}
+
 /// The fitted pose of a detection; `feature_width` is A in metres.
 ///
 /// The yaw is scanned over ±80° about facing the camera in 2° steps on a coarse wireframe
@@ -288,27 +314,11 @@ pub fn fit_head_pose(detection: &FaceDetection, back: &Camera, feature_width: f6
             |b, &s| if s.1 < b.1 { s } else { b },
         )
         .0;
-    // Golden section on the fine wireframe, one new cost per step.
+    // The fine wireframe's minimum within a coarse step of the scan's best.
     let step = f64::from(COARSE_STEP_DEG).to_radians();
-    let g = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut a, mut b) = (best - step, best + step);
-    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-    let (mut fc, mut fd) = (
-        fit.cost(fine, c, &mut distance).0,
-        fit.cost(fine, d, &mut distance).0,
-    );
-    for _ in 0..24 {
-        if fc < fd {
-            (b, d, fd) = (d, c, fc);
-            c = b - g * (b - a);
-            fc = fit.cost(fine, c, &mut distance).0;
-        } else {
-            (a, c, fc) = (c, d, fd);
-            d = a + g * (b - a);
-            fd = fit.cost(fine, d, &mut distance).0;
-        }
-    }
-    let yaw = (a + b) / 2.0;
+    let yaw = golden_section_min(best - step, best + step, GOLDEN_STEPS, |yaw| {
+        fit.cost(fine, yaw, &mut distance).0
+    });
     let (best_cost, _, _, eye) = fit.cost(fine, yaw, &mut distance);
     let best_cost = best_cost.min(2.0 * fit.cap * fit.cap);
     let other = scan
@@ -329,6 +339,45 @@ pub fn fit_head_pose(detection: &FaceDetection, back: &Camera, feature_width: f6
 mod tests {
     use super::*;
     use crate::geometry::camera::Camera;
+
+    /// The golden section finds the minimum of unimodal functions within its documented
+    /// bound, (b − a) · 0.618^steps / 2, wherever the minimum lies in the bracket (near
+    /// either end, at an end, off centre on an asymmetric function), with one evaluation
+    /// per step beyond the first two.
+    #[test]
+    fn the_golden_section_finds_a_minimum_within_its_shrunken_bracket() {
+        let g = (5f64.sqrt() - 1.0) / 2.0;
+        let cases: [(&str, f64, f64, f64, fn(f64) -> f64); 6] = [
+            ("parabola at 0.3", 0.0, 1.0, 0.3, |x| (x - 0.3) * (x - 0.3)),
+            ("parabola at 0.93", 0.0, 1.0, 0.93, |x| {
+                (x - 0.93) * (x - 0.93)
+            }),
+            ("parabola at -0.71", -1.0, 1.0, -0.71, |x| {
+                (x + 0.71) * (x + 0.71)
+            }),
+            ("exp(x) − 3x at ln 3", 0.0, 2.0, 3f64.ln(), |x| {
+                x.exp() - 3.0 * x
+            }),
+            ("rising: at its left end", 2.0, 5.0, 2.0, |x| x * x),
+            ("falling: at its right end", -4.0, -1.0, -1.0, |x| x * x),
+        ];
+        for (name, a, b, at, f) in cases {
+            for steps in [8, 24] {
+                let mut calls = 0;
+                let found = golden_section_min(a, b, steps, |x| {
+                    calls += 1;
+                    assert!((a..=b).contains(&x), "{name}: evaluated at {x} outside");
+                    f(x)
+                });
+                let bound = (b - a) * g.powi(steps as i32) / 2.0;
+                assert!(
+                    (found - at).abs() <= bound * (1.0 + 1e-9),
+                    "{name}, {steps} steps: {found} against {at} (bound {bound:e})"
+                );
+                assert_eq!(calls, steps + 2, "{name}");
+            }
+        }
+    }
 
     /// A detection whose pupils and outline candidates are the exact projections of the head
     /// model at a known eye and yaw: the fit must return that eye and yaw.
