@@ -415,8 +415,9 @@ fn a_wet_map_coats_its_lanes_sidewalks_kerbs_and_marks_but_not_its_verges() {
 fn what_the_importer_skips_in_a_map_is_a_warning_naming_the_map() {
     // A road with a `<geometry>` of no length (which xodr drops, and says so) renders, with
     // one `warning:` line naming the map and the geometry; the bundled map has none. So do
-    // `capture` and `dataset`, which read the scene their own way, `score`, which captures
-    // again, and `reproduce`, which says it before it refuses a scene without das's car.
+    // `capture` and `dataset`, which read the scene their own way (`dataset` also when a
+    // sample then fails), `score`, which captures again, and `reproduce`, which says it
+    // before it refuses a scene without das's car.
     let dir = tempfile::tempdir().unwrap();
     let geometry = "<geometry s=\"0\" x=\"-20\" y=\"0\" hdg=\"0\" length=\"60\"><line/></geometry>";
     let right = lane(-1, "driving", &width(3.5, 0.0), "none", "");
@@ -441,6 +442,8 @@ fn what_the_importer_skips_in_a_map_is_a_warning_naming_the_map() {
         let image = dir.path().join("one_pixel.png");
         image::RgbImage::new(1, 1).save(&image).unwrap();
         let (captured, image) = (at("capture"), image.to_str().unwrap().to_string());
+        std::fs::create_dir_all(out.join("dataset_blocked/samples")).unwrap();
+        std::fs::write(out.join("dataset_blocked/samples/000000"), "").unwrap();
         let commands: Vec<(Vec<String>, bool)> = [
             (
                 vec![
@@ -455,6 +458,13 @@ fn what_the_importer_skips_in_a_map_is_a_warning_naming_the_map() {
                 true,
             ),
             (vec!["dataset", spec, "--quiet", "--out"], "dataset", true),
+            // A sample that cannot be written (its folder's name taken by a file): the map's
+            // warning is said before the error, not lost with the samples' at the end.
+            (
+                vec!["dataset", spec, "--quiet", "--out"],
+                "dataset_blocked",
+                false,
+            ),
             (
                 vec!["reproduce", "--quick", "--scene", scene, "--out"],
                 "reproduce",

@@ -63,24 +63,38 @@ pub fn dataset(
     )
     .map_err(to_py)?;
     let spec = DatasetSpec::load(&spec).map_err(|e| input_error(&spec, e.into()))?;
+    let scene_warnings = std::sync::Mutex::new(Vec::new());
     let made = detached(py, || -> anyhow::Result<_> {
         let job = DatasetJob {
             spec: &spec,
             out: &out,
             shard,
             exr,
+            scene_warning: &|warning| {
+                if let Ok(mut kept) = scene_warnings.lock() {
+                    kept.push(warning.to_string());
+                }
+            },
         };
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads.unwrap_or(0))
             .build()?;
         pool.install(|| make_dataset(&job))
-    })?
-    .map_err(to_py)?;
-    let warnings: Vec<String> = made.warnings.iter().map(|w| as_keywords(w)).collect();
+    })?;
+    // The scene's warnings are raised even when the making failed (before its error).
     let warn = py.import("warnings")?;
-    for warning in &warnings {
+    let scene_warnings: Vec<String> = (scene_warnings.into_inner().unwrap_or_default().iter())
+        .map(|w| as_keywords(w))
+        .collect();
+    for warning in &scene_warnings {
         warn.call_method1("warn", (warning,))?;
     }
+    let made = made.map_err(to_py)?;
+    let sample_warnings: Vec<String> = made.warnings.iter().map(|w| as_keywords(w)).collect();
+    for warning in &sample_warnings {
+        warn.call_method1("warn", (warning,))?;
+    }
+    let warnings = [scene_warnings, sample_warnings].concat();
     let dict = PyDict::new(py);
     dict.set_item("made", made.made)?;
     dict.set_item("kept", made.kept)?;

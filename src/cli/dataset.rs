@@ -52,6 +52,7 @@ impl Dataset {
             out: &self.out,
             shard: self.shard,
             exr: self.exr,
+            scene_warning: &|warning| eprintln!("warning: {}", as_flags(warning)),
         };
         let made = with_threads(self.threads, || make_dataset(&job))??;
         for warning in &made.warnings {

@@ -43,6 +43,10 @@ pub struct DatasetJob<'a> {
     pub shard: Option<Shard>,
     /// What each view's EXR holds.
     pub exr: ExrContent,
+    /// Told what reading the base scene doubted (an OpenDRIVE map's skipped features), in
+    /// the library's words, as soon as the scene is read: before any sample is checked or
+    /// made, so that a making that fails or runs for hours still says it first.
+    pub scene_warning: &'a (dyn Fn(&str) + Sync),
 }
 
 /// What a making did.
@@ -59,8 +63,8 @@ pub struct DatasetMade {
     pub seconds: f64,
     /// Whether every sample is done and the manifest and view.html were written.
     pub manifest: bool,
-    /// What reading the base scene doubted (an OpenDRIVE map's skipped features), then each
-    /// made sample's warnings, as "sample N: …", in the library's words.
+    /// Each made sample's warnings, as "sample N: …", in the library's words, in sample
+    /// order (the base scene's went to [`DatasetJob::scene_warning`]).
     pub warnings: Vec<String>,
 }
 
@@ -81,8 +85,12 @@ pub fn make_dataset(job: &DatasetJob) -> Result<DatasetMade> {
         out,
         shard,
         exr,
+        scene_warning,
     } = *job;
     let base = BaseScene::load(&spec.scene)?;
+    for warning in &base.scene.warnings {
+        scene_warning(warning);
+    }
     for index in 0..spec.samples {
         prepared(spec, &base, index)?;
     }
@@ -125,9 +133,7 @@ pub fn make_dataset(job: &DatasetJob) -> Result<DatasetMade> {
         samples: spec.samples,
         seconds: start.elapsed().as_secs_f64(),
         manifest,
-        warnings: (base.scene.warnings.iter().cloned())
-            .chain(warnings.into_iter().flatten())
-            .collect(),
+        warnings: warnings.into_iter().flatten().collect(),
     })
 }
 
