@@ -1000,6 +1000,57 @@ mod tests {
         assert_eq!(used, read);
     }
 
+    /// Through a lens, the frontal equations run on the pupils undistorted into the pinhole
+    /// of the same focal length: a face square to a back camera with strong barrel distortion
+    /// (k1 = −0.3), 14 cm right of and 6 cm below its axis, comes back to a micrometre (the
+    /// equations are exact for a face parallel to the image). On the distorted pixels
+    /// themselves the eye would be 2.8 cm off.
+    #[test]
+    fn a_lens_back_cameras_pupils_are_undistorted_before_the_equations() {
+        use crate::geometry::lens::{Distortion, Lens};
+        let (w, h) = (640, 480);
+        let pinhole = Camera::look_at(
+            DVec3::new(0.3, 1.2, 0.4),
+            DVec3::new(0.3, 1.2, -1.0),
+            DVec3::Y,
+            35f64.to_radians(),
+            w,
+            h,
+        )
+        .unwrap();
+        let lens = Lens {
+            distortion: Distortion::Brown {
+                k1: -0.3,
+                k2: 0.1,
+                k3: 0.0,
+                p1: 0.0,
+                p2: 0.0,
+            },
+            ..Lens::pinhole(35f64.to_radians(), w, h)
+        };
+        let back = Camera::with_lens(pinhole.world_from_camera, lens, w, h).unwrap();
+        let eye = back
+            .world_from_camera
+            .transform_point3(DVec3::new(0.14, -0.06, -0.7));
+        let across = back.world_from_camera.transform_vector3(DVec3::X) * 0.032;
+        let pupils = [eye - across, eye + across].map(|p| back.project_point(p).unwrap());
+        let detection = FaceDetection {
+            face_box: [300, 250, 420, 400],
+            pupils: pupils.map(|p| p.to_array()),
+            pupil_areas_px: [20, 20],
+            row_edges: [[0.0; 2]; 2],
+            outline_candidates: [[[f64::NAN; 2]; OUTLINE_CANDIDATES]; 2],
+            confidence: HeadConfidence::of([300, 250, 420, 400], pupils, [20, 20]),
+        };
+        let found = eye_from_detection(&detection, &back, 0.064);
+        assert!(found.distance(eye) < 1e-6, "{found} against {eye}");
+        let read_as_pinhole = eye_from_detection(&detection, &pinhole, 0.064);
+        assert!(
+            read_as_pinhole.distance(eye) > 0.01,
+            "the lens is too weak to tell: {read_as_pinhole}"
+        );
+    }
+
     /// Through skin that never ends, each walk stops after 1.5 face widths (15 px for a
     /// 10 px face; the quarter-pixel steps reach 15 exactly), its edge a quarter step beyond.
     #[test]
