@@ -410,15 +410,37 @@ fn triangles_closest<const N: usize>(
     h: &mut Hits<N>,
     on: Mask<N>,
 ) {
-    for j in 0..used_lanes(packet) {
-        let prim = packet.prim[j];
-        let mut t = [0.0; N];
-        let valid = triangle_hits(packet, j, r, &h.tmax, &mut t);
-        for i in 0..N {
-            let take = on[i] && valid[i] && closer(t[i], prim, h.tmax[i], h.prim[i]);
-            h.tmax[i] = if take { t[i] } else { h.tmax[i] };
-            h.prim[i] = if take { prim } else { h.prim[i] };
-        }
+    // The lanes in use one by one, not as a loop: see `triangles_any`.
+    const _: () = assert!(TRI_LANES == 4);
+    let used = used_lanes(packet);
+    triangle_closest(packet, 0, r, h, on);
+    if used > 1 {
+        triangle_closest(packet, 1, r, h, on);
+    }
+    if used > 2 {
+        triangle_closest(packet, 2, r, h, on);
+    }
+    if used > 3 {
+        triangle_closest(packet, 3, r, h, on);
+    }
+}
+
+/// Tests the rays of `on` against triangle `j` of `packet` for their closest hits.
+#[inline(always)]
+fn triangle_closest<const N: usize>(
+    packet: &Triangles4,
+    j: usize,
+    r: &Rays<N>,
+    h: &mut Hits<N>,
+    on: Mask<N>,
+) {
+    let prim = packet.prim[j];
+    let mut t = [0.0; N];
+    let valid = triangle_hits(packet, j, r, &h.tmax, &mut t);
+    for i in 0..N {
+        let take = on[i] && valid[i] && closer(t[i], prim, h.tmax[i], h.prim[i]);
+        h.tmax[i] = if take { t[i] } else { h.tmax[i] };
+        h.prim[i] = if take { prim } else { h.prim[i] };
     }
 }
 
@@ -432,15 +454,32 @@ fn triangles_any<const N: usize>(
     blocked: &mut Mask<N>,
 ) {
     // Every lane, used or not (an unused lane repeats lane 0's triangle, which gives the same
-    // answer): a loop of fixed length, unrolled whatever the code around it. Bounded by the
-    // lanes in use, it was unrolled fourfold, eightfold or not at all as that code changed,
-    // and das's shadow rays ran up to 13 % slower.
-    for j in 0..TRI_LANES {
-        let mut t = [0.0; N];
-        let hit = triangle_hits(packet, j, r, tmax, &mut t);
-        for i in 0..N {
-            blocked[i] |= hit[i] & on[i];
-        }
+    // answer), written out one by one: straight code, whatever the code around it. As a loop
+    // bounded by the lanes in use, it was unrolled fourfold, eightfold or not at all as that
+    // code changed, and das's shadow rays ran up to 13 % slower; as a loop of four, the
+    // compiler sometimes folded the four bodies back into one behind a jump table, and the
+    // blocked lanes were moved byte by byte around it (10-15 % slower).
+    const _: () = assert!(TRI_LANES == 4);
+    triangle_any(packet, 0, r, tmax, on, blocked);
+    triangle_any(packet, 1, r, tmax, on, blocked);
+    triangle_any(packet, 2, r, tmax, on, blocked);
+    triangle_any(packet, 3, r, tmax, on, blocked);
+}
+
+/// Adds to `blocked` the rays of `on` that hit triangle `j` of `packet` in [tmin, `tmax`].
+#[inline(always)]
+fn triangle_any<const N: usize>(
+    packet: &Triangles4,
+    j: usize,
+    r: &Rays<N>,
+    tmax: &[f32; N],
+    on: Mask<N>,
+    blocked: &mut Mask<N>,
+) {
+    let mut t = [0.0; N];
+    let hit = triangle_hits(packet, j, r, tmax, &mut t);
+    for i in 0..N {
+        blocked[i] |= hit[i] & on[i];
     }
 }
 
