@@ -347,7 +347,9 @@ mod tests {
     #[test]
     fn the_golden_section_finds_a_minimum_within_its_shrunken_bracket() {
         let g = (5f64.sqrt() - 1.0) / 2.0;
-        let cases: [(&str, f64, f64, f64, fn(f64) -> f64); 6] = [
+        // Name, bracket [a, b], where the minimum lies, the function.
+        type Case = (&'static str, f64, f64, f64, fn(f64) -> f64);
+        let cases: [Case; 6] = [
             ("parabola at 0.3", 0.0, 1.0, 0.3, |x| (x - 0.3) * (x - 0.3)),
             ("parabola at 0.93", 0.0, 1.0, 0.93, |x| {
                 (x - 0.93) * (x - 0.93)
