@@ -381,10 +381,8 @@ mod tests {
         }
     }
 
-    /// A detection whose pupils and outline candidates are the exact projections of the head
-    /// model at a known eye and yaw: the fit must return that eye and yaw.
-    #[test]
-    fn a_consistent_detection_is_fitted_back_to_its_pose() {
+    /// The back camera and eye of the fit's tests: das's, with the face 0.75 m before the camera.
+    fn back_and_eye() -> (Camera, DVec3) {
         let back = Camera::look_at(
             DVec3::new(1.05, 1.425, -0.75),
             DVec3::new(1.05, 1.425, 1.0),
@@ -394,9 +392,75 @@ mod tests {
             480,
         )
         .unwrap();
-        let eye = DVec3::new(1.4, 1.2, 0.0);
+        (back, DVec3::new(1.4, 1.2, 0.0))
+    }
+
+    /// A detection whose pupils and outline candidates are the exact projections of the head
+    /// model (its interpupillary distance `width`, metres) with its eye at `eye`, turned by
+    /// `turn` degrees from facing `back`, its outline edges then moved `outward` pixels
+    /// away from the face along the pupils' line.
+    fn consistent_detection(
+        back: &Camera,
+        eye: DVec3,
+        turn: f64,
+        width: f64,
+        outward: f64,
+    ) -> FaceDetection {
         let to_camera = back.position() - eye;
         let facing = (-to_camera.x).atan2(-to_camera.z);
+        let scale = width / (2.0 * HALF_IPD);
+        let yaw = facing + turn.to_radians();
+        // The scene's rotation convention (what the renderer turns the mesh by).
+        let r = crate::scene::head_model::head_rotation(yaw.to_degrees(), 0.0);
+        let pupils = [1.0, -1.0].map(|s| {
+            back.project_point(eye + r * DVec3::X * s * HALF_IPD * scale)
+                .unwrap()
+        });
+        // The outline, by brute force: every vertex of the fine wireframe projected, the
+        // extreme crossings of the projected edges with the pupils' image line (the fit
+        // intersects the pupils' plane in the head's frame instead and projects two points).
+        let (vertices, edges) = skin_wireframe(88, 60);
+        let along = (pupils[1] - pupils[0]).normalize();
+        let normal = DVec2::new(-along.y, along.x);
+        let mid = (pupils[0] + pupils[1]) / 2.0;
+        let projected: Vec<DVec2> = vertices
+            .iter()
+            .map(|v| back.project_point(eye + r * *v * scale).unwrap())
+            .collect();
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for [i, j] in edges {
+            let (p, q) = (projected[i], projected[j]);
+            let (dp, dq) = ((p - mid).dot(normal), (q - mid).dot(normal));
+            if (dp > 0.0) != (dq > 0.0) {
+                let s = (p + (q - p) * (dp / (dp - dq)) - mid).dot(along);
+                (lo, hi) = (lo.min(s), hi.max(s));
+            }
+        }
+        let mut outline_candidates = [[[f64::NAN; 2]; crate::system::head::OUTLINE_CANDIDATES]; 2];
+        outline_candidates[0][0] = (mid + along * (lo - outward)).to_array();
+        outline_candidates[1][0] = (mid + along * (hi + outward)).to_array();
+        // A decoy step inside the face on each side.
+        outline_candidates[0][1] = (mid + along * lo * 0.6).to_array();
+        outline_candidates[1][1] = (mid + along * hi * 0.6).to_array();
+        FaceDetection {
+            face_box: [80, 280, 180, 460],
+            pupils: pupils.map(|p| p.to_array()),
+            pupil_areas_px: [30, 30],
+            row_edges: [[0.0; 2]; 2],
+            outline_candidates,
+            confidence: crate::system::head::HeadConfidence::of(
+                [80, 280, 180, 460],
+                pupils,
+                [30, 30],
+            ),
+        }
+    }
+
+    /// A detection whose pupils and outline candidates are the exact projections of the head
+    /// model at a known eye and yaw: the fit must return that eye and yaw.
+    #[test]
+    fn a_consistent_detection_is_fitted_back_to_its_pose() {
+        let (back, eye) = back_and_eye();
         // The shipped head's interpupillary distance, and a wider face (the head scaled).
         for (turn, width) in [
             (-30.0f64, 2.0 * HALF_IPD),
@@ -405,53 +469,7 @@ mod tests {
             (-30.0, 0.071),
             (20.0, 0.071),
         ] {
-            let scale = width / (2.0 * HALF_IPD);
-            let yaw = facing + turn.to_radians();
-            // The scene's rotation convention (what the renderer turns the mesh by).
-            let r = crate::scene::head_model::head_rotation(yaw.to_degrees(), 0.0);
-            let pupils = [1.0, -1.0].map(|s| {
-                back.project_point(eye + r * DVec3::X * s * HALF_IPD * scale)
-                    .unwrap()
-            });
-            // The outline, by brute force: every vertex of the fine wireframe projected, the
-            // extreme crossings of the projected edges with the pupils' image line (the fit
-            // intersects the pupils' plane in the head's frame instead and projects two points).
-            let (vertices, edges) = skin_wireframe(88, 60);
-            let along = (pupils[1] - pupils[0]).normalize();
-            let normal = DVec2::new(-along.y, along.x);
-            let mid = (pupils[0] + pupils[1]) / 2.0;
-            let projected: Vec<DVec2> = vertices
-                .iter()
-                .map(|v| back.project_point(eye + r * *v * scale).unwrap())
-                .collect();
-            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-            for [i, j] in edges {
-                let (p, q) = (projected[i], projected[j]);
-                let (dp, dq) = ((p - mid).dot(normal), (q - mid).dot(normal));
-                if (dp > 0.0) != (dq > 0.0) {
-                    let s = (p + (q - p) * (dp / (dp - dq)) - mid).dot(along);
-                    (lo, hi) = (lo.min(s), hi.max(s));
-                }
-            }
-            let mut outline_candidates =
-                [[[f64::NAN; 2]; crate::system::head::OUTLINE_CANDIDATES]; 2];
-            outline_candidates[0][0] = (mid + along * lo).to_array();
-            outline_candidates[1][0] = (mid + along * hi).to_array();
-            // A decoy step inside the face on each side.
-            outline_candidates[0][1] = (mid + along * lo * 0.6).to_array();
-            outline_candidates[1][1] = (mid + along * hi * 0.6).to_array();
-            let detection = FaceDetection {
-                face_box: [80, 280, 180, 460],
-                pupils: pupils.map(|p| p.to_array()),
-                pupil_areas_px: [30, 30],
-                row_edges: [[0.0; 2]; 2],
-                outline_candidates,
-                confidence: crate::system::head::HeadConfidence::of(
-                    [80, 280, 180, 460],
-                    pupils,
-                    [30, 30],
-                ),
-            };
+            let detection = consistent_detection(&back, eye, turn, width, 0.0);
             let pose = fit_head_pose(&detection, &back, width);
             let error = (DVec3::from(pose.eye) - eye).length();
             // The detection is exact and the fit's outline the same fine wireframe's: the eye
@@ -467,6 +485,22 @@ mod tests {
                 pose.yaw_deg
             );
             assert!(pose.edge_rms_px < 1e-3, "{pose:?}");
+        }
+    }
+
+    /// The outline's residual is in image pixels along the pupils' line: a face whose edges
+    /// both lie `outward` pixels beyond the model's (wider than its pupils say, which no turn
+    /// explains: a turn moves both edges one way) leaves `outward` pixels on each side.
+    #[test]
+    fn a_face_wider_than_its_pupils_leaves_its_excess_as_the_edge_residual() {
+        let (back, eye) = back_and_eye();
+        for outward in [1.0, 3.0] {
+            let detection = consistent_detection(&back, eye, 0.0, 2.0 * HALF_IPD, outward);
+            let pose = fit_head_pose(&detection, &back, 2.0 * HALF_IPD);
+            assert!(
+                (pose.edge_rms_px - outward).abs() < 0.05 * outward,
+                "{outward} px outward: {pose:?}"
+            );
         }
     }
 }
