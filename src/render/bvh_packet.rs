@@ -566,6 +566,12 @@ fn closest_walk<const N: usize>(
     stack.nodes.push(0);
     stack.masks.push(mask);
     stack.entries.push(entry);
+    // A node's entered children, sort keys, lanes and entries: filled afresh at every node
+    // before they are read, and set up once per walk (zeroing them at every node was 640
+    // bytes of stores).
+    let mut keys = [u64::MAX; WIDTH];
+    let mut masks = [[false; PACKET]; WIDTH];
+    let mut entries = [[0.0f32; PACKET]; WIDTH];
     while let Some(current) = stack.nodes.pop() {
         let mask: Mask<N> = part(&stack.masks.pop().unwrap_or([false; PACKET]), 0);
         let entry: [f32; N] = part(&stack.entries.pop().unwrap_or([0.0; PACKET]), 0);
@@ -589,9 +595,6 @@ fn closest_walk<const N: usize>(
         }
         let node = &bvh.nodes[current as usize];
         // The children any lane enters, sorted far to near by their nearest lane's entry.
-        let mut keys = [u64::MAX; WIDTH];
-        let mut masks = [[false; PACKET]; WIDTH];
-        let mut entries = [[0.0f32; PACKET]; WIDTH];
         let mut n = 0;
         for c in 0..WIDTH {
             if node.children[c] == EMPTY {
@@ -628,13 +631,12 @@ fn closest_walk<const N: usize>(
 /// non-negative floats order as their bits), `u32::MAX` where no lane is set.
 #[inline(always)]
 pub(crate) fn nearest_entry<const N: usize>(m: &Mask<N>, e: &[f32; N]) -> u32 {
-    (0..N).fold(u32::MAX, |a, i| {
-        a.min(if m[i] {
-            e[i].to_bits() & 0x7fff_ffff
-        } else {
-            u32::MAX
-        })
-    })
+    // The lanes' keys first, all ones where a lane is off, then their minimum: a vector
+    // select and reduction. As one fold with a branch per lane, it compiled to sixteen
+    // scalar tests and extractions for every child a packet enters.
+    let keys: [u32; N] =
+        std::array::from_fn(|i| (e[i].to_bits() & 0x7fff_ffff) | u32::from(!m[i]).wrapping_neg());
+    keys.iter().fold(u32::MAX, |a, &k| a.min(k))
 }
 
 /// Which rays of `on` (`r`) are blocked in `bvh` within each lane's [tmin, `tmax`], boxes and
@@ -778,4 +780,43 @@ pub(crate) fn any<const N: usize>(bvh: &Bvh, packet: &RayPacket, stack: &mut Pac
         }
     }
     blocked
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The nearest entry against its definition, lane by lane: the smallest entry among the
+    /// lanes set (as a float; -0.0 as 0.0), `u32::MAX` where none is, for every mask of a
+    /// few hundred drawn ones, entries of every order of magnitude, and ties.
+    #[test]
+    fn the_nearest_entry_is_the_smallest_among_the_lanes_set() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut draw = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1);
+            (state >> 33) as u32
+        };
+        for case in 0..500 {
+            let mask = if case == 0 { 0 } else { draw() & 0xffff };
+            let m: Mask<PACKET> = lanes_of(mask);
+            let e: [f32; PACKET] = std::array::from_fn(|_| match draw() % 8 {
+                0 => 0.0,
+                1 => -0.0,
+                2 => 3.5, // ties across lanes
+                _ => (draw() % 1_000_000) as f32 * 10f32.powi((draw() % 9) as i32 - 4),
+            });
+            let want = (0..PACKET)
+                .filter(|&i| m[i])
+                .map(|i| e[i].abs())
+                .fold(None, |a: Option<f32>, x| Some(a.map_or(x, |a| a.min(x))))
+                .map_or(u32::MAX, f32::to_bits);
+            assert_eq!(
+                nearest_entry(&m, &e),
+                want,
+                "mask {mask:#06x}, entries {e:?}"
+            );
+        }
+    }
 }
