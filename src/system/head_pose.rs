@@ -268,10 +268,10 @@ pub fn fit_head_pose(detection: &FaceDetection, back: &Camera, feature_width: f6
     let normal = rays[0].cross(rays[1]).normalize_or(DVec3::Y);
     let forward =
         (rays[0].normalize_or_zero() + rays[1].normalize_or_zero()).normalize_or(DVec3::NEG_Z);
-    let mut across = normal.cross(forward).normalize_or(DVec3::X);
-    if across.dot(rays[1]) < across.dot(rays[0]) {
-        across = -across;
-    }
+    // From pupil 0's ray toward pupil 1's, with no test needed: (r0 × r1) × f = r1 (r0·f) −
+    // r0 (r1·f), so across·r1 − across·r0 = (r0·f)(|r1|² − r0·r1) + (r1·f)(|r0|² − r0·r1),
+    // which is |r0||r1|(|r0| + |r1|)(1 − cos θ) > 0 for the bisector f of two rays θ apart.
+    let across = normal.cross(forward).normalize_or(DVec3::X);
     let measured: [Vec<f64>; 2] = [0, 1].map(|k| {
         detection.outline_candidates[k]
             .iter()
