@@ -503,4 +503,56 @@ mod tests {
             );
         }
     }
+
+    /// An outline edge far off on one side (hair, an ear, the seat's edge) costs at most the
+    /// cap, 5 % of the face box's width: the other side's edge still fits the pose, and the
+    /// residual is the cap's.
+    #[test]
+    fn an_edge_far_off_on_one_side_is_capped_and_the_other_side_fits_the_pose() {
+        let (back, eye) = back_and_eye();
+        let width = 2.0 * HALF_IPD;
+        for turn in [0.0, 20.0] {
+            let mut detection = consistent_detection(&back, eye, turn, width, 0.0);
+            let [p0, p1] = detection.pupils.map(DVec2::from);
+            let along = (p1 - p0).normalize();
+            let edge = DVec2::from(detection.outline_candidates[1][0]);
+            detection.outline_candidates[1][0] = (edge + along * 8.0).to_array();
+            // No decoys: with one side capped, the other side's single edge is all there is
+            // to fit, and a decoy there would fit some other yaw as well (an ambiguity the
+            // margin reports).
+            detection.outline_candidates[0][1] = [f64::NAN; 2];
+            detection.outline_candidates[1][1] = [f64::NAN; 2];
+            let pose = fit_head_pose(&detection, &back, width);
+            let cap = 0.05 * f64::from(detection.face_box[2] - detection.face_box[0]);
+            assert!((pose.yaw_deg - turn).abs() < 0.2, "turn {turn}: {pose:?}");
+            assert!(
+                (DVec3::from(pose.eye) - eye).length() < 1e-4,
+                "turn {turn}: {pose:?}"
+            );
+            assert!(
+                (pose.edge_rms_px - cap / 2f64.sqrt()).abs() < 1e-6,
+                "turn {turn}: {pose:?}, cap {cap} px"
+            );
+        }
+    }
+
+    /// The fit searches turns within ±80° of facing the camera (beyond, the far eye is
+    /// hidden and the pupils' line no longer measures the head): a detection made at a
+    /// turn near either end of that range is fitted at its turn, one made beyond it within
+    /// the range, not at its own turn.
+    #[test]
+    fn the_fit_searches_turns_within_eighty_degrees_of_facing_the_camera() {
+        let (back, eye) = back_and_eye();
+        for turn in [-70.0, 70.0] {
+            let detection = consistent_detection(&back, eye, turn, 2.0 * HALF_IPD, 0.0);
+            let pose = fit_head_pose(&detection, &back, 2.0 * HALF_IPD);
+            assert!((pose.yaw_deg - turn).abs() < 0.2, "turn {turn}: {pose:?}");
+        }
+        for turn in [-120.0, 120.0] {
+            let detection = consistent_detection(&back, eye, turn, 2.0 * HALF_IPD, 0.0);
+            let pose = fit_head_pose(&detection, &back, 2.0 * HALF_IPD);
+            let bound = f64::from(YAW_RANGE_DEG + COARSE_STEP_DEG);
+            assert!(pose.yaw_deg.abs() <= bound, "turn {turn}: {pose:?}");
+        }
+    }
 }
