@@ -555,4 +555,22 @@ mod tests {
             assert!(pose.yaw_deg.abs() <= bound, "turn {turn}: {pose:?}");
         }
     }
+
+    /// A face whose outline was not found (no candidate on either side) fits every turn as
+    /// well: each side's residual is the cap, 5 % of the face box's width, and the margin
+    /// between the best turn and any other is nil, which the confidence reads as doubt.
+    #[test]
+    fn a_face_without_an_outline_leaves_the_cap_on_both_sides_and_no_margin() {
+        let (back, eye) = back_and_eye();
+        let mut detection = consistent_detection(&back, eye, 10.0, 2.0 * HALF_IPD, 0.0);
+        detection.outline_candidates =
+            [[[f64::NAN; 2]; crate::system::head::OUTLINE_CANDIDATES]; 2];
+        let pose = fit_head_pose(&detection, &back, 2.0 * HALF_IPD);
+        let cap = 0.05 * f64::from(detection.face_box[2] - detection.face_box[0]);
+        assert!(
+            (pose.edge_rms_px - cap).abs() < 1e-9,
+            "{pose:?}, cap {cap} px"
+        );
+        assert_eq!(pose.margin, 0.0, "{pose:?}");
+    }
 }
