@@ -270,7 +270,8 @@ pub fn fit_head_pose(detection: &FaceDetection, back: &Camera, feature_width: f6
         (rays[0].normalize_or_zero() + rays[1].normalize_or_zero()).normalize_or(DVec3::NEG_Z);
     // From pupil 0's ray toward pupil 1's, with no test needed: (r0 × r1) × f = r1 (r0·f) −
     // r0 (r1·f), so across·r1 − across·r0 = (r0·f)(|r1|² − r0·r1) + (r1·f)(|r0|² − r0·r1),
-    // which is |r0||r1|(|r0| + |r1|)(1 − cos θ) > 0 for the bisector f of two rays θ apart.
+    // which is cos(θ/2)|r0||r1|(|r0| + |r1|)(1 − cos θ) > 0 for the unit bisector f of two
+    // rays θ < 180° apart (r·f = |r| cos(θ/2)).
     let across = normal.cross(forward).normalize_or(DVec3::X);
     let measured: [Vec<f64>; 2] = [0, 1].map(|k| {
         detection.outline_candidates[k]
