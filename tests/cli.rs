@@ -609,6 +609,45 @@ fn bench_times_only_the_parts_asked_for() {
 }
 
 #[test]
+fn bench_times_the_kernels_named_by_isa_or_says_the_cpu_lacks_them() {
+    // Every part runs on the kernels asked for (the JSON names them), and bench's own check
+    // of its packets against the per-ray path holds on each; an ISA this CPU lacks is one
+    // error line. The portable kernels run everywhere.
+    let mut ran = Vec::new();
+    for isa in ["avx512", "avx2", "portable"] {
+        let (ok, out, err) = seethru(&[
+            "bench",
+            "scenes/das.toml",
+            "--width",
+            "64",
+            "--height",
+            "36",
+            "--repeat",
+            "1",
+            "--parts",
+            "trace",
+            "--isa",
+            isa,
+            "--json",
+        ]);
+        if ok {
+            let report: serde_json::Value =
+                serde_json::from_str(out.lines().last().unwrap()).unwrap();
+            assert_eq!(report["isa"], isa, "{report}");
+            ran.push(isa);
+        } else {
+            let lines: Vec<&str> = err.lines().collect();
+            assert_eq!(lines.len(), 1, "{err}");
+            assert!(
+                lines[0].starts_with(&format!("error: --isa {isa}: this CPU lacks {isa}")),
+                "{err}"
+            );
+        }
+    }
+    assert!(ran.contains(&"portable"), "{ran:?}");
+}
+
+#[test]
 fn bench_measures_its_repeats_and_how_busy_the_frame_kept_its_workers() {
     let (ok, out, err) = seethru(&[
         "bench",

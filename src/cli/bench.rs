@@ -25,7 +25,30 @@ use serde_json::json;
 
 use seethru::system::memory::{bench_estimate, check_memory};
 
+use clap::ValueEnum;
+
 use crate::cli::args::{MemoryLimit, choice, integer, pixels, real, threads, with_threads};
+
+/// The widest packet kernels the tracer may use, for `--isa`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Kernels {
+    /// AVX-512: 16 lanes per walk.
+    Avx512,
+    /// AVX2: 8 lanes per walk.
+    Avx2,
+    /// The target's baseline (SSE2 on x86-64): 4 lanes per walk.
+    Portable,
+}
+
+impl Kernels {
+    fn isa(self) -> Isa {
+        match self {
+            Kernels::Avx512 => Isa::Avx512,
+            Kernels::Avx2 => Isa::Avx2,
+            Kernels::Portable => Isa::Portable,
+        }
+    }
+}
 
 /// A part of the benchmark, for `--parts`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -74,6 +97,11 @@ pub struct Bench {
         default_value = "trace,methods,sequence,run"
     )]
     parts: Vec<Part>,
+    /// The packet kernels every part uses, to time narrower ones than this CPU's widest
+    /// (the images are the same; default: the widest this CPU runs). One this CPU lacks is
+    /// an error.
+    #[arg(long, value_parser = choice::<Kernels>())]
+    isa: Option<Kernels>,
     /// Print only the JSON line.
     #[arg(long)]
     json: bool,
@@ -96,6 +124,15 @@ impl Bench {
             self.flatten,
         )?;
         check_memory(&estimate, self.memory.max_memory)?;
+        if let Some(kernels) = self.isa {
+            let name = kernels
+                .to_possible_value()
+                .map(|v| v.get_name().to_string());
+            kernels
+                .isa()
+                .limit_to()
+                .map_err(|why| anyhow::anyhow!("--isa {}: {why}", name.unwrap_or_default()))?;
+        }
         with_threads(self.threads, || bench(&self).map(|_| ()))?
     }
 }

@@ -31,6 +31,9 @@ pub enum Isa {
     Portable,
 }
 
+/// The kernels every packet query uses unless it names others: [`Isa::best`].
+static BEST: OnceLock<Isa> = OnceLock::new();
+
 impl Isa {
     pub const ALL: [Isa; 3] = [Isa::Avx512, Isa::Avx2, Isa::Portable];
 
@@ -53,15 +56,43 @@ impl Isa {
         }
     }
 
-    /// The widest available ISA (detected once).
+    /// The widest available ISA (detected once), or the one [`Isa::limit_to`] set.
     pub fn best() -> Isa {
-        static BEST: OnceLock<Isa> = OnceLock::new();
         *BEST.get_or_init(|| {
             Isa::ALL
                 .into_iter()
                 .find(|isa| isa.available())
                 .unwrap_or(Isa::Portable)
         })
+    }
+
+    /// Makes `self` what [`Isa::best`] answers for the rest of the process, so that the
+    /// renders and `bench` use `self`'s kernels (to time AVX2's or the portable ones on a
+    /// CPU that has wider). Called before anything asked for the best.
+    ///
+    /// # Errors
+    /// Where this CPU lacks `self`, or the best was already chosen and is another ISA.
+    pub fn limit_to(self) -> Result<(), String> {
+        if !self.available() {
+            let runs: Vec<&str> = Isa::ALL
+                .into_iter()
+                .filter(|isa| isa.available())
+                .map(Isa::name)
+                .collect();
+            return Err(format!(
+                "this CPU lacks {} (it runs {})",
+                self.name(),
+                runs.join(", ")
+            ));
+        }
+        match BEST.get_or_init(|| self) {
+            &chosen if chosen == self => Ok(()),
+            &chosen => Err(format!(
+                "the kernels were already chosen ({}) before {} was asked for",
+                chosen.name(),
+                self.name()
+            )),
+        }
     }
 
     /// Rays per traversal.
@@ -220,5 +251,28 @@ mod x86 {
         stack: &mut PacketStack,
     ) -> u32 {
         level.any_packet::<8>(packet, stack)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Once chosen, the best stays: limiting it to itself is allowed, to any other ISA an
+    /// error, and so is an ISA this CPU lacks.
+    #[test]
+    fn the_best_is_limited_once_and_only_to_an_isa_this_cpu_runs() {
+        let best = Isa::best();
+        assert_eq!(best.limit_to(), Ok(()));
+        for isa in Isa::ALL.into_iter().filter(|&isa| isa != best) {
+            let why = isa.limit_to().unwrap_err();
+            let want = if isa.available() {
+                format!("already chosen ({})", best.name())
+            } else {
+                format!("this CPU lacks {}", isa.name())
+            };
+            assert!(why.contains(&want), "{why}");
+        }
+        assert_eq!(Isa::best(), best);
     }
 }
