@@ -392,7 +392,8 @@ fn next_octant<const N: usize>(octant: &[u32; N], rest: &mut Mask<N>) -> Option<
 }
 
 /// [`box_hits`] of child `c` of `node` for rays of the octant of `planes`, bit for bit in
-/// every comparison.
+/// every comparison, among the lanes of `on` (taken in the same loop: and-ed apart, the
+/// 8-lane kernels moved the lanes byte by byte).
 ///
 /// Within an octant the reciprocal's sign is known, and it is finite and not 0, so
 /// (lo − o)·inv ≤ (hi − o)·inv where inv > 0 and ≥ where inv < 0 (subtraction and
@@ -406,7 +407,7 @@ fn child_hits<const N: usize>(
     c: usize,
     planes: &Planes,
     r: &Rays<N>,
-    tmax: &[f32; N],
+    (tmax, on): (&[f32; N], &Mask<N>),
     entry: &mut [f32; N],
 ) -> Mask<N> {
     let b = &node.bounds;
@@ -423,7 +424,7 @@ fn child_hits<const N: usize>(
         let e = max(max(max(r.tmin[i], z0), y0), x0);
         let x = min(min(min(tmax[i], z1), y1), x1);
         entry[i] = e;
-        hit[i] = e <= x * EXIT_ROUND_UP;
+        hit[i] = on[i] & (e <= x * EXIT_ROUND_UP);
     }
     hit
 }
@@ -457,7 +458,9 @@ fn triangle_hits<const N: usize>(
         // A -0.0 barycentric is a miss, like a negative one (the sign bit, as obvhs).
         let outside = (u.to_bits() | v.to_bits() | w.to_bits()) >> 31 != 0;
         t_out[i] = t;
-        valid[i] = inv_det != 0.0 && t >= r.tmin[i] && t <= tmax[i] && !outside;
+        // `&`, not `&&`: short-circuits kept the 8-lane (AVX2) kernels' triangle tests
+        // scalar, one lane at a time.
+        valid[i] = (inv_det != 0.0) & (t >= r.tmin[i]) & (t <= tmax[i]) & !outside;
     }
     valid
 }
@@ -507,7 +510,7 @@ fn triangle_closest<const N: usize>(
     let mut t = [0.0; N];
     let valid = triangle_hits(packet, j, r, &h.tmax, &mut t);
     for i in 0..N {
-        let take = on[i] && valid[i] && closer(t[i], prim, h.tmax[i], h.prim[i]);
+        let take = on[i] & valid[i] & closer(t[i], prim, h.tmax[i], h.prim[i]);
         h.tmax[i] = if take { t[i] } else { h.tmax[i] };
         h.prim[i] = if take { prim } else { h.prim[i] };
     }
@@ -670,7 +673,7 @@ fn closest_walk<const N: usize>(
                 break;
             }
             let mut e = [0.0; N];
-            let m = and(child_hits(node, c, planes, boxes, &h.tmax, &mut e), on);
+            let m = child_hits(node, c, planes, boxes, (&h.tmax, &on), &mut e);
             if !any_set(&m) {
                 continue;
             }
@@ -754,7 +757,7 @@ fn any_walk<const N: usize>(
             if node.children[c] == EMPTY {
                 break;
             }
-            let cm = and(child_hits(node, c, planes, boxes, tmax, &mut scratch), m);
+            let cm = child_hits(node, c, planes, boxes, (tmax, &m), &mut scratch);
             if any_set(&cm) {
                 let mut wide = [false; PACKET];
                 wide[..N].copy_from_slice(&cm);
@@ -940,7 +943,14 @@ mod tests {
                 );
                 for lane in 0..PACKET {
                     let planes = Planes::of(octant[lane]);
-                    let got = child_hits(&node, c, &planes, &r, &packet.tmax, &mut entry);
+                    let got = child_hits(
+                        &node,
+                        c,
+                        &planes,
+                        &r,
+                        (&packet.tmax, &[true; PACKET]),
+                        &mut entry,
+                    );
                     assert_eq!(got[lane], want[lane], "case {case}, child {c}, lane {lane}");
                     assert_eq!(
                         entry[lane], want_entry[lane],

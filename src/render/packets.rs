@@ -28,7 +28,7 @@ use crate::scene::world::Ellipsoid;
 /// shared edge hit by a ray, both triangles can give the same distance.
 #[inline(always)]
 pub fn closer(t: f32, prim: u32, tmax: f32, best: u32) -> bool {
-    t < tmax || (t == tmax && best != NO_PRIM && prim < best)
+    (t < tmax) | ((t == tmax) & (best != NO_PRIM) & (prim < best))
 }
 
 /// Triangles per packet.
