@@ -248,10 +248,16 @@ impl<const N: usize> Rays<N> {
         let linear = |v: &[[f32; N]; 3], row: usize, i: usize| {
             c[0][row] * v[0][i] + c[1][row] * v[1][i] + c[2][row] * v[2][i]
         };
-        let o = [0, 1, 2].map(|row| std::array::from_fn(|i| linear(&self.o, row, i) + t[row]));
-        let d: [[f32; N]; 3] =
-            [0, 1, 2].map(|row| std::array::from_fn(|i| linear(&self.d, row, i)));
-        let inv = d.map(|axis| axis.map(reciprocal));
+        // Plain loops: `array::map` was compiled apart, without the kernels' target
+        // features, and called at every placement a packet visits.
+        let (mut o, mut d, mut inv) = ([[0.0; N]; 3], [[0.0; N]; 3], [[0.0; N]; 3]);
+        for row in 0..3 {
+            for i in 0..N {
+                o[row][i] = linear(&self.o, row, i) + t[row];
+                d[row][i] = linear(&self.d, row, i);
+                inv[row][i] = reciprocal(d[row][i]);
+            }
+        }
         Rays {
             o,
             d,
@@ -367,7 +373,13 @@ impl Planes {
 /// sign is its direction's (a NaN direction, which no triangle test hits, gets either).
 #[inline(always)]
 fn octants<const N: usize>(r: &Rays<N>) -> [u32; N] {
-    std::array::from_fn(|i| (0..3).fold(0, |k, a| k | ((r.inv[a][i].to_bits() >> 31) << a)))
+    let mut octant = [0; N];
+    for (a, inv) in r.inv.iter().enumerate() {
+        for i in 0..N {
+            octant[i] |= (inv[i].to_bits() >> 31) << a;
+        }
+    }
+    octant
 }
 
 /// The next octant group of the lanes of `rest`: the lanes of the octant of its first lane
@@ -386,8 +398,11 @@ fn next_octant<const N: usize>(octant: &[u32; N], rest: &mut Mask<N>) -> Option<
     if first == N {
         return None;
     }
-    let group: Mask<N> = std::array::from_fn(|i| rest[i] & (octant[i] == octant[first]));
-    *rest = std::array::from_fn(|i| rest[i] & !group[i]);
+    let mut group = [false; N];
+    for i in 0..N {
+        group[i] = rest[i] & (octant[i] == octant[first]);
+        rest[i] &= !group[i];
+    }
     Some((group, Planes::of(octant[first])))
 }
 
