@@ -85,9 +85,9 @@ impl Isa {
                 runs.join(", ")
             ));
         }
-        match BEST.get_or_init(|| self) {
-            &chosen if chosen == self => Ok(()),
-            &chosen => Err(format!(
+        match *BEST.get_or_init(|| self) {
+            chosen if chosen == self => Ok(()),
+            chosen => Err(format!(
                 "the kernels were already chosen ({}) before {} was asked for",
                 chosen.name(),
                 self.name()
