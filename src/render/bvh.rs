@@ -64,14 +64,22 @@ pub use crate::render::packets::NO_PRIM;
 struct RayLanes {
     origin: [f32; 3],
     inv_dir: [f32; 3],
+    /// Per axis, the row of a node's bounds that holds the plane the ray meets first (min
+    /// where it runs toward +, max toward −) and the one it meets last.
+    near: [usize; 3],
+    far: [usize; 3],
 }
 
 impl RayLanes {
     #[inline(always)]
     fn new(ray: &TraceRay) -> RayLanes {
+        let inv_dir = [ray.inv_dir.x, ray.inv_dir.y, ray.inv_dir.z];
+        let toward_minus = |axis: usize| (inv_dir[axis].to_bits() >> 31) as usize;
         RayLanes {
             origin: [ray.origin.x, ray.origin.y, ray.origin.z],
-            inv_dir: [ray.inv_dir.x, ray.inv_dir.y, ray.inv_dir.z],
+            inv_dir,
+            near: [0, 1, 2].map(|a| 2 * a + toward_minus(a)),
+            far: [0, 1, 2].map(|a| 2 * a + 1 - toward_minus(a)),
         }
     }
 }
@@ -116,29 +124,32 @@ impl Node {
 
     /// Which children the ray enters in [tmin, tmax] (bit i for child i), and where: four
     /// children at a time in a `Vec4` (SSE on any x86-64).
+    ///
+    /// Each axis's near plane is the ray's `near` row, its far plane the `far` row: the
+    /// reciprocal direction is finite and not 0 ([`crate::render::ray::reciprocal`]), so
+    /// (lo − o)·inv ≤ (hi − o)·inv where inv > 0 and ≥ where inv < 0 (subtraction and
+    /// multiplication round monotonically), and the near plane's distance is the min of the
+    /// two, the far one's the max, bit for bit but for a zero's sign, which compares equal:
+    /// the packets' test (`bvh_packet.rs`'s `child_hits`) and the slab test's min and max
+    /// answer alike.
     #[inline(always)]
     fn intersect(&self, lanes: &RayLanes, tmin: f32, tmax: f32) -> (u32, [f32; WIDTH]) {
         let b = &self.bounds;
         let [ox, oy, oz] = lanes.origin.map(Vec4::splat);
         let [ix, iy, iz] = lanes.inv_dir.map(Vec4::splat);
+        let (near, far) = (&lanes.near, &lanes.far);
         let mut entries = [0.0; WIDTH];
         let mut mask = 0;
         for k in (0..WIDTH).step_by(4) {
-            let at = |axis: usize| Vec4::from_slice(&b[axis][k..k + 4]);
-            let (x0, x1) = ((at(0) - ox) * ix, (at(1) - ox) * ix);
-            let (y0, y1) = ((at(2) - oy) * iy, (at(3) - oy) * iy);
-            let (z0, z1) = ((at(4) - oz) * iz, (at(5) - oz) * iz);
-            // SSE min/max return the second operand where either is NaN (as [`min`],
-            // [`max`]): an empty slot's NaN box (last operand) makes its entry NaN, and
-            // NaN ≤ anything is false.
-            let entry = Vec4::splat(tmin)
-                .max(z0.min(z1))
-                .max(y0.min(y1))
-                .max(x0.min(x1));
-            let exit = Vec4::splat(tmax)
-                .min(z0.max(z1))
-                .min(y0.max(y1))
-                .min(x0.max(x1));
+            let at = |row: usize| Vec4::from_slice(&b[row][k..k + 4]);
+            let (x0, x1) = ((at(near[0]) - ox) * ix, (at(far[0]) - ox) * ix);
+            let (y0, y1) = ((at(near[1]) - oy) * iy, (at(far[1]) - oy) * iy);
+            let (z0, z1) = ((at(near[2]) - oz) * iz, (at(far[2]) - oz) * iz);
+            // An empty slot's NaN box makes both distances NaN, and SSE's max and min
+            // return their second operand where either is NaN (as [`min`], [`max`]): its
+            // entry is NaN, and NaN ≤ anything is false.
+            let entry = Vec4::splat(tmin).max(z0).max(y0).max(x0);
+            let exit = Vec4::splat(tmax).min(z1).min(y1).min(x1);
             mask |= entry.cmple(exit * EXIT_ROUND_UP).bitmask() << k;
             entry.write_to_slice(&mut entries[k..k + 4]);
         }
@@ -958,5 +969,73 @@ impl Builder<'_> {
         }
         self.out
             .push_leaf(self.world, &mut prims, self.summaries[node].triangles)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The slab test of child `c` as the min and max of its two planes' distances per axis,
+    /// in the order the per-ray test took them before it knew its near and far rows: whether
+    /// `ray` enters the child, and where.
+    fn slab_min_max(node: &Node, c: usize, ray: &TraceRay) -> (bool, f32) {
+        let b = &node.bounds;
+        let d = |axis: usize, row: usize| (b[row][c] - ray.origin[axis]) * ray.inv_dir[axis];
+        let (x0, x1, y0, y1, z0, z1) = (d(0, 0), d(0, 1), d(1, 2), d(1, 3), d(2, 4), d(2, 5));
+        let e = max(max(max(ray.tmin, min(z0, z1)), min(y0, y1)), min(x0, x1));
+        let x = min(min(min(ray.tmax, max(z0, z1)), max(y0, y1)), max(x0, x1));
+        (e <= x * EXIT_ROUND_UP, e)
+    }
+
+    /// The per-ray test of a node's eight children, with the ray's near and far rows,
+    /// against the slab test's min and max ([`slab_min_max`]): the same children
+    /// entered at the same entries, for drawn boxes (some flat) and rays of every octant,
+    /// axis-parallel ones among them, and an empty slot never entered.
+    #[test]
+    fn a_node_tested_with_the_rays_near_and_far_rows_answers_as_with_min_and_max() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut draw = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        };
+        let mut entered = 0;
+        for case in 0..300 {
+            let mut node = Node::EMPTY;
+            for c in 0..WIDTH - 1 {
+                for axis in 0..3 {
+                    let (a, b) = (8.0 * draw(), 8.0 * draw());
+                    let b = if case % 7 == 0 { a } else { b };
+                    node.bounds[2 * axis][c] = a.min(b);
+                    node.bounds[2 * axis + 1][c] = a.max(b);
+                }
+                node.children[c] = c as u32;
+            }
+            for lane in 0..16 {
+                let mut d = glam::Vec3::new(draw(), draw(), draw());
+                if lane % 5 == 0 {
+                    d[lane % 3] = if lane % 2 == 0 { 0.0 } else { -0.0 };
+                }
+                let o = glam::Vec3::new(4.0 * draw(), 4.0 * draw(), 4.0 * draw());
+                let tmax = if lane % 3 == 0 { 2.0 } else { f32::INFINITY };
+                let d = d.normalize_or(glam::Vec3::X);
+                let ray = TraceRay::new(o.into(), d.into(), 0.0, tmax);
+                let (mask, entries) = node.intersect(&RayLanes::new(&ray), ray.tmin, ray.tmax);
+                assert_eq!(mask >> (WIDTH - 1), 0, "the empty slot was entered");
+                for (c, &got_entry) in entries.iter().enumerate().take(WIDTH - 1) {
+                    let (want, want_entry) = slab_min_max(&node, c, &ray);
+                    let got = mask >> c & 1 != 0;
+                    assert_eq!(got, want, "case {case}, ray {lane}, child {c}");
+                    assert_eq!(got_entry, want_entry, "case {case}, ray {lane}, child {c}");
+                    entered += usize::from(got);
+                }
+            }
+        }
+        assert!(
+            (3_000..25_000).contains(&entered),
+            "{entered} of 33 600 entered"
+        );
     }
 }

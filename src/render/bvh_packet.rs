@@ -9,10 +9,11 @@
 //! (8 lanes) and baseline x86-64 or any other target (4 lanes) and picks one at run time.
 //!
 //! Every lane computes what the per-ray traversal ([`crate::render::bvh::Bvh::closest`])
-//! computes for its ray, without fused multiply-adds: the same conservative box test (with
-//! the near and far planes of the lane's octant, which answer as the per-ray test's min and
-//! max, bit for bit: [`child_hits`]; a packet is walked once per octant among its rays), the
-//! same triangle test, operation for operation, and the same choice of the closest hit
+//! computes for its ray, operation for operation and without fused multiply-adds: the same
+//! conservative box test (each axis's near and far planes chosen by the direction's sign,
+//! which answers as the slab test's min and max, bit for bit: [`child_hits`]; a packet is
+//! walked once per octant among its rays), the same triangle test, and the same choice of
+//! the closest hit
 //! ([`closer`]), which does not depend on the order of the tests. So a packet gives every ray
 //! the hit the per-ray path gives it, bit for bit, on every ISA (`tests/accel.rs`).
 
