@@ -972,8 +972,66 @@ impl Builder<'_> {
     }
 }
 
+/// Drawn nodes and rays for the checks of the box tests against the slab test's min and max
+/// (here and in `bvh_packet.rs`).
+#[cfg(test)]
+pub(crate) mod drawn {
+    use super::{Node, TraceRay, WIDTH};
+
+    /// A seeded stream of floats in [−1, 1).
+    pub(crate) struct Draws(u64);
+
+    impl Draws {
+        pub(crate) fn new(seed: u64) -> Draws {
+            Draws(seed)
+        }
+
+        pub(crate) fn next(&mut self) -> f32 {
+            self.0 = self
+                .0
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((self.0 >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        }
+
+        /// A node whose first `used` children have drawn boxes within ±8 m (flat ones, every
+        /// axis's two planes equal, where `flat`), the rest empty.
+        pub(crate) fn node(&mut self, used: usize, flat: bool) -> Node {
+            let mut node = Node::EMPTY;
+            for c in 0..used.min(WIDTH) {
+                for axis in 0..3 {
+                    let (a, b) = (8.0 * self.next(), 8.0 * self.next());
+                    let b = if flat { a } else { b };
+                    node.bounds[2 * axis][c] = a.min(b);
+                    node.bounds[2 * axis + 1][c] = a.max(b);
+                }
+                node.children[c] = c as u32;
+            }
+            node
+        }
+
+        /// Ray `k` of a drawn set: from within ±4 m, every octant, every fifth with one
+        /// direction component ±0 (axis-parallel in that axis), every third with tmax 2 m.
+        pub(crate) fn ray(&mut self, k: usize) -> TraceRay {
+            let mut d = glam::Vec3::new(self.next(), self.next(), self.next());
+            if k.is_multiple_of(5) {
+                d[k % 3] = if k.is_multiple_of(2) { 0.0 } else { -0.0 };
+            }
+            let o = glam::Vec3::new(4.0 * self.next(), 4.0 * self.next(), 4.0 * self.next());
+            let tmax = if k.is_multiple_of(3) {
+                2.0
+            } else {
+                f32::INFINITY
+            };
+            let d = d.normalize_or(glam::Vec3::X);
+            TraceRay::new(o.into(), d.into(), 0.0, tmax)
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::drawn::Draws;
     use super::*;
 
     /// The slab test of child `c` as the min and max of its two planes' distances per axis,
@@ -994,41 +1052,19 @@ mod tests {
     /// axis-parallel ones among them, and an empty slot never entered.
     #[test]
     fn a_node_tested_with_the_rays_near_and_far_rows_answers_as_with_min_and_max() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut draw = || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
-        };
+        let mut draws = Draws::new(0x9e37_79b9_7f4a_7c15);
         let mut entered = 0;
         for case in 0..300 {
-            let mut node = Node::EMPTY;
-            for c in 0..WIDTH - 1 {
-                for axis in 0..3 {
-                    let (a, b) = (8.0 * draw(), 8.0 * draw());
-                    let b = if case % 7 == 0 { a } else { b };
-                    node.bounds[2 * axis][c] = a.min(b);
-                    node.bounds[2 * axis + 1][c] = a.max(b);
-                }
-                node.children[c] = c as u32;
-            }
-            for lane in 0..16 {
-                let mut d = glam::Vec3::new(draw(), draw(), draw());
-                if lane % 5 == 0 {
-                    d[lane % 3] = if lane % 2 == 0 { 0.0 } else { -0.0 };
-                }
-                let o = glam::Vec3::new(4.0 * draw(), 4.0 * draw(), 4.0 * draw());
-                let tmax = if lane % 3 == 0 { 2.0 } else { f32::INFINITY };
-                let d = d.normalize_or(glam::Vec3::X);
-                let ray = TraceRay::new(o.into(), d.into(), 0.0, tmax);
+            let node = draws.node(WIDTH - 1, case % 7 == 0);
+            for k in 0..16 {
+                let ray = draws.ray(k);
                 let (mask, entries) = node.intersect(&RayLanes::new(&ray), ray.tmin, ray.tmax);
                 assert_eq!(mask >> (WIDTH - 1), 0, "the empty slot was entered");
                 for (c, &got_entry) in entries.iter().enumerate().take(WIDTH - 1) {
                     let (want, want_entry) = slab_min_max(&node, c, &ray);
                     let got = mask >> c & 1 != 0;
-                    assert_eq!(got, want, "case {case}, ray {lane}, child {c}");
-                    assert_eq!(got_entry, want_entry, "case {case}, ray {lane}, child {c}");
+                    assert_eq!(got, want, "case {case}, ray {k}, child {c}");
+                    assert_eq!(got_entry, want_entry, "case {case}, ray {k}, child {c}");
                     entered += usize::from(got);
                 }
             }

@@ -917,34 +917,13 @@ mod tests {
     /// of every octant, axis-parallel ones among them, each lane tested in its own octant.
     #[test]
     fn a_child_tested_with_its_octants_planes_answers_as_with_min_and_max() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut draw = || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
-        };
+        let mut draws = crate::render::bvh::drawn::Draws::new(0x2545_f491_4f6c_dd1d);
         let mut entered = 0;
         for case in 0..400 {
-            let mut node = Node::EMPTY;
-            for c in 0..WIDTH {
-                for axis in 0..3 {
-                    let (a, b) = (8.0 * draw(), 8.0 * draw());
-                    let b = if case % 7 == 0 { a } else { b };
-                    node.bounds[2 * axis][c] = a.min(b);
-                    node.bounds[2 * axis + 1][c] = a.max(b);
-                }
-            }
+            let node = draws.node(WIDTH, case % 7 == 0);
             let mut packet = RayPacket::new();
             for lane in 0..PACKET {
-                let mut d = glam::Vec3::new(draw(), draw(), draw());
-                if lane % 5 == 0 {
-                    d[lane % 3] = if lane % 2 == 0 { 0.0 } else { -0.0 };
-                }
-                let o = glam::Vec3::new(4.0 * draw(), 4.0 * draw(), 4.0 * draw());
-                let tmax = if lane % 3 == 0 { 2.0 } else { f32::INFINITY };
-                let d = d.normalize_or(glam::Vec3::X);
-                packet.set(lane, &TraceRay::new(o.into(), d.into(), 0.0, tmax));
+                packet.set(lane, &draws.ray(lane));
             }
             let r = Rays::<PACKET>::load(&packet, 0);
             let octant = octants(&r);
