@@ -60,26 +60,44 @@ pub(crate) const EXIT_ROUND_UP: f32 = 1.0 + 8.0 * f32::EPSILON;
 const PARALLEL_BOXES: usize = 1 << 16;
 pub use crate::render::packets::NO_PRIM;
 
+/// Which rows of a node's bounds hold each axis's near and far planes for rays of one
+/// octant: [min, max] on an axis they run along toward +, [max, min] toward −.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Planes {
+    pub(crate) near: [usize; 3],
+    pub(crate) far: [usize; 3],
+}
+
+impl Planes {
+    /// The planes of octant `octant` (bit a set where the rays run toward − on axis a).
+    #[inline(always)]
+    pub(crate) fn of(octant: u32) -> Planes {
+        let toward_minus = |axis: usize| (octant >> axis) & 1;
+        Planes {
+            near: [0, 1, 2].map(|a| 2 * a + toward_minus(a) as usize),
+            far: [0, 1, 2].map(|a| 2 * a + 1 - toward_minus(a) as usize),
+        }
+    }
+}
+
 /// What the box test needs of a ray: computed once per traversal.
 struct RayLanes {
     origin: [f32; 3],
     inv_dir: [f32; 3],
-    /// Per axis, the row of a node's bounds that holds the plane the ray meets first (min
-    /// where it runs toward +, max toward −) and the one it meets last.
-    near: [usize; 3],
-    far: [usize; 3],
+    /// The planes the ray meets first and last on each axis: those of its octant (bit a set
+    /// where its reciprocal direction's axis-a component has its sign bit set).
+    planes: Planes,
 }
 
 impl RayLanes {
     #[inline(always)]
     fn new(ray: &TraceRay) -> RayLanes {
         let inv_dir = [ray.inv_dir.x, ray.inv_dir.y, ray.inv_dir.z];
-        let toward_minus = |axis: usize| (inv_dir[axis].to_bits() >> 31) as usize;
+        let octant = (0..3).fold(0, |k, a| k | ((inv_dir[a].to_bits() >> 31) << a));
         RayLanes {
             origin: [ray.origin.x, ray.origin.y, ray.origin.z],
             inv_dir,
-            near: [0, 1, 2].map(|a| 2 * a + toward_minus(a)),
-            far: [0, 1, 2].map(|a| 2 * a + 1 - toward_minus(a)),
+            planes: Planes::of(octant),
         }
     }
 }
@@ -137,7 +155,7 @@ impl Node {
         let b = &self.bounds;
         let [ox, oy, oz] = lanes.origin.map(Vec4::splat);
         let [ix, iy, iz] = lanes.inv_dir.map(Vec4::splat);
-        let (near, far) = (&lanes.near, &lanes.far);
+        let (near, far) = (&lanes.planes.near, &lanes.planes.far);
         let mut entries = [0.0; WIDTH];
         let mut mask = 0;
         for k in (0..WIDTH).step_by(4) {

@@ -23,7 +23,7 @@ use glam::{Affine3A, Vec3A};
 
 use crate::render::bvh::{
     Bvh, COUNT_MASK, COUNT_SHIFT, ELLIPSOIDS, EMPTY, EXIT_ROUND_UP, FIRST_MASK, LEAF, NO_PRIM,
-    Node, STACK, WIDTH, max, min, packets_of,
+    Node, Planes, STACK, WIDTH, max, min, packets_of,
 };
 use crate::render::packets::{TRI_LANES, Triangles4, closer};
 use crate::render::ray::{Hit, TraceRay, reciprocal};
@@ -347,26 +347,6 @@ pub(crate) fn box_hits<const N: usize>(
         hit[i] = e <= x * EXIT_ROUND_UP;
     }
     hit
-}
-
-/// Which rows of a node's bounds hold each axis's near and far planes for rays of one
-/// octant: [min, max] on an axis they run along toward +, [max, min] toward −.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Planes {
-    near: [usize; 3],
-    far: [usize; 3],
-}
-
-impl Planes {
-    /// The planes of octant `octant` (bit a set where the rays run toward − on axis a).
-    #[inline(always)]
-    fn of(octant: u32) -> Planes {
-        let toward_minus = |axis: usize| (octant >> axis) & 1;
-        Planes {
-            near: [0, 1, 2].map(|a| 2 * a + toward_minus(a) as usize),
-            far: [0, 1, 2].map(|a| 2 * a + 1 - toward_minus(a) as usize),
-        }
-    }
 }
 
 /// Each lane's octant: bit a set where its reciprocal direction's axis-a component has its
