@@ -24,7 +24,7 @@ use glam::Vec3A;
 use obvhs::aabb::Aabb;
 use rayon::prelude::*;
 
-use crate::render::bvh::{Bvh, Node, STACK, WIDTH};
+use crate::render::bvh::{Bvh, Draft, Node, STACK, WIDTH};
 use crate::render::bvh_build::Builder as Made;
 use crate::render::packets::TRI_LANES;
 use crate::scene::world::World;
@@ -626,7 +626,7 @@ struct Builder<'a> {
     /// The items of this part; ranges index into them.
     items: Items<'a>,
     world: &'a World,
-    out: Bvh,
+    out: Draft,
     /// Subtrees of [`TASK`] boxes or more, left to build apart.
     deferred: Vec<Deferred>,
     /// A leaf's primitives (kept to spare an allocation per leaf).
@@ -636,7 +636,7 @@ struct Builder<'a> {
 /// A subtree built apart: its hierarchy (its root first), and the subtrees built apart below
 /// it, each with the node and slot that refers to it.
 struct Part {
-    bvh: Bvh,
+    bvh: Draft,
     links: Vec<(usize, usize, Part)>,
 }
 
@@ -644,17 +644,14 @@ impl Part {
     /// Builds the subtree of `range` (all of `items`), its subtrees of [`TASK`] boxes or
     /// more side by side.
     fn build(items: Items, range: Range, depth: usize, world: &World) -> Result<Part> {
-        let mut out = Bvh::empty();
-        out.nodes.reserve(range.len() / 8);
-        out.triangles.reserve(range.len() / 3);
         let mut builder = Builder {
             items,
             world,
-            out,
+            out: Draft::with_room(range.len()),
             deferred: Vec::new(),
             leaf: Vec::with_capacity(TRI_LANES),
         };
-        let root = builder.reserve();
+        let root = builder.out.reserve();
         builder.fill(root, range, depth)?;
         let Builder {
             items,
@@ -685,7 +682,7 @@ impl Part {
 
     /// This part and those below it in preorder, with each link as (its part's index, node,
     /// slot, the linked part's index).
-    fn flatten<'a>(&'a self, parts: &mut Vec<&'a Bvh>, links: &mut Vec<[usize; 4]>) -> usize {
+    fn flatten<'a>(&'a self, parts: &mut Vec<&'a Draft>, links: &mut Vec<[usize; 4]>) -> usize {
         let me = parts.len();
         parts.push(&self.bvh);
         for (node, slot, part) in &self.links {
@@ -717,17 +714,12 @@ pub fn build(world: &World, boxes: &mut [Aabb], prims: &mut [u32]) -> Result<Bvh
     let root = Part::build(items, bounds, 1, world)?;
     let (mut parts, mut links) = (Vec::new(), Vec::new());
     root.flatten(&mut parts, &mut links);
-    let mut bvh = Bvh::concatenate(&parts, &links)?;
+    let mut bvh = Draft::concatenate(&parts, &links, world)?;
     bvh.builder = Some(Made::Binned);
     Ok(bvh)
 }
 
 impl Builder<'_> {
-    fn reserve(&mut self) -> usize {
-        self.out.nodes.push(Node::EMPTY);
-        self.out.nodes.len() - 1
-    }
-
     /// Fills wide node `at` with the subtrees of `range`, split largest first until there
     /// are [`WIDTH`].
     fn fill(&mut self, at: usize, range: Range, depth: usize) -> Result<()> {
@@ -783,7 +775,7 @@ impl Builder<'_> {
                     slot,
                 });
             } else {
-                let index = self.reserve();
+                let index = self.out.reserve();
                 node.children[slot] = index as u32;
                 reserved[inner] = (index, c);
                 inner += 1;
