@@ -43,7 +43,7 @@ pub(crate) const COUNT_SHIFT: u32 = 27;
 pub(crate) const COUNT_MASK: u32 = 0b111;
 pub(crate) const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 /// Most packets in one leaf.
-const MAX_LEAF_PACKETS: usize = COUNT_MASK as usize + 1;
+pub(crate) const MAX_LEAF_PACKETS: usize = COUNT_MASK as usize + 1;
 /// The error of a hierarchy whose leaf references cannot hold its packets.
 const TOO_MANY_PACKETS: &str = "the scene has more than 134217727 triangle packets or ellipsoids in one hierarchy, the most its leaf references hold: use fewer or coarser meshes";
 const _: () = assert!(FIRST_MASK == 134_217_727);

@@ -7,8 +7,10 @@
 //! largest area first, until it has [`WIDTH`] children. Each split bins the boxes' centres
 //! into up to [`BINS`] slabs per axis and cuts where the surface-area cost is least, counting
 //! whole packets of [`TRI_LANES`] triangles (so leaves come out full); ranges of at most
-//! [`SMALL`] boxes are cut by the exact sweep instead. No binary hierarchy is kept: each box
-//! is touched a few times per wide level. Its trees are also tighter than PLOC's (on das:
+//! [`SMALL`] boxes are cut by the exact sweep instead. A child of up to [`LARGE_LEAF`]
+//! triangles stays one leaf of several packets where that costs less than a node over its
+//! best split, as in Embree ([`NODE_COST`]). No binary hierarchy is kept: each box is touched
+//! a few times per wide level. Its trees are also tighter than PLOC's (on das:
 //! 3–10 % faster rays, 16 % less memory; docs/notebook/benchmark-history.md).
 //!
 //! Both cores from the first split, and the same tree on any thread count: ranges of
@@ -24,7 +26,7 @@ use glam::Vec3A;
 use obvhs::aabb::Aabb;
 use rayon::prelude::*;
 
-use crate::render::bvh::{Bvh, Draft, Node, STACK, WIDTH};
+use crate::render::bvh::{Bvh, Draft, MAX_LEAF_PACKETS, Node, STACK, WIDTH};
 use crate::render::bvh_build::Builder as Made;
 use crate::render::packets::TRI_LANES;
 use crate::scene::world::World;
@@ -43,6 +45,12 @@ const PARTITION_BLOCK: usize = 1 << 15;
 const TASK: usize = 1 << 14;
 /// Ranges of at most this many items are split by the exact sweep, not binned.
 const SMALL: usize = 16;
+/// Most items in a leaf of several packets (as many as its reference can count).
+const LARGE_LEAF: usize = MAX_LEAF_PACKETS * TRI_LANES;
+/// A node's cost, in packets of triangles tested: Embree's `travCost` over its `intCost`.
+/// Leaves of several packets where cheaper: the 1 M scene's hierarchy 9 % smaller, its rays
+/// as fast (docs/notebook/benchmark-history.md).
+const NODE_COST: f32 = 1.0;
 /// Wide depth from which ranges split at the median (bounding the depth on any input).
 const SAH_DEPTH: usize = 24;
 
@@ -112,11 +120,14 @@ impl<'a> Items<'a> {
         if range.len() > TRI_LANES {
             return None;
         }
-        let triangles = self
-            .prims(range)
-            .iter()
-            .all(|&prim| (prim as usize) < self.triangles);
+        let triangles = self.all_triangles(range);
         (range.len() == 1 || triangles).then_some(triangles)
+    }
+
+    fn all_triangles(&self, range: &Range) -> bool {
+        self.prims(range)
+            .iter()
+            .all(|&prim| (prim as usize) < self.triangles)
     }
 
     /// Splits `range` into at most 2^`levels` ranges that are not leaves, by halves side by
@@ -137,51 +148,86 @@ impl<'a> Items<'a> {
         out.extend(b);
     }
 
-    /// Splits `range` (two or more items, not one leaf) into two non-empty ranges: apart by
-    /// kind where that makes leaves, else by the surface-area heuristic (below
-    /// [`SAH_DEPTH`]), else at the median.
+    /// Splits `range` (two or more items, not one leaf) into two non-empty ranges.
     fn split(&mut self, range: Range, depth: usize) -> (Range, Range) {
+        let (cut, _) = self.plan(&range, depth);
+        self.apply(range, cut)
+    }
+
+    /// How to split `range` (two or more items, not one leaf) into two non-empty ranges, and
+    /// that split's cost (each part's half-area times its packets; infinite where not chosen
+    /// by cost): apart by kind where that makes leaves, else by the surface-area heuristic
+    /// (below [`SAH_DEPTH`]), else at the median. May reorder the range's items.
+    fn plan(&mut self, range: &Range, depth: usize) -> (Cut, f32) {
         if range.len() <= TRI_LANES {
             // A leaf but for its kinds (triangles and ellipsoids, or several ellipsoids).
-            let triangles = self.triangles;
-            let (left, right) = self.partition(range, |_, prim| (prim as usize) < triangles);
-            if left.len() > 0 && right.len() > 0 {
-                return (left, right);
+            let triangles = self
+                .prims(range)
+                .iter()
+                .filter(|&&prim| (prim as usize) < self.triangles)
+                .count();
+            if triangles > 0 && triangles < range.len() {
+                return (Cut::Kinds, f32::INFINITY);
             }
         }
         if depth >= SAH_DEPTH {
-            return self.median_split(range);
+            return (self.median_order(range), f32::INFINITY);
         }
         if range.len() <= SMALL {
-            return self.small_split(range);
+            return self.small_order(range);
         }
         let extent = range.centres.diagonal();
         if extent.cmpgt(Vec3A::ZERO).any() {
             let map = BinMap::new(&range.centres, range.len());
-            let boxes = self.boxes(&range);
+            let boxes = self.boxes(range);
             let best = match map.bins {
                 8 => Bins::<8>::best_split_of(boxes, &map),
                 16 => Bins::<16>::best_split_of(boxes, &map),
                 _ => Bins::<BINS>::best_split_of(boxes, &map),
             };
-            if let Some((axis, slab)) = best {
-                // Centres are finite (the world's vertices are), so none is NaN.
-                let t = map.threshold(axis, slab, &range.centres);
-                return match axis {
-                    0 => self.partition(range, |b, _| b.min.x + b.max.x <= t),
-                    1 => self.partition(range, |b, _| b.min.y + b.max.y <= t),
-                    _ => self.partition(range, |b, _| b.min.z + b.max.z <= t),
-                };
+            if let Some((cost, axis, slab)) = best {
+                let threshold = map.threshold(axis, slab, &range.centres);
+                return (Cut::Centre { axis, threshold }, cost);
             }
         }
-        self.median_split(range)
+        (self.median_order(range), f32::INFINITY)
     }
 
-    /// Splits a small range (at most [`SMALL`] items) where the surface-area cost is least
-    /// over every cut of its items sorted by centre along the axis where the centres spread
-    /// most (ties by place): the exact sweep, cheaper than binning so few.
-    fn small_split(&mut self, range: Range) -> (Range, Range) {
-        let boxes = self.boxes(&range);
+    /// `range` split as `cut` says (planned for it, its items unchanged since).
+    fn apply(&mut self, range: Range, cut: Cut) -> (Range, Range) {
+        match cut {
+            Cut::At(at) => self.halves(range, at),
+            Cut::Kinds => {
+                let triangles = self.triangles;
+                self.partition(range, |_, prim| (prim as usize) < triangles)
+            }
+            // Centres are finite (the world's vertices are), so none is NaN.
+            Cut::Centre { axis: 0, threshold } => {
+                self.partition(range, |b, _| b.min.x + b.max.x <= threshold)
+            }
+            Cut::Centre { axis: 1, threshold } => {
+                self.partition(range, |b, _| b.min.y + b.max.y <= threshold)
+            }
+            Cut::Centre { threshold, .. } => {
+                self.partition(range, |b, _| b.min.z + b.max.z <= threshold)
+            }
+        }
+    }
+
+    /// Whether `range` (not a leaf by count) is cheaper as one leaf of several packets than
+    /// as a node over the split `cost` costs, as Embree decides (`leafSAH <= splitSAH`): its
+    /// half-area times its packets, against its half-area times [`NODE_COST`] plus `cost`.
+    fn cheaper_as_leaf(&self, range: &Range, cost: f32) -> bool {
+        let area = range.aabb.half_area();
+        let leaf = area * range.len().div_ceil(TRI_LANES) as f32;
+        leaf <= area * NODE_COST + cost
+    }
+
+    /// Orders a small range (at most [`SMALL`] items) by centre along the axis where the
+    /// centres spread most (ties by place) and cuts it where the surface-area cost is least:
+    /// the exact sweep, cheaper than binning so few.
+    fn small_order(&mut self, range: &Range) -> (Cut, f32) {
+        let boxes = self.boxes(range);
         let n = boxes.len();
         let axis = range.centres.largest_axis();
         // Sort keys: the centre's bits in an order that sorts as the floats do, above the
@@ -210,12 +256,12 @@ impl<'a> Items<'a> {
         let (mut boxes_sorted, mut prims_sorted) = ([Aabb::INVALID; SMALL], [0; SMALL]);
         for k in 0..n {
             boxes_sorted[k] = boxes[place(k)];
-            prims_sorted[k] = self.prims(&range)[place(k)];
+            prims_sorted[k] = self.prims(range)[place(k)];
         }
         let (start, end) = (range.start - self.offset, range.end - self.offset);
         self.boxes[start..end].copy_from_slice(&boxes_sorted[..n]);
         self.prims[start..end].copy_from_slice(&prims_sorted[..n]);
-        self.halves(range, range.start + best.1)
+        (Cut::At(range.start + best.1), best.0)
     }
 
     /// `range` cut at `split`, with the bounds of both parts.
@@ -236,13 +282,13 @@ impl<'a> Items<'a> {
         )
     }
 
-    /// Splits `range` at its median along the axis where its centres spread most; by order
-    /// where they coincide.
-    fn median_split(&mut self, range: Range) -> (Range, Range) {
+    /// Orders `range` about its median along the axis where its centres spread most (by
+    /// order where they coincide) and cuts it there.
+    fn median_order(&mut self, range: &Range) -> Cut {
         let mid = range.len() / 2;
         let axis = range.centres.largest_axis();
         if range.centres.diagonal()[axis] > 0.0 {
-            let (boxes, prims) = (self.boxes(&range), self.prims(&range));
+            let (boxes, prims) = (self.boxes(range), self.prims(range));
             let mut order: Vec<usize> = (0..range.len()).collect();
             order.select_nth_unstable_by(mid, |&a, &b| {
                 centre2(&boxes[a])[axis]
@@ -250,9 +296,9 @@ impl<'a> Items<'a> {
                     .then(prims[a].cmp(&prims[b]))
                     .then(a.cmp(&b))
             });
-            self.reorder(&range, &order);
+            self.reorder(range, &order);
         }
-        self.halves(range, range.start + mid)
+        Cut::At(range.start + mid)
     }
 
     /// Reorders `range` so that the items for which `left` holds come first; returns both
@@ -414,6 +460,17 @@ impl Range {
     fn len(&self) -> usize {
         self.end - self.start
     }
+}
+
+/// How a range is split in two.
+#[derive(Clone, Copy)]
+enum Cut {
+    /// At this index of all items (the range's items ordered for it).
+    At(usize),
+    /// The items whose doubled centre on `axis` is at most `threshold` first.
+    Centre { axis: usize, threshold: f32 },
+    /// Triangles first, then ellipsoids.
+    Kinds,
 }
 
 /// Box and centre bounds, grown item by item.
@@ -585,7 +642,7 @@ impl<const N: usize> Bins<N> {
 
     /// The cheapest split of the boxes of a range, binned by `map` (of `N` slabs), side by
     /// side in chunks where they are many.
-    fn best_split_of(boxes: &[Aabb], map: &BinMap) -> Option<(usize, u32)> {
+    fn best_split_of(boxes: &[Aabb], map: &BinMap) -> Option<(f32, usize, u32)> {
         debug_assert_eq!(map.bins, N);
         let bins = if boxes.len() >= PARALLEL_BINNING {
             boxes
@@ -635,7 +692,7 @@ impl<const N: usize> Bins<N> {
 
     /// The cheapest split, (axis, last slab of the left part), where one leaves both parts
     /// non-empty. Cost: each part's half-area times its packets of [`TRI_LANES`].
-    fn best_split(&self) -> Option<(usize, u32)> {
+    fn best_split(&self) -> Option<(f32, usize, u32)> {
         let packets = |count: u32| count.div_ceil(TRI_LANES as u32) as f32;
         let mut best: Option<(f32, usize, u32)> = None;
         for axis in 0..3 {
@@ -662,7 +719,7 @@ impl<const N: usize> Bins<N> {
                 }
             }
         }
-        best.map(|(_, axis, slab)| (axis, slab))
+        best
     }
 }
 
@@ -705,7 +762,7 @@ impl Part {
             leaf: Vec::with_capacity(TRI_LANES),
         };
         let root = builder.out.reserve();
-        builder.fill(root, range, depth)?;
+        builder.fill(root, range, depth, None)?;
         let Builder {
             items,
             out,
@@ -775,7 +832,8 @@ pub fn build(world: &World, boxes: &mut [Aabb], prims: &mut [u32]) -> Result<Bvh
 impl Builder<'_> {
     /// Fills wide node `at` with the subtrees of `range`, split largest first until there
     /// are [`WIDTH`].
-    fn fill(&mut self, at: usize, range: Range, depth: usize) -> Result<()> {
+    /// `planned`: the split of `range`, where its parent planned it.
+    fn fill(&mut self, at: usize, range: Range, depth: usize, planned: Option<Cut>) -> Result<()> {
         // A closest-hit query stacks at most WIDTH − 1 entries per level, an any-hit WIDTH.
         // Below SAH_DEPTH every node halves its largest range at least: this cannot fail.
         if depth * WIDTH > STACK {
@@ -784,8 +842,9 @@ impl Builder<'_> {
                 STACK / WIDTH
             );
         }
-        // The children, each with the kind of leaf it makes (None: an inner node).
-        let mut children = [(range, self.items.leaf_kind(&range)); WIDTH];
+        // The children, each with the kind of leaf it makes (None: an inner node) and its
+        // split where already planned.
+        let mut children = [(range, self.items.leaf_kind(&range), planned); WIDTH];
         let mut count = 1;
         if range.len() >= PARALLEL_SPLITS {
             // Big: three levels of halves, side by side (largest first would split one
@@ -795,26 +854,40 @@ impl Builder<'_> {
             items.split_levels(range, depth, WIDTH.ilog2(), &mut ranges);
             count = ranges.len();
             for (child, r) in children.iter_mut().zip(ranges) {
-                *child = (r, self.items.leaf_kind(&r));
+                *child = (r, self.items.leaf_kind(&r), None);
             }
         }
         while count < WIDTH {
             let open = children[..count]
                 .iter()
                 .enumerate()
-                .filter(|(_, (_, kind))| kind.is_none())
+                .filter(|(_, (_, kind, _))| kind.is_none())
                 .max_by(|a, b| a.1.0.aabb.half_area().total_cmp(&b.1.0.aabb.half_area()));
-            let Some((i, &(c, _))) = open else { break };
-            let (left, right) = self.items.split(c, depth);
+            let Some((i, &(c, _, cut))) = open else { break };
+            let cut = cut.unwrap_or_else(|| self.items.plan(&c, depth).0);
+            let (left, right) = self.items.apply(c, cut);
             children.copy_within(i + 1..count, i + 2);
-            children[i] = (left, self.items.leaf_kind(&left));
-            children[i + 1] = (right, self.items.leaf_kind(&right));
+            children[i] = (left, self.items.leaf_kind(&left), None);
+            children[i + 1] = (right, self.items.leaf_kind(&right), None);
             count += 1;
         }
+        // Small children of triangles: one leaf of several packets where that is cheaper than
+        // a node (whose first split is then planned already).
+        for child in &mut children[..count] {
+            let (c, kind, cut) = child;
+            if kind.is_none() && c.len() <= LARGE_LEAF && self.items.all_triangles(c) {
+                let (planned, cost) = self.items.plan(c, depth + 1);
+                if self.items.cheaper_as_leaf(c, cost) {
+                    *kind = Some(true);
+                } else {
+                    *cut = Some(planned);
+                }
+            }
+        }
         let mut node = Node::EMPTY;
-        let mut reserved = [(0, range); WIDTH];
+        let mut reserved = [(0, range, None); WIDTH];
         let mut inner = 0;
-        for (slot, &(c, kind)) in children[..count].iter().enumerate() {
+        for (slot, &(c, kind, cut)) in children[..count].iter().enumerate() {
             node.set_child_box(slot, &c.aabb);
             if let Some(triangles) = kind {
                 self.leaf.clear();
@@ -830,13 +903,13 @@ impl Builder<'_> {
             } else {
                 let index = self.out.reserve();
                 node.children[slot] = index as u32;
-                reserved[inner] = (index, c);
+                reserved[inner] = (index, c, cut);
                 inner += 1;
             }
         }
         self.out.nodes[at] = node;
-        for &(index, c) in &reserved[..inner] {
-            self.fill(index, c, depth + 1)?;
+        for &(index, c, cut) in &reserved[..inner] {
+            self.fill(index, c, depth + 1, cut)?;
         }
         Ok(())
     }
@@ -864,6 +937,55 @@ mod tests {
                 Aabb::new(c - h, c + h)
             })
             .collect()
+    }
+
+    /// Eight clusters of eight triangles, 100 m apart: the root's eight children. Four are
+    /// fans of nearly the same triangle (split, each half covers almost the whole: a leaf
+    /// of two packets is cheaper), four are two fours 10 m apart (a node over two leaves
+    /// is cheaper).
+    #[test]
+    fn a_small_child_is_one_leaf_of_several_packets_where_that_is_cheaper_than_a_node() {
+        use obvhs::rt_triangle::RtTriangle;
+        let mut triangles = Vec::new();
+        for cluster in 0..8 {
+            for k in 0..8 {
+                let x = 100.0 * cluster as f32
+                    + if cluster < 4 {
+                        0.01 * k as f32
+                    } else {
+                        10.0 * (k / 4) as f32
+                    };
+                let v = |dx: f32, dy: f32| Vec3A::new(x + dx, dy, 0.0);
+                triangles.push(RtTriangle::new(v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)));
+            }
+        }
+        let mut boxes: Vec<Aabb> = triangles
+            .iter()
+            .map(|t| {
+                let (v0, v1, v2) = (t.v0, t.v0 - t.e1, t.v0 + t.e2);
+                Aabb::new(v0.min(v1).min(v2), v0.max(v1).max(v2))
+            })
+            .collect();
+        let mut prims: Vec<u32> = (0..64).collect();
+        let world = World::of_triangles(triangles, Vec::new());
+        let bvh = build(&world, &mut boxes, &mut prims).unwrap();
+        let root = &bvh.nodes[0];
+        let mut kinds: Vec<(f32, &str)> = (0..WIDTH)
+            .map(|slot| {
+                let child = root.children[slot];
+                let kind = if child & crate::render::bvh::LEAF == 0 {
+                    "node"
+                } else if crate::render::bvh::packets_of(child).1 == 2 {
+                    "leaf of 2"
+                } else {
+                    "other"
+                };
+                (root.bounds[0][slot], kind)
+            })
+            .collect();
+        kinds.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let kinds: Vec<&str> = kinds.iter().map(|k| k.1).collect();
+        assert_eq!(kinds, [["leaf of 2"; 4], ["node"; 4]].concat());
     }
 
     /// The cut's threshold against the slab it stands for: over drawn ranges of centres (of
