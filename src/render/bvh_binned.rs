@@ -124,6 +124,7 @@ impl<'a> Items<'a> {
         (range.len() == 1 || triangles).then_some(triangles)
     }
 
+    /// Whether `range` holds triangles only (no ellipsoid).
     fn all_triangles(&self, range: &Range) -> bool {
         self.prims(range)
             .iter()
