@@ -960,15 +960,9 @@ mod tests {
                 triangles.push(RtTriangle::new(v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)));
             }
         }
-        let mut boxes: Vec<Aabb> = triangles
-            .iter()
-            .map(|t| {
-                let (v0, v1, v2) = (t.v0, t.v0 - t.e1, t.v0 + t.e2);
-                Aabb::new(v0.min(v1).min(v2), v0.max(v1).max(v2))
-            })
-            .collect();
-        let mut prims: Vec<u32> = (0..64).collect();
         let world = World::of_triangles(triangles, Vec::new());
+        let (mut boxes, mut prims) =
+            crate::render::bvh::primitive_boxes(&world, &(0..64).collect::<Vec<u32>>());
         let bvh = build(&world, &mut boxes, &mut prims).unwrap();
         let root = &bvh.nodes[0];
         let mut kinds: Vec<(f32, &str)> = (0..WIDTH)
